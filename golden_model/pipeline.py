@@ -1,0 +1,583 @@
+"""Golden geometry pipeline: the SNU paper's transformation and lighting stages.
+
+Stages (seed 004, section 4.2; names as in the report and in ``docs/pipeline.md``),
+each vectorised over every vertex or polygon of the scene at once:
+
+``vertex_transform``   4x4 model-view-projection, w fixed at 1 (12 mul + 12 add)
+``backface_cull``      orientation of corners 0, 1, 2 in homogeneous clip space
+``normal_transform``   3x3 (inverse transpose of the view rotation) into eye space
+``normalise``          unit normals: sum of squares, 1/sqrt, scale
+``light``              ambient + diffuse + Blinn-Phong specular, directional lights,
+                       viewer direction only, exponent from a lookup table
+``clip``               Sutherland-Hodgman against the six planes of the view volume
+``perspective_divide`` x, y, z times 1/w
+``screen_map``         NDC -> pixels (y down), z in [0, 1] with 0 = near, ``zq``
+
+then :func:`fan_triangulate` turns the clipped convex polygons into
+:class:`~rasterhw.golden_model.screen.ScreenTriangles` in submission order.
+
+Every floating-point step runs through an :class:`~rasterhw.golden_model.opcount.OpCounter`
+so ``ScreenTriangles.ops`` holds what the code really did (see ``opcount.py``).
+
+Conventions decided here (the papers are silent; see ``docs/pipeline.md``):
+
+* a polygon is front-facing when its corners 0, 1, 2 run **counter-clockwise** seen
+  from the eye (OpenGL's default); zero-area polygons are culled with the back faces;
+* clip space is ``-w <= x, y <= w`` and ``0 <= z <= w`` (z already 0 = near, 1 = far
+  after the divide, so the screen mapping needs no z offset);
+* on a clip-plane crossing the new corner is interpolated from the inside corner
+  toward the outside one, so an edge shared by two polygons is cut at the same point;
+  on the near plane the new corner gets ``z = 0`` and ``w = near`` exactly;
+* ``zq = min(rint(z * 2**z_bits), 2**z_bits - 1)`` (the paper's "multiply z by
+  2^24"), flipped to ``2**z_bits - 1 - zq`` when ``z_far_is_zero``;
+* screen x, y are clamped to ``[0, width] x [0, height]`` and z to ``<= 1``: a
+  corner made by clipping a huge polygon can land a rounding error outside.
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import RasterhwError
+from .opcount import OpCounter
+from .scene import Camera, Scene
+from .screen import ScreenTriangles
+
+__all__ = [
+    "MAX_SIZE",
+    "SPEC_LUT_SIZE",
+    "STAGES",
+    "Lighting",
+    "backface_cull",
+    "clip",
+    "fan_triangulate",
+    "frame_setup",
+    "light",
+    "normal_transform",
+    "normalise",
+    "perspective_divide",
+    "projection_matrix",
+    "run_geometry",
+    "screen_map",
+    "vertex_transform",
+    "view_matrix",
+]
+
+STAGES = (
+    "vertex_transform",
+    "backface_cull",
+    "normal_transform",
+    "normalise",
+    "light",
+    "clip",
+    "perspective_divide",
+    "screen_map",
+)
+MAX_SIZE = 16384
+#: Entries of the specular-exponent table over cos in [0, 1].
+SPEC_LUT_SIZE = 1024
+
+# Column layout of the per-corner array that travels through clipping.
+_X, _Y, _Z, _W = 0, 1, 2, 3
+_RGB = slice(4, 7)
+
+
+def _ops(ops: OpCounter | None) -> OpCounter:
+    return OpCounter() if ops is None else ops
+
+
+# ----------------------------------------------------------------------------- set-up
+def _unit(v: np.ndarray, what: str) -> np.ndarray:
+    n = float(np.linalg.norm(v))
+    if not (n > 0.0 and math.isfinite(n)):
+        raise RasterhwError(f"{what} {tuple(float(x) for x in v)} has no direction")
+    return v / n
+
+
+def view_matrix(camera: Camera) -> np.ndarray:
+    """World -> eye space (right-handed, eye at the origin looking down -z, y up)."""
+    eye = np.asarray(camera.eye, dtype=float)
+    f = _unit(np.asarray(camera.target, dtype=float) - eye, "camera view direction")
+    s = np.cross(f, np.asarray(camera.up, dtype=float))
+    if not np.linalg.norm(s) > 1e-12:
+        raise RasterhwError(f"camera up {camera.up} is parallel to the view direction")
+    s = s / np.linalg.norm(s)
+    u = np.cross(s, f)
+    m = np.eye(4)
+    m[0, :3], m[1, :3], m[2, :3] = s, u, -f
+    m[:3, 3] = -m[:3, :3] @ eye
+    return m
+
+
+def projection_matrix(camera: Camera, aspect: float) -> np.ndarray:
+    """Eye -> clip space: ``-w <= x, y <= w``, ``0 <= z <= w`` (z = 0 near, w = -z_eye)."""
+    f = 1.0 / math.tan(math.radians(camera.fovy_deg) / 2.0)
+    n, fa = camera.near, camera.far
+    m = np.zeros((4, 4))
+    m[0, 0] = f / aspect
+    m[1, 1] = f
+    m[2, 2] = fa / (n - fa)
+    m[2, 3] = fa * n / (n - fa)
+    m[3, 2] = -1.0
+    return m
+
+
+@dataclass(frozen=True)
+class Lighting:
+    """Per-frame lighting constants, all in eye space.
+
+    ambient : (3,) ``ka * Ia``.
+    to_light : (L, 3) unit vectors toward each light (``-direction``).
+    half : (L, 3) unit Blinn half vectors between ``to_light`` and the viewer
+        direction (0, 0, 1) -- the viewer's direction only, no distance.
+    diffuse : (L, 3) ``kd * light colour``.
+    specular : (L, 3) ``ks * light colour`` (all zero when ``ks == 0``).
+    lut : (SPEC_LUT_SIZE,) ``(i / (SPEC_LUT_SIZE - 1)) ** shininess``.
+    """
+
+    ambient: np.ndarray
+    to_light: np.ndarray
+    half: np.ndarray
+    diffuse: np.ndarray
+    specular: np.ndarray
+    lut: np.ndarray
+
+    @property
+    def has_specular(self) -> bool:
+        return bool(np.any(self.specular > 0.0))
+
+
+@dataclass(frozen=True)
+class FrameSetup:
+    """Per-frame constants (not counted: they are per frame, not per triangle)."""
+
+    mvp: np.ndarray
+    normal_matrix: np.ndarray
+    lighting: Lighting
+    near: float
+
+
+def frame_setup(scene: Scene, width: int, height: int) -> FrameSetup:
+    """Matrices and lighting constants for one frame."""
+    mat = scene.material
+    for name in ("ka", "kd", "ks"):
+        v = getattr(mat, name)
+        if not (math.isfinite(v) and v >= 0.0):
+            raise RasterhwError(f"material {name} must be finite and >= 0, got {v!r}")
+    if (
+        isinstance(mat.shininess, bool)
+        or not isinstance(mat.shininess, (int, np.integer))
+        or not (0 <= mat.shininess <= 1024)
+    ):
+        raise RasterhwError(
+            f"material shininess must be an integer in 0..1024, got {mat.shininess!r}"
+        )
+    amb = np.asarray(scene.ambient, dtype=float)
+    if amb.shape != (3,) or not np.all(np.isfinite(amb)) or np.any(amb < 0):
+        raise RasterhwError(f"ambient must be three finite values >= 0, got {scene.ambient!r}")
+
+    view = view_matrix(scene.camera)
+    proj = projection_matrix(scene.camera, width / height)
+    rot = view[:3, :3]
+    nmat = np.linalg.inv(rot).T
+    to_light, half, dif, spe = [], [], [], []
+    for i, lt in enumerate(scene.lights):
+        c = np.asarray(lt.colour, dtype=float)
+        if c.shape != (3,) or not np.all(np.isfinite(c)) or np.any(c < 0):
+            raise RasterhwError(
+                f"light {i} colour must be three finite values >= 0, got {lt.colour!r}"
+            )
+        d = rot @ _unit(np.asarray(lt.direction, dtype=float), f"light {i} direction")
+        tl = -d / np.linalg.norm(d)
+        h = tl + np.array([0.0, 0.0, 1.0])
+        hn = np.linalg.norm(h)
+        # Light straight from behind the viewer's line: no highlight can face both.
+        h = h / hn if hn > 1e-12 else np.zeros(3)
+        to_light.append(tl)
+        half.append(h)
+        dif.append(mat.kd * c)
+        spe.append(mat.ks * c)
+    shape = (len(to_light), 3)
+    lut = (np.arange(SPEC_LUT_SIZE) / (SPEC_LUT_SIZE - 1)) ** int(mat.shininess)
+    lighting = Lighting(
+        ambient=mat.ka * amb,
+        to_light=np.array(to_light).reshape(shape),
+        half=np.array(half).reshape(shape),
+        diffuse=np.array(dif).reshape(shape),
+        specular=np.array(spe).reshape(shape),
+        lut=lut,
+    )
+    return FrameSetup(
+        mvp=proj @ view, normal_matrix=nmat, lighting=lighting, near=scene.camera.near
+    )
+
+
+# ----------------------------------------------------------------------------- stages
+def vertex_transform(
+    positions: np.ndarray, mvp: np.ndarray, *, ops: OpCounter | None = None
+) -> np.ndarray:
+    """(V, 3) world positions -> (V, 4) clip coordinates; w of the input fixed at 1.
+
+    Per vertex: 12 mul + 12 add (the fourth column is added, not multiplied).
+    """
+    return _ops(ops).affine(positions, mvp[:, :3], mvp[:, 3])
+
+
+def normal_transform(
+    normals: np.ndarray, normal_matrix: np.ndarray, *, ops: OpCounter | None = None
+) -> np.ndarray:
+    """(V, 3) normals -> eye space with a 3x3 matrix: 9 mul + 6 add per vertex."""
+    return _ops(ops).affine(normals, normal_matrix)
+
+
+def normalise(v: np.ndarray, *, ops: OpCounter | None = None) -> np.ndarray:
+    """(V, 3) -> unit length: 3 mul + 2 add, 1 sqrt, 1 recip, 3 mul per vertex.
+
+    Inputs must have a finite, non-zero length (``run_geometry`` checks the scene).
+    """
+    o = _ops(ops)
+    inv = o.recip(o.sqrt(o.dot(v, v)))
+    return o.mul(v, inv[:, None])
+
+
+def light(
+    normals: np.ndarray, base: np.ndarray, lighting: Lighting, *, ops: OpCounter | None = None
+) -> np.ndarray:
+    """Lit vertex colours (V, 3) from unit eye-space normals and base colours.
+
+    ``I = base * (ka Ia + sum_l kd C_l max(0, N.L_l)) + sum_l ks C_l T[N.H_l]``, clamped
+    to 1, where ``L_l`` points toward light ``l``, ``H_l`` is the Blinn half vector
+    with the viewer direction (0, 0, 1) and ``T`` the exponent table (entry nearest
+    to ``N.H``; zero where ``N.L <= 0`` or ``N.H <= 0``). With ``ks = 0`` and
+    ``ka = 1`` this is the vector Z-buffer paper's ``I = Ia + k (-N.L)/(|N||L|)``
+    (``L`` the travel direction) for a lit face and ``I = Ia`` for an unlit one,
+    times the base colour.
+
+    Per vertex and light: 3 mul + 2 add + 1 cmp (N.L), 3 mul + 3 add (diffuse);
+    with specular also 3 mul + 2 add + 1 cmp (N.H), 1 mul + 1 cvt + 1 lookup
+    (table), 3 mul (+ 3 add from the second light on). Per vertex once:
+    3 mul (+ 3 add with specular) and 3 cmp (clamp).
+    """
+    o = _ops(ops)
+    n_v = normals.shape[0]
+    diffuse = np.broadcast_to(lighting.ambient, (n_v, 3))
+    spec = None
+    for li in range(lighting.to_light.shape[0]):
+        ndl = o.dot(normals, lighting.to_light[li])
+        lit = o.gt(ndl, 0.0)
+        ndl = np.where(lit, ndl, 0.0)
+        diffuse = o.add(diffuse, o.mul(ndl[:, None], lighting.diffuse[li]))
+        if lighting.has_specular:
+            ndh = o.dot(normals, lighting.half[li])
+            on = lit & o.gt(ndh, 0.0)
+            idx = o.rint_int(o.mul(np.where(on, ndh, 0.0), SPEC_LUT_SIZE - 1))
+            s = np.where(on, o.lookup(lighting.lut, idx), 0.0)
+            term = o.mul(s[:, None], lighting.specular[li])
+            spec = term if spec is None else o.add(spec, term)
+    col = o.mul(base, diffuse)
+    if spec is not None:
+        col = o.add(col, spec)
+    return o.minimum(col, 1.0)
+
+
+def backface_cull(clip_corners: np.ndarray, *, ops: OpCounter | None = None) -> np.ndarray:
+    """Front-facing mask (P,) from the clip coordinates of corners 0, 1, 2 (P, 3, 4).
+
+    The determinant of the corners' (x, y, w) rows is a negative multiple of the signed
+    volume of (eye, v0, v1, v2) for any signs of w, so no divide is needed and corners
+    behind the eye are handled. ``det > 0``: counter-clockwise seen from the eye.
+    Per polygon: 9 mul + 5 add + 1 cmp.
+    """
+    o = _ops(ops)
+    x, y, w = clip_corners[:, :, _X], clip_corners[:, :, _Y], clip_corners[:, :, _W]
+    m0 = o.sub(o.mul(y[:, 1], w[:, 2]), o.mul(w[:, 1], y[:, 2]))
+    m1 = o.sub(o.mul(x[:, 1], w[:, 2]), o.mul(w[:, 1], x[:, 2]))
+    m2 = o.sub(o.mul(x[:, 1], y[:, 2]), o.mul(y[:, 1], x[:, 2]))
+    det = o.add(o.sub(o.mul(x[:, 0], m0), o.mul(y[:, 0], m1)), o.mul(w[:, 0], m2))
+    return o.gt(det, 0.0)
+
+
+# Clip planes in the order applied: (name, axis, side). side +1: axis <= w, distance
+# w - axis; side -1: axis >= -w, distance w + axis; the near plane is z >= 0, distance z.
+# Near goes first so every later corner has w >= near > 0.
+_PLANES = (
+    ("near", _Z, 0),
+    ("far", _Z, +1),
+    ("left", _X, -1),
+    ("right", _X, +1),
+    ("bottom", _Y, -1),
+    ("top", _Y, +1),
+)
+
+
+def _inside(o: OpCounter, v: np.ndarray, axis: int, side: int) -> np.ndarray:
+    if side == 0:
+        return o.ge(v[:, axis], 0.0)
+    if side > 0:
+        return o.le(v[:, axis], v[:, _W])
+    return o.ge(v[:, axis], -v[:, _W])  # sign change: not counted
+
+
+def _distance(o: OpCounter, v: np.ndarray, axis: int, side: int) -> np.ndarray:
+    if side == 0:
+        return v[:, axis]
+    if side > 0:
+        return o.sub(v[:, _W], v[:, axis])
+    return o.add(v[:, _W], v[:, axis])
+
+
+def clip(
+    corners: np.ndarray, nverts: np.ndarray, near: float, *, ops: OpCounter | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Sutherland-Hodgman clipping of convex polygons against the view volume.
+
+    Parameters
+    ----------
+    corners : (P, K, C) per-corner rows ``x, y, z, w`` (clip space) then attributes,
+        which are interpolated linearly along cut edges.
+    nverts : (P,) corners in use.
+    near : the camera's near distance (``w`` of any point on the near plane).
+
+    Returns
+    -------
+    out : (P, K + 6, C) clipped corners.
+    n_out : (P,) corners in use; 0 for a polygon clipped away.
+    cut : (P,) bool, whether a plane cut the polygon (it crossed a plane).
+
+    Work is vectorised over polygons; the loop runs over the six planes. Each plane
+    costs one compare per corner of every polygon still alive; only polygons with
+    corners on both sides pay for the cut: per new corner 2 distances (0 for near),
+    1 add + 1 div for ``t``, and C add + C mul + C add to interpolate (C - 2 on the
+    near plane, where z and w are exact).
+    """
+    o = _ops(ops)
+    n_p, k, n_c = corners.shape
+    m = k + 6
+    out = np.zeros((n_p, m, n_c))
+    out[:, :k] = corners
+    n_out = np.asarray(nverts, dtype=np.int64).copy()
+    cut = np.zeros(n_p, dtype=bool)
+    slots = np.arange(m)
+    for _name, axis, side in _PLANES:
+        live = np.flatnonzero(n_out > 0)
+        if live.size == 0:
+            break
+        sub = out[live]
+        n_sub = n_out[live]
+        used = slots[None, :] < n_sub[:, None]
+        ins = np.zeros(used.shape, dtype=bool)
+        ins[used] = _inside(o, sub[used], axis, side)
+        n_in = ins.sum(axis=1)
+        n_out[live[n_in == 0]] = 0
+        xi = np.flatnonzero((n_in > 0) & (n_in < n_sub))
+        if xi.size == 0:
+            continue
+        polys = live[xi]
+        cut[polys] = True
+        px, nx, ix = sub[xi], n_sub[xi], ins[xi]
+        valid = used[xi]
+        prev = (slots[None, :] - 1 + nx[:, None]) % nx[:, None]
+        ip = np.take_along_axis(ix, prev, axis=1)
+        crossing = valid & (ip != ix)
+        keep = valid & ix
+        cnt = crossing.astype(np.int64) + keep
+        start = np.cumsum(cnt, axis=1) - cnt
+        new_n = cnt.sum(axis=1)
+        if int(new_n.max()) > m:
+            raise RasterhwError(
+                "clip: a polygon gained more corners than a convex one can; polygons must be convex"
+            )
+        qi, si = np.nonzero(crossing)
+        pi = prev[qi, si]
+        a, b = px[qi, pi], px[qi, si]
+        a_in = ix[qi, pi][:, None]
+        v_in, v_out = np.where(a_in, a, b), np.where(a_in, b, a)
+        d_in = _distance(o, v_in, axis, side)
+        d_out = _distance(o, v_out, axis, side)
+        t = o.div(d_in, o.sub(d_in, d_out))[:, None]
+        new_v = np.empty_like(v_in)
+        if side == 0:
+            cols = [c for c in range(n_c) if c not in (_Z, _W)]
+            new_v[:, _Z], new_v[:, _W] = 0.0, near
+        else:
+            cols = list(range(n_c))
+        new_v[:, cols] = o.add(v_in[:, cols], o.mul(t, o.sub(v_out[:, cols], v_in[:, cols])))
+        fresh = np.zeros((xi.size, m, n_c))
+        fresh[qi, start[qi, si]] = new_v
+        qk, sk = np.nonzero(keep)
+        fresh[qk, start[qk, sk] + crossing[qk, sk]] = px[qk, sk]
+        out[polys] = fresh
+        n_out[polys] = new_n
+    n_out[n_out < 3] = 0
+    return out, n_out, cut
+
+
+def perspective_divide(clip_xyzw: np.ndarray, *, ops: OpCounter | None = None) -> np.ndarray:
+    """(V, 4) clip -> (V, 3) normalised device coordinates: 1 recip + 3 mul per vertex."""
+    o = _ops(ops)
+    inv_w = o.recip(clip_xyzw[:, _W])
+    return o.mul(clip_xyzw[:, :3], inv_w[:, None])
+
+
+def screen_map(
+    ndc: np.ndarray,
+    width: int,
+    height: int,
+    *,
+    z_bits: int = 24,
+    z_far_is_zero: bool = False,
+    ops: OpCounter | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """NDC (V, 3) -> pixel xy (V, 2), z (V,) in [0, 1] (0 = near) and zq (V,) int64.
+
+    x = -1 -> 0, +1 -> width; y = +1 -> 0 (top), -1 -> height. Per vertex:
+    2 mul + 2 add (x, y), 5 cmp (clamps of x, y, z), 1 mul + 1 cvt + 1 cmp (zq),
+    1 add if flipped.
+    """
+    o = _ops(ops)
+    hw, hh = 0.5 * width, 0.5 * height
+    sx = o.add(o.mul(ndc[:, 0], hw), hw)
+    sy = o.add(o.mul(ndc[:, 1], -hh), hh)
+    sx = o.minimum(o.maximum(sx, 0.0), float(width))
+    sy = o.minimum(o.maximum(sy, 0.0), float(height))
+    # z >= 0 already: clipping leaves z_clip >= 0 and w > 0, and the product of two
+    # non-negative floats is non-negative, so only the top needs a clamp.
+    z = o.minimum(ndc[:, 2], 1.0)
+    top = (1 << z_bits) - 1
+    zq = o.minimum(o.rint_int(o.mul(z, float(1 << z_bits))), top)
+    if z_far_is_zero:
+        zq = o.sub(top, zq)
+    return np.stack([sx, sy], axis=-1), z, zq.astype(np.int64)
+
+
+def fan_triangulate(nverts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Fan triangles of convex polygons stored back to back.
+
+    Returns (T, 3) indices into the concatenated corner list (polygon ``p``'s corners
+    start at ``sum(nverts[:p])``) and (T,) polygon indices: polygon order, and within
+    a polygon the fan (0, i, i + 1), i = 1 .. n - 2. Polygons with n < 3 give none.
+    """
+    n = np.asarray(nverts, dtype=np.int64)
+    first = np.cumsum(n) - n
+    per = np.maximum(n - 2, 0)
+    poly = np.repeat(np.arange(n.size), per)
+    j = np.arange(poly.size) - np.repeat(np.cumsum(per) - per, per)
+    base = first[poly]
+    idx = np.stack([base, base + j + 1, base + j + 2], axis=-1)
+    return idx, poly
+
+
+# ----------------------------------------------------------------------------- top level
+def _check_int(name: str, v, lo: int, hi: int) -> int:
+    if isinstance(v, bool):
+        raise RasterhwError(f"{name} must be an integer in {lo}..{hi}, got {v!r}")
+    try:
+        i = operator.index(v)
+    except TypeError:
+        raise RasterhwError(f"{name} must be an integer in {lo}..{hi}, got {v!r}") from None
+    if not lo <= i <= hi:
+        raise RasterhwError(f"{name} must be in {lo}..{hi}, got {i}")
+    return i
+
+
+def run_geometry(
+    scene: Scene, width: int, height: int, *, z_bits: int = 24, z_far_is_zero: bool = False
+) -> ScreenTriangles:
+    """Transform, light, cull, clip and map a scene to screen-space triangles.
+
+    Order: vertex_transform -> backface_cull -> (front polygons only) normal_transform
+    -> normalise -> light -> clip -> perspective_divide -> screen_map -> fan. The paper's
+    table 1 order with the cull moved right after the vertex transform, where the clip
+    coordinates it needs first exist, so back faces are not lit.
+    """
+    width = _check_int("width", width, 1, MAX_SIZE)
+    height = _check_int("height", height, 1, MAX_SIZE)
+    z_bits = _check_int("z_bits", z_bits, 1, 32)
+    if not isinstance(scene, Scene):
+        raise RasterhwError(f"run_geometry needs a Scene, got {type(scene).__name__}")
+    scene.validate()
+    n_p, k = scene.n_polygons, scene.max_corners
+    used = np.arange(k)[None, :] < scene.nverts[:, None]
+    cols = scene.colours[used]
+    if np.any(cols < 0.0) or np.any(cols > 1.0):
+        raise RasterhwError(f"scene {scene.name!r}: vertex colours must be in [0, 1]")
+    nn = np.einsum("ij,ij->i", scene.normals[used], scene.normals[used])
+    if not np.all((nn > 1e-200) & (nn < 1e200)):
+        raise RasterhwError(
+            f"scene {scene.name!r}: a vertex normal has zero or absurd length; rescale it"
+        )
+    setup = frame_setup(scene, width, height)
+    o = OpCounter()
+
+    with o.stage("vertex_transform"):
+        clip_used = vertex_transform(scene.positions[used], setup.mvp, ops=o)
+    clip_pos = np.zeros((n_p, k, 4))
+    clip_pos[used] = clip_used
+    # Padding slots repeat the last corner so every slot stays finite.
+    last = clip_pos[np.arange(n_p), scene.nverts - 1]
+    clip_pos[~used] = np.broadcast_to(last[:, None, :], clip_pos.shape)[~used]
+
+    with o.stage("backface_cull"):
+        front = backface_cull(clip_pos[:, :3], ops=o)
+    fidx = np.flatnonzero(front)
+    fused = used[fidx]
+
+    with o.stage("normal_transform"):
+        n_eye = normal_transform(scene.normals[fidx][fused], setup.normal_matrix, ops=o)
+    with o.stage("normalise"):
+        n_unit = normalise(n_eye, ops=o)
+    with o.stage("light"):
+        lit = light(n_unit, scene.colours[fidx][fused], setup.lighting, ops=o)
+
+    n_attr = 7 + (2 if scene.uv is not None else 0)
+    corners = np.zeros((fidx.size, k, n_attr))
+    corners[:, :, :4] = clip_pos[fidx]
+    corners[:, :, _RGB][fused] = lit
+    if scene.uv is not None:
+        corners[:, :, 7:9] = scene.uv[fidx]
+
+    with o.stage("clip"):
+        clipped, n_clip, cut = clip(corners, scene.nverts[fidx], setup.near, ops=o)
+    drawn = np.flatnonzero(n_clip > 0)
+    n_draw = n_clip[drawn]
+    flat = clipped[drawn][np.arange(clipped.shape[1])[None, :] < n_draw[:, None]]
+
+    with o.stage("perspective_divide"):
+        ndc = perspective_divide(flat[:, :4], ops=o)
+    with o.stage("screen_map"):
+        xy, z, zq = screen_map(
+            ndc, width, height, z_bits=z_bits, z_far_is_zero=z_far_is_zero, ops=o
+        )
+
+    tri, tri_poly = fan_triangulate(n_draw)
+    poly_id = fidx[drawn][tri_poly]
+    ops = o.as_dict()
+    ops["polygons"] = n_p
+    ops["vertices"] = int(scene.nverts.sum())
+    ops["triangles"] = int(tri.shape[0])
+    stats = {
+        "polygons_in": n_p,
+        "polygons_culled": int(n_p - fidx.size),
+        "polygons_clipped_away": int(fidx.size - drawn.size),
+        "polygons_drawn": int(drawn.size),
+        "polygons_cut": int(np.count_nonzero(cut[drawn])),
+        "triangles": int(tri.shape[0]),
+    }
+    return ScreenTriangles(
+        width=width,
+        height=height,
+        xy=xy[tri],
+        z=z[tri],
+        zq=zq[tri],
+        colour=flat[:, _RGB][tri],
+        poly_id=poly_id.astype(np.int64),
+        uv=flat[:, 7:9][tri] if scene.uv is not None else None,
+        z_bits=z_bits,
+        z_far_is_zero=bool(z_far_is_zero),
+        stats=stats,
+        ops=ops,
+    )
