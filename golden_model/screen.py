@@ -42,10 +42,12 @@ class ScreenTriangles:
     z_bits : width of ``zq``.
     z_far_is_zero : whether ``zq`` is flipped.
     stats : counts from the pipeline (``polygons_in``, ``polygons_culled``,
-        ``polygons_clipped_away``, ``polygons_drawn``, ``triangles``).
+        ``polygons_clipped_away``, ``polygons_cut`` (crossed a clip plane and survived),
+        ``polygons_drawn``, ``triangles``).
     ops : per-stage operation counts from the instrumented pipeline
-        (stage name -> {"mul", "add", "cmp", "div", "sqrt", "lookup", "total"}),
-        totals over the whole scene, plus ``"vertices"``/``"triangles"`` processed.
+        (stage name -> {"mul", "add", "cmp", "div", "sqrt", "lookup", "cvt", "total"}),
+        totals over the whole scene, plus ``"vertices"``, ``"triangles"`` and
+        ``"polygons"`` processed (see ``golden_model/opcount.py``).
     """
 
     width: int
