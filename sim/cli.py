@@ -130,13 +130,13 @@ def render(scene: str, arch: str, size: str | None, output: str | None, z_bits: 
         extra = {"fragments": int(frame.fragments), "pixels_covered": int(frame.pixels_covered)}
     else:  # snu: Gouraud scan converter (golden, bit-accurate) into the pixel-bus frame buffer model
         from rasterhw.golden_model.pipeline import run_geometry
-        from rasterhw.golden_model.pixelbus import frame_buffer
+        from rasterhw.golden_model.pixelbus import pixelbus_frame, rgb_image
         from rasterhw.golden_model.snu_gouraud import scan_convert
 
         sc, (w, h) = load_scene_and_size(scene, size)
         tris = run_geometry(sc, w, h, z_bits=z_bits, z_far_is_zero=True)
         stream = scan_convert(tris)
-        rgb8, _z = frame_buffer(stream)
+        rgb8 = rgb_image(pixelbus_frame(stream)[0])
         pixels_written = len(stream)
         extra = {"pixel_writes": len(stream)}
     wall = time.perf_counter() - t0
@@ -198,8 +198,9 @@ def compare(a: str, b: str, output: str | None, tolerance: int, as_json: bool) -
 @click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON on stdout.")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), default="docs/reproduction", show_default=True,
               help="Where SYSTEM.md and its plots are written.")
-@click.option("--engine", type=click.Choice(["pysim", "verilator", "icarus"]), default="pysim", show_default=True,
-              help="HDL simulator used for rows measured from HDL cycles.")
+@click.option("--engine", type=click.Choice(["pysim", "verilator", "icarus"]), default="verilator",
+              show_default=True, help="HDL simulator for rows measured from HDL cycles (full frames always "
+              "run on a compiled simulator).")
 def report(system: str, as_json: bool, out_dir: str, engine: str) -> None:
     """Reproduce a paper's figures: paper value, formula value, measured value, ratio."""
     from rasterhw.sim.report import SYSTEMS, run_report

@@ -1,0 +1,88 @@
+"""The command line as a user meets it: JSON results, and one-line errors for bad input."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+PY = sys.executable
+
+
+def run(*args: str, cwd=None) -> subprocess.CompletedProcess:
+    return subprocess.run([PY, "-m", "rasterhw.sim.cli", *args], capture_output=True, text=True,
+                          cwd=cwd, timeout=300)
+
+
+@pytest.mark.parametrize("scene,polys", [("c300", 1801), ("sp27", 2701)])
+def test_render_reference_json(tmp_path, scene, polys):
+    out = tmp_path / f"{scene}.png"
+    r = run("render", scene, "--arch", "reference", "--json", "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout)
+    for key in ("scene", "arch", "width", "height", "polygons_in", "polygons_drawn", "pixels_written", "wall_s"):
+        assert key in res
+    assert (res["width"], res["height"]) == (512, 512)
+    assert res["polygons_in"] == polys
+    assert 0 < res["polygons_drawn"] < polys
+    assert res["pixels_written"] > 0
+    assert out.stat().st_size > 0
+
+
+def test_render_is_deterministic(tmp_path):
+    a, b = tmp_path / "a.png", tmp_path / "b.png"
+    assert run("render", "c50", "-o", str(a)).returncode == 0
+    assert run("render", "c50", "-o", str(b)).returncode == 0
+    assert a.read_bytes() == b.read_bytes()
+    r = run("compare", str(a), str(b), "--json")
+    assert r.returncode == 0 and json.loads(r.stdout)["differing_pixels"] == 0
+
+
+def test_scenes_lists_counts():
+    r = run("scenes", "--json")
+    assert r.returncode == 0, r.stderr
+    rows = {row["name"]: row for row in json.loads(r.stdout)}
+    for name in ("c50", "c100", "c150", "c200", "c250", "c300", "sp27", "sp5", "sp8", "zbm-5x5",
+                 "snu-100px", "experts-1000", "experts-2000"):
+        assert name in rows
+    assert rows["c300"]["polygons"] == 1801 and rows["sp27"]["polygons"] == 2701
+
+
+def _assert_one_line_error(r: subprocess.CompletedProcess) -> None:
+    assert r.returncode == 2, (r.returncode, r.stdout, r.stderr)
+    assert "Traceback" not in r.stderr
+    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error: "), r.stderr
+
+
+BAD_OBJS = {
+    "nan.obj": "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n",
+    "empty.obj": "",
+    "twovert.obj": "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n",
+    "huge.obj": "v 0 0 0\nv 1e30 0 0\nv 0 1 0\nf 1 2 3\n",
+}
+
+
+@pytest.mark.parametrize("name", sorted(BAD_OBJS))
+def test_bad_mesh_gives_one_line_error(tmp_path, name):
+    path = tmp_path / name
+    path.write_text(BAD_OBJS[name])
+    _assert_one_line_error(run("render", str(path), "-o", str(tmp_path / "x.png")))
+
+
+@pytest.mark.parametrize("args", [
+    ("render", "c50", "--size", "0x0"),
+    ("render", "c50", "--size", "banana"),
+    ("render", "no-such-scene"),
+    ("render", "/no/such/file.obj"),
+    ("verilog", "no-such-block", "-o", "x.v"),
+])
+def test_bad_arguments_give_one_line_error(tmp_path, args):
+    _assert_one_line_error(run(*args, cwd=tmp_path))
+
+
+def test_help_answers():
+    r = run("--help")
+    assert r.returncode == 0 and "render" in r.stdout and "report" in r.stdout
