@@ -1,0 +1,134 @@
+"""ZB/M cycle model: the paper's Table 1 formula and an event-level count for any edge-pair stream.
+
+Paper (seed 003, sec. 6.1), assumptions, our translation:
+ 1. each polygon is expanded into 2 edge pairs;  2. an edge pair is 5 x 5 = 25 pixels on
+ average;  3. the ZB/M input clock is 25 MHz;  4. loading an edge pair into the segment
+ generator takes 9 cycles;  5. while an edge pair is loaded the ZB/M gets no input: 9 idle
+ cycles;  6. input to a ZB/M waits on average "the segment length per ZB/M" cycles, and takes 8
+ cycles from the start of input;  7. half of the time is lost waiting, because of timing skew
+ with the neighbouring ZB/M.
+ => cycles per edge pair = 9 + (len_chip + 8) * 5, polygons/s = 25e6 / cycles / 2 / 2.
+
+``len_chip`` is the segment length on the busiest chip: a 5-pixel segment spread over I
+interleaved chips gives ceil(5 / I) = 5, 3, 2, 1, 1 pixels for I = 1, 2, 4, 8, 16 -- exactly
+the paper's "average segment length per ZB/M" values (for I = 2 the chips get 3 and 2; the
+segment is done when the busier chip is done).
+
+Event-level rules (the HDL implements the same; ``docs/zbm.md`` lists them):
+ R1 a line starts by loading, from the input FIFO, every edge pair whose top line has been
+    reached, while the active-edge-pair memory has room: 9 cycles each, no segment issued;
+ R2 then the active pairs are read in memory order; a pair whose segment is empty after the
+    fill rule and clipping costs 1 cycle; a non-empty segment is broadcast to all chips of the
+    unit and costs ``max over chips (n_c + 8)`` = ``ceil(len / I) + 8`` cycles (a chip that owns
+    none of its pixels drops it in 1 cycle; the busiest chip sets the pace);
+ R3 a pair loaded late (memory was full) is first stepped down to the current line: 1 cycle per
+    missed line;
+ R4 the merge side streams each chip's ``ceil(W / I)`` pixels of the previous line, one per
+    merge cycle, while the loop works on the current line (double-buffered pixel memories);
+    a line ends when both are done (merge clock = segment clock unless ``merge_ratio`` given).
+ R5 the skew of condition 7 is not modelled (chips of a unit are in lock-step); the formula's
+    factor 2 is reported separately.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .errors import RasterhwError
+from .zbm import EdgePairs, segment_generator
+from .zbm_formats import AEP_CAPACITY, EP_LOAD_CYCLES, INTERLEAVES, PACKET_FLITS
+
+__all__ = ["PAPER_TABLE1_KPOLYS", "PAPER_LEN_CHIP", "len_chip", "formula_cycles_per_edge_pair",
+           "formula_polygons_per_s", "paper_table1", "event_cycles", "paper_workload"]
+
+#: Table 1 of the paper, K polygons/s per unit, by interleave.
+PAPER_TABLE1_KPOLYS = {1: 84.5, 2: 97.7, 4: 105.9, 8: 115.8, 16: 115.8}
+#: The paper's "average segment length per ZB/M" by interleave.
+PAPER_LEN_CHIP = {1: 5, 2: 3, 4: 2, 8: 1, 16: 1}
+CLOCK_HZ = 25e6
+
+
+def len_chip(seg_len: int, interleave: int) -> int:
+    """Pixels of a ``seg_len``-pixel segment on the busiest of ``interleave`` chips."""
+    if interleave not in INTERLEAVES:
+        raise RasterhwError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+    if seg_len < 0:
+        raise RasterhwError(f"segment length must be >= 0, not {seg_len!r}")
+    return math.ceil(seg_len / interleave)
+
+
+def formula_cycles_per_edge_pair(interleave: int, *, seg_len: int = 5, lines: int = 5,
+                                 load: int = EP_LOAD_CYCLES, packet: int = PACKET_FLITS) -> int:
+    """Paper's formula: ``load + (len_chip + packet) * lines`` (74, 64, 59, 54, 54)."""
+    return load + (len_chip(seg_len, interleave) + packet) * lines
+
+
+def formula_polygons_per_s(interleave: int, *, clock_hz: float = CLOCK_HZ, skew: float = 2.0,
+                           eps_per_polygon: int = 2, units: int = 1, **kw) -> float:
+    """Paper's throughput: ``clock / cycles / skew / eps_per_polygon * units``."""
+    return clock_hz / formula_cycles_per_edge_pair(interleave, **kw) / skew / eps_per_polygon * units
+
+
+def paper_table1() -> list[dict]:
+    """Rows: interleave, len_chip, cycles, K polygons/s (formula), paper value, ratio."""
+    rows = []
+    for i in INTERLEAVES:
+        k = formula_polygons_per_s(i) / 1e3
+        rows.append({"interleave": i, "len_chip": len_chip(5, i), "cycles_per_edge_pair":
+                     formula_cycles_per_edge_pair(i), "kpolys_formula": round(k, 1),
+                     "kpolys_paper": PAPER_TABLE1_KPOLYS[i], "ratio": k / PAPER_TABLE1_KPOLYS[i]})
+    return rows
+
+
+def event_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: int = 8,
+                 capacity: int = AEP_CAPACITY, merge_ratio: float = 1.0) -> dict:
+    """Count cycles of one unit (segment generator + ``interleave`` chips) under rules R1-R5.
+
+    Returns totals (``loop_cycles``: R1-R3 summed; ``frame_cycles``: with R4's overlap),
+    per-line arrays and per-edge-pair averages.
+    """
+    if interleave not in INTERLEAVES:
+        raise RasterhwError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+    if not merge_ratio > 0:
+        raise RasterhwError(f"merge_ratio must be > 0, not {merge_ratio!r}")
+    segs = segment_generator(eps, height, width=width, capacity=capacity)
+    seg_cost = -(-segs.len // interleave) + PACKET_FLITS
+    per_seg_line = np.bincount(segs.y, weights=seg_cost, minlength=height).astype(np.int64)
+    load = segs.loads * EP_LOAD_CYCLES
+    loop = load + per_seg_line + segs.empty + segs.late_steps
+    merge_line = math.ceil(math.ceil(width / interleave) * merge_ratio)
+    busy = np.flatnonzero(loop > 0)
+    # R4: line y's loop overlaps the merge of line y-1 (only lines with work are merged here).
+    frame = 0
+    prev_merge = 0
+    for y in busy:
+        frame += max(int(loop[y]), prev_merge)
+        prev_merge = merge_line
+    frame += prev_merge
+    n = max(len(eps), 1)
+    return {"edge_pairs": len(eps), "segments": int(segs.y.size),
+            "load_cycles": int(load.sum()), "segment_cycles": int(per_seg_line.sum()),
+            "empty_cycles": int(segs.empty.sum()), "late_cycles": int(segs.late_steps.sum()),
+            "loop_cycles": int(loop.sum()), "frame_cycles": int(frame),
+            "loop_cycles_per_edge_pair": float(loop.sum()) / n,
+            "loop_per_line": loop, "merge_cycles_per_line": merge_line,
+            "segment_stats": segs.stats}
+
+
+def paper_workload(n_pairs: int, *, interleave_phase: int = 0, lines_apart: int = 5) -> EdgePairs:
+    """``n_pairs`` edge pairs of exactly 5 lines x 5 pixels (the paper's cond. 2), stacked so
+    that each starts ``lines_apart`` lines below the previous (wrapping within 512 lines),
+    left end at pixel ``interleave_phase`` + a per-pair shift (so all chip alignments occur)."""
+    if n_pairs < 1:
+        raise RasterhwError(f"n_pairs must be >= 1, not {n_pairs!r}")
+    one = 1 << 40
+    i = np.arange(n_pairs)
+    y = (i * lines_apart) % (512 - 5)
+    x0 = (interleave_phase + 7 * i) % 400
+    o = np.argsort(y, kind="stable")
+    z = np.zeros((n_pairs, 5), np.int64)
+    return EdgePairs(y=y[o], h=np.full(n_pairs, 5), x=(x0[o] * one), dxdy=np.zeros(n_pairs, np.int64),
+                     len=np.full(n_pairs, 5 * one), dlendy=np.zeros(n_pairs, np.int64),
+                     val=z, ddy=z.copy(), ddx=z.copy(), tag=i[o])
