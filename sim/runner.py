@@ -178,6 +178,9 @@ def run_cocotb(
             waves=os.getenv("WAVES") == "1",
             timescale=("1ns", "1ps") if sim == "icarus" else None,
             results_xml=str(Path(test_dir or build_dir) / "results.xml"),
+            # the simulator's chatter goes to a file unless asked for (COCOTB_LOG_STDOUT=1);
+            # a failure below names the file
+            log_file=None if os.getenv("COCOTB_LOG_STDOUT") == "1" else str(Path(test_dir or build_dir) / "sim.log"),
         )
         t2 = time.perf_counter()
         if timings is not None:
@@ -188,7 +191,8 @@ def run_cocotb(
         os.environ["PATH"] = old_path
     n_tests, n_failed = get_results(results)
     if n_tests == 0 or n_failed:
-        raise RasterhwError(f"cocotb: {n_failed} of {n_tests} tests failed (see {results})")
+        raise RasterhwError(f"cocotb: {n_failed} of {n_tests} tests failed (see {results} and "
+                            f"{Path(results).parent / 'sim.log'})")
     return Path(results)
 
 
