@@ -18,12 +18,18 @@ from amaranth.lib import wiring
 from ..golden_model.errors import RasterhwError
 from ..hdl.pixelbus import PixelBus
 from ..hdl.pixelbus_bank import RAM_VERILOG, PixelBusBank
+from ..hdl.zbm_chip import ZbmChip
+from ..hdl.zbm_seggen import ZbmSegmentGenerator
+from ..hdl.zbm_unit import ZbmUnit
 
 __all__ = ["BLOCKS", "EXTRA_VERILOG", "generate_verilog", "write_verilog", "make_block"]
 
 BLOCKS: dict[str, Callable[..., wiring.Component]] = {
     "pixelbus-bank": PixelBusBank,
     "pixelbus": PixelBus,
+    "zbm-chip": ZbmChip,
+    "zbm-seggen": ZbmSegmentGenerator,
+    "zbm-unit": ZbmUnit,
 }
 
 # Hand-written Verilog a block needs next to its generated code: name -> callable(component)
