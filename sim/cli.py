@@ -13,7 +13,6 @@ import time
 from pathlib import Path
 
 import click
-
 from rasterhw.golden_model.errors import RasterhwError
 
 ARCHS = ("reference", "snu")
@@ -175,7 +174,6 @@ def compare(a: str, b: str, output: str | None, tolerance: int, as_json: bool) -
     """Compare two images pixel by pixel; exit 1 if they differ beyond --tolerance."""
     import numpy as np
     from PIL import Image
-
     from rasterhw.golden_model.compare import compare_images, write_diff_png
 
     ia = np.asarray(Image.open(a).convert("RGB"))
