@@ -49,7 +49,7 @@ from .zbm_formats import (
 
 __all__ = [
     "EdgePairs", "Segments", "DoubleZ", "ZbmResult",
-    "edge_pairs", "segment_generator", "initial_processor", "chip_scanline", "unit_scanline",
+    "edge_pairs", "max_active_edge_pairs", "segment_generator", "initial_processor", "chip_scanline", "unit_scanline",
     "merge", "merge_chain", "composite", "map_samples", "render_zbm", "render_zbm_float",
     "default_maps",
 ]
@@ -121,7 +121,8 @@ class Segments:
     line_start : (H + 1,) segments of line y are ``line_start[y]:line_start[y+1]``.
     loads : (H,) edge pairs loaded from the FIFO at the start of each line.
     empty : (H,) active edge pairs whose segment was empty after the fill rule and clipping.
-    late_steps : (H,) per-line catch-up steps of edge pairs loaded late (memory was full).
+    late_steps : (H,) always 0 (kept for compatibility: no pair is ever loaded late; a stream
+        over capacity raises instead).
     stats : counts (``segments``, ``aep_max``, ``stall_lines``, ``segments_lost``, ...).
     """
 
@@ -339,20 +340,37 @@ def _px_ceil(xq: np.ndarray) -> np.ndarray:
     return (xq - HALF_X + ONE_X - 1) >> X_FRAC
 
 
+def max_active_edge_pairs(eps: EdgePairs) -> tuple[int, int]:
+    """(count, line): the most edge pairs active on one scan line, and the first such line.
+
+    Every pair is active on lines ``y .. y + h - 1``; the segment generator needs this many
+    entries of active-edge-pair memory (``capacity``) or it stalls with ``overflow``."""
+    if len(eps) == 0:
+        return 0, 0
+    top = int((eps.y + eps.h).max()) + 1
+    d = np.zeros(top + 1, np.int64)
+    np.add.at(d, eps.y, 1)
+    np.add.at(d, eps.y + eps.h, -1)
+    c = np.cumsum(d)
+    y = int(np.argmax(c))
+    return int(c[y]), y
+
+
 def segment_generator(eps: EdgePairs, height: int, *, width: int = MAX_WIDTH,
                       capacity: int = AEP_CAPACITY) -> Segments:
     """Edge pairs (FIFO order) -> the segments of every scan line, line by line.
 
     Per line ``y``: (1) the loader moves every FIFO edge pair whose top line is ``<= y`` into the
-    active-edge-pair memory (appended, FIFO order) while the memory has room -- if it is full
-    the loader **stalls** (the pair waits
-    when loaded later it is first stepped down to the
-    current line, one add per missed line, and its segments on the missed lines are lost:
-    ``stats['segments_lost']``); (2) the active pairs are read in memory order, each emits its
-    segment for line ``y`` (if not empty after the fill rule and clipping to ``[0, width)``),
-    is stepped (``x += dx/dy``, ``len += dlen/dy``, attributes ``+= d/dy``, 56-bit wrap) and
-    written back unless this was its last line (the paper: "read in order, updated, and only
-    the ones still needed are stored back").
+    active-edge-pair memory (appended, FIFO order); (2) the active pairs are read in memory
+    order, each emits its segment for line ``y`` (if not empty after the fill rule and clipping
+    to ``[0, width)``), is stepped (``x += dx/dy``, ``len += dlen/dy``, attributes ``+= d/dy``,
+    56-bit wrap) and written back unless this was its last line (the paper: "read in order,
+    updated, and only the ones still needed are stored back").
+
+    No loss: if line ``y`` needs more simultaneously active edge pairs than ``capacity``, the
+    hardware cannot produce the line (it stalls and raises ``overflow``); this model raises
+    :class:`RasterhwError` naming the line and the count. Drivers can check first with
+    :func:`max_active_edge_pairs`.
 
     Left-end values: the value on the edge plus ``floor(off * d/dx)`` where ``off`` is the
     distance from the edge to the centre of the first pixel, truncated to Q.16.
@@ -390,28 +408,18 @@ def segment_generator(eps: EdgePairs, height: int, *, width: int = MAX_WIDTH,
     empty = np.zeros(height, np.int64)
     late = np.zeros(height, np.int64)
     aep_max = 0
-    stall_lines = 0
-    lost = 0
     count = 0
     for y in range(height):
         # (1) loader
         start = nxt
-        while nxt < n and eps.y[nxt] <= y and active.size + (nxt - start) < capacity:
+        while nxt < n and eps.y[nxt] <= y:
             nxt += 1
-        new = np.arange(start, nxt)
-        if nxt < n and eps.y[nxt] <= y:
-            stall_lines += 1
-        if new.size:
-            miss = y - eps.y[new]
-            for i, m in zip(new[miss > 0], miss[miss > 0], strict=True):
-                x[i] = wrap(x[i] + m * eps.dxdy[i])
-                ln[i] = wrap(ln[i] + m * eps.dlendy[i])
-                val[i] = wrap(val[i] + m * eps.ddy[i])
-                left[i] -= m
-                lost += int(m)
-                late[y] += int(m)
-            new = new[left[new] > 0]
-            active = np.concatenate([active, new])
+        if active.size + (nxt - start) > capacity:
+            raise RasterhwError(f"segment generator: line {y} needs {active.size + nxt - start} "
+                                f"simultaneously active edge pairs, more than the active-edge-pair "
+                                f"memory's capacity {int(capacity)} (the hardware stalls with "
+                                f"'overflow'; split the stream or raise capacity)")
+        active = np.concatenate([active, np.arange(start, nxt)])
         loads[y] = nxt - start
         aep_max = max(aep_max, active.size)
         # (2) emit
@@ -443,7 +451,7 @@ def segment_generator(eps: EdgePairs, height: int, *, width: int = MAX_WIDTH,
     cat = {k: (np.concatenate(v) if v else np.zeros((0, C) if k in ("val", "inc") else 0, np.int64))
            for k, v in out.items()}
     stats = {"segments": count, "empty_segments": int(empty.sum()), "aep_max": aep_max,
-             "aep_capacity": int(capacity), "stall_lines": stall_lines, "segments_lost": lost,
+             "aep_capacity": int(capacity), "stall_lines": 0, "segments_lost": 0,
              "edge_pairs": n}
     return Segments(cat["y"].astype(np.int64), cat["x"].astype(np.int64), cat["len"].astype(np.int64),
                     cat["val"].astype(np.int64), cat["inc"].astype(np.int64), cat["ep"].astype(np.int64),

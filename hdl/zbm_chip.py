@@ -55,7 +55,11 @@ class ZbmChip(wiring.Component):
     Timing: a segment is received in ``1 + channels`` cycles, overlapping the loop; packets
     enter the loop ``len_chip + 8`` cycles apart (``ZbmLoop``); a segment with no pixel on this
     chip is dropped after its words are read. An end-of-line record waits for the loop to
-    drain and for the merge-bus reader to finish the previous line, then swaps (1 cycle).
+    drain (its last Z write landing in this cycle: ``ZbmLoop.swap_ok``) and for the merge-bus
+    reader to finish the previous line, then swaps; the next line's first packet is taken by
+    the segment processor in the swap cycle, so across a line the loop keeps its
+    ``len_chip + 8`` spacing. The merge-bus reader starts the cycle after the swap and
+    finishes ``chip_pixels + 2`` cycles after it.
     """
 
     def __init__(self, *, interleave: int = 1, chip: int = 0, width: int = F.MAX_WIDTH,
@@ -156,7 +160,11 @@ class ZbmChip(wiring.Component):
                 m.d.sync += recv.eq(recv - 1)
                 with m.If((recv == 1) & keep):
                     m.d.sync += pkt_valid.eq(1)
-        m.d.comb += [loop.i.payload.eq(pkt), loop.i.valid.eq(pkt_valid & (eol == 0))]
+        # The next line's packet may enter the segment processor in the swap cycle itself: it
+        # starts on the ring the cycle after, when the memories have been exchanged.
+        swap = Signal()
+        m.d.comb += [loop.i.payload.eq(pkt),
+                     loop.i.valid.eq(pkt_valid & ((eol == 0) | ((eol == 1) & swap)))]
         with m.If(loop.i.valid & loop.i.ready):
             m.d.sync += pkt_valid.eq(0)
 
@@ -175,8 +183,7 @@ class ZbmChip(wiring.Component):
         reader_done = (q == self._npx) & ~dv
 
         # ---- end of line: swap once the loop has drained and the previous line is read
-        swap = Signal()
-        m.d.comb += [swap.eq((eol != 0) & loop.idle & reader_done), loop.swap.eq(swap)]
+        m.d.comb += [swap.eq((eol != 0) & loop.swap_ok & reader_done), loop.swap.eq(swap)]
         m.d.sync += eol.eq(eol + eol_in - swap)
         with m.If(swap):
             m.d.sync += [q.eq(0), self.lines.eq(self.lines + 1)]

@@ -44,6 +44,11 @@ class ZbmLoop(wiring.Component):
         Exchange loop-side and merge-bus-side memories; only while ``idle``.
     idle : Out(1)
         No packet held or travelling: every Z write of the line has landed.
+    swap_ok : Out(1)
+        (Added.) No packet held, and the last Z write of the travelling packet (if any) lands
+        at the end of this cycle: a ``swap`` now is safe. High one cycle before ``idle``, so
+        the first packet of the next line can enter ``len + LOOP_GAP`` cycles after the last
+        one of this line, as within a line.
     mb_addr : In(range(chip pixels)), mb_rd : In(1), mb_data : Out(PIXEL2)
         The merge bus: chip pixel ``q`` (processor ``q % 8``, address ``q // 8``) appears on
         ``mb_data`` one cycle after ``mb_rd`` and is cleared for the next line.
@@ -67,6 +72,7 @@ class ZbmLoop(wiring.Component):
             "i": In(stream.Signature(PACKET)),
             "swap": In(1),
             "idle": Out(1),
+            "swap_ok": Out(1),
             "mb_addr": In(range(self._npx)),
             "mb_rd": In(1),
             "mb_data": Out(PIXEL2),
@@ -129,6 +135,9 @@ class ZbmLoop(wiring.Component):
                 pp.mb_rd.eq(self.mb_rd & (self.mb_addr[:3] == k)),
             ]
         m.d.comb += self.idle.eq(~full & (wait == 0))
+        # The last flit (7) of a packet started in cycle t0 writes its last pixel (hop len - 1)
+        # in cycle t0 + len + 6; wait == 1 in cycle t0 + len + 7.
+        m.d.comb += self.swap_ok.eq(~full & (wait <= 1))
 
         # ---- merge bus
         sel = Signal(range(n))

@@ -41,18 +41,14 @@ AEP = data.StructLayout({
 })
 
 
-class _State(enum.Enum, shape=4):
-    LOAD_CHECK = 0
-    LOAD_WORD = 1
-    LATE = 2
-    APPEND = 3
-    READ = 4
-    COMPUTE = 5
-    SEND_HDR = 6
-    SEND_FLIT = 7
-    STEP = 8
-    EOL = 9
-    FRAME_END = 10
+class _State(enum.Enum, shape=3):
+    CHECK = 0        # look at the FIFO head: load it, or read the first active pair
+    LOAD = 1         # channel words 1..8 of an edge pair; the record is appended with word 8
+    SEG = 2          # the pair just read (read-port data) sends its header, or is empty
+    FLIT = 3         # channel flits; with the last one: write back, read the next pair
+    EOL = 4          # end-of-line word
+    FRAME_END = 5    # consume the end-of-frame marker
+    OVERFLOW = 6     # a due pair does not fit: stalled for good (sticky ``overflow``)
 
 
 class ZbmSegmentGenerator(wiring.Component):
@@ -77,12 +73,18 @@ class ZbmSegmentGenerator(wiring.Component):
         Line being generated.
     frames : Out(16)
         Frames completed.
+    overflow : Out(1)
+        Sticky: a line needs more active edge pairs than ``capacity``. The generator then
+        stops (no word of that line is emitted; the input FIFO fills and ``i.ready`` falls)
+        until reset. Nothing is ever dropped.
 
-    Timing (segment clock): loading an edge pair takes 9 cycles (one FIFO word per cycle, the
-    paper's figure), plus 1 cycle per missed line for a pair loaded late, plus 1 to append it;
-    an active pair costs READ + COMPUTE + STEP = 3 cycles, plus 1 + channels words for a
-    non-empty segment (each held until the chips accept it); a line ends with one
-    end-of-line word.
+    Timing (segment clock, every word held until the chips accept it): per line, 1 cycle
+    (CHECK: the FIFO head is examined and, if no pair is due, the first active pair is read in
+    the same cycle) + 9 per edge pair loaded (its 9 FIFO words, one per cycle, the paper's
+    figure; the record is appended with the 9th word; a load that follows another overlaps
+    its header word with the CHECK) + per active pair ``1 + channels`` words if its segment is
+    non-empty, else 1 cycle (the pair's write-back and the read of the next pair happen with
+    its last word) + 1 end-of-line word. ``golden_model.zbm_cycles.hdl_cycles`` counts this.
     """
 
     def __init__(self, *, width: int = F.MAX_WIDTH, height: int = F.MAX_HEIGHT,
@@ -100,6 +102,7 @@ class ZbmSegmentGenerator(wiring.Component):
             "o": Out(stream.Signature(unsigned(F.LOOP_BITS))),
             "line": Out(9),
             "frames": Out(16),
+            "overflow": Out(1),
         })
 
     @property
@@ -126,19 +129,17 @@ class ZbmSegmentGenerator(wiring.Component):
         rp = mem.read_port()
         wp = mem.write_port()
 
-        rec = Signal(AEP)
+        rec = Signal(AEP)                    # edge pair being loaded
+        cur = data.View(AEP, rp.data)        # active pair being emitted (read port holds it)
         y = self.line
         n_mem = Signal(range(cap + 1))       # active pairs in memory
-        n_start = Signal(range(cap + 1))     # active pairs at the start of this line
-        loaded = Signal(range(cap + 1))      # pairs taken from the FIFO this line
         word = Signal(range(F.EP_WORDS))
-        late = Signal(10)
-        r = Signal(range(cap + 1))           # read index of the emit pass
+        r = Signal(range(cap + 1))           # read index of the emit pass (pairs read so far)
         w = Signal(range(cap + 1))           # write-back index (w <= r: in-place compaction)
         off = Signal(unsigned(24))           # Q.12 distance from the left edge to the first centre
         c = Signal(range(N_CH + 1))          # attribute channel being sent (2..)
         state = Signal(_State)
-        n_attr = Mux(rec.mode == F.MODE_MAPPING, len(F.CHANNELS[F.MODE_MAPPING]),
+        n_attr = Mux(cur.mode == F.MODE_MAPPING, len(F.CHANNELS[F.MODE_MAPPING]),
                      len(F.CHANNELS[F.MODE_COLOUR]))
 
         # left-end pixel range: first centre >= edge, i.e. ceil(xq - 0.5) (golden _px_ceil)
@@ -147,80 +148,81 @@ class ZbmSegmentGenerator(wiring.Component):
         def px_ceil(xq):
             return (xq - half_x + (one_x - 1)) >> F.X_FRAC
 
-        xl = rec.ch[0].value
-        xr = xl + rec.ch[1].value               # 57-bit: no wrap, as the golden int64 sum
+        xl = cur.ch[0].value
+        xr = xl + cur.ch[1].value               # 57-bit: no wrap, as the golden int64 sum
         s_raw, e_raw = px_ceil(xl), px_ceil(xr)
         s_cl = Mux(s_raw < 0, 0, s_raw)
         e_cl = Mux(e_raw > self._width, self._width, e_raw)
 
-        def step(dst, src):
-            """The adders: every channel one scan line down (56-bit wrap)."""
-            stmts = []
-            for k in range(N_CH):
-                stmts.append(dst.ch[k].value.eq(src.ch[k].value + src.ch[k].ddy))
-            return stmts
-
         m.d.comb += [wp.en.eq(0), rp.en.eq(0)]
         m.d.comb += self.o.valid.eq(0)
+
+        def retire():
+            """The current pair is done: step it and store it back if still needed (the adders:
+            every channel one line down, 56-bit wrap); read the next pair, or end the line."""
+            stepped = Signal(AEP)
+            m.d.comb += [stepped.eq(cur), stepped.left.eq(cur.left - 1)]
+            for k in range(N_CH):
+                m.d.comb += stepped.ch[k].value.eq(cur.ch[k].value + cur.ch[k].ddy)
+            keep = cur.left > 1
+            with m.If(keep):
+                m.d.comb += [wp.en.eq(1), wp.addr.eq(w), wp.data.eq(stepped)]
+            m.d.sync += w.eq(w + keep)
+            with m.If(r == n_mem):
+                m.d.sync += [state.eq(_State.EOL), n_mem.eq(w + keep)]
+            with m.Else():
+                m.d.comb += [rp.en.eq(1), rp.addr.eq(r)]
+                m.d.sync += [r.eq(r + 1), state.eq(_State.SEG)]
+
         with m.Switch(state):
-            # ---------------- (1) loader: pairs whose top line has been reached, while room
-            with m.Case(_State.LOAD_CHECK):
+            # ---------------- (1) loader: pairs whose top line has been reached
+            with m.Case(_State.CHECK):
                 with m.If(fq.r_rdy):
-                    with m.If(head.h == 0):                     # end of frame: no more pairs
-                        m.d.sync += [state.eq(_State.READ), r.eq(0), w.eq(0)]
-                    with m.Elif((head.y <= y) & (n_start + loaded < cap)):
-                        m.d.sync += [rec.eq(0), rec.y.eq(head.y), rec.left.eq(head.h),
-                                     rec.mode.eq(head.mode), word.eq(1), loaded.eq(loaded + 1)]
-                        m.d.comb += fq.r_en.eq(1)
-                        m.d.sync += state.eq(_State.LOAD_WORD)
-                    with m.Else():
-                        m.d.sync += [state.eq(_State.READ), r.eq(0), w.eq(0)]
-            with m.Case(_State.LOAD_WORD):
+                    with m.If((head.h != 0) & (head.y <= y)):
+                        with m.If(n_mem == cap):             # due but no room: cannot make line y
+                            m.d.sync += [state.eq(_State.OVERFLOW), self.overflow.eq(1)]
+                        with m.Else():
+                            m.d.comb += fq.r_en.eq(1)
+                            m.d.sync += [rec.eq(0), rec.y.eq(head.y), rec.left.eq(head.h),
+                                         rec.mode.eq(head.mode), word.eq(1), state.eq(_State.LOAD)]
+                    with m.Elif(n_mem == 0):                 # nothing due, nothing active
+                        m.d.sync += state.eq(_State.EOL)
+                    with m.Else():                           # emit: read the first pair now
+                        m.d.comb += [rp.en.eq(1), rp.addr.eq(0)]
+                        m.d.sync += [r.eq(1), w.eq(0), state.eq(_State.SEG)]
+            with m.Case(_State.LOAD):
                 with m.If(fq.r_rdy):
                     m.d.comb += fq.r_en.eq(1)
+                    full = Signal(AEP)
+                    m.d.comb += full.eq(rec)
                     with m.Switch(word):
                         for k in range(1, F.EP_WORDS):
                             with m.Case(k):
                                 m.d.sync += [rec.ch[k - 1].value.eq(head_ch.value),
                                              rec.ch[k - 1].ddy.eq(head_ch.ddy),
                                              rec.ch[k - 1].ddx.eq(head_ch.ddx)]
+                                if k == F.EP_WORDS - 1:
+                                    m.d.comb += [full.ch[k - 1].value.eq(head_ch.value),
+                                                 full.ch[k - 1].ddy.eq(head_ch.ddy),
+                                                 full.ch[k - 1].ddx.eq(head_ch.ddx)]
                     m.d.sync += word.eq(word + 1)
-                    with m.If(word == F.EP_WORDS - 1):
-                        m.d.sync += [state.eq(_State.LATE), late.eq(y - rec.y)]
-            with m.Case(_State.LATE):                        # R3: step down to this line
-                with m.If(late == 0):
-                    m.d.sync += state.eq(_State.APPEND)
-                with m.Elif(rec.left <= 1):                  # ends before this line: dropped
-                    m.d.sync += [state.eq(_State.LOAD_CHECK)]
-                with m.Else():
-                    m.d.sync += step(rec, rec)
-                    m.d.sync += [rec.left.eq(rec.left - 1), late.eq(late - 1)]
-            with m.Case(_State.APPEND):
-                m.d.comb += [wp.en.eq(1), wp.addr.eq(n_mem), wp.data.eq(rec)]
-                m.d.sync += [n_mem.eq(n_mem + 1), state.eq(_State.LOAD_CHECK)]
-            # ---------------- (2) emit: read in memory order, send, step, store back if needed
-            with m.Case(_State.READ):
-                with m.If(r == n_mem):
-                    m.d.sync += [state.eq(_State.EOL), n_mem.eq(w)]
-                with m.Else():
-                    m.d.comb += [rp.en.eq(1), rp.addr.eq(r)]
-                    m.d.sync += [state.eq(_State.COMPUTE), r.eq(r + 1)]
-            with m.Case(_State.COMPUTE):
-                m.d.sync += rec.eq(rp.data)
-                m.d.sync += state.eq(_State.SEND_HDR)
-            with m.Case(_State.SEND_HDR):
+                    with m.If(word == F.EP_WORDS - 1):       # append with the last word
+                        m.d.comb += [wp.en.eq(1), wp.addr.eq(n_mem), wp.data.eq(full)]
+                        m.d.sync += [n_mem.eq(n_mem + 1), state.eq(_State.CHECK)]
+            # ---------------- (2) emit: in memory order, send, step, store back if needed
+            with m.Case(_State.SEG):
                 with m.If(e_cl > s_cl):
                     hdr = data.View(SEG_HEADER, self.o.payload)
                     m.d.comb += [self.o.valid.eq(1), hdr.y.eq(y), hdr.x.eq(s_cl),
-                                 hdr.len.eq(e_cl - s_cl), hdr.mode.eq(rec.mode)]
+                                 hdr.len.eq(e_cl - s_cl), hdr.mode.eq(cur.mode)]
                     with m.If(self.o.ready):
                         # Q.12 offset from the edge to the first centre (>= 0)
                         m.d.sync += [off.eq(((s_cl << F.X_FRAC) + half_x - xl) >> (F.X_FRAC - F.OFF_FRAC)),
-                                     c.eq(2), state.eq(_State.SEND_FLIT)]
-                with m.Else():
-                    m.d.sync += state.eq(_State.STEP)
-            with m.Case(_State.SEND_FLIT):
-                ch = rec.ch[c]
+                                     c.eq(2), state.eq(_State.FLIT)]
+                with m.Else():                               # empty after fill rule / clipping
+                    retire()
+            with m.Case(_State.FLIT):
+                ch = cur.ch[c]
                 fl = data.View(FLIT, self.o.payload)
                 m.d.comb += [self.o.valid.eq(1),
                              fl.value.eq(ch.value + ((off * ch.ddx) >> F.OFF_FRAC)),
@@ -228,15 +230,7 @@ class ZbmSegmentGenerator(wiring.Component):
                 with m.If(self.o.ready):
                     m.d.sync += c.eq(c + 1)
                     with m.If(c == n_attr + 1):
-                        m.d.sync += state.eq(_State.STEP)
-            with m.Case(_State.STEP):
-                stepped = Signal(AEP)
-                m.d.comb += [stepped.eq(rec), stepped.left.eq(rec.left - 1)]
-                m.d.comb += step(stepped, rec)
-                with m.If(rec.left > 1):
-                    m.d.comb += [wp.en.eq(1), wp.addr.eq(w), wp.data.eq(stepped)]
-                    m.d.sync += w.eq(w + 1)
-                m.d.sync += state.eq(_State.READ)
+                        retire()
             with m.Case(_State.EOL):
                 hdr = data.View(SEG_HEADER, self.o.payload)
                 m.d.comb += [self.o.valid.eq(1), hdr.y.eq(y), hdr.len.eq(0)]
@@ -244,16 +238,17 @@ class ZbmSegmentGenerator(wiring.Component):
                     with m.If(y == self._height - 1):
                         m.d.sync += [state.eq(_State.FRAME_END), word.eq(0)]
                     with m.Else():
-                        m.d.sync += [y.eq(y + 1), state.eq(_State.LOAD_CHECK),
-                                     n_start.eq(n_mem), loaded.eq(0)]
+                        m.d.sync += [y.eq(y + 1), state.eq(_State.CHECK)]
             with m.Case(_State.FRAME_END):
-                # Drop pairs never loaded (memory was full to the end: their segments are
-                # lost, as in the golden model), then the end-of-frame marker; next frame.
+                # Every pair ends inside the frame, so the next word is the end-of-frame
+                # marker; words of a malformed stream before it are skipped.
                 with m.If(fq.r_rdy):
                     m.d.comb += fq.r_en.eq(1)
                     with m.If((word == 0) & (head.h == 0)):
-                        m.d.sync += [y.eq(0), n_mem.eq(0), n_start.eq(0), loaded.eq(0),
-                                     self.frames.eq(self.frames + 1), state.eq(_State.LOAD_CHECK)]
+                        m.d.sync += [y.eq(0), n_mem.eq(0),
+                                     self.frames.eq(self.frames + 1), state.eq(_State.CHECK)]
                     with m.Else():
                         m.d.sync += word.eq(Mux(word == F.EP_WORDS - 1, 0, word + 1))
+            with m.Case(_State.OVERFLOW):
+                pass
         return m

@@ -8,7 +8,7 @@ interleave slot. The head unit (``head=True``) feeds its chips empty pixels itse
 
 from __future__ import annotations
 
-from amaranth import Module, Signal, unsigned
+from amaranth import Module, Mux, Signal, unsigned
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model import zbm_formats as F
@@ -46,6 +46,12 @@ class ZbmUnit(wiring.Component):
         Segment-clock cycles since reset.
     frames : Out(16)
         Frames the segment generator has finished.
+    lines : Out(16)
+        (Added.) Scan lines every chip has finished (pixel memories swapped): the minimum of
+        the chips' ``lines`` counters.
+    overflow : Out(1)
+        (Added.) The segment generator's sticky overflow: a line needs more active edge pairs
+        than ``capacity``; the unit has stopped without emitting that line.
 
     Timing: the segment generator's word goes to all chips in the same cycle and is taken
     when every chip is ready, so the busiest chip sets the pace (``len_chip + 8`` per segment).
@@ -64,6 +70,8 @@ class ZbmUnit(wiring.Component):
             "o_merge": Out(stream.Signature(PIXEL2)).array(interleave),
             "cycles": Out(32),
             "frames": Out(16),
+            "lines": Out(16),
+            "overflow": Out(1),
         }
         if not head:
             members["i_merge"] = In(stream.Signature(PIXEL2)).array(interleave)
@@ -103,5 +111,10 @@ class ZbmUnit(wiring.Component):
         for rdy in readies[1:]:
             ready_and = ready_and & rdy
         m.d.comb += [all_ready.eq(ready_and), sg.o.ready.eq(ready_and)]
-        m.d.comb += [self.cycles.eq(chips[0].cycles), self.frames.eq(sg.frames)]
+        m.d.comb += [self.cycles.eq(chips[0].cycles), self.frames.eq(sg.frames),
+                     self.overflow.eq(sg.overflow)]
+        low = chips[0].lines
+        for chip in chips[1:]:
+            low = Mux(chip.lines < low, chip.lines, low)
+        m.d.comb += self.lines.eq(low)
         return m

@@ -149,9 +149,20 @@ def test_segment_generator_errors_and_stall():
     full = zbm.segment_generator(eps, 32, width=32)
     assert full.stats["stall_lines"] == 0 and full.stats["segments_lost"] == 0
     assert full.stats["aep_max"] > 2
-    small = zbm.segment_generator(eps, 32, width=32, capacity=2)
-    assert small.stats["aep_max"] <= 2 and small.stats["stall_lines"] > 0
-    assert small.stats["segments_lost"] > 0 and small.y.size < full.y.size
+    # no loss: a stream needing more active pairs than the memory holds is an error that names
+    # the line and the count; exactly at capacity it works and gives the same segments
+    need, line = zbm.max_active_edge_pairs(eps)
+    assert need == full.stats["aep_max"] > 2
+    act = [(eps.y <= y) & (y < eps.y + eps.h) for y in range(32)]
+    assert max(a.sum() for a in act) == need and act[line].sum() == need
+    with pytest.raises(RasterhwError, match=rf"line {line} needs {need} simultaneously active"):
+        zbm.segment_generator(eps, 32, width=32, capacity=need - 1)
+    tris = ref.random_triangles(32, 32, 12, mean_area=60, seed=7)
+    with pytest.raises(RasterhwError, match="capacity 2"):
+        zbm.render_zbm(tris, capacity=2)
+    exact = zbm.segment_generator(eps, 32, width=32, capacity=need)
+    assert np.array_equal(exact.val, full.val) and np.array_equal(exact.ep, full.ep)
+    assert zbm.max_active_edge_pairs(eps.take(np.arange(0))) == (0, 0)
     # all segments of one line are emitted together, lines in order
     assert (np.diff(full.y) >= 0).all()
 
@@ -330,7 +341,20 @@ def test_event_model_rules():
     off.x[:] = -50 << fmt.X_FRAC
     e = cyc.event_cycles(off, 64, width=64, interleave=8)
     assert e["loop_cycles"] == 9 + 5 and e["segments"] == 0
-    # R3: a full memory delays loads; late pairs pay one cycle per missed line
+    # over capacity: an error, never lost segments
     tris = ref.random_triangles(32, 32, 12, mean_area=60, seed=7)
-    e = cyc.event_cycles(zbm.edge_pairs(tris), 32, width=32, interleave=8, capacity=2)
-    assert e["late_cycles"] > 0
+    with pytest.raises(RasterhwError, match="simultaneously active"):
+        cyc.event_cycles(zbm.edge_pairs(tris), 32, width=32, interleave=8, capacity=2)
+
+
+def test_hdl_cycle_model_steady_state():
+    """hdl_cycles on the paper's workload: per extra edge pair 4 (len_chip + 8) + max(len_chip + 8, 18)
+    (docs/zbm.md, HDL); HDL equality is tested in tests/test_zbm_unit_pysim.py."""
+    for i in fmt.INTERLEAVES:
+        w = max(4 * i, 8)
+        a = cyc.hdl_cycles(cyc.paper_workload(4, width=w), 20, width=w, interleave=i)["cycles"]
+        b = cyc.hdl_cycles(cyc.paper_workload(5, width=w), 25, width=w, interleave=i)["cycles"]
+        lc = -(-5 // i)
+        assert b - a == 4 * (lc + 8) + max(lc + 8, 18)
+    with pytest.raises(RasterhwError, match="line 2 needs 3"):
+        cyc.hdl_cycles(cyc.paper_workload(3, lines_apart=1, width=16), 8, width=16, interleave=2, capacity=2)

@@ -9,8 +9,10 @@ from amaranth import Module
 from amaranth.lib import wiring
 from amaranth.sim import Simulator
 from rasterhw.golden_model import zbm as G
+from rasterhw.golden_model import zbm_cycles as C
 from rasterhw.golden_model import zbm_formats as F
 from rasterhw.hdl.zbm_unit import ZbmUnit
+from rasterhw.sim.zbm_cycles_hdl import measure_cycles_per_edge_pair, run_unit_cycles
 from test_zbm_helpers_pysim import edge_pair_words, pixel2_words, random_triangles
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
@@ -98,61 +100,36 @@ def test_unit_bad_parameters():
         ZbmUnit(interleave=5)
 
 
-def workload_5x5(n_pairs: int, interleave: int) -> tuple[G.EdgePairs, int, int]:
-    """The paper's Table 1 workload (sec. 6.1 cond. 1-2): edge pairs of exactly 5 lines x 5
-    pixels, one pair every 5 lines (one segment per line), left ends stepping through all chip
-    alignments. Width ``8 * interleave`` keeps each chip's merge readout (8 pixels per line)
-    shorter than its loop work, so the count is the loop side's, as in the paper."""
-    width = max(8 * interleave, 8)
-    one = 1 << F.X_FRAC
-    i = np.arange(n_pairs)
-    x0 = (i * 3) % (width - 5 + 1)
-    z = np.zeros((n_pairs, 5), np.int64)
-    # left edge at the pixel's left boundary: covers centres x0 + 0.5 .. x0 + 4.5
-    eps = G.EdgePairs(y=i * 5, h=np.full(n_pairs, 5), x=x0 * one, dxdy=np.zeros(n_pairs, np.int64),
-                      len=np.full(n_pairs, 5 * one), dlendy=np.zeros(n_pairs, np.int64),
-                      val=z, ddy=z.copy(), ddx=z.copy(), tag=i)
-    return eps, width, 5 * n_pairs
+@pytest.mark.parametrize("interleave,seed", [(1, 0), (2, 1), (8, 2)])
+def test_cycle_model_is_exact(interleave, seed):
+    """HDL cycles == golden_model.zbm_cycles.hdl_cycles on random small streams (empty and
+    clipped segments, several pairs per line, loads on many lines)."""
+    w, h = 8 * interleave if interleave > 1 else 24, 10
+    rng = np.random.default_rng(seed)
+    eps = G.edge_pairs(random_triangles(rng, 6, w, h, size=10))
+    model = C.hdl_cycles(eps, h, width=w, interleave=interleave)
+    assert G.max_active_edge_pairs(eps)[0] >= 2 and len(eps) >= 5 and model["generator"]["empty"] > 0
+    hdl = run_unit_cycles(eps, h, width=w, interleave=interleave)
+    assert hdl["overflow"] == 0 and hdl["lines"] == h
+    assert hdl["cycles"] == model["cycles"], (hdl, model)
 
 
-def measure_cycles_per_edge_pair(interleave: int, n_pairs: int = 6) -> dict:
-    """Run one head unit on :func:`workload_5x5` in pysim; cycles until the segment generator
-    has finished the frame (its last end-of-line word taken), per edge pair."""
-    eps, width, height = workload_5x5(n_pairs, interleave)
-    segs = G.segment_generator(eps, height, width=width)
-    assert np.all(segs.len == 5) and segs.y.size == 5 * n_pairs
-    unit = ZbmUnit(interleave=interleave, width=width, height=height, head=True)
-    sim = Simulator(unit)
-    sim.add_clock(1e-8, domain="sync")
-    sim.add_clock(1e-8, domain="merge")
-    out = {}
-
-    async def src(ctx):
-        for w in edge_pair_words(eps):
-            ctx.set(unit.i.payload, w)
-            ctx.set(unit.i.valid, 1)
-            await ctx.tick().until(unit.i.ready)
-            ctx.set(unit.i.valid, 0)
-
-    async def bench(ctx):
-        for c in range(interleave):
-            ctx.set(unit.o_merge[c].ready, 1)
-        start = ctx.get(unit.cycles)
-        await ctx.tick().until(unit.frames == 1)
-        out["cycles"] = ctx.get(unit.cycles) - start
-
-    sim.add_testbench(src, background=True)
-    sim.add_testbench(bench)
-    sim.run()
-    return {"interleave": interleave, "edge_pairs": n_pairs, "cycles": out["cycles"],
-            "cycles_per_edge_pair": out["cycles"] / n_pairs}
+def test_unit_overflow_flag():
+    """Over capacity the unit stops with ``overflow`` instead of finishing the frame."""
+    eps = C.paper_workload(3, lines_apart=1, width=16)          # 3 pairs active on line 2
+    assert G.max_active_edge_pairs(eps) == (3, 2)
+    hdl = run_unit_cycles(eps, 8, width=16, interleave=2, capacity=2, max_cycles=400)
+    assert hdl["overflow"] == 1 and hdl["lines"] <= 2
+    ok = run_unit_cycles(eps, 8, width=16, interleave=2, capacity=3)
+    assert ok["overflow"] == 0 and ok["lines"] == 8
+    assert ok["cycles"] == C.hdl_cycles(eps, 8, width=16, interleave=2, capacity=3)["cycles"]
 
 
-def test_cycles_per_edge_pair_interleave_2():
-    """Interleave 2: paper's formula 9 + (3 + 8) * 5 = 64; the HDL cannot beat the paper's own
-    lower bound, and its overhead is bounded (about 2-3 cycles per line, see docs/zbm.md, HDL)."""
-    r = measure_cycles_per_edge_pair(2, n_pairs=3)
-    assert 64 <= r["cycles_per_edge_pair"] <= 64 + 5 * 3
+def test_cycles_per_edge_pair_interleave_8():
+    """The report's measurement: HDL == model; steady state 4 (len_chip + 8) + 18 (docs/zbm.md)."""
+    r = measure_cycles_per_edge_pair(8, n_edge_pairs=3)
+    assert r["cycles"] == r["model_cycles"]
+    assert r["marginal_cycles_per_edge_pair"] == 4 * (1 + 8) + 18
 
 
 @pytest.mark.slow
@@ -160,12 +137,11 @@ def test_cycles_per_edge_pair_interleave_2():
 def test_cycles_per_edge_pair_sweep(interleave):
     r = measure_cycles_per_edge_pair(interleave)
     print(r)
-    assert r["cycles_per_edge_pair"] >= 9 + (-(-5 // interleave) + 8) * 5
+    assert r["cycles"] == r["model_cycles"]
+    lc = -(-5 // interleave)
+    assert r["marginal_cycles_per_edge_pair"] == 4 * (lc + 8) + max(lc + 8, 18)
 
 
 if __name__ == "__main__":    # python tests/test_zbm_unit_pysim.py -> the Table 1 measurement
-    import sys
-
     for i in F.INTERLEAVES:
-        r = measure_cycles_per_edge_pair(i, n_pairs=int(sys.argv[1]) if len(sys.argv) > 1 else 6)
-        print(i, r["cycles"], round(r["cycles_per_edge_pair"], 2), "paper", 9 + (-(-5 // i) + 8) * 5)
+        print(measure_cycles_per_edge_pair(i))
