@@ -6,8 +6,7 @@ conventions of :mod:`rasterhw.golden_model.screen` exactly:
 * pixel centres at ``(col + 0.5, row + 0.5)``, y down;
 * top-left fill rule, decided **exactly**: vertex positions are snapped to a grid of
   ``1/SUBPIXEL`` px (``SUBPIXEL = 256``, round half up) and the edge functions are then
-  integers (held in ``int64`` for the span limits and in ``float64`` for the weights; every
-  value is an integer below 2**53, so both are exact);
+  integers (held in ``float64``; every value is an integer below 2**53, so they are exact);
 * depth ``z``: 0 = near; the Z test is ``z_new < z_stored`` (strict), so on a tie the triangle
   submitted first keeps the pixel;
 * colour and depth are interpolated with barycentric weights ``w_i = E_i / E`` in float64
@@ -23,17 +22,21 @@ How it is vectorised (no per-triangle Python loop):
 2. one record per (triangle, scan line) of its bounding box; for each record the exact span
    ``[col_lo, col_hi]`` where all three edge functions pass the fill rule, from integer floor
    divisions (``E_k(col)`` is affine in ``col``);
-3. the spans are expanded to fragments with ``np.repeat`` and the depth of every fragment is
-   computed as whole-array operations;
-4. Z resolve: fragments are grouped by pixel (stable sort keeps submission order inside a
-   pixel) and numbered by layer (0 = the first fragment to arrive at its pixel, 1 = the
-   second, ...). Each layer touches every pixel at most once, so a layer is one vectorised
-   step of a serial Z-buffer; running the layers in order gives exactly what a serial
-   Z-buffer writes (``pixels_written``) and the final winner per pixel;
+3. the spans are expanded to fragments (each per-record value is gathered on the record
+   index of every fragment) and the weights and depth of every fragment are computed as
+   whole-array operations;
+4. Z resolve by layers: layer 0 is the earliest fragment of every pixel (``np.minimum.at``
+   on the fragment index), layer 1 the next one, ... Each layer touches every pixel at most
+   once, so a layer is one vectorised step of a serial Z-buffer; running the layers in order
+   gives exactly what a serial Z-buffer writes (``pixels_written``) and the final winner per
+   pixel;
 5. colour is computed only for the winners.
 
 Triangles are processed in chunks of at most about ``CHUNK_CANDIDATES`` bounding-box pixels,
 carrying the depth buffer from chunk to chunk, so memory stays bounded for large frames.
+Fresh memory is expensive here (a page fault per 4 kB page), so the fragment arrays live in a
+per-thread pool reused from chunk to chunk and call to call, and the four outputs share one
+new block per call, aligned so that it is backed by 2 MiB pages.
 """
 
 from __future__ import annotations
@@ -166,10 +169,20 @@ def _setup(xy: np.ndarray, width: int, height: int) -> dict:
     # Per row, E_i(col) = K_i(row) + S_i * col with K_i(row) = dx_i * Yc + k_i.
     k = -dx * Ya - dy * (half - Xa)
     S = -SUBPIXEL * dy
-    # One (m, T) table so a single gather serves every row record.
-    table = np.concatenate([dx, k, S, s * S, np.where(topleft, 0.0, 1.0), s[None],
-                            area[keep][None], c0[keep][None], c1[keep][None]])
-    return {"keep": keep, "table": table, "r0": r0[keep].astype(np.int64),
+    # Fill rule in the triangle's own orientation: s*E_i >= thr_i  <=>  sS_i * col >= N_i with
+    # N_i(row) = thr_i - s*K_i(row) = na_i * Yc + nb_i (exact integers, see _fragments).
+    sS = s * S
+    sS[sS == 0] = 0.0  # horizontal edges: +0.0, never -0.0, so N / sS = +inf exactly when N > 0
+    thr = np.where(topleft, 0.0, 1.0)
+    na = -s * dx
+    nb = thr - s * k
+    # An edge with sS < 0 bounds the span from above, any other edge from below.
+    side = np.where(sS < 0, -np.inf, np.inf)
+    # One (14, T) table repeated over the row records, one (7, T) table gathered for the
+    # records that have fragments: what the weights need (E_1, E_2 and the area).
+    table = np.concatenate([na, nb, sS, side, c0[keep][None], c1[keep][None]])
+    wtab = np.concatenate([dx[1:], k[1:], S[1:], area[keep][None]])
+    return {"keep": keep, "table": table, "wtab": wtab, "r0": r0[keep].astype(np.int64),
             "r1": r1[keep].astype(np.int64)}
 
 
@@ -182,23 +195,24 @@ def _fragments(st: dict, lo_t: int, hi_t: int, width: int, z: np.ndarray) -> dic
     first = np.cumsum(nrows) - nrows
     row = np.repeat(r0 - first, nrows) + np.arange(nr)
     tab = np.repeat(st["table"][:, lo_t:hi_t], nrows, axis=1)
-    dx, k, S, sS, thr = tab[0:3], tab[3:6], tab[6:9], tab[9:12], tab[12:15]
-    s, area, c0, c1 = tab[15], tab[16], tab[17], tab[18]
+    na, nb, sS, side, c0, c1 = tab[0:3], tab[3:6], tab[6:9], tab[9:12], tab[12], tab[13]
     Yc = (row * SUBPIXEL + SUBPIXEL // 2).astype(np.float64)
-    K = dx * Yc + k  # (3, R): E_i at column 0 of this row, an exact integer
-    # Fill rule in the triangle's own orientation: s*E_i >= thr_i  <=>  sS_i * col >= N_i.
+    N = na * Yc
+    N += nb  # (3, R), exact integers
+    # The span is where sS_i * col >= N_i for all three edges.
     # floor/ceil of the float quotient are exact: N and sS are integers with |sS| <= 2**33,
     # so a non-integer quotient is at least 2**-33 from an integer, while the rounding error
-    # of a quotient below 2**17 in size is at most 2**-36; larger quotients are clipped to
-    # just outside the frame, which is all that matters.
-    N = thr - s * K
+    # of a quotient below 2**17 in size is at most 2**-36. A larger quotient lies beyond
+    # every column a triangle can reach (|coordinates| <= 2**16 px), where an error of one
+    # changes nothing once the span is clamped to the bounding box.
     with np.errstate(divide="ignore", invalid="ignore"):
-        q = np.clip(N / sS, -2.0, width + 1.0)
-    fl = np.floor(q)  # sS < 0: largest col with sS*col >= N
-    ce = np.ceil(q)  # sS > 0: smallest col with sS*col >= N
-    big = float(width + 2)
-    hi = np.where(sS < 0, fl, np.where((sS == 0) & (N > 0), -big, big)).min(axis=0)
-    lo = np.where(sS > 0, ce, -big).max(axis=0)
+        q = N / sS
+        # sS > 0: ceil(q) is the smallest column that passes, a lower bound; sS < 0: floor(q)
+        # is the largest, an upper bound (``side`` = -inf masks the other kind). A horizontal
+        # edge (sS = 0) passes every column or none: q is -inf or NaN (N < 0 or N = 0, all
+        # pass) or +inf (N > 0, none); it acts as a lower bound, and fmax ignores NaN.
+        lo = np.fmax.reduce(np.minimum(np.ceil(q), side), axis=0)
+        hi = np.fmax(np.floor(q), side).min(axis=0)
     hi = np.minimum(hi, c1)
     lo = np.maximum(lo, c0)
     n = np.maximum(hi - lo + 1, 0).astype(np.int64)
@@ -209,49 +223,98 @@ def _fragments(st: dict, lo_t: int, hi_t: int, width: int, z: np.ndarray) -> dic
         return {"F": 0}
     lo = lo[nz].astype(np.int64)
     start = np.cumsum(n) - n
-    col = np.arange(F, dtype=np.int64)
-    col += np.repeat(lo - start, n)
-    pix = np.repeat(row[nz] * width, n)
-    pix += col
-    rec = np.repeat(np.arange(nz.size), n)  # (non-empty) row record of each fragment
-    colf = col.astype(np.float64)
-    del col
-    K1, K2, S1, S2, area = K[1, nz], K[2, nz], S[1, nz], S[2, nz], area[nz]
-    zr = z[rt[nz]]
+    # Fragment-sized arrays live in the per-thread pool (see _Pool); each per-record value is
+    # spread over its fragments by a gather on ``rec``, the record of each fragment.
+    pool = _pool()
+    iota = pool.iota(F)
+    rec = pool.get("rec", F, np.int64)
+    rec.fill(0)
+    rec[start[1:]] = 1
+    np.cumsum(rec, out=rec)
+
+    def spread(v: np.ndarray, name: str, dtype=np.float64) -> np.ndarray:
+        return np.take(v, rec, out=pool.get(name, F, dtype), mode="clip")
+
+    pix = spread(row[nz] * width + (lo - start), "pix", np.int64)
+    pix += iota
+    colf = spread((lo - start).astype(np.float64), "col")
+    colf += iota  # exact: |col| < 2**31
+    rt = rt[nz]
+    dx1, dx2, k1, k2, S1, S2, area = np.take(st["wtab"], rt, axis=1)
+    Yc = Yc[nz]
+    K1 = dx1 * Yc + k1  # E_1, E_2 at column 0 of the row, exact integers
+    K2 = dx2 * Yc + k2
+    zr = np.take(z, rt, axis=1)  # (vertex, record)
     # Barycentric weights (w0 = (1 - w1) - w2 is exact, 1 or 0, at every vertex) and depth,
-    # computed in place to keep the number of fragment-sized temporaries small.
-    arear = np.repeat(area, n)
-    w1 = np.repeat(S1, n)
+    # computed in place.
+    arear = spread(area, "area")
+    t = pool.get("t", F)
+    w1 = spread(S1, "w1")
     w1 *= colf
-    w1 += np.repeat(K1, n)
+    w1 += np.take(K1, rec, out=t, mode="clip")
     w1 /= arear
-    w2 = np.repeat(S2, n)
+    w2 = spread(S2, "w2")
     w2 *= colf
-    w2 += np.repeat(K2, n)
+    w2 += np.take(K2, rec, out=t, mode="clip")
     w2 /= arear
-    del arear, colf
-    zz = np.subtract(1.0, w1)
-    zz -= w2
-    zz *= np.repeat(zr[:, 0], n)
-    w1 *= np.repeat(zr[:, 1], n)  # the weights are not kept: reuse their buffers
-    zz += w1
-    w2 *= np.repeat(zr[:, 2], n)
-    zz += w2
-    del w1, w2
-    recs = {"row": row[nz], "rt": rt[nz], "K1": K1, "K2": K2, "S1": S1, "S2": S2, "area": area}
-    return {"F": F, "pix": pix, "rec": rec, "z": zz, "recs": recs}
-
-
-def _weights(recs: dict, rec: np.ndarray, col: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Barycentric weights of fragments ``(rec, col)``, bit-identical to those in _fragments."""
-    colf = col.astype(np.float64)
-    area = recs["area"][rec]
-    w1 = (recs["S1"][rec] * colf + recs["K1"][rec]) / area
-    w2 = (recs["S2"][rec] * colf + recs["K2"][rec]) / area
-    return (1.0 - w1) - w2, w1, w2
+    w0 = np.subtract(1.0, w1, out=pool.get("w0", F))
+    w0 -= w2
+    # Depth z = w0*z0 + w1*z1 + w2*z2, summed left to right; the weights are kept for the
+    # colour of the winners.
+    zz = spread(zr[0], "z")
+    zz *= w0
+    np.take(zr[1], rec, out=t, mode="clip")
+    t *= w1
+    zz += t
+    np.take(zr[2], rec, out=t, mode="clip")
+    t *= w2
+    zz += t
+    return {"F": F, "pix": pix, "rec": rec, "z": zz, "w": (w0, w1, w2), "rt": rt}
 
 
 _local = threading.local()
+
+
+class _Pool:
+    """Fragment-sized scratch arrays kept between calls, one pool per thread.
+
+    Touching fresh memory costs about 2.5 us per 4 kB page on this machine, more than the
+    arithmetic done in it, and the C allocator may hand freed blocks back to the kernel
+    between chunks, so the fragment arrays of a chunk are written (``out=``) into these
+    buffers instead. Nothing from the pool ends up in a Frame. Buffers are sized for the
+    largest chunk seen (at most ``CHUNK_CANDIDATES`` fragments are kept; a chunk made of one
+    bigger triangle gets temporary buffers)."""
+
+    def __init__(self) -> None:
+        self.bufs: dict[str, np.ndarray] = {}
+        self._iota = np.arange(0, dtype=np.int64)
+
+    def get(self, name: str, n: int, dtype=np.float64) -> np.ndarray:
+        buf = self.bufs.get(name)
+        if buf is None or buf.size < n or buf.dtype != dtype:
+            buf = np.empty(n, dtype=dtype)
+            if n <= CHUNK_CANDIDATES:
+                self.bufs[name] = buf
+        return buf[:n]
+
+    def iota(self, n: int) -> np.ndarray:
+        """``arange(n)`` (int64), read-only."""
+        if n > CHUNK_CANDIDATES:
+            return np.arange(n, dtype=np.int64)
+        if self._iota.size < n:
+            self._iota = np.arange(n, dtype=np.int64)
+            self._iota.flags.writeable = False
+        return self._iota[:n]
+
+
+def _pool() -> _Pool:
+    pool = getattr(_local, "pool", None)
+    if pool is None:
+        pool = _local.pool = _Pool()
+    return pool
+
+
+_RGB = np.dtype((np.void, 24))  # one pixel's colour (three float64) as a single item
 
 
 def _scratch(npix: int) -> tuple[np.ndarray, np.ndarray]:
@@ -288,28 +351,52 @@ def rasterise(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0)) -> Frame:
         raise
 
 
+def _fresh_block(nbytes: int) -> np.ndarray:
+    """A new uint8 buffer of ``nbytes`` whose start is aligned to 2 MiB.
+
+    NumPy asks the kernel for transparent huge pages on allocations of 4 MiB and more, but a
+    huge page only backs a 2 MiB-aligned stretch that lies entirely inside the allocation;
+    aligning the start makes every whole 2 MiB of the buffer eligible. First touch then costs
+    one fault per 2 MiB instead of one per 4 kB (about 0.3 ms against 1 to 1.3 ms per 2 MiB
+    on this machine). The unused head of the allocation is never touched, so it costs
+    address space only."""
+    align = 1 << 21
+    if nbytes < align:
+        return np.empty(nbytes, dtype=np.uint8)
+    raw = np.empty(nbytes + align, dtype=np.uint8)
+    off = -raw.ctypes.data % align
+    return raw[off:off + nbytes]
+
+
 def _rasterise(tris, xy, z, vcol, pid, bg) -> Frame:
     W, H = int(tris.width), int(tris.height)
     npix = W * H
-    # Per-pixel arrays share two blocks: blocks of 4 MB and more are backed by huge pages
-    # (NumPy asks for them), which makes first touch several times cheaper than 4 kB pages.
-    out = np.empty((3, npix), dtype=np.int64)
-    depth = out[0].view(np.float64)
+    # The four outputs share one fresh block (a new one per call: a returned Frame is never
+    # aliased by a later call).
+    block = _fresh_block(48 * npix)
+    depth = block[:8 * npix].view(np.float64)
+    tri_id = block[8 * npix:16 * npix].view(np.int64)
+    poly = block[16 * npix:24 * npix].view(np.int64)
+    colour = block[24 * npix:].view(np.float64).reshape(npix, 3)
     depth.fill(np.inf)
-    tri_id, poly = out[1], out[2]
     tri_id.fill(-1)
+    poly.fill(-1)
+    # Background (a broadcast over a length-3 axis is slow: fill, or copy whole rows).
+    if bg.tobytes() == bg[:1].tobytes() * 3:  # same bits in all channels (-0.0 is not 0.0)
+        colour.fill(bg[0])
+    else:
+        np.copyto(colour.reshape(H, 3 * W), np.tile(bg, W))
     win, first = _scratch(npix)  # winning fragment per pixel (this chunk); layer scratch
     big = np.iinfo(np.int64).max
-    colour = np.empty((npix, 3))
-    colour[:] = bg
     fragments = written = 0
     if xy.shape[0]:
         st = _setup(xy, W, H)
         keep = st["keep"]
-        zk = z[keep]
+        zk = z[keep].T.copy()  # (vertex, kept triangle)
+        pk = pid[keep]
         ctab = vcol[keep].reshape(-1, 9).T.copy()  # (vertex*3 + channel, kept triangle)
         table = st["table"]
-        bbox = (st["r1"] - st["r0"] + 1) * (table[18] - table[17] + 1).astype(np.int64)
+        bbox = (st["r1"] - st["r0"] + 1) * (table[13] - table[12] + 1).astype(np.int64)
         # Chunks of consecutive triangles (submission order is preserved across chunks).
         cum = np.cumsum(bbox)
         bounds = [0]
@@ -326,8 +413,8 @@ def _rasterise(tris, xy, z, vcol, pid, bg) -> Frame:
             pix, zz = fr["pix"], fr["z"]
             # Serial Z-buffer, one layer at a time: a layer is the earliest remaining fragment
             # of every pixel, so no pixel appears twice in it and its Z test is one vector op.
-            win.fill(-1)
-            idx = np.arange(F, dtype=np.int64)
+            win[pix] = -1
+            idx = idx0 = _pool().iota(F)
             rp = pix
             while idx.size:
                 np.minimum.at(first, rp, idx)
@@ -345,26 +432,21 @@ def _rasterise(tris, xy, z, vcol, pid, bg) -> Frame:
                     break
                 rest = ~isfirst
                 idx, rp = idx[rest], rp[rest]
-            # Winners in fragment order (sequential gathers), then colour only for them.
-            mark = np.zeros(F, dtype=bool)
-            mark[win[win >= 0]] = True
-            wf = np.flatnonzero(mark)
+            # Winners in fragment order (sequential gathers), then colour only for them. A
+            # fragment won its pixel if it was the last one written there in this chunk.
+            wf = np.flatnonzero(win[pix] == idx0)
             wp = pix[wf]
-            rec = fr["rec"][wf]
-            recs = fr["recs"]
-            wt = recs["rt"][rec]
+            wt = fr["rt"][fr["rec"][wf]]
             tri_id[wp] = keep[wt]
-            w0, w1, w2 = _weights(recs, rec, wp - recs["row"][rec] * W)
-            flat = colour.reshape(-1)
+            poly[wp] = pk[wt]
+            w0, w1, w2 = (w[wf] for w in fr["w"])
+            rgb = np.empty((wf.size, 3))
             for ch in range(3):
-                flat[3 * wp + ch] = (w0 * ctab[ch][wt] + w1 * ctab[3 + ch][wt]
-                                     + w2 * ctab[6 + ch][wt])
-    covered = tri_id >= 0
-    if pid.size:
-        np.copyto(poly, pid[np.maximum(tri_id, 0)])
-        poly[~covered] = -1
-    else:
-        poly.fill(-1)
+                v = w0 * ctab[ch][wt]
+                v += w1 * ctab[3 + ch][wt]
+                np.add(v, w2 * ctab[6 + ch][wt], out=rgb[:, ch])
+            # One scatter of whole RGB triples (24-byte items).
+            colour.view(_RGB)[wp, 0] = rgb.view(_RGB)[:, 0]
     return Frame(
         colour=colour.reshape(H, W, 3),
         depth=depth.reshape(H, W),
@@ -372,7 +454,7 @@ def _rasterise(tris, xy, z, vcol, pid, bg) -> Frame:
         poly_id=poly.reshape(H, W),
         fragments=int(fragments),
         pixels_written=int(written),
-        pixels_covered=int(np.count_nonzero(covered)),
+        pixels_covered=int(np.count_nonzero(tri_id >= 0)),
     )
 
 

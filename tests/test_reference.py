@@ -87,6 +87,27 @@ def test_matches_brute_force(seed):
     np.testing.assert_array_equal(frame.poly_id, np.where(tri_id >= 0, tri_id + 100, -1))
 
 
+def test_horizontal_edges_match_brute_force():
+    """Horizontal top and bottom edges, on pixel centres and off them, in both windings: a
+    horizontal edge admits a whole row or none of it, whatever the sign of its zero slope."""
+    rng = np.random.default_rng(5)
+    xy = []
+    for _ in range(60):
+        y = int(rng.integers(1, H - 1)) + float(rng.choice([0.5, 0.0, 0.3]))
+        xa, xb = sorted(rng.random(2) * (W + 4) - 2)
+        tri = [[xa, y], [xb, y], [rng.random() * (W + 4) - 2, rng.random() * (H + 4) - 2]]
+        xy.append(tri[::-1] if rng.random() < 0.5 else tri)
+    tris = make_tris(xy, rng.random((60, 3)))
+    cov = brute_coverage(tris)
+    assert cov.sum() > 500
+    np.testing.assert_array_equal(cover_each(tris), cov)
+    tri_id, depth, written = brute_visible(tris)
+    frame = rasterise(tris)
+    np.testing.assert_array_equal(frame.tri_id, tri_id)
+    np.testing.assert_array_equal(frame.depth, depth)
+    assert frame.pixels_written == written
+
+
 def test_random_scenes_hit_the_ties():
     """The generator really produces on-edge centres, shared edges and zero-area triangles."""
     tris = random_scene(1)
@@ -106,6 +127,20 @@ def test_chunked_equals_unchunked(monkeypatch):
     for name in ("colour", "depth", "tri_id", "poly_id"):
         np.testing.assert_array_equal(getattr(whole, name), getattr(parts, name))
     assert (whole.fragments, whole.pixels_written) == (parts.fragments, parts.pixels_written)
+
+
+def test_later_calls_do_not_touch_earlier_frames(monkeypatch):
+    """Scratch memory is reused between calls; returned frames must not be part of it."""
+    a_tris = random_triangles(96, 64, 300, mean_area=60, seed=3)
+    a = rasterise(a_tris)
+    keep = {name: getattr(a, name).copy() for name in ("colour", "depth", "tri_id", "poly_id")}
+    rasterise(random_triangles(96, 64, 300, mean_area=60, seed=4), background=(0.1, 0.2, 0.3))
+    monkeypatch.setattr(reference, "CHUNK_CANDIDATES", 16)  # chunks bigger than the pool
+    small = rasterise(a_tris)
+    rasterise(random_triangles(512, 512, 1800, seed=1))  # a frame with huge-page outputs
+    for name, arr in keep.items():
+        np.testing.assert_array_equal(getattr(a, name), arr)
+        np.testing.assert_array_equal(getattr(small, name), arr)
 
 
 def test_quad_split_covers_each_pixel_once():
