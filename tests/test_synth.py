@@ -1,0 +1,76 @@
+# amaranth: UnusedElaboratable=no
+"""yosys gate counts (``sim.synth``): parsing, memory handling, parameter scaling, bad input."""
+
+from __future__ import annotations
+
+import shutil
+
+import pytest
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim import synth
+from rasterhw.sim.synth import YosysUnavailable, gate_equivalent, synthesise
+
+needs_yosys = pytest.mark.skipif(shutil.which("yosys") is None, reason="yosys not on PATH (apt-get install yosys)")
+
+
+@needs_yosys
+def test_bank_counts_are_parsed_and_sane():
+    depth, z_bits = 64, 16
+    r = synthesise("pixelbus-bank", depth=depth, z_bits=z_bits)
+    assert r["yosys_version"].startswith("Yosys")
+    assert r["check_problems"] == 0
+    assert r["cells"] == sum(r["by_type"].values()) > 0
+    # the three bank RAMs (Z, RGB0, RGB1) are black boxes, outside the logic
+    assert r["by_type"]["rasterhw_pixelbus_ram"] == r["ram_cells"] == 3
+    assert r["logic_cells"] == r["cells"] - 3 > 0
+    assert r["ram_bits"] == depth * (z_bits + 2 * 24)
+    # registers: count(3) clearing(1) clr_addr(a) draw(1) pending(1) w_addr(a) w_rgb(24)
+    # w_z(z) phys(1), a = 6 address bits
+    assert r["flipflops"] == 31 + 2 * 6 + z_bits
+    assert r["lut4"] > 0 and r["gate_equivalent"] > r["flipflops"] * synth.FF_WEIGHT
+    assert (r["build_dir"] / "stat.txt").exists()
+
+
+@needs_yosys
+def test_wider_z_gives_more_cells():
+    small = synthesise("pixelbus-bank", depth=64, z_bits=8)
+    big = synthesise("pixelbus-bank", depth=64, z_bits=24)
+    assert big["cells"] > small["cells"]
+    assert big["logic_cells"] > small["logic_cells"]
+    assert big["flipflops"] == small["flipflops"] + 16
+    assert big["gate_equivalent"] > small["gate_equivalent"]
+
+
+@needs_yosys
+def test_amaranth_memory_kept_or_mapped():
+    kept = synthesise("pixelbus-bank", depth=4, z_bits=8, ram="memory")
+    assert kept["by_type"].get("$mem_v2") == kept["ram_cells"] == 3
+    assert kept["ram_bits"] == 4 * (8 + 48)
+    mapped = synthesise("pixelbus-bank", depth=4, z_bits=8, ram="memory", memory="map")
+    assert mapped["ram_cells"] == mapped["ram_bits"] == 0
+    assert mapped["flipflops"] >= kept["flipflops"] + 4 * (8 + 48)  # every RAM bit a flip-flop
+
+
+@needs_yosys
+def test_report_mentions_counts():
+    text = synth.synth_report("pixelbus-bank", depth=16)
+    assert "flip-flops" in text and "gate equivalent" in text and "rasterhw_pixelbus_ram" in text
+
+
+def test_gate_equivalent_weights():
+    assert gate_equivalent({"$_AND_": 2, "$_NOT_": 2, "$_MUX_": 1}) == 2 + 1 + 3
+    assert gate_equivalent({"$_DFF_P_": 1, "$_SDFFE_PP0P_": 1, "$_DFFE_PP_": 1}) == 6 + 10 + 9
+    assert gate_equivalent({"$mem_v2": 3, "rasterhw_pixelbus_ram": 1, "$lut": 5}) == 0
+
+
+def test_bad_input():
+    with pytest.raises(RasterhwError, match="unknown block"):
+        synthesise("no-such-block")
+    with pytest.raises(RasterhwError, match="memory must be"):
+        synthesise("pixelbus-bank", depth=16, memory="rom")
+
+
+def test_missing_yosys_says_how_to_install(monkeypatch):
+    monkeypatch.setattr(synth.shutil, "which", lambda name: None)
+    with pytest.raises(YosysUnavailable, match="apt-get install yosys"):
+        synthesise("pixelbus-bank", depth=16)
