@@ -1,0 +1,222 @@
+// Bench wrapper for a chain of ZB/M units (`zbm_chain_flat`, written by rasterhw.sim.zbm
+// around the generated `zbm_unit` Verilog; unit 0 is the head of the merge chain).
+//
+// No Python in the inner loop: two Verilog-side clocks (segment clock `clk`, merge clock
+// `mclk`, half periods SYNC_HALF / MERGE_HALF ns), the edge-pair words of every unit
+// preloaded with $readmemh and played into the units' input streams with the idle gaps
+// stored beside each word, every merge output slot drained with seeded random
+// back-pressure into a frame memory (screen order), then dumped with $writememh.
+//
+// Stimulus word (hex, one per line): {gap[GW-1:0], word[167:0]}: word = the 168-bit loader
+// word (golden_model.zbm_formats), raised `gap` clocks after the previous transfer.
+// Index file: for unit k, two hex lines: first stimulus word, number of words.
+// Plusargs: +stim=<file> +index=<file> +out=<file>.
+// Output file: W*H lines of 32 hex digits (PIXEL2 = s1:s0), pixel (x, y) at line y*W + x.
+// `cycles`: segment-clock cycles (unit 0's counter) when the last merge word was taken.
+// The run also ends (early) on the watchdog (`timeout`) or a unit's sticky `overflow`.
+module tb_zbm_unit #(
+  parameter I = 8,             // interleave (merge slots)
+  parameter U = 1,             // units
+  parameter W = 64,
+  parameter H = 16,
+  parameter GW = 8,            // gap bits
+  parameter SDEPTH = 1024      // stimulus memory depth (> all words + 1)
+) (
+  output reg finished,
+  output reg timeout,
+  output reg [31:0] cycles,
+  output reg [31:0] proto_errors,
+  output reg frames_ok,
+  output reg overflow
+);
+  localparam EW = 168;
+  localparam MW = 128;
+  localparam SW = GW + EW;
+  localparam NPIX = W * H;
+
+  // run-time settings (plusargs, so one simulator build serves every clock ratio and pattern):
+  // +sync_half=/+merge_half= ns (default 5), +merge_phase= ns (1), +stall= 0..256 (ready low
+  // when an 8-bit random number is below it; 0 = never), +seed=, +maxcyc= (watchdog)
+  integer SYNC_HALF = 5, MERGE_HALF = 5, MERGE_PHASE = 1, STALL = 0, SEED = 1;
+  integer MAXCYC = 100000000;
+  initial begin
+    if (!$value$plusargs("sync_half=%d", SYNC_HALF)) SYNC_HALF = 5;
+    if (!$value$plusargs("merge_half=%d", MERGE_HALF)) MERGE_HALF = 5;
+    if (!$value$plusargs("merge_phase=%d", MERGE_PHASE)) MERGE_PHASE = 1;
+    if (!$value$plusargs("stall=%d", STALL)) STALL = 0;
+    if (!$value$plusargs("seed=%d", SEED)) SEED = 1;
+    if (!$value$plusargs("maxcyc=%d", MAXCYC)) MAXCYC = 100000000;
+  end
+
+  reg clk = 1'b0;
+  reg mclk = 1'b0;
+  reg rst = 1'b1;
+  reg mrst = 1'b1;
+  initial begin
+    #1;
+    forever #(SYNC_HALF) clk = ~clk;
+  end
+  initial begin
+    #1;  // let the plusargs be read first
+    #(MERGE_PHASE);
+    forever #(MERGE_HALF) mclk = ~mclk;
+  end
+
+  reg [SW-1:0] stim [0:SDEPTH-1];
+  reg [31:0] idx [0:2*U-1];
+  reg [MW-1:0] frame [0:NPIX-1];
+  reg [8*512-1:0] fstim, findex, fout;
+  integer k0;
+
+  initial begin
+    finished = 1'b0;
+    timeout = 1'b0;
+    cycles = 32'd0;
+    frames_ok = 1'b0;
+    overflow = 1'b0;
+    if (!$value$plusargs("stim=%s", fstim)) $fatal(1, "tb_zbm_unit: +stim= missing");
+    if (!$value$plusargs("index=%s", findex)) $fatal(1, "tb_zbm_unit: +index= missing");
+    if (!$value$plusargs("out=%s", fout)) $fatal(1, "tb_zbm_unit: +out= missing");
+    $readmemh(fstim, stim);
+    $readmemh(findex, idx);
+    for (k0 = 0; k0 < NPIX; k0 = k0 + 1) frame[k0] = {MW{1'b1}};
+    // release both resets away from every clock edge (edges fall on whole ns)
+    repeat (3) @(posedge clk);
+    repeat (3) @(posedge mclk);
+    #0.5;
+    rst = 1'b0;
+    mrst = 1'b0;
+  end
+
+  // --- device under test ----------------------------------------------------------------
+  wire [U-1:0] i_valid, i_ready;
+  wire [EW*U-1:0] i_payload;
+  wire [I-1:0] o_valid, o_ready;
+  wire [MW*I-1:0] o_payload;
+  wire [32*U-1:0] dut_cycles;
+  wire [16*U-1:0] dut_frames;
+  wire [U-1:0] dut_overflow;
+
+  zbm_chain_flat dut (
+    .clk(clk), .rst(rst), .merge_clk(mclk), .merge_rst(mrst),
+    .i_valid(i_valid), .i_ready(i_ready), .i_payload(i_payload),
+    .o_valid(o_valid), .o_ready(o_ready), .o_payload(o_payload),
+    .cycles(dut_cycles), .frames(dut_frames), .overflow(dut_overflow)
+  );
+
+  // --- one player per unit input stream ---------------------------------------------------
+  wire [32*U-1:0] in_err;
+  genvar k;
+  generate
+    for (k = 0; k < U; k = k + 1) begin : player
+      wire [31:0] base = idx[2*k];
+      wire [31:0] count = idx[2*k+1];
+      reg [31:0] ptr;
+      reg [GW-1:0] wt;
+      wire [SW-1:0] cur = stim[base + ptr];
+      wire [SW-1:0] nxt = stim[base + ptr + 1];
+      wire v = !rst && (ptr < count) && (wt == {GW{1'b0}});
+      wire r = i_ready[k];
+      wire [EW-1:0] p = cur[EW-1:0];
+      assign i_valid[k] = v;
+      assign i_payload[k*EW +: EW] = p;
+      always @(posedge clk) begin
+        if (rst) begin
+          ptr <= 32'd0;
+          wt <= stim[base][SW-1:EW];
+        end else if (v && r) begin
+          ptr <= ptr + 32'd1;
+          wt <= nxt[SW-1:EW];
+        end else if (wt != {GW{1'b0}}) begin
+          wt <= wt - 1'b1;
+        end
+      end
+      wire [31:0] transfers;
+      zbm_stream_check #(.PW(EW)) chk (.clk(clk), .rst(rst), .valid(v), .ready(r), .payload(p),
+                                       .errors(in_err[32*k +: 32]), .transfers(transfers));
+    end
+  endgenerate
+
+  // --- one sink per merge slot: random back-pressure, frame address from arrival order ---
+  function [31:0] xorshift(input [31:0] x);
+    reg [31:0] a;
+    begin
+      a = x ^ (x << 13);
+      a = a ^ (a >> 17);
+      xorshift = a ^ (a << 5);
+    end
+  endfunction
+
+  wire [I-1:0] slot_done;
+  wire [32*I-1:0] faddr;
+  wire [32*I-1:0] out_err;
+  genvar c;
+  generate
+    for (c = 0; c < I; c = c + 1) begin : slot
+      localparam integer NPX = (W - c + I - 1) / I;
+      reg [31:0] lf;
+      reg [31:0] q, y;
+      wire v = o_valid[c];
+      wire r = !mrst && (lf[7:0] >= STALL);
+      wire [MW-1:0] p = o_payload[c*MW +: MW];
+      assign o_ready[c] = r;
+      assign slot_done[c] = (y == H);
+      assign faddr[32*c +: 32] = y * W + q * I + c;
+      always @(posedge mclk) begin
+        if (mrst) begin
+          lf <= 32'h9E3779B9 ^ (SEED * 32'd7919 + c * 32'd104729 + 32'd1);
+          q <= 32'd0;
+          y <= 32'd0;
+        end else begin
+          lf <= xorshift(lf);
+          if (v && r && y < H) begin
+            if (q == NPX - 1) begin
+              q <= 32'd0;
+              y <= y + 32'd1;
+            end else begin
+              q <= q + 32'd1;
+            end
+          end
+        end
+      end
+      wire [31:0] transfers;
+      zbm_stream_check #(.PW(MW)) chk (.clk(mclk), .rst(mrst), .valid(v), .ready(r), .payload(p),
+                                       .errors(out_err[32*c +: 32]), .transfers(transfers));
+    end
+  endgenerate
+
+  integer s;
+  always @(posedge mclk) begin
+    if (!mrst) begin
+      for (s = 0; s < I; s = s + 1)
+        if (o_valid[s] && o_ready[s] && !slot_done[s]) frame[faddr[32*s +: 32]] <= o_payload[s*MW +: MW];
+    end
+  end
+
+  // --- completion ---------------------------------------------------------------------------
+  integer e;
+  reg all_frames;
+  always @(*) begin
+    proto_errors = 32'd0;
+    for (e = 0; e < U; e = e + 1) proto_errors = proto_errors + in_err[32*e +: 32];
+    for (e = 0; e < I; e = e + 1) proto_errors = proto_errors + out_err[32*e +: 32];
+    all_frames = 1'b1;
+    for (e = 0; e < U; e = e + 1) all_frames = all_frames && (dut_frames[16*e +: 16] == 16'd1);
+  end
+
+  always @(posedge mclk) begin
+    if (!mrst && !finished && ((&slot_done) || timeout || (|dut_overflow))) begin
+      cycles <= dut_cycles[31:0];
+      overflow <= |dut_overflow;
+      frames_ok <= all_frames;
+      $writememh(fout, frame);
+      finished <= 1'b1;
+    end
+  end
+
+  always @(posedge clk) begin
+    if (!rst && !finished && dut_cycles[31:0] >= MAXCYC) begin
+      timeout <= 1'b1;
+    end
+  end
+endmodule
