@@ -39,7 +39,7 @@ def run_bench(*, repeat: int = 11, hdl: bool = True, progress: bool = True) -> l
     rows: list[dict] = []
     steps = ["c300 geometry", "c300 raster 512", "sp27 raster 512", "memory 1280x1024"]
     if hdl:
-        steps += ["pixelbus verilator"]
+        steps += ["pixelbus verilator", "zbm verilator"]
     bar = tqdm(steps, desc="bench", disable=not progress, leave=False)
 
     def step(name):
@@ -68,6 +68,8 @@ def run_bench(*, repeat: int = 11, hdl: bool = True, progress: bool = True) -> l
     if hdl:
         step("pixelbus verilator")
         rows += _bench_pixelbus()
+        step("zbm verilator")
+        rows += _bench_zbm()
     bar.close()
     return rows
 
@@ -85,4 +87,19 @@ def _bench_pixelbus() -> list[dict]:
         {"name": "pixel bus, snu-100px 1280x1024 on Verilator, wall", "value": res["wall_s"], "unit": "s",
          "note": f"target < 60 s; {res['pixels_compared']} pixels compared, {res['mismatches']} mismatches"},
         {"name": "pixel bus, Verilator simulation rate", "value": res["cycles_per_s"], "unit": "cycles/s"},
+    ]
+
+
+def _bench_zbm() -> list[dict]:
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.sim.zbm import chip_speed, simulate_zbm
+
+    res = simulate_zbm(build_scene("c300"), 512, 512, interleave=8, engine="verilator")
+    chip = chip_speed(interleave=8, repeat=8)
+    return [
+        {"name": "ZB/M unit, c300 512x512, interleave 8, Verilator, wall", "value": res["wall_s"], "unit": "s",
+         "note": f"target < 60 s; build {res.get('build_s', 0):.0f} s of it; {res['mismatches']} mismatches"},
+        {"name": "ZB/M unit, Verilator simulation rate", "value": res["cycles_per_s"], "unit": "cycles/s"},
+        {"name": "ZB/M chip, preloaded c300 segments, Verilator rate", "value": chip["cycles_per_s"],
+         "unit": "cycles/s", "note": f"target >= 1e6; {chip['mismatches']} mismatches"},
     ]
