@@ -62,6 +62,10 @@ VERILATOR_BUILD_ARGS = [
 LINT_WAIVERS = [
     # the file is named after the block, the module after the block with '-' -> '_'
     "-Wno-DECLFILENAME",
+    # ZB/M's merge-clock crossing: Amaranth's AsyncFIFO resets its read side through
+    # lib.cdc.ResetSynchronizer, which asserts asynchronously and releases synchronously, while
+    # the segment domain uses the same `rst` synchronously -- the intended reset-bridge pattern
+    "-Wno-SYNCASYNCNET",
     # Amaranth writes every register as `reg x = init;` and then assigns it in `always`
     "-Wno-PROCASSINIT",
     # yosys keeps alias wires for every named Amaranth signal and struct field, and

@@ -49,6 +49,9 @@ def test_unknown_block_and_bad_params():
     ("pixelbus", {"width": 40, "height": 16}),
     ("pixelbus", {"width": 40, "height": 16, "ram": "verilog"}),
     ("pixelbus-bank", {"depth": 100}),
+    ("zbm-seggen", {"width": 64, "height": 16}),
+    ("zbm-chip", {"interleave": 2, "width": 64}),
+    ("zbm-unit", {"interleave": 2, "width": 64, "height": 16}),
 ])
 def test_verilator_lint_clean(tmp_path, block, params):
     path = write_verilog(block, tmp_path / f"{block}.v", **params)
