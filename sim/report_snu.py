@@ -23,6 +23,12 @@ PATTERN_SIZE = (40, 25)  # a small frame whose width is a multiple of 5, as the 
 
 
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path) -> tuple[list[dict], list[str]]:
+    out = golden_rows() + pixelbus_rows(engine=engine, progress=progress)
+    return out, _plot_table1(out, out_dir)
+
+
+def golden_rows() -> list[dict]:
+    """Table 1, traversal and inner-loop rows: measured by running the golden models."""
     from rasterhw.golden_model.opcount import ops_per_triangle
     from rasterhw.golden_model.snu_balance import table1_rows
     from rasterhw.golden_model.snu_gouraud import inner_loop_ops
@@ -38,9 +44,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path) -> tup
     loop = inner_loop_ops()
     out.append(make_row("snu", "text 4.3", "Gouraud inner loop, integer operations per pixel", paper=8,
                         formula=6 + 1 + 1, measured=loop["total"], unit="ops", source="golden"))
-    out += pixelbus_rows(engine=engine, progress=progress)
-    sections = _plot_table1(out, out_dir)
-    return out, sections
+    return out
 
 
 def pixelbus_rows(*, engine: str, progress: bool) -> list[dict]:
