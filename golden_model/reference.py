@@ -113,30 +113,8 @@ class Frame:
 
 
 def _check(tris: ScreenTriangles, background) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    w, h = tris.width, tris.height
-    for name, v in (("width", w), ("height", h)):
-        if not isinstance(v, (int, np.integer)) or isinstance(v, bool) or v < 1:
-            raise RasterhwError(f"screen triangles: {name} must be a positive integer, not {v!r}")
-    xy = np.asarray(tris.xy, dtype=np.float64)
-    if xy.ndim != 3 or xy.shape[1:] != (3, 2):
-        raise RasterhwError(f"screen triangles: xy must be (T, 3, 2), got {xy.shape}")
-    t = xy.shape[0]
-    z = np.asarray(tris.z, dtype=np.float64)
-    col = np.asarray(tris.colour, dtype=np.float64)
+    xy, z, col = tris.validate(max_coord=MAX_COORD)
     pid = np.asarray(tris.poly_id)
-    for name, arr, shape in (("z", z, (t, 3)), ("colour", col, (t, 3, 3)), ("poly_id", pid, (t,))):
-        if arr.shape != shape:
-            raise RasterhwError(f"screen triangles: {name} must be {shape}, got {arr.shape}")
-    for name, arr in (("xy", xy), ("z", z), ("colour", col)):
-        if not np.all(np.isfinite(arr)):
-            bad = int(np.flatnonzero(~np.isfinite(arr).reshape(t, -1).all(axis=1))[0])
-            raise RasterhwError(f"screen triangles: triangle {bad} has a NaN or infinite {name}")
-    if t and np.abs(xy).max() > MAX_COORD:
-        bad = int(np.flatnonzero(np.abs(xy).reshape(t, -1).max(axis=1) > MAX_COORD)[0])
-        raise RasterhwError(
-            f"screen triangles: triangle {bad} has a vertex coordinate {np.abs(xy[bad]).max():.6g} px "
-            f"(more than {MAX_COORD:g} px from the origin)"
-        )
     bg = np.asarray(background, dtype=np.float64)
     if bg.shape != (3,) or not np.all(np.isfinite(bg)):
         raise RasterhwError(f"background must be three finite numbers, not {background!r}")

@@ -23,6 +23,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .errors import RasterhwError
+
 __all__ = ["ScreenTriangles"]
 
 
@@ -66,3 +68,38 @@ class ScreenTriangles:
     @property
     def n_triangles(self) -> int:
         return int(self.xy.shape[0])
+
+    def validate(self, *, who: str = "screen triangles", max_width: int = 16384, max_height: int = 16384,
+                 max_coord: float = 65536.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Check what every rasteriser relies on; return ``(xy, z, colour)`` as float64.
+
+        Frame size within ``max_width x max_height``; every array shaped for ``T`` triangles;
+        positions, depths and colours finite; no vertex coordinate of magnitude above
+        ``max_coord`` px (the rasteriser's fixed-point range). Raises :class:`RasterhwError`
+        naming ``who``, the field and the first bad triangle.
+        """
+        for name, v, lim in (("width", self.width, max_width), ("height", self.height, max_height)):
+            if not isinstance(v, (int, np.integer)) or isinstance(v, bool) or not 1 <= v <= lim:
+                raise RasterhwError(f"{who}: {name} must be an integer in 1..{lim}, not {v!r}")
+        xy = np.asarray(self.xy, dtype=np.float64)
+        if xy.ndim != 3 or xy.shape[1:] != (3, 2):
+            raise RasterhwError(f"{who}: xy must be of shape (T, 3, 2), got shape {xy.shape}")
+        t = xy.shape[0]
+        z = np.asarray(self.z, dtype=np.float64)
+        col = np.asarray(self.colour, dtype=np.float64)
+        for name, arr, shape in (("z", z, (t, 3)), ("zq", np.asarray(self.zq), (t, 3)),
+                                 ("colour", col, (t, 3, 3)), ("poly_id", np.asarray(self.poly_id), (t,))):
+            if arr.shape != shape:
+                raise RasterhwError(f"{who}: {name} must be of shape {shape}, got shape {arr.shape}")
+        for name, arr in (("xy", xy), ("z", z), ("colour", col)):
+            ok = np.isfinite(arr).reshape(t, arr.size // t if t else 0).all(axis=1)
+            if not ok.all():
+                raise RasterhwError(f"{who}: triangle {int(np.flatnonzero(~ok)[0])} has a NaN or infinite {name}")
+        if t:
+            mag = np.abs(xy).reshape(t, -1).max(axis=1)
+            if mag.max() > max_coord:
+                bad = int(np.argmax(mag > max_coord))
+                raise RasterhwError(
+                    f"{who}: triangle {bad} has a vertex coordinate of magnitude {mag[bad]:.6g} px, "
+                    f"more than {max_coord:g} px (outside the rasteriser's range; clip first)")
+        return xy, z, col

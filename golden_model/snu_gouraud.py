@@ -132,27 +132,13 @@ def _check(tris: ScreenTriangles, frac_bits, n_pipes) -> None:
         raise RasterhwError(f"n_pipes must be a positive integer, not {n_pipes!r}")
     if not tris.z_far_is_zero:
         raise RasterhwError("the SNU scan converter needs zq with far = 0 (z_far_is_zero=True), got False")
-    if not (isinstance(tris.width, (int, np.integer)) and isinstance(tris.height, (int, np.integer))
-            and 1 <= tris.width <= 16384 and 1 <= tris.height <= 16384):
-        raise RasterhwError(f"frame size must be 1..16384 x 1..16384, got {tris.width!r} x {tris.height!r}")
     if not 1 <= tris.z_bits <= 32:
         raise RasterhwError(f"z_bits must be in 1..32, not {tris.z_bits!r}")
+    tris.validate(who="SNU scan converter", max_coord=_MAX_COORD)
     t = tris.n_triangles
-    for name, arr, shape in (("xy", tris.xy, (t, 3, 2)), ("zq", tris.zq, (t, 3)),
-                             ("colour", tris.colour, (t, 3, 3))):
-        if np.shape(arr) != shape:
-            raise RasterhwError(f"ScreenTriangles.{name} has shape {np.shape(arr)}, expected {shape}")
-    xy = np.asarray(tris.xy, dtype=np.float64)
-    if not np.all(np.isfinite(xy)):
-        raise RasterhwError("ScreenTriangles.xy has a NaN or infinite vertex coordinate")
-    if t and np.abs(xy).max() > _MAX_COORD:
-        raise RasterhwError(
-            f"a vertex coordinate has magnitude {np.abs(xy).max():.6g} px (more than {_MAX_COORD:g}); "
-            "clip before scan conversion"
-        )
     col = np.asarray(tris.colour, dtype=np.float64)
-    if t and not (np.all(np.isfinite(col)) and col.min() >= 0.0 and col.max() <= 1.0):
-        bad = col[~(np.isfinite(col) & (col >= 0) & (col <= 1))][0]
+    if t and not (col.min() >= 0.0 and col.max() <= 1.0):  # finite: validate() checked
+        bad = col[(col < 0) | (col > 1)][0]
         raise RasterhwError(f"vertex colour {bad!r} outside [0, 1]")
     zq = np.asarray(tris.zq)
     if t and (not np.issubdtype(zq.dtype, np.integer) or zq.min() < 0 or zq.max() >= (1 << tris.z_bits)):

@@ -182,24 +182,10 @@ class ZbmResult:
 
 # ====================================================================== level 1: edge pairs
 def _check_tris(tris: ScreenTriangles) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    w, h = tris.width, tris.height
-    for name, v, lim in (("width", w, MAX_WIDTH), ("height", h, MAX_HEIGHT)):
-        if not isinstance(v, (int, np.integer)) or isinstance(v, bool) or not 1 <= v <= lim:
-            raise RasterhwError(f"ZB/M: {name} must be an integer in 1..{lim}, not {v!r}")
-    xy = np.asarray(tris.xy, dtype=np.float64)
-    if xy.ndim != 3 or xy.shape[1:] != (3, 2):
-        raise RasterhwError(f"ZB/M: xy must be (T, 3, 2), got {xy.shape}")
-    t = xy.shape[0]
-    z = np.asarray(tris.z, dtype=np.float64)
-    col = np.asarray(tris.colour, dtype=np.float64)
-    if z.shape != (t, 3) or col.shape != (t, 3, 3):
-        raise RasterhwError(f"ZB/M: z must be ({t}, 3) and colour ({t}, 3, 3), got {z.shape}, {col.shape}")
-    for name, arr in (("xy", xy), ("z", z), ("colour", col)):
-        if not np.all(np.isfinite(arr)):
-            raise RasterhwError(f"ZB/M: a triangle has a NaN or infinite {name}")
-    if t and np.abs(xy).max() >= COORD_LIMIT:
-        raise RasterhwError(f"ZB/M: vertex coordinate {np.abs(xy).max():.6g} px is outside +-{COORD_LIMIT} px")
-    return xy, z, col
+    # |coordinate| must stay below COORD_LIMIT (12 integer bits incl. sign): the largest float
+    # under it is the inclusive bound validate() takes
+    return tris.validate(who="ZB/M", max_width=MAX_WIDTH, max_height=MAX_HEIGHT,
+                         max_coord=float(np.nextafter(COORD_LIMIT, 0)))
 
 
 def _divfloor(n: np.ndarray, d: np.ndarray, shift: int) -> np.ndarray:
