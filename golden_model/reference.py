@@ -51,22 +51,17 @@ from pathlib import Path
 import numpy as np
 
 from .errors import RasterhwError
-from .screen import ScreenTriangles
+from .screen import SUBPIXEL_BITS, ScreenTriangles, snap
 
 __all__ = ["SUBPIXEL", "MAX_COORD", "Frame", "rasterise", "benchmark", "random_triangles", "snap"]
 
 #: Sub-pixel grid: vertex coordinates are snapped to multiples of ``1 / SUBPIXEL`` px.
-SUBPIXEL = 256
+SUBPIXEL = 1 << SUBPIXEL_BITS
 #: Largest vertex coordinate magnitude accepted, in pixels (keeps every edge function an
 #: integer below 2**53 on the sub-pixel grid, so float64 holds it exactly).
 MAX_COORD = 65536.0
 #: Bounding-box pixels per chunk (bounds the size of the fragment arrays).
 CHUNK_CANDIDATES = 1 << 18
-
-
-def snap(v: np.ndarray) -> np.ndarray:
-    """Coordinates in pixels -> integers on the sub-pixel grid (float64), round half up."""
-    return np.floor(np.asarray(v, dtype=np.float64) * SUBPIXEL + 0.5)
 
 
 @dataclass

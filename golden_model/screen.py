@@ -5,7 +5,9 @@ Conventions (written once, used everywhere; see ``docs/conventions.md``):
 * pixel (col, row) covers ``[col, col+1) x [row, row+1)``; its centre is at
   ``(col + 0.5, row + 0.5)``; x grows right, y grows **down** (row 0 is the top line);
 * coverage uses the **top-left fill rule**: a centre exactly on an edge belongs to the
-  triangle only if that edge is a top edge or a left edge;
+  triangle only if that edge is a top edge or a left edge; vertices are first snapped to a
+  grid of ``1 / 2**SUBPIXEL_BITS`` px (:func:`snap`, round half up) so every rasteriser
+  decides edge ties exactly and identically;
 * ``z`` is the float depth after the perspective divide mapped to [0, 1]:
   **0 = near plane, 1 = far plane**; it is affine in screen space, so linear
   interpolation over the triangle is exact;
@@ -25,7 +27,15 @@ import numpy as np
 
 from .errors import RasterhwError
 
-__all__ = ["ScreenTriangles"]
+__all__ = ["SUBPIXEL_BITS", "ScreenTriangles", "snap"]
+
+#: vertices are snapped to 1/256 px before coverage is decided (every rasteriser, golden and HDL)
+SUBPIXEL_BITS = 8
+
+
+def snap(v) -> np.ndarray:
+    """Coordinates in pixels -> integers (as float64) on the 1/2**SUBPIXEL_BITS px grid, round half up."""
+    return np.floor(np.asarray(v, dtype=np.float64) * (1 << SUBPIXEL_BITS) + 0.5)
 
 
 @dataclass

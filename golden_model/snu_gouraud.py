@@ -52,7 +52,7 @@ import numpy as np
 
 from .errors import RasterhwError
 from .pixelstream import PixelStream
-from .screen import ScreenTriangles
+from .screen import SUBPIXEL_BITS, ScreenTriangles, snap
 
 __all__ = [
     "INNER_LOOP",
@@ -67,7 +67,6 @@ __all__ = [
 
 #: Vertices are snapped to 1/2**SUBPIXEL_BITS px (round half up) before coverage is decided:
 #: the float reference's grid (``reference.SUBPIXEL = 256``, docs/reference.md).
-SUBPIXEL_BITS = 8
 
 #: The inner loop the model implements, one entry per i860 operation per pixel:
 #: (kind, operand). The accumulators stepped by :func:`scan_convert` are exactly the
@@ -170,7 +169,7 @@ def setup_spans(tris: ScreenTriangles, *, frac_bits: int = 16) -> dict:
     t = tris.n_triangles
 
     # Snap to the sub-pixel grid (round half up, as the float reference), units of 1/s px.
-    xs = np.floor(np.asarray(tris.xy, dtype=np.float64) * s + 0.5).astype(np.int64)  # (T,3,2)
+    xs = snap(tris.xy).astype(np.int64)  # (T,3,2)
     attr = np.empty((t, 3, 4), dtype=np.float64)
     attr[:, :, :3] = np.asarray(tris.colour, dtype=np.float64) * 255.0
     attr[:, :, 3] = np.asarray(tris.zq, dtype=np.float64)

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import RasterhwError
-from .screen import ScreenTriangles
+from .screen import ScreenTriangles, snap
 from .zbm_formats import (
     AEP_CAPACITY,
     ATTR_FRAC,
@@ -241,8 +241,8 @@ def edge_pairs(tris: ScreenTriangles, *, mode: int = MODE_COLOUR, alpha=None) ->
     xy, _, _ = _check_tris(tris)
     att = _attributes(tris, mode, alpha)             # (T, 3, C)
     T = xy.shape[0]
-    X = np.floor(xy[..., 0] * SUB + 0.5).astype(np.int64)
-    Y = np.floor(xy[..., 1] * SUB + 0.5).astype(np.int64)
+    X = snap(xy[..., 0]).astype(np.int64)
+    Y = snap(xy[..., 1]).astype(np.int64)
     order = np.argsort(Y, axis=1, kind="stable")
     ti = np.arange(T)[:, None]
     X, Y, att = X[ti, order], Y[ti, order], att[ti, order]
@@ -719,8 +719,8 @@ def render_zbm_float(tris: ScreenTriangles, *, alpha=None, background=(0.0, 0.0,
     W, H = tris.width, tris.height
     segs = segment_generator(eps, H, width=W)
     xy = np.asarray(tris.xy, np.float64)
-    X = np.floor(xy[..., 0] * SUB + 0.5) / SUB
-    Y = np.floor(xy[..., 1] * SUB + 0.5) / SUB
+    X = snap(xy[..., 0]) / SUB
+    Y = snap(xy[..., 1]) / SUB
     att = _attributes(tris, MODE_COLOUR, alpha) / np.array([Z_SCALE, 255, 255, 255, 255])
     zb = np.full((H, W, 2), np.inf)
     cb = np.zeros((H, W, 2, 4))

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import RasterhwError
+from .screen import SUBPIXEL_BITS
 
 __all__ = [
     "MAX_WIDTH", "MAX_HEIGHT", "SUBPIX_BITS", "COORD_LIMIT", "X_FRAC", "ATTR_FRAC", "OFF_FRAC",
@@ -50,7 +51,7 @@ __all__ = [
 # ---------------------------------------------------------------- global parameters
 MAX_WIDTH = 512          #: pixels per scan line the chips' line memories hold (x: 10 bits u)
 MAX_HEIGHT = 512         #: scan lines (y: 9 bits u)
-SUBPIX_BITS = 8          #: vertices snapped to 1/256 px, round half up (= reference.SUBPIXEL)
+SUBPIX_BITS = SUBPIXEL_BITS  #: vertices snapped to 1/256 px, round half up (screen.snap)
 COORD_LIMIT = 2048       #: |vertex coordinate| < 2048 px (12 integer bits incl. sign)
 X_FRAC = 40              #: x, len, dx/dy, dlen/dy: signed Q.40 pixels, floor-rounded
 ATTR_FRAC = 24           #: z, colour, alpha, u, v values and increments: signed Q.24
