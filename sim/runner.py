@@ -135,12 +135,17 @@ def run_cocotb(
     testcase: str | None = None,
     test_dir: Path | None = None,
     timings: dict | None = None,
+    verilator_args: Sequence[str | Path] = (),
 ) -> Path:
     """Build (if needed) and run cocotb ``test_module`` on ``toplevel``; return results.xml.
 
     Raises :class:`RasterhwError` if any cocotb test failed.  ``timings``, if given, gets
     ``build_s`` and ``test_s`` (wall seconds of the two steps).  ``test_module`` is imported
     from the repository root (e.g. ``cocotb_tests.pixelbus.test_pixelbus``).
+    ``verilator_args`` are appended to :data:`VERILATOR_BUILD_ARGS` (Verilator builds only),
+    e.g. ``--no-public-flat-rw`` and a ``.vlt`` file naming the few signals the bench reads:
+    cocotb's runner always passes ``--public-flat-rw``, which makes every signal of the
+    design public and keeps Verilator from optimising it.
     """
     from cocotb_tools.runner import get_results, get_runner
 
@@ -150,7 +155,8 @@ def run_cocotb(
     os.environ["PATH"] = env["PATH"]  # the runner looks the simulator up in os.environ
     try:
         runner = get_runner(sim)
-        build_args: list[str] = list(VERILATOR_BUILD_ARGS) if sim == "verilator" else ["-g2005"]
+        build_args: list[str] = ([*VERILATOR_BUILD_ARGS, *map(str, verilator_args)] if sim == "verilator"
+                                 else ["-g2005"])
         build_dir = Path(build_dir)
         build_dir.mkdir(parents=True, exist_ok=True)
         t0 = time.perf_counter()

@@ -47,14 +47,26 @@ module tb_zbm_chip #(
   reg mclk = 1'b0;
   reg rst = 1'b1;
   reg mrst = 1'b1;
-  initial begin
-    #1;
-    forever #(SYNC_HALF) clk = ~clk;
-  end
+  // Equal clocks in phase (+merge_phase=0, the speed runs) toggle in one process: one
+  // coroutine resumption per edge instead of two.
+  wire one_clock = (MERGE_PHASE == 0) && (MERGE_HALF == SYNC_HALF);
   initial begin
     #1;  // let the plusargs be read first
-    #(MERGE_PHASE);
-    forever #(MERGE_HALF) mclk = ~mclk;
+    if (one_clock)
+      forever begin
+        #(SYNC_HALF);
+        clk = ~clk;
+        mclk = ~mclk;
+      end
+    else
+      forever #(SYNC_HALF) clk = ~clk;
+  end
+  initial begin
+    #1;
+    if (!one_clock) begin
+      #(MERGE_PHASE);
+      forever #(MERGE_HALF) mclk = ~mclk;
+    end
   end
 
   reg [GW+SEGW-1:0] seg [0:SDEPTH-1];
@@ -77,11 +89,25 @@ module tb_zbm_chip #(
     $readmemh(fseg, seg);
     $readmemh(fup, up);
     for (k0 = 0; k0 < NOUT; k0 = k0 + 1) frame[k0] = {MW{1'b1}};
-    repeat (3) @(posedge clk);
-    repeat (3) @(posedge mclk);
-    #0.5;
-    rst = 1'b0;
-    mrst = 1'b0;
+  end
+
+  // Each reset is released by a process that counts only its own clock's edges, 0.5 ns
+  // after a rising edge of that clock: before its falling edge (half periods are >= 1 ns)
+  // and away from every edge of either clock (edges fall on whole ns). The Python stream
+  // monitors sample at the falling edge, so they see the same reset value as the design's
+  // next rising edge. (Both resets used to be released 0.5 ns after a merge-clock edge,
+  // which can fall between a falling and the next rising edge of the segment clock: the
+  // monitor then saw the stream still in reset while the design took its first word, and
+  // missed that transfer -- "transfer 0 is <word 1>" with half periods 2:3. A non-blocking
+  // release at the edge itself is not used: Verilator --timing and Icarus then disagree by
+  // one cycle on when the flops see it.)
+  initial begin
+    repeat (6) @(posedge clk);
+    #0.5 rst = 1'b0;
+  end
+  initial begin
+    repeat (6) @(posedge mclk);
+    #0.5 mrst = 1'b0;
   end
 
   // --- segment player (segment clock) -----------------------------------------------------
