@@ -448,29 +448,14 @@ def chip_speed(*, interleave: int = 8, width: int = 512, height: int = 512, scen
 def run_units_pysim(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, interleave: int,
                     capacity: int = F.AEP_CAPACITY, max_cycles: int = 2_000_000) -> dict:
     """The same chain in the Amaranth simulator (small frames): returns ``{"s0", "s1", "cycles"}``."""
-    from amaranth import Module
-    from amaranth.lib import wiring
     from amaranth.sim import Simulator
 
+    from ..hdl.zbm_chain import ZbmChain
     from ..hdl.zbm_unit import ZbmUnit
-
-    class _Chain(wiring.Component):
-        def __init__(self, units):
-            self._units = units
-            super().__init__({})
-
-        def elaborate(self, platform):
-            m = Module()
-            for k, u in enumerate(self._units):
-                m.submodules[f"u{k}"] = u
-            for a, b in zip(self._units, self._units[1:], strict=False):
-                for c in range(interleave):
-                    wiring.connect(m, a.o_merge[c], b.i_merge[c])
-            return m
 
     units = [ZbmUnit(interleave=interleave, width=width, height=height, capacity=capacity, head=(k == 0))
              for k in range(len(eps_per_unit))]
-    sim = Simulator(_Chain(units))
+    sim = Simulator(ZbmChain(units))
     sim.add_clock(1e-8, domain="sync")
     sim.add_clock(1e-8, domain="merge")
     last = units[-1]

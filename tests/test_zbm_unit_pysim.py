@@ -5,12 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from amaranth import Module
-from amaranth.lib import wiring
 from amaranth.sim import Simulator
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model import zbm_cycles as C
 from rasterhw.golden_model import zbm_formats as F
+from rasterhw.hdl.zbm_chain import ZbmChain
 from rasterhw.hdl.zbm_unit import ZbmUnit
 from rasterhw.sim.zbm_cycles_hdl import measure_cycles_per_edge_pair, run_unit_cycles
 from test_zbm_helpers_pysim import edge_pair_words, pixel2_words, random_triangles
@@ -18,26 +17,9 @@ from test_zbm_helpers_pysim import edge_pair_words, pixel2_words, random_triangl
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 
 
-class _Chain(wiring.Component):
-    """Test top: units chained by merge ports (unit 0 at the head)."""
-
-    def __init__(self, units):
-        self._units = units
-        super().__init__({})
-
-    def elaborate(self, platform):
-        m = Module()
-        for k, u in enumerate(self._units):
-            m.submodules[f"u{k}"] = u
-        for a, b in zip(self._units, self._units[1:], strict=False):
-            for c in range(a.interleave):
-                wiring.connect(m, a.o_merge[c], b.i_merge[c])
-        return m
-
-
 def run_units(units, words_per_unit, n_lines, *, merge_period=1e-8, stall_p=0.0, seed=0,
               max_cycles=200_000):
-    top = _Chain(units)
+    top = ZbmChain(units)
     sim = Simulator(top)
     sim.add_clock(1e-8, domain="sync")
     sim.add_clock(merge_period, domain="merge")
