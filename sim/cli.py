@@ -55,9 +55,9 @@ def info(msg: str) -> None:
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="rasterhw")
 def cli() -> None:
-    """RTL models of five parallel 3-D rendering machines (EXPERTS, vector Z-buffer,
-    sparse-raster matrix generator, ZB/M, SNU pixel bus), checked against a NumPy golden
-    model.
+    """RTL models (Amaranth) of parallel 3-D rendering machines, checked against a NumPy
+    golden model: the SNU pixel-bus Z comparator and the ZB/M scan-line Z-buffer merger
+    (EXPERTS, the vector Z-buffer and the sparse-raster generator are planned).
 
     \b
     Start with:
@@ -217,17 +217,25 @@ def report(system: str, as_json: bool, out_dir: str, engine: str) -> None:
 
 
 @cli.command()
-@click.argument("block")
-@click.option("-o", "--output", type=click.Path(dir_okay=False), required=True, help="Verilog file to write.")
+@click.argument("block", required=False)
+@click.option("--list", "list_blocks", is_flag=True, help="List the blocks and exit.")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="Verilog file to write.")
 @click.option("-p", "--param", "params", multiple=True, metavar="NAME=VALUE",
               help="Block parameter, e.g. -p width=40 -p height=16 (repeatable).")
 @click.option("--interleave", type=int, default=None, help="Shortcut for -p interleave=N (ZB/M blocks).")
-def verilog(block: str, output: str, params: tuple[str, ...], interleave: int | None) -> None:
+def verilog(block: str | None, list_blocks: bool, output: str | None, params: tuple[str, ...],
+            interleave: int | None) -> None:
     """Generate Verilog for BLOCK (see `rasterhw verilog --list`)."""
     from rasterhw.sim.verilog import BLOCKS, write_verilog
 
-    if block == "--list" or block not in BLOCKS:
-        raise RasterhwError(f"unknown block {block!r}; blocks: {', '.join(sorted(BLOCKS))}")
+    if list_blocks:
+        click.echo("\n".join(sorted(BLOCKS)))
+        return
+    if block not in BLOCKS:
+        what = f"unknown block {block!r}" if block else "name a block"
+        raise RasterhwError(f"{what}; blocks: {', '.join(sorted(BLOCKS))}")
+    if output is None:
+        raise RasterhwError("say where to write the Verilog: -o FILE")
     kw = {}
     for p in params:
         if "=" not in p:
