@@ -86,3 +86,12 @@ def test_bad_arguments_give_one_line_error(tmp_path, args):
 def test_help_answers():
     r = run("--help")
     assert r.returncode == 0 and "render" in r.stdout and "report" in r.stdout
+
+
+def test_verilog_list_and_generate(tmp_path):
+    r = run("verilog", "--list")
+    assert r.returncode == 0 and {"pixelbus", "zbm-chip", "zbm-unit"} <= set(r.stdout.split())
+    out = tmp_path / "bank.v"
+    r = run("verilog", "pixelbus-bank", "-p", "depth=16", "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    assert "module pixelbus_bank" in out.read_text()
