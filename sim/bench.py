@@ -93,16 +93,20 @@ def _bench_pixelbus() -> list[dict]:
 def _bench_zbm() -> list[dict]:
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.sim.zbm import chip_speed, simulate_zbm
+    from rasterhw.sim.zbm_fast import chip_speed_fast
 
     res = simulate_zbm(build_scene("c300"), 512, 512, interleave=8, engine="verilator")
     chip = chip_speed(interleave=8, repeat=8)
+    fast = chip_speed_fast(interleave=8, repeat=32)
     small = simulate_zbm(build_scene("c50"), 64, 64, interleave=8, engine="pysim")
     return [
         {"name": "ZB/M unit, c300 512x512, interleave 8, Verilator, wall", "value": res["wall_s"], "unit": "s",
          "note": f"target < 60 s; build {res.get('build_s', 0):.0f} s of it; {res['mismatches']} mismatches"},
         {"name": "ZB/M unit, Verilator simulation rate", "value": res["cycles_per_s"], "unit": "cycles/s"},
-        {"name": "ZB/M chip, preloaded c300 segments, Verilator rate", "value": chip["cycles_per_s"],
-         "unit": "cycles/s", "note": f"target >= 1e6; {chip['mismatches']} mismatches"},
+        {"name": "ZB/M chip, preloaded c300 segments, Verilator + C++ main", "value": fast["cycles_per_s"],
+         "unit": "cycles/s", "note": f"target >= 1e6; clock loop only; {fast['mismatches']} mismatches"},
+        {"name": "ZB/M chip, same stimulus, Verilator under cocotb", "value": chip["cycles_per_s"],
+         "unit": "cycles/s", "note": f"start-up included; {chip['mismatches']} mismatches"},
         {"name": "ZB/M unit, c50 64x64, interleave 8, Amaranth pysim rate", "value": small["cycles_per_s"],
          "unit": "cycles/s", "note": f"for comparison; {small['mismatches']} mismatches"},
     ]
