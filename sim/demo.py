@@ -58,6 +58,7 @@ def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator") -> di
     bar.set_postfix_str(f"snu-100px: pixel-bus HDL on {engine}")
     res = simulate_pixelbus(stream, engine=engine, progress=False)
     hdl_rgb = res.pop("frame_rgb")
+    snu_run = (stris, stream, res)
     Image.fromarray(hdl_rgb).save(out / f"snu-100px-pixelbus-{engine}.png")
     cmp = compare_images(golden_rgb, hdl_rgb)
     write_diff_png(golden_rgb, hdl_rgb, out / "snu-100px-diff.png")
@@ -71,7 +72,7 @@ def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator") -> di
     bar.update(1)
 
     bar.set_postfix_str("report snu")
-    rows = run_report("snu", out_dir=out / "reproduction", engine=engine, progress=False)
+    rows = run_report("snu", out_dir=out / "reproduction", engine=engine, progress=False, snu_100px=snu_run)
     bar.update(1)
     bar.close()
 

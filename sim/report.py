@@ -94,11 +94,16 @@ def _load(system: str) -> Callable:
 
 
 def run_report(system: str, *, out_dir: Path = Path("docs/reproduction"), engine: str = "pysim",
-               progress: bool = False) -> list[dict]:
-    """Measure every row of SYSTEM, write ``out_dir/SYSTEM.md`` and its plots, return the rows."""
+               progress: bool = False, **known) -> list[dict]:
+    """Measure every row of SYSTEM, write ``out_dir/SYSTEM.md`` and its plots, return the rows.
+
+    Keyword arguments beyond these are passed to the system's rows function (see its docstring).
+    """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    rows, sections = _load(system)(engine=engine, progress=progress, out_dir=out_dir)
+    # ``known``: results the caller already measured in this run (e.g. the demo's snu-100px
+    # simulation), handed to the system's rows function so the work is not done twice
+    rows, sections = _load(system)(engine=engine, progress=progress, out_dir=out_dir, **known)
     for r in rows:
         missing = [k for k in ROW_KEYS if k not in r]
         if missing:

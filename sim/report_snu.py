@@ -22,8 +22,11 @@ PATTERN_PIXELS = 2000  # writes per access pattern; enough for a steady state
 PATTERN_SIZE = (40, 25)  # a small frame whose width is a multiple of 5, as the paper's 1280
 
 
-def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path) -> tuple[list[dict], list[str]]:
-    out = golden_rows() + pixelbus_rows(engine=engine, progress=progress)
+def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
+         snu_100px: tuple | None = None) -> tuple[list[dict], list[str]]:
+    """All SNU rows. ``snu_100px``: ``(triangles, pixel stream, simulate_pixelbus result)`` of the
+    snu-100px frame if the caller has already run it in HDL (the demo), else it is run here."""
+    out = golden_rows() + pixelbus_rows(engine=engine, progress=progress, snu_100px=snu_100px)
     return out, _plot_table1(out, out_dir)
 
 
@@ -47,7 +50,7 @@ def golden_rows() -> list[dict]:
     return out
 
 
-def pixelbus_rows(*, engine: str, progress: bool) -> list[dict]:
+def pixelbus_rows(*, engine: str, progress: bool, snu_100px: tuple | None = None) -> list[dict]:
     """Bus rates measured from HDL cycles on synthetic patterns and on snu-100px."""
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.pixelbus import CLOCK_HZ, pattern_stream, pixels_per_second
@@ -73,11 +76,16 @@ def pixelbus_rows(*, engine: str, progress: bool) -> list[dict]:
         formula = {"scanline": PAPER_BUS_RATE, "vertical": 2 / 400e-9, "random": None}[pattern]
         out.append(make_row("snu", "text 3.2", f"pixel-bus rate, {note}", paper=paper, formula=formula,
                             measured=rate, unit="pixels/s", source=src))
-    tris = run_geometry(build_scene("snu-100px"), 1280, 1024, z_bits=24, z_far_is_zero=True)
-    stream = scan_convert(tris)
-    res = simulate_pixelbus(stream, engine=engine if engine != "pysim" else "verilator", progress=progress)
+    if snu_100px is None:
+        tris = run_geometry(build_scene("snu-100px"), 1280, 1024, z_bits=24, z_far_is_zero=True)
+        stream = scan_convert(tris)
+        res = simulate_pixelbus(stream, engine=engine if engine != "pysim" else "verilator", progress=progress)
+    else:
+        tris, stream, res = snu_100px
+    if res["mismatches"]:
+        raise RuntimeError("pixel bus HDL differs from the golden model on snu-100px")
     seconds = res["cycles"] / CLOCK_HZ
-    src_scene = f"hdl:{engine if engine != 'pysim' else 'verilator'}"
+    src_scene = f"hdl:{res['engine']}"
     out.append(make_row("snu", "abstract", "snu-100px: ~100-pixel Gouraud polygons/s through the pixel bus",
                         paper=PAPER_POLYS_PER_S, formula=PAPER_BUS_RATE / 100, measured=tris.n_triangles / seconds,
                         unit="polygons/s", source=src_scene))
