@@ -7,7 +7,7 @@ from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2
 
-from .pixelbus_bank import RAM_KINDS, Command, PixelBusBank, bank_write_layout
+from .pixelbus_bank import Command, PixelBusBank, bank_write_layout, check_bank_params
 
 __all__ = ["Command", "PixelBus"]
 
@@ -79,12 +79,7 @@ class PixelBus(wiring.Component):
             raise ValueError(f"n_banks must be a positive integer, not {n_banks!r}")
         if width * height < n_banks:
             raise ValueError(f"a {width}x{height} frame is smaller than {n_banks} banks")
-        if not isinstance(z_bits, int) or not 1 <= z_bits <= 32:
-            raise ValueError(f"z_bits must be an integer in 1..32, not {z_bits!r}")
-        if not isinstance(mem_cycle, int) or mem_cycle < 2:
-            raise ValueError(f"mem_cycle must be an integer >= 2, not {mem_cycle!r}")
-        if ram not in RAM_KINDS:
-            raise ValueError(f"ram must be one of {', '.join(RAM_KINDS)}, not {ram!r}")
+        check_bank_params(z_bits=z_bits, mem_cycle=mem_cycle, ram=ram)
         self._ram = ram
         self._width = width
         self._height = height

@@ -61,6 +61,17 @@ def bank_write_layout(addr_bits: int, z_bits: int) -> data.StructLayout:
     )
 
 
+def check_bank_params(*, z_bits: int, mem_cycle: int, ram: str) -> None:
+    """Raise ``ValueError`` for bank parameters the controller cannot take (shared with
+    ``PixelBus``, which checks them before it builds its banks in ``elaborate``)."""
+    if not isinstance(z_bits, int) or not 1 <= z_bits <= 32:
+        raise ValueError(f"z_bits must be an integer in 1..32, not {z_bits!r}")
+    if not isinstance(mem_cycle, int) or mem_cycle < 2:
+        raise ValueError(f"mem_cycle must be an integer >= 2, not {mem_cycle!r}")
+    if ram not in RAM_KINDS:
+        raise ValueError(f"ram must be one of {', '.join(RAM_KINDS)}, not {ram!r}")
+
+
 class PixelBusBank(wiring.Component):
     """One bank: read stored Z, compare, write RGB+Z when the bus Z is strictly larger.
 
@@ -108,12 +119,7 @@ class PixelBusBank(wiring.Component):
     def __init__(self, *, depth: int, z_bits: int = 24, mem_cycle: int = 5, ram: str = "memory") -> None:
         if not isinstance(depth, int) or depth < 1:
             raise ValueError(f"depth must be a positive integer, not {depth!r}")
-        if not isinstance(z_bits, int) or not 1 <= z_bits <= 32:
-            raise ValueError(f"z_bits must be an integer in 1..32, not {z_bits!r}")
-        if not isinstance(mem_cycle, int) or mem_cycle < 2:
-            raise ValueError(f"mem_cycle must be an integer >= 2, not {mem_cycle!r}")
-        if ram not in RAM_KINDS:
-            raise ValueError(f"ram must be one of {', '.join(RAM_KINDS)}, not {ram!r}")
+        check_bank_params(z_bits=z_bits, mem_cycle=mem_cycle, ram=ram)
         self._depth = depth
         self._ram = ram
         self._z_bits = z_bits
