@@ -22,7 +22,8 @@ import numpy as np
 from ..golden_model import pixelbus as golden
 from ..golden_model.errors import RasterhwError
 from ..golden_model.pixelstream import PixelStream
-from .runner import REPO_ROOT, build_dir_for, get_sim, run_cocotb, stream_put
+from .harness import stream_protocol_checker, stream_put
+from .runner import REPO_ROOT, build_dir_for, get_sim, run_cocotb
 
 __all__ = ["ENGINES", "GAP_BITS", "simulate_pixelbus", "run_pysim", "write_stimulus", "read_frame_dump"]
 
@@ -50,7 +51,6 @@ def run_pysim(
     from amaranth.sim import Simulator
 
     from ..hdl.pixelbus import PixelBus
-    from .runner import stream_protocol_checker
 
     dut = PixelBus(width=stream.width, height=stream.height, z_bits=stream.z_bits,
                    n_banks=n_banks, mem_cycle=mem_cycle)

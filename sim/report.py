@@ -9,8 +9,10 @@ A row is a dict with the keys of :data:`ROW_KEYS`:
 ``formula``   our closed-form value from the paper's own formula (``None`` if there is none)
 ``measured``  the value our model produced when this report ran — never typed in
 ``unit``      unit of the three values
-``source``    where ``measured`` came from: ``golden``, ``hdl:pysim``, ``hdl:verilator``, ``hdl:icarus``,
-              or ``hdl:yosys`` (a synthesis of the generated Verilog)
+``source``    what produced ``measured`` in this run: ``golden`` (a golden model ran), ``model`` (a cost
+              or timing model ran, e.g. on counted operations), ``formula`` (arithmetic on other
+              values), ``hdl:pysim``, ``hdl:verilator``, ``hdl:icarus`` (the HDL was simulated),
+              ``hdl:yosys`` / ``hdl:nextpnr`` (the generated Verilog was synthesised / placed)
 
 Each system registers a function ``rows(engine, progress) -> (rows, plots)`` in
 :data:`SYSTEMS`; :func:`run_report` runs it, writes ``docs/reproduction/SYSTEM.md`` with the
@@ -25,7 +27,8 @@ from collections.abc import Callable
 from pathlib import Path
 
 ROW_KEYS = ("system", "figure", "quantity", "paper", "formula", "measured", "unit", "source")
-SOURCES = ("golden", "hdl:pysim", "hdl:verilator", "hdl:icarus", "hdl:yosys")
+SOURCES = ("golden", "model", "formula", "hdl:pysim", "hdl:verilator", "hdl:icarus", "hdl:yosys",
+           "hdl:nextpnr")
 
 #: system name -> "module:function" producing (rows, plots); imported lazily so one
 #: system's missing optional tool never breaks another's report.

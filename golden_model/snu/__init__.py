@@ -1,0 +1,1 @@
+"""rasterhw.golden_model.snu"""

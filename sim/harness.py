@@ -1,0 +1,110 @@
+"""The verification harness every block's Amaranth-pysim bench uses.
+
+Streams follow Amaranth's rules (``amaranth.lib.stream``): a source raises ``valid`` without
+waiting for ``ready`` and holds its payload until the transfer; a transfer happens at a clock
+edge where both are high.  These helpers are the one implementation of that handshake on the
+testbench side:
+
+* :func:`stream_put` — offer one payload, hold it until accepted;
+* :func:`stream_get` — take one payload, optionally after idle clocks of back-pressure;
+* :func:`stream_sink` — a background testbench that drains a stream into a list under a
+  ``ready`` pattern (always, ``itertools.cycle([1, 1, 1, 0])``, seeded random ...);
+* :func:`stream_protocol_checker` — a background testbench that fails the simulation when a
+  source breaks the rules (``valid`` dropped or payload changed before the transfer), and logs
+  every transfer for an in-order scoreboard.
+
+Usage::
+
+    sim.add_testbench(stream_protocol_checker(dut.o, "o", log), background=True)
+    sim.add_testbench(stream_sink(dut.o, got, ready=itertools.cycle([1, 0])), background=True)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+
+__all__ = ["as_plain", "stream_get", "stream_protocol_checker", "stream_put", "stream_sink"]
+
+
+async def stream_put(ctx, port, payload, *, gap: int = 0) -> None:
+    """Offer ``payload`` on stream ``port`` after ``gap`` idle clocks; hold until accepted.
+
+    Returns in the clock after the one in which the transfer happened.
+    """
+    for _ in range(gap):
+        await ctx.tick()
+    ctx.set(port.payload, payload)
+    ctx.set(port.valid, 1)
+    await ctx.tick().until(port.ready)
+    ctx.set(port.valid, 0)
+
+
+async def stream_get(ctx, port, *, gap: int = 0):
+    """Take one payload from stream ``port``, after ``gap`` clocks with ``ready`` low.
+
+    Returns the payload (a plain int or struct view as :func:`as_plain` gives it) in the clock
+    after the transfer.
+    """
+    ctx.set(port.ready, 0)
+    for _ in range(gap):
+        await ctx.tick()
+    ctx.set(port.ready, 1)
+    _clk, _rst, payload = await ctx.tick().sample(port.payload).until(port.valid)
+    ctx.set(port.ready, 0)
+    return as_plain(payload)
+
+
+def stream_sink(port, out: list, *, ready: Iterable[int] | None = None):
+    """A background testbench that accepts every transfer on ``port`` into ``out``.
+
+    ``ready`` is the back-pressure pattern, one value per clock (``None``: always ready);
+    a finite pattern ends in ``ready`` held high.
+    """
+
+    async def sink(ctx):
+        pattern: Iterator[int] | None = iter(ready) if ready is not None else None
+        ctx.set(port.ready, 1)
+        async for _clk, _rst, valid, rdy, payload in ctx.tick().sample(port.valid, port.ready, port.payload):
+            if valid and rdy:
+                out.append(as_plain(payload))
+            ctx.set(port.ready, 1 if pattern is None else next(pattern, 1))
+
+    return sink
+
+
+def stream_protocol_checker(port, name: str = "stream", log: list | None = None):
+    """A background pysim testbench checking the stream rules on ``port`` at every clock.
+
+    Once ``valid`` is high and ``ready`` low at a clock edge, the next clock must still
+    have ``valid`` high and the same payload.  Violations raise ``AssertionError``;
+    accepted payloads are appended to ``log`` (if given) for an in-order scoreboard.
+
+    Usage: ``sim.add_testbench(stream_protocol_checker(dut.i, "i", log), background=True)``.
+    """
+
+    async def checker(ctx):
+        held = None
+        async for _clk, _rst, valid, ready, payload in ctx.tick().sample(port.valid, port.ready, port.payload):
+            payload = as_plain(payload)
+            if held is not None:
+                assert valid, f"{name}: valid dropped before the transfer of {held}"
+                assert payload == held, f"{name}: payload changed from {held} to {payload} before the transfer"
+            if valid and ready:
+                if log is not None:
+                    log.append(payload)
+                held = None
+            elif valid:
+                held = payload
+            else:
+                held = None
+
+    return checker
+
+
+def as_plain(v):
+    """Sampled payload (int or data.Const) -> something comparable and printable."""
+    if hasattr(v, "as_value"):
+        v = v.as_value()
+    if hasattr(v, "value"):
+        return v.value
+    return v

@@ -1,0 +1,157 @@
+"""The machine registry: the one place a machine declares what it offers.
+
+Each machine is a package ``rasterhw.sim.<name>`` whose ``machine.py`` defines ``MACHINE``, a
+:class:`Machine`.  :func:`machines` finds every such package (no list to edit), so ``rasterhw
+render --arch``, ``verilog``, ``sim``, ``report``, ``bench`` and ``demo`` pick up a new machine
+as soon as its folder exists.
+
+Everything a machine names is a ``"module:attribute"`` string imported only when used, so a
+machine whose optional tools are missing never breaks another machine's command, and
+``rasterhw --help`` stays fast.
+
+Contracts of the named callables:
+
+* arch renderer: ``render(scene, width, height, *, arch, **options) -> Rendered``
+  (:class:`rasterhw.golden_model.arch.Rendered`); ``options`` are the :class:`Option` values
+  the arch declares, already converted;
+* verilog block: ``factory(**params) -> wiring.Component`` (ValueError/TypeError on a bad one);
+* sim block: ``simulate(scene, width, height, *, engine, progress, **options) -> dict`` with at
+  least the keys of :data:`SIM_KEYS` and optionally ``frame_rgb``;
+* report: ``rows(*, engine, progress, out_dir, **known) -> (rows, markdown sections)``;
+* bench: ``bench(*, repeat, hdl, progress) -> list of {"name", "value", "unit", "note"}``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import cache
+
+from ..golden_model.errors import RasterhwError
+
+__all__ = ["SIM_KEYS", "Arch", "Machine", "Option", "SimBlock", "load", "machines"]
+
+#: keys every ``rasterhw sim`` JSON result carries
+SIM_KEYS = ("engine", "cycles", "clock_hz", "pixels_compared", "mismatches", "wall_s", "cycles_per_s")
+
+
+@dataclass(frozen=True)
+class Option:
+    """A command-line option an arch or sim block takes (``--name``)."""
+
+    name: str                          # python name; the flag is --name with _ -> -
+    help: str
+    default: object = None
+    choices: tuple[str, ...] | None = None
+    type: type = str                   # str, int, float, or bool (a --name/--no-name flag)
+
+    @property
+    def flag(self) -> str:
+        return "--" + self.name.replace("_", "-")
+
+
+@dataclass(frozen=True)
+class Arch:
+    """A golden renderer ``rasterhw render --arch NAME`` can run."""
+
+    name: str
+    help: str
+    render: str                        # "module:function"
+    options: tuple[Option, ...] = ()
+
+
+@dataclass(frozen=True)
+class SimBlock:
+    """A scene run through a block's HDL: ``rasterhw sim NAME``."""
+
+    name: str
+    help: str
+    simulate: str                      # "module:function"
+    default_scene: str
+    options: tuple[Option, ...] = ()
+
+
+@dataclass(frozen=True)
+class Machine:
+    """One of the papers' machines and everything it registers."""
+
+    name: str                          # folder name in every tree: hdl/NAME, golden_model/NAME ...
+    title: str
+    seed: str                          # file in shared/seeds/
+    archs: tuple[Arch, ...] = ()
+    blocks: dict[str, str] = field(default_factory=dict)   # verilog block -> "module:factory"
+    sims: tuple[SimBlock, ...] = ()
+    report: str | None = None          # "module:rows"
+    bench: str | None = None           # "module:bench"
+    status: str = ""                   # one line for the README / index page
+
+
+def load(ref: str) -> Callable:
+    """``"pkg.module:attr"`` -> the attribute (imports the module)."""
+    mod, _, attr = ref.partition(":")
+    return getattr(importlib.import_module(mod), attr)
+
+
+@cache
+def machines() -> dict[str, Machine]:
+    """Every registered machine, by name, in folder order."""
+    import rasterhw.sim as sim_pkg
+
+    found: dict[str, Machine] = {}
+    for info in sorted(pkgutil.iter_modules(sim_pkg.__path__), key=lambda m: m.name):
+        if not info.ispkg:
+            continue
+        try:
+            mod = importlib.import_module(f"rasterhw.sim.{info.name}.machine")
+        except ModuleNotFoundError as e:
+            if e.name == f"rasterhw.sim.{info.name}.machine":
+                continue
+            raise
+        m = mod.MACHINE
+        if m.name != info.name:
+            raise RuntimeError(f"rasterhw.sim.{info.name}.machine registers {m.name!r}: names must match")
+        found[m.name] = m
+    return found
+
+
+def archs() -> dict[str, tuple[Machine, Arch]]:
+    """Every arch name -> (its machine, the arch)."""
+    out: dict[str, tuple[Machine, Arch]] = {}
+    for m in machines().values():
+        for a in m.archs:
+            if a.name in out:
+                raise RuntimeError(f"arch {a.name!r} registered by {out[a.name][0].name} and {m.name}")
+            out[a.name] = (m, a)
+    return out
+
+
+def blocks() -> dict[str, str]:
+    """Every Verilog block name -> its factory reference."""
+    out: dict[str, str] = {}
+    for m in machines().values():
+        for name, ref in m.blocks.items():
+            if name in out:
+                raise RuntimeError(f"block {name!r} registered twice")
+            out[name] = ref
+    return out
+
+
+def sim_blocks() -> dict[str, tuple[Machine, SimBlock]]:
+    """Every ``rasterhw sim`` block name -> (its machine, the block)."""
+    out: dict[str, tuple[Machine, SimBlock]] = {}
+    for m in machines().values():
+        for s in m.sims:
+            if s.name in out:
+                raise RuntimeError(f"sim block {s.name!r} registered twice")
+            out[s.name] = (m, s)
+    return out
+
+
+def machine(name: str) -> Machine:
+    """The machine called ``name``, or a one-line error naming the known ones."""
+    ms = machines()
+    if name not in ms:
+        raise RasterhwError(f"unknown machine {name!r}; machines: {', '.join(ms)}")
+    return ms[name]

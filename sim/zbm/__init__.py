@@ -1,0 +1,1 @@
+"""rasterhw.sim.zbm"""
