@@ -21,7 +21,6 @@ table (plus a ratio column) and whatever plots the system drew.
 
 from __future__ import annotations
 
-import importlib
 import math
 from collections.abc import Callable
 from pathlib import Path
@@ -87,13 +86,25 @@ def format_table(rows: list[dict], *, markdown: bool = False) -> str:
                      [fmt.format(*row) for row in body])
 
 
+def systems() -> list[str]:
+    """Every system with a report: the registered machines' and the legacy table's."""
+    from .registry import machines
+
+    names = [m.name for m in machines().values() if m.report]
+    return names + [n for n in SYSTEMS if n not in names]
+
+
 def _load(system: str) -> Callable:
+    from .registry import load, machines
+
+    m = machines().get(system)
+    if m is not None and m.report:
+        return load(m.report)
     if system not in SYSTEMS:
         from rasterhw.golden_model.errors import RasterhwError
 
-        raise RasterhwError(f"unknown system {system!r}; systems: {', '.join(SYSTEMS)}")
-    mod, fn = SYSTEMS[system].split(":")
-    return getattr(importlib.import_module(mod), fn)
+        raise RasterhwError(f"unknown system {system!r}; systems: {', '.join(systems())}")
+    return load(SYSTEMS[system])
 
 
 def run_report(system: str, *, out_dir: Path = Path("docs/reproduction"), engine: str = "pysim",
