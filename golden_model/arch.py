@@ -11,8 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-
-from .screen import ScreenTriangles
+from rasterhw.golden_model.screen import ScreenTriangles
 
 __all__ = ["Rendered"]
 

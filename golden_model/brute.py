@@ -23,8 +23,7 @@ import math
 from fractions import Fraction
 
 import numpy as np
-
-from .screen import ScreenTriangles
+from rasterhw.golden_model.screen import ScreenTriangles
 
 __all__ = ["brute_coverage", "brute_visible"]
 

@@ -8,8 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-
-from .errors import RasterhwError
+from rasterhw.golden_model.errors import RasterhwError
 
 __all__ = ["compare_images", "diff_image", "write_diff_png"]
 

@@ -17,9 +17,8 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-
-from .errors import RasterhwError
-from .scene import Camera, Light, Material, Scene
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.scene import Camera, Light, Material, Scene
 
 __all__ = ["MESH_EXTENSIONS", "load_mesh", "load_scene"]
 
@@ -191,7 +190,7 @@ def load_mesh(path: str | Path, *, name: str | None = None, smooth: bool = True)
 
 def load_scene(spec: str) -> Scene:
     """A built-in scene name (see :data:`rasterhw.golden_model.scenes.SCENES`) or an .obj/.ply path."""
-    from .scenes import SCENES, build_scene
+    from rasterhw.golden_model.scenes import SCENES, build_scene
 
     if spec in SCENES:
         return build_scene(spec)

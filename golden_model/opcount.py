@@ -27,8 +27,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 import numpy as np
-
-from .errors import RasterhwError
+from rasterhw.golden_model.errors import RasterhwError
 
 __all__ = [
     "CATEGORIES",
@@ -176,7 +175,7 @@ class OpCounter:
 
 def _default_triangle_scene():
     """A single lit, unclipped, front-facing triangle with the full Phong model on."""
-    from .scene import Camera, Light, Material, Scene
+    from rasterhw.golden_model.scene import Camera, Light, Material, Scene
 
     pos = np.array([[[-1.0, -0.8, 0.0], [1.0, -0.6, -0.3], [0.1, 0.9, 0.2]]])
     nrm = np.array([[[-0.2, -0.1, 1.0], [0.3, -0.1, 1.0], [0.0, 0.3, 1.0]]])
@@ -206,7 +205,7 @@ def ops_per_triangle(
     a clip plane. Returns stage -> {category: count, "total": n} in pipeline order
     plus a ``"total"`` row.
     """
-    from .pipeline import STAGES, run_geometry
+    from rasterhw.golden_model.pipeline import STAGES, run_geometry
 
     scene = _default_triangle_scene() if scene is None else scene
     if scene.n_polygons != 1 or int(scene.nverts[0]) != 3:

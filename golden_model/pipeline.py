@@ -41,11 +41,10 @@ import operator
 from dataclasses import dataclass
 
 import numpy as np
-
-from .errors import RasterhwError
-from .opcount import OpCounter
-from .scene import Camera, Scene
-from .screen import ScreenTriangles
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.opcount import OpCounter
+from rasterhw.golden_model.scene import Camera, Scene
+from rasterhw.golden_model.screen import ScreenTriangles
 
 __all__ = [
     "MAX_SIZE",

@@ -49,9 +49,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-
-from .errors import RasterhwError
-from .screen import SUBPIXEL_BITS, ScreenTriangles, snap
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles, snap
 
 __all__ = ["SUBPIXEL", "MAX_COORD", "Frame", "rasterise", "benchmark", "random_triangles", "snap"]
 

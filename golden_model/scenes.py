@@ -26,9 +26,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-
-from .errors import RasterhwError
-from .scene import Camera, Light, Material, Scene
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.scene import Camera, Light, Material, Scene
 
 __all__ = ["SCENES", "SceneInfo", "build_scene", "list_scenes", "screen_stats"]
 

@@ -24,8 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-
-from .errors import RasterhwError
+from rasterhw.golden_model.errors import RasterhwError
 
 __all__ = ["SUBPIXEL_BITS", "ScreenTriangles", "snap"]
 

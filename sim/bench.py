@@ -77,8 +77,8 @@ def run_bench(*, repeat: int = 11, hdl: bool = True, progress: bool = True) -> l
 def _bench_pixelbus() -> list[dict]:
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.snu_gouraud import scan_convert
-    from rasterhw.sim.pixelbus import simulate_pixelbus
+    from rasterhw.golden_model.snu.gouraud import scan_convert
+    from rasterhw.sim.snu.pixelbus import simulate_pixelbus
 
     tris = run_geometry(build_scene("snu-100px"), 1280, 1024, z_bits=24, z_far_is_zero=True)
     stream = scan_convert(tris)
@@ -92,8 +92,8 @@ def _bench_pixelbus() -> list[dict]:
 
 def _bench_zbm() -> list[dict]:
     from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.sim.zbm import chip_speed, simulate_zbm
-    from rasterhw.sim.zbm_fast import chip_speed_fast
+    from rasterhw.sim.zbm.driver import chip_speed, simulate_zbm
+    from rasterhw.sim.zbm.fast import chip_speed_fast
 
     res = simulate_zbm(build_scene("c300"), 512, 512, interleave=8, engine="verilator")
     chip = chip_speed(interleave=8, repeat=8)

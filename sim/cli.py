@@ -129,8 +129,8 @@ def render(scene: str, arch: str, size: str | None, output: str | None, z_bits: 
         extra = {"fragments": int(frame.fragments), "pixels_covered": int(frame.pixels_covered)}
     else:  # snu: Gouraud scan converter (golden, bit-accurate) into the pixel-bus frame buffer model
         from rasterhw.golden_model.pipeline import run_geometry
-        from rasterhw.golden_model.pixelbus import pixelbus_frame, rgb_image
-        from rasterhw.golden_model.snu_gouraud import scan_convert
+        from rasterhw.golden_model.snu.gouraud import scan_convert
+        from rasterhw.golden_model.snu.pixelbus import pixelbus_frame, rgb_image
 
         sc, (w, h) = load_scene_and_size(scene, size)
         tris = run_geometry(sc, w, h, z_bits=z_bits, z_far_is_zero=True)
@@ -269,8 +269,8 @@ def sim_cmd(block, scene, size, engine, interleave, units, output, as_json) -> N
 
     if block == "pixelbus":
         from rasterhw.golden_model.pipeline import run_geometry
-        from rasterhw.golden_model.snu_gouraud import scan_convert
-        from rasterhw.sim.pixelbus import simulate_pixelbus
+        from rasterhw.golden_model.snu.gouraud import scan_convert
+        from rasterhw.sim.snu.pixelbus import simulate_pixelbus
 
         scene = scene or "snu-100px"
         sc, (w, h) = load_scene_and_size(scene, size)
@@ -278,7 +278,7 @@ def sim_cmd(block, scene, size, engine, interleave, units, output, as_json) -> N
         stream = scan_convert(tris)
         res = simulate_pixelbus(stream, engine=engine, progress=not as_json)
     else:
-        from rasterhw.sim.zbm import simulate_zbm
+        from rasterhw.sim.zbm.driver import simulate_zbm
 
         scene = scene or "c300"
         sc, (w, h) = load_scene_and_size(scene, size)

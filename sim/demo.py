@@ -22,13 +22,13 @@ from tqdm import tqdm
 def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator") -> dict:
     from rasterhw.golden_model.compare import compare_images, write_diff_png
     from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.pixelbus import pixelbus_frame, rgb_image
     from rasterhw.golden_model.reference import rasterise
     from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.snu_gouraud import scan_convert
-    from rasterhw.sim.pixelbus import simulate_pixelbus
+    from rasterhw.golden_model.snu.gouraud import scan_convert
+    from rasterhw.golden_model.snu.pixelbus import pixelbus_frame, rgb_image
     from rasterhw.sim.report import format_table, run_report
-    from rasterhw.sim.zbm import simulate_zbm
+    from rasterhw.sim.snu.pixelbus import simulate_pixelbus
+    from rasterhw.sim.zbm.driver import simulate_zbm
 
     out.mkdir(parents=True, exist_ok=True)
     summary: dict = {}

@@ -29,7 +29,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cache
 
-from ..golden_model.errors import RasterhwError
+from rasterhw.golden_model.errors import RasterhwError
 
 __all__ = ["SIM_KEYS", "Arch", "Machine", "Option", "SimBlock", "load", "machines"]
 

@@ -32,8 +32,8 @@ SOURCES = ("golden", "model", "formula", "hdl:pysim", "hdl:verilator", "hdl:icar
 #: system name -> "module:function" producing (rows, plots); imported lazily so one
 #: system's missing optional tool never breaks another's report.
 SYSTEMS: dict[str, str] = {
-    "snu": "rasterhw.sim.report_snu:rows",
-    "zbm": "rasterhw.sim.report_zbm:rows",
+    "snu": "rasterhw.sim.snu.report:rows",
+    "zbm": "rasterhw.sim.zbm.report:rows",
 }
 
 
@@ -88,14 +88,14 @@ def format_table(rows: list[dict], *, markdown: bool = False) -> str:
 
 def systems() -> list[str]:
     """Every system with a report: the registered machines' and the legacy table's."""
-    from .registry import machines
+    from rasterhw.sim.registry import machines
 
     names = [m.name for m in machines().values() if m.report]
     return names + [n for n in SYSTEMS if n not in names]
 
 
 def _load(system: str) -> Callable:
-    from .registry import load, machines
+    from rasterhw.sim.registry import load, machines
 
     m = machines().get(system)
     if m is not None and m.report:

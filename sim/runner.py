@@ -19,7 +19,7 @@ import time
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
-from ..golden_model.errors import RasterhwError
+from rasterhw.golden_model.errors import RasterhwError
 
 __all__ = [
     "LINT_WAIVERS",
@@ -139,7 +139,7 @@ def run_cocotb(
 
     Raises :class:`RasterhwError` if any cocotb test failed.  ``timings``, if given, gets
     ``build_s`` and ``test_s`` (wall seconds of the two steps).  ``test_module`` is imported
-    from the repository root (e.g. ``cocotb_tests.pixelbus.test_pixelbus``).
+    from the repository root (e.g. ``cocotb_tests.snu.pixelbus.test_pixelbus``).
     ``verilator_args`` are appended to :data:`VERILATOR_BUILD_ARGS` (Verilator builds only),
     e.g. ``--no-public-flat-rw`` and a ``.vlt`` file naming the few signals the bench reads:
     cocotb's runner always passes ``--public-flat-rw``, which makes every signal of the

@@ -46,9 +46,9 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from ..golden_model.errors import RasterhwError
-from .runner import REPO_ROOT
-from .verilog import BLOCKS, EXTRA_VERILOG, generate_verilog, make_block
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim.runner import REPO_ROOT
+from rasterhw.sim.verilog import BLOCKS, EXTRA_VERILOG, generate_verilog, make_block
 
 __all__ = [
     "GATE_WEIGHTS",

@@ -14,13 +14,12 @@ from pathlib import Path
 
 from amaranth.back import verilog
 from amaranth.lib import wiring
-
-from ..golden_model.errors import RasterhwError
-from ..hdl.pixelbus import PixelBus
-from ..hdl.pixelbus_bank import RAM_VERILOG, PixelBusBank
-from ..hdl.zbm_chip import ZbmChip
-from ..hdl.zbm_seggen import ZbmSegmentGenerator
-from ..hdl.zbm_unit import ZbmUnit
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.hdl.snu.pixelbus import PixelBus
+from rasterhw.hdl.snu.pixelbus_bank import RAM_VERILOG, PixelBusBank
+from rasterhw.hdl.zbm.chip import ZbmChip
+from rasterhw.hdl.zbm.seggen import ZbmSegmentGenerator
+from rasterhw.hdl.zbm.unit import ZbmUnit
 
 __all__ = ["BLOCKS", "EXTRA_VERILOG", "generate_verilog", "write_verilog", "make_block"]
 

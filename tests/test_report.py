@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 from rasterhw.golden_model.opcount import ops_per_triangle
 from rasterhw.sim.report import ROW_KEYS, format_table, make_row, ratio, run_report
-from rasterhw.sim.report_snu import golden_rows
-from rasterhw.sim.report_zbm import PAPER_CYCLES, PAPER_KPOLYS, polygons_per_s
+from rasterhw.sim.snu.report import golden_rows
+from rasterhw.sim.zbm.report import PAPER_CYCLES, PAPER_KPOLYS, polygons_per_s
 
 
 def test_make_row_checks_source():

@@ -1,0 +1,99 @@
+"""Cycle counts of one ZB/M unit (``hdl/zbm_unit.py``) from HDL simulation, beside the exact
+cycle model ``golden_model.zbm_cycles.hdl_cycles`` and the paper's Table 1 formula.
+
+``measure_cycles_per_edge_pair(interleave)`` runs the paper's workload (sec. 6.1 cond. 1-2:
+edge pairs of 5 lines x 5 pixels, one segment per line, ``zbm_cycles.paper_workload``) through
+one head unit in Amaranth pysim. The frame is ``table1_width(interleave)`` pixels wide so each
+chip's merge-bus readout of a line (``chip_pixels + 2`` cycles) is shorter than its loop work
+and the count is the segment side's, as in the paper's estimate.
+"""
+
+from __future__ import annotations
+
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.zbm import cycles as C
+from rasterhw.golden_model.zbm.formats import AEP_CAPACITY, INTERLEAVES
+from rasterhw.golden_model.zbm.render import EdgePairs
+
+__all__ = ["run_unit_cycles", "measure_cycles_per_edge_pair", "table1_width"]
+
+
+def table1_width(interleave: int) -> int:
+    """Frame width for the Table 1 workload: 4 pixels per chip (8 at least, a 5-pixel segment
+    must fit)."""
+    return max(4 * interleave, 8)
+
+
+def run_unit_cycles(eps: EdgePairs, height: int, *, width: int, interleave: int,
+                    capacity: int = AEP_CAPACITY, max_cycles: int = 200_000) -> dict:
+    """Run one head ``ZbmUnit`` in pysim: edge-pair words offered one per cycle from cycle 0,
+    merge outputs always ready, merge clock = segment clock (the assumptions of
+    ``zbm_cycles.hdl_cycles``). Returns ``cycles`` = value of ``ZbmUnit.cycles`` in the first
+    cycle with ``ZbmUnit.lines == height`` (every chip has finished the frame) and
+    ``overflow``."""
+    from amaranth.sim import Simulator
+    from rasterhw.hdl.zbm.unit import ZbmUnit
+
+    words = [w for i in range(len(eps)) for w in eps.words(i)] + [0]   # h == 0: end of frame
+    unit = ZbmUnit(interleave=interleave, width=width, height=height, capacity=capacity, head=True)
+    sim = Simulator(unit)
+    sim.add_clock(1e-8, domain="sync")
+    sim.add_clock(1e-8, domain="merge")
+    out = {}
+
+    async def src(ctx):
+        for w in words:
+            ctx.set(unit.i.payload, w)
+            ctx.set(unit.i.valid, 1)
+            await ctx.tick().until(unit.i.ready)
+        ctx.set(unit.i.valid, 0)
+
+    async def bench(ctx):
+        for c in range(interleave):
+            ctx.set(unit.o_merge[c].ready, 1)
+        for _ in range(max_cycles):
+            _, _, lines, cyc, ovf = await ctx.tick().sample(unit.lines, unit.cycles, unit.overflow)
+            if lines == height or ovf:
+                break
+        out.update(cycles=cyc, lines=lines, overflow=ovf)
+
+    sim.add_testbench(src, background=True)
+    sim.add_testbench(bench)
+    sim.run()
+    return out
+
+
+def measure_cycles_per_edge_pair(interleave: int, *, n_edge_pairs: int = 8,
+                                 engine: str = "pysim") -> dict:
+    """Cycles per edge pair of one unit on the paper's workload, from HDL simulation.
+
+    Returns ``cycles`` (HDL, whole frame: first word offered .. every chip done), ``edge_pairs``,
+    ``cycles_per_edge_pair`` (= cycles / edge_pairs, so it includes pipeline fill and drain),
+    ``model_cycles`` (``zbm_cycles.hdl_cycles``, must equal ``cycles``), ``marginal_cycles_per_edge_pair``
+    (model: cycles(n + 1) - cycles(n), the steady state) and ``paper_formula`` (74, 64, 59,
+    54, 54: the paper's Table 1 estimate, not a measurement)."""
+    if interleave not in INTERLEAVES:
+        raise ValueError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+    if engine != "pysim":
+        raise ValueError(f"engine must be 'pysim' (the only one wired here), not {engine!r}")
+    if not (isinstance(n_edge_pairs, int) and 1 <= n_edge_pairs <= 100):
+        raise ValueError(f"n_edge_pairs must be 1..100, not {n_edge_pairs!r}")
+    width = table1_width(interleave)
+    eps = C.paper_workload(n_edge_pairs, width=width)
+    height = 5 * n_edge_pairs
+    model = C.hdl_cycles(eps, height, width=width, interleave=interleave)
+    more = C.hdl_cycles(C.paper_workload(n_edge_pairs + 1, width=width), height + 5, width=width,
+                        interleave=interleave)
+    hdl = run_unit_cycles(eps, height, width=width, interleave=interleave)
+    if hdl["overflow"] or hdl["lines"] != height:
+        raise RasterhwError(f"ZB/M unit did not finish the frame: {hdl}")
+    return {"interleave": interleave, "cycles": int(hdl["cycles"]), "edge_pairs": n_edge_pairs,
+            "cycles_per_edge_pair": hdl["cycles"] / n_edge_pairs, "model_cycles": model["cycles"],
+            "marginal_cycles_per_edge_pair": more["cycles"] - model["cycles"],
+            "paper_formula": C.formula_cycles_per_edge_pair(interleave), "width": width,
+            "height": height}
+
+
+if __name__ == "__main__":
+    for i in INTERLEAVES:
+        print(measure_cycles_per_edge_pair(i))

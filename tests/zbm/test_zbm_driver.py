@@ -1,0 +1,69 @@
+"""simulate_zbm (sim/zbm.py) on a tiny scene in Amaranth pysim, and its input checks."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.scenes import SCENES
+from rasterhw.golden_model.zbm import render as G
+from rasterhw.golden_model.zbm import words as W
+from rasterhw.golden_model.zbm.stimulus import random_triangles
+from rasterhw.sim.zbm import driver as Z
+
+
+def _scene():
+    from rasterhw.golden_model.meshio import load_scene
+
+    name = "c300" if "c300" in SCENES else sorted(SCENES)[0]
+    return load_scene(name)
+
+
+def test_simulate_zbm_pysim_tiny_frame():
+    r = Z.simulate_zbm(_scene(), 32, 16, interleave=2, engine="pysim")
+    assert r["block"] == "zbm" and r["engine"] == "pysim" and r["units"] == 1
+    assert r["pixels_compared"] == 32 * 16 and r["mismatches"] == 0
+    assert r["edge_pairs"] > 0 and r["cycles"] > 0 and r["frame_rgb"].shape == (16, 32, 3)
+    assert r["frame_rgb"].dtype == np.uint8 and r["frame_rgb"].any()
+    assert r["float_tolerance"]["ok"], r["float_tolerance"]
+
+
+def test_bad_arguments():
+    sc = _scene()
+    with pytest.raises(RasterhwError, match="engine"):
+        Z.simulate_zbm(sc, 32, 16, engine="modelsim")
+    with pytest.raises(RasterhwError, match="interleave"):
+        Z.simulate_zbm(sc, 32, 16, interleave=3, engine="pysim")
+    with pytest.raises(RasterhwError, match="units"):
+        Z.simulate_zbm(sc, 32, 16, units=0, engine="pysim")
+    with pytest.raises(RasterhwError, match="width"):
+        Z.simulate_zbm(sc, 1024, 16, engine="pysim")
+
+
+def _eps():
+    return G.edge_pairs(random_triangles(np.random.default_rng(0), 12, 32, 16, size=8))
+
+
+def test_edge_pair_checks():
+    eps = _eps()
+    assert Z.check_edge_pairs(eps, 32, 16) >= 1
+    bad = eps.take(np.arange(len(eps)))
+    bad.len[2] = -1
+    with pytest.raises(RasterhwError, match="len -1 < 0"):
+        Z.check_edge_pairs(bad, 32, 16)
+    bad = eps.take(np.arange(len(eps)))
+    bad.h[-1] = 40
+    with pytest.raises(RasterhwError, match="outside 0..15"):
+        Z.check_edge_pairs(bad, 32, 16)
+    with pytest.raises(RasterhwError, match="active-edge-pair memory"):
+        Z.check_edge_pairs(eps, 32, 16, capacity=2)
+    # dealing to more units lowers each unit's peak
+    assert Z.check_edge_pairs(eps, 32, 16, units=3) <= Z.check_edge_pairs(eps, 32, 16)
+
+
+def test_words_round_trip():
+    gold = G.render_zbm(random_triangles(np.random.default_rng(1), 10, 32, 16), interleave=2)
+    s0, s1 = W.doublez_words(gold.pixels)
+    px = W.words_to_doublez(s0, s1)
+    assert np.array_equal(px.z, gold.pixels.z) and np.array_equal(px.c, gold.pixels.c)
+    assert np.array_equal(G.composite(px), gold.rgb8)

@@ -1,0 +1,130 @@
+"""Pysim tests of ZB/M units (segment generator + chips), chained by merge ports, against
+golden_model.zbm.render_zbm; and the cycles-per-edge-pair measurement of Table 1."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from amaranth.sim import Simulator
+from rasterhw.golden_model.zbm import cycles as C
+from rasterhw.golden_model.zbm import formats as F
+from rasterhw.golden_model.zbm import render as G
+from rasterhw.golden_model.zbm.stimulus import random_triangles
+from rasterhw.golden_model.zbm.words import edge_pair_words, pixel2_words
+from rasterhw.hdl.zbm.chain import ZbmChain
+from rasterhw.hdl.zbm.unit import ZbmUnit
+from rasterhw.sim.zbm.cycles_hdl import measure_cycles_per_edge_pair, run_unit_cycles
+
+pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+
+
+def run_units(units, words_per_unit, n_lines, *, merge_period=1e-8, stall_p=0.0, seed=0,
+              max_cycles=200_000):
+    top = ZbmChain(units)
+    sim = Simulator(top)
+    sim.add_clock(1e-8, domain="sync")
+    sim.add_clock(merge_period, domain="merge")
+    last = units[-1]
+    got = {c: [] for c in range(last.interleave)}
+    need = {c: last.chip_pixels(c) * n_lines for c in range(last.interleave)}
+
+    def src(u, words):
+        async def bench(ctx):
+            for w in words:
+                ctx.set(u.i.payload, w)
+                ctx.set(u.i.valid, 1)
+                await ctx.tick().until(u.i.ready)
+                ctx.set(u.i.valid, 0)
+        return bench
+
+    async def sink(ctx):      # samples at the clock edge, random back-pressure
+        rng = np.random.default_rng(seed)
+        n = 0
+        sigs = []
+        for c in got:
+            sigs += [last.o_merge[c].valid, last.o_merge[c].payload]
+        while any(len(got[c]) < need[c] for c in got):
+            rdy = {c: rng.random() >= stall_p for c in got}
+            for c in got:
+                ctx.set(last.o_merge[c].ready, rdy[c])
+            _, _, *vals = await ctx.tick("merge").sample(*sigs)
+            n += 1
+            assert n < max_cycles, "timeout"
+            for i, c in enumerate(got):
+                if vals[2 * i] and rdy[c]:
+                    got[c].append(vals[2 * i + 1].as_value().value)
+
+    for u, words in zip(units, words_per_unit, strict=True):
+        sim.add_testbench(src(u, words), background=True)
+    sim.add_testbench(sink)
+    sim.run()
+    return got
+
+
+@pytest.mark.parametrize("interleave,n_units,merge_period", [(2, 1, 1e-8), (4, 2, 1.9e-8)])
+def test_units_match_render_zbm(interleave, n_units, merge_period):
+    w, h = 32, 10
+    rng = np.random.default_rng(interleave)
+    tris = random_triangles(rng, 8, w, h, size=8)
+    res = G.render_zbm(tris, interleave=interleave, units=n_units)
+    eps = G.edge_pairs(tris)
+    units = [ZbmUnit(interleave=interleave, width=w, height=h, head=(k == 0)) for k in range(n_units)]
+    words = [edge_pair_words(eps.take(np.flatnonzero(eps.tag % n_units == k))) for k in range(n_units)]
+    got = run_units(units, words, h, merge_period=merge_period, stall_p=0.3)
+    exp_all = np.array(pixel2_words(res.pixels), dtype=object).reshape(h, w)
+    for c in range(interleave):
+        exp = [int(v) for v in exp_all[:, c::interleave].ravel()]
+        assert got[c] == exp, c
+    assert res.stats["z_writes"] > 0
+
+
+def test_unit_bad_parameters():
+    with pytest.raises(ValueError, match="interleave must be 1, 2, 4, 8 or 16, not 5"):
+        ZbmUnit(interleave=5)
+
+
+@pytest.mark.parametrize("interleave,seed", [(1, 0), (2, 1), (8, 2)])
+def test_cycle_model_is_exact(interleave, seed):
+    """HDL cycles == golden_model.zbm_cycles.hdl_cycles on random small streams (empty and
+    clipped segments, several pairs per line, loads on many lines)."""
+    w, h = 8 * interleave if interleave > 1 else 24, 10
+    rng = np.random.default_rng(seed)
+    eps = G.edge_pairs(random_triangles(rng, 6, w, h, size=10))
+    model = C.hdl_cycles(eps, h, width=w, interleave=interleave)
+    assert G.max_active_edge_pairs(eps)[0] >= 2 and len(eps) >= 5 and model["generator"]["empty"] > 0
+    hdl = run_unit_cycles(eps, h, width=w, interleave=interleave)
+    assert hdl["overflow"] == 0 and hdl["lines"] == h
+    assert hdl["cycles"] == model["cycles"], (hdl, model)
+
+
+def test_unit_overflow_flag():
+    """Over capacity the unit stops with ``overflow`` instead of finishing the frame."""
+    eps = C.paper_workload(3, lines_apart=1, width=16)          # 3 pairs active on line 2
+    assert G.max_active_edge_pairs(eps) == (3, 2)
+    hdl = run_unit_cycles(eps, 8, width=16, interleave=2, capacity=2, max_cycles=400)
+    assert hdl["overflow"] == 1 and hdl["lines"] <= 2
+    ok = run_unit_cycles(eps, 8, width=16, interleave=2, capacity=3)
+    assert ok["overflow"] == 0 and ok["lines"] == 8
+    assert ok["cycles"] == C.hdl_cycles(eps, 8, width=16, interleave=2, capacity=3)["cycles"]
+
+
+def test_cycles_per_edge_pair_interleave_8():
+    """The report's measurement: HDL == model; steady state 4 (len_chip + 8) + 18 (docs/zbm.md)."""
+    r = measure_cycles_per_edge_pair(8, n_edge_pairs=3)
+    assert r["cycles"] == r["model_cycles"]
+    assert r["marginal_cycles_per_edge_pair"] == 4 * (1 + 8) + 18
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("interleave", F.INTERLEAVES)
+def test_cycles_per_edge_pair_sweep(interleave):
+    r = measure_cycles_per_edge_pair(interleave)
+    print(r)
+    assert r["cycles"] == r["model_cycles"]
+    lc = -(-5 // interleave)
+    assert r["marginal_cycles_per_edge_pair"] == 4 * (lc + 8) + max(lc + 8, 18)
+
+
+if __name__ == "__main__":    # python tests/test_zbm_unit_pysim.py -> the Table 1 measurement
+    for i in F.INTERLEAVES:
+        print(measure_cycles_per_edge_pair(i))
