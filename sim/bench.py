@@ -37,9 +37,10 @@ def run_bench(*, repeat: int = 11, hdl: bool = True, progress: bool = True) -> l
     from rasterhw.golden_model.scenes import build_scene
 
     rows: list[dict] = []
-    steps = ["c300 geometry", "c300 raster 512", "sp27 raster 512", "memory 1280x1024"]
-    if hdl:
-        steps += ["pixelbus verilator", "zbm verilator"]
+    from rasterhw.sim.registry import load, machines
+
+    benches = [(m.name, load(m.bench)) for m in machines().values() if m.bench]
+    steps = ["c300 geometry", "c300 raster 512", "sp27 raster 512", "memory 1280x1024"] + [n for n, _ in benches]
     bar = tqdm(steps, desc="bench", disable=not progress, leave=False)
 
     def step(name):
@@ -65,48 +66,8 @@ def run_bench(*, repeat: int = 11, hdl: bool = True, progress: bool = True) -> l
     peak = _peak_mb(lambda: rasterise(big))
     rows.append({"name": "reference rasteriser, c300, 1280x1024, peak traced memory", "value": peak,
                  "unit": "MB", "note": "target < 500 MB"})
-    if hdl:
-        step("pixelbus verilator")
-        rows += _bench_pixelbus()
-        step("zbm verilator")
-        rows += _bench_zbm()
+    for name, fn in benches:
+        step(name)
+        rows += fn(repeat=repeat, hdl=hdl, progress=progress)
     bar.close()
     return rows
-
-
-def _bench_pixelbus() -> list[dict]:
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.snu.gouraud import scan_convert
-    from rasterhw.sim.snu.pixelbus import simulate_pixelbus
-
-    tris = run_geometry(build_scene("snu-100px"), 1280, 1024, z_bits=24, z_far_is_zero=True)
-    stream = scan_convert(tris)
-    res = simulate_pixelbus(stream, engine="verilator", progress=False)
-    return [
-        {"name": "pixel bus, snu-100px 1280x1024 on Verilator, wall", "value": res["wall_s"], "unit": "s",
-         "note": f"target < 60 s; {res['pixels_compared']} pixels compared, {res['mismatches']} mismatches"},
-        {"name": "pixel bus, Verilator simulation rate", "value": res["cycles_per_s"], "unit": "cycles/s"},
-    ]
-
-
-def _bench_zbm() -> list[dict]:
-    from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.sim.zbm.driver import chip_speed, simulate_zbm
-    from rasterhw.sim.zbm.fast import chip_speed_fast
-
-    res = simulate_zbm(build_scene("c300"), 512, 512, interleave=8, engine="verilator")
-    chip = chip_speed(interleave=8, repeat=8)
-    fast = chip_speed_fast(interleave=8, repeat=32)
-    small = simulate_zbm(build_scene("c50"), 64, 64, interleave=8, engine="pysim")
-    return [
-        {"name": "ZB/M unit, c300 512x512, interleave 8, Verilator, wall", "value": res["wall_s"], "unit": "s",
-         "note": f"target < 60 s; build {res.get('build_s', 0):.0f} s of it; {res['mismatches']} mismatches"},
-        {"name": "ZB/M unit, Verilator simulation rate", "value": res["cycles_per_s"], "unit": "cycles/s"},
-        {"name": "ZB/M chip, preloaded c300 segments, Verilator + C++ main", "value": fast["cycles_per_s"],
-         "unit": "cycles/s", "note": f"target >= 1e6; clock loop only; {fast['mismatches']} mismatches"},
-        {"name": "ZB/M chip, same stimulus, Verilator under cocotb", "value": chip["cycles_per_s"],
-         "unit": "cycles/s", "note": f"start-up included; {chip['mismatches']} mismatches"},
-        {"name": "ZB/M unit, c50 64x64, interleave 8, Amaranth pysim rate", "value": small["cycles_per_s"],
-         "unit": "cycles/s", "note": f"for comparison; {small['mismatches']} mismatches"},
-    ]

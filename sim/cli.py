@@ -14,8 +14,100 @@ from pathlib import Path
 
 import click
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim import registry
 
-ARCHS = ("reference", "snu")
+#: the float reference rasteriser is shared by every machine; the rest come from the registry
+REFERENCE = "reference"
+ARCHS = (REFERENCE, *registry.archs())
+SIM_BLOCKS = tuple(registry.sim_blocks())
+ENGINES = ("pysim", "verilator", "icarus")
+
+
+def _union_options(decls) -> list[registry.Option]:
+    """Every distinct option the given archs / sim blocks declare (one flag, one meaning)."""
+    seen: dict[str, registry.Option] = {}
+    for o in (o for d in decls for o in d.options):
+        if o.name in seen and seen[o.name] != o:
+            prev = seen[o.name]
+            if (prev.type, prev.choices is None) != (o.type, o.choices is None):
+                raise RuntimeError(f"option {o.flag} declared twice with different types")
+            choices = tuple(dict.fromkeys((*(prev.choices or ()), *(o.choices or ())))) or None
+            seen[o.name] = registry.Option(o.name, prev.help, prev.default, choices, prev.type)
+        else:
+            seen.setdefault(o.name, o)
+    return list(seen.values())
+
+
+def _click_options(opts: list[registry.Option]):
+    """Click decorators for registry options; every value defaults to None (= not given)."""
+    def deco(f):
+        for o in reversed(opts):
+            if o.type is bool:
+                f = click.option(f"{o.flag}/--no-{o.flag[2:]}", o.name, default=None, help=o.help)(f)
+            else:
+                kind = click.Choice(o.choices) if o.choices else o.type
+                f = click.option(o.flag, o.name, type=kind, default=None, help=f"{o.help} (default: {o.default})")(f)
+        return f
+    return deco
+
+
+def _take_options(given: dict, declared: tuple[registry.Option, ...], who: str) -> dict:
+    """The values for one arch / block: its declared options (defaults filled in); an option
+    given on the command line that it does not take is an error, not silently ignored."""
+    names = {o.name for o in declared}
+    for k, v in given.items():
+        if v is not None and k not in names:
+            raise RasterhwError(f"--{k.replace('_', '-')} does not apply to {who}")
+    out = {}
+    for o in declared:
+        v = given.get(o.name)
+        if v is not None and o.choices and v not in o.choices:
+            raise RasterhwError(f"{who}: {o.flag} must be one of {', '.join(o.choices)}, not {v!r}")
+        out[o.name] = o.default if v is None else v
+    return out
+
+
+_RENDER_OPTIONS = _union_options(a for _, a in registry.archs().values())
+_SIM_OPTIONS = _union_options(b for _, b in registry.sim_blocks().values())
+
+
+def parse_params(params: tuple[str, ...], factory) -> dict:
+    """``-p NAME=VALUE`` pairs -> keyword arguments typed by ``factory``'s signature: a parameter
+    whose default is a bool takes true/false/1/0, an int default takes an integer, and so on;
+    an unknown name is an error."""
+    import inspect
+
+    sig = inspect.signature(factory)
+    out: dict = {}
+    for p in params:
+        if "=" not in p:
+            raise RasterhwError(f"--param must be NAME=VALUE, not {p!r}")
+        k, v = p.split("=", 1)
+        if k not in sig.parameters:
+            raise RasterhwError(f"no parameter {k!r}; parameters: {', '.join(sig.parameters)}")
+        if k in out:
+            raise RasterhwError(f"parameter {k!r} given twice")
+        default = sig.parameters[k].default
+        if isinstance(default, bool):
+            low = v.lower()
+            if low not in ("true", "false", "1", "0", "yes", "no"):
+                raise RasterhwError(f"parameter {k!r} is true or false, not {v!r}")
+            out[k] = low in ("true", "1", "yes")
+        elif isinstance(default, int) or default is inspect.Parameter.empty:
+            try:
+                out[k] = int(v, 0)
+            except ValueError:
+                if isinstance(default, int):
+                    raise RasterhwError(f"parameter {k!r} is an integer, not {v!r}") from None
+                out[k] = v
+        elif isinstance(default, float):
+            try:
+                out[k] = float(v)
+            except ValueError:
+                raise RasterhwError(f"parameter {k!r} is a number, not {v!r}") from None
+        else:
+            out[k] = v
+    return out
 
 
 def parse_size(text: str | None) -> tuple[int, int] | None:
@@ -55,9 +147,8 @@ def info(msg: str) -> None:
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="rasterhw")
 def cli() -> None:
-    """RTL models (Amaranth) of parallel 3-D rendering machines, checked against a NumPy
-    golden model: the SNU pixel-bus Z comparator and the ZB/M scan-line Z-buffer merger
-    (EXPERTS, the vector Z-buffer and the sparse-raster generator are planned).
+    """RTL models (Amaranth) of parallel 3-D rendering machines of the 1980s-90s, checked
+    against a NumPy golden model. Machines: see `rasterhw machines`.
 
     \b
     Start with:
@@ -111,33 +202,45 @@ def render_reference(scene: str, size: str | None, z_bits: int = 24):
 
 
 @cli.command()
+def machines() -> None:
+    """List the machines with their archs, HDL blocks and sim blocks."""
+    for m in registry.machines().values():
+        click.echo(f"{m.name:<9}{m.title}  (seed {m.seed})")
+        if m.status:
+            click.echo(f"{'':9}{m.status}")
+        for label, names in (("archs", [a.name for a in m.archs]), ("blocks", list(m.blocks)),
+                             ("sim", [b.name for b in m.sims])):
+            if names:
+                click.echo(f"{'':9}{label}: {', '.join(names)}")
+
+
+@cli.command()
 @click.argument("scene")
-@click.option("--arch", type=click.Choice(ARCHS), default="reference", show_default=True,
-              help="Which renderer: the float reference, or an architecture's golden model.")
+@click.option("--arch", type=click.Choice(ARCHS), default=REFERENCE, show_default=True,
+              help="Which renderer: the float reference, or a machine's golden model (rasterhw machines).")
 @click.option("--size", default=None, metavar="WxH", help="Frame size (default: the scene's own, e.g. 512x512).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
               help="PNG file to write (default: out/SCENE-ARCH.png).")
-@click.option("--z-bits", type=int, default=24, show_default=True, help="Width of the quantised Z.")
+@click.option("--z-bits", type=int, default=24, show_default=True, help="Width of the quantised Z (reference).")
+@_click_options(_RENDER_OPTIONS)
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout.")
-def render(scene: str, arch: str, size: str | None, output: str | None, z_bits: int, as_json: bool) -> None:
+def render(scene: str, arch: str, size: str | None, output: str | None, z_bits: int, as_json: bool,
+           **arch_options) -> None:
     """Render SCENE (a built-in name or an .obj/.ply file) and write a PNG."""
     t0 = time.perf_counter()
-    if arch == "reference":
+    if arch == REFERENCE:
+        _take_options(arch_options, (), "--arch reference")
         sc, tris, frame, _, _ = render_reference(scene, size, z_bits)
         rgb8 = frame.to_rgb8()
         pixels_written = int(frame.pixels_written)
         extra = {"fragments": int(frame.fragments), "pixels_covered": int(frame.pixels_covered)}
-    else:  # snu: Gouraud scan converter (golden, bit-accurate) into the pixel-bus frame buffer model
-        from rasterhw.golden_model.pipeline import run_geometry
-        from rasterhw.golden_model.snu.gouraud import scan_convert
-        from rasterhw.golden_model.snu.pixelbus import pixelbus_frame, rgb_image
-
+    else:
+        _machine, a = registry.archs()[arch]
+        opts = _take_options(arch_options, a.options, f"--arch {arch}")
         sc, (w, h) = load_scene_and_size(scene, size)
-        tris = run_geometry(sc, w, h, z_bits=z_bits, z_far_is_zero=True)
-        stream = scan_convert(tris)
-        rgb8 = rgb_image(pixelbus_frame(stream)[0])
-        pixels_written = len(stream)
-        extra = {"pixel_writes": len(stream)}
+        res = registry.load(a.render)(sc, w, h, arch=arch, **opts)
+        rgb8, tris, pixels_written = res.rgb8, res.tris, int(res.pixels_written)
+        extra = {**opts, **res.stats}
     wall = time.perf_counter() - t0
     out = Path(output) if output else Path("out") / f"{Path(scene).stem}-{arch}.png"
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -192,18 +295,18 @@ def compare(a: str, b: str, output: str | None, tolerance: int, as_json: bool) -
 
 
 @cli.command()
-@click.argument("system", type=click.Choice(["snu", "zbm", "all"]))
+@click.argument("system", type=click.Choice([*(m.name for m in registry.machines().values() if m.report), "all"]))
 @click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON on stdout.")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), default="docs/reproduction", show_default=True,
               help="Where SYSTEM.md and its plots are written.")
-@click.option("--engine", type=click.Choice(["pysim", "verilator", "icarus"]), default="verilator",
+@click.option("--engine", type=click.Choice(ENGINES), default="verilator",
               show_default=True, help="HDL simulator for rows measured from HDL cycles (full frames always "
               "run on a compiled simulator).")
 def report(system: str, as_json: bool, out_dir: str, engine: str) -> None:
     """Reproduce a paper's figures: paper value, formula value, measured value, ratio."""
-    from rasterhw.sim.report import SYSTEMS, run_report
+    from rasterhw.sim.report import run_report, systems
 
-    names = list(SYSTEMS) if system == "all" else [system]
+    names = systems() if system == "all" else [system]
     rows = []
     for name in names:
         rows += run_report(name, out_dir=Path(out_dir), engine=engine, progress=not as_json)
@@ -226,26 +329,20 @@ def report(system: str, as_json: bool, out_dir: str, engine: str) -> None:
 def verilog(block: str | None, list_blocks: bool, output: str | None, params: tuple[str, ...],
             interleave: int | None) -> None:
     """Generate Verilog for BLOCK (see `rasterhw verilog --list`)."""
-    from rasterhw.sim.verilog import BLOCKS, write_verilog
+    from rasterhw.sim.verilog import block_names, write_verilog
 
     if list_blocks:
-        click.echo("\n".join(sorted(BLOCKS)))
+        click.echo("\n".join(block_names()))
         return
-    if block not in BLOCKS:
+    if block not in block_names():
         what = f"unknown block {block!r}" if block else "name a block"
-        raise RasterhwError(f"{what}; blocks: {', '.join(sorted(BLOCKS))}")
+        raise RasterhwError(f"{what}; blocks: {', '.join(block_names())}")
     if output is None:
         raise RasterhwError("say where to write the Verilog: -o FILE")
-    kw = {}
-    for p in params:
-        if "=" not in p:
-            raise RasterhwError(f"--param must be NAME=VALUE, not {p!r}")
-        k, v = p.split("=", 1)
-        try:
-            kw[k] = int(v)
-        except ValueError:
-            kw[k] = v
+    kw = parse_params(params, registry.load(registry.blocks()[block]))
     if interleave is not None:
+        if "interleave" in kw and kw["interleave"] != interleave:
+            raise RasterhwError(f"--interleave {interleave} contradicts -p interleave={kw['interleave']}")
         kw["interleave"] = interleave
     try:
         write_verilog(block, output, **kw)
@@ -255,34 +352,23 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
 
 
 @cli.command("sim")
-@click.argument("block", type=click.Choice(["pixelbus", "zbm"]))
-@click.option("--scene", default=None, help="Built-in scene or .obj/.ply (default: snu-100px / c300).")
+@click.argument("block", type=click.Choice(SIM_BLOCKS))
+@click.option("--scene", default=None, help="Built-in scene or .obj/.ply (default: the block's own, "
+              + ", ".join(f"{n}: {b.default_scene}" for n, (_, b) in registry.sim_blocks().items()) + ").")
 @click.option("--size", default=None, metavar="WxH", help="Frame size (default: the scene's own).")
-@click.option("--engine", type=click.Choice(["pysim", "verilator", "icarus"]), default="verilator", show_default=True)
-@click.option("--interleave", type=int, default=8, show_default=True, help="ZB/M chips per scan line.")
-@click.option("--units", type=int, default=1, show_default=True, help="ZB/M units chained by merge ports.")
+@click.option("--engine", type=click.Choice(ENGINES), default="verilator", show_default=True)
+@_click_options(_SIM_OPTIONS)
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="PNG of the HDL frame.")
 @click.option("--json", "as_json", is_flag=True)
-def sim_cmd(block, scene, size, engine, interleave, units, output, as_json) -> None:
+def sim_cmd(block, scene, size, engine, output, as_json, **block_options) -> None:
     """Run a scene through a block's HDL, compare with the golden model, write the frame."""
     from PIL import Image
 
-    if block == "pixelbus":
-        from rasterhw.golden_model.pipeline import run_geometry
-        from rasterhw.golden_model.snu.gouraud import scan_convert
-        from rasterhw.sim.snu.pixelbus import simulate_pixelbus
-
-        scene = scene or "snu-100px"
-        sc, (w, h) = load_scene_and_size(scene, size)
-        tris = run_geometry(sc, w, h, z_bits=24, z_far_is_zero=True)
-        stream = scan_convert(tris)
-        res = simulate_pixelbus(stream, engine=engine, progress=not as_json)
-    else:
-        from rasterhw.sim.zbm.driver import simulate_zbm
-
-        scene = scene or "c300"
-        sc, (w, h) = load_scene_and_size(scene, size)
-        res = simulate_zbm(sc, w, h, interleave=interleave, units=units, engine=engine, progress=not as_json)
+    _machine, b = registry.sim_blocks()[block]
+    opts = _take_options(block_options, b.options, f"sim {block}")
+    scene = scene or b.default_scene
+    sc, (w, h) = load_scene_and_size(scene, size)
+    res = registry.load(b.simulate)(sc, w, h, engine=engine, progress=not as_json, **opts)
     frame = res.pop("frame_rgb", None)
     out = Path(output) if output else Path("out") / f"{Path(scene).stem}-{block}-{engine}.png"
     if frame is not None:
@@ -296,6 +382,23 @@ def sim_cmd(block, scene, size, engine, interleave, units, output, as_json) -> N
         info(" ".join(f"{k}={v}" for k, v in res.items()))
     if res.get("mismatches", 0):
         sys.exit(1)
+
+
+@cli.command()
+@click.argument("block")
+@click.option("-p", "--param", "params", multiple=True, metavar="NAME=VALUE",
+              help="Block parameter, e.g. -p interleave=8 (repeatable).")
+@click.option("--memory", type=click.Choice(["keep", "map"]), default="keep", show_default=True,
+              help="keep: memories as RAM blocks (counted as RAM bits); map: memories to flip-flops.")
+def synth(block: str, params: tuple[str, ...], memory: str) -> None:
+    """Synthesise BLOCK with Yosys and print gate equivalents, flip-flops and RAM bits."""
+    from rasterhw.sim.synth import synth_report
+    from rasterhw.sim.verilog import block_names
+
+    if block not in block_names():
+        raise RasterhwError(f"unknown block {block!r}; blocks: {', '.join(block_names())}")
+    kw = parse_params(params, registry.load(registry.blocks()[block]))
+    click.echo(synth_report(block, memory=memory, **kw))
 
 
 @cli.command()
@@ -317,8 +420,8 @@ def bench(as_json: bool, repeat: int, hdl: bool) -> None:
 @cli.command()
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), default="out", show_default=True)
 @click.option("--scene", default="c300", show_default=True, help="Scene for the reference render.")
-@click.option("--engine", type=click.Choice(["pysim", "verilator", "icarus"]), default="verilator",
-              show_default=True, help="HDL simulator for the hardware run.")
+@click.option("--engine", type=click.Choice(ENGINES), default="verilator",
+              show_default=True, help="HDL simulator for the hardware runs.")
 def demo(out_dir: str, scene: str, engine: str) -> None:
     """Render a default scene through the golden model and the hardware; write images and a report."""
     from rasterhw.sim.demo import run_demo

@@ -1,110 +1,168 @@
-"""``rasterhw demo``: the main job on built-in defaults.
+"""``rasterhw demo``: the main job on built-in defaults, for every registered machine.
 
-1. renders a scene (default ``c300``) through the golden geometry pipeline and the float
-   reference rasteriser;
-2. runs ``snu-100px`` through the SNU Gouraud scan converter (golden, bit-accurate) and the
-   pixel-bus HDL, compares the two frames bit for bit and counts cycles;
-3. runs the same ``scene`` through one ZB/M unit (interleave 8) in HDL, compared line by line
-   with the bit-accurate ZB/M model;
-4. writes PNGs, a diff image, ``summary.json`` and ``report.md`` (the cycle report) under ``out/``.
+1. renders a scene (default ``c300``, 512x512) through the golden geometry pipeline and the
+   float reference rasteriser;
+2. renders the same scene through every machine's golden archs (``rasterhw machines``) and
+   counts the pixels where each differs from the reference;
+3. runs every machine's HDL sim blocks on their default scenes (the SNU pixel bus on
+   ``snu-100px`` at 1280x1024, the ZB/M unit on ``c300``) on ``engine``, each compared bit for
+   bit with its golden model, with cycles and throughput;
+4. writes the PNGs, ``summary.json``, ``report.md`` and ``index.html`` (open it in a browser:
+   every image side by side with its numbers) under ``out/``.
+
+A machine that registers an arch or a sim block appears here with no edit to this file.
 """
 
 from __future__ import annotations
 
+import html
 import json
 import time
 from pathlib import Path
 
+import numpy as np
 from PIL import Image
+from rasterhw.golden_model.compare import compare_images
+from rasterhw.golden_model.pipeline import run_geometry
+from rasterhw.golden_model.reference import rasterise
+from rasterhw.golden_model.scenes import SCENES, build_scene
+from rasterhw.sim import registry
 from tqdm import tqdm
+
+__all__ = ["run_demo"]
+
+SIZE = (512, 512)
 
 
 def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator") -> dict:
-    from rasterhw.golden_model.compare import compare_images, write_diff_png
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.reference import rasterise
-    from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.snu.gouraud import scan_convert
-    from rasterhw.golden_model.snu.pixelbus import pixelbus_frame, rgb_image
-    from rasterhw.sim.report import format_table, run_report
-    from rasterhw.sim.snu.pixelbus import simulate_pixelbus
-    from rasterhw.sim.zbm.driver import simulate_zbm
-
+    """Run the demo into ``out``; raises SystemExit if any HDL run differs from its golden model."""
     out.mkdir(parents=True, exist_ok=True)
-    summary: dict = {}
-    bar = tqdm(total=5, desc="demo", unit="step")
+    archs = [(m, a) for m in registry.machines().values() for a in m.archs]
+    sims = [(m, b) for m in registry.machines().values() for b in m.sims]
+    bar = tqdm(total=1 + len(archs) + len(sims), desc="demo", unit="step")
+    summary: dict = {"scene": scene, "engine": engine, "archs": [], "sims": []}
 
     bar.set_postfix_str(f"{scene}: reference render")
     sc = build_scene(scene)
     t0 = time.perf_counter()
-    tris = run_geometry(sc, 512, 512)
+    tris = run_geometry(sc, *SIZE)
     frame = rasterise(tris)
     wall = time.perf_counter() - t0
+    ref_rgb = frame.to_rgb8()
     ref_png = out / f"{scene}-reference.png"
-    frame.save_png(ref_png)
-    summary["reference"] = {"scene": scene, "width": 512, "height": 512, **tris.stats,
+    Image.fromarray(ref_rgb).save(ref_png)
+    summary["reference"] = {"scene": scene, "width": SIZE[0], "height": SIZE[1], **tris.stats,
                             "fragments": int(frame.fragments), "pixels_written": int(frame.pixels_written),
-                            "wall_s": round(wall, 4), "image": str(ref_png)}
+                            "wall_s": round(wall, 4), "image": ref_png.name}
     bar.update(1)
 
-    bar.set_postfix_str("snu-100px: golden scan conversion")
-    snu = build_scene("snu-100px")
-    stris = run_geometry(snu, 1280, 1024, z_bits=24, z_far_is_zero=True)
-    stream = scan_convert(stris)
-    golden_rgb = rgb_image(pixelbus_frame(stream)[0])
-    Image.fromarray(golden_rgb).save(out / "snu-100px-golden.png")
-    bar.update(1)
+    for m, a in archs:
+        bar.set_postfix_str(f"{scene}: {m.name} golden ({a.name})")
+        defaults = {o.name: o.default for o in a.options}
+        t0 = time.perf_counter()
+        res = registry.load(a.render)(sc, *SIZE, arch=a.name, **defaults)
+        wall = time.perf_counter() - t0
+        png = out / f"{scene}-{a.name}.png"
+        Image.fromarray(res.rgb8).save(png)
+        cmp = compare_images(ref_rgb, res.rgb8)
+        summary["archs"].append({"machine": m.name, "arch": a.name, "help": a.help, "options": defaults,
+                                 "pixels_written": int(res.pixels_written),
+                                 "differing_from_reference": int(cmp["differing_pixels"]),
+                                 "wall_s": round(wall, 4), "image": png.name,
+                                 "stats": _plain(res.stats)})
+        bar.update(1)
 
-    bar.set_postfix_str(f"snu-100px: pixel-bus HDL on {engine}")
-    res = simulate_pixelbus(stream, engine=engine, progress=False)
-    hdl_rgb = res.pop("frame_rgb")
-    snu_run = (stris, stream, res)
-    Image.fromarray(hdl_rgb).save(out / f"snu-100px-pixelbus-{engine}.png")
-    cmp = compare_images(golden_rgb, hdl_rgb)
-    write_diff_png(golden_rgb, hdl_rgb, out / "snu-100px-diff.png")
-    summary["pixelbus"] = {"scene": "snu-100px", **res, "image_compare": cmp}
-    bar.update(1)
-
-    bar.set_postfix_str(f"{scene}: ZB/M unit HDL on {engine} (first run builds the model, ~1 min)")
-    zres = simulate_zbm(sc, 512, 512, interleave=8, units=1, engine=engine)
-    Image.fromarray(zres.pop("frame_rgb")).save(out / f"{scene}-zbm-{engine}.png")
-    summary["zbm"] = {"scene": scene, **zres}
-    bar.update(1)
-
-    bar.set_postfix_str("report snu")
-    rows = run_report("snu", out_dir=out / "reproduction", engine=engine, progress=False, snu_100px=snu_run)
-    bar.update(1)
+    for m, b in sims:
+        s_name = b.default_scene
+        bar.set_postfix_str(f"{s_name}: {m.name} {b.name} HDL on {engine} (a first run builds the model)")
+        w, h = SCENES[s_name].size
+        defaults = {o.name: o.default for o in b.options}
+        res = registry.load(b.simulate)(build_scene(s_name), w, h, engine=engine, progress=False, **defaults)
+        png = out / f"{s_name}-{b.name}-{engine}.png"
+        frame_rgb = res.pop("frame_rgb", None)
+        if frame_rgb is not None:
+            Image.fromarray(frame_rgb).save(png)
+        summary["sims"].append({"machine": m.name, "block": b.name, "scene": s_name, "help": b.help,
+                                **defaults, **_plain(res), "image": png.name if frame_rgb is not None else None})
+        bar.update(1)
     bar.close()
 
     (out / "summary.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
-    pb = summary["pixelbus"]
-    md = [
-        "# rasterhw demo", "",
-        f"## Reference render: {scene} at 512x512", "",
-        f"![{scene}]({ref_png.name})", "",
-        f"{summary['reference'].get('polygons_in')} polygons in, {summary['reference'].get('polygons_drawn')} drawn, "
-        f"{summary['reference']['fragments']} fragments, {summary['reference']['pixels_written']} pixel writes, "
-        f"{summary['reference']['wall_s'] * 1e3:.1f} ms.", "",
-        f"## SNU pixel bus: snu-100px at 1280x1024 on {engine}", "",
-        f"- pixel writes: {len(stream)}; pixels compared: {pb['pixels_compared']}; mismatches: {pb['mismatches']}",
-        f"- HDL cycles: {pb['cycles']} at {pb['clock_hz'] / 1e6:g} MHz = "
-        f"{pb['cycles'] / pb['clock_hz'] * 1e3:.2f} ms of bus time "
-        f"({len(stream) / (pb['cycles'] / pb['clock_hz']) / 1e6:.2f} Mpixel/s; paper: 12.5 Mpixel/s peak)",
-        f"- simulation: {pb['wall_s']:.1f} s wall, {pb['cycles_per_s']:.3g} cycles/s", "",
-        f"## ZB/M: {scene} through one unit (interleave 8) on {engine}", "",
-        f"![{scene} ZB/M]({scene}-zbm-{engine}.png)", "",
-        f"- edge pairs: {summary['zbm']['edge_pairs']}; pixels compared: {summary['zbm']['pixels_compared']}; "
-        f"mismatches: {summary['zbm']['mismatches']}",
-        f"- HDL cycles: {summary['zbm']['cycles']} at 25 MHz = {summary['zbm']['cycles'] / 25e6 * 1e3:.2f} ms "
-        f"({summary['zbm']['polygons_per_s'] / 1e3:.1f} K triangles/s, no skew allowance)",
-        f"- simulation: {summary['zbm']['wall_s']:.1f} s wall, {summary['zbm']['cycles_per_s']:.3g} cycles/s", "",
-        "## SNU report", "", format_table(rows, markdown=True), "",
-        "ZB/M Table 1 from HDL cycles: `rasterhw report zbm` (pysim, ~2 min) -> docs/reproduction/zbm.md.", "",
-    ]
-    (out / "report.md").write_text("\n".join(md) + "\n")
-    print(format_table(rows))
-    print(f"\nwrote {out}/report.md, {out}/summary.json and images in {out}/")
-    if pb["mismatches"] or summary["zbm"]["mismatches"]:
-        raise SystemExit(f"HDL differs from the golden model: pixel bus {pb['mismatches']}, "
-                         f"ZB/M {summary['zbm']['mismatches']} mismatches")
+    (out / "report.md").write_text(_markdown(summary))
+    (out / "index.html").write_text(_html(summary))
+    print(_markdown(summary))
+    print(f"wrote {out}/index.html (open it in a browser), {out}/report.md, {out}/summary.json and images")
+    bad = [f"{s['machine']} {s['block']}: {s['mismatches']} mismatches" for s in summary["sims"] if s["mismatches"]]
+    if bad:
+        raise SystemExit("HDL differs from the golden model: " + "; ".join(bad))
     return summary
+
+
+def _plain(d: dict) -> dict:
+    """JSON-able copy: numpy scalars to Python numbers, arrays and nested objects left out."""
+    out = {}
+    for k, v in d.items():
+        if isinstance(v, np.generic):
+            v = v.item()
+        if isinstance(v, (int, float, str, bool)) or v is None:
+            out[k] = v
+    return out
+
+
+def _sim_line(s: dict) -> str:
+    clock = s.get("clock_hz") or 0
+    t = s["cycles"] / clock if clock else 0
+    return (f"{s['pixels_compared']:,} pixels compared, {s['mismatches']} mismatches; "
+            f"{s['cycles']:,} HDL cycles" + (f" = {t * 1e3:.2f} ms at {clock / 1e6:g} MHz" if clock else "")
+            + f"; simulated at {s['cycles_per_s']:.3g} cycles/s, {s['wall_s']:.1f} s wall")
+
+
+def _markdown(summary: dict) -> str:
+    ref = summary["reference"]
+    md = ["# rasterhw demo", "",
+          f"## {ref['scene']} at {ref['width']}x{ref['height']}: the float reference and every machine's golden model", "",
+          f"![{ref['scene']}]({ref['image']})", "",
+          f"Reference: {ref.get('polygons_in')} polygons in, {ref.get('polygons_drawn')} drawn, "
+          f"{ref['fragments']} fragments, {ref['pixels_written']} pixel writes, {ref['wall_s'] * 1e3:.1f} ms.", "",
+          "| machine | arch | pixel writes | pixels differing from the reference | ms | image |",
+          "|---|---|---|---|---|---|"]
+    for a in summary["archs"]:
+        md.append(f"| {a['machine']} | {a['arch']} | {a['pixels_written']:,} | {a['differing_from_reference']:,} "
+                  f"| {a['wall_s'] * 1e3:.1f} | [{a['image']}]({a['image']}) |")
+    md += ["", f"## HDL runs on {summary['engine']}", ""]
+    for s in summary["sims"]:
+        md += [f"### {s['machine']} {s['block']} on {s['scene']}", "", f"- {_sim_line(s)}", ""]
+        if s["image"]:
+            md += [f"![{s['block']}]({s['image']})", ""]
+    md += ["Paper figures beside measured ones: `rasterhw report all` -> docs/reproduction/.", ""]
+    return "\n".join(md)
+
+
+def _html(summary: dict) -> str:
+    e = html.escape
+    ref = summary["reference"]
+    cards = [f"<figure><img src='{e(ref['image'])}'><figcaption><b>reference</b> (float)<br>"
+             f"{ref['pixels_written']:,} pixel writes, {ref['wall_s'] * 1e3:.1f} ms</figcaption></figure>"]
+    for a in summary["archs"]:
+        cards.append(f"<figure><img src='{e(a['image'])}'><figcaption><b>{e(a['machine'])} / {e(a['arch'])}</b>"
+                     f"<br>{e(a['help'])}<br>{a['pixels_written']:,} pixel writes; "
+                     f"{a['differing_from_reference']:,} px differ from the reference; {a['wall_s'] * 1e3:.1f} ms"
+                     f"</figcaption></figure>")
+    sims = []
+    for s in summary["sims"]:
+        img = f"<img src='{e(s['image'])}'>" if s["image"] else ""
+        ok = "ok" if s["mismatches"] == 0 else "MISMATCH"
+        sims.append(f"<figure>{img}<figcaption><b>{e(s['machine'])} / {e(s['block'])}</b> on {e(s['scene'])} "
+                    f"[{ok}]<br>{e(s['help'])}<br>{e(_sim_line(s))}</figcaption></figure>")
+    return f"""<!doctype html>
+<html><head><meta charset="utf-8"><title>rasterhw demo</title>
+<style>body{{font-family:sans-serif;margin:2em}} figure{{display:inline-block;width:300px;vertical-align:top;margin:0 1em 1em 0}}
+img{{width:300px;image-rendering:pixelated;border:1px solid #ccc}} figcaption{{font-size:85%}}</style></head>
+<body><h1>rasterhw demo</h1>
+<h2>{e(ref['scene'])} at {ref['width']}x{ref['height']}: the float reference and every machine's golden model</h2>
+{''.join(cards)}
+<h2>HDL runs on {e(summary['engine'])}, each compared bit for bit with its golden model</h2>
+{''.join(sims)}
+<p>Paper figures beside measured ones: <code>rasterhw report all</code> writes docs/reproduction/.</p>
+</body></html>
+"""

@@ -2,8 +2,8 @@
 """Gate counts of the HDL blocks: generated Verilog through Debian's ``yosys`` (``synth`` + ``stat``).
 
 ``synthesise(block, **params)`` writes the block's Verilog (:func:`rasterhw.sim.verilog.generate_verilog`
-plus its :data:`~rasterhw.sim.verilog.EXTRA_VERILOG`) into ``build/synth-<block>-<hash>/``, runs
-``yosys`` on it and parses ``stat`` into a dict.  Any block in :data:`~rasterhw.sim.verilog.BLOCKS`
+plus its hand-written ``extra_verilog()``) into ``build/synth-<block>-<hash>/``, runs
+``yosys`` on it and parses ``stat`` into a dict.  Any registered block (``rasterhw verilog --list``)
 works; blocks that need different defaults for synthesis add them to :data:`SYNTH_DEFAULTS`, and
 hand-written memory modules are named in :data:`RAM_MODULES`.
 
@@ -32,7 +32,7 @@ NOT 0.5, BUF 0, MUX 3 (an AND-OR with one inverted select), AOI3/OAI3 2, AOI4/OA
 flip-flop 6 (the classic six-NAND edge-triggered D flip-flop), plus 3 for a clock enable
 (a 2:1 mux) and 1 for a synchronous or asynchronous set/reset.  Memory cells weigh 0.
 
-Usage: ``python -m rasterhw.sim.synth pixelbus-bank depth=262144`` prints :func:`synth_report`.
+Usage: ``rasterhw synth pixelbus-bank -p depth=262144`` prints :func:`synth_report`.
 """
 
 from __future__ import annotations
@@ -48,7 +48,7 @@ from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.runner import REPO_ROOT
-from rasterhw.sim.verilog import BLOCKS, EXTRA_VERILOG, generate_verilog, make_block
+from rasterhw.sim.verilog import block_names, generate_verilog, make_block
 
 __all__ = [
     "GATE_WEIGHTS",
@@ -213,7 +213,7 @@ def synthesise(
     Parameters
     ----------
     block : str
-        A name in :data:`rasterhw.sim.verilog.BLOCKS`.
+        A registered block name (``rasterhw verilog --list``).
     top : str, optional
         Top module; default the block's module name (``-`` -> ``_``).
     memory : str
@@ -244,18 +244,18 @@ def synthesise(
     """
     if memory not in MEMORY_MODES:
         raise RasterhwError(f"memory must be one of {', '.join(MEMORY_MODES)}, not {memory!r}")
-    if block not in BLOCKS:
-        raise RasterhwError(f"unknown block {block!r}; known: {', '.join(sorted(BLOCKS))}")
+    if block not in block_names():
+        raise RasterhwError(f"unknown block {block!r}; known: {', '.join(block_names())}")
     yosys = yosys_path()
     params = {**SYNTH_DEFAULTS.get(block, {}), **params}
     comp = make_block(block, **params)
     top = top or block.replace("-", "_")
 
     text = generate_verilog(block, **params)
-    extra = EXTRA_VERILOG.get(block, lambda c: "")(comp)
+    extra = comp.extra_verilog() if hasattr(comp, "extra_verilog") else ""
     if extra:
         if not text.endswith("\n" + extra):
-            raise RasterhwError(f"block {block!r}: generated Verilog does not end with its EXTRA_VERILOG")
+            raise RasterhwError(f"block {block!r}: generated Verilog does not end with its extra_verilog()")
         text = text[: -len(extra) - 1]
     synth_extra, stubs = _split_extra(extra)
 
@@ -354,39 +354,3 @@ def synth_report(block: str, **params) -> str:
         *(f"    {t:<28} {n}" for t, n in sorted(r["by_type"].items())),
     ]
     return "\n".join(lines)
-
-
-def _parse_value(v: str):
-    for conv in (int, float):
-        try:
-            return conv(v)
-        except ValueError:
-            pass
-    return {"true": True, "false": False}.get(v.lower(), v)
-
-
-def main(argv: list[str] | None = None) -> int:
-    """``python -m rasterhw.sim.synth BLOCK [name=value ...] [--memory keep|map]``."""
-    import argparse
-
-    ap = argparse.ArgumentParser(description="yosys gate counts of an HDL block")
-    ap.add_argument("block", choices=sorted(BLOCKS))
-    ap.add_argument("params", nargs="*", help="block parameters as name=value")
-    ap.add_argument("--memory", default="keep", choices=MEMORY_MODES)
-    a = ap.parse_intermixed_args(argv)
-    params = {}
-    for kv in a.params:
-        if "=" not in kv:
-            ap.error(f"parameter {kv!r} is not name=value")
-        k, v = kv.split("=", 1)
-        params[k] = _parse_value(v)
-    try:
-        print(synth_report(a.block, memory=a.memory, **params))
-    except RasterhwError as e:
-        print(f"error: {e}")
-        return 1
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -1,50 +1,35 @@
 # amaranth: UnusedElaboratable=no
-"""Verilog generation for the HDL blocks: a name -> factory registry.
+"""Verilog generation for the HDL blocks the machines register (``Machine.blocks``).
 
-Add a block by adding an entry to :data:`BLOCKS` (a factory taking keyword parameters
-and returning a ``wiring.Component``), and, if it instantiates hand-written Verilog
-modules, their source to :data:`EXTRA_VERILOG`.
+A block is a factory taking keyword parameters and returning a ``wiring.Component``; a
+component that instantiates hand-written Verilog returns that source from its
+``extra_verilog()`` method, and it is appended to the generated text.
 """
 
 from __future__ import annotations
 
 import inspect
-from collections.abc import Callable
 from pathlib import Path
 
 from amaranth.back import verilog
 from amaranth.lib import wiring
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.hdl.snu.pixelbus import PixelBus
-from rasterhw.hdl.snu.pixelbus_bank import RAM_VERILOG, PixelBusBank
-from rasterhw.hdl.zbm.chip import ZbmChip
-from rasterhw.hdl.zbm.seggen import ZbmSegmentGenerator
-from rasterhw.hdl.zbm.unit import ZbmUnit
+from rasterhw.sim.registry import blocks, load
 
-__all__ = ["BLOCKS", "EXTRA_VERILOG", "generate_verilog", "write_verilog", "make_block"]
+__all__ = ["block_names", "generate_verilog", "write_verilog", "make_block"]
 
-BLOCKS: dict[str, Callable[..., wiring.Component]] = {
-    "pixelbus-bank": PixelBusBank,
-    "pixelbus": PixelBus,
-    "zbm-chip": ZbmChip,
-    "zbm-seggen": ZbmSegmentGenerator,
-    "zbm-unit": ZbmUnit,
-}
 
-# Hand-written Verilog a block needs next to its generated code: name -> callable(component)
-# returning the extra source text ("" if none).
-EXTRA_VERILOG: dict[str, Callable[[wiring.Component], str]] = {
-    "pixelbus-bank": lambda c: RAM_VERILOG if c.ram == "verilog" else "",
-    "pixelbus": lambda c: RAM_VERILOG if c.ram == "verilog" else "",
-}
+def block_names() -> list[str]:
+    """Every registered block, sorted (``rasterhw verilog --list``)."""
+    return sorted(blocks())
 
 
 def make_block(name: str, **params) -> wiring.Component:
     """Build the registered block ``name`` with ``params``; bad names/params raise ``RasterhwError``."""
-    try:
-        factory = BLOCKS[name]
-    except KeyError:
-        raise RasterhwError(f"unknown block {name!r}; known: {', '.join(sorted(BLOCKS))}") from None
+    refs = blocks()
+    if name not in refs:
+        raise RasterhwError(f"unknown block {name!r}; known: {', '.join(sorted(refs))}")
+    factory = load(refs[name])
     sig = inspect.signature(factory)
     unknown = [k for k in params if k not in sig.parameters]
     if unknown:
@@ -69,7 +54,8 @@ def generate_verilog(name: str, **params) -> str:
     """
     comp = make_block(name, **params)
     text = verilog.convert(comp, name=_module_name(name), emit_src=False)
-    extra = EXTRA_VERILOG.get(name, lambda c: "")(comp)
+    # hand-written Verilog the block instantiates (e.g. a RAM model) travels with it
+    extra = comp.extra_verilog() if hasattr(comp, "extra_verilog") else ""
     return text + ("\n" + extra if extra else "")
 
 

@@ -8,12 +8,11 @@ import shutil
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.runner import SimulatorUnavailable, build_dir_for, get_sim, lint_verilog
-from rasterhw.sim.verilog import BLOCKS, generate_verilog, write_verilog
+from rasterhw.sim.verilog import block_names, generate_verilog, write_verilog
 
 
-def test_registry_has_pixelbus_blocks():
-    assert isinstance(BLOCKS, dict)
-    assert {"pixelbus", "pixelbus-bank"} <= set(BLOCKS)
+def test_registry_has_every_machines_blocks():
+    assert {"pixelbus", "pixelbus-bank", "zbm-chip", "zbm-seggen", "zbm-unit"} <= set(block_names())
 
 
 def test_write_verilog_pixelbus(tmp_path):

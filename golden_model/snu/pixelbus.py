@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.snu.formats import CLOCK_HZ, MEM_CYCLE, N_BANKS, N_PIPES
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 
 __all__ = [
@@ -40,10 +41,6 @@ __all__ = [
     "rgb_image",
 ]
 
-CLOCK_HZ = 12.5e6  # one 80 ns bus slot per clock
-MEM_CYCLE = 5  # 400 ns memory cycle / 80 ns slot
-N_BANKS = 5  # 5:1 interleave
-N_PIPES = 2  # two geometry pipelines share the bus
 
 
 def _check_params(mem_cycle: int, n_banks: int) -> None:

@@ -39,6 +39,7 @@ import math
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.zbm import EdgePairs, segment_generator
 from rasterhw.golden_model.zbm.formats import (
     AEP_CAPACITY,
     CHANNELS,
@@ -46,7 +47,6 @@ from rasterhw.golden_model.zbm.formats import (
     INTERLEAVES,
     PACKET_FLITS,
 )
-from rasterhw.golden_model.zbm.render import EdgePairs, segment_generator
 
 __all__ = ["PAPER_TABLE1_KPOLYS", "PAPER_LEN_CHIP", "len_chip", "formula_cycles_per_edge_pair",
            "formula_polygons_per_s", "paper_table1", "event_cycles", "paper_workload", "hdl_cycles",

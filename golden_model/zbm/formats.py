@@ -291,3 +291,16 @@ def unpack_samples(w) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     a = ((w >> np.uint64(24)) & np.uint64(0xFF)).astype(np.int64)
     c = np.stack([((w >> np.uint64(32 + 8 * i)) & np.uint64(0xFF)).astype(np.int64) for i in range(4)], axis=-1)
     return z, a, c
+
+
+# ---------------------------------------------------------------- derived constants
+SUB = 1 << SUBPIX_BITS          # sub-pixel grid, 256
+HALF_SUB = SUB // 2
+ONE_X = 1 << X_FRAC
+HALF_X = ONE_X >> 1
+ONE_A = 1 << ATTR_FRAC
+HALF_A = ONE_A >> 1
+Z_SCALE = (1 << Z_BITS) - 1     # float z in [0, 1] -> Z LSBs (same as ScreenTriangles.zq)
+TEX = 1 << TEX_BITS
+INC_LIMIT = (1 << 47) - 1       # attribute increments saturate here (keeps offset * inc in int64)
+VAL_LIMIT = (1 << 53) - 1       # attribute start values saturate here (room for 511 line steps)

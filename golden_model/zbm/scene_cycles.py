@@ -40,6 +40,7 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.scene import Scene
 from rasterhw.golden_model.screen import ScreenTriangles
+from rasterhw.golden_model.zbm import EdgePairs, edge_pairs, segment_generator
 from rasterhw.golden_model.zbm import cycles as zbm_cycles
 from rasterhw.golden_model.zbm.cycles import (
     CLOCK_HZ,
@@ -48,7 +49,6 @@ from rasterhw.golden_model.zbm.cycles import (
     formula_cycles_per_edge_pair,
 )
 from rasterhw.golden_model.zbm.formats import INTERLEAVES, MAX_HEIGHT, MAX_WIDTH, wrap
-from rasterhw.golden_model.zbm.render import EdgePairs, edge_pairs, segment_generator
 
 __all__ = ["LEVELS", "SEG_LEN_BINS", "polygon_edge_pairs", "scene_edge_pairs", "scene_rows",
            "scene_table", "format_table"]

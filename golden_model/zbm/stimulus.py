@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import numpy as np
+from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.screen import ScreenTriangles
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.golden_model.zbm import render as G
 
 __all__ = ["multi_line_segments", "random_doublez", "random_segments", "random_triangles"]
 

@@ -8,8 +8,8 @@ its results through these functions; the word layouts themselves are defined onc
 from __future__ import annotations
 
 import numpy as np
+from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.golden_model.zbm import render as G
 
 __all__ = ["doublez_words", "edge_pair_words", "packets", "pixel2_words", "segment_words",
            "words_to_doublez"]

@@ -6,7 +6,16 @@ from amaranth import Array, Module, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2
+from rasterhw.golden_model.snu.formats import (
+    FRAME_HEIGHT,
+    FRAME_WIDTH,
+    MEM_CYCLE,
+    N_BANKS,
+    RGB_BITS,
+    Z_BITS,
+)
 from rasterhw.hdl.snu.pixelbus_bank import (
+    RAM_VERILOG,
     Command,
     PixelBusBank,
     bank_write_layout,
@@ -53,7 +62,7 @@ class PixelBus(wiring.Component):
         Frame-buffer commands.
     rd_addr : In(addr_bits), rd_buf : In(1)
         Read-back linear address; 0 = draw buffer, 1 = display buffer.
-    rd_rgb : Out(24), rd_z : Out(z_bits)
+    rd_rgb : Out(RGB_BITS), rd_z : Out(z_bits)
         Read-back data, one clock later.
     cycle : Out(32)
         Free-running clock counter (bit 0 is the slot owner).
@@ -69,11 +78,11 @@ class PixelBus(wiring.Component):
     def __init__(
         self,
         *,
-        width: int = 1280,
-        height: int = 1024,
-        z_bits: int = 24,
-        n_banks: int = 5,
-        mem_cycle: int = 5,
+        width: int = FRAME_WIDTH,
+        height: int = FRAME_HEIGHT,
+        z_bits: int = Z_BITS,
+        n_banks: int = N_BANKS,
+        mem_cycle: int = MEM_CYCLE,
         ram: str = "memory",
     ) -> None:
         for name, v in (("width", width), ("height", height)):
@@ -100,7 +109,7 @@ class PixelBus(wiring.Component):
                 "i_cmd": In(stream.Signature(Command)),
                 "rd_addr": In(self._addr_bits),
                 "rd_buf": In(1),
-                "rd_rgb": Out(24),
+                "rd_rgb": Out(RGB_BITS),
                 "rd_z": Out(z_bits),
                 "cycle": Out(32),
                 "busy": Out(1),
@@ -122,6 +131,10 @@ class PixelBus(wiring.Component):
     def clear_cycles(self) -> int:
         """Clocks a clear keeps the banks busy after its accept."""
         return self._bank_depth
+
+    def extra_verilog(self) -> str:
+        """Hand-written Verilog this block instantiates (the RAM model when ``ram="verilog"``)."""
+        return RAM_VERILOG if self.ram == "verilog" else ""
 
     def elaborate(self, platform):
         m = Module()

@@ -6,6 +6,11 @@ from amaranth import ClockSignal, Instance, Module, Mux, Signal, unsigned
 from amaranth.lib import data, enum, memory, stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2
+from rasterhw.golden_model.snu.formats import (
+    MEM_CYCLE,
+    RGB_BITS,
+    Z_BITS,
+)
 
 __all__ = ["RAM_KINDS", "RAM_VERILOG", "Command", "PixelBusBank", "bank_write_layout"]
 
@@ -55,7 +60,7 @@ def bank_write_layout(addr_bits: int, z_bits: int) -> data.StructLayout:
     return data.StructLayout(
         {
             "addr": unsigned(addr_bits),  # word address
-            "rgb": unsigned(24),  # r << 16 | g << 8 | b
+            "rgb": unsigned(RGB_BITS),  # r << 16 | g << 8 | b
             "z": unsigned(z_bits),  # 0 = far; a larger value is nearer
         }
     )
@@ -104,7 +109,7 @@ class PixelBusBank(wiring.Component):
         ``depth`` clocks after the accept; ``SWAP`` takes effect in the next clock.
     rd_addr : In(ceil_log2(depth)), rd_buf : In(1)
         Read-back address and buffer (0 = draw buffer, 1 = display buffer).
-    rd_rgb : Out(24), rd_z : Out(z_bits)
+    rd_rgb : Out(RGB_BITS), rd_z : Out(z_bits)
         Read-back data, one clock after ``rd_addr``/``rd_buf``.  Independent of the
         write path (a separate read port, as the VRAM's serial/display port).
     busy : Out(1)
@@ -116,7 +121,7 @@ class PixelBusBank(wiring.Component):
     the read-back port two clocks after its accept.
     """
 
-    def __init__(self, *, depth: int, z_bits: int = 24, mem_cycle: int = 5, ram: str = "memory") -> None:
+    def __init__(self, *, depth: int, z_bits: int = Z_BITS, mem_cycle: int = MEM_CYCLE, ram: str = "memory") -> None:
         if not isinstance(depth, int) or depth < 1:
             raise ValueError(f"depth must be a positive integer, not {depth!r}")
         check_bank_params(z_bits=z_bits, mem_cycle=mem_cycle, ram=ram)
@@ -131,7 +136,7 @@ class PixelBusBank(wiring.Component):
                 "i_cmd": In(stream.Signature(Command)),
                 "rd_addr": In(self._addr_bits),
                 "rd_buf": In(1),
-                "rd_rgb": Out(24),
+                "rd_rgb": Out(RGB_BITS),
                 "rd_z": Out(z_bits),
                 "busy": Out(1),
                 "draw_buf": Out(1),
@@ -158,11 +163,15 @@ class PixelBusBank(wiring.Component):
     def ram(self) -> str:
         return self._ram
 
+    def extra_verilog(self) -> str:
+        """Hand-written Verilog this block instantiates (the RAM model when ``ram="verilog"``)."""
+        return RAM_VERILOG if self._ram == "verilog" else ""
+
     def elaborate(self, platform):
         m = Module()
 
         rams = {}
-        for name, width in (("zmem", self._z_bits), ("rgb0", 24), ("rgb1", 24)):
+        for name, width in (("zmem", self._z_bits), ("rgb0", RGB_BITS), ("rgb1", RGB_BITS)):
             rams[name] = _ram(m, name, width=width, depth=self._depth, addr_bits=self._addr_bits, ram=self._ram)
         zmem = rams["zmem"]
         rgb = [rams["rgb0"], rams["rgb1"]]
@@ -173,7 +182,7 @@ class PixelBusBank(wiring.Component):
         draw = Signal()  # physical buffer drawn into; the other one is displayed
         pending = Signal()  # compare/write clock of an accepted write
         w_addr = Signal(self._addr_bits)
-        w_rgb = Signal(24)
+        w_rgb = Signal(RGB_BITS)
         w_z = Signal(self._z_bits)
 
         m.d.comb += [

@@ -317,3 +317,14 @@ def main(argv: list[str] | None = None) -> int:
 
 if __name__ == "__main__":
     raise SystemExit(main())
+
+
+def simulate_scene(scene, width: int, height: int, *, engine: str = "verilator", progress: bool = False) -> dict:
+    """``rasterhw sim pixelbus``: geometry and the golden Gouraud scan converter make the pixel
+    stream of ``scene``; :func:`simulate_pixelbus` runs it through the HDL."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.snu.formats import Z_BITS
+    from rasterhw.golden_model.snu.gouraud import scan_convert
+
+    tris = run_geometry(scene, width, height, z_bits=Z_BITS, z_far_is_zero=True)
+    return simulate_pixelbus(scan_convert(tris), engine=engine, progress=progress)

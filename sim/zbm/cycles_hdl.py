@@ -11,9 +11,9 @@ and the count is the segment side's, as in the paper's estimate.
 from __future__ import annotations
 
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.zbm import EdgePairs
 from rasterhw.golden_model.zbm import cycles as C
 from rasterhw.golden_model.zbm.formats import AEP_CAPACITY, INTERLEAVES
-from rasterhw.golden_model.zbm.render import EdgePairs
 
 __all__ = ["run_unit_cycles", "measure_cycles_per_edge_pair", "table1_width"]
 

@@ -28,9 +28,9 @@ import time
 from pathlib import Path
 
 import numpy as np
+from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.golden_model.zbm import render as G
 from rasterhw.golden_model.zbm.words import doublez_words, edge_pair_words, words_to_doublez
 from rasterhw.sim.runner import REPO_ROOT, build_dir_for, get_sim, run_cocotb
 
@@ -491,7 +491,9 @@ def float_tolerance(tris, px: G.DoubleZ, rgb8: np.ndarray, eps: G.EdgePairs, tag
     same = cov_h & cov_f & (tags[..., 0] == fl["tag"][..., 0])
     zf = np.clip(np.floor(np.where(cov_f, fl["z"][..., 0], 0) * G.Z_SCALE + 0.5), 0, F.Z_MAX_SAMPLE)
     dz = np.abs(px.z[..., 0] - zf)
-    dzdx = np.zeros(int(tags.max(initial=-1)) + 2)
+    # one slot per triangle tag (visible or not) plus a spare zero at index -1 for pixels
+    # whose front sample is not the float model's
+    dzdx = np.zeros(max(int(tags.max(initial=-1)), int(eps.tag.max(initial=-1))) + 2)
     if len(eps):
         np.maximum.at(dzdx, eps.tag, np.abs(eps.ddx[:, 0]) / float(1 << F.ATTR_FRAC))
     zbound = 1 + dzdx[np.where(same, tags[..., 0], -1)] * 2.0 ** -16

@@ -21,9 +21,9 @@ import time
 from pathlib import Path
 
 import numpy as np
+from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.golden_model.zbm import render as G
 from rasterhw.sim.runner import REPO_ROOT, verilator_bin_dir
 from rasterhw.sim.zbm.driver import (
     GAP_BITS,

@@ -12,9 +12,9 @@ import sys
 import numpy as np
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.zbm import edge_pairs, segment_generator
 from rasterhw.golden_model.zbm import formats as fmt
 from rasterhw.golden_model.zbm import scene_cycles as zsc
-from rasterhw.golden_model.zbm.render import edge_pairs, segment_generator
 
 HAVE_YOSYS = shutil.which("yosys") is not None
 

@@ -16,8 +16,8 @@ import shutil
 
 import numpy as np
 import pytest
+from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.golden_model.zbm import render as G
 from rasterhw.golden_model.zbm.stimulus import random_doublez, random_triangles
 from rasterhw.golden_model.zbm.words import doublez_words
 from rasterhw.sim.zbm import driver as Z

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.golden_model.scenes import SCENES
-from rasterhw.golden_model.zbm import render as G
+from rasterhw.golden_model.scenes import SCENES, build_scene
 from rasterhw.golden_model.zbm import words as W
 from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.sim.zbm import driver as Z
@@ -67,3 +67,10 @@ def test_words_round_trip():
     px = W.words_to_doublez(s0, s1)
     assert np.array_equal(px.z, gold.pixels.z) and np.array_equal(px.c, gold.pixels.c)
     assert np.array_equal(G.composite(px), gold.rgb8)
+
+
+def test_float_tolerance_when_last_triangles_cover_no_pixel():
+    """Issue 14 row 1: the highest-numbered triangles of c50 at 16x16 cover no pixel; the
+    float-tolerance check must still size its per-triangle table by every edge-pair tag."""
+    res = Z.simulate_zbm(build_scene("c50"), 16, 16, interleave=1, engine="pysim")
+    assert res["mismatches"] == 0 and res["pixels_compared"] == 256

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from rasterhw.golden_model.zbm import render as G
+from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.zbm.stimulus import random_doublez, random_triangles
 from rasterhw.sim.zbm import driver as Z
 from rasterhw.sim.zbm import fast as ZF

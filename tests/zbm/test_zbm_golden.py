@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from rasterhw.golden_model import reference as ref
+from rasterhw.golden_model import zbm as zbm
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.screen import ScreenTriangles
 from rasterhw.golden_model.zbm import cycles as cyc
 from rasterhw.golden_model.zbm import formats as fmt
-from rasterhw.golden_model.zbm import render as zbm
 
 
 def exact_cover(tris: ScreenTriangles) -> list[np.ndarray]:

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from amaranth.sim import Simulator
+from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.golden_model.zbm import render as G
 from rasterhw.golden_model.zbm.stimulus import random_segments
 from rasterhw.golden_model.zbm.words import packets, pixel2_words
 from rasterhw.hdl.zbm.loop import LOOP_GAP, ZbmLoop
