@@ -55,11 +55,9 @@ def chip_scanline(segs: Segments, y: int, chip: int, interleave: int, width: int
     """One chip, one scan line: segment packets through the loop, double-Z pixel memories.
 
     The pixel memory holds the chip's ``ceil(width / I)`` pixels (chip pixel ``q`` = screen x
-    ``q * I + chip``
-    pixel processor ``q % 8`` owns it). For each segment of line ``y`` in
-    emission order: the initial processor forms the packet
-    pixel ``k`` of the packet gets the
-    value ``v + k * (inc * I)`` (the loop's repeated 56-bit adds) and is Z-tested into the
+    ``q * I + chip``; pixel processor ``q % 8`` owns it). For each segment of line ``y``, in
+    emission order, the initial processor forms the packet (:func:`initial_processor`), and
+    pixel ``k`` of the packet gets the value ``v + k * (inc * I)`` (the loop's repeated 56-bit adds) and is Z-tested into the
     double-Z memory. Returns the memory and counts (``packets``, ``pixels``, ``writes``).
     """
     _check_interleave(interleave, chip)

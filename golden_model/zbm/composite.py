@@ -20,9 +20,8 @@ def composite(px: DoubleZ, background=(0, 0, 0)) -> np.ndarray:
     """Alpha-composite the final 2 samples over the background -> (H, W, 3) uint8.
 
     ``back = (a1 * c1 + (255 - a1) * bg + 127) // 255`` (bg if s1 empty), then
-    ``out = (a0 * c0 + (255 - a0) * back + 127) // 255`` (bg if s0 empty)
-    with a0 = 255 the
-    output is exactly c0. Samples behind the second are lost (the paper keeps 2).
+    ``out = (a0 * c0 + (255 - a0) * back + 127) // 255`` (bg if s0 empty);
+    with a0 = 255 the output is exactly c0. Samples behind the second are lost (the paper keeps 2).
     """
     bg = np.asarray(background, np.int64)
     if bg.shape != (3,) or bg.min() < 0 or bg.max() > 255:

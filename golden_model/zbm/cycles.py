@@ -14,9 +14,9 @@ interleaved chips gives ceil(5 / I) = 5, 3, 2, 1, 1 pixels for I = 1, 2, 4, 8, 1
 the paper's "average segment length per ZB/M" values (for I = 2 the chips get 3 and 2; the
 segment is done when the busier chip is done).
 
-Two counts of one unit: ``event_cycles`` applies the paper's stated conditions as rules R1-R5
+Two counts of one unit: ``event_cycles`` applies the paper's stated conditions as rules R1, R2, R4, R5
 (it does NOT describe our HDL); ``hdl_cycles`` is a cycle-stepped model of the control of
-``hdl/zbm_unit.py`` and equals its pysim cycle count exactly (tests/test_zbm_unit_pysim.py).
+``hdl/zbm/unit.py`` and equals its pysim cycle count exactly (tests/zbm/test_zbm_unit_pysim.py).
 
 Paper rules of ``event_cycles`` (``docs/zbm.md`` lists them):
  R1 a line starts by loading, from the input FIFO, every edge pair whose top line has been
@@ -25,7 +25,6 @@ Paper rules of ``event_cycles`` (``docs/zbm.md`` lists them):
     fill rule and clipping costs 1 cycle; a non-empty segment is broadcast to all chips of the
     unit and costs ``max over chips (n_c + 8)`` = ``ceil(len / I) + 8`` cycles (a chip that owns
     none of its pixels drops it in 1 cycle; the busiest chip sets the pace);
- R3 (no longer occurs: a stream needing more active pairs than ``capacity`` raises);
  R4 the merge side streams each chip's ``ceil(W / I)`` pixels of the previous line, one per
     merge cycle, while the loop works on the current line (double-buffered pixel memories);
     a line ends when both are done (merge clock = segment clock unless ``merge_ratio`` given).
@@ -93,9 +92,9 @@ def paper_table1() -> list[dict]:
 
 def event_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: int = 8,
                  capacity: int = AEP_CAPACITY, merge_ratio: float = 1.0) -> dict:
-    """Count cycles of one unit (segment generator + ``interleave`` chips) under rules R1-R5.
+    """Count cycles of one unit (segment generator + ``interleave`` chips) under rules R1, R2, R4, R5.
 
-    Returns totals (``loop_cycles``: R1-R3 summed; ``frame_cycles``: with R4's overlap),
+    Returns totals (``loop_cycles``: R1 and R2 summed; ``frame_cycles``: with R4's overlap),
     per-line arrays and per-edge-pair averages.
     """
     if interleave not in INTERLEAVES:
@@ -106,7 +105,7 @@ def event_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: i
     seg_cost = -(-segs.len // interleave) + PACKET_FLITS
     per_seg_line = np.bincount(segs.y, weights=seg_cost, minlength=height).astype(np.int64)
     load = segs.loads * EP_LOAD_CYCLES
-    loop = load + per_seg_line + segs.empty + segs.late_steps
+    loop = load + per_seg_line + segs.empty
     merge_line = math.ceil(math.ceil(width / interleave) * merge_ratio)
     busy = np.flatnonzero(loop > 0)
     # R4: line y's loop overlaps the merge of line y-1 (only lines with work are merged here).
@@ -119,7 +118,7 @@ def event_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: i
     n = max(len(eps), 1)
     return {"edge_pairs": len(eps), "segments": int(segs.y.size),
             "load_cycles": int(load.sum()), "segment_cycles": int(per_seg_line.sum()),
-            "empty_cycles": int(segs.empty.sum()), "late_cycles": int(segs.late_steps.sum()),
+            "empty_cycles": int(segs.empty.sum()),
             "loop_cycles": int(loop.sum()), "frame_cycles": int(frame),
             "loop_cycles_per_edge_pair": float(loop.sum()) / n,
             "loop_per_line": loop, "merge_cycles_per_line": merge_line,

@@ -128,8 +128,8 @@ def edge_pairs(tris: ScreenTriangles, *, mode: int = MODE_COLOUR, alpha=None) ->
     is never right of the true edge and stays within 2**-31 px of it over 512 lines, closer
     than any pixel centre can be to an edge on this grid without lying on it (>= 2**-28 px):
     the coverage is exactly the reference's. Attributes are float64 plane equations
-    rounded to nearest Q.24. Lines are clipped to the frame
-    pairs with no line are dropped.
+    rounded to nearest Q.24. Lines are clipped to the frame, and
+    pairs with no line left are dropped.
 
     Returns the pairs in input-FIFO order: sorted by top line, ties in submission order.
     """

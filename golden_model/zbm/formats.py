@@ -41,7 +41,7 @@ __all__ = [
     "EP_WORDS", "EP_LOAD_CYCLES", "LOOP_BITS", "PACKET_FLITS", "PP_PER_CHIP", "INTERLEAVES",
     "AEP_CAPACITY", "MODE_COLOUR", "MODE_MAPPING", "CHANNELS",
     "Field", "Layout", "EP_HEADER", "EP_CHANNEL", "SEG_HEADER", "FLIT", "PKT_HEADER",
-    "SAMPLE", "PIXEL2", "MERGE_WORD",
+    "SAMPLE", "PIXEL2",
     "wrap", "to_fixed_floor", "slot_check",
     "pack_edge_pair", "unpack_edge_pair", "pack_segment", "unpack_segment",
     "pack_samples", "unpack_samples",
@@ -233,13 +233,11 @@ SAMPLE = Layout("sample", [
     Field("c2", 8, meaning="b or ui"),
     Field("c3", 8, meaning="0 or vi"),
 ])
-SAMPLE_FIELDS = ("z", "a", "c0", "c1", "c2", "c3")
 # Double-Z pixel = the merge-bus word and the merge-port word: s0 (nearer or equal), s1.
 PIXEL2 = Layout("pixel2", [
     Field("s0", 64, meaning="nearest sample (paper: 'the nearest 2 points')"),
     Field("s1", 64, meaning="second nearest sample"),
 ])
-MERGE_WORD = PIXEL2
 
 
 # ---------------------------------------------------------------- record helpers

@@ -1,6 +1,7 @@
 """ZB/M golden model (Matsushita scan-line Z-buffer merger, seed 003): bit-accurate and float.
 
-Stages, one function each, named as the hardware blocks (formats in :mod:`.zbm_formats`):
+Stages, one function each in a module of the same block name (formats in
+:mod:`rasterhw.golden_model.zbm.formats`):
 
 ``edge_pairs``          level-1 processor (software, float64 -> fixed point): triangle -> 2 edge pairs
 ``segment_generator``   input FIFO + active-edge-pair memory + adders: edge pairs -> segments per line
@@ -12,8 +13,7 @@ Stages, one function each, named as the hardware blocks (formats in :mod:`.zbm_f
 ``render_zbm``          the whole machine: units (segment generator + chips) chained by merge ports
 
 Everything from :class:`EdgePairs` on is integer arithmetic in ``int64`` with the hardware's
-widths, masks and shifts
-the HDL must match it bit for bit. ``render_zbm_float`` is the ideal
+widths, masks and shifts, and the HDL must match it bit for bit. ``render_zbm_float`` is the ideal
 twin (same coverage, attributes from the float plane equations, float double Z).
 """
 
@@ -57,8 +57,7 @@ def render_zbm(tris: ScreenTriangles, *, interleave: int = 8, units: int = 1, mo
                per_chip: bool = False) -> ZbmResult:
     """Render with ``units`` polygon-processing units (segment generator + ``interleave`` chips).
 
-    Triangles are dealt to units round-robin (triangle i -> unit i % units)
-    each unit has its
+    Triangles are dealt to units round-robin (triangle i -> unit i % units); each unit has its
     own segment generator and per-line double-Z buffers; the units' lines are merged along
     the chain (unit 0 at the head), then mapped (mapping mode) and alpha-composited.
     ``per_chip=True`` runs every chip's loop (:func:`chip_scanline`); the default uses the
@@ -103,11 +102,9 @@ def render_zbm_float(tris: ScreenTriangles, *, alpha=None, background=(0.0, 0.0,
     """The ideal twin (colour mode): the same coverage, float64 everywhere else.
 
     Coverage comes from the bit-accurate segment generator (it is exact: the reference's top-left
-    rule)
-    depth and colour are the float plane equations at pixel centres
-    double Z in float
-    (strict ``<``, earlier segment wins ties)
-    float alpha-compositing of the 2 nearest.
+    rule); depth and colour are the float plane equations at pixel centres; double Z is kept in
+    float (strict ``<``, the earlier segment wins ties); the 2 nearest are alpha-composited in
+    float.
     Returns ``{"rgb": (H, W, 3) float in [0, 1], "z": (H, W, 2) float (inf = empty),
     "tag": (H, W, 2)}``.
     """

@@ -39,9 +39,7 @@ class Segments:
     line_start : (H + 1,) segments of line y are ``line_start[y]:line_start[y+1]``.
     loads : (H,) edge pairs loaded from the FIFO at the start of each line.
     empty : (H,) active edge pairs whose segment was empty after the fill rule and clipping.
-    late_steps : (H,) always 0 (kept for compatibility: no pair is ever loaded late; a stream
-        over capacity raises instead).
-    stats : counts (``segments``, ``aep_max``, ``stall_lines``, ``segments_lost``, ...).
+    stats : counts (``segments``, ``aep_max``, ``aep_capacity``, ...).
     """
 
     y: np.ndarray
@@ -54,7 +52,6 @@ class Segments:
     line_start: np.ndarray
     loads: np.ndarray
     empty: np.ndarray
-    late_steps: np.ndarray
     mode: int = MODE_COLOUR
     stats: dict = field(default_factory=dict)
 
@@ -133,7 +130,6 @@ def segment_generator(eps: EdgePairs, height: int, *, width: int = MAX_WIDTH,
     line_start = np.zeros(height + 1, np.int64)
     loads = np.zeros(height, np.int64)
     empty = np.zeros(height, np.int64)
-    late = np.zeros(height, np.int64)
     aep_max = 0
     count = 0
     for y in range(height):
@@ -178,9 +174,9 @@ def segment_generator(eps: EdgePairs, height: int, *, width: int = MAX_WIDTH,
     cat = {k: (np.concatenate(v) if v else np.zeros((0, C) if k in ("val", "inc") else 0, np.int64))
            for k, v in out.items()}
     stats = {"segments": count, "empty_segments": int(empty.sum()), "aep_max": aep_max,
-             "aep_capacity": int(capacity), "stall_lines": 0, "segments_lost": 0,
+             "aep_capacity": int(capacity),
              "edge_pairs": n}
     return Segments(cat["y"].astype(np.int64), cat["x"].astype(np.int64), cat["len"].astype(np.int64),
                     cat["val"].astype(np.int64), cat["inc"].astype(np.int64), cat["ep"].astype(np.int64),
                     eps.tag[cat["ep"].astype(np.int64)] if n else cat["ep"].astype(np.int64),
-                    line_start, loads, empty, late, eps.mode, stats)
+                    line_start, loads, empty, eps.mode, stats)

@@ -27,7 +27,7 @@ def random_segments(rng: np.random.Generator, n: int, width: int, mode: int = F.
         val[-1, 0] = (1 << 48) - 1                                 # and at Z_MAX_SAMPLE
     z1 = np.zeros(n, np.int64)
     return G.Segments(np.full(n, y), x, ln, val, inc, np.arange(n), np.arange(n),
-                      np.array([0] * (y + 1) + [n]), z1, z1, z1, mode)
+                      np.array([0] * (y + 1) + [n]), z1, z1, mode)
 
 
 def multi_line_segments(rng: np.random.Generator, counts: list[int], width: int,
@@ -40,7 +40,7 @@ def multi_line_segments(rng: np.random.Generator, counts: list[int], width: int,
     line_start = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
     z1 = np.zeros(len(counts), np.int64)
     return G.Segments(ys, cat["x"], cat["len"], cat["val"], cat["inc"], np.arange(n), np.arange(n),
-                      line_start, z1, z1, z1, mode)
+                      line_start, z1, z1, mode)
 
 
 def random_doublez(rng: np.random.Generator, n: int) -> G.DoubleZ:

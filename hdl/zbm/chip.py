@@ -1,4 +1,4 @@
-"""ZB/M chip: initial processor -> segment processor -> segment loop -> pixel memories ->
+"""ZB/M chip: initial processor (``ZbmInitialProcessor``) -> segment processor -> segment loop -> pixel memories ->
 merge bus -> merger (paper, sec. 5.4, fig. 5).
 
 Segment input protocol (our decision; the paper only names the port): a segment is a
@@ -11,12 +11,13 @@ finished line, ``ceil((width - chip) / interleave)`` double-Z words, down the me
 
 from __future__ import annotations
 
-from amaranth import Module, Mux, Signal, unsigned
-from amaranth.lib import data, stream, wiring
+from amaranth import Module, Signal, unsigned
+from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.hdl.zbm.layouts import FLIT, PIXEL2, PKT_HEADER, SEG_HEADER
-from rasterhw.hdl.zbm.loop import PACKET, ZbmLoop
+from rasterhw.hdl.zbm.initial import ZbmInitialProcessor
+from rasterhw.hdl.zbm.layouts import PIXEL2
+from rasterhw.hdl.zbm.loop import ZbmLoop
 from rasterhw.hdl.zbm.merger import ZbmMerger
 
 __all__ = ["ZbmChip"]
@@ -102,7 +103,6 @@ class ZbmChip(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        lg = self._interleave.bit_length() - 1
         n_int = self._interleave
         m.submodules.loop = loop = ZbmLoop(interleave=n_int, width=self._width)
         m.submodules.merger = merger = ZbmMerger(word_layout=PIXEL2, fifo_depth=self._fifo_depth)
@@ -112,60 +112,21 @@ class ZbmChip(wiring.Component):
         m.d.sync += self.cycles.eq(self.cycles + 1)
 
         # ---- initial processor: segment words -> one packet for this chip's interleave slot
-        pkt = Signal(PACKET)
-        pkt_valid = Signal()     # complete packet waiting for the segment processor
-        recv = Signal(range(F.PACKET_FLITS))   # channel words still expected
-        j = Signal(4)            # pixels skipped to reach this chip's first pixel
-        keep = Signal()
+        m.submodules.initial = ip = ZbmInitialProcessor(interleave=n_int, chip=self._chip)
+        wiring.connect(m, wiring.flipped(self.i_seg), ip.i)
         eol = Signal(2)          # end-of-line records seen whose swap is pending (0..2)
-        seg_hdr = data.View(SEG_HEADER, self.i_seg.payload)
-        seg_flit = data.View(FLIT, self.i_seg.payload)
         # The next line's segment may be received while a swap is pending: a held packet
         # always belongs after every pending end of line (it blocks further input).
-        m.d.comb += self.i_seg.ready.eq(~pkt_valid & (eol != 2))
-        eol_in = Signal()
-        with m.If(self.i_seg.valid & self.i_seg.ready):
-            with m.If(recv == 0):
-                with m.If(seg_hdr.len == 0):
-                    m.d.comb += eol_in.eq(1)
-                with m.Else():
-                    jj = (self._chip - seg_hdr.x)[:lg] if lg else 0
-                    n = Signal(11)
-                    m.d.comb += n.eq(Mux(seg_hdr.len > jj, (seg_hdr.len - jj + (n_int - 1)) >> lg, 0))
-                    m.d.sync += [
-                        j.eq(jj), keep.eq(n != 0),
-                        recv.eq(len(F.CHANNELS[F.MODE_COLOUR]) + seg_hdr.mode),
-                        pkt[0].eq(0),
-                    ]
-                    hdr = data.View(PKT_HEADER, pkt[0])
-                    m.d.sync += [hdr.x.eq(seg_hdr.x + jj), hdr.len.eq(n), hdr.y.eq(seg_hdr.y),
-                                 hdr.mode.eq(seg_hdr.mode), hdr.dx.eq(n_int)]
-                    for k in range(1, F.PACKET_FLITS):
-                        m.d.sync += pkt[k].eq(0)
-            with m.Else():
-                out = Signal(FLIT)
-                m.d.comb += [
-                    out.value.eq(seg_flit.value + j * seg_flit.inc),
-                    out.inc.eq(seg_flit.inc << lg),
-                ]
-                # channel word number c (1-based) = channels + mode - recv + 1
-                cnum = Signal(range(F.PACKET_FLITS + 1))
-                hdr_mode = data.View(PKT_HEADER, pkt[0]).mode
-                m.d.comb += cnum.eq(len(F.CHANNELS[F.MODE_COLOUR]) + hdr_mode - recv + 1)
-                with m.Switch(cnum):
-                    for k in range(1, F.PACKET_FLITS):
-                        with m.Case(k):
-                            m.d.sync += pkt[k].eq(out.as_value())
-                m.d.sync += recv.eq(recv - 1)
-                with m.If((recv == 1) & keep):
-                    m.d.sync += pkt_valid.eq(1)
+        m.d.comb += ip.hold.eq(eol == 2)
+        eol_in = ip.eol
         # The next line's packet may enter the segment processor in the swap cycle itself: it
-        # starts on the ring the cycle after, when the memories have been exchanged.
+        # starts on the ring the cycle after, when the memories have been exchanged. The gate
+        # depends on the swap condition only, never on the loop's ready.
         swap = Signal()
-        m.d.comb += [loop.i.payload.eq(pkt),
-                     loop.i.valid.eq(pkt_valid & ((eol == 0) | ((eol == 1) & swap)))]
-        with m.If(loop.i.valid & loop.i.ready):
-            m.d.sync += pkt_valid.eq(0)
+        gate = (eol == 0) | ((eol == 1) & swap)
+        m.d.comb += [loop.i.payload.eq(ip.o.payload),
+                     loop.i.valid.eq(ip.o.valid & gate),
+                     ip.o.ready.eq(loop.i.ready & gate)]
 
         # ---- merge-bus reader: streams the merge-side buffer into the clock crossing.
         # The read port holds its data while not enabled, so it is the output register.
@@ -186,6 +147,6 @@ class ZbmChip(wiring.Component):
         m.d.sync += eol.eq(eol + eol_in - swap)
         with m.If(swap):
             m.d.sync += [q.eq(0), self.lines.eq(self.lines + 1)]
-        with m.If(self.i_seg.valid | (recv != 0) | pkt_valid | ~loop.idle | (eol != 0)):
+        with m.If(self.i_seg.valid | ip.busy | ~loop.idle | (eol != 0)):
             m.d.sync += self.busy_cycles.eq(self.busy_cycles + 1)
         return m

@@ -1,4 +1,4 @@
-"""Amaranth views of the ZB/M word formats defined in ``golden_model/zbm_formats.py``.
+"""Amaranth views of the ZB/M word formats defined in ``golden_model/zbm/formats.py``.
 
 The golden model is the contract: every ``data.StructLayout`` here is built from its
 :class:`~rasterhw.golden_model.zbm.formats.Layout` (same field order, widths, signedness,
@@ -14,7 +14,7 @@ from rasterhw.golden_model.zbm import formats as F
 
 __all__ = [
     "struct_of", "EP_HEADER", "EP_CHANNEL", "SEG_HEADER", "FLIT", "PKT_HEADER",
-    "SAMPLE", "PIXEL2", "LOOP_WORD",
+    "SAMPLE", "PIXEL2", "PACKET",
 ]
 
 
@@ -38,4 +38,6 @@ FLIT = struct_of(F.FLIT)                 # value, inc: signed 56, Q.24
 PKT_HEADER = struct_of(F.PKT_HEADER)     # x: u10, len: u10, y: u9, mode: u1, dx: u5
 SAMPLE = struct_of(F.SAMPLE)             # z: u24 (0 = near, 0xFFFFFF = empty), a, c0..c3: u8
 PIXEL2 = struct_of(F.PIXEL2, sub={"s0": SAMPLE, "s1": SAMPLE})   # s0 nearer or equal
-LOOP_WORD = unsigned(F.LOOP_BITS)        # one flit on the 112-bit segment loop
+#: one segment packet as the initial processor hands it over: 8 flits of the 112-bit loop,
+#: flit 0 = PKT_HEADER
+PACKET = data.ArrayLayout(unsigned(F.LOOP_BITS), F.PACKET_FLITS)

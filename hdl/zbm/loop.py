@@ -13,13 +13,11 @@ from amaranth import Module, Mux, Signal, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.hdl.zbm.layouts import PIXEL2, PKT_HEADER
+from rasterhw.hdl.zbm.layouts import PACKET, PIXEL2, PKT_HEADER
 from rasterhw.hdl.zbm.pixel import ZbmPixelProcessor
 
 __all__ = ["ZbmLoop", "PACKET", "LOOP_GAP"]
 
-#: one segment packet as the initial processor hands it over: 8 flits, flit 0 = PKT_HEADER
-PACKET = data.ArrayLayout(unsigned(F.LOOP_BITS), F.PACKET_FLITS)
 #: cycles between a packet's header entering the loop and the next header: len + LOOP_GAP
 #: (the paper's "waits len cycles, then 8 cycles from the start of input", sec. 6.1 cond. 6)
 LOOP_GAP = F.PACKET_FLITS

@@ -135,7 +135,7 @@ class ZbmSegmentGenerator(wiring.Component):
         word = Signal(range(F.EP_WORDS))
         r = Signal(range(cap + 1))           # read index of the emit pass (pairs read so far)
         w = Signal(range(cap + 1))           # write-back index (w <= r: in-place compaction)
-        off = Signal(unsigned(24))           # Q.12 distance from the left edge to the first centre
+        off = Signal(unsigned(24))           # Q.16 (OFF_FRAC) distance from the left edge to the first centre
         c = Signal(range(N_CH + 1))          # attribute channel being sent (2..)
         state = Signal(_State)
         n_attr = Mux(cur.mode == F.MODE_MAPPING, len(F.CHANNELS[F.MODE_MAPPING]),
@@ -215,7 +215,7 @@ class ZbmSegmentGenerator(wiring.Component):
                     m.d.comb += [self.o.valid.eq(1), hdr.y.eq(y), hdr.x.eq(s_cl),
                                  hdr.len.eq(e_cl - s_cl), hdr.mode.eq(cur.mode)]
                     with m.If(self.o.ready):
-                        # Q.12 offset from the edge to the first centre (>= 0)
+                        # Q.16 (OFF_FRAC) offset from the edge to the first centre (>= 0)
                         m.d.sync += [off.eq(((s_cl << F.X_FRAC) + half_x - xl) >> (F.X_FRAC - F.OFF_FRAC)),
                                      c.eq(2), state.eq(_State.FLIT)]
                 with m.Else():                               # empty after fill rule / clipping

@@ -147,7 +147,6 @@ def test_segment_generator_errors_and_stall():
     with pytest.raises(RasterhwError, match="height"):
         zbm.segment_generator(eps, 600)
     full = zbm.segment_generator(eps, 32, width=32)
-    assert full.stats["stall_lines"] == 0 and full.stats["segments_lost"] == 0
     assert full.stats["aep_max"] > 2
     # no loss: a stream needing more active pairs than the memory holds is an error that names
     # the line and the count; exactly at capacity it works and gives the same segments

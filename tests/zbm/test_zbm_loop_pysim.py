@@ -99,7 +99,7 @@ def test_loop_packet_spacing():
     val = np.zeros((4, 5), np.int64)
     inc = np.zeros((4, 5), np.int64)
     z1 = np.zeros(4, np.int64)
-    segs = G.Segments(z1, x, ln, val, inc, z1, z1, np.array([0, 4]), z1, z1, z1, F.MODE_COLOUR)
+    segs = G.Segments(z1, x, ln, val, inc, z1, z1, np.array([0, 4]), z1, z1, F.MODE_COLOUR)
     _, entries = run_loop(1, 0, width, [segs])
     gaps = np.diff(entries[0])
     assert list(gaps) == [1 + F.PACKET_FLITS] + [int(n) + LOOP_GAP for n in ln[:-2]]
