@@ -91,13 +91,13 @@ async def zbm_unit_frame(dut):
     await RisingEdge(dut.finished)
     meta = _write_result(dut, frames_ok=bool(to_int(dut.frames_ok)), overflow=bool(to_int(dut.overflow)))
     dut._log.info("unit bench: %s", meta)
-    if meta["overflow"] and os.environ.get("ZBM_EXPECT_OVERFLOW") == "1":
-        return
     assert not meta["overflow"], "a unit's active-edge-pair memory overflowed"
     assert not meta["timeout"], f"watchdog fired at {meta['cycles']} cycles"
     assert meta["proto_errors"] == 0, f"{meta['proto_errors']} stream-rule violations (Verilog checkers)"
     assert meta["frames_ok"], "a segment generator did not finish exactly one frame"
     if exp is None:
+        # no golden frame: only a speed run, which compares the dump in Python itself, may do this
+        assert os.environ.get("ZBM_SPEED_RUN") == "1", "no ZBM_EXPECT: nothing to compare against"
         return
     s0, s1 = exp["s0"], exp["s1"]
     h, w = s0.shape
@@ -135,6 +135,8 @@ async def zbm_chip_lines(dut):
     assert not meta["timeout"], f"watchdog fired at {meta['cycles']} cycles"
     assert meta["proto_errors"] == 0, f"{meta['proto_errors']} stream-rule violations (Verilog checkers)"
     if exp is None:
+        # no golden frame: only a speed run, which compares the dump in Python itself, may do this
+        assert os.environ.get("ZBM_SPEED_RUN") == "1", "no ZBM_EXPECT: nothing to compare against"
         return
     s0, s1 = exp["s0"], exp["s1"]
     rep = int(exp["repeat"])

@@ -256,6 +256,14 @@ class _pch_fix:
             os.environ["MAKEFLAGS"] = self.old
 
 
+def _expect_env(expect, speed_run: bool) -> dict:
+    """A bench run compares with the golden frame inside cocotb; without one it must be an
+    explicit speed run whose caller compares the dump itself (simulate_zbm, chip_speed)."""
+    if expect is None and not speed_run:
+        raise RasterhwError("ZB/M bench: give the golden frame (expect=) or say speed_run=True")
+    return {"ZBM_SPEED_RUN": "1"} if expect is None else {}
+
+
 def _depth(n: int) -> int:
     return max(1024, 1 << int(n + 2).bit_length())
 
@@ -264,7 +272,8 @@ def _depth(n: int) -> int:
 def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, interleave: int,
                    sim: str | None = None, capacity: int = F.AEP_CAPACITY, ratio: tuple[int, int] = (5, 5),
                    stall: int = 0, seed: int = 1, gap_seed: int | None = None,
-                   expect: tuple[np.ndarray, np.ndarray] | None = None, check_protocol: bool = False,
+                   expect: tuple[np.ndarray, np.ndarray] | None = None, speed_run: bool = False,
+                   check_protocol: bool = False,
                    keep: bool = False, phase: int = 1) -> dict:
     """Run a chain of units (unit k gets ``eps_per_unit[k]``) on the generated Verilog.
 
@@ -273,9 +282,11 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
     the random idle gaps before input words (None: none); ``phase`` = merge clock delay in ns
     (1, or 0 for speed runs: see :func:`_plusargs`).  With ``expect`` = (s0, s1) (H, W)
     golden words the cocotb test itself compares every scan line and (``check_protocol``)
-    runs the Python stream checkers and in-order scoreboards.
+    runs the Python stream checkers and in-order scoreboards. Without ``expect`` the caller must say
+    ``speed_run=True`` (it compares the returned dump itself); else RasterhwError.
     Returns ``{"s0", "s1": (H, W) uint64, "cycles", "proto_errors", "build_s", "run_s", ...}``.
     """
+    exp_env = _expect_env(expect, speed_run)   # before any work
     sim = get_sim(sim)
     units = len(eps_per_unit)
     t0 = time.perf_counter()
@@ -297,7 +308,7 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
     (run_dir / "index.hex").write_text("\n".join(f"{v:x}" for v in index) + "\n")
     out_path = run_dir / "frame.hex"
     env = {"ZBM_BENCH": "unit", "ZBM_OUT": str(out_path), "ZBM_CHECK_PROTOCOL": "1" if check_protocol else "0",
-           **_SIM_ENV}
+           **exp_env, **_SIM_ENV}
     if expect is not None:
         exp_path = run_dir / "expect.npz"
         np.savez(exp_path, s0=expect[0], s1=expect[1], interleave=interleave, units=units,
@@ -353,11 +364,13 @@ def chip_stimulus(segs: G.Segments, lines: int, upstream: G.DoubleZ, *, chip: in
 def run_chip_bench(seg_words: list[int], up_words: list[int], *, lines: int, chip: int, interleave: int,
                    width: int, sim: str | None = None, ratio: tuple[int, int] = (5, 5), stall: int = 0,
                    seed: int = 1, gap_seed: int | None = None, repeat: int = 1,
-                   expect: tuple[np.ndarray, np.ndarray] | None = None, check_protocol: bool = False,
+                   expect: tuple[np.ndarray, np.ndarray] | None = None, speed_run: bool = False,
+                   check_protocol: bool = False,
                    phase: int = 1) -> dict:
     """Run one ``zbm-chip`` on the generated Verilog (see :func:`run_unit_bench` for the knobs);
     ``repeat`` plays the stimulus that many times (speed runs).  Returns ``{"s0", "s1":
     (lines, npx) uint64 of the last repetition, "cycles", "lines", "proto_errors", "run_s", ...}``."""
+    exp_env = _expect_env(expect, speed_run)   # before any work
     from rasterhw.sim.verilog import generate_verilog
 
     sim = get_sim(sim)
@@ -375,7 +388,7 @@ def run_chip_bench(seg_words: list[int], up_words: list[int], *, lines: int, chi
     _write_hex(run_dir / "up.hex", up_words, g[len(seg_words):], F.PIXEL2.width)
     out_path = run_dir / "out.hex"
     env = {"ZBM_BENCH": "chip", "ZBM_OUT": str(out_path), "ZBM_CHECK_PROTOCOL": "1" if check_protocol else "0",
-           **_SIM_ENV}
+           **exp_env, **_SIM_ENV}
     if expect is not None:
         np.savez(run_dir / "expect.npz", s0=expect[0], s1=expect[1], repeat=repeat,
                  seg=np.array([f"{x:x}" for x in seg_words]), up=np.array([f"{x:x}" for x in up_words]))
@@ -415,7 +428,7 @@ def chip_speed(*, interleave: int = 8, width: int = 512, height: int = 512, scen
     up = G.DoubleZ.empty((height, npx))
     seg_w, up_w, exp = chip_stimulus(segs, height, up, chip=0, interleave=interleave, width=width)
     r = run_chip_bench(seg_w, up_w, lines=height, chip=0, interleave=interleave, width=width, sim=sim,
-                       repeat=repeat, phase=0)
+                       repeat=repeat, phase=0, speed_run=True)
     bad = int(np.count_nonzero((r["s0"] != exp[0]) | (r["s1"] != exp[1])))
     return {"block": "zbm-chip", "engine": sim, "interleave": interleave, "scene": scene, "repeat": repeat,
             "cycles": r["cycles"], "run_s": r["run_s"], "build_s": r["build_s"],
@@ -570,7 +583,9 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
         r = run_units_pysim(per_unit, width=width, height=height, interleave=interleave)
         sim_s, build_s = time.perf_counter() - t1, 0.0
     else:
-        r = run_unit_bench(per_unit, width=width, height=height, interleave=interleave, sim=engine, phase=0)
+        # compared with the golden frame below, in Python
+        r = run_unit_bench(per_unit, width=width, height=height, interleave=interleave, sim=engine, phase=0,
+                           speed_run=True)
         sim_s, build_s = r["run_s"], r["prepare_s"] + r["build_s"]
         if r.get("timeout"):
             raise RasterhwError(f"ZB/M {engine}: the bench's watchdog fired after {r['cycles']} cycles")

@@ -74,3 +74,13 @@ def test_float_tolerance_when_last_triangles_cover_no_pixel():
     float-tolerance check must still size its per-triangle table by every edge-pair tag."""
     res = Z.simulate_zbm(build_scene("c50"), 16, 16, interleave=1, engine="pysim")
     assert res["mismatches"] == 0 and res["pixels_compared"] == 256
+
+
+def test_bench_without_golden_frame_must_say_speed_run():
+    """A cocotb bench run with nothing to compare against is refused unless it is an explicit
+    speed run whose caller compares the dump itself."""
+    with pytest.raises(RasterhwError, match="speed_run"):
+        Z.run_chip_bench([0], [0], lines=1, chip=0, interleave=1, width=8, sim="verilator")
+    with pytest.raises(RasterhwError, match="speed_run"):
+        Z.run_unit_bench([G.edge_pairs(random_triangles(np.random.default_rng(0), 2, 8, 8))], width=8,
+                         height=8, interleave=1, sim="verilator")

@@ -35,6 +35,6 @@ def test_fast_chip_matches_golden_and_cocotb_cycles():
     assert int(np.count_nonzero((fast["s0"] != exp[0]) | (fast["s1"] != exp[1]))) == 0
     assert fast["lines"] == (2 * H) % (1 << 16) and fast["cycles"] > 0
     ref = Z.run_chip_bench(seg_w, up_w, lines=H, chip=CHIP, interleave=ILV, width=W, sim="verilator",
-                           ratio=(5, 5), stall=0, repeat=2, phase=0)
+                           ratio=(5, 5), stall=0, repeat=2, phase=0, expect=exp)
     assert np.array_equal(ref["s0"], exp[0]) and np.array_equal(ref["s1"], exp[1])
     assert fast["cycles"] == ref["cycles"]
