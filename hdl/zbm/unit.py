@@ -8,10 +8,11 @@ interleave slot. The head unit (``head=True``) feeds its chips empty pixels itse
 
 from __future__ import annotations
 
-from amaranth import Module, Mux, Signal, unsigned
+from amaranth import Module, Mux, unsigned
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
+from rasterhw.hdl.broadcast import StreamBroadcast
 from rasterhw.hdl.zbm.chip import ZbmChip
 from rasterhw.hdl.zbm.layouts import PIXEL2
 from rasterhw.hdl.zbm.pixel import EMPTY_PIXEL2
@@ -94,22 +95,17 @@ class ZbmUnit(wiring.Component):
                                                        capacity=self._capacity)
         wiring.connect(m, wiring.flipped(self.i), sg.i)
         chips = [ZbmChip(interleave=n, chip=c, width=self._width) for c in range(n)]
-        all_ready = Signal()
-        readies = []
+        m.submodules.broadcast = bc = StreamBroadcast(sg.o.payload.shape(), n=n)
+        wiring.connect(m, sg.o, bc.i)
         for c, chip in enumerate(chips):
             m.submodules[f"chip{c}"] = chip
-            readies.append(chip.i_seg.ready)
-            m.d.comb += [chip.i_seg.payload.eq(sg.o.payload), chip.i_seg.valid.eq(sg.o.valid & all_ready)]
+            wiring.connect(m, bc.o[c], chip.i_seg)
             wiring.connect(m, chip.o_merge, wiring.flipped(self.o_merge[c]))
             if self._head:
                 m.d.comb += [chip.i_merge.valid.eq(1),
                              chip.i_merge.payload.eq(PIXEL2.const(EMPTY_PIXEL2))]
             else:
                 wiring.connect(m, wiring.flipped(self.i_merge[c]), chip.i_merge)
-        ready_and = readies[0]
-        for rdy in readies[1:]:
-            ready_and = ready_and & rdy
-        m.d.comb += [all_ready.eq(ready_and), sg.o.ready.eq(ready_and)]
         m.d.comb += [self.cycles.eq(chips[0].cycles), self.frames.eq(sg.frames),
                      self.overflow.eq(sg.overflow)]
         low = chips[0].lines
