@@ -84,16 +84,18 @@ class ZbmMerger(wiring.Component):
         width = self._layout.size
         m.submodules.cdc = cdc = fifo.AsyncFIFO(width=width, depth=self._fifo_depth,
                                                 w_domain="sync", r_domain="merge")
+        # the FIFO's streams carry the raw word: the same stream, viewed as its layout here
+        w, r = cdc.w_stream, cdc.r_stream
         m.d.comb += [
-            cdc.w_data.eq(self.i_own.payload.as_value()),
-            cdc.w_en.eq(self.i_own.valid),
-            self.i_own.ready.eq(cdc.w_rdy),
+            w.payload.eq(self.i_own.payload.as_value()),
+            w.valid.eq(self.i_own.valid),
+            self.i_own.ready.eq(w.ready),
         ]
-        own = data.View(self._layout, cdc.r_data)
+        own = data.View(self._layout, r.payload)
         # Output register stage (stream docs' template): load when empty or being taken.
         take = Signal()
-        m.d.comb += take.eq(cdc.r_rdy & self.i_merge.valid & (~self.o_merge.valid | self.o_merge.ready))
-        m.d.comb += [cdc.r_en.eq(take), self.i_merge.ready.eq(take)]
+        m.d.comb += take.eq(r.valid & self.i_merge.valid & (~self.o_merge.valid | self.o_merge.ready))
+        m.d.comb += [r.ready.eq(take), self.i_merge.ready.eq(take)]
         with m.If(self.o_merge.ready):
             m.d.merge += self.o_merge.valid.eq(0)
         with m.If(take):
