@@ -249,40 +249,57 @@ class PixelBusBank(wiring.Component):
         return m
 
 
-class _Ram:
-    """Signals of one bank RAM: a write port and two synchronous read ports."""
-
-    def __init__(self, width: int, addr_bits: int, name: str) -> None:
-        self.wr_addr = Signal(addr_bits, name=f"{name}_wr_addr")
-        self.wr_data = Signal(width, name=f"{name}_wr_data")
-        self.wr_en = Signal(name=f"{name}_wr_en")
-        self.rd0_addr = Signal(addr_bits, name=f"{name}_rd0_addr")
-        self.rd0_en = Signal(name=f"{name}_rd0_en")
-        self.rd0_data = Signal(width, name=f"{name}_rd0_data")
-        self.rd1_addr = Signal(addr_bits, name=f"{name}_rd1_addr")
-        self.rd1_data = Signal(width, name=f"{name}_rd1_data")
+def bank_ram_signature(width: int, addr_bits: int) -> wiring.Signature:
+    """One bank RAM as the bank controller sees it: a write port and two synchronous read
+    ports (port 0 with an enable, port 1 always reading)."""
+    return wiring.Signature({
+        "wr_addr": In(addr_bits), "wr_data": In(width), "wr_en": In(1),
+        "rd0_addr": In(addr_bits), "rd0_en": In(1), "rd0_data": Out(width),
+        "rd1_addr": In(addr_bits), "rd1_data": Out(width),
+    })
 
 
-def _ram(m: Module, name: str, *, width: int, depth: int, addr_bits: int, ram: str) -> _Ram:
-    r = _Ram(width, addr_bits, name)
-    if ram == "memory":
-        mem = memory.Memory(shape=unsigned(width), depth=depth, init=[])
-        m.submodules[name] = mem
-        wr = mem.write_port()
-        rd0 = mem.read_port()
-        rd1 = mem.read_port()
+class _BankRamMemory(wiring.Component):
+    """:func:`bank_ram_signature` on an Amaranth ``Memory`` (pysim, small frames)."""
+
+    def __init__(self, width: int, depth: int, addr_bits: int) -> None:
+        self._width, self._depth = width, depth
+        super().__init__(bank_ram_signature(width, addr_bits))
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.mem = mem = memory.Memory(shape=unsigned(self._width), depth=self._depth, init=[])
+        wr, rd0, rd1 = mem.write_port(), mem.read_port(), mem.read_port()
         m.d.comb += [
-            wr.addr.eq(r.wr_addr), wr.data.eq(r.wr_data), wr.en.eq(r.wr_en),
-            rd0.addr.eq(r.rd0_addr), rd0.en.eq(r.rd0_en), r.rd0_data.eq(rd0.data),
-            rd1.addr.eq(r.rd1_addr), r.rd1_data.eq(rd1.data),
+            wr.addr.eq(self.wr_addr), wr.data.eq(self.wr_data), wr.en.eq(self.wr_en),
+            rd0.addr.eq(self.rd0_addr), rd0.en.eq(self.rd0_en), self.rd0_data.eq(rd0.data),
+            rd1.addr.eq(self.rd1_addr), self.rd1_data.eq(rd1.data),
         ]
-    else:
-        m.submodules[name] = Instance(
+        return m
+
+
+class _BankRamVerilog(wiring.Component):
+    """:func:`bank_ram_signature` on the hand-written :data:`RAM_VERILOG` model (large frames:
+    no multi-megabyte initial value in the netlist)."""
+
+    def __init__(self, width: int, depth: int, addr_bits: int) -> None:
+        self._width, self._depth, self._addr_bits = width, depth, addr_bits
+        super().__init__(bank_ram_signature(width, addr_bits))
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.ram = Instance(
             "rasterhw_pixelbus_ram",
-            p_WIDTH=width, p_DEPTH=depth, p_ABITS=addr_bits,
+            p_WIDTH=self._width, p_DEPTH=self._depth, p_ABITS=self._addr_bits,
             i_clk=ClockSignal(),
-            i_wr_addr=r.wr_addr, i_wr_data=r.wr_data, i_wr_en=r.wr_en,
-            i_rd0_addr=r.rd0_addr, i_rd0_en=r.rd0_en, o_rd0_data=r.rd0_data,
-            i_rd1_addr=r.rd1_addr, o_rd1_data=r.rd1_data,
+            i_wr_addr=self.wr_addr, i_wr_data=self.wr_data, i_wr_en=self.wr_en,
+            i_rd0_addr=self.rd0_addr, i_rd0_en=self.rd0_en, o_rd0_data=self.rd0_data,
+            i_rd1_addr=self.rd1_addr, o_rd1_data=self.rd1_data,
         )
+        return m
+
+
+def _ram(m: Module, name: str, *, width: int, depth: int, addr_bits: int, ram: str) -> wiring.Component:
+    r = (_BankRamMemory if ram == "memory" else _BankRamVerilog)(width, depth, addr_bits)
+    m.submodules[name] = r
     return r
