@@ -23,11 +23,11 @@ import math
 from fractions import Fraction
 
 import numpy as np
-from rasterhw.golden_model.screen import ScreenTriangles
+from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles
 
 __all__ = ["brute_coverage", "brute_visible"]
 
-GRID = 256
+GRID = 1 << SUBPIXEL_BITS   # the convention (screen.py); the arithmetic below is our own
 
 
 def _snap(v: float) -> int:

@@ -2,7 +2,7 @@
 
 Driven by ``rasterhw.sim.zbm.driver`` (``run_unit_bench`` / ``run_chip_bench``), which writes the
 stimulus, the golden result and the plusargs (clock ratio, back-pressure, seed); run them
-with ``pytest tests/test_zbm_cocotb.py``.  The designs run free on Verilog-side clocks;
+with ``pytest tests/zbm/test_zbm_cocotb.py``.  The designs run free on Verilog-side clocks;
 Python only waits for ``finished`` unless ZBM_CHECK_PROTOCOL=1, which adds the stream
 checker of ``cocotb_tests/common.py`` on every stream (each clock; small runs) feeding
 in-order scoreboards.  The Verilog checkers (zbm_check.v) run always.

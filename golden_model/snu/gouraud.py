@@ -29,7 +29,7 @@ What this module does (decisions the paper leaves open are marked *ours*; see
   ``dA/dy + (cs(row+1) - cs(row)) * dA/dx`` (integer adds), **inner loop** (per pixel): the
   8 operations of :data:`INNER_LOOP`. Both loops are evaluated in closed form
   (``start + k * inc`` in ``np.int64``), which is bit-identical to the repeated adds because
-  integer addition is exact; ``tests/test_snu_gouraud.py`` checks this against a literal loop;
+  integer addition is exact; ``tests/snu/test_snu_gouraud.py`` checks this against a literal loop;
 * **output** -- the 8-bit channels and the ``z_bits`` Z are the accumulators' integer parts,
   masked to their widths as the hardware store would (no clamp: no clamp is in the paper's
   8-operation loop; with ``frac_bits >= 12`` the error bound keeps every covered pixel in

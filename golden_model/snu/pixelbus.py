@@ -1,6 +1,6 @@
 """SNU pixel-bus controller: bit-accurate frame buffer and cycle model (NumPy only).
 
-Mirrors ``hdl/pixelbus.py`` (``PixelBus``) and ``hdl/pixelbus_bank.py`` (``PixelBusBank``):
+Mirrors ``hdl/snu/pixelbus.py`` (``PixelBus``) and ``hdl/snu/pixelbus_bank.py`` (``PixelBusBank``):
 
 * one clock = one 80 ns bus slot (12.5 MHz); slot ``t`` belongs to pipeline ``t % 2``
   (fixed time slots, no arbitration; an empty slot is wasted);

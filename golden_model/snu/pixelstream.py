@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.snu.formats import RGB_BITS, Z_BITS
 
 __all__ = ["PixelStream"]
 
@@ -33,7 +34,7 @@ class PixelStream:
     rgb: np.ndarray
     z: np.ndarray
     pipe: np.ndarray
-    z_bits: int = 24
+    z_bits: int = Z_BITS
 
     def __post_init__(self) -> None:
         self.addr = np.ascontiguousarray(self.addr, dtype=np.int64)
@@ -57,7 +58,7 @@ class PixelStream:
         if n and (self.z.min() < 0 or self.z.max() >= (1 << self.z_bits)):
             bad = int(self.z[(self.z < 0) | (self.z >= (1 << self.z_bits))][0])
             raise RasterhwError(f"pixel stream: Z value {bad} does not fit in {self.z_bits} bits")
-        if n and (self.rgb.min() < 0 or self.rgb.max() >= (1 << 24)):
-            raise RasterhwError("pixel stream: an RGB value does not fit in 24 bits")
+        if n and (self.rgb.min() < 0 or self.rgb.max() >= (1 << RGB_BITS)):
+            raise RasterhwError(f"pixel stream: an RGB value does not fit in {RGB_BITS} bits")
         if n and (self.pipe.min() < 0 or self.pipe.max() >= n_pipes):
             raise RasterhwError(f"pixel stream: pipeline index outside 0..{n_pipes - 1}")

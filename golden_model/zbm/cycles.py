@@ -166,12 +166,12 @@ def _line_entries(eps: EdgePairs, segs, height: int) -> list[list[tuple[int, int
 
 def hdl_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: int = 8,
                capacity: int = AEP_CAPACITY, max_cycles: int = 10_000_000) -> dict:
-    """Cycle-exact count of one ``hdl/zbm_unit.py`` unit on ``eps`` (one frame).
+    """Cycle-exact count of one ``hdl/zbm/unit.py`` unit on ``eps`` (one frame).
 
     A cycle-stepped model of the control of ``ZbmSegmentGenerator``, the unit's broadcast
     and each ``ZbmChip`` (initial processor, segment processor and ring spacing, line swap,
     merge-bus reader); data values are not modelled. Assumptions (as the tests and
-    ``sim/zbm_cycles_hdl.py`` run it): the edge-pair words are offered one per cycle from
+    ``sim/zbm/cycles_hdl.py`` run it): the edge-pair words are offered one per cycle from
     cycle 0 (word k readable in cycle ``k + FIFO_LATENCY`` at the earliest), the merge outputs
     are always ready and the merge clock equals the segment clock (the merge-bus reader never
     waits). Returns ``cycles`` = the first cycle in which every chip has swapped the last

@@ -24,6 +24,7 @@ from rasterhw.golden_model.zbm.formats import (
     ONE_A,
     ONE_X,
     SUB,
+    SUBPIX_BITS,
     TEX,
     VAL_LIMIT,
     X_FRAC,
@@ -184,12 +185,12 @@ def edge_pairs(tris: ScreenTriangles, *, mode: int = MODE_COLOUR, alpha=None) ->
         hk = (r1 - r0)[idx]
 
         def edge_x(xa, ya, xb, yb, Yc=Yc, hk=hk):
-            # x = n / (256 dy) px -> Q.40 = floor(n * 2**32 / dy); dx/dy -> floor(dX * 2**40 / dy).
+            # x = n / (SUB dy) px -> Q.40 = floor(n * 2**(X_FRAC - SUBPIX_BITS) / dy); dx/dy -> floor(dX * 2**40 / dy).
             # dx/dy is only used when h >= 2, and then dy > 1 px, so |dx/dy| < 4096 fits the slot;
             # a one-line pair carries dx/dy = 0.
             dy = yb - ya
             n = xa * dy + (Yc - ya) * (xb - xa)
-            return _divfloor(n, dy, 32), np.where(hk >= 2, _divfloor(xb - xa, dy, X_FRAC), 0)
+            return _divfloor(n, dy, X_FRAC - SUBPIX_BITS), np.where(hk >= 2, _divfloor(xb - xa, dy, X_FRAC), 0)
 
         xl, dxl = edge_x(LXa[idx], LYa[idx], LXb[idx], LYb[idx])
         xr, dxr = edge_x(RXa[idx], RYa[idx], RXb[idx], RYb[idx])

@@ -1,6 +1,6 @@
 """ZB/M fixed-point formats: every field the hardware carries, in hardware order.
 
-This file is the contract between the golden model (``golden_model/zbm.py``) and the HDL
+This file is the contract between the golden model (``golden_model/zbm/``) and the HDL
 (``hdl/zbm_*.py``): the same widths, fractional bits, signedness, rounding and bit order.
 Words are packed **LSB first**: the first field of a layout sits in bit 0.
 
@@ -292,6 +292,8 @@ def unpack_samples(w) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 # ---------------------------------------------------------------- derived constants
+PP_BITS = PP_PER_CHIP.bit_length() - 1         # pixel-processor index bits (8 -> 3)
+FLIT_BITS = PACKET_FLITS.bit_length() - 1      # flit index bits within a packet (8 -> 3)
 SUB = 1 << SUBPIX_BITS          # sub-pixel grid, 256
 HALF_SUB = SUB // 2
 ONE_X = 1 << X_FRAC

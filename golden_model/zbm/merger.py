@@ -16,7 +16,7 @@ __all__ = ["merge", "merge_chain"]
 def merge(a: DoubleZ, b: DoubleZ) -> DoubleZ:
     """Merger: nearest 2 of ``a``'s 2 and ``b``'s 2 samples; ``a`` (upstream input) wins ties.
 
-    Same selection as ``hdl/zbm_merger.py``'s ``merge_words``: ``s0 = a0 if a0.z <= b0.z else
+    Same selection as ``hdl/zbm/merger.py``'s ``merge_words``: ``s0 = a0 if a0.z <= b0.z else
     b0``
     ``s1`` the nearer of (a1, b0) or of (a0, b1), upstream first on equal Z. Equivalent to
     a stable sort of (a0, a1, b0, b1) by Z, so chaining is associative.

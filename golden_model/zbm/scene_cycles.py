@@ -3,7 +3,7 @@
 The paper's Table 1 (seed 003, sec. 6.1) assumes every polygon becomes 2 edge pairs of 5 lines
 x 5 pixels. This module runs real scenes through the golden geometry pipeline
 (:func:`.pipeline.run_geometry`), the level-1 edge-pair split (:func:`.zbm.edge_pairs`) and the
-event-level cycle model (:func:`.zbm_cycles.event_cycles`) and reports, per scene and
+event-level cycle model (:func:`rasterhw.golden_model.zbm.cycles.event_cycles`) and reports, per scene and
 interleave: edge pairs per polygon, lines per edge pair, the segment-length distribution,
 cycles per edge pair and polygons/s at 25 MHz.
 
@@ -199,7 +199,7 @@ def scene_rows(scene, *, interleaves: Iterable[int] = INTERLEAVES, level: str = 
                      "paper_cycles_per_edge_pair": formula_cycles_per_edge_pair(i),
                      "paper_kpolys": PAPER_TABLE1_KPOLYS[i]})
         if hdl:
-            # cycle-exact model of hdl/zbm_unit.py (whole frame, merge readout included)
+            # cycle-exact model of hdl/zbm/unit.py (whole frame, merge readout included)
             hc = int(zbm_cycles.hdl_cycles(eps, height, width=width, interleave=i)["cycles"])
             rows[-1].update({"hdl_cycles": hc, "hdl_cycles_per_edge_pair": hc / max(n_eps, 1),
                              "kpolys_hdl": kp(hc)})
@@ -227,8 +227,8 @@ def scene_table(scenes=("zbm-5x5", "c300", "sp27"), interleaves=(1, 2, 4, 8, 16)
     ``kpolys_loop`` (K polygons/s from the loop cycles), ``kpolys_loop_skew`` (same / 2, the
     paper's cond. 7, comparable to Table 1), ``kpolys_frame``/``kpolys_frame_skew`` (including
     the merge readout), and the paper's formula and Table 1 values for the interleave.
-    With ``hdl=True`` also ``hdl_cycles`` (``zbm_cycles.hdl_cycles``: the cycle-exact model of
-    ``hdl/zbm_unit.py``, whole frame incl. merge readout, ~1 s per row), its per-pair value and
+    With ``hdl=True`` also ``hdl_cycles`` (``zbm.cycles.hdl_cycles``: the cycle-exact model of
+    ``hdl/zbm/unit.py``, whole frame incl. merge readout, ~1 s per row), its per-pair value and
     ``kpolys_hdl``.
     """
     if isinstance(scenes, (str, Scene)):

@@ -110,14 +110,14 @@ class ZbmLoop(wiring.Component):
         with m.If(wait != 0):
             m.d.sync += wait.eq(wait - 1)
         with m.If(start):
-            m.d.sync += [inj_pp.eq((hdr.x >> lg)[:3]), wait.eq(hdr.len + LOOP_GAP - 1)]
+            m.d.sync += [inj_pp.eq((hdr.x >> lg)[:F.PP_BITS]), wait.eq(hdr.len + LOOP_GAP - 1)]
         with m.If(injecting):
             m.d.sync += inj.eq(inj + 1)
             with m.If(inj == F.PACKET_FLITS - 1):
                 m.d.sync += [full.eq(0), inj.eq(0)]
-        cur_pp = Mux(start, (hdr.x >> lg)[:3], inj_pp)
+        cur_pp = Mux(start, (hdr.x >> lg)[:F.PP_BITS], inj_pp)
         flit = Signal(unsigned(F.LOOP_BITS))
-        m.d.comb += flit.eq(buf[inj[:3]])
+        m.d.comb += flit.eq(buf[inj[:F.FLIT_BITS]])
 
         # ---- the ring: processor k's input is k-1's output unless the segment processor injects
         for k, pp in enumerate(pps):
@@ -125,10 +125,10 @@ class ZbmLoop(wiring.Component):
             here = injecting & (cur_pp == k)
             m.d.comb += [
                 pp.i_loop.valid.eq(Mux(here, 1, prev.valid)),
-                pp.i_loop.idx.eq(Mux(here, inj[:3], prev.idx)),
+                pp.i_loop.idx.eq(Mux(here, inj[:F.FLIT_BITS], prev.idx)),
                 pp.i_loop.flit.eq(Mux(here, flit, prev.flit)),
                 pp.swap.eq(self.swap),
-                pp.mb_addr.eq(self.mb_addr >> 3),
+                pp.mb_addr.eq(self.mb_addr >> F.PP_BITS),
                 pp.mb_rd.eq(self.mb_rd & (self.mb_addr[:3] == k)),
             ]
         m.d.comb += self.idle.eq(~full & (wait == 0))

@@ -11,10 +11,10 @@ Bit-exact with ``golden_model.zbm.segment_generator`` (same per-line order: load
 in memory order, step, store back the pairs still needed).
 
 Input protocol: edge-pair records of 9 words (``EP_HEADER`` + 8 ``EP_CHANNEL``, 168 bits each,
-:func:`golden_model.zbm_formats.pack_edge_pair`) in FIFO order (top lines non-decreasing);
+:func:`golden_model.zbm.formats.pack_edge_pair`) in FIFO order (top lines non-decreasing);
 an ``EP_HEADER`` word with ``h == 0`` (and no channel words) ends the frame. Output: the
 chip segment-input records (``SEG_HEADER`` + channel ``FLIT`` words) of every line, each line
-closed by an end-of-line ``SEG_HEADER`` with ``len == 0`` (see ``hdl/zbm_chip.py``).
+closed by an end-of-line ``SEG_HEADER`` with ``len == 0`` (see ``hdl/zbm/chip.py``).
 """
 
 from __future__ import annotations
@@ -83,7 +83,7 @@ class ZbmSegmentGenerator(wiring.Component):
     figure; the record is appended with the 9th word; a load that follows another overlaps
     its header word with the CHECK) + per active pair ``1 + channels`` words if its segment is
     non-empty, else 1 cycle (the pair's write-back and the read of the next pair happen with
-    its last word) + 1 end-of-line word. ``golden_model.zbm_cycles.hdl_cycles`` counts this.
+    its last word) + 1 end-of-line word. ``golden_model.zbm.cycles.hdl_cycles`` counts this.
     """
 
     def __init__(self, *, width: int = F.MAX_WIDTH, height: int = F.MAX_HEIGHT,

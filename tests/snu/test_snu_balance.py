@@ -1,5 +1,5 @@
-"""SNU table 1 / stage balance (golden_model/snu_balance.py) and PHIGS traversal
-(golden_model/snu_traversal.py)."""
+"""SNU table 1 / stage balance (golden_model/snu/balance.py) and PHIGS traversal
+(golden_model/snu/traversal.py)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""SNU Gouraud scan converter (golden_model/snu_gouraud.py): coverage, values, order, errors."""
+"""SNU Gouraud scan converter (golden_model/snu/gouraud.py): coverage, values, order, errors."""
 
 from __future__ import annotations
 

@@ -5,7 +5,7 @@ Each run uses random idle gaps on every input stream, seeded random back-pressur
 output stream, a segment:merge clock ratio (half periods in ns), the Python stream checker of
 cocotb_tests/common.py on every stream feeding in-order scoreboards (which must end empty),
 the Verilog stream checkers, and compares every scan line bit for bit (both samples, Z and
-colour) with golden_model/zbm.py.  Frames are 64x16.  From cold build folders the default set
+colour) with golden_model/zbm/.  Frames are 64x16.  From cold build folders the default set
 (not ``slow``) takes about 70 s here (Verilator builds: unit ~28 s, chip ~21 s); later runs
 reuse build/.
 """

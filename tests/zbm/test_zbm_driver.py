@@ -1,4 +1,4 @@
-"""simulate_zbm (sim/zbm.py) on a tiny scene in Amaranth pysim, and its input checks."""
+"""simulate_zbm (sim/zbm/driver.py) on a tiny scene in Amaranth pysim, and its input checks."""
 
 from __future__ import annotations
 

@@ -348,7 +348,7 @@ def test_event_model_rules():
 
 def test_hdl_cycle_model_steady_state():
     """hdl_cycles on the paper's workload: per extra edge pair 4 (len_chip + 8) + max(len_chip + 8, 18)
-    (docs/zbm.md, HDL); HDL equality is tested in tests/test_zbm_unit_pysim.py."""
+    (docs/zbm.md, HDL); HDL equality is tested in tests/zbm/test_zbm_unit_pysim.py."""
     for i in fmt.INTERLEAVES:
         w = max(4 * i, 8)
         a = cyc.hdl_cycles(cyc.paper_workload(4, width=w), 20, width=w, interleave=i)["cycles"]

@@ -85,7 +85,7 @@ def test_unit_bad_parameters():
 
 @pytest.mark.parametrize("interleave,seed", [(1, 0), (2, 1), (8, 2)])
 def test_cycle_model_is_exact(interleave, seed):
-    """HDL cycles == golden_model.zbm_cycles.hdl_cycles on random small streams (empty and
+    """HDL cycles == golden_model.zbm.cycles.hdl_cycles on random small streams (empty and
     clipped segments, several pairs per line, loads on many lines)."""
     w, h = 8 * interleave if interleave > 1 else 24, 10
     rng = np.random.default_rng(seed)
@@ -125,6 +125,6 @@ def test_cycles_per_edge_pair_sweep(interleave):
     assert r["marginal_cycles_per_edge_pair"] == 4 * (lc + 8) + max(lc + 8, 18)
 
 
-if __name__ == "__main__":    # python tests/test_zbm_unit_pysim.py -> the Table 1 measurement
+if __name__ == "__main__":    # python tests/zbm/test_zbm_unit_pysim.py -> the Table 1 measurement
     for i in F.INTERLEAVES:
         print(measure_cycles_per_edge_pair(i))
