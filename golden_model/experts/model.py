@@ -48,6 +48,7 @@ class ExpertsFrame:
     records: slp.Records
     lines: dict                 # per-line SLP counts (slp.l_sort_x_merge)
     costs: dict                 # per-pixel PXP counts (pxp.pixel_costs)
+    win: np.ndarray | None = None   # (H*W,) winning record per pixel, -1 empty
     aj_pixels: int = 0
     fragments: int = 0
     stats: dict = field(default_factory=dict)
@@ -80,9 +81,21 @@ def render_frame(tris: ScreenTriangles, *, model: str = "float", aj: str = "none
     poly = np.where(win >= 0, st.poly[rec.tri[np.maximum(win, 0)]], -1).reshape(H, W)
     return ExpertsFrame(width=W, height=H, model=model, aj=aj, rgb8=pxp.to_rgb8(st, fields, H, W),
                         fields=fields, tri_id=tri_id, poly_id=poly, setup=st, records=rec, lines=lines,
-                        costs=costs, aj_pixels=info["pixels"] if info else 0, fragments=fr["F"],
+                        costs=costs, win=win, aj_pixels=info["pixels"] if info else 0, fragments=fr["F"],
                         stats={"sat_dzdx": st.sat_dzdx, "sat_didx": st.sat_didx,
-                               "triangles": int(tris.n_triangles), "kept": st.n})
+                               "triangles": int(tris.n_triangles), "kept": st.n,
+                               "crossings": crossings(rec, win, W, H)})
+
+
+def crossings(rec: slp.Records, win: np.ndarray, W: int, H: int) -> int:
+    """Visible-surface changes inside both segments (neither ends nor starts there): where
+    interpenetrating faces cross on a scan line."""
+    w2 = win.reshape(H, W)
+    a, b = w2[:, :-1], w2[:, 1:]
+    yy, xx = np.nonzero((a != b) & (a >= 0) & (b >= 0))
+    ra, rb = a[yy, xx], b[yy, xx]
+    inside = (rec.c1[ra] > xx) & (rec.c0[rb] < xx + 1)
+    return int(np.count_nonzero(inside))
 
 
 def equal_bounds(n: int, parts: int) -> np.ndarray:
@@ -119,7 +132,8 @@ def slp_line_costs(fr: ExpertsFrame, pn: int) -> tuple[np.ndarray, np.ndarray]:
     common = ln["m"] + pn + ASB_WORDS * ln["m"] + 2 * pn + slp.SLP_OPS["mid_reload"] * mid
     cont = (common + per_tri * enter_tris + slp.SLP_OPS["update_per_segment"] * ln["survive"]
             + ln["lsort"] + ln["xmerge"])
-    start = common + per_tri * ln["m"] + ln["xmerge_start"]
+    # on a band's first line the short side's edge is chosen directly: no reload
+    start = common - slp.SLP_OPS["mid_reload"] * mid + per_tri * ln["m"] + ln["xmerge_start"]
     return cont.astype(np.int64), start.astype(np.int64)
 
 
