@@ -108,3 +108,34 @@ def line_segments(n: int = 8, *, width: int = 512, height: int = 512, seed: int 
     order = np.argsort(pid, kind="stable")
     return ScreenTriangles(width=width, height=height, xy=xy[order], z=z[order],
                            zq=np.rint(z[order] * 65535).astype(np.int64), colour=col[order], poly_id=pid[order])
+
+
+def tolerance(tris: ScreenTriangles) -> dict:
+    """Bit model against float model on one frame: how many pixels differ, and why.
+
+    A pixel whose visible triangle differs is put down to **x** (16-bit vertex and edge x:
+    Q10.6 vertices, edge stepping) when the two models do not agree on which triangles cover it,
+    and to **z** (16-bit depth: Q16.0 zL, sQ11.4 dz/dx, the 16-bit comparator and its tie rule)
+    when they agree on the cover but pick a different nearest one.
+    """
+    from . import pxp
+    from .model import render_frame
+    fl, bt = render_frame(tris, model="float"), render_frame(tris, model="bit")
+    npix = fl.width * fl.height
+    T = int(tris.n_triangles) + 1
+
+    def pairs(f):
+        fr = pxp.fragments(f.setup, f.records, f.width)
+        return fr["pix"] * T + f.setup.keep[f.records.tri[fr["rec"]]]
+
+    pf, pb = pairs(fl), pairs(bt)
+    both = fl.covered & bt.covered
+    diff = np.flatnonzero((both & (fl.tri_id != bt.tri_id)).ravel())
+    tf, tb = fl.tri_id.ravel()[diff], bt.tri_id.ravel()[diff]
+    same_cover = np.isin(diff * T + tf, pb) & np.isin(diff * T + tb, pf)
+    zt = int(np.count_nonzero(same_cover))
+    # z ties: the bit model's 16-bit keys of the two candidates are equal
+    return {"pixels": npix, "covered": int(fl.covered.sum()),
+            "cover_diff": int(np.count_nonzero(fl.covered != bt.covered)),
+            "visible_diff": int(diff.size), "visible_diff_x": int(diff.size - zt), "visible_diff_z": zt,
+            "sat_dzdx": bt.stats["sat_dzdx"], "sat_didx": bt.stats["sat_didx"]}
