@@ -313,6 +313,15 @@ def _build_experts(fr: int) -> Callable[[int], Scene]:
     return build
 
 
+def _experts_builder(fn: str, *args) -> Callable[[int], Scene]:
+    """An EXPERTS builder from golden_model/experts/scenes.py, imported when first used."""
+    def build(seed: int) -> Scene:
+        from .experts import scenes as ex
+        f = getattr(ex, fn)
+        return (f(*args) if args else f)(seed)
+    return build
+
+
 def _info(name, desc, size, builder, seed, polygons) -> SceneInfo:
     return SceneInfo(name, desc, size[0], size[1], builder, seed, polygons)
 
@@ -341,6 +350,22 @@ SCENES: dict[str, SceneInfo] = {
                           (512, 512), _build_experts(1000), 1000, 1000),
     "experts-2000": _info("experts-2000", "Fr = 2000 front-facing triangles at depth complexity 3 (EXPERTS fig. 4.1)",
                           (512, 512), _build_experts(2000), 2000, 2000),
+    # EXPERTS: tilted, interpenetrating faces (same Fr, Dc), table 2.1's solids, an uneven load
+    # (builders in golden_model/experts/scenes.py, imported when a scene is built)
+    **{
+        f"experts-tilt-{fr}": _info(f"experts-tilt-{fr}", f"Fr = {fr} tilted, interpenetrating triangles at Dc = 3 "
+                                    "(EXPERTS fig. 4.1)", (512, 512), _experts_builder("build_tilt", fr), fr, fr)
+        for fr in (1000, 2000)
+    },
+    **{
+        f"experts-solid-{k}": _info(f"experts-solid-{k}", f"EXPERTS table 2.1 solid with {k} visible edges",
+                                    (512, 512), _experts_builder("build_solid", str(k)), 21, n)
+        for k, n in ((5, 4), (9, 6), (15, 9), (20, 12))
+    },
+    "experts-solids": _info("experts-solids", "the four solids of EXPERTS table 2.1 in one frame",
+                            (512, 512), _experts_builder("build_solids"), 21, 31),
+    "experts-uneven": _info("experts-uneven", "850 small triangles crowded top-left over 150 large ones "
+                            "(EXPERTS load balancing)", (512, 512), _experts_builder("build_uneven"), 8, 1000),
 }
 
 

@@ -15,6 +15,8 @@ EXPECTED = {
     "c50": 301, "c100": 601, "c150": 901, "c200": 1201, "c250": 1501, "c300": 1801,
     "sp27": 2701, "sp5": 2001, "sp8": 1354,
     "zbm-5x5": 1000, "snu-100px": 2000, "experts-1000": 1000, "experts-2000": 2000,
+    "experts-tilt-1000": 1000, "experts-tilt-2000": 2000, "experts-solid-5": 4, "experts-solid-9": 6,
+    "experts-solid-15": 9, "experts-solid-20": 12, "experts-solids": 31, "experts-uneven": 1000,
 }
 
 
@@ -177,11 +179,42 @@ def test_snu_triangles_100px_on_screen():
     assert np.mean(np.abs(sc.colours[:, 0] - sc.colours[:, 1])) > 0.1
 
 
-@pytest.mark.parametrize("fr", [1000, 2000])
-def test_experts_relevant_faces_and_depth_complexity(fr):
-    s = screen_stats(build_scene(f"experts-{fr}"), 512, 512)
+@pytest.mark.parametrize("name", ["experts-1000", "experts-2000", "experts-tilt-1000", "experts-tilt-2000"])
+def test_experts_relevant_faces_and_depth_complexity(name):
+    fr = int(name.rsplit("-", 1)[1])
+    s = screen_stats(build_scene(name), 512, 512)
     assert s["drawn"] == fr and s["back_facing"] == 0 and s["off_screen"] == 0
-    assert s["depth_complexity"] == pytest.approx(3.0, rel=1e-9)
+    assert s["depth_complexity"] == pytest.approx(3.0, rel=1e-6)
+
+
+@pytest.mark.parametrize("fr", [1000, 2000])
+def test_experts_tilt_faces_are_tilted_and_interpenetrate(fr):
+    from rasterhw.golden_model.experts import slp
+    from rasterhw.golden_model.pipeline import run_geometry
+    flat = slp.set_up(run_geometry(build_scene(f"experts-{fr}"), 512, 512), bit=False)
+    tilt = slp.set_up(run_geometry(build_scene(f"experts-tilt-{fr}"), 512, 512), bit=False)
+    assert np.abs(flat.dzdx).max() < 1e-9          # one depth per face: dz/dx = 0
+    assert np.median(np.abs(tilt.dzdx)) > 1e-5      # tilted
+    from rasterhw.golden_model.experts.model import render_frame
+    # interpenetration: the visible face changes where neither segment starts or ends
+    assert render_frame(run_geometry(build_scene(f"experts-{fr}"), 512, 512)).stats["crossings"] == 0
+    assert render_frame(run_geometry(build_scene(f"experts-tilt-{fr}"), 512, 512)).stats["crossings"] > 500
+
+
+@pytest.mark.parametrize("key,edges", [("5", 5), ("9", 9), ("15", 15), ("20", 20)])
+def test_experts_solids_show_table_2_1_edge_counts(key, edges):
+    from rasterhw.golden_model.experts.scenes import visible_edges
+    sc = build_scene(f"experts-solid-{key}")
+    assert visible_edges(sc) == edges
+    s = screen_stats(sc, 512, 512)
+    assert s["off_screen"] == 0 and s["drawn"] >= 2
+
+
+def test_experts_uneven_is_uneven_in_x_and_y():
+    sxy, _ = _project(build_scene("experts-uneven"), 512, 512)
+    c = sxy.mean(axis=1)
+    crowd = (c[:, 0] < 176) & (c[:, 1] < 200)
+    assert crowd.sum() >= 850  # 850 crowded in 13 % of the frame
 
 
 # ----------------------------------------------------------------------------- screen regime

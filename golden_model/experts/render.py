@@ -1,0 +1,37 @@
+"""The EXPERTS golden renderer as ``rasterhw render --arch experts`` runs it."""
+
+from __future__ import annotations
+
+from rasterhw.golden_model.arch import Rendered
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.pipeline import run_geometry
+from rasterhw.golden_model.scene import Scene
+
+from .formats import Z_BITS, Formats
+from .model import render_frame, stage_totals
+from .parallel import run_parallel
+
+__all__ = ["render"]
+
+
+def render(scene: Scene, width: int, height: int, *, arch: str = "experts", aj: str | None = "c",
+           model: str | None = "bit", sn: int | None = 8, pn: int | None = 8,
+           intensity_bits: int | None = 7) -> Rendered:
+    """One frame through the SLP/PXP golden model; stats carry the 8 x 8 (or Sn x Pn) timing.
+
+    ``pixels_written`` counts DSLB writes (every pixel of every line, background included).
+    """
+    aj = "c" if aj is None else aj
+    model = "bit" if model is None else model
+    sn = 8 if sn is None else sn
+    pn = 8 if pn is None else pn
+    if width > 1024 or height > 1024:
+        raise RasterhwError(f"experts: frame {width}x{height} is larger than the Q10.6 coordinates allow (1024)")
+    tris = run_geometry(scene, width, height, z_bits=Z_BITS)
+    f = render_frame(tris, model=model, aj=aj, fmt=Formats(7 if intensity_bits is None else intensity_bits))
+    par = run_parallel(f, sn, pn, band_method="pl", range_method="ii")
+    ops = stage_totals(f, sn=sn, pn=pn)
+    return Rendered(f.rgb8, tris, width * height,
+                    {"model": model, "aj": aj, "sn": sn, "pn": pn, "aj_pixels": f.aj_pixels,
+                     "operations": int(sum(ops.values())), "frame_op_times": round(par.frame_time, 1),
+                     "pxp_imbalance": round(par.imbalance(), 4), "crossings": f.stats["crossings"]})

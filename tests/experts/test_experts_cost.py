@@ -1,0 +1,53 @@
+"""EXPERTS cost model: the paper's formulas, and the measured counts behaving as the formulas say."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from rasterhw.golden_model.experts import cost
+from rasterhw.golden_model.experts.model import render_frame
+from rasterhw.golden_model.pipeline import run_geometry
+from rasterhw.golden_model.scenes import build_scene
+
+
+@pytest.mark.parametrize("fr,pn", [(1000, 7.06), (2000, 3.95)])
+def test_balance_pn_is_where_q_s_meets_q_p(fr, pn):
+    lo, hi = 1.0, 64.0
+    for _ in range(60):  # bisection on the formulas, independent of the closed form
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if cost.q_p(fr, 1, mid) > cost.q_s(fr, 1) else (lo, mid)
+    assert cost.balance_pn(fr) == pytest.approx(lo, rel=1e-9)
+    assert cost.balance_pn(fr) == pytest.approx(pn, abs=0.01)
+    # the totals are the sums the paper prints: 893 + 31607 = 32500
+    assert cost.q_s(fr, 1) + cost.q_p(fr, 1, 1) == pytest.approx(cost.q_seq(fr))
+
+
+def test_measured_q_par_falls_with_pn_until_the_slp_binds():
+    f = render_frame(run_geometry(build_scene("experts-tilt-1000"), 512, 512))
+    q = [cost.measured_q(f, 1, pn) for pn in (1, 2, 4, 8, 16, 32)]
+    par = [d["q_par"] for d in q]
+    assert all(a >= b for a, b in zip(par, par[1:], strict=False))
+    assert q[0]["q_p"] > q[0]["q_s"] and q[-1]["q_s"] >= q[-1]["q_p"]     # PXP-bound, then SLP-bound
+    assert q[-1]["q_par"] == q[-1]["q_s"]
+    # the measured Q_seq is the sum of the stages, whatever the partition
+    assert all(d["q_seq"] == q[0]["q_seq"] for d in q)
+
+
+def test_alpha_error_curves():
+    e = cost.alpha_error()
+    a = e["angle"]
+    assert e["c_max"][a == 90.0][0] < 1e-12 and e["b_max"][a == 90.0][0] < 1e-12   # vertical edge: exact
+    # (c) is worst at the 45-degree switch; (b) is never worse than (c) there
+    k45 = int(np.argmin(np.abs(a - 45)))
+    assert e["c_max"][k45] == pytest.approx(e["c_max"].max())
+    assert e["b_max"][k45] <= e["c_max"][k45]
+
+
+def test_line_segments_scene():
+    ls = cost.line_segments(8)
+    assert ls.n_triangles == 16 and len(set(ls.poly_id.tolist())) == 8
+    f = render_frame(ls, aj="c")
+    assert f.aj_pixels > 8 * 2 * 100   # both long sides of every segment are blended
+    assert math.isfinite(cost.total_ops(f))

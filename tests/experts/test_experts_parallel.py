@@ -1,0 +1,77 @@
+"""EXPERTS parallel model: pipeline bounds, both balancing methods, both levels."""
+
+from __future__ import annotations
+
+from functools import cache
+
+import numpy as np
+import pytest
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.experts.model import pxp_range_ops, render_frame
+from rasterhw.golden_model.experts.parallel import Balance, rebalance, run_parallel
+from rasterhw.golden_model.pipeline import run_geometry
+from rasterhw.golden_model.scenes import build_scene
+
+
+@cache
+def _frame(name: str):
+    return render_frame(run_geometry(build_scene(name), 512, 512), model="bit", aj="c")
+
+
+def test_rebalance_methods():
+    w = np.array([64, 64, 64, 64])
+    t = np.array([100.0, 200.0, 100.0, 400.0])
+    wi = rebalance(w, t, "i")
+    assert wi.sum() == 256 and wi[3] < wi[1] < wi[0]
+    # method i: widths proportional to width / time (pixels per op time)
+    assert np.allclose(wi / wi.sum(), (w / t) / (w / t).sum(), atol=2 / 256)
+    wii = rebalance(w, t, "ii", Balance(theta_shift=3, shrink_shift=3))
+    # mean 200, threshold 225: only PXP 3 is late; it gives 64 >> 3 = 8 to the earliest (PXP 0)
+    assert list(wii) == [72, 64, 64, 56]
+    assert list(rebalance(w, t, "static")) == list(w)
+    with pytest.raises(RasterhwError, match="balancing method"):
+        rebalance(w, t, "iii")
+
+
+def test_pipeline_time_bounds():
+    f = _frame("experts-tilt-1000")
+    r = run_parallel(f, 2, 4)
+    for s in range(2):
+        y0, y1 = r.bands[s], r.bands[s + 1]
+        slp = r.slp_busy[s]
+        pxp = r.pxp_busy[s].max()
+        drain = Balance().fb_cost * 512 * (y1 - y0)
+        # overlap: never faster than the busiest stage, never slower than running them one after another
+        assert r.group_time[s] >= max(slp, pxp, drain) - 1e-6
+        assert r.group_time[s] <= slp + r.pxp_time[y0:y1].max(axis=1).sum() + drain + 1e-6
+    # static ranges: PXP times are exactly the range op counts of the golden model
+    assert np.allclose(r.pxp_time, pxp_range_ops(f, np.arange(5) * 128))
+
+
+def test_dynamic_ranges_beat_static_on_the_uneven_scene():
+    f = _frame("experts-uneven")
+    st = run_parallel(f, 1, 8, range_method="static").imbalance()
+    m1 = run_parallel(f, 1, 8, range_method="i").imbalance()
+    m2 = run_parallel(f, 1, 8, range_method="ii").imbalance()
+    assert m2 < m1 < st
+    assert st > 1.5 and m2 < 1.3
+
+
+def test_host_bands_beat_equal_bands_on_the_uneven_scene():
+    f = _frame("experts-uneven")
+    eq = run_parallel(f, 8, 8, band_method="equal")
+    pl = run_parallel(f, 8, 8, band_method="pl")
+    assert pl.frame_time < 0.7 * eq.frame_time
+    assert pl.group_time.max() / pl.group_time.mean() < eq.group_time.max() / eq.group_time.mean()
+    fi = run_parallel(f, 8, 8, band_method="i", frames=4)
+    assert fi.frame_time < eq.frame_time
+
+
+def test_bad_parameters():
+    f = _frame("experts-tilt-1000")
+    with pytest.raises(RasterhwError, match="range method"):
+        run_parallel(f, 1, 2, range_method="x")
+    with pytest.raises(RasterhwError, match="band method"):
+        run_parallel(f, 1, 2, band_method="x")
+    with pytest.raises(RasterhwError, match="parts"):
+        run_parallel(f, 1, 1000)
