@@ -44,6 +44,7 @@ class Counters:
     ztests: int = 0               # Z-test vector steps (alg 1: one per span; alg 2: one per k)
     elements: int = 0             # pixels Z-tested
     masked_off: int = 0           # alg 2: slots masked off inside a Z-test step
+    written: int = 0              # pixels that passed the Z test (Z-buffer writes)
     edge_updates: int = 0         # edge-update vector steps
     edge_elements: int = 0        # elements in them
     max_slots: int = 0            # alg 2: largest s-list occupancy
@@ -55,7 +56,7 @@ class Counters:
 
     def as_dict(self) -> dict:
         return {"passes": self.passes, "ztests": self.ztests, "elements": self.elements,
-                "masked_off": self.masked_off, "edge_updates": self.edge_updates,
+                "masked_off": self.masked_off, "written": self.written, "edge_updates": self.edge_updates,
                 "edge_elements": self.edge_elements, "max_slots": self.max_slots,
                 "mean_vector_length": self.mean_vector_length}
 
@@ -123,6 +124,7 @@ def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
             win = z < zrow[a:b]
             c.ztests += 1
             c.elements += b - a
+            c.written += int(np.count_nonzero(win))
             if mode == "real":
                 zrow[a:b][win] = z[win]
                 qrow[a:b][win] = poly[active[k]]
@@ -200,6 +202,7 @@ def algorithm2(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
             c.ztests += 1
             c.elements += sel.size
             c.masked_off += ys.size - sel.size
+            c.written += int(np.count_nonzero(win))
             if mode == "real":
                 p = pix[win]
                 depth[p] = z[win]

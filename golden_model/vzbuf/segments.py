@@ -141,17 +141,17 @@ def build_segments(sp: ScreenPolygons, height: int) -> SegmentBlock:
         src[f"{side}thr"] = thr[q, e]
         src[f"{side}tdx"], src[f"{side}tdy"] = tdx[q, e], tdy[q, e]
         src[f"{side}tXa"], src[f"{side}tYa"] = XA[q, e], YA[q, e]
-    seg = _assemble(src, y0, yend, q, np.zeros(q.size, np.int64), np.ones(q.size, np.int64), sp)
-    return seg
+    return _assemble(src, y0, yend, q, np.zeros(q.size, np.int64), np.ones(q.size, np.int64),
+                     sp.plane[q, 0].copy())
 
 
-def _assemble(src, y0, yend, q, part, parts, sp) -> SegmentBlock:
+def _assemble(src, y0, yend, q, part, parts, dzdx) -> SegmentBlock:
     S = y0.size
     L = _edge_state(src, "L", y0.astype(float))
     R = _edge_state(src, "R", y0.astype(float))
     edges = EdgeBlock(**{k: np.concatenate([L[k], R[k]]) for k in L})
     return SegmentBlock(y0=y0, yend=yend, poly=q, left=np.arange(S), right=np.arange(S, 2 * S),
-                        dzdx=sp.plane[q, 0].copy() if S else np.zeros(0), part=part, parts=parts,
+                        dzdx=dzdx, part=part, parts=parts,
                         edges=edges, src=src)
 
 
@@ -194,14 +194,15 @@ def extents(seg: SegmentBlock, width: int) -> tuple[np.ndarray, np.ndarray]:
     return xl.astype(float), (seg.yend - seg.y0 + 1).astype(float)
 
 
-def split_segments(seg: SegmentBlock, sp: ScreenPolygons, width: int) -> tuple[SegmentBlock, dict]:
+def split_segments(seg: SegmentBlock, width: int) -> tuple[SegmentBlock, dict]:
     """Algorithm 2's split: "x, y 各方向について、セグメントの最長部が全セグメントの平均長より
     長いセグメントを分割する" -- a segment longer than the mean in y is cut into
     ``ceil(len / mean)`` runs of lines, one longer than the mean in x into ``ceil(len / mean)``
     parts across (see the module docstring); the means are over all segments before splitting.
     """
     if seg.n == 0:
-        return seg, {"mean_x": 0.0, "mean_y": 0.0, "segments_before": 0, "segments_after": 0}
+        return seg, {"mean_x": 0.0, "mean_y": 0.0, "segments_before": 0, "segments_after": 0,
+                     "split_y": 0, "split_x": 0, "source": np.zeros(0, np.int64)}
     xl, yl = extents(seg, width)
     mx, my = float(xl.mean()), float(yl.mean())
     ky = np.where(yl > my, np.ceil(yl / my), 1).astype(np.int64)
@@ -221,9 +222,9 @@ def split_segments(seg: SegmentBlock, sp: ScreenPolygons, width: int) -> tuple[S
     part = np.arange(sid2.size) - np.repeat(np.cumsum(kx2) - kx2, kx2)
     parts = kx[sid2]
     src = {key: v[sid2] for key, v in seg.src.items()}
-    new = _assemble(src, ny0, nyend, seg.poly[sid2], part.astype(np.int64), parts, sp)
+    new = _assemble(src, ny0, nyend, seg.poly[sid2], part.astype(np.int64), parts, seg.dzdx[sid2])
     return new, {"mean_x": mx, "mean_y": my, "segments_before": seg.n, "segments_after": new.n,
-                 "split_y": int((ky > 1).sum()), "split_x": int((kx > 1).sum())}
+                 "split_y": int((ky > 1).sum()), "split_x": int((kx > 1).sum()), "source": sid2}
 
 
 def ylist(seg: SegmentBlock, height: int) -> tuple[np.ndarray, np.ndarray]:
@@ -241,3 +242,22 @@ def ylist(seg: SegmentBlock, height: int) -> tuple[np.ndarray, np.ndarray]:
         same = ys[1:] == ys[:-1]
         nxt[order[:-1][same]] = order[1:][same]
     return head, nxt
+
+
+def concat_segments(parts: list[SegmentBlock]) -> SegmentBlock:
+    """Several segment blocks as one (polygon indices offset so they stay distinct)."""
+    parts = [p for p in parts if p.n]
+    if not parts:
+        return _empty()
+    if len(parts) == 1:
+        return parts[0]
+    qoff = np.cumsum([0] + [int(p.poly.max()) + 1 for p in parts[:-1]])
+    S = sum(p.n for p in parts)
+    keys = ("x", "dxdy", "z", "dzdy", "i", "didy", "n", "dn", "ss")
+    E = {k: np.concatenate([getattr(p.edges, k)[:p.n] for p in parts]
+                           + [getattr(p.edges, k)[p.n:] for p in parts]) for k in keys}
+    cat = lambda name: np.concatenate([getattr(p, name) for p in parts])  # noqa: E731
+    return SegmentBlock(y0=cat("y0"), yend=cat("yend"), poly=np.concatenate([p.poly + o for p, o in zip(parts, qoff, strict=True)]),
+                        left=np.arange(S), right=np.arange(S, 2 * S), dzdx=cat("dzdx"), part=cat("part"),
+                        parts=cat("parts"), edges=EdgeBlock(**E),
+                        src={k: np.concatenate([p.src[k] for p in parts]) for k in parts[0].src})
