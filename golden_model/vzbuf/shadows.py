@@ -223,7 +223,7 @@ def shadow_map_test(scene: Scene, width: int, height: int, depth: np.ndarray, vi
 
 
 def ray_shadow(scene: Scene, width: int, height: int, depth: np.ndarray, poly: np.ndarray,
-               *, rel_eps: float = 1e-7) -> np.ndarray:
+               *, rel_eps: float = 1e-5) -> np.ndarray:
     """Brute force: is the segment from each visible pixel's world point to the light blocked?
 
     ``poly`` is the scene polygon per pixel (-1 = background). Returns an (H, W) bool array.
