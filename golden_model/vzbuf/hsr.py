@@ -16,7 +16,10 @@ remain: (1) drop exited segments from the s-list, (2) where slist(y) is empty an
 not, take ylist(y)'s head, (3) Z-test all non-empty slots at once, masked, repeating for the
 longest segment's span length, (4) step the edges, slist(i+1) <- slist(i), slist(0) <- empty.
 Slot ``y`` always holds the segment being drawn on line ``y`` (asserted every pass), so a pass
-touches each line at most once: no recurrent Z-buffer references within a vector.
+touches each line at most once: no recurrent Z-buffer references within a vector. The mask of
+step k ("k < span length") is applied as a prefix: the pass's slots are ordered by span length
+once, so every masked step is a slice of the pass's vectors (same elements, same order of
+writes per pixel, since no two slots share a line).
 
 Both write the same outputs: ``depth`` (H, W) (+inf = the Z-buffer's "maximum"), ``qid`` (H, W)
 screen-polygon index (-1 = background), ``inten`` (H, W) intensity. ``mode="shadow"`` runs
@@ -27,6 +30,7 @@ pass of ray casting).
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -48,6 +52,9 @@ class Counters:
     edge_updates: int = 0         # edge-update vector steps
     edge_elements: int = 0        # elements in them
     max_slots: int = 0            # alg 2: largest s-list occupancy
+    t_ztest: float = 0.0          # fig. 3 "hidden-surface removal": span set-up and Z tests (s)
+    t_update1: float = 0.0        # fig. 3 update 1: edge updates (s)
+    t_update2: float = 0.0        # fig. 3 update 2: segments entering and leaving (s)
     slot_hist: list = field(default_factory=list)
 
     @property
@@ -58,6 +65,7 @@ class Counters:
         return {"passes": self.passes, "ztests": self.ztests, "elements": self.elements,
                 "masked_off": self.masked_off, "written": self.written, "edge_updates": self.edge_updates,
                 "edge_elements": self.edge_elements, "max_slots": self.max_slots,
+                "t_ztest": self.t_ztest, "t_update1": self.t_update1, "t_update2": self.t_update2,
                 "mean_vector_length": self.mean_vector_length}
 
 
@@ -87,7 +95,9 @@ def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
     poly = seg.poly
     active = np.zeros(0, np.int64)
     zline = np.empty(width)
+    clk = time.perf_counter
     for y in range(height):
+        ta = clk()
         if active.size:
             active = active[yend[active] >= y]
         s = head[y]
@@ -97,6 +107,8 @@ def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
                 new.append(s)
                 s = nxt[s]
             active = np.concatenate([active, np.asarray(new, np.int64)])
+        tb = clk()
+        c.t_update2 += tb - ta
         if active.size == 0:
             continue
         c.passes += 1
@@ -135,6 +147,8 @@ def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
                 zrow[a:b][win] = z[win]
         if mode == "real" and not full_frame:
             depth[y] = zline
+        tc = clk()
+        c.t_ztest += tc - tb
         # step the edges of every x-list segment at once
         both = np.concatenate([L, R])
         ex[both] += dxdy[both]
@@ -143,6 +157,7 @@ def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
         en[both] += dn[both]
         c.edge_updates += 4
         c.edge_elements += 4 * both.size
+        c.t_update1 += clk() - tc
     return c
 
 
@@ -163,7 +178,9 @@ def algorithm2(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
     depth = buf["depth"].reshape(-1)
     qid, inten, count = buf["qid"].reshape(-1), buf["inten"].reshape(-1), buf["count"].reshape(-1)
     slist = np.full(height, -1, np.int64)
+    clk = time.perf_counter
     while True:
+        ta = clk()
         # (1) drop exited segments
         ys = np.flatnonzero(slist >= 0)
         if ys.size:
@@ -176,12 +193,15 @@ def algorithm2(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
             ptr[fill] = nxt[ptr[fill]]
         ys = np.flatnonzero(slist >= 0)
         if ys.size == 0:
+            c.t_update2 += clk() - ta
             break
         segs = slist[ys]
         assert np.array_equal(crow[segs], ys), "algorithm 2: an s-list slot holds a segment of another line"
         c.passes += 1
         c.max_slots = max(c.max_slots, int(ys.size))
         c.slot_hist.append(int(ys.size))
+        tb = clk()
+        c.t_update2 += tb - ta
         # (3) masked Z-test of every slot at once, k = 0 .. longest span - 1
         L, R = left[segs], right[segs]
         lo, hi = span_from_n(en[L], ss[L], en[R], ss[R], part[segs], parts[segs], width)
@@ -189,29 +209,40 @@ def algorithm2(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
         xl, zl, il, xr, ir = ex[L], ez[L], ei[L], ex[R], ei[R]
         with np.errstate(divide="ignore", invalid="ignore"):
             didx = np.where(xr > xl, (ir - il) / (xr - xl), 0.0)
-        dz = dzdx[segs]
-        base = ys * width
-        mx = int(ln.max()) if ln.size else 0
+        # The mask "k < span length" is a prefix once the slots are ordered by span length
+        # (longest first): each masked step is then a slice of the pass's vectors.
+        o = np.argsort(-ln, kind="stable")
+        ln_o = ln[o]
+        lo_o, xl_o, zl_o = lo[o], xl[o], zl[o]
+        dz_o = dzdx[segs][o]
+        base_o = ys[o] * width + lo_o
+        if mode == "real":
+            il_o, did_o, q_o = il[o], didx[o], poly[segs][o]
+        elif mode == "shadow":
+            sg_o = sign[segs][o]
+        mx = int(ln_o[0]) if ln_o.size else 0
+        live = ln_o.size - np.searchsorted(ln_o[::-1], np.arange(mx), side="right")
         for k in range(mx):
-            sel = np.flatnonzero(ln > k)
-            col = lo[sel] + k
-            pix = base[sel] + col
-            xc = col + 0.5 - xl[sel]
-            z = zl[sel] + dz[sel] * xc
+            m = int(live[k])
+            pix = base_o[:m] + k
+            xc = (lo_o[:m] + k) + 0.5 - xl_o[:m]
+            z = zl_o[:m] + dz_o[:m] * xc
             win = z < depth[pix]
             c.ztests += 1
-            c.elements += sel.size
-            c.masked_off += ys.size - sel.size
+            c.elements += m
+            c.masked_off += ys.size - m
             c.written += int(np.count_nonzero(win))
             if mode == "real":
                 p = pix[win]
                 depth[p] = z[win]
-                qid[p] = poly[segs[sel[win]]]
-                inten[p] = (il[sel] + didx[sel] * xc)[win]
+                qid[p] = q_o[:m][win]
+                inten[p] = (il_o[:m] + did_o[:m] * xc)[win]
             elif mode == "shadow":
-                count[pix[win]] += sign[segs[sel[win]]]
+                count[pix[win]] += sg_o[:m][win]
             else:
                 depth[pix[win]] = z[win]
+        tc = clk()
+        c.t_ztest += tc - tb
         # (4) step the edges, shift the s-list one line down
         both = np.concatenate([L, R])
         ex[both] += dxdy[both]
@@ -221,6 +252,9 @@ def algorithm2(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
         crow[segs] += 1
         c.edge_updates += 5
         c.edge_elements += 4 * both.size + segs.size
+        td = clk()
+        c.t_update1 += td - tc
         slist[1:] = slist[:-1].copy()
         slist[0] = -1
+        c.t_update2 += clk() - td
     return c
