@@ -17,6 +17,7 @@ def test_whole_array_equals_vz2(name):
     assert np.array_equal(w["poly"], f.poly)
     assert np.array_equal(w["shadowed"], f.shadowed)
     m = f.poly >= 0
-    assert np.array_equal(w["depth"][m], f.depth[m])
-    assert np.abs(w["inten"] - f.inten).max() < 1e-12
+    # closed-form edge values here, stepped ones in vz2: equal to rounding
+    assert (np.abs(w["depth"][m] - f.depth[m]) / f.depth[m]).max() < 1e-12
+    assert np.abs(w["inten"] - f.inten).max() < 1e-9
     assert w["fragments_real"] + w["fragments_shadow"] == f.stats["pixels_real"] + f.stats["pixels_shadow"]
