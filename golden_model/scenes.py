@@ -253,7 +253,9 @@ def _grid(nx: int, ny: int, nz: int, spacing: float = 2.0) -> np.ndarray:
     return np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
 
 
-_SP5_CENTRES = np.array([[-2.5, 1.0, -2.5], [2.5, 1.0, -2.5], [0.0, 1.0, 0.0], [-2.5, 1.0, 2.5], [2.5, 1.0, 2.5]])
+# sp5: a quincunx of spacing 7.5 seen along its diagonal from high up, so the five spheres are
+# spread down the screen (fewer empty lines than the narrow sp8; docs/scenes.md).
+_SP5_CENTRES = np.array([[-7.5, 1.0, -7.5], [7.5, 1.0, -7.5], [0.0, 1.0, 0.0], [-7.5, 1.0, 7.5], [7.5, 1.0, 7.5]])
 
 
 def _build_zbm(seed: int, *, n: int = 1000, width: int = 512, height: int = 512) -> Scene:
@@ -336,9 +338,9 @@ SCENES: dict[str, SceneInfo] = {
     "sp27": _info("sp27", "3x3x3 stacked spheres of 10x10 polygons on a ground plate (vector Z-buffer paper)",
                   (512, 512), _build_spheres("sp27", _grid(3, 3, 3), 10, 10, ground_half=5.0, ground_pieces=1,
                                              azimuth=30.0, elevation=25.0, distance=15.0), 27, 2701),
-    "sp5": _info("sp5", "5 spheres of 20x20 polygons on a ground plate (vector Z-buffer paper)",
-                 (512, 512), _build_spheres("sp5", _SP5_CENTRES, 20, 20, ground_half=5.0, ground_pieces=1,
-                                            azimuth=30.0, elevation=35.0, distance=22.0), 5, 2001),
+    "sp5": _info("sp5", "5 spheres of 20x20 polygons spread down the screen on a ground plate (vector Z-buffer paper)",
+                 (512, 512), _build_spheres("sp5", _SP5_CENTRES, 20, 20, ground_half=8.5, ground_pieces=1,
+                                            azimuth=45.0, elevation=75.0, distance=35.0), 5, 2001),
     "sp8": _info("sp8", "a column of 8 spheres of 13x13 polygons, small on screen (vector Z-buffer paper)",
                  (512, 512), _build_spheres("sp8", _grid(1, 8, 1), 13, 13, ground_half=2.0, ground_pieces=2,
                                             azimuth=30.0, elevation=15.0, distance=28.0), 8, 1354),

@@ -345,3 +345,11 @@ def test_load_scene_unknown():
     assert "c300" in str(e.value) and ".obj" in str(e.value)
     with pytest.raises(RasterhwError, match="no such file"):
         load_scene("/no/such/file.ply")
+
+
+def test_sp5_spreads_over_more_lines_than_sp8():
+    """The paper's narrow scene is sp8 (results note 1): sp5 must leave fewer empty lines."""
+    sp5 = screen_stats(build_scene("sp5"), 512, 512)
+    sp8 = screen_stats(build_scene("sp8"), 512, 512)
+    assert sp5["empty_row_fraction"] < sp8["empty_row_fraction"]
+    assert 0.2 <= sp8["empty_row_fraction"] <= 0.35

@@ -1,0 +1,25 @@
+"""The registry's renderer for archs ``vz1`` and ``vz2``."""
+
+from __future__ import annotations
+
+from ..arch import Rendered
+from ..errors import RasterhwError
+from ..scene import Scene
+from .render import DEFAULT_EPS, render_frame
+
+__all__ = ["render"]
+
+
+def render(scene: Scene, width: int, height: int, *, arch: str, shadows: str = "none",
+           eps: float = DEFAULT_EPS) -> Rendered:
+    """``rasterhw render SCENE --arch vz1|vz2 [--shadows none|polygons|map] [--eps E]``."""
+    algs = {"vz1": 1, "vz2": 2}
+    if arch not in algs:
+        raise RasterhwError(f"vzbuf: arch must be vz1 or vz2, not {arch!r}")
+    f = render_frame(scene, width, height, alg=algs[arch], shadows=shadows, eps=eps)
+    c = f.stats["counters"]
+    stats = {"stages_s": f.stages, "segments": f.stats["segments"], "passes": c["passes"],
+             "ztests": c["ztests"], "mean_vector_length": c["mean_vector_length"],
+             "pixels_real": f.stats["pixels_real"], "pixels_shadow": f.stats["pixels_shadow"],
+             "shadowed_pixels": int(f.shadowed.sum())}
+    return Rendered(rgb8=f.rgb8, tris=f.sp.tris, pixels_written=int(c["written"]), stats=stats)
