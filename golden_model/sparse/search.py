@@ -12,10 +12,12 @@ Coverage tests
 --------------
 * Levels ``i < n``: the sub-window is the rectangle ``[p(2**(n-i) - 1) + alpha] x
   [q(2**(n-i) - 1) + beta]`` px around its centre (the paper's window, aperture ``alpha x beta``).
-  The test is the edges-only test of a raster processor that holds edge equations: the window
-  survives unless one edge's largest value over the rectangle is below the fill-rule threshold.
-  It never rejects a window holding a covered pixel centre (``alpha, beta >= 0``), so no pixel
-  is lost.
+  The window survives unless one edge's largest value over the rectangle is below the fill-rule
+  threshold or (``test="exact"``, the default) the rectangle misses the triangle's bounding box:
+  together these are the separating-axis test, so a window survives exactly when it meets the
+  (closed) triangle, and the count is the paper's "filtered polygon" count. ``test="edges"`` is
+  the edges-only test. Neither rejects a window holding a covered pixel centre (``alpha, beta >=
+  0``), so no pixel is lost.
 * Level ``n`` (pixels): the reference rasteriser's point test, ``E_k >= thr_k`` for the three
   edges at the pixel centre (top-left rule, vertices on the 1/256 px grid), exactly. The same
   level also counts the windows that pass the aperture test (``w_n`` of the theory).
@@ -73,6 +75,7 @@ class EdgeSetup:
     thr : (3, T) int64 — 0 on a top or left edge, 1 otherwise.
     sign : (T,) int64 — sign of the snapped area (orientation); ``E_unsigned = sign * E``.
     area : (T,) int64 — twice the signed area on the sub-pixel grid (reference's ``E``).
+    bbox : (4, T) int64 — ``Xmin, Xmax, Ymin, Ymax`` of the snapped vertices (sub-pixel units).
     """
 
     tri: np.ndarray
@@ -82,6 +85,7 @@ class EdgeSetup:
     thr: np.ndarray
     sign: np.ndarray
     area: np.ndarray
+    bbox: np.ndarray
 
 
 def edge_setup(xy: np.ndarray) -> EdgeSetup:
@@ -104,7 +108,8 @@ def edge_setup(xy: np.ndarray) -> EdgeSetup:
     check_signed("edge coefficient A/B", np.concatenate([A.ravel(), B.ravel()]), EDGE_AB_BITS)
     check_signed("edge constant C", C, EDGE_BITS)
     return EdgeSetup(tri=keep.astype(np.int64), A=A, B=B, C=C, thr=np.where(topleft, 0, 1).astype(np.int64),
-                     sign=s.astype(np.int64), area=area[keep])
+                     sign=s.astype(np.int64), area=area[keep],
+                     bbox=np.stack([X[:, keep].min(0), X[:, keep].max(0), Y[:, keep].min(0), Y[:, keep].max(0)]))
 
 
 @dataclass
@@ -167,7 +172,7 @@ def _check_aperture(name: str, v) -> int:
 
 
 def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: int = 2,
-                  depth: str = "float", background=(0.0, 0.0, 0.0)) -> SparseFrame:
+                  test: str = "exact", depth: str = "float", background=(0.0, 0.0, 0.0)) -> SparseFrame:
     """Draw ``tris`` with a ``p x q`` matrix of video processors by recursive pixel search.
 
     Parameters
@@ -176,6 +181,9 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
     matrix : ``"PxQ"`` or ``(p, q)``, powers of two.
     alpha, beta : the filter aperture in pixels (window size at levels below n; the paper's
         examples use 2 x 2). Any value >= 0 gives the same image; it changes the counts.
+    test : window coverage test below the pixel level: ``"exact"`` (the window rectangle meets
+        the triangle: the three edges and the triangle's bounding box, the paper's "filtered
+        polygon" count) or ``"edges"`` (the three edges only). Same image either way.
     depth : ``"float"`` (reference arithmetic, bit-identical image) or ``"fixed"`` (quantised
         depth as a fixed-point plane, the bit-accurate layer).
     """
@@ -183,6 +191,8 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
     W, H = tris.width, tris.height
     n = sparse_geometry(W, H, p, q)
     al, be = _check_aperture("alpha", alpha), _check_aperture("beta", beta)
+    if test not in ("exact", "edges"):
+        raise RasterhwError(f"sparse: test must be 'exact' or 'edges', not {test!r}")
     if depth not in ("float", "fixed"):
         raise RasterhwError(f"sparse: depth must be 'float' or 'fixed', not {depth!r}")
     xy, z, vcol = tris.validate(who="sparse", max_coord=float(1 << 13))
@@ -228,19 +238,31 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
         Bp4 = np.repeat(Bp, 4, axis=1)
         E4 = np.repeat(E, 4, axis=1) + Ap4 * du4 + Bp4 * dv4
         thr = thr_all[:, rt4]
+        u4 = np.repeat(u0, 4) + du4
+        v4 = np.repeat(v0, 4) + dv4
+        if test == "exact":
+            # The window rectangle (sub-pixel units) against the triangle's bounding box.
+            pa4, pb4 = proc4 % p, proc4 // p
+            bb = es.bbox[:, rt4]
+            x0 = (p * u4 + pa4) * _SUB + _HALF - al * _HALF
+            x1 = (p * (u4 + N - 1) + pa4) * _SUB + _HALF + al * _HALF
+            y0 = (q * v4 + pb4) * _SUB + _HALF - be * _HALF
+            y1 = (q * (v4 + N - 1) + pb4) * _SUB + _HALF + be * _HALF
+            inbox = (x1 >= bb[0]) & (x0 <= bb[1]) & (y1 >= bb[2]) & (y0 <= bb[3])
+        else:
+            inbox = True
         if i < n:
             # Largest value of each edge over the window rectangle (sample span plus aperture).
             mx = E4 + (np.maximum(Ap4, 0) + np.maximum(Bp4, 0)) * (N - 1) + ext_all[:, rt4]
-            ok = (mx >= thr).all(axis=0)
+            ok = (mx >= thr).all(axis=0) & inbox
         else:
-            ok_ap = ((E4 + ext_all[:, rt4]) >= thr).all(axis=0)
+            ok_ap = ((E4 + ext_all[:, rt4]) >= thr).all(axis=0) & inbox
             ap_n = int(np.count_nonzero(ok_ap))
             ok = (E4 >= thr).all(axis=0)
         keep = np.flatnonzero(ok)
         rt, proc = rt4[keep], proc4[keep]
         E, Ap, Bp = E4[:, keep], Ap4[:, keep], Bp4[:, keep]
-        u0 = np.repeat(u0, 4)[keep] + du4[keep]
-        v0 = np.repeat(v0, 4)[keep] + dv4[keep]
+        u0, v0 = u4[keep], v4[keep]
         windows[i] = rt.size
         wpp[:, i] = np.bincount(proc, minlength=P)
         if i < n:
@@ -327,5 +349,5 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
         writer=interleave(written_by), local_tri=local_tri,
         windows=windows, tests=tests, windows_aperture_n=ap_n, windows_per_proc=wpp,
         tests_per_proc=tpp, fragments=int(F), pixels_written=written, triangles=int(T),
-        stats={"alpha": al, "beta": be, "depth": depth, "frag_x": x, "frag_y": y, "frag_proc": proc,
+        stats={"alpha": al, "beta": be, "test": test, "depth": depth, "frag_x": x, "frag_y": y, "frag_proc": proc,
                "frag_tri": tri})

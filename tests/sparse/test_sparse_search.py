@@ -51,9 +51,10 @@ def test_union_equals_reference_one_processor_per_pixel(scene, matrix):
     assert f.windows[0] == f.triangles * p * q
 
 
-def _brute_counts(xy, W, H, p, q, alpha, beta):
-    """Windows per level passing the edges-only test, by evaluating every window of every
-    processor at its four corners straight from the vertices (no increments, float64)."""
+def _brute_counts(xy, W, H, p, q, alpha, beta, test):
+    """Windows per level passing the test, by evaluating every window of every processor at its
+    four corners straight from the vertices (no increments, float64); ``exact`` adds the
+    triangle's bounding box."""
     n = sparse_geometry(W, H, p, q)
     sub = 256.0
     counts = np.zeros(n + 1, dtype=np.int64)
@@ -89,6 +90,8 @@ def _brute_counts(xy, W, H, p, q, alpha, beta):
                         for e in edges:
                             m = np.maximum.reduce([E(e, x0, y0), E(e, x1, y0), E(e, x0, y1), E(e, x1, y1)])
                             ok &= m >= e[4]
+                        if test == "exact":
+                            ok &= (x1 >= X.min()) & (x0 <= X.max()) & (y1 >= Y.min()) & (y0 <= Y.max())
                     else:  # pixel centres
                         cx, cy = (p * gx + a + 0.5) * sub, (q * gy + b + 0.5) * sub
                         ok = np.ones(gx.shape, dtype=bool)
@@ -98,14 +101,23 @@ def _brute_counts(xy, W, H, p, q, alpha, beta):
     return counts
 
 
+@pytest.mark.parametrize("test", ["exact", "edges"])
 @pytest.mark.parametrize("matrix,size,alpha", [("2x2", (16, 16), 2), ("4x2", (32, 16), 1), ("1x1", (8, 8), 2),
                                                ("4x4", (32, 32), 0)])
-def test_window_counts_match_brute_force(matrix, size, alpha):
+def test_window_counts_match_brute_force(matrix, size, alpha, test):
     W, H = size
     tris = random_triangles(W, H, 25, mean_area=12.0, seed=11)
     p, q = parse_matrix(matrix)
-    f = sparse_render(tris, matrix, alpha=alpha, beta=alpha)
-    assert np.array_equal(f.windows, _brute_counts(np.asarray(tris.xy), W, H, p, q, alpha, alpha))
+    f = sparse_render(tris, matrix, alpha=alpha, beta=alpha, test=test)
+    assert np.array_equal(f.windows, _brute_counts(np.asarray(tris.xy), W, H, p, q, alpha, alpha, test))
+
+
+def test_exact_test_never_counts_more_than_edges_only():
+    tris = random_triangles(128, 128, 200, mean_area=30.0, seed=3)
+    fe = sparse_render(tris, "4x4", test="exact")
+    fo = sparse_render(tris, "4x4", test="edges")
+    assert np.all(fe.windows <= fo.windows) and fe.windows[2:-1].sum() < fo.windows[2:-1].sum()
+    assert np.array_equal(fe.tri_id, fo.tri_id)
 
 
 def test_aperture_does_not_change_the_image():
@@ -155,6 +167,8 @@ def test_bad_options():
         sparse_render(tris, "4x4", alpha=-1)
     with pytest.raises(RasterhwError):
         sparse_render(tris, "4x4", depth="double")
+    with pytest.raises(RasterhwError):
+        sparse_render(tris, "4x4", test="bbox")
 
 
 def test_non_square_matrix_on_matching_raster():
