@@ -15,11 +15,12 @@ import numpy as np
 from ..screen import SUBPIXEL_BITS, ScreenTriangles, snap
 from .formats import Z_ACC_BITS, Z_FRAC_BITS, check_signed
 
-__all__ = ["depth_plane"]
+__all__ = ["broadcast_records", "depth_plane", "plane_full"]
 
 
-def depth_plane(tris: ScreenTriangles, es, p: int, q: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(Z0 (T, q, p), Zu (T,), Zv (T,))`` int64 for the kept triangles of ``es`` (an EdgeSetup)."""
+def plane_full(tris: ScreenTriangles, es) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(Z00, Zx, Zy)`` (T,) int64: the depth plane over full-raster pixel indices, as the
+    geometry processor broadcasts it, for the kept triangles of ``es`` (an EdgeSetup)."""
     sub = float(1 << SUBPIXEL_BITS)
     xy = np.asarray(tris.xy, dtype=np.float64)[es.tri]
     X = snap(xy[:, :, 0]) / sub  # snapped vertex positions in px
@@ -41,9 +42,37 @@ def depth_plane(tris: ScreenTriangles, es, p: int, q: int) -> tuple[np.ndarray, 
     Zx = np.floor(zx * one + 0.5).astype(np.int64)
     Zy = np.floor(zy * one + 0.5).astype(np.int64)
     Z00 = np.floor(z00 * one + 0.5).astype(np.int64)
+    check_signed("depth plane", np.concatenate([Z00, Zx, Zy]), Z_ACC_BITS)
+    return Z00, Zx, Zy
+
+
+def depth_plane(tris: ScreenTriangles, es, p: int, q: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(Z0 (T, q, p), Zu (T,), Zv (T,))`` int64: :func:`plane_full` rewritten for every
+    processor's lattice (``Z0 = Z00 + a*Zx + b*Zy``, ``Zu = p*Zx``, ``Zv = q*Zy``)."""
+    Z00, Zx, Zy = plane_full(tris, es)
     a = np.arange(p, dtype=np.int64)
     b = np.arange(q, dtype=np.int64)
     Z0 = Z00[:, None, None] + b[None, :, None] * Zy[:, None, None] + a[None, None, :] * Zx[:, None, None]
     Zu, Zv = p * Zx, q * Zy
     check_signed("depth plane", np.concatenate([Z0.ravel(), Zu, Zv]), Z_ACC_BITS)
     return Z0, Zu, Zv
+
+
+def broadcast_records(tris: ScreenTriangles) -> list[dict]:
+    """What the geometry processor broadcasts, one dict of Python ints per non-degenerate
+    triangle in submission order: ``A, B, C, thr`` (3 each, oriented edge equations over
+    full-raster pixel indices), ``bbox`` (Xmin, Xmax, Ymin, Ymax in sub-pixel units),
+    ``z00, zx, zy`` (the depth plane, ``Z_FRAC_BITS`` fraction bits) and ``tri`` (input index).
+    The HDL video processor takes exactly these fields (``hdl/sparse/layouts.py``)."""
+    from .search import edge_setup
+
+    xy, _, _ = tris.validate(who="sparse broadcast", max_coord=float(1 << 13))
+    es = edge_setup(xy)
+    Z00, Zx, Zy = plane_full(tris, es)
+    out = []
+    for t in range(es.tri.size):
+        out.append({"A": [int(v) for v in es.A[:, t]], "B": [int(v) for v in es.B[:, t]],
+                    "C": [int(v) for v in es.C[:, t]], "thr": [int(v) for v in es.thr[:, t]],
+                    "bbox": [int(v) for v in es.bbox[:, t]], "z00": int(Z00[t]), "zx": int(Zx[t]),
+                    "zy": int(Zy[t]), "tri": int(es.tri[t])})
+    return out

@@ -41,7 +41,11 @@ from ..errors import RasterhwError
 from ..screen import SUBPIXEL_BITS
 
 __all__ = [
+    "COORD_BITS",
     "EDGE_AB_BITS",
+    "EXT_BITS",
+    "TRI_BITS",
+    "UV_BITS",
     "EDGE_BITS",
     "MATRIX_LOG2_MAX",
     "MAX_RASTER_BITS",
@@ -64,6 +68,14 @@ _DELTA_BITS = MAX_RASTER_BITS + SUBPIXEL_BITS + 2
 EDGE_AB_BITS = _DELTA_BITS + SUBPIXEL_BITS
 #: E, C, C' and window-corner values (signed): |dx*(y) - dy*(x)| plus the aperture growth
 EDGE_BITS = 2 * _DELTA_BITS + 3
+#: snapped vertex coordinates and bounding boxes (signed, sub-pixel units; |x| <= 2**13 px accepted)
+COORD_BITS = 13 + SUBPIXEL_BITS + 2
+#: triangle index in the local memory; all ones marks an empty pixel
+TRI_BITS = 16
+#: sparse pixel coordinates u, v (a sparse raster is at most 2**MAX_RASTER_BITS on a side)
+UV_BITS = MAX_RASTER_BITS + 1
+#: aperture growth (|A| alpha + |B| beta) / 2, unsigned, for apertures up to 15 px
+EXT_BITS = EDGE_AB_BITS + 4
 #: quantised depth is at most 32 bits wide
 Z_BITS_MAX = 32
 #: fraction bits of the fixed-point depth plane
