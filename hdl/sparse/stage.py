@@ -5,7 +5,7 @@ from __future__ import annotations
 from amaranth.hdl import Module, Signal, signed
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
-from rasterhw.golden_model.sparse.formats import EDGE_BITS, SUBPIXEL_BITS
+from rasterhw.golden_model.sparse.formats import EDGE_BITS, MATRIX_LOG2_MAX, SUBPIXEL_BITS
 
 from .layouts import RECORD
 
@@ -25,6 +25,7 @@ class LevelStage(wiring.Component):
 
     Members
     -------
+    a, b : In(MATRIX_LOG2_MAX) — the processor's place in the matrix (only the exact test uses it).
     i : In(stream RECORD) — headers and parent windows.
     o : Out(stream RECORD) — headers and surviving sub-windows (pixels at the last level).
     tests : Out(32) — coverage tests made (one per busy cycle: the stage's ``t_i / τ``).
@@ -34,15 +35,16 @@ class LevelStage(wiring.Component):
     Throughput: 4 cycles per window plus one cycle to accept it; a header costs two cycles.
     """
 
-    def __init__(self, *, level: int, n: int, p: int, q: int, a: int, b: int, alpha: int = 2, beta: int = 2,
+    def __init__(self, *, level: int, n: int, p: int, q: int, alpha: int = 2, beta: int = 2,
                  test: str = "exact"):
         if not 1 <= level <= n:
             raise ValueError(f"level must be in 1..{n}, not {level!r}")
         if test not in ("exact", "edges"):
             raise ValueError(f"test must be 'exact' or 'edges', not {test!r}")
-        self._level, self._n, self._p, self._q, self._a, self._b = level, n, p, q, a, b
+        self._level, self._n, self._p, self._q = level, n, p, q
         self._alpha, self._beta, self._test = alpha, beta, test
-        super().__init__({"i": In(stream.Signature(RECORD)), "o": Out(stream.Signature(RECORD)),
+        super().__init__({"a": In(MATRIX_LOG2_MAX), "b": In(MATRIX_LOG2_MAX),
+                          "i": In(stream.Signature(RECORD)), "o": Out(stream.Signature(RECORD)),
                           "tests": Out(32), "stalls": Out(32), "idle": Out(1)})
 
     @property
@@ -85,7 +87,7 @@ class LevelStage(wiring.Component):
             us = Signal(signed(24))
             vs = Signal(signed(24))
             m.d.comb += [us.eq(out.u), vs.eq(out.v)]
-            a, b, al, be = self._a, self._b, self._alpha, self._beta
+            a, b, al, be = self.a, self.b, self._alpha, self._beta
             x0 = (us * p + a) * sub + half - al * half
             x1 = ((us + (N - 1)) * p + a) * sub + half + al * half
             y0 = (vs * q + b) * sub + half - be * half

@@ -11,7 +11,7 @@ from .layouts import BROADCAST, RECORD
 from .pixel import PixelProcessor
 from .stage import LevelStage
 
-__all__ = ["VideoProcessor"]
+__all__ = ["VideoProcessor", "make_vp"]
 
 
 def _log2(name: str, v: int) -> int:
@@ -21,7 +21,8 @@ def _log2(name: str, v: int) -> int:
 
 
 class VideoProcessor(wiring.Component):
-    """Video processor ``(a, b)`` of a ``p x q`` matrix with ``2**n x 2**n`` sparse rasters.
+    """A video processor of a ``p x q`` matrix with ``2**n x 2**n`` sparse rasters; its place
+    ``(a, b)`` in the matrix is an input (every processor is the same hardware).
 
     The set-up rewrites each broadcast triangle for this processor's lattice — ``A' = pA``,
     ``B' = qB``, ``C' = C + aA + bB``, depth ``Z0 = z00 + a*zx + b*zy``, ``zu = p*zx``,
@@ -31,6 +32,7 @@ class VideoProcessor(wiring.Component):
 
     Members
     -------
+    a, b : In(MATRIX_LOG2_MAX) — the processor's index in the matrix (held constant).
     i : In(stream BROADCAST) — triangles, in submission order.
     rd_addr, rd_z, rd_tri — the local memory's video-controller read port (one cycle latency).
     tests : Out(32) per level (``tests_1 .. tests_n``) — coverage tests (busy cycles) per stage.
@@ -39,23 +41,34 @@ class VideoProcessor(wiring.Component):
     busy : Out(1) — a record is still somewhere in the processor.
     """
 
-    def __init__(self, *, n: int, p: int = 4, q: int = 4, a: int = 0, b: int = 0, alpha: int = 2, beta: int = 2,
+    def __init__(self, *, n: int, p: int = 4, q: int = 4, alpha: int = 2, beta: int = 2,
                  z_bits: int = 24, fifo_depth: int = 8, test: str = "exact"):
-        if not isinstance(n, int) or not 1 <= n <= 12:
-            raise ValueError(f"n must be an integer in 1..12, not {n!r}")
-        self._lp, self._lq = _log2("p", p), _log2("q", q)
-        if not (0 <= a < p and 0 <= b < q):
-            raise ValueError(f"processor ({a}, {b}) is outside a {p}x{q} matrix")
-        if not (isinstance(alpha, int) and isinstance(beta, int) and 0 <= alpha <= 15 and 0 <= beta <= 15):
-            raise ValueError(f"aperture must be integers in 0..15, not {alpha}x{beta}")
-        self._n, self._p, self._q, self._a, self._b = n, p, q, a, b
+        try:
+            self._check(n, p, q, alpha, beta)
+            if test not in ("exact", "edges"):
+                raise ValueError(f"test must be 'exact' or 'edges', not {test!r}")
+            if not isinstance(z_bits, int) or not 1 <= z_bits <= 32:
+                raise ValueError(f"z_bits must be an integer in 1..32, not {z_bits!r}")
+            if not isinstance(fifo_depth, int) or fifo_depth < 2:
+                raise ValueError(f"fifo_depth must be an integer >= 2, not {fifo_depth!r}")
+        except ValueError:
+            self._MustUse__silence = True  # a rejected parameter set is not an unused design
+            raise
+        self._n, self._p, self._q = n, p, q
         self._alpha, self._beta, self._z_bits, self._depth, self._test = alpha, beta, z_bits, fifo_depth, test
-        ports = {"i": In(stream.Signature(BROADCAST)), "rd_addr": In(2 * n), "rd_z": Out(z_bits + 1),
+        ports = {"a": In(MATRIX_LOG2_MAX), "b": In(MATRIX_LOG2_MAX), "i": In(stream.Signature(BROADCAST)), "rd_addr": In(2 * n), "rd_z": Out(z_bits + 1),
                  "rd_tri": Out(TRI_BITS), "writes": Out(32), "busy": Out(1)}
         for lvl in range(1, n + 1):
             ports[f"tests_{lvl}"] = Out(32)
             ports[f"stalls_{lvl}"] = Out(32)
         super().__init__(ports)
+
+    def _check(self, n, p, q, alpha, beta) -> None:
+        if not isinstance(n, int) or not 1 <= n <= 12:
+            raise ValueError(f"n must be an integer in 1..12, not {n!r}")
+        self._lp, self._lq = _log2("p", p), _log2("q", q)
+        if not (isinstance(alpha, int) and isinstance(beta, int) and 0 <= alpha <= 15 and 0 <= beta <= 15):
+            raise ValueError(f"aperture must be integers in 0..15, not {alpha}x{beta}")
 
     @property
     def n(self) -> int:
@@ -67,8 +80,9 @@ class VideoProcessor(wiring.Component):
         stages = []
         fifos = []
         for lvl in range(1, n + 1):
-            st = LevelStage(level=lvl, n=n, p=self._p, q=self._q, a=self._a, b=self._b, alpha=self._alpha,
-                            beta=self._beta, test=self._test)
+            st = LevelStage(level=lvl, n=n, p=self._p, q=self._q, alpha=self._alpha, beta=self._beta,
+                            test=self._test)
+            m.d.comb += [st.a.eq(self.a), st.b.eq(self.b)]
             m.submodules[f"level{lvl}"] = st
             stages.append(st)
         for k in range(n + 1):
@@ -88,7 +102,7 @@ class VideoProcessor(wiring.Component):
         bc = Signal(BROADCAST)
         hdr = Signal(RECORD)
         root = Signal(RECORD)
-        a, b, lp, lq = self._a, self._b, self._lp, self._lq
+        a, b, lp, lq = self.a, self.b, self._lp, self._lq
         for k in range(3):
             absA = (bc.A[k] < 0).as_unsigned() * -bc.A[k] + (bc.A[k] >= 0).as_unsigned() * bc.A[k]
             absB = (bc.B[k] < 0).as_unsigned() * -bc.B[k] + (bc.B[k] >= 0).as_unsigned() * bc.B[k]
@@ -129,3 +143,10 @@ class VideoProcessor(wiring.Component):
             idle = idle & (f.level == 0)
         m.d.comb += self.busy.eq(~idle)
         return m
+
+
+def make_vp(*, n: int = 7, p: int = 4, q: int = 4, alpha: int = 2, beta: int = 2,
+            z_bits: int = 24, fifo_depth: int = 8) -> VideoProcessor:
+    """Factory for ``rasterhw verilog sparse-vp``: by default a processor of a 4x4 matrix on the
+    512 x 512 raster (n = 7)."""
+    return VideoProcessor(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth)

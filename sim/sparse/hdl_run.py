@@ -28,11 +28,15 @@ def run_processor(recs: list[dict], *, n: int, p: int, q: int, a: int, b: int, z
     from rasterhw.hdl.sparse.vp import VideoProcessor
     from rasterhw.sim.harness import stream_put
 
-    dut = VideoProcessor(n=n, p=p, q=q, a=a, b=b, z_bits=z_bits)
+    if not (0 <= a < p and 0 <= b < q):
+        raise RasterhwError(f"sparse HDL: processor ({a}, {b}) is outside a {p}x{q} matrix")
+    dut = VideoProcessor(n=n, p=p, q=q, z_bits=z_bits)
     N = 1 << n
     res: dict = {}
 
     async def bench(ctx):
+        ctx.set(dut.a, a)
+        ctx.set(dut.b, b)
         cycles = 0
         for r in recs:
             await stream_put(ctx, dut.i, r)

@@ -41,10 +41,10 @@ def test_one_processor_sees_only_its_pixels():
     assert (h["local_tri"][1] == -1).all() and (h["local_tri"][0, 0] == -1).all()
 
 
-@pytest.mark.filterwarnings("ignore::amaranth.hdl.UnusedElaboratable")
 def test_bad_parameters():
     from rasterhw.hdl.sparse.vp import VideoProcessor
 
-    for kw in ({"n": 0}, {"n": 3, "p": 3}, {"n": 3, "a": 4}, {"n": 3, "alpha": 16}):
+    for kw in ({"n": 0}, {"n": 3, "p": 3}, {"n": 3, "q": 128}, {"n": 3, "alpha": 16}, {"n": 3, "test": "bbox"},
+               {"n": 3, "z_bits": 0}):
         with pytest.raises(ValueError):
             VideoProcessor(**kw)
