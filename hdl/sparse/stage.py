@@ -1,0 +1,127 @@
+"""One level of the recursive pixel search: a pipeline stage of the raster processor."""
+
+from __future__ import annotations
+
+from amaranth.hdl import Module, Signal, signed
+from amaranth.lib import stream, wiring
+from amaranth.lib.wiring import In, Out
+from rasterhw.golden_model.sparse.formats import EDGE_BITS, MATRIX_LOG2_MAX, SUBPIXEL_BITS
+
+from .layouts import RECORD
+
+__all__ = ["LevelStage"]
+
+
+class LevelStage(wiring.Component):
+    """Level ``level`` (1..n) of processor ``(a, b)`` of a ``p x q`` matrix.
+
+    A triangle header is latched and passed on; each window record entering the level is split
+    into its four sub-windows (``du, dv`` in 0, 1: corner values by the per-level increments
+    ``A' * 2**(n-level)``, ``B' * 2**(n-level)``, depth likewise) and each sub-window gets one
+    coverage test per cycle (τ = one cycle): below the pixel level the window rectangle
+    ``[p(2**(n-i) - 1) + alpha] x [q(2**(n-i) - 1) + beta]`` against the three edges and (test
+    ``"exact"``) the triangle's bounding box; at the pixel level the top-left point test.
+    Survivors go out in order ``(0,0), (1,0), (0,1), (1,1)``, as the golden model's.
+
+    Members
+    -------
+    a, b : In(MATRIX_LOG2_MAX) — the processor's place in the matrix (only the exact test uses it).
+    i : In(stream RECORD) — headers and parent windows.
+    o : Out(stream RECORD) — headers and surviving sub-windows (pixels at the last level).
+    tests : Out(32) — coverage tests made (one per busy cycle: the stage's ``t_i / τ``).
+    stalls : Out(32) — cycles a survivor waited for ``o.ready``.
+    idle : Out(1) — no record held.
+
+    Throughput: 4 cycles per window plus one cycle to accept it; a header costs two cycles.
+    """
+
+    def __init__(self, *, level: int, n: int, p: int, q: int, alpha: int = 2, beta: int = 2,
+                 test: str = "exact"):
+        if not 1 <= level <= n:
+            raise ValueError(f"level must be in 1..{n}, not {level!r}")
+        if test not in ("exact", "edges"):
+            raise ValueError(f"test must be 'exact' or 'edges', not {test!r}")
+        self._level, self._n, self._p, self._q = level, n, p, q
+        self._alpha, self._beta, self._test = alpha, beta, test
+        super().__init__({"a": In(MATRIX_LOG2_MAX), "b": In(MATRIX_LOG2_MAX),
+                          "i": In(stream.Signature(RECORD)), "o": Out(stream.Signature(RECORD)),
+                          "tests": Out(32), "stalls": Out(32), "idle": Out(1)})
+
+    @property
+    def level(self) -> int:
+        return self._level
+
+    def elaborate(self, platform):
+        m = Module()
+        n, lvl, p, q = self._n, self._level, self._p, self._q
+        sh = n - lvl  # log2 of the sub-window side N
+        N = 1 << sh
+        last = lvl == n
+        hdr = Signal(RECORD)
+        win = Signal(RECORD)
+        child = Signal(2)
+        du, dv = child[0], child[1]
+        out = Signal(RECORD)
+        ok = Signal()
+        sub, half = 1 << SUBPIXEL_BITS, 1 << (SUBPIXEL_BITS - 1)
+
+        # the sub-window: corner values by increments, no multiplier (N is a power of two)
+        m.d.comb += [out.eq(win), out.hdr.eq(0)]
+        for k in range(3):
+            m.d.comb += out.E[k].eq(win.E[k] + (du * hdr.Ap[k] << sh) + (dv * hdr.Bp[k] << sh))
+        m.d.comb += [out.z.eq(win.z + (du * hdr.zu << sh) + (dv * hdr.zv << sh)),
+                     out.u.eq(win.u + (du << sh)), out.v.eq(win.v + (dv << sh))]
+        conds = []
+        for k in range(3):
+            if last:
+                val = out.E[k]
+            else:
+                mx = Signal(signed(EDGE_BITS + 2), name=f"mx{k}")
+                pos = Signal(signed(EDGE_BITS), name=f"pos{k}")
+                m.d.comb += pos.eq((hdr.Ap[k] > 0).as_unsigned() * hdr.Ap[k]
+                                   + (hdr.Bp[k] > 0).as_unsigned() * hdr.Bp[k])
+                m.d.comb += mx.eq(out.E[k] + (pos << sh) - pos + hdr.ext[k])
+                val = mx
+            conds.append(val >= hdr.thr[k])
+        if self._test == "exact" and not last:
+            us = Signal(signed(24))
+            vs = Signal(signed(24))
+            m.d.comb += [us.eq(out.u), vs.eq(out.v)]
+            a, b, al, be = self.a, self.b, self._alpha, self._beta
+            x0 = (us * p + a) * sub + half - al * half
+            x1 = ((us + (N - 1)) * p + a) * sub + half + al * half
+            y0 = (vs * q + b) * sub + half - be * half
+            y1 = ((vs + (N - 1)) * q + b) * sub + half + be * half
+            conds += [x1 >= hdr.bbox[0], x0 <= hdr.bbox[1], y1 >= hdr.bbox[2], y0 <= hdr.bbox[3]]
+        acc = conds[0]
+        for c in conds[1:]:
+            acc = acc & c
+        m.d.comb += ok.eq(acc)
+
+        with m.FSM():
+            with m.State("IDLE"):
+                m.d.comb += [self.i.ready.eq(1), self.idle.eq(1)]
+                with m.If(self.i.valid):
+                    with m.If(self.i.payload.hdr):
+                        m.d.sync += hdr.eq(self.i.payload)
+                        m.next = "HDR"
+                    with m.Else():
+                        m.d.sync += [win.eq(self.i.payload), child.eq(0)]
+                        m.next = "TEST"
+            with m.State("HDR"):
+                m.d.comb += [self.o.valid.eq(1), self.o.payload.eq(hdr)]
+                with m.If(self.o.ready):
+                    m.next = "IDLE"
+            with m.State("TEST"):
+                advance = Signal()
+                with m.If(ok):
+                    m.d.comb += [self.o.valid.eq(1), self.o.payload.eq(out), advance.eq(self.o.ready)]
+                    with m.If(~self.o.ready):
+                        m.d.sync += self.stalls.eq(self.stalls + 1)
+                with m.Else():
+                    m.d.comb += advance.eq(1)
+                with m.If(advance):
+                    m.d.sync += [self.tests.eq(self.tests + 1), child.eq(child + 1)]
+                    with m.If(child == 3):
+                        m.next = "IDLE"
+        return m

@@ -1,0 +1,152 @@
+"""A video processor of the matrix: set-up, one pipeline stage per level with FIFOs, pixel processor."""
+
+from __future__ import annotations
+
+from amaranth.hdl import Module, Signal
+from amaranth.lib import fifo, stream, wiring
+from amaranth.lib.wiring import In, Out
+from rasterhw.golden_model.sparse.formats import MATRIX_LOG2_MAX, TRI_BITS
+
+from .layouts import BROADCAST, RECORD
+from .pixel import PixelProcessor
+from .stage import LevelStage
+
+__all__ = ["VideoProcessor", "make_vp"]
+
+
+def _log2(name: str, v: int) -> int:
+    if not isinstance(v, int) or v < 1 or v & (v - 1) or v > 1 << MATRIX_LOG2_MAX:
+        raise ValueError(f"{name} must be a power of two in 1..{1 << MATRIX_LOG2_MAX}, not {v!r}")
+    return v.bit_length() - 1
+
+
+class VideoProcessor(wiring.Component):
+    """A video processor of a ``p x q`` matrix with ``2**n x 2**n`` sparse rasters; its place
+    ``(a, b)`` in the matrix is an input (every processor is the same hardware).
+
+    The set-up rewrites each broadcast triangle for this processor's lattice — ``A' = pA``,
+    ``B' = qB``, ``C' = C + aA + bB``, depth ``Z0 = z00 + a*zx + b*zy``, ``zu = p*zx``,
+    ``zv = q*zy``, aperture growth ``(|A| alpha + |B| beta) / 2`` — and sends a header and the
+    root window into the input FIFO of level 1. Levels 1..n are :class:`LevelStage` s, each fed
+    by a FIFO (``fifo_depth`` records); the last one feeds the :class:`PixelProcessor`.
+
+    Members
+    -------
+    a, b : In(MATRIX_LOG2_MAX) — the processor's index in the matrix (held constant).
+    i : In(stream BROADCAST) — triangles, in submission order.
+    rd_addr, rd_z, rd_tri — the local memory's video-controller read port (one cycle latency).
+    tests : Out(32) per level (``tests_1 .. tests_n``) — coverage tests (busy cycles) per stage.
+    stalls : Out(32) per level.
+    writes : Out(32) — pixels written.
+    busy : Out(1) — a record is still somewhere in the processor.
+    """
+
+    def __init__(self, *, n: int, p: int = 4, q: int = 4, alpha: int = 2, beta: int = 2,
+                 z_bits: int = 24, fifo_depth: int = 8, test: str = "exact"):
+        try:
+            self._check(n, p, q, alpha, beta)
+            if test not in ("exact", "edges"):
+                raise ValueError(f"test must be 'exact' or 'edges', not {test!r}")
+            if not isinstance(z_bits, int) or not 1 <= z_bits <= 32:
+                raise ValueError(f"z_bits must be an integer in 1..32, not {z_bits!r}")
+            if not isinstance(fifo_depth, int) or fifo_depth < 2:
+                raise ValueError(f"fifo_depth must be an integer >= 2, not {fifo_depth!r}")
+        except ValueError:
+            self._MustUse__silence = True  # a rejected parameter set is not an unused design
+            raise
+        self._n, self._p, self._q = n, p, q
+        self._alpha, self._beta, self._z_bits, self._depth, self._test = alpha, beta, z_bits, fifo_depth, test
+        ports = {"a": In(MATRIX_LOG2_MAX), "b": In(MATRIX_LOG2_MAX), "i": In(stream.Signature(BROADCAST)), "rd_addr": In(2 * n), "rd_z": Out(z_bits + 1),
+                 "rd_tri": Out(TRI_BITS), "writes": Out(32), "busy": Out(1)}
+        for lvl in range(1, n + 1):
+            ports[f"tests_{lvl}"] = Out(32)
+            ports[f"stalls_{lvl}"] = Out(32)
+        super().__init__(ports)
+
+    def _check(self, n, p, q, alpha, beta) -> None:
+        if not isinstance(n, int) or not 1 <= n <= 12:
+            raise ValueError(f"n must be an integer in 1..12, not {n!r}")
+        self._lp, self._lq = _log2("p", p), _log2("q", q)
+        if not (isinstance(alpha, int) and isinstance(beta, int) and 0 <= alpha <= 15 and 0 <= beta <= 15):
+            raise ValueError(f"aperture must be integers in 0..15, not {alpha}x{beta}")
+
+    @property
+    def n(self) -> int:
+        return self._n
+
+    def elaborate(self, platform):
+        m = Module()
+        n = self._n
+        stages = []
+        fifos = []
+        for lvl in range(1, n + 1):
+            st = LevelStage(level=lvl, n=n, p=self._p, q=self._q, alpha=self._alpha, beta=self._beta,
+                            test=self._test)
+            m.d.comb += [st.a.eq(self.a), st.b.eq(self.b)]
+            m.submodules[f"level{lvl}"] = st
+            stages.append(st)
+        for k in range(n + 1):
+            f = fifo.SyncFIFOBuffered(width=RECORD.size, depth=self._depth)
+            m.submodules[f"fifo{k}"] = f
+            fifos.append(f)
+        m.submodules.pixel = px = PixelProcessor(n=n, z_bits=self._z_bits)
+
+        def push(src, f):
+            m.d.comb += [f.w_data.eq(src.payload), f.w_en.eq(src.valid), src.ready.eq(f.w_rdy)]
+
+        def pop(f, dst):
+            m.d.comb += [dst.payload.eq(f.r_data), dst.valid.eq(f.r_rdy), f.r_en.eq(dst.ready)]
+
+        # set-up: header, then the root window, into FIFO 0
+        setup_o = stream.Signature(RECORD).create()
+        bc = Signal(BROADCAST)
+        hdr = Signal(RECORD)
+        root = Signal(RECORD)
+        a, b, lp, lq = self.a, self.b, self._lp, self._lq
+        for k in range(3):
+            absA = (bc.A[k] < 0).as_unsigned() * -bc.A[k] + (bc.A[k] >= 0).as_unsigned() * bc.A[k]
+            absB = (bc.B[k] < 0).as_unsigned() * -bc.B[k] + (bc.B[k] >= 0).as_unsigned() * bc.B[k]
+            m.d.comb += [hdr.Ap[k].eq(bc.A[k] << lp), hdr.Bp[k].eq(bc.B[k] << lq), hdr.thr[k].eq(bc.thr[k]),
+                         hdr.ext[k].eq((absA * self._alpha + absB * self._beta) >> 1),
+                         root.E[k].eq(bc.C[k] + a * bc.A[k] + b * bc.B[k])]
+        for k in range(4):
+            m.d.comb += hdr.bbox[k].eq(bc.bbox[k])
+        m.d.comb += [hdr.hdr.eq(1), hdr.zu.eq(bc.zx << lp), hdr.zv.eq(bc.zy << lq), hdr.tri.eq(bc.tri),
+                     root.z.eq(bc.z00 + a * bc.zx + b * bc.zy)]
+        setup_idle = Signal()
+        with m.FSM(name="setup"):
+            with m.State("IDLE"):
+                m.d.comb += [self.i.ready.eq(1), setup_idle.eq(1)]
+                with m.If(self.i.valid):
+                    m.d.sync += bc.eq(self.i.payload)
+                    m.next = "HDR"
+            with m.State("HDR"):
+                m.d.comb += [setup_o.valid.eq(1), setup_o.payload.eq(hdr)]
+                with m.If(setup_o.ready):
+                    m.next = "ROOT"
+            with m.State("ROOT"):
+                m.d.comb += [setup_o.valid.eq(1), setup_o.payload.eq(root)]
+                with m.If(setup_o.ready):
+                    m.next = "IDLE"
+        push(setup_o, fifos[0])
+        for k, st in enumerate(stages):
+            pop(fifos[k], st.i)
+            push(st.o, fifos[k + 1])
+            m.d.comb += [getattr(self, f"tests_{k + 1}").eq(st.tests), getattr(self, f"stalls_{k + 1}").eq(st.stalls)]
+        pop(fifos[n], px.i)
+        m.d.comb += [px.rd_addr.eq(self.rd_addr), self.rd_z.eq(px.rd_z), self.rd_tri.eq(px.rd_tri),
+                     self.writes.eq(px.writes)]
+        idle = setup_idle & px.idle
+        for st in stages:
+            idle = idle & st.idle
+        for f in fifos:
+            idle = idle & (f.level == 0)
+        m.d.comb += self.busy.eq(~idle)
+        return m
+
+
+def make_vp(*, n: int = 7, p: int = 4, q: int = 4, alpha: int = 2, beta: int = 2,
+            z_bits: int = 24, fifo_depth: int = 8) -> VideoProcessor:
+    """Factory for ``rasterhw verilog sparse-vp``: by default a processor of a 4x4 matrix on the
+    512 x 512 raster (n = 7)."""
+    return VideoProcessor(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth)

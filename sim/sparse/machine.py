@@ -1,0 +1,23 @@
+"""Registry entry of the matrix-pipeline generator on sparse rasters (seed 002)."""
+
+from __future__ import annotations
+
+from rasterhw.sim.registry import Arch, Machine, Option
+
+MACHINE = Machine(
+    name="sparse",
+    title="Matrix-pipeline generator on sparse rasters (recursive pixel search)",
+    seed="002_a1ff7020b0ad58f6.txt",
+    archs=(
+        Arch(name="sparse",
+             help="p x q matrix of video processors, recursive pixel search on sparse rasters "
+                  "(image equals the reference)",
+             render="rasterhw.golden_model.sparse.render:render",
+             options=(Option(name="matrix", help="matrix of video processors PxQ (powers of two; "
+                                                 "the raster must be p*2^n x q*2^n)",
+                             default="4x4"),)),
+    ),
+    report="rasterhw.sim.sparse.report:rows",
+    bench="rasterhw.sim.sparse.bench:bench",
+    status="golden model (image = reference), formulas (1)-(12), Monte-Carlo window counts, figs. 3-6; no HDL yet",
+)
