@@ -49,7 +49,7 @@ async def stream_get(ctx, port, *, gap: int = 0):
     for _ in range(gap):
         await ctx.tick()
     ctx.set(port.ready, 1)
-    _clk, _rst, payload = await ctx.tick().sample(port.payload).until(port.valid)
+    (payload,) = await ctx.tick().sample(port.payload).until(port.valid)
     ctx.set(port.ready, 0)
     return as_plain(payload)
 
@@ -72,19 +72,20 @@ def stream_sink(port, out: list, *, ready: Iterable[int] | None = None):
     return sink
 
 
-def stream_protocol_checker(port, name: str = "stream", log: list | None = None):
+def stream_protocol_checker(port, name: str = "stream", log: list | None = None, *, domain: str = "sync"):
     """A background pysim testbench checking the stream rules on ``port`` at every clock.
 
     Once ``valid`` is high and ``ready`` low at a clock edge, the next clock must still
     have ``valid`` high and the same payload.  Violations raise ``AssertionError``;
     accepted payloads are appended to ``log`` (if given) for an in-order scoreboard.
+    ``domain`` is the clock domain the port lives in.
 
     Usage: ``sim.add_testbench(stream_protocol_checker(dut.i, "i", log), background=True)``.
     """
 
     async def checker(ctx):
         held = None
-        async for _clk, _rst, valid, ready, payload in ctx.tick().sample(port.valid, port.ready, port.payload):
+        async for _clk, _rst, valid, ready, payload in ctx.tick(domain).sample(port.valid, port.ready, port.payload):
             payload = as_plain(payload)
             if held is not None:
                 assert valid, f"{name}: valid dropped before the transfer of {held}"

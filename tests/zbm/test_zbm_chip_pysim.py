@@ -10,6 +10,7 @@ from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.stimulus import multi_line_segments, random_doublez
 from rasterhw.golden_model.zbm.words import pixel2_words, segment_words
 from rasterhw.hdl.zbm.chip import ZbmChip
+from rasterhw.sim.harness import stream_protocol_checker
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 
@@ -56,6 +57,8 @@ def run_chip(dut, words, merge_in, *, period_merge=1e-8, idle_p=0.0, stall_p=0.0
 
     sim.add_testbench(seg_src, background=True)
     sim.add_testbench(merge_src, background=True)
+    sim.add_testbench(stream_protocol_checker(dut.i_seg, "i_seg"), background=True)
+    sim.add_testbench(stream_protocol_checker(dut.o_merge, "o_merge", domain="merge"), background=True)
     sim.add_testbench(sink)
     sim.run()
     assert len(got) == n_out, f"timeout: {len(got)} of {n_out} words"

@@ -11,6 +11,7 @@ from rasterhw.golden_model.zbm.stimulus import random_segments
 from rasterhw.golden_model.zbm.words import packets, pixel2_words
 from rasterhw.hdl.zbm.loop import LOOP_GAP, ZbmLoop
 from rasterhw.hdl.zbm.pixel import ZbmPixelProcessor
+from rasterhw.sim.harness import stream_protocol_checker
 
 
 def run_loop(interleave, chip, width, segs_list, *, idle_p=0.0, seed=0):
@@ -58,6 +59,7 @@ def run_loop(interleave, chip, width, segs_list, *, idle_p=0.0, seed=0):
             out.append(line)
 
     sim.add_testbench(monitor, background=True)
+    sim.add_testbench(stream_protocol_checker(dut.i, "i"), background=True)
     sim.add_testbench(bench)
     sim.run()
     return out, entries

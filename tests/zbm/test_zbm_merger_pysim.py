@@ -8,6 +8,7 @@ import pytest
 from amaranth.lib import data
 from amaranth.sim import Simulator
 from rasterhw.hdl.zbm.merger import ZbmMerger
+from rasterhw.sim.harness import stream_protocol_checker
 
 # Background sources are closed mid-`until` when the sink finishes; that is expected.
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
@@ -80,6 +81,8 @@ def run(n, period_sync, period_merge, seed, stall_p=0.3):
 
     sim.add_testbench(put_own, background=True)
     sim.add_testbench(put_in, background=True)
+    sim.add_testbench(stream_protocol_checker(dut.o_merge, "o_merge", domain="merge"), background=True)
+    sim.add_testbench(stream_protocol_checker(dut.i_own, "i_own"), background=True)
     sim.add_testbench(get_out)
     sim.run()
     for k in range(n):

@@ -11,6 +11,7 @@ from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.golden_model.zbm.words import edge_pair_words, segment_words
 from rasterhw.hdl.zbm.seggen import ZbmSegmentGenerator
+from rasterhw.sim.harness import stream_protocol_checker
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 
@@ -45,6 +46,7 @@ def run_seggen(dut, words, n_out, *, idle_p=0.0, stall_p=0.0, seed=0, cycles=200
                 got.append(payload)
 
     sim.add_testbench(src, background=True)
+    sim.add_testbench(stream_protocol_checker(dut.o, "o"), background=True)
     sim.add_testbench(sink)
     sim.run()
     assert len(got) == n_out, f"timeout: {len(got)} of {n_out} words"
@@ -108,6 +110,7 @@ def test_seggen_overflow_stalls_without_loss():
         state["line"] = ctx.get(dut.line)
 
     sim.add_testbench(src, background=True)
+    sim.add_testbench(stream_protocol_checker(dut.o, "o"), background=True)
     sim.add_testbench(sink)
     sim.run()
     assert state["ovf"] == 1 and state["line"] == line

@@ -13,6 +13,7 @@ from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.golden_model.zbm.words import edge_pair_words, pixel2_words
 from rasterhw.hdl.zbm.chain import ZbmChain
 from rasterhw.hdl.zbm.unit import ZbmUnit
+from rasterhw.sim.harness import stream_protocol_checker
 from rasterhw.sim.zbm.cycles_hdl import measure_cycles_per_edge_pair, run_unit_cycles
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
@@ -56,6 +57,10 @@ def run_units(units, words_per_unit, n_lines, *, merge_period=1e-8, stall_p=0.0,
 
     for u, words in zip(units, words_per_unit, strict=True):
         sim.add_testbench(src(u, words), background=True)
+    for c in range(last.interleave):
+        sim.add_testbench(stream_protocol_checker(last.o_merge[c], f"o_merge[{c}]", domain="merge"), background=True)
+    for k, u in enumerate(units):
+        sim.add_testbench(stream_protocol_checker(u.i, f"unit{k}.i"), background=True)
     sim.add_testbench(sink)
     sim.run()
     return got
