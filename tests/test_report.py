@@ -49,9 +49,15 @@ def test_run_report_writes_markdown(tmp_path, monkeypatch):
     def fake(*, engine, progress, out_dir):
         return [make_row("fake", "t1", "q", paper=2, formula=2, measured=2, unit="u", source="golden")], ["extra"]
 
-    monkeypatch.setitem(report.SYSTEMS, "fake", "tests.fake:rows")
     monkeypatch.setattr(report, "_load", lambda name: fake)
     rows = run_report("fake", out_dir=tmp_path)
     assert rows[0]["measured"] == 2
     text = (tmp_path / "fake.md").read_text()
     assert "| fake | t1 | q |" in text and "extra" in text
+
+
+def test_unknown_system_is_a_one_line_error():
+    from rasterhw.golden_model.errors import RasterhwError
+
+    with pytest.raises(RasterhwError, match="unknown machine 'nope'"):
+        run_report("nope")

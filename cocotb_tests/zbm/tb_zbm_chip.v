@@ -45,8 +45,6 @@ module tb_zbm_chip #(
 
   reg clk = 1'b0;
   reg mclk = 1'b0;
-  reg rst = 1'b1;
-  reg mrst = 1'b1;
   // Equal clocks in phase (+merge_phase=0, the speed runs) toggle in one process: one
   // coroutine resumption per edge instead of two.
   wire one_clock = (MERGE_PHASE == 0) && (MERGE_HALF == SYNC_HALF);
@@ -69,11 +67,9 @@ module tb_zbm_chip #(
     end
   end
 
-  reg [GW+SEGW-1:0] seg [0:SDEPTH-1];
-  reg [GW+MW-1:0] up [0:MDEPTH-1];
   reg [MW-1:0] frame [0:NOUT-1];
   reg [31:0] nseg, nup;
-  reg [8*512-1:0] fseg, fup, fout;
+  reg [8*512-1:0] fout;
   integer k0;
 
   initial begin
@@ -81,78 +77,27 @@ module tb_zbm_chip #(
     timeout = 1'b0;
     cycles = 32'd0;
     lines = 32'd0;
-    if (!$value$plusargs("seg=%s", fseg)) $fatal(1, "tb_zbm_chip: +seg= missing");
-    if (!$value$plusargs("up=%s", fup)) $fatal(1, "tb_zbm_chip: +up= missing");
     if (!$value$plusargs("out=%s", fout)) $fatal(1, "tb_zbm_chip: +out= missing");
     if (!$value$plusargs("nseg=%d", nseg)) $fatal(1, "tb_zbm_chip: +nseg= missing");
     if (!$value$plusargs("nup=%d", nup)) $fatal(1, "tb_zbm_chip: +nup= missing");
-    $readmemh(fseg, seg);
-    $readmemh(fup, up);
     for (k0 = 0; k0 < NOUT; k0 = k0 + 1) frame[k0] = {MW{1'b1}};
   end
 
-  // Each reset is released by a process that counts only its own clock's edges, 0.5 ns
-  // after a rising edge of that clock: before its falling edge (half periods are >= 1 ns)
-  // and away from every edge of either clock (edges fall on whole ns). The Python stream
-  // monitors sample at the falling edge, so they see the same reset value as the design's
-  // next rising edge. (Both resets used to be released 0.5 ns after a merge-clock edge,
-  // which can fall between a falling and the next rising edge of the segment clock: the
-  // monitor then saw the stream still in reset while the design took its first word, and
-  // missed that transfer -- "transfer 0 is <word 1>" with half periods 2:3. A non-blocking
-  // release at the edge itself is not used: Verilator --timing and Icarus then disagree by
-  // one cycle on when the flops see it.)
-  initial begin
-    repeat (6) @(posedge clk);
-    #0.5 rst = 1'b0;
-  end
-  initial begin
-    repeat (6) @(posedge mclk);
-    #0.5 mrst = 1'b0;
-  end
+  wire rst, mrst;
+  rasterhw_reset #(.CYCLES(6), .DELAY(0.5)) seg_reset (.clk(clk), .rst(rst));
+  rasterhw_reset #(.CYCLES(6), .DELAY(0.5)) merge_reset (.clk(mclk), .rst(mrst));
 
-  // --- segment player (segment clock) -----------------------------------------------------
-  reg [31:0] sp, srep;
-  reg [GW-1:0] swt;
-  wire [GW+SEGW-1:0] scur = seg[sp];
-  wire [GW+SEGW-1:0] snxt = seg[(sp + 1 == nseg) ? 32'd0 : sp + 1];
-  wire seg_v = !rst && (srep < REPEAT) && (sp < nseg) && (swt == {GW{1'b0}});
-  wire seg_r;
-  wire [SEGW-1:0] seg_p = scur[SEGW-1:0];
-  always @(posedge clk) begin
-    if (rst) begin
-      sp <= 32'd0;
-      srep <= 32'd0;
-      swt <= seg[0][GW+SEGW-1:SEGW];
-    end else if (seg_v && seg_r) begin
-      sp <= (sp + 1 == nseg) ? 32'd0 : sp + 32'd1;
-      if (sp + 1 == nseg) srep <= srep + 32'd1;
-      swt <= snxt[GW+SEGW-1:SEGW];
-    end else if (swt != {GW{1'b0}}) begin
-      swt <= swt - 1'b1;
-    end
-  end
-
-  // --- upstream merge-port player (merge clock) --------------------------------------------
-  reg [31:0] upp, urep;
-  reg [GW-1:0] uwt;
-  wire [GW+MW-1:0] ucur = up[upp];
-  wire [GW+MW-1:0] unxt = up[(upp + 1 == nup) ? 32'd0 : upp + 1];
-  wire up_v = !mrst && (urep < REPEAT) && (upp < nup) && (uwt == {GW{1'b0}});
-  wire up_r;
-  wire [MW-1:0] up_p = ucur[MW-1:0];
-  always @(posedge mclk) begin
-    if (mrst) begin
-      upp <= 32'd0;
-      urep <= 32'd0;
-      uwt <= up[0][GW+MW-1:MW];
-    end else if (up_v && up_r) begin
-      upp <= (upp + 1 == nup) ? 32'd0 : upp + 32'd1;
-      if (upp + 1 == nup) urep <= urep + 32'd1;
-      uwt <= unxt[GW+MW-1:MW];
-    end else if (uwt != {GW{1'b0}}) begin
-      uwt <= uwt - 1'b1;
-    end
-  end
+  // --- stimulus players: segment words (segment clock), upstream pixels (merge clock) ------
+  wire seg_v, seg_r, up_v, up_r;
+  wire [SEGW-1:0] seg_p;
+  wire [MW-1:0] up_p;
+  wire seg_done, up_done;
+  rasterhw_stream_player #(.PW(SEGW), .GW(GW), .DEPTH(SDEPTH), .FILE_ARG("seg=%s")) seg_player (
+    .clk(clk), .rst(rst), .base(32'd0), .count(nseg), .repeats(REPEAT),
+    .valid(seg_v), .ready(seg_r), .payload(seg_p), .done(seg_done));
+  rasterhw_stream_player #(.PW(MW), .GW(GW), .DEPTH(MDEPTH), .FILE_ARG("up=%s")) up_player (
+    .clk(mclk), .rst(mrst), .base(32'd0), .count(nup), .repeats(REPEAT),
+    .valid(up_v), .ready(up_r), .payload(up_p), .done(up_done));
 
   // --- device under test ----------------------------------------------------------------
   wire o_v;
@@ -197,11 +142,11 @@ module tb_zbm_chip #(
   end
 
   wire [31:0] e_seg, e_up, e_out, t_seg, t_up, t_out;
-  zbm_stream_check #(.PW(SEGW)) chk_seg (.clk(clk), .rst(rst), .valid(seg_v), .ready(seg_r),
+  rasterhw_stream_check #(.PW(SEGW)) chk_seg (.clk(clk), .rst(rst), .valid(seg_v), .ready(seg_r),
                                           .payload(seg_p), .errors(e_seg), .transfers(t_seg));
-  zbm_stream_check #(.PW(MW)) chk_up (.clk(mclk), .rst(mrst), .valid(up_v), .ready(up_r),
+  rasterhw_stream_check #(.PW(MW)) chk_up (.clk(mclk), .rst(mrst), .valid(up_v), .ready(up_r),
                                       .payload(up_p), .errors(e_up), .transfers(t_up));
-  zbm_stream_check #(.PW(MW)) chk_out (.clk(mclk), .rst(mrst), .valid(o_v), .ready(o_r),
+  rasterhw_stream_check #(.PW(MW)) chk_out (.clk(mclk), .rst(mrst), .valid(o_v), .ready(o_r),
                                        .payload(o_p), .errors(e_out), .transfers(t_out));
 
   always @(posedge mclk) begin

@@ -8,7 +8,7 @@
 // back-pressure into a frame memory (screen order), then dumped with $writememh.
 //
 // Stimulus word (hex, one per line): {gap[GW-1:0], word[167:0]}: word = the 168-bit loader
-// word (golden_model.zbm_formats), raised `gap` clocks after the previous transfer.
+// word (golden_model/zbm/formats.py), raised `gap` clocks after the previous transfer.
 // Index file: for unit k, two hex lines: first stimulus word, number of words.
 // Plusargs: +stim=<file> +index=<file> +out=<file>.
 // Output file: W*H lines of 32 hex digits (PIXEL2 = s1:s0), pixel (x, y) at line y*W + x.
@@ -31,7 +31,6 @@ module tb_zbm_unit #(
 );
   localparam EW = 168;
   localparam MW = 128;
-  localparam SW = GW + EW;
   localparam NPIX = W * H;
 
   // run-time settings (plusargs, so one simulator build serves every clock ratio and pattern):
@@ -50,8 +49,6 @@ module tb_zbm_unit #(
 
   reg clk = 1'b0;
   reg mclk = 1'b0;
-  reg rst = 1'b1;
-  reg mrst = 1'b1;
   // Equal clocks in phase (+merge_phase=0, the speed runs) toggle in one process: one
   // coroutine resumption per edge instead of two.
   wire one_clock = (MERGE_PHASE == 0) && (MERGE_HALF == SYNC_HALF);
@@ -74,10 +71,9 @@ module tb_zbm_unit #(
     end
   end
 
-  reg [SW-1:0] stim [0:SDEPTH-1];
   reg [31:0] idx [0:2*U-1];
   reg [MW-1:0] frame [0:NPIX-1];
-  reg [8*512-1:0] fstim, findex, fout;
+  reg [8*512-1:0] findex, fout;
   integer k0;
 
   initial begin
@@ -86,32 +82,15 @@ module tb_zbm_unit #(
     cycles = 32'd0;
     frames_ok = 1'b0;
     overflow = 1'b0;
-    if (!$value$plusargs("stim=%s", fstim)) $fatal(1, "tb_zbm_unit: +stim= missing");
     if (!$value$plusargs("index=%s", findex)) $fatal(1, "tb_zbm_unit: +index= missing");
     if (!$value$plusargs("out=%s", fout)) $fatal(1, "tb_zbm_unit: +out= missing");
-    $readmemh(fstim, stim);
     $readmemh(findex, idx);
     for (k0 = 0; k0 < NPIX; k0 = k0 + 1) frame[k0] = {MW{1'b1}};
   end
 
-  // Each reset is released by a process that counts only its own clock's edges, 0.5 ns
-  // after a rising edge of that clock: before its falling edge (half periods are >= 1 ns)
-  // and away from every edge of either clock (edges fall on whole ns). The Python stream
-  // monitors sample at the falling edge, so they see the same reset value as the design's
-  // next rising edge. (Both resets used to be released 0.5 ns after a merge-clock edge,
-  // which can fall between a falling and the next rising edge of the segment clock: the
-  // monitor then saw the stream still in reset while the design took its first word, and
-  // missed that transfer -- "transfer 0 is <word 1>" with half periods 2:3. A non-blocking
-  // release at the edge itself is not used: Verilator --timing and Icarus then disagree by
-  // one cycle on when the flops see it.)
-  initial begin
-    repeat (6) @(posedge clk);
-    #0.5 rst = 1'b0;
-  end
-  initial begin
-    repeat (6) @(posedge mclk);
-    #0.5 mrst = 1'b0;
-  end
+  wire rst, mrst;
+  rasterhw_reset #(.CYCLES(6), .DELAY(0.5)) seg_reset (.clk(clk), .rst(rst));
+  rasterhw_reset #(.CYCLES(6), .DELAY(0.5)) merge_reset (.clk(mclk), .rst(mrst));
 
   // --- device under test ----------------------------------------------------------------
   wire [U-1:0] i_valid, i_ready;
@@ -136,28 +115,17 @@ module tb_zbm_unit #(
     for (k = 0; k < U; k = k + 1) begin : player
       wire [31:0] base = idx[2*k];
       wire [31:0] count = idx[2*k+1];
-      reg [31:0] ptr;
-      reg [GW-1:0] wt;
-      wire [SW-1:0] cur = stim[base + ptr];
-      wire [SW-1:0] nxt = stim[base + ptr + 1];
-      wire v = !rst && (ptr < count) && (wt == {GW{1'b0}});
+      wire v, done;
       wire r = i_ready[k];
-      wire [EW-1:0] p = cur[EW-1:0];
+      wire [EW-1:0] p;
       assign i_valid[k] = v;
       assign i_payload[k*EW +: EW] = p;
-      always @(posedge clk) begin
-        if (rst) begin
-          ptr <= 32'd0;
-          wt <= stim[base][SW-1:EW];
-        end else if (v && r) begin
-          ptr <= ptr + 32'd1;
-          wt <= nxt[SW-1:EW];
-        end else if (wt != {GW{1'b0}}) begin
-          wt <= wt - 1'b1;
-        end
-      end
+      // every player loads the whole stimulus file and plays its own unit's words
+      rasterhw_stream_player #(.PW(EW), .GW(GW), .DEPTH(SDEPTH), .FILE_ARG("stim=%s")) u (
+        .clk(clk), .rst(rst), .base(base), .count(count), .repeats(32'd1),
+        .valid(v), .ready(r), .payload(p), .done(done));
       wire [31:0] transfers;
-      zbm_stream_check #(.PW(EW)) chk (.clk(clk), .rst(rst), .valid(v), .ready(r), .payload(p),
+      rasterhw_stream_check #(.PW(EW)) chk (.clk(clk), .rst(rst), .valid(v), .ready(r), .payload(p),
                                        .errors(in_err[32*k +: 32]), .transfers(transfers));
     end
   endgenerate
@@ -205,7 +173,7 @@ module tb_zbm_unit #(
         end
       end
       wire [31:0] transfers;
-      zbm_stream_check #(.PW(MW)) chk (.clk(mclk), .rst(mrst), .valid(v), .ready(r), .payload(p),
+      rasterhw_stream_check #(.PW(MW)) chk (.clk(mclk), .rst(mrst), .valid(v), .ready(r), .payload(p),
                                        .errors(out_err[32*c +: 32]), .transfers(transfers));
     end
   endgenerate

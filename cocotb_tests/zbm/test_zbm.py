@@ -5,7 +5,7 @@ stimulus, the golden result and the plusargs (clock ratio, back-pressure, seed);
 with ``pytest tests/zbm/test_zbm_cocotb.py``.  The designs run free on Verilog-side clocks;
 Python only waits for ``finished`` unless ZBM_CHECK_PROTOCOL=1, which adds the stream
 checker of ``cocotb_tests/common.py`` on every stream (each clock; small runs) feeding
-in-order scoreboards.  The Verilog checkers (zbm_check.v) run always.
+in-order scoreboards.  The Verilog checkers (cocotb_tests/harness.v) run always.
 
 Environment: ZBM_OUT (dump written by the wrapper; result.json goes beside it),
 ZBM_EXPECT (.npz with the golden (s0, s1) words and the stimulus), ZBM_CHECK_PROTOCOL.

@@ -22,7 +22,7 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.snu import pixelbus as golden
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.sim.harness import stream_protocol_checker, stream_put
-from rasterhw.sim.runner import REPO_ROOT, build_dir_for, get_sim, run_cocotb
+from rasterhw.sim.runner import HARNESS_V, REPO_ROOT, build_dir_for, get_sim, run_cocotb
 
 __all__ = ["ENGINES", "GAP_BITS", "simulate_pixelbus", "run_pysim", "write_stimulus", "read_frame_dump"]
 
@@ -169,7 +169,8 @@ def run_cocotb_bench(
     n1 = len(stream) - n0
     sdepth = max(1024, 1 << ceil_log2(max(n0, n1) + 2))
     params = {"width": w, "height": h, "z_bits": stream.z_bits, "ram": ram}
-    bdir = build_dir_for("pixelbus", sim, sdepth=sdepth, **params)
+    bdir = build_dir_for("pixelbus", sim, sources=[HARNESS_V, BENCH_DIR / "tb_pixelbus.v"], sdepth=sdepth,
+                         **params)
     bdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     vpath = bdir / "pixelbus.v"
@@ -195,7 +196,7 @@ def run_cocotb_bench(
     t1 = time.perf_counter()
     timings: dict = {}
     run_cocotb(
-        sources=[vpath, BENCH_DIR / "tb_pixelbus.v"],
+        sources=[vpath, HARNESS_V, BENCH_DIR / "tb_pixelbus.v"],
         toplevel="tb_pixelbus",
         test_module="cocotb_tests.snu.pixelbus.test_pixelbus",
         build_dir=bdir,

