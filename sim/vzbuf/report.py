@@ -196,6 +196,18 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
         out.append(make_row(SYS, "check", f"{n}: visible pixels in shadow (shadow polygons)", paper=None,
                             formula=None, measured=int(fp.shadowed.sum()), unit="px", source="golden"))
 
+    # shadow-map epsilon: the paper gives none; agreement with the ray check over a sweep
+    if "c300" in scenes and ("table 5", "c300") in times:
+        sc = build_scene("c300")
+        fp = times[("table 5", "c300")][2]
+        ray = ray_shadow(sc, W, H, fp.depth, fp.poly)
+        vis = fp.poly >= 0
+        for eps in (1e-3, 2e-3, 5e-3, 1e-2, 2e-2):
+            fm = render_frame(sc, W, H, alg=2, shadows="map", eps=eps)
+            out.append(make_row(SYS, "check", f"c300: shadow map (eps = {eps:g}) agrees with the ray to the light",
+                                paper=None, formula=None, measured=float((ray == fm.shadowed)[vis].mean()),
+                                unit="fraction", source="golden"))
+
     # vector lengths
     for n in scenes:
         for table in ("table 2", "table 3"):
