@@ -95,7 +95,7 @@ def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
     poly = seg.poly
     active = np.zeros(0, np.int64)
     zline = np.empty(width)
-    clk = time.perf_counter
+    clk = time.process_time
     for y in range(height):
         ta = clk()
         if active.size:
@@ -178,7 +178,7 @@ def algorithm2(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
     depth = buf["depth"].reshape(-1)
     qid, inten, count = buf["qid"].reshape(-1), buf["inten"].reshape(-1), buf["count"].reshape(-1)
     slist = np.full(height, -1, np.int64)
-    clk = time.perf_counter
+    clk = time.process_time
     while True:
         ta = clk()
         # (1) drop exited segments
