@@ -95,3 +95,47 @@ def test_verilog_list_and_generate(tmp_path):
     r = run("verilog", "pixelbus-bank", "-p", "depth=16", "-o", str(out))
     assert r.returncode == 0, r.stderr
     assert "module pixelbus_bank" in out.read_text()
+
+
+def _registered_archs():
+    from rasterhw.sim import registry
+
+    return sorted(registry.archs())
+
+
+@pytest.mark.parametrize("arch", _registered_archs())
+def test_render_every_registered_arch(tmp_path, arch):
+    """Every machine's golden arch renders through the CLI and covers the reference's pixels
+    (an arch that drew nothing or the wrong frame size would fail here)."""
+    import numpy as np
+    from PIL import Image
+
+    out, ref = tmp_path / f"{arch}.png", tmp_path / "ref.png"
+    r = run("render", "c50", "--size", "64x64", "--arch", arch, "--json", "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout)
+    assert res["arch"] == arch and (res["width"], res["height"]) == (64, 64) and res["pixels_written"] > 0
+    assert run("render", "c50", "--size", "64x64", "-o", str(ref)).returncode == 0
+    a = np.asarray(Image.open(out).convert("RGB")).any(axis=2)
+    b = np.asarray(Image.open(ref).convert("RGB")).any(axis=2)
+    assert a.shape == (64, 64) and (a & b).sum() >= 0.5 * b.sum()
+
+
+def test_option_of_another_arch_is_refused():
+    r = run("render", "c50", "--size", "32x32", "--arch", "reference", "--interleave", "2")
+    assert r.returncode == 2 and r.stderr.strip() == "error: --interleave does not apply to --arch reference"
+
+
+def test_typed_block_parameters(tmp_path):
+    r = run("verilog", "zbm-unit", "--interleave", "1", "-p", "width=16", "-p", "height=8", "-p", "head=maybe",
+            "-o", str(tmp_path / "t.v"))
+    assert r.returncode == 2 and "true or false" in r.stderr and not (tmp_path / "t.v").exists()
+    r = run("verilog", "zbm-unit", "--interleave", "2", "-p", "interleave=1", "-o", str(tmp_path / "t.v"))
+    assert r.returncode == 2 and "contradicts" in r.stderr
+
+
+def test_machines_lists_every_machine():
+    r = run("machines")
+    assert r.returncode == 0
+    for name in ("snu", "zbm"):
+        assert name in r.stdout
