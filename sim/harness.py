@@ -72,13 +72,15 @@ def stream_sink(port, out: list, *, ready: Iterable[int] | None = None):
     return sink
 
 
-def stream_protocol_checker(port, name: str = "stream", log: list | None = None, *, domain: str = "sync"):
+def stream_protocol_checker(port, name: str = "stream", log: list | None = None, *, domain: str = "sync",
+                            errors: list | None = None):
     """A background pysim testbench checking the stream rules on ``port`` at every clock.
 
     Once ``valid`` is high and ``ready`` low at a clock edge, the next clock must still
     have ``valid`` high and the same payload.  Violations raise ``AssertionError``;
     accepted payloads are appended to ``log`` (if given) for an in-order scoreboard.
-    ``domain`` is the clock domain the port lives in.
+    ``domain`` is the clock domain the port lives in. With ``errors`` (a list) a violation is
+    appended to it instead of raised, so a run can count them.
 
     Usage: ``sim.add_testbench(stream_protocol_checker(dut.i, "i", log), background=True)``.
     """
@@ -88,8 +90,13 @@ def stream_protocol_checker(port, name: str = "stream", log: list | None = None,
         async for _clk, _rst, valid, ready, payload in ctx.tick(domain).sample(port.valid, port.ready, port.payload):
             payload = as_plain(payload)
             if held is not None:
-                assert valid, f"{name}: valid dropped before the transfer of {held}"
-                assert payload == held, f"{name}: payload changed from {held} to {payload} before the transfer"
+                bad = (f"{name}: valid dropped before the transfer of {held}" if not valid else
+                       f"{name}: payload changed from {held} to {payload} before the transfer"
+                       if payload != held else None)
+                if bad and errors is None:
+                    raise AssertionError(bad)
+                if bad:
+                    errors.append(bad)
             if valid and ready:
                 if log is not None:
                     log.append(payload)

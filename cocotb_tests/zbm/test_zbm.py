@@ -21,14 +21,9 @@ from pathlib import Path
 import cocotb
 import numpy as np
 from cocotb.triggers import RisingEdge
+from rasterhw.golden_model.zbm.words import merge_words
 
 from cocotb_tests.common import start_checker, to_int
-
-MASK64 = (1 << 64) - 1
-
-
-def _words(s0: np.ndarray, s1: np.ndarray) -> list[int]:
-    return [int(a) | (int(b) << 64) for a, b in zip(s0.ravel().tolist(), s1.ravel().tolist(), strict=True)]
 
 
 def _read_dump(path: str) -> list[int]:
@@ -111,10 +106,10 @@ async def zbm_unit_frame(dut):
             Scoreboard(f"i[{k}]", want).check(log)
         interleave = len(logs_out)
         for c, log in enumerate(logs_out):
-            Scoreboard(f"o_merge[{c}]", _words(s0[:, c::interleave], s1[:, c::interleave])).check(log)
+            Scoreboard(f"o_merge[{c}]", merge_words(s0[:, c::interleave], s1[:, c::interleave])).check(log)
     got = np.array(_read_dump(os.environ["ZBM_OUT"]), dtype=object)
     assert got.size == h * w, f"dump has {got.size} words, expected {h * w}"
-    want = np.array(_words(s0, s1), dtype=object)
+    want = np.array(merge_words(s0, s1), dtype=object)
     msg = _line_report(got.reshape(h, w), want.reshape(h, w))
     assert not msg, msg
 
@@ -147,8 +142,8 @@ async def zbm_chip_lines(dut):
         up = [int(x, 16) for x in exp["up"]] * rep
         Scoreboard("i_seg", seg).check(logs["i_seg"])
         Scoreboard("i_merge", up).check(logs["i_merge"])
-        Scoreboard("o_merge", _words(s0, s1) * rep).check(logs["o_merge"])
+        Scoreboard("o_merge", merge_words(s0, s1) * rep).check(logs["o_merge"])
     got = np.array(_read_dump(os.environ["ZBM_OUT"]), dtype=object).reshape(s0.shape)
-    want = np.array(_words(s0, s1), dtype=object).reshape(s0.shape)
+    want = np.array(merge_words(s0, s1), dtype=object).reshape(s0.shape)
     msg = _line_report(got, want)
     assert not msg, msg

@@ -11,7 +11,7 @@ import numpy as np
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.zbm import formats as F
 
-__all__ = ["doublez_words", "edge_pair_words", "packets", "pixel2_words", "segment_words",
+__all__ = ["merge_words", "split_merge_words", "doublez_words", "edge_pair_words", "packets", "pixel2_words", "segment_words",
            "words_to_doublez"]
 
 
@@ -45,7 +45,7 @@ def packets(segs: G.Segments, y: int, chip: int, interleave: int) -> list[list[i
 def pixel2_words(buf: G.DoubleZ) -> list[int]:
     """Golden double-Z pixels -> PIXEL2 integers (s0 in bits 0..63, s1 in 64..127)."""
     w = buf.words()
-    return [int(a) | (int(b) << 64) for a, b in w.reshape(-1, 2)]
+    return merge_words(w[..., 0], w[..., 1])
 
 
 def doublez_words(px: G.DoubleZ) -> tuple[np.ndarray, np.ndarray]:
@@ -61,3 +61,22 @@ def words_to_doublez(s0: np.ndarray, s1: np.ndarray) -> G.DoubleZ:
         z, a, c = F.unpack_samples(w)
         d.z[..., k], d.a[..., k], d.c[..., k, :] = z, a, c
     return d
+
+
+_SAMPLE_BITS = F.SAMPLE.width
+_SAMPLE_MASK = (1 << _SAMPLE_BITS) - 1
+
+
+def merge_words(s0, s1) -> list[int]:
+    """(s0, s1) sample words (any shape, uint64) -> merge-bus words ``s1 << 64 | s0`` (PIXEL2),
+    flattened in C order."""
+    return [int(a) | (int(b) << _SAMPLE_BITS)
+            for a, b in zip(np.ravel(s0).tolist(), np.ravel(s1).tolist(), strict=True)]
+
+
+def split_merge_words(words) -> tuple[np.ndarray, np.ndarray]:
+    """Merge-bus words (PIXEL2 integers, any shape) -> (s0, s1) uint64 arrays of that shape."""
+    v = np.asarray(words, dtype=object)
+    s0 = np.vectorize(lambda x: int(x) & _SAMPLE_MASK, otypes=[np.uint64])(v) if v.size else v.astype(np.uint64)
+    s1 = np.vectorize(lambda x: int(x) >> _SAMPLE_BITS, otypes=[np.uint64])(v) if v.size else v.astype(np.uint64)
+    return s0, s1

@@ -16,7 +16,7 @@ from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.hdl.zbm.initial import ZbmInitialProcessor
-from rasterhw.hdl.zbm.layouts import PIXEL2
+from rasterhw.hdl.zbm.layouts import PIXEL2, check_interleave
 from rasterhw.hdl.zbm.loop import ZbmLoop
 from rasterhw.hdl.zbm.merger import ZbmMerger
 
@@ -64,10 +64,7 @@ class ZbmChip(wiring.Component):
 
     def __init__(self, *, interleave: int = 1, chip: int = 0, width: int = F.MAX_WIDTH,
                  fifo_depth: int = 16):
-        if interleave not in F.INTERLEAVES:
-            raise ValueError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
-        if not (isinstance(chip, int) and 0 <= chip < interleave):
-            raise ValueError(f"chip must be in 0..{interleave - 1}, not {chip!r}")
+        check_interleave(interleave, chip)
         if not (isinstance(width, int) and chip < width <= F.MAX_WIDTH):
             raise ValueError(f"width must be in {chip + 1}..{F.MAX_WIDTH}, not {width!r}")
         self._interleave = interleave

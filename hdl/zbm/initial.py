@@ -11,7 +11,7 @@ from amaranth import Module, Mux, Signal, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.hdl.zbm.layouts import FLIT, PACKET, PKT_HEADER, SEG_HEADER
+from rasterhw.hdl.zbm.layouts import FLIT, PACKET, PKT_HEADER, SEG_HEADER, check_interleave
 
 __all__ = ["ZbmInitialProcessor"]
 
@@ -51,10 +51,7 @@ class ZbmInitialProcessor(wiring.Component):
     """
 
     def __init__(self, *, interleave: int = 1, chip: int = 0):
-        if interleave not in F.INTERLEAVES:
-            raise ValueError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
-        if not (isinstance(chip, int) and 0 <= chip < interleave):
-            raise ValueError(f"chip must be in 0..{interleave - 1}, not {chip!r}")
+        check_interleave(interleave, chip)
         self._interleave = interleave
         self._chip = chip
         super().__init__({

@@ -13,7 +13,7 @@ from amaranth.lib import data
 from rasterhw.golden_model.zbm import formats as F
 
 __all__ = [
-    "struct_of", "EP_HEADER", "EP_CHANNEL", "SEG_HEADER", "FLIT", "PKT_HEADER",
+    "check_interleave", "struct_of", "EP_HEADER", "EP_CHANNEL", "SEG_HEADER", "FLIT", "PKT_HEADER",
     "SAMPLE", "PIXEL2", "PACKET",
 ]
 
@@ -41,3 +41,12 @@ PIXEL2 = struct_of(F.PIXEL2, sub={"s0": SAMPLE, "s1": SAMPLE})   # s0 nearer or 
 #: one segment packet as the initial processor hands it over: 8 flits of the 112-bit loop,
 #: flit 0 = PKT_HEADER
 PACKET = data.ArrayLayout(unsigned(F.LOOP_BITS), F.PACKET_FLITS)
+
+
+def check_interleave(interleave, chip=None) -> None:
+    """The one parameter check of every ZB/M block: ``interleave`` one of 1, 2, 4, 8, 16 (paper,
+    sec. 5.3) and, if given, ``0 <= chip < interleave``; else ``ValueError``."""
+    if interleave not in F.INTERLEAVES:
+        raise ValueError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+    if chip is not None and not (isinstance(chip, int) and 0 <= chip < interleave):
+        raise ValueError(f"chip must be in 0..{interleave - 1}, not {chip!r}")

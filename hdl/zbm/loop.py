@@ -13,7 +13,7 @@ from amaranth import Module, Mux, Signal, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.hdl.zbm.layouts import PACKET, PIXEL2, PKT_HEADER
+from rasterhw.hdl.zbm.layouts import PACKET, PIXEL2, PKT_HEADER, check_interleave
 from rasterhw.hdl.zbm.pixel import ZbmPixelProcessor
 
 __all__ = ["ZbmLoop", "PACKET", "LOOP_GAP"]
@@ -58,8 +58,7 @@ class ZbmLoop(wiring.Component):
     """
 
     def __init__(self, *, interleave: int = 1, width: int = F.MAX_WIDTH):
-        if interleave not in F.INTERLEAVES:
-            raise ValueError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+        check_interleave(interleave)
         if not 1 <= width <= F.MAX_WIDTH:
             raise ValueError(f"width must be 1..{F.MAX_WIDTH}, not {width!r}")
         self._interleave = interleave

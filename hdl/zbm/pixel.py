@@ -16,7 +16,7 @@ from amaranth.lib import data, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.hdl.zbm.layouts import FLIT, PIXEL2, PKT_HEADER, SAMPLE
+from rasterhw.hdl.zbm.layouts import FLIT, PIXEL2, PKT_HEADER, SAMPLE, check_interleave
 
 __all__ = ["ZbmPixelProcessor", "LoopSignature", "flit_to_sample_field", "EMPTY_PIXEL2"]
 
@@ -80,8 +80,7 @@ class ZbmPixelProcessor(wiring.Component):
     def __init__(self, *, index: int, interleave: int = 1, width: int = F.MAX_WIDTH):
         if index not in range(F.PP_PER_CHIP):
             raise ValueError(f"index must be 0..{F.PP_PER_CHIP - 1}, not {index!r}")
-        if interleave not in F.INTERLEAVES:
-            raise ValueError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+        check_interleave(interleave)
         if not 1 <= width <= F.MAX_WIDTH:
             raise ValueError(f"width must be 1..{F.MAX_WIDTH}, not {width!r}")
         self._index = index

@@ -14,7 +14,7 @@ from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.hdl.broadcast import StreamBroadcast
 from rasterhw.hdl.zbm.chip import ZbmChip
-from rasterhw.hdl.zbm.layouts import PIXEL2
+from rasterhw.hdl.zbm.layouts import PIXEL2, check_interleave
 from rasterhw.hdl.zbm.pixel import EMPTY_PIXEL2
 from rasterhw.hdl.zbm.seggen import EP_WORD_BITS, ZbmSegmentGenerator
 
@@ -59,8 +59,7 @@ class ZbmUnit(wiring.Component):
 
     def __init__(self, *, interleave: int = 8, width: int = F.MAX_WIDTH, height: int = F.MAX_HEIGHT,
                  capacity: int = F.AEP_CAPACITY, head: bool = True):
-        if interleave not in F.INTERLEAVES:
-            raise ValueError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+        check_interleave(interleave)
         if not (isinstance(width, int) and interleave <= width <= F.MAX_WIDTH):
             raise ValueError(f"width must be {interleave}..{F.MAX_WIDTH}, not {width!r}")
         self._interleave, self._width, self._height = interleave, width, height

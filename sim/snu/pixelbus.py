@@ -20,7 +20,9 @@ from pathlib import Path
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.snu import pixelbus as golden
+from rasterhw.golden_model.snu.formats import RGB_BITS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
+from rasterhw.golden_model.snu.words import payload_words
 from rasterhw.sim.harness import stream_protocol_checker, stream_put
 from rasterhw.sim.runner import HARNESS_V, REPO_ROOT, build_dir_for, get_sim, run_cocotb
 
@@ -104,23 +106,17 @@ def run_pysim(
     return out
 
 
-def _payload_words(stream: PixelStream, idx: np.ndarray, aw: int) -> list[int]:
-    zs = 24 + aw
-    return [(int(z) << zs) | (int(c) << aw) | int(a) for a, c, z in
-            zip(stream.addr[idx].tolist(), stream.rgb[idx].tolist(), stream.z[idx].tolist(), strict=True)]
-
-
 def write_stimulus(stream: PixelStream, gaps: np.ndarray | None, folder: Path, aw: int) -> tuple[list[Path], list[int]]:
     """Write ``stim0.hex``/``stim1.hex`` for tb_pixelbus.v; return the paths and counts."""
     n = len(stream)
     gap = np.zeros(n, dtype=np.int64) if gaps is None else np.asarray(gaps, dtype=np.int64)
     if n and gap.max() >= (1 << GAP_BITS):
         raise RasterhwError(f"gap {int(gap.max())} does not fit the bench's {GAP_BITS}-bit gap field")
-    pw = stream.z_bits + 24 + aw
+    pw = stream.z_bits + RGB_BITS + aw
     paths, counts = [], []
     for p in range(2):
         idx = np.flatnonzero(stream.pipe == p)
-        words = [(int(g) << pw) | w for g, w in zip(gap[idx].tolist(), _payload_words(stream, idx, aw), strict=True)]
+        words = [(int(g) << pw) | w for g, w in zip(gap[idx].tolist(), payload_words(stream, idx, aw), strict=True)]
         path = Path(folder) / f"stim{p}.hex"
         # one dummy word keeps $readmemh happy on an empty pipeline
         path.write_text("\n".join(f"{w:x}" for w in (words or [0])) + "\n")
@@ -186,7 +182,7 @@ def run_cocotb_bench(
     exp_path = run_dir / "expect.npz"
     # payload words are up to 69 bits: stored as hex strings
     payloads = {
-        f"payload{p}": np.array([f"{w:x}" for w in _payload_words(stream, np.flatnonzero(stream.pipe == p), aw)], dtype=str)
+        f"payload{p}": np.array([f"{w:x}" for w in payload_words(stream, np.flatnonzero(stream.pipe == p), aw)], dtype=str)
         if check_protocol else np.zeros(0, dtype=str)
         for p in range(2)
     }

@@ -31,7 +31,15 @@ import numpy as np
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.golden_model.zbm.words import doublez_words, edge_pair_words, words_to_doublez
+from rasterhw.golden_model.zbm.words import (
+    doublez_words,
+    edge_pair_words,
+    merge_words,
+    segment_words,
+    split_merge_words,
+    words_to_doublez,
+)
+from rasterhw.sim.harness import stream_protocol_checker
 from rasterhw.sim.runner import (
     HARNESS_V,
     REPO_ROOT,
@@ -326,18 +334,12 @@ def chip_stimulus(segs: G.Segments, lines: int, upstream: G.DoubleZ, *, chip: in
     seg_words = []
     exp = G.DoubleZ.empty((lines, upstream.z.shape[1]))
     for y in range(lines):
-        for s in range(*segs.line(y).indices(len(segs.y))):
-            chans = [{"value": int(a), "inc": int(b)} for a, b in zip(segs.val[s], segs.inc[s], strict=True)]
-            seg_words += F.pack_segment({"y": y, "x": int(segs.x[s]), "len": int(segs.len[s]),
-                                         "mode": segs.mode}, chans)
-        seg_words.append(F.SEG_HEADER.pack(y=y, len=0))
+        seg_words += segment_words(segs, y)
         own, _ = G.chip_scanline(segs, y, chip, interleave, width)
         up = G.DoubleZ(upstream.z[y], upstream.a[y], upstream.c[y], upstream.tag[y])
         m = G.merge(up, own)
         exp.z[y], exp.a[y], exp.c[y], exp.tag[y] = m.z, m.a, m.c, m.tag
-    u0, u1 = doublez_words(upstream)
-    up_words = [int(a) | (int(b) << 64) for a, b in zip(u0.ravel().tolist(), u1.ravel().tolist(), strict=True)]
-    return seg_words, up_words, doublez_words(exp)
+    return seg_words, merge_words(*doublez_words(upstream)), doublez_words(exp)
 
 
 def run_chip_bench(seg_words: list[int], up_words: list[int], *, lines: int, chip: int, interleave: int,
@@ -417,7 +419,8 @@ def chip_speed(*, interleave: int = 8, width: int = 512, height: int = 512, scen
 # ====================================================================== pysim
 def run_units_pysim(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, interleave: int,
                     capacity: int = F.AEP_CAPACITY, max_cycles: int = 2_000_000) -> dict:
-    """The same chain in the Amaranth simulator (small frames): returns ``{"s0", "s1", "cycles"}``."""
+    """The same chain in the Amaranth simulator (small frames): returns ``{"s0", "s1", "cycles",
+    "proto_errors"}`` (stream-rule violations counted by checkers on every input and output)."""
     from amaranth.sim import Simulator
     from rasterhw.hdl.zbm.chain import ZbmChain
     from rasterhw.hdl.zbm.unit import ZbmUnit
@@ -456,18 +459,20 @@ def run_units_pysim(eps_per_unit: list[G.EdgePairs], *, width: int, height: int,
                     got[c].append(vals[2 * i + 1].as_value().value)
         out["cycles"] = int(ctx.get(units[0].cycles))
 
+    violations: list[str] = []   # stream-rule violations on every unit input and merge output
     for u, e in zip(units, eps_per_unit, strict=True):
         sim.add_testbench(src(u, edge_pair_words(e)), background=True)
+        sim.add_testbench(stream_protocol_checker(u.i, "i", errors=violations), background=True)
+    for c in range(interleave):
+        sim.add_testbench(stream_protocol_checker(last.o_merge[c], f"o_merge[{c}]", errors=violations,
+                                                  domain="merge"), background=True)
     sim.add_testbench(sink)
     sim.run()
     s0 = np.zeros((height, width), np.uint64)
     s1 = np.zeros((height, width), np.uint64)
-    mask = (1 << 64) - 1
     for c in got:
-        v = np.array(got[c], dtype=object).reshape(height, -1)
-        s0[:, c::interleave] = np.vectorize(lambda x: x & mask, otypes=[np.uint64])(v)
-        s1[:, c::interleave] = np.vectorize(lambda x: x >> 64, otypes=[np.uint64])(v)
-    return {"s0": s0, "s1": s1, "cycles": out["cycles"], "proto_errors": 0}
+        s0[:, c::interleave], s1[:, c::interleave] = split_merge_words(np.array(got[c], dtype=object).reshape(height, -1))
+    return {"s0": s0, "s1": s1, "cycles": out["cycles"], "proto_errors": len(violations)}
 
 
 # ====================================================================== float tolerance

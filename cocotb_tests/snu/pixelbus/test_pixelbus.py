@@ -14,22 +14,9 @@ import os
 import cocotb
 import numpy as np
 from cocotb.triggers import RisingEdge, with_timeout
+from rasterhw.sim.snu.pixelbus import read_frame_dump
 
 from cocotb_tests.common import start_checker, to_int
-
-
-def read_dump(path: str, size: int) -> tuple[np.ndarray, np.ndarray, int]:
-    with open(path) as f:
-        lines = f.read().split("\n")
-    cyc = [ln for ln in lines if ln.startswith("cycles")]
-    if not cyc:
-        raise AssertionError(f"{path}: no 'cycles' line (wrapper did not finish)")
-    data = [ln.split() for ln in lines if ln and not ln.startswith("cycles")]
-    if len(data) != size:
-        raise AssertionError(f"{path}: {len(data)} pixels, expected {size}")
-    rgb = np.array([int(a, 16) for a, _ in data], dtype=np.int64)
-    z = np.array([int(b, 16) for _, b in data], dtype=np.int64)
-    return rgb, z, int(cyc[0].split()[1])
 
 
 @cocotb.test()
@@ -44,7 +31,9 @@ async def pixelbus_stream(dut):
     await with_timeout(RisingEdge(dut.finished), timeout, "ns")
     cycles = to_int(dut.cycles)
     size = int(exp["rgb"].size)
-    rgb, z, dump_cycles = read_dump(os.environ["PIXELBUS_OUT"], size)
+    h, w = exp["rgb"].shape
+    rgb, z, dump_cycles = read_frame_dump(os.environ["PIXELBUS_OUT"], w, h)
+    assert rgb.size == size
     assert dump_cycles == cycles
     if os.environ.get("PIXELBUS_CHECK_PROTOCOL") == "1":
         # in-order scoreboard: every write transferred exactly once, in pipeline order
@@ -53,7 +42,7 @@ async def pixelbus_stream(dut):
             want = [int(x, 16) for x in exp[f"payload{p}"]]
             diff = [k for k, (a, b) in enumerate(zip(logs[p], want, strict=True)) if a != b]
             assert not diff, f"pipe {p}: transfer {diff[0]} is {logs[p][diff[0]]:#x}, stimulus {want[diff[0]]:#x}"
-    bad = int(np.count_nonzero((rgb != exp["rgb"].ravel()) | (z != exp["z"].ravel())))
+    bad = int(np.count_nonzero((rgb != exp["rgb"]) | (z != exp["z"])))
     dut._log.info("cycles %d (golden %d), %d pixels, %d mismatches", cycles, int(exp["cycles"]), size, bad)
     assert cycles == int(exp["cycles"]), f"cycles {cycles} != golden {int(exp['cycles'])}"
     assert bad == 0, f"{bad} of {size} pixels differ from the golden frame"
