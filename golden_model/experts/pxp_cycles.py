@@ -1,0 +1,67 @@
+"""The PXP HDL's golden side: its input records, its pixels and its exact cycle count.
+
+``hdl/experts/pxp.py`` resolves depth segment by segment into a line depth buffer kept beside
+the DSLB (a Z-buffer of one range of one line): for every segment of the clipped ASL it computes
+the start values at its first owned pixel with the multiplier, steps z and i, and keeps a pixel
+when its 16-bit z key is smaller than the stored one, or equal with a lower ASB address -- the
+golden depth search's rule, so the pixels equal the bit model's (tested). Its cycle count is its
+own (below), not the span-cull / depth-search operation count of :mod:`pxp`.
+
+Cycles of one line of a range of R pixels, the input always valid and the output always ready::
+
+    R                      clear the line depth buffer / DSLB
+    + sum over segments (2 + 2 n)   accept, start values (multiplier), read + compare/write per pixel
+    + 1                    accept the end-of-line token
+    + 2 R                  drain the DSLB (read, then offer the pixel)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .model import ExpertsFrame
+from .pxp import pixel_words
+
+__all__ = ["SEG_FIELDS", "line_segments", "line_pixels", "line_cycles", "ADDR_BITS"]
+
+SEG_FIELDS = ("xl", "xr", "zl", "il", "dzdx", "didx", "hue", "addr")
+ADDR_BITS = 12   # ASB address (PL order): up to 4096 triangles
+
+
+def line_segments(fr: ExpertsFrame, y: int, lo: int, hi: int) -> list[dict]:
+    """The segments the SLP's block lists hand the PXP of ``[lo, hi)`` on line ``y``, in ASL order."""
+    if fr.model != "bit":
+        raise ValueError("the PXP HDL's golden side needs the bit model")
+    rec, st = fr.records, fr.setup
+    if st.n >= (1 << ADDR_BITS) - 1:
+        raise ValueError(f"{st.n} triangles do not fit the {ADDR_BITS}-bit ASB address")
+    sel = np.flatnonzero((rec.row == y) & (rec.c1 >= lo) & (rec.c0 <= hi - 1) & (rec.c1 >= rec.c0))
+    sel = sel[np.lexsort((rec.tri[sel], rec.xl[sel]))]
+    out = []
+    for r in sel:
+        t = int(rec.tri[r])
+        h = st.hue[t]
+        out.append({"xl": int(rec.xl[r]), "xr": int(rec.xr[r]), "zl": int(rec.zl[r]), "il": int(rec.il[r]),
+                    "dzdx": int(st.dzdx[t]), "didx": int(st.didx[t]),
+                    "hue": int((h[0] << 6) | (h[1] << 3) | h[2]), "addr": t})
+    return out
+
+
+def line_pixels(fr: ExpertsFrame, y: int, lo: int, hi: int) -> list[int]:
+    """The bit model's pixel words (no A.J.) of ``[lo, hi)`` on line ``y``."""
+    if fr.aj != "none":
+        raise ValueError("the PXP HDL has no A.J.: compare with aj='none'")
+    w = pixel_words(fr.setup, fr.fields).reshape(fr.height, fr.width)
+    return [int(v) for v in w[y, lo:hi]]
+
+
+def line_cycles(segs: list[dict], lo: int, hi: int) -> int:
+    """Exact cycles of one line (see the module docstring)."""
+    r = hi - lo
+    cyc = r + 1 + 2 * r
+    for s in segs:
+        c0 = (s["xl"] + 31) >> 6
+        c1 = ((s["xr"] + 31) >> 6) - 1
+        n = max(min(c1, hi - 1) - max(c0, lo) + 1, 0)
+        cyc += 2 + 2 * n
+    return cyc

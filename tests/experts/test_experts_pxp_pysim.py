@@ -1,0 +1,121 @@
+"""EXPERTS PXP HDL in Amaranth pysim: pixel- and cycle-exact with the bit-accurate golden PXP."""
+
+from __future__ import annotations
+
+import itertools
+import random
+from functools import cache
+
+import pytest
+from amaranth.sim import Simulator
+from rasterhw.golden_model.experts.model import render_frame
+from rasterhw.golden_model.experts.pxp_cycles import line_cycles, line_pixels, line_segments
+from rasterhw.golden_model.pipeline import run_geometry
+from rasterhw.golden_model.scenes import build_scene
+from rasterhw.hdl.experts.pxp import ExpertsPxp
+from rasterhw.sim.harness import stream_protocol_checker, stream_put, stream_sink
+
+
+@cache
+def _frame(name: str = "experts-tilt-1000"):
+    return render_frame(run_geometry(build_scene(name), 512, 512, z_bits=16), model="bit", aj="none")
+
+
+def _run(lines, lo, hi, *, ready=None, gap=0, name="experts-tilt-1000", fr=None):
+    fr = _frame(name) if fr is None else fr
+    dut = ExpertsPxp(width=512)
+    sim = Simulator(dut)
+    sim.add_clock(1e-8)
+    got, log, cycles = [], [], []
+    segs = {y: line_segments(fr, y, lo, hi) for y in lines}
+
+    async def feed(ctx):
+        ctx.set(dut.lo, lo)
+        ctx.set(dut.hi, hi)
+        for y in lines:
+            for s in segs[y]:
+                await stream_put(ctx, dut.i, {"last": 0, **s}, gap=gap)
+            await stream_put(ctx, dut.i, {"last": 1, "xl": 0, "xr": 0, "zl": 0, "il": 0, "dzdx": 0, "didx": 0,
+                                          "hue": 0, "addr": 0}, gap=gap)
+
+    async def watch(ctx):
+        seen = 0
+        async for _clk, _rst, n, c in ctx.tick().sample(dut.lines, dut.line_cycles):
+            if n != seen:
+                cycles.append(c)
+                seen = n
+            if seen == len(lines):
+                return
+
+    sim.add_testbench(feed)
+    sim.add_testbench(stream_sink(dut.o, got, ready=ready), background=True)
+    sim.add_testbench(stream_protocol_checker(dut.o, "o", log), background=True)
+    sim.add_testbench(watch)
+    sim.run()
+    expect = [p for y in lines for p in line_pixels(fr, y, lo, hi)]
+    return got, log, cycles, expect, [line_cycles(segs[y], lo, hi) for y in lines]
+
+
+@pytest.mark.parametrize("lo,hi", [(128, 192), (0, 37), (475, 512)])
+def test_pixels_and_cycles_exact(lo, hi):
+    got, log, cycles, expect, want = _run([100, 101, 300], lo, hi)
+    assert got == expect and log == expect
+    assert cycles == want
+    assert any(p for p in got)  # the range is not empty background
+
+
+def test_crossing_segments_and_ties_exact():
+    # lines of the tilted scene where faces interpenetrate inside the range
+    fr = _frame()
+    w = fr.win.reshape(512, 512)
+    rec = fr.records
+    a, b = w[:, :-1], w[:, 1:]
+    inside = (a != b) & (a >= 0) & (b >= 0)
+    ys = [y for y in range(512) if inside[y, 200:260].any()
+          and (rec.c1[a[y, 200:260]] > 200).any()][:2]
+    got, _, cycles, expect, want = _run(ys, 200, 264)
+    assert got == expect and cycles == want
+
+
+def test_back_pressure_and_idle_input_keep_pixels_exact():
+    rng = random.Random(5)
+    ready = [rng.randint(0, 1) for _ in range(4000)]
+    got, log, cycles, expect, want = _run([250], 300, 340, ready=ready, gap=2)
+    assert got == expect and log == expect
+    # stalls only add cycles
+    assert cycles[0] > want[0]
+    got2, _, _, expect2, _ = _run([250], 300, 340, ready=itertools.cycle([1, 1, 1, 0]))
+    assert got2 == expect2
+
+
+def test_z_tie_goes_to_the_lower_asb_address():
+    """Two coplanar faces overlap; the one submitted first starts left, so the PXP meets it first
+    and must keep it against the later one's equal z (and the reverse order too)."""
+    import numpy as np
+    from rasterhw.golden_model.screen import ScreenTriangles
+    xy = np.array([[[100.3, 10.0], [100.3, 40.0], [200.3, 25.0]],     # submitted first, left
+                   [[150.3, 10.0], [150.3, 40.0], [250.3, 25.0]],     # second, right: ties lose
+                   [[300.3, 10.0], [300.3, 40.0], [400.3, 25.0]],     # second pair: the later face
+                   [[250.3, 10.0], [250.3, 40.0], [350.3, 25.0]]])    # starts left, the earlier wins
+    z = np.full((4, 3), 0.5)
+    col = np.repeat(np.array([[0.9, 0.2, 0.2], [0.2, 0.9, 0.2], [0.2, 0.2, 0.9], [0.9, 0.9, 0.2]])[:, None], 3, 1)
+    tris = ScreenTriangles(512, 64, xy, z, np.zeros((4, 3), np.int64), col, np.arange(4))
+    fr = render_frame(tris, model="bit")
+    got, _, cycles, expect, want = _run([25], 96, 416, fr=fr)
+    assert got == expect and cycles == want
+    hue = [p >> 7 for p in got]
+    assert hue[175 - 96] == (7 << 6) | (2 << 3) | 2   # the first face (red) wins the tie
+    assert hue[320 - 96] == (2 << 6) | (2 << 3) | 7   # face 2 (blue, before face 3) wins
+
+
+def test_empty_line_is_background():
+    got, _, cycles, expect, want = _run([0], 0, 16, name="experts-solid-15")
+    assert got == expect == [0] * 16 and cycles == want
+
+
+def test_bad_parameters():
+    with pytest.raises(ValueError, match="width"):
+        ExpertsPxp(width=0)
+    from rasterhw.golden_model.errors import RasterhwError
+    with pytest.raises(RasterhwError, match="intensity_bits"):
+        ExpertsPxp(intensity_bits=9)
