@@ -224,8 +224,47 @@ def _tolerance(out: list, progress: bool) -> None:
                                 measured=t[key], unit="pixels", source="golden"))
 
 
+def _hdl(out: list, engine: str, progress: bool) -> None:
+    """PXP HDL rows: pysim on a sample of lines (always), the whole experts-1000 frame on Verilator
+    when ``engine == "verilator"``; the 30 frames/s PXP clock from the cycle model the HDL matched."""
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.sim.experts.pxp_sim import jobs, simulate_scene
+    small = simulate_scene(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=2, pn=4)
+    out.append(make_row(SYS, "HDL", "PXP pixel mismatches, experts-tilt-1000 at 64x16, 2x4 (pysim)", paper=None,
+                        formula=0, measured=small["mismatches"], unit="pixels", source="hdl:pysim"))
+    out.append(make_row(SYS, "HDL", "PXP lines whose cycles differ from the golden cycle model, experts-tilt-1000 "
+                        "at 64x16, 2x4 (pysim)", paper=None, formula=None, measured=small["cycle_mismatches"],
+                        unit="lines", source="hdl:pysim"))
+    fr = _frame("experts-1000", "bit")
+    jb = jobs(fr, 8, 8)
+    per = {}
+    for (sidx, p), c in zip(jb["owner"], jb["cycles"], strict=True):
+        per[(sidx, p)] = per.get((sidx, p), 0) + int(c)
+    busiest = max(per.values())
+    src = "model"
+    meas = busiest
+    if engine == "verilator":
+        if progress:
+            print("experts: experts-1000 through the PXP HDL on Verilator")
+        r = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8)
+        out.append(make_row(SYS, "HDL", "PXP pixel mismatches, experts-1000, 8x8 (262,144 compared)", paper=None,
+                            formula=0, measured=r["mismatches"], unit="pixels", source="hdl:verilator"))
+        out.append(make_row(SYS, "HDL", "PXP lines whose cycles differ from the golden cycle model, experts-1000, 8x8",
+                            paper=None, formula=None, measured=r["cycle_mismatches"], unit="lines",
+                            source="hdl:verilator"))
+        out.append(make_row(SYS, "HDL", "PXP cycles per scan line (mean of 4096 PXP lines), experts-1000, 8x8",
+                            paper=None, formula=None, measured=r["pxp_cycles_per_line_mean"], unit="cycles",
+                            source="hdl:verilator"))
+        meas, src = r["frame_cycles_busiest_pxp"], "hdl:verilator"
+    what = "HDL on Verilator" if src != "model" else "the golden cycle model the HDL matches"
+    out.append(make_row(SYS, "5 / HDL", f"busiest PXP's cycles per frame, experts-1000, 8x8 ({what})",
+                        paper=None, formula=None, measured=meas, unit="cycles", source=src))
+    out.append(make_row(SYS, "5 / HDL", f"PXP clock for 30 frames/s of experts-1000 at 8x8, PXPs only ({what})",
+                        paper=None, formula=None, measured=round(meas * 30 / 1e6, 3), unit="MHz", source=src))
+
+
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, **known) -> tuple[list[dict], list[str]]:
-    """Every EXPERTS row (no HDL rows yet: ``engine`` is not used)."""
+    """Every EXPERTS row; ``engine="verilator"`` also runs the whole experts-1000 frame through the PXP HDL."""
     out_dir = Path(out_dir)
     out: list[dict] = []
     sections: list[str] = []
@@ -233,4 +272,5 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, **know
     _tables(out, sections, out_dir, progress)
     _balance(out, sections, out_dir, progress)
     _tolerance(out, progress)
+    _hdl(out, engine, progress)
     return out, sections
