@@ -15,7 +15,9 @@ MACHINE = Machine(
                                 ("float", "bit")),
                          Option("sn", "SLPs (bands of scan lines) for the timing stats", 8, type=int),
                          Option("pn", "PXPs per SLP (ranges of each line) for the timing stats", 8, type=int))),),
-    blocks={"experts-pxp": "rasterhw.hdl.experts.pxp:ExpertsPxp"},
+    blocks={"experts-pxp": "rasterhw.hdl.experts.pxp:ExpertsPxp",
+            "experts-dmm": "rasterhw.hdl.experts.dmm:ExpertsDmm",
+            "experts-pxp-unit": "rasterhw.hdl.experts.unit:ExpertsPxpUnit"},
     sims=(SimBlock("pxp", "every PXP line of the frame through the PXP HDL, against the bit-accurate golden PXP "
                    "(pixels and cycles)", "rasterhw.sim.experts.pxp_sim:simulate_scene", default_scene="experts-1000",
                    options=(Option("sn", "SLPs (bands)", 8, type=int),

@@ -231,7 +231,7 @@ def _hdl(out: list, engine: str, progress: bool) -> None:
     from rasterhw.sim.experts.pxp_sim import jobs, simulate_scene
     small = simulate_scene(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=2, pn=4)
     out.append(make_row(SYS, "HDL", "PXP pixel mismatches, experts-tilt-1000 at 64x16, 2x4 (pysim)", paper=None,
-                        formula=0, measured=small["mismatches"], unit="pixels", source="hdl:pysim"))
+                        formula=None, measured=small["mismatches"], unit="pixels", source="hdl:pysim"))
     out.append(make_row(SYS, "HDL", "PXP lines whose cycles differ from the golden cycle model, experts-tilt-1000 "
                         "at 64x16, 2x4 (pysim)", paper=None, formula=None, measured=small["cycle_mismatches"],
                         unit="lines", source="hdl:pysim"))
@@ -248,7 +248,7 @@ def _hdl(out: list, engine: str, progress: bool) -> None:
             print("experts: experts-1000 through the PXP HDL on Verilator")
         r = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8)
         out.append(make_row(SYS, "HDL", "PXP pixel mismatches, experts-1000, 8x8 (262,144 compared)", paper=None,
-                            formula=0, measured=r["mismatches"], unit="pixels", source="hdl:verilator"))
+                            formula=None, measured=r["mismatches"], unit="pixels", source="hdl:verilator"))
         out.append(make_row(SYS, "HDL", "PXP lines whose cycles differ from the golden cycle model, experts-1000, 8x8",
                             paper=None, formula=None, measured=r["cycle_mismatches"], unit="lines",
                             source="hdl:verilator"))

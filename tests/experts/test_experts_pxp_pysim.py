@@ -13,6 +13,7 @@ from rasterhw.golden_model.experts.pxp_cycles import line_cycles, line_pixels, l
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.hdl.experts.pxp import ExpertsPxp
+from rasterhw.hdl.experts.unit import ExpertsPxpUnit
 from rasterhw.sim.harness import stream_protocol_checker, stream_put, stream_sink
 
 
@@ -21,9 +22,9 @@ def _frame(name: str = "experts-tilt-1000"):
     return render_frame(run_geometry(build_scene(name), 512, 512, z_bits=16), model="bit", aj="none")
 
 
-def _run(lines, lo, hi, *, ready=None, gap=0, name="experts-tilt-1000", fr=None):
+def _run(lines, lo, hi, *, ready=None, gap=0, name="experts-tilt-1000", fr=None, unit=False):
     fr = _frame(name) if fr is None else fr
-    dut = ExpertsPxp(width=512)
+    dut = ExpertsPxpUnit(width=512, depth=256) if unit else ExpertsPxp(width=512)
     sim = Simulator(dut)
     sim.add_clock(1e-8)
     got, log, cycles = [], [], []
@@ -106,6 +107,14 @@ def test_z_tie_goes_to_the_lower_asb_address():
     hue = [p >> 7 for p in got]
     assert hue[175 - 96] == (7 << 6) | (2 << 3) | 2   # the first face (red) wins the tie
     assert hue[320 - 96] == (2 << 6) | (2 << 3) | 7   # face 2 (blue, before face 3) wins
+
+
+def test_through_the_dmm_pixels_exact_and_never_faster():
+    """DMM/P in front: the SLP writes the next line while the PXP works; same pixels, and the
+    PXP's line cycles are at least the bare PXP's (it can only wait for its input)."""
+    got, log, cycles, expect, want = _run([100, 101, 102], 64, 128, unit=True)
+    assert got == expect and log == expect
+    assert all(c >= w for c, w in zip(cycles, want, strict=True))
 
 
 def test_empty_line_is_background():
