@@ -13,6 +13,8 @@ MACHINE = Machine(
                                 "(c) along/across the scan line (EXPERTS)", "c", ("none", "a", "b", "c")),
                          Option("model", "float (ideal arithmetic) or bit (16-bit hardware formats)", "bit",
                                 ("float", "bit")),
+                         Option("shadows", "none, or shadow polygons in the scan line (Crow; our choice, "
+                                "the paper gives no method)", "none", ("none", "polygons")),
                          Option("sn", "SLPs (bands of scan lines) for the timing stats", 8, type=int),
                          Option("pn", "PXPs per SLP (ranges of each line) for the timing stats", 8, type=int))),),
     blocks={"experts-pxp": "rasterhw.hdl.experts.pxp:ExpertsPxp",
