@@ -263,6 +263,27 @@ def _hdl(out: list, engine: str, progress: bool) -> None:
                         paper=None, formula=None, measured=round(meas * 30 / 1e6, 3), unit="MHz", source=src))
 
 
+def _shadows(out: list, progress: bool) -> None:
+    """Crow shadow polygons (our choice): shadowed pixels, agreement with ray casting, extra work."""
+    from rasterhw.golden_model.experts import cost
+    from rasterhw.golden_model.experts.model import render_frame
+    from rasterhw.golden_model.experts.shadow import shadow_faces
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    for name in ("experts-solids", "sp5"):
+        sc = build_scene(name)
+        tris = run_geometry(sc, 512, 512, z_bits=16)
+        sf = shadow_faces(sc, 512, 512)
+        f = render_frame(tris, model="bit", shadows=sf)
+        base = cost.total_ops(render_frame(tris, model="bit"))
+        out.append(make_row(SYS, "2.1 c) (ours: Crow)", f"shadowed pixels, {name} ({sf.n_faces} shadow faces, "
+                            f"{f.stats['shadow_segments']} shadow segments)", paper=None, formula=None,
+                            measured=f.stats["shadowed_pixels"], unit="pixels", source="golden"))
+        out.append(make_row(SYS, "2.1 c) (ours: Crow)", f"PXP work with shadow polygons / without, {name}",
+                            paper=None, formula=None, measured=round(cost.total_ops(f) / base, 4), unit="x",
+                            source="golden"))
+
+
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, **known) -> tuple[list[dict], list[str]]:
     """Every EXPERTS row; ``engine="verilator"`` also runs the whole experts-1000 frame through the PXP HDL."""
     out_dir = Path(out_dir)
@@ -272,5 +293,6 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, **know
     _tables(out, sections, out_dir, progress)
     _balance(out, sections, out_dir, progress)
     _tolerance(out, progress)
+    _shadows(out, progress)
     _hdl(out, engine, progress)
     return out, sections
