@@ -65,3 +65,31 @@ def line_cycles(segs: list[dict], lo: int, hi: int) -> int:
         n = max(min(c1, hi - 1) - max(c0, lo) + 1, 0)
         cyc += 2 + 2 * n
     return cyc
+
+
+def reference_line(segs: list[dict], lo: int, hi: int, *, intensity_bits: int = 7) -> list[int]:
+    """Pixel words of ``[lo, hi)`` from a segment list, one pixel at a time in plain Python.
+
+    An independent statement of the PXP's rules (for random ASLs that come from no scene): the
+    covering segments of a pixel are those with ``c0 <= x <= c1``; the nearest has the smallest
+    clamped 16-bit key ``((zL << 4) + ((xc - xL) dz/dx >> 6)) >> 4``, then the lowest address;
+    its pixel is ``hue << I | clamp(iL + ((xc - xL) di/dx >> 6)) >> (16 - I)``; none: 0.
+    """
+    f = 16 - intensity_bits
+    imax = ((1 << intensity_bits) - 1) << f
+    out = []
+    for x in range(lo, hi):
+        xc = (x << 6) + 32
+        best = None
+        for s in segs:
+            c0 = (s["xl"] + 31) >> 6
+            c1 = ((s["xr"] + 31) >> 6) - 1
+            if not (c0 <= x <= c1):
+                continue
+            d = xc - s["xl"]
+            key = min(max(((s["zl"] << 4) + ((d * s["dzdx"]) >> 6)) >> 4, 0), 65535)
+            if best is None or (key, s["addr"]) < best[0]:
+                i = min(max(s["il"] + ((d * s["didx"]) >> 6), 0), imax)
+                best = ((key, s["addr"]), (s["hue"] << intensity_bits) | (i >> f))
+        out.append(0 if best is None else best[1])
+    return out

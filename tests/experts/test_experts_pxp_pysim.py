@@ -117,6 +117,57 @@ def test_through_the_dmm_pixels_exact_and_never_faster():
     assert all(c >= w for c, w in zip(cycles, want, strict=True))
 
 
+def _random_line(rng, n, lo, hi):
+    segs = []
+    for _ in range(n):
+        a = rng.randrange((lo - 8) * 64 if lo >= 8 else 0, (hi + 8) * 64)
+        b = a + rng.randrange(0, 40 * 64)
+        segs.append({"xl": a, "xr": min(b, 512 * 64), "zl": rng.choice([rng.randrange(1 << 16), 30000]),
+                     "il": rng.randrange(127 << 9), "dzdx": rng.choice([0, rng.randrange(-3000, 3000)]),
+                     "didx": rng.randrange(-2000, 2000), "hue": rng.randrange(512), "addr": rng.randrange(4000)})
+    segs.sort(key=lambda s: (s["xl"], s["addr"]))
+    return segs
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_random_asls_against_the_per_pixel_reference(seed):
+    """Random ASLs (no scene): crossing segments, equal depths (z ties), segments outside the
+    range, ranges at odd alignments -- pixels from an independent per-pixel reference."""
+    from rasterhw.golden_model.experts.pxp_cycles import reference_line
+    rng = random.Random(seed)
+    lo = rng.randrange(0, 400)
+    hi = lo + rng.randrange(1, 100)
+    lines = [_random_line(rng, rng.randrange(0, 12), lo, hi) for _ in range(3)]
+    dut = ExpertsPxp(width=512)
+    sim = Simulator(dut)
+    sim.add_clock(1e-8)
+    got, cycles = [], []
+
+    async def feed(ctx):
+        ctx.set(dut.lo, lo)
+        ctx.set(dut.hi, hi)
+        for segs in lines:
+            for s in segs:
+                await stream_put(ctx, dut.i, {"last": 0, **s})
+            await stream_put(ctx, dut.i, {"last": 1})
+
+    async def watch(ctx):
+        seen = 0
+        async for _clk, _rst, n, c in ctx.tick().sample(dut.lines, dut.line_cycles):
+            if n != seen:
+                cycles.append(c)
+                seen = n
+            if seen == len(lines):
+                return
+
+    sim.add_testbench(feed)
+    sim.add_testbench(stream_sink(dut.o, got), background=True)
+    sim.add_testbench(watch)
+    sim.run()
+    assert got == [p for segs in lines for p in reference_line(segs, lo, hi)]
+    assert cycles == [line_cycles(segs, lo, hi) for segs in lines]
+
+
 def test_empty_line_is_background():
     got, _, cycles, expect, want = _run([0], 0, 16, name="experts-solid-15")
     assert got == expect == [0] * 16 and cycles == want
@@ -128,3 +179,11 @@ def test_bad_parameters():
     from rasterhw.golden_model.errors import RasterhwError
     with pytest.raises(RasterhwError, match="intensity_bits"):
         ExpertsPxp(intensity_bits=9)
+
+
+def test_per_pixel_reference_equals_the_golden_model_on_scene_lines():
+    from rasterhw.golden_model.experts.pxp_cycles import reference_line
+    fr = _frame()
+    for y in (40, 200, 333):
+        for lo, hi in ((0, 64), (250, 321)):
+            assert reference_line(line_segments(fr, y, lo, hi), lo, hi) == line_pixels(fr, y, lo, hi)
