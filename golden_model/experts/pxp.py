@@ -199,7 +199,11 @@ def anti_jagging(st: Setup, rec: Records, win: np.ndarray, fields: np.ndarray, W
         fl, frr = fields[yy * W + xx - 1], fields[yy * W + xx]
         val = al[:, None] * fl + (1 - al[:, None]) * frr
     qp = yy * W + q
-    out[qp] = val
+    # two boundaries may blend the same pixel (a one-pixel run): the later (right) one wins, as a
+    # PXP that walks the line left to right would have it
+    _, last = np.unique(qp[::-1], return_index=True)
+    keep = qp.size - 1 - last
+    out[qp[keep]] = val[keep]
     return out, {"pixels": int(qp.size), "shallow": shallow, "boundaries": int(np.count_nonzero(a != b)),
                  "qpix": qp, "shallow_mask": (np.abs(s) > (1 << SLOPE_FRAC if st.bit else 1))}
 

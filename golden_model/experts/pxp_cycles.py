@@ -24,17 +24,25 @@ from .pxp import pixel_words
 
 __all__ = ["SEG_FIELDS", "line_segments", "line_pixels", "line_cycles", "ADDR_BITS"]
 
-SEG_FIELDS = ("xl", "xr", "zl", "il", "dzdx", "didx", "hue", "addr")
-ADDR_BITS = 12   # ASB address (PL order): up to 4096 triangles
+SEG_FIELDS = ("xl", "xr", "zl", "il", "dzdx", "didx", "hue", "addr", "poly", "sl", "ql", "sr", "qr")
+ADDR_BITS = 12   # ASB address (PL order) and polygon number: up to 4095 (4095 = none)
+SLOT_BITS = 8    # the A.J. segment table: 256 segments per line (= a DMM/P bank)
 
 
-def line_segments(fr: ExpertsFrame, y: int, lo: int, hi: int) -> list[dict]:
-    """The segments the SLP's block lists hand the PXP of ``[lo, hi)`` on line ``y``, in ASL order."""
+def guarded(lo: int, hi: int, width: int, aj: str) -> tuple[int, int]:
+    """The pixels a PXP resolves: its range, plus one guard pixel each side with A.J."""
+    return (max(lo - 1, 0), min(hi + 1, width)) if aj == "c" else (lo, hi)
+
+
+def line_segments(fr: ExpertsFrame, y: int, lo: int, hi: int, *, aj: str = "none") -> list[dict]:
+    """The segments the SLP's block lists hand the PXP of ``[lo, hi)`` on line ``y``, in ASL order
+    (with A.J., those reaching its guard pixels too)."""
+    lo, hi = guarded(lo, hi, fr.width, aj)
     if fr.model != "bit":
         raise ValueError("the PXP HDL's golden side needs the bit model")
     rec, st = fr.records, fr.setup
-    if st.n >= (1 << ADDR_BITS) - 1:
-        raise ValueError(f"{st.n} triangles do not fit the {ADDR_BITS}-bit ASB address")
+    if st.n >= (1 << ADDR_BITS) - 1 or (st.n and int(st.poly.max()) >= (1 << ADDR_BITS) - 1):
+        raise ValueError(f"{st.n} triangles do not fit the {ADDR_BITS}-bit ASB address / polygon number")
     sel = np.flatnonzero((rec.row == y) & (rec.c1 >= lo) & (rec.c0 <= hi - 1) & (rec.c1 >= rec.c0))
     sel = sel[np.lexsort((rec.tri[sel], rec.xl[sel]))]
     out = []
@@ -43,26 +51,29 @@ def line_segments(fr: ExpertsFrame, y: int, lo: int, hi: int) -> list[dict]:
         h = st.hue[t]
         out.append({"xl": int(rec.xl[r]), "xr": int(rec.xr[r]), "zl": int(rec.zl[r]), "il": int(rec.il[r]),
                     "dzdx": int(st.dzdx[t]), "didx": int(st.didx[t]),
-                    "hue": int((h[0] << 6) | (h[1] << 3) | h[2]), "addr": t})
+                    "hue": int((h[0] << 6) | (h[1] << 3) | h[2]), "addr": t, "poly": int(st.poly[t]),
+                    "sl": int(rec.sl[r]), "ql": int(rec.ql[r]), "sr": int(rec.sr[r]), "qr": int(rec.qr[r])})
     return out
 
 
 def line_pixels(fr: ExpertsFrame, y: int, lo: int, hi: int) -> list[int]:
-    """The bit model's pixel words (no A.J.) of ``[lo, hi)`` on line ``y``."""
-    if fr.aj != "none":
-        raise ValueError("the PXP HDL has no A.J.: compare with aj='none'")
+    """The bit model's pixel words (after A.J. if the frame has it) of ``[lo, hi)`` on line ``y``."""
+    if fr.aj not in ("none", "c"):
+        raise ValueError("the PXP HDL has A.J. method (c) only")
     w = pixel_words(fr.setup, fr.fields).reshape(fr.height, fr.width)
     return [int(v) for v in w[y, lo:hi]]
 
 
-def line_cycles(segs: list[dict], lo: int, hi: int) -> int:
-    """Exact cycles of one line (see the module docstring)."""
-    r = hi - lo
-    cyc = r + 1 + 2 * r
+def line_cycles(segs: list[dict], lo: int, hi: int, *, aj: str = "none", width: int = 512) -> int:
+    """Exact cycles of one line (see the module docstring; with A.J. over the guarded pixels
+    ``G``: ``G + sum(2 + 2 n) + 1 + 3 G``, plus 1 when the range ends at the frame's edge)."""
+    glo, ghi = guarded(lo, hi, width, aj)
+    g = ghi - glo
+    cyc = g + 1 + (3 * g + (1 if ghi == hi else 0) if aj == "c" else 2 * g)
     for s in segs:
         c0 = (s["xl"] + 31) >> 6
         c1 = ((s["xr"] + 31) >> 6) - 1
-        n = max(min(c1, hi - 1) - max(c0, lo) + 1, 0)
+        n = max(min(c1, ghi - 1) - max(c0, glo) + 1, 0)
         cyc += 2 + 2 * n
     return cyc
 

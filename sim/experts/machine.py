@@ -23,7 +23,8 @@ MACHINE = Machine(
     sims=(SimBlock("pxp", "every PXP line of the frame through the PXP HDL, against the bit-accurate golden PXP "
                    "(pixels and cycles)", "rasterhw.sim.experts.pxp_sim:simulate_scene", default_scene="experts-1000",
                    options=(Option("sn", "SLPs (bands)", 8, type=int),
-                            Option("pn", "PXPs per SLP (ranges)", 8, type=int))),),
+                            Option("pn", "PXPs per SLP (ranges)", 8, type=int),
+                            Option("aj", "anti-jagging in the PXP: none or c", "c", ("none", "a", "b", "c")))),),
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",
     status="scan-line golden model split as SLP/PXP (float and 16-bit), Sn x Pn parallel model with "

@@ -29,7 +29,7 @@ __all__ = ["jobs", "run_pysim", "run_verilator", "simulate_scene", "ENGINES"]
 
 ENGINES = ("pysim", "verilator")
 BENCH_DIR = Path(__file__).resolve().parent / "verilator"
-SEG_BITS = 118
+SEG_BITS = 194          # seg_layout().size (checked in jobs)
 
 
 def _pack(seg: dict, layout) -> int:
@@ -40,6 +40,9 @@ def jobs(fr: ExpertsFrame, sn: int, pn: int) -> dict:
     """Stimulus words, expected pixels (frame order) and expected cycles for every (line, PXP)."""
     from rasterhw.hdl.experts.pxp import seg_layout
     lay = seg_layout()
+    if lay.size != SEG_BITS:
+        raise RasterhwError(f"experts: the bench expects {SEG_BITS}-bit segments, the PXP has {lay.size}")
+    aj = fr.aj
     W, H = fr.width, fr.height
     bands = equal_bounds(H, sn)
     rb = equal_bounds(W, pn)
@@ -48,16 +51,16 @@ def jobs(fr: ExpertsFrame, sn: int, pn: int) -> dict:
     pix = pixel_words(fr.setup, fr.fields).reshape(H, W)
     for k, (y, p) in enumerate(order):
         lo, hi = int(rb[p]), int(rb[p + 1])
-        segs = line_segments(fr, y, lo, hi)
+        segs = line_segments(fr, y, lo, hi, aj=aj)
         for s in segs:
             words.append(_pack({"last": 0, **s}, lay))
         ny, np_ = order[k + 1] if k + 1 < len(order) else order[k]
         nlo, nhi = int(rb[np_]), int(rb[np_ + 1])
-        words.append((nhi << 128) | (nlo << SEG_BITS) | _pack({"last": 1}, lay))
-        exp_cyc.append(line_cycles(segs, lo, hi))
+        words.append((nhi << (SEG_BITS + 10)) | (nlo << SEG_BITS) | _pack({"last": 1}, lay))
+        exp_cyc.append(line_cycles(segs, lo, hi, aj=aj, width=W))
         owner.append((int(np.searchsorted(bands, y, side="right") - 1), p))
     return {"words": words, "pixels": pix.ravel().astype(np.int64), "cycles": np.array(exp_cyc, np.int64),
-            "owner": owner, "lo0": int(rb[0]), "hi0": int(rb[1]), "lines": len(order)}
+            "owner": owner, "lo0": int(rb[0]), "hi0": int(rb[1]), "lines": len(order), "aj": aj}
 
 
 def run_pysim(jb: dict, *, width: int) -> dict:
@@ -65,7 +68,7 @@ def run_pysim(jb: dict, *, width: int) -> dict:
     from amaranth.sim import Simulator
     from rasterhw.hdl.experts.pxp import ExpertsPxp
     from rasterhw.sim.harness import stream_sink
-    dut = ExpertsPxp(width=width)
+    dut = ExpertsPxp(width=width, aj=jb["aj"])
     sim = Simulator(dut)
     sim.add_clock(1e-8)
     got, cyc = [], []
@@ -82,7 +85,7 @@ def run_pysim(jb: dict, *, width: int) -> dict:
             ctx.set(dut.i.valid, 0)
             if w & 1:
                 ctx.set(dut.lo, (w >> SEG_BITS) & 0x3FF)
-                ctx.set(dut.hi, (w >> 128) & 0x7FF)
+                ctx.set(dut.hi, (w >> (SEG_BITS + 10)) & 0x7FF)
 
     async def watch(ctx):
         seen = 0
@@ -104,11 +107,11 @@ def run_pysim(jb: dict, *, width: int) -> dict:
 NSEG_MAX, NOUT_MAX, NLINE_MAX = 1 << 19, 1 << 18, 1 << 14
 
 
-def _build(width: int) -> tuple[Path, float]:
+def _build(width: int, aj: str) -> tuple[Path, float]:
     from amaranth.back import verilog
     from rasterhw.hdl.experts.pxp import ExpertsPxp
     from rasterhw.sim.runner import REPO_ROOT, verilator_bin_dir
-    src = verilog.convert(ExpertsPxp(width=width), name="experts_pxp")
+    src = verilog.convert(ExpertsPxp(width=width, aj=aj), name="experts_pxp")
     args = ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast", "-Wno-fatal",
             "-Wno-lint", "-Wno-style", "--build-jobs", "2"]
     params = {"NSEG": NSEG_MAX, "NOUT": NOUT_MAX, "NLINE": NLINE_MAX}
@@ -150,7 +153,7 @@ def run_verilator(jb: dict, *, width: int) -> dict:
     if nseg > NSEG_MAX or nout > NOUT_MAX or nline > NLINE_MAX:
         raise RasterhwError(f"experts: {nseg} words / {nout} pixels / {nline} lines exceed the bench's "
                             f"{NSEG_MAX} / {NOUT_MAX} / {NLINE_MAX}")
-    exe, build_s = _build(width)
+    exe, build_s = _build(width, jb["aj"])
     run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=exe.parent.parent))
     (run_dir / "seg.hex").write_text("\n".join(f"{w:x}" for w in jb["words"]) + "\n")
     cmd = [str(exe), f"+seg={run_dir / 'seg.hex'}", f"+out={run_dir / 'out.hex'}", f"+cyc={run_dir / 'cyc.hex'}",
@@ -171,7 +174,7 @@ def run_verilator(jb: dict, *, width: int) -> dict:
 
 
 def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", progress: bool = False,
-                   sn: int | None = 8, pn: int | None = 8) -> dict:
+                   sn: int | None = 8, pn: int | None = 8, aj: str | None = "c") -> dict:
     """Registry sim block ``pxp``: the whole frame through the PXP HDL, compared with the golden model."""
     from rasterhw.golden_model.pipeline import run_geometry
     if engine not in ENGINES:
@@ -179,7 +182,10 @@ def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", pro
     sn = 8 if sn is None else sn
     pn = 8 if pn is None else pn
     t0 = time.perf_counter()
-    fr = render_frame(run_geometry(scene, width, height, z_bits=16), model="bit", aj="none")
+    aj = "c" if aj is None else aj
+    if aj not in ("none", "c"):
+        raise RasterhwError(f"experts: sim pxp aj must be none or c (the PXP HDL has method (c)), not {aj!r}")
+    fr = render_frame(run_geometry(scene, width, height, z_bits=16), model="bit", aj=aj)
     jb = jobs(fr, sn, pn)
     if progress:
         print(f"experts: {jb['lines']} PXP lines, {len(jb['words'])} words, {int(jb['cycles'].sum()):,} cycles expected")
@@ -199,5 +205,5 @@ def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", pro
             "cycles_per_s": round(total / res["run_s"], 1) if res["run_s"] > 0 else None,
             "cycle_mismatches": cyc_mism, "frame_cycles_busiest_pxp": frame_cycles,
             "pxp_cycles_per_line_mean": round(total / max(jb["lines"], 1), 2),
-            "pxp_clock_for_30fps_hz": frame_cycles * 30, "sn": sn, "pn": pn,
+            "pxp_clock_for_30fps_hz": frame_cycles * 30, "sn": sn, "pn": pn, "aj": aj,
             "run_s": round(res["run_s"], 3), "build_s": round(res.get("build_s", 0.0), 2)}

@@ -229,13 +229,13 @@ def _hdl(out: list, engine: str, progress: bool) -> None:
     when ``engine == "verilator"``; the 30 frames/s PXP clock from the cycle model the HDL matched."""
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.sim.experts.pxp_sim import jobs, simulate_scene
-    small = simulate_scene(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=2, pn=4)
-    out.append(make_row(SYS, "HDL", "PXP pixel mismatches, experts-tilt-1000 at 64x16, 2x4 (pysim)", paper=None,
+    small = simulate_scene(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=2, pn=4, aj="c")
+    out.append(make_row(SYS, "HDL", "PXP pixel mismatches with A.J. (c), experts-tilt-1000 at 64x16, 2x4 (pysim)", paper=None,
                         formula=None, measured=small["mismatches"], unit="pixels", source="hdl:pysim"))
     out.append(make_row(SYS, "HDL", "PXP lines whose cycles differ from the golden cycle model, experts-tilt-1000 "
                         "at 64x16, 2x4 (pysim)", paper=None, formula=None, measured=small["cycle_mismatches"],
                         unit="lines", source="hdl:pysim"))
-    fr = _frame("experts-1000", "bit")
+    fr = _frame("experts-1000", "bit", "c")
     jb = jobs(fr, 8, 8)
     per = {}
     for (sidx, p), c in zip(jb["owner"], jb["cycles"], strict=True):
@@ -246,8 +246,8 @@ def _hdl(out: list, engine: str, progress: bool) -> None:
     if engine == "verilator":
         if progress:
             print("experts: experts-1000 through the PXP HDL on Verilator")
-        r = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8)
-        out.append(make_row(SYS, "HDL", "PXP pixel mismatches, experts-1000, 8x8 (262,144 compared)", paper=None,
+        r = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c")
+        out.append(make_row(SYS, "HDL", "PXP pixel mismatches with A.J. (c), experts-1000, 8x8 (262,144 compared)", paper=None,
                             formula=None, measured=r["mismatches"], unit="pixels", source="hdl:verilator"))
         out.append(make_row(SYS, "HDL", "PXP lines whose cycles differ from the golden cycle model, experts-1000, 8x8",
                             paper=None, formula=None, measured=r["cycle_mismatches"], unit="lines",
@@ -257,9 +257,9 @@ def _hdl(out: list, engine: str, progress: bool) -> None:
                             source="hdl:verilator"))
         meas, src = r["frame_cycles_busiest_pxp"], "hdl:verilator"
     what = "HDL on Verilator" if src != "model" else "the golden cycle model the HDL matches"
-    out.append(make_row(SYS, "5 / HDL", f"busiest PXP's cycles per frame, experts-1000, 8x8 ({what})",
+    out.append(make_row(SYS, "5 / HDL", f"busiest PXP's cycles per frame, A.J. (c), experts-1000, 8x8 ({what})",
                         paper=None, formula=None, measured=meas, unit="cycles", source=src))
-    out.append(make_row(SYS, "5 / HDL", f"PXP clock for 30 frames/s of experts-1000 at 8x8, PXPs only ({what})",
+    out.append(make_row(SYS, "5 / HDL", f"PXP clock for 30 frames/s of experts-1000 at 8x8 with A.J. (c), PXPs only ({what})",
                         paper=None, formula=None, measured=round(meas * 30 / 1e6, 3), unit="MHz", source=src))
 
 

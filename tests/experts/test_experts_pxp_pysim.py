@@ -18,17 +18,17 @@ from rasterhw.sim.harness import stream_protocol_checker, stream_put, stream_sin
 
 
 @cache
-def _frame(name: str = "experts-tilt-1000"):
-    return render_frame(run_geometry(build_scene(name), 512, 512, z_bits=16), model="bit", aj="none")
+def _frame(name: str = "experts-tilt-1000", aj: str = "none"):
+    return render_frame(run_geometry(build_scene(name), 512, 512, z_bits=16), model="bit", aj=aj)
 
 
-def _run(lines, lo, hi, *, ready=None, gap=0, name="experts-tilt-1000", fr=None, unit=False):
-    fr = _frame(name) if fr is None else fr
-    dut = ExpertsPxpUnit(width=512, depth=256) if unit else ExpertsPxp(width=512)
+def _run(lines, lo, hi, *, ready=None, gap=0, name="experts-tilt-1000", fr=None, unit=False, aj="none"):
+    fr = _frame(name, aj) if fr is None else fr
+    dut = ExpertsPxpUnit(width=512, depth=256) if unit else ExpertsPxp(width=512, aj=aj)
     sim = Simulator(dut)
     sim.add_clock(1e-8)
     got, log, cycles = [], [], []
-    segs = {y: line_segments(fr, y, lo, hi) for y in lines}
+    segs = {y: line_segments(fr, y, lo, hi, aj=aj) for y in lines}
 
     async def feed(ctx):
         ctx.set(dut.lo, lo)
@@ -54,7 +54,7 @@ def _run(lines, lo, hi, *, ready=None, gap=0, name="experts-tilt-1000", fr=None,
     sim.add_testbench(watch)
     sim.run()
     expect = [p for y in lines for p in line_pixels(fr, y, lo, hi)]
-    return got, log, cycles, expect, [line_cycles(segs[y], lo, hi) for y in lines]
+    return got, log, cycles, expect, [line_cycles(segs[y], lo, hi, aj=aj) for y in lines]
 
 
 @pytest.mark.parametrize("lo,hi", [(128, 192), (0, 37), (475, 512)])
@@ -63,6 +63,25 @@ def test_pixels_and_cycles_exact(lo, hi):
     assert got == expect and log == expect
     assert cycles == want
     assert any(p for p in got)  # the range is not empty background
+
+
+@pytest.mark.parametrize("lo,hi", [(128, 192), (0, 37), (475, 512), (300, 301)])
+def test_anti_jagging_c_pixels_and_cycles_exact(lo, hi):
+    """Method (c) in the HDL: every blended edge pixel equal to the golden model's, guard pixels
+    at the range ends included (the range's edges see their neighbours' pixels)."""
+    got, log, cycles, expect, want = _run([100, 101, 300], lo, hi, aj="c")
+    assert got == expect and log == expect and cycles == want
+    plain = [p for y in (100, 101, 300) for p in line_pixels(_frame(), y, lo, hi)]
+    if hi - lo > 30:
+        assert got != plain   # some pixel was blended
+
+
+def test_anti_jagging_on_the_solids_and_under_back_pressure():
+    rng = random.Random(9)
+    ready = [rng.randint(0, 1) for _ in range(6000)]
+    got, log, cycles, expect, want = _run([200, 260], 160, 352, aj="c", name="experts-solids", ready=ready, gap=1)
+    assert got == expect and log == expect
+    assert all(c >= w for c, w in zip(cycles, want, strict=True))
 
 
 def test_crossing_segments_and_ties_exact():

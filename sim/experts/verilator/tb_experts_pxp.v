@@ -1,6 +1,6 @@
 // Timing-free bench for one EXPERTS PXP (`experts_pxp`), for plain Verilator runs (main.cpp
 // toggles `clk`). Memories are sized for a 512 x 512 frame at up to 16 x 64 PXP lines (one build
-// serves every scene). Stimulus (+seg=, +nseg= words of {next_hi[10:0], next_lo[9:0], payload[117:0]})
+// serves every scene). Stimulus (+seg=, +nseg= words of {next_hi[10:0], next_lo[9:0], payload[193:0]})
 // is played back to back; when an end-of-line token (payload bit 0) is taken, the range of the
 // next line (next_lo, next_hi) is put on lo/hi, which the PXP samples as the line ends. The first
 // line's range comes from +lo0= / +hi0=. Every pixel word is stored in order (dumped to +out=),
@@ -14,7 +14,7 @@ module tb_experts_pxp #(
   output reg done,
   output reg [63:0] cycles
 );
-  reg [138:0] stim [0:NSEG-1];
+  reg [214:0] stim [0:NSEG-1];
   reg [15:0] frame [0:NOUT-1];
   reg [15:0] lcyc [0:NLINE-1];
   reg [8*512-1:0] fseg, fout, fcyc;
@@ -44,14 +44,14 @@ module tb_experts_pxp #(
     $writememh(fcyc, lcyc);
   end
 
-  wire [138:0] w = stim[p];
+  wire [214:0] w = stim[p];
   wire iv = (p < nseg);
   wire ir, ov;
   wire [15:0] opl;
   wire [15:0] line_cycles, lines;
   experts_pxp dut (
     .clk(clk), .rst(1'b0),
-    .i__valid(iv), .i__ready(ir), .i__payload(w[117:0]),
+    .i__valid(iv), .i__ready(ir), .i__payload(w[193:0]),
     .o__valid(ov), .o__ready(1'b1), .o__payload(opl),
     .lo(lo), .hi(hi), .line_cycles(line_cycles), .lines(lines)
   );
@@ -61,8 +61,8 @@ module tb_experts_pxp #(
     if (iv && ir) begin
       p <= p + 1;
       if (w[0]) begin
-        lo <= w[127:118];
-        hi <= w[138:128];
+        lo <= w[203:194];
+        hi <= w[214:204];
       end
     end
     if (ov) begin
