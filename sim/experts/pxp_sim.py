@@ -36,31 +36,37 @@ def _pack(seg: dict, layout) -> int:
     return int(layout.const(seg).as_value().value)
 
 
-def jobs(fr: ExpertsFrame, sn: int, pn: int) -> dict:
-    """Stimulus words, expected pixels (frame order) and expected cycles for every (line, PXP)."""
+def job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
+    """Stimulus, expected pixels and cycles for PXP lines ``(y, lo, hi)`` run one after another."""
     from rasterhw.hdl.experts.pxp import seg_layout
     lay = seg_layout()
     if lay.size != SEG_BITS:
         raise RasterhwError(f"experts: the bench expects {SEG_BITS}-bit segments, the PXP has {lay.size}")
     aj = fr.aj
-    W, H = fr.width, fr.height
-    bands = equal_bounds(H, sn)
-    rb = equal_bounds(W, pn)
-    words, exp_cyc, owner = [], [], []
-    order = [(y, p) for y in range(H) for p in range(pn)]
-    pix = pixel_words(fr.setup, fr.fields).reshape(H, W)
-    for k, (y, p) in enumerate(order):
-        lo, hi = int(rb[p]), int(rb[p + 1])
+    W = fr.width
+    words, exp_cyc, exp_pix = [], [], []
+    pix = pixel_words(fr.setup, fr.fields).reshape(fr.height, W)
+    for k, (y, lo, hi) in enumerate(todo):
         segs = line_segments(fr, y, lo, hi, aj=aj)
         for s in segs:
             words.append(_pack({"last": 0, **s}, lay))
-        ny, np_ = order[k + 1] if k + 1 < len(order) else order[k]
-        nlo, nhi = int(rb[np_]), int(rb[np_ + 1])
+        _, nlo, nhi = todo[k + 1] if k + 1 < len(todo) else todo[k]
         words.append((nhi << (SEG_BITS + 10)) | (nlo << SEG_BITS) | _pack({"last": 1}, lay))
         exp_cyc.append(line_cycles(segs, lo, hi, aj=aj, width=W))
-        owner.append((int(np.searchsorted(bands, y, side="right") - 1), p))
-    return {"words": words, "pixels": pix.ravel().astype(np.int64), "cycles": np.array(exp_cyc, np.int64),
-            "owner": owner, "lo0": int(rb[0]), "hi0": int(rb[1]), "lines": len(order), "aj": aj}
+        exp_pix.append(pix[y, lo:hi])
+    return {"words": words, "pixels": np.concatenate(exp_pix).astype(np.int64) if exp_pix else np.zeros(0, np.int64),
+            "cycles": np.array(exp_cyc, np.int64), "lo0": todo[0][1], "hi0": todo[0][2], "lines": len(todo), "aj": aj}
+
+
+def jobs(fr: ExpertsFrame, sn: int, pn: int) -> dict:
+    """:func:`job_list` for every (line, PXP) of an equal static Sn x Pn split, in frame order."""
+    H = fr.height
+    bands = equal_bounds(H, sn)
+    rb = equal_bounds(fr.width, pn)
+    todo = [(y, int(rb[p]), int(rb[p + 1])) for y in range(H) for p in range(pn)]
+    jb = job_list(fr, todo)
+    jb["owner"] = [(int(np.searchsorted(bands, y, side="right") - 1), p) for y in range(H) for p in range(pn)]
+    return jb
 
 
 def run_pysim(jb: dict, *, width: int) -> dict:
