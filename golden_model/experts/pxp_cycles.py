@@ -7,12 +7,13 @@ when its 16-bit z key is smaller than the stored one, or equal with a lower ASB 
 golden depth search's rule, so the pixels equal the bit model's (tested). Its cycle count is its
 own (below), not the span-cull / depth-search operation count of :mod:`pxp`.
 
-Cycles of one line of a range of R pixels, the input always valid and the output always ready::
-
-    R                      clear the line depth buffer / DSLB
-    + sum over segments (2 + 2 n)   accept, start values (multiplier), read + compare/write per pixel
-    + 1                    accept the end-of-line token
-    + 2 R                  drain the DSLB (read, then offer the pixel)
+The DSLB has two banks: the resolve side (clear, segments, token, hand-over) works on one while
+the drain side (read, offer; with A.J. read, segment table, blend/offer) empties the other. Cycles,
+the input always valid and the output always ready, are in :func:`schedule`: per line the resolve
+side takes ``G + sum(2 + 2 n) + 1`` (clear the G pixels, per segment accept + start values and
+read + compare/write per owned pixel, the end-of-line token), then one hand-over cycle, waiting
+while the drain side is still busy with the line before; the drain takes ``2 R`` (``3 G`` plus one
+at the frame's right edge with A.J.).
 """
 
 from __future__ import annotations
@@ -64,18 +65,49 @@ def line_pixels(fr: ExpertsFrame, y: int, lo: int, hi: int) -> list[int]:
     return [int(v) for v in w[y, lo:hi]]
 
 
-def line_cycles(segs: list[dict], lo: int, hi: int, *, aj: str = "none", width: int = 512) -> int:
-    """Exact cycles of one line (see the module docstring; with A.J. over the guarded pixels
-    ``G``: ``G + sum(2 + 2 n) + 1 + 3 G``, plus 1 when the range ends at the frame's edge)."""
+def resolve_cycles(segs: list[dict], lo: int, hi: int, *, aj: str = "none", width: int = 512) -> int:
+    """Resolve-side cycles of one line before its hand-over: clear ``G``, ``2 + 2 n`` per segment,
+    1 for the end-of-line token (``G``: the range, with A.J. plus its guard pixels)."""
     glo, ghi = guarded(lo, hi, width, aj)
-    g = ghi - glo
-    cyc = g + 1 + (3 * g + (1 if ghi == hi else 0) if aj == "c" else 2 * g)
+    cyc = (ghi - glo) + 1
     for s in segs:
         c0 = (s["xl"] + 31) >> 6
         c1 = ((s["xr"] + 31) >> 6) - 1
         n = max(min(c1, ghi - 1) - max(c0, glo) + 1, 0)
         cyc += 2 + 2 * n
     return cyc
+
+
+def drain_cycles(lo: int, hi: int, *, aj: str = "none", width: int = 512) -> int:
+    """Drain-side cycles of one line: ``2 R`` without A.J.; ``3 G`` (+1 at the frame's right edge) with."""
+    glo, ghi = guarded(lo, hi, width, aj)
+    return 3 * (ghi - glo) + (1 if ghi == hi else 0) if aj == "c" else 2 * (hi - lo)
+
+
+def schedule(lines: list[tuple[list[dict], int, int]], *, aj: str = "none", width: int = 512) -> dict:
+    """Exact timing of lines ``(segments, lo, hi)`` through the PXP with its double-banked DSLB.
+
+    Cycle 0 is line 0's first clear cycle. Resolve of line k starts at ``S_k``, hands its bank over
+    at ``H_k = max(S_k + r_k, F_{k-1})`` (``F``: the first cycle the drain is free), the drain runs
+    ``H_k + 1 .. H_k + d_k``; ``S_{k+1} = H_k + 1``. The finish-time counter of line k is
+    ``H_k - S_k + 1``. Returns ``{"line_cycles": [...], "last_pixel": H_{N-1} + d_{N-1}}``.
+    """
+    s_k, free = 0, 0
+    out, h = [], 0
+    d = 0
+    for segs, lo, hi in lines:
+        r = resolve_cycles(segs, lo, hi, aj=aj, width=width)
+        h = max(s_k + r, free)
+        out.append(h - s_k + 1)
+        d = drain_cycles(lo, hi, aj=aj, width=width)
+        free = h + d + 1
+        s_k = h + 1
+    return {"line_cycles": out, "last_pixel": h + d}
+
+
+def line_cycles(segs: list[dict], lo: int, hi: int, *, aj: str = "none", width: int = 512) -> int:
+    """The finish-time counter of a line run alone (its drain bank free): resolve + hand-over."""
+    return resolve_cycles(segs, lo, hi, aj=aj, width=width) + 1
 
 
 def reference_line(segs: list[dict], lo: int, hi: int, *, intensity_bits: int = 7) -> list[int]:

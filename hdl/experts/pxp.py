@@ -12,8 +12,10 @@ gives exactly the golden depth search's pixels (16-bit key, ties to the lower AS
 boundary between two polygons where the right run's left edge starts or the left run's right edge
 ends -- the golden model's rule (``golden_model/experts/pxp.py``); to see the boundaries at its
 range ends it also resolves one guard pixel on each side (``[lo-1, hi+1)`` within the frame) and
-outputs only ``[lo, hi)``. Bit- and cycle-exact with ``golden_model.experts.pxp_cycles``.
-Not in this block: the second DSLB bank (the line drains before the next is cleared), shadows.
+outputs only ``[lo, hi)``. The DSLB is double-banked ("DSLBもDMM同様、2重系の構成とし、PXPによる
+書き込みと、FBへの転送のための読み出しとを並行して同時に行なう"): the next line is cleared and
+resolved in one bank while the other drains, the banks swapping by a hand-over once the drain is
+free. Bit- and cycle-exact with ``golden_model.experts.pxp_cycles``. Not in this block: shadows.
 
 Input protocol: per line, the clipped ASL segments (``SEG`` payloads with ``last = 0``) in ASL
 order, then one ``last = 1`` token; ``lo``/``hi`` (the range ``[lo, hi)``) are sampled when a line
@@ -73,6 +75,7 @@ class _S(enum.Enum, shape=4):
     DSEG = 7      # drain with A.J.: read the segment table
     DAJ = 8       # drain with A.J.: blend the boundary, offer the pixel on its left
     FLUSH = 9     # drain with A.J.: offer the range's last pixel
+    HAND = 10     # resolve side: hand the bank to the drain (waits while the drain is busy)
 
 
 class ExpertsPxp(wiring.Component):
@@ -94,16 +97,17 @@ class ExpertsPxp(wiring.Component):
     lo, hi : In(10), In(11)
         The range ``[lo, hi)``, sampled at the start of each line.
     line_cycles : Out(16)
-        Finish-time counter: cycles of the last finished line (clear to last pixel out).
+        Finish-time counter: cycles of the last line from its first clear cycle to its hand-over to
+        the drain (waits for the drain included).
     lines : Out(16)
-        Lines finished.
+        Lines handed over.
     slot_overflow : Out(1)
         Sticky (A.J. only): a line had more segments than the segment table's 256 slots (the
         DMM/P bank in front holds 256, so this cannot happen behind one).
 
-    Cycles per line with the input always valid and the output always ready
-    (``pxp_cycles.line_cycles``): without A.J. ``R + sum(2 + 2 n) + 1 + 2 R``; with A.J.
-    ``G + sum(2 + 2 n) + 1 + 3 G + [hi == frame end]`` over the ``G`` pixels with guards.
+    Cycles with the input always valid and the output always ready: ``pxp_cycles.schedule``
+    (resolve ``G + sum(2 + 2 n) + 1`` and one hand-over cycle per line, overlapped with the drain
+    of the line before: ``2 R``, with A.J. ``3 G`` plus one at the frame's right edge).
     """
 
     def __init__(self, *, width: int = 512, intensity_bits: int = 7, aj: str = "none"):
@@ -145,17 +149,22 @@ class ExpertsPxp(wiring.Component):
         aj = self._aj == "c"
         word = data.StructLayout({"z": unsigned(Z_BITS), "addr": unsigned(ADDR_BITS), "pix": unsigned(pb),
                                   "slot": unsigned(SLOT_BITS)})
-        m.submodules.mem = mem = Memory(shape=word, depth=W, init=[])
-        rd = mem.read_port(transparent_for=())
+        # the DSLB: two banks (bank = top address bit), one resolved while the other drains
+        m.submodules.mem = mem = Memory(shape=word, depth=2 * W, init=[])
+        rd = mem.read_port(transparent_for=())      # resolve side: read-compare-write
         wr = mem.write_port()
+        drd = mem.read_port(transparent_for=())     # drain side
+        ab = (2 * W - 1).bit_length() - 1           # bank bit position
         ent = data.StructLayout({"xl": unsigned(16), "xr": unsigned(16), "poly": unsigned(ADDR_BITS),
                                  "sl": signed(16), "ql": signed(16), "sr": signed(16), "qr": signed(16)})
         if aj:
-            m.submodules.tab = tab = Memory(shape=ent, depth=1 << SLOT_BITS, init=[])
+            m.submodules.tab = tab = Memory(shape=ent, depth=2 << SLOT_BITS, init=[])
             trd = tab.read_port(transparent_for=())
             twr = tab.write_port()
 
+        # ---------------------------------------------------------------- resolve side
         state = Signal(_S)
+        rbank = Signal()
         x = Signal(11)
         end = Signal(11)          # last owned pixel of the segment
         lo = Signal(10)
@@ -211,18 +220,28 @@ class ExpertsPxp(wiring.Component):
         m.d.comb += stored.eq(rd.data)
         wins = Signal()
         m.d.comb += wins.eq((key < stored.z) | ((key == stored.z) & (seg.addr < stored.addr)))
-
-        m.d.comb += [rd.en.eq(0), wr.en.eq(0), self.i.ready.eq(0), self.o.valid.eq(0),
-                     self.o.payload.eq(stored.pix)]
-
-        # --- A.J. walk: prev = pixel x-1, cur = pixel x (read ports), outputs and blend
+        m.d.comb += [rd.en.eq(0), wr.en.eq(0), drd.en.eq(0), self.i.ready.eq(0), self.o.valid.eq(0)]
         if aj:
             m.d.comb += [trd.en.eq(0), twr.en.eq(0)]
-            p_pix = Signal(pb)            # pixel x-1 before A.J.
-            p_out = Signal(pb)            # pixel x-1 as it will be output
+
+        # ---------------------------------------------------------------- drain side
+        dstate = Signal(_S)           # IDLE (= CLEAR value unused) / DRD / DOUT / DSEG / DAJ / FLUSH
+        dbusy = Signal()
+        dbank = Signal()
+        dx = Signal(11)
+        dlo = Signal(10)
+        dhi = Signal(11)
+        dghi = Signal(11)
+        dstored = Signal(word)
+        m.d.comb += dstored.eq(drd.data)
+        m.d.comb += self.o.payload.eq(dstored.pix)
+
+        if aj:
+            p_pix = Signal(pb)            # pixel dx-1 before A.J.
+            p_out = Signal(pb)            # pixel dx-1 as it will be output
             p_addr = Signal(ADDR_BITS)
             p_ent = Signal(ent)
-            p_ok = Signal()               # there is a pixel x-1 in the walk
+            p_ok = Signal()               # there is a pixel dx-1 in the walk
             c_pix = Signal(pb)
             c_addr = Signal(ADDR_BITS)
             c_ent = Signal(ent)
@@ -238,22 +257,22 @@ class ExpertsPxp(wiring.Component):
             m.d.comb += [cc0.eq((c_ent.xl + 31) >> X_FRAC), pc1.eq(((p_ent.xr + 31) >> X_FRAC) - 1)]
             starts = Signal()
             ends = Signal()
-            m.d.comb += [starts.eq(~bg_c & (x == Mux(cc0 < 0, 0, cc0))),
-                         ends.eq(~bg_p & (x - 1 == Mux(pc1 > W - 1, W - 1, pc1)))]
+            m.d.comb += [starts.eq(~bg_c & (dx == Mux(cc0 < 0, 0, cc0))),
+                         ends.eq(~bg_p & (dx - 1 == Mux(pc1 > W - 1, W - 1, pc1)))]
             edge = Signal()
             use_b = Signal()
             use_a = Signal()
-            m.d.comb += [edge.eq(p_ok & (x > 0) & (p_addr != c_addr) & (poly_p != poly_c)),
+            m.d.comb += [edge.eq(p_ok & (dx > 0) & (p_addr != c_addr) & (poly_p != poly_c)),
                          use_b.eq(edge & starts), use_a.eq(edge & ~starts & ends)]
             xe = Signal(16)
             sl = Signal(signed(16))
             qq = Signal(signed(16))
             m.d.comb += [xe.eq(Mux(use_b, c_ent.xl, p_ent.xr)), sl.eq(Mux(use_b, c_ent.sl, p_ent.sr)),
                          qq.eq(Mux(use_b, c_ent.ql, p_ent.qr))]
-            right = Signal()              # the blended pixel is x (else x - 1)
-            m.d.comb += right.eq((xe >> X_FRAC) >= x)
+            right = Signal()              # the blended pixel is dx (else dx - 1)
+            m.d.comb += right.eq((xe >> X_FRAC) >= dx)
             q = Signal(11)
-            m.d.comb += q.eq(Mux(right, x, x - 1))
+            m.d.comb += q.eq(Mux(right, dx, dx - 1))
             delta = Signal(signed(20))
             m.d.comb += delta.eq(xe - ((q << X_FRAC) + (1 << (X_FRAC - 1))))
             steep = Signal()
@@ -268,36 +287,31 @@ class ExpertsPxp(wiring.Component):
             m.d.comb += alpha.eq(Mux(araw < 0, 0, Mux(araw > one, one, araw)))
             # eq. (5) per field (R, G, B, I), C = alpha C_L + (1 - alpha) C_R, Q0.8, rounded
             blend = Signal(pb)
-            fields = ((ib + 6, 3), (ib + 3, 3), (ib, 3), (0, ib))
             parts = []
-            for lsb, w in fields:
+            for lsb, w in ((ib + 6, 3), (ib + 3, 3), (ib, 3), (0, ib)):
                 fl = p_pix[lsb:lsb + w]
                 fr = c_pix[lsb:lsb + w]
                 v = Signal(w, name=f"blend_{lsb}")
                 m.d.comb += v.eq((alpha * fl + (one - alpha) * fr + (one >> 1)) >> ALPHA_BITS)
                 parts.append((lsb, v))
-            m.d.comb += blend.eq(sum((v.as_unsigned() << lsb) for lsb, v in parts))
-            o_prev = Signal(pb)          # pixel x-1's value after this boundary
-            o_cur = Signal(pb)           # pixel x's value so far
+            m.d.comb += blend.eq(sum((v << lsb) for lsb, v in parts))
+            o_prev = Signal(pb)          # pixel dx-1's value after this boundary
+            o_cur = Signal(pb)           # pixel dx's value so far
             m.d.comb += [o_prev.eq(Mux((use_a | use_b) & ~right, blend, p_out)),
                          o_cur.eq(Mux((use_a | use_b) & right, blend, c_pix))]
             emit = Signal()
-            m.d.comb += emit.eq(p_ok & (x >= lo + 1) & (x <= hi))
+            m.d.comb += emit.eq(p_ok & (dx >= dlo + 1) & (dx <= dhi))
 
         m.d.sync += cyc.eq(cyc + 1)
         started = Signal()
-
-        def line_done():
-            return [self.line_cycles.eq(cyc + 1), cyc.eq(0), self.lines.eq(self.lines + 1),
-                    state.eq(_S.CLEAR), *sample_range()]
 
         with m.If(~started):
             # out of reset: sample the first line's range
             m.d.sync += [started.eq(1), cyc.eq(0), *sample_range()]
         with m.Else(), m.Switch(state):
             with m.Case(_S.CLEAR):
-                m.d.comb += [wr.addr.eq(x), wr.data.eq(word.const({"z": (1 << Z_BITS) - 1, "addr": NONE,
-                                                                   "pix": 0, "slot": 0})),
+                m.d.comb += [wr.addr.eq((rbank << ab) | x),
+                             wr.data.eq(word.const({"z": (1 << Z_BITS) - 1, "addr": NONE, "pix": 0, "slot": 0})),
                              wr.en.eq(x < ghi)]
                 m.d.sync += x.eq(x + 1)
                 with m.If(x + 1 >= ghi):
@@ -307,14 +321,13 @@ class ExpertsPxp(wiring.Component):
                 with m.If(self.i.valid):
                     m.d.sync += seg.eq(self.i.payload)
                     with m.If(self.i.payload.last):
-                        m.d.sync += [state.eq(_S.DRD), x.eq(glo)]
-                        if aj:
-                            m.d.sync += p_ok.eq(0)
+                        m.d.sync += state.eq(_S.HAND)
                     with m.Else():
                         m.d.sync += state.eq(_S.START)
             with m.Case(_S.START):
                 if aj:
-                    m.d.comb += [twr.addr.eq(slot), twr.en.eq(slot < (1 << SLOT_BITS)),
+                    m.d.comb += [twr.addr.eq((rbank << SLOT_BITS) | slot[:SLOT_BITS]),
+                                 twr.en.eq(slot < (1 << SLOT_BITS)),
                                  twr.data.xl.eq(seg.xl), twr.data.xr.eq(seg.xr), twr.data.poly.eq(seg.poly),
                                  twr.data.sl.eq(seg.sl), twr.data.ql.eq(seg.ql), twr.data.sr.eq(seg.sr),
                                  twr.data.qr.eq(seg.qr)]
@@ -325,46 +338,61 @@ class ExpertsPxp(wiring.Component):
                 with m.Else():
                     m.d.sync += [x.eq(s), end.eq(e), zrun.eq(zstart), irun.eq(istart), state.eq(_S.READ)]
             with m.Case(_S.READ):
-                m.d.comb += [rd.addr.eq(x), rd.en.eq(1)]
+                m.d.comb += [rd.addr.eq((rbank << ab) | x), rd.en.eq(1)]
                 m.d.sync += state.eq(_S.CMP)
             with m.Case(_S.CMP):
                 with m.If(wins):
-                    m.d.comb += [wr.addr.eq(x), wr.en.eq(1), wr.data.z.eq(key), wr.data.addr.eq(seg.addr),
-                                 wr.data.pix.eq(pix), wr.data.slot.eq(slot)]
+                    m.d.comb += [wr.addr.eq((rbank << ab) | x), wr.en.eq(1), wr.data.z.eq(key),
+                                 wr.data.addr.eq(seg.addr), wr.data.pix.eq(pix), wr.data.slot.eq(slot)]
                 m.d.sync += [zrun.eq(zrun + seg.dzdx), irun.eq(irun + seg.didx), x.eq(x + 1)]
                 with m.If(x == end):
                     m.d.sync += [state.eq(_S.SEG), slot.eq(slot + 1)]
                 with m.Else():
                     m.d.sync += state.eq(_S.READ)
-            with m.Case(_S.DRD):
-                m.d.comb += [rd.addr.eq(x), rd.en.eq(1)]
-                m.d.sync += state.eq(_S.DSEG if aj else _S.DOUT)
-            with m.Case(_S.DOUT):
-                m.d.comb += self.o.valid.eq(1)
-                with m.If(self.o.ready):
-                    m.d.sync += x.eq(x + 1)
-                    with m.If(x + 1 >= hi):
-                        m.d.sync += line_done()
-                    with m.Else():
-                        m.d.sync += state.eq(_S.DRD)
-            if aj:
-                with m.Case(_S.DSEG):
-                    m.d.comb += [trd.addr.eq(stored.slot), trd.en.eq(1)]
-                    m.d.sync += [c_pix.eq(stored.pix), c_addr.eq(stored.addr), state.eq(_S.DAJ)]
-                with m.Case(_S.DAJ):
-                    m.d.comb += [self.o.valid.eq(emit), self.o.payload.eq(o_prev)]
-                    with m.If(~emit | self.o.ready):
-                        m.d.sync += [p_pix.eq(c_pix), p_out.eq(o_cur), p_addr.eq(c_addr), p_ent.eq(c_ent),
-                                     p_ok.eq(1), x.eq(x + 1)]
-                        with m.If(x + 1 >= ghi):
-                            with m.If(ghi == hi):
-                                m.d.sync += state.eq(_S.FLUSH)
-                            with m.Else():
-                                m.d.sync += line_done()
-                        with m.Else():
-                            m.d.sync += state.eq(_S.DRD)
-                with m.Case(_S.FLUSH):
-                    m.d.comb += [self.o.valid.eq(1), self.o.payload.eq(p_out)]
+            with m.Case(_S.HAND):
+                # swap handshake: the resolved bank goes to the drain once the drain is free
+                with m.If(~dbusy):
+                    m.d.sync += [dbusy.eq(1), dbank.eq(rbank), dlo.eq(lo), dhi.eq(hi), dghi.eq(ghi), dx.eq(glo),
+                                 dstate.eq(_S.DRD), rbank.eq(~rbank), state.eq(_S.CLEAR),
+                                 self.line_cycles.eq(cyc + 1), cyc.eq(0), self.lines.eq(self.lines + 1),
+                                 *sample_range()]
+                    if aj:
+                        m.d.sync += p_ok.eq(0)
+
+        with m.If(dbusy):
+            def drain_done():
+                return [dbusy.eq(0)]
+
+            with m.Switch(dstate):
+                with m.Case(_S.DRD):
+                    m.d.comb += [drd.addr.eq((dbank << ab) | dx), drd.en.eq(1)]
+                    m.d.sync += dstate.eq(_S.DSEG if aj else _S.DOUT)
+                with m.Case(_S.DOUT):
+                    m.d.comb += self.o.valid.eq(1)
                     with m.If(self.o.ready):
-                        m.d.sync += line_done()
+                        m.d.sync += dx.eq(dx + 1)
+                        with m.If(dx + 1 >= dhi):
+                            m.d.sync += drain_done()
+                        with m.Else():
+                            m.d.sync += dstate.eq(_S.DRD)
+                if aj:
+                    with m.Case(_S.DSEG):
+                        m.d.comb += [trd.addr.eq((dbank << SLOT_BITS) | dstored.slot), trd.en.eq(1)]
+                        m.d.sync += [c_pix.eq(dstored.pix), c_addr.eq(dstored.addr), dstate.eq(_S.DAJ)]
+                    with m.Case(_S.DAJ):
+                        m.d.comb += [self.o.valid.eq(emit), self.o.payload.eq(o_prev)]
+                        with m.If(~emit | self.o.ready):
+                            m.d.sync += [p_pix.eq(c_pix), p_out.eq(o_cur), p_addr.eq(c_addr), p_ent.eq(c_ent),
+                                         p_ok.eq(1), dx.eq(dx + 1)]
+                            with m.If(dx + 1 >= dghi):
+                                with m.If(dghi == dhi):
+                                    m.d.sync += dstate.eq(_S.FLUSH)
+                                with m.Else():
+                                    m.d.sync += drain_done()
+                            with m.Else():
+                                m.d.sync += dstate.eq(_S.DRD)
+                    with m.Case(_S.FLUSH):
+                        m.d.comb += [self.o.valid.eq(1), self.o.payload.eq(p_out)]
+                        with m.If(self.o.ready):
+                            m.d.sync += drain_done()
         return m

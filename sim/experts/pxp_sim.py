@@ -23,7 +23,7 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.experts.model import ExpertsFrame, equal_bounds, render_frame
 from rasterhw.golden_model.experts.pxp import pixel_words
-from rasterhw.golden_model.experts.pxp_cycles import line_cycles, line_segments
+from rasterhw.golden_model.experts.pxp_cycles import line_segments, schedule
 
 __all__ = ["jobs", "run_pysim", "run_verilator", "simulate_scene", "ENGINES"]
 
@@ -44,7 +44,7 @@ def job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
         raise RasterhwError(f"experts: the bench expects {SEG_BITS}-bit segments, the PXP has {lay.size}")
     aj = fr.aj
     W = fr.width
-    words, exp_cyc, exp_pix = [], [], []
+    words, exp_pix, lines = [], [], []
     pix = pixel_words(fr.setup, fr.fields).reshape(fr.height, W)
     for k, (y, lo, hi) in enumerate(todo):
         segs = line_segments(fr, y, lo, hi, aj=aj)
@@ -52,20 +52,31 @@ def job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
             words.append(_pack({"last": 0, **s}, lay))
         _, nlo, nhi = todo[k + 1] if k + 1 < len(todo) else todo[k]
         words.append((nhi << (SEG_BITS + 10)) | (nlo << SEG_BITS) | _pack({"last": 1}, lay))
-        exp_cyc.append(line_cycles(segs, lo, hi, aj=aj, width=W))
+        lines.append((segs, lo, hi))
         exp_pix.append(pix[y, lo:hi])
+    sch = schedule(lines, aj=aj, width=W)
     return {"words": words, "pixels": np.concatenate(exp_pix).astype(np.int64) if exp_pix else np.zeros(0, np.int64),
-            "cycles": np.array(exp_cyc, np.int64), "lo0": todo[0][1], "hi0": todo[0][2], "lines": len(todo), "aj": aj}
+            "cycles": np.array(sch["line_cycles"], np.int64), "last_pixel": sch["last_pixel"],
+            "lo0": todo[0][1], "hi0": todo[0][2], "lines": len(todo), "aj": aj}
 
 
 def jobs(fr: ExpertsFrame, sn: int, pn: int) -> dict:
-    """:func:`job_list` for every (line, PXP) of an equal static Sn x Pn split, in frame order."""
+    """:func:`job_list` for every (line, PXP) of an equal static Sn x Pn split, in frame order,
+    plus each PXP's own frame time by the cycle model (its band's lines back to back, as that PXP
+    runs them): ``pxp_frame_cycles`` (Sn, Pn)."""
     H = fr.height
     bands = equal_bounds(H, sn)
     rb = equal_bounds(fr.width, pn)
     todo = [(y, int(rb[p]), int(rb[p + 1])) for y in range(H) for p in range(pn)]
     jb = job_list(fr, todo)
     jb["owner"] = [(int(np.searchsorted(bands, y, side="right") - 1), p) for y in range(H) for p in range(pn)]
+    per = np.zeros((sn, pn), np.int64)
+    for sidx in range(sn):
+        for p in range(pn):
+            lo, hi = int(rb[p]), int(rb[p + 1])
+            own = [(line_segments(fr, y, lo, hi, aj=fr.aj), lo, hi) for y in range(int(bands[sidx]), int(bands[sidx + 1]))]
+            per[sidx, p] = schedule(own, aj=fr.aj, width=fr.width)["last_pixel"] + 1
+    jb["pxp_frame_cycles"] = per
     return jb
 
 
@@ -93,13 +104,21 @@ def run_pysim(jb: dict, *, width: int) -> dict:
                 ctx.set(dut.lo, (w >> SEG_BITS) & 0x3FF)
                 ctx.set(dut.hi, (w >> (SEG_BITS + 10)) & 0x7FF)
 
+    npix = int(jb["pixels"].size)
+    last = {}
+
     async def watch(ctx):
-        seen = 0
-        async for _clk, _rst, n, c in ctx.tick().sample(dut.lines, dut.line_cycles):
+        seen = t = taken = 0
+        async for _clk, _rst, n, c, v, r in ctx.tick().sample(dut.lines, dut.line_cycles, dut.o.valid, dut.o.ready):
+            t += 1
+            if v and r:
+                taken += 1
+                if taken == npix:
+                    last["cycle"] = t
             if n != seen:
                 cyc.append(c)
                 seen = n
-            if seen == n_lines:
+            if seen == n_lines and taken >= npix:
                 return
 
     sim.add_testbench(feed)
@@ -107,7 +126,8 @@ def run_pysim(jb: dict, *, width: int) -> dict:
     sim.add_testbench(watch)
     t = time.perf_counter()
     sim.run()
-    return {"pixels": np.array(got, np.int64), "cycles": np.array(cyc, np.int64), "run_s": time.perf_counter() - t}
+    return {"pixels": np.array(got, np.int64), "cycles": np.array(cyc, np.int64), "run_s": time.perf_counter() - t,
+            "last_pixel": last.get("cycle")}
 
 
 NSEG_MAX, NOUT_MAX, NLINE_MAX = 1 << 19, 1 << 18, 1 << 14
@@ -201,15 +221,16 @@ def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", pro
     mism = int(np.count_nonzero(got[:n] != jb["pixels"][:n])) + abs(got.size - jb["pixels"].size)
     cyc = res["cycles"][:jb["lines"]]
     cyc_mism = int(np.count_nonzero(cyc != jb["cycles"][:cyc.size])) + (jb["lines"] - cyc.size)
-    per = np.zeros((sn, pn), np.int64)
-    for (s, p), c in zip(jb["owner"], cyc, strict=False):
-        per[s, p] += int(c)
-    total = int(cyc.sum())
-    frame_cycles = int(per.max())
+    # the HDL ran every line of every PXP, interleaved, and matched the cycle model line for line;
+    # a PXP's frame time (its own lines back to back) is then the model's
+    # cycles simulated: up to the frame's last pixel (the DUT's first cycle samples the range)
+    total = int(res["sim_cycles"] if engine == "verilator" else (res.get("last_pixel") or 0))
+    frame_cycles = int(jb["pxp_frame_cycles"].max())
     return {"engine": engine, "cycles": total, "clock_hz": None, "pixels_compared": int(n),
             "mismatches": mism, "wall_s": round(time.perf_counter() - t0, 3),
             "cycles_per_s": round(total / res["run_s"], 1) if res["run_s"] > 0 else None,
             "cycle_mismatches": cyc_mism, "frame_cycles_busiest_pxp": frame_cycles,
-            "pxp_cycles_per_line_mean": round(total / max(jb["lines"], 1), 2),
+            "last_pixel_mismatch": int(total != jb["last_pixel"] + 2),
+            "pxp_cycles_per_line_mean": round(float(cyc.mean()), 2) if cyc.size else 0.0,
             "pxp_clock_for_30fps_hz": frame_cycles * 30, "sn": sn, "pn": pn, "aj": aj,
             "run_s": round(res["run_s"], 3), "build_s": round(res.get("build_s", 0.0), 2)}

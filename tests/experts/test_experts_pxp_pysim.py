@@ -9,7 +9,7 @@ from functools import cache
 import pytest
 from amaranth.sim import Simulator
 from rasterhw.golden_model.experts.model import render_frame
-from rasterhw.golden_model.experts.pxp_cycles import line_cycles, line_pixels, line_segments
+from rasterhw.golden_model.experts.pxp_cycles import line_pixels, line_segments, schedule
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.hdl.experts.pxp import ExpertsPxp
@@ -39,13 +39,15 @@ def _run(lines, lo, hi, *, ready=None, gap=0, name="experts-tilt-1000", fr=None,
             await stream_put(ctx, dut.i, {"last": 1, "xl": 0, "xr": 0, "zl": 0, "il": 0, "dzdx": 0, "didx": 0,
                                           "hue": 0, "addr": 0}, gap=gap)
 
+    expect = [p for y in lines for p in line_pixels(fr, y, lo, hi)]
+
     async def watch(ctx):
         seen = 0
         async for _clk, _rst, n, c in ctx.tick().sample(dut.lines, dut.line_cycles):
             if n != seen:
                 cycles.append(c)
                 seen = n
-            if seen == len(lines):
+            if seen == len(lines) and len(got) >= len(expect):
                 return
 
     sim.add_testbench(feed)
@@ -53,8 +55,8 @@ def _run(lines, lo, hi, *, ready=None, gap=0, name="experts-tilt-1000", fr=None,
     sim.add_testbench(stream_protocol_checker(dut.o, "o", log), background=True)
     sim.add_testbench(watch)
     sim.run()
-    expect = [p for y in lines for p in line_pixels(fr, y, lo, hi)]
-    return got, log, cycles, expect, [line_cycles(segs[y], lo, hi, aj=aj) for y in lines]
+    want = schedule([(segs[y], lo, hi) for y in lines], aj=aj)["line_cycles"]
+    return got, log, cycles, expect, want
 
 
 @pytest.mark.parametrize("lo,hi", [(128, 192), (0, 37), (475, 512)])
@@ -102,8 +104,8 @@ def test_back_pressure_and_idle_input_keep_pixels_exact():
     ready = [rng.randint(0, 1) for _ in range(4000)]
     got, log, cycles, expect, want = _run([250], 300, 340, ready=ready, gap=2)
     assert got == expect and log == expect
-    # stalls only add cycles
-    assert cycles[0] > want[0]
+    # stalls only add cycles (output back-pressure stalls the drain bank, not the resolve side)
+    assert cycles[0] >= want[0]
     got2, _, _, expect2, _ = _run([250], 300, 340, ready=itertools.cycle([1, 1, 1, 0]))
     assert got2 == expect2
 
@@ -170,21 +172,23 @@ def test_random_asls_against_the_per_pixel_reference(seed):
                 await stream_put(ctx, dut.i, {"last": 0, **s})
             await stream_put(ctx, dut.i, {"last": 1})
 
+    expect = [p for segs in lines for p in reference_line(segs, lo, hi)]
+
     async def watch(ctx):
         seen = 0
         async for _clk, _rst, n, c in ctx.tick().sample(dut.lines, dut.line_cycles):
             if n != seen:
                 cycles.append(c)
                 seen = n
-            if seen == len(lines):
+            if seen == len(lines) and len(got) >= len(expect):
                 return
 
     sim.add_testbench(feed)
     sim.add_testbench(stream_sink(dut.o, got), background=True)
     sim.add_testbench(watch)
     sim.run()
-    assert got == [p for segs in lines for p in reference_line(segs, lo, hi)]
-    assert cycles == [line_cycles(segs, lo, hi) for segs in lines]
+    assert got == expect
+    assert cycles == schedule([(segs, lo, hi) for segs in lines])["line_cycles"]
 
 
 def test_empty_line_is_background():
@@ -220,3 +224,5 @@ def test_ranges_at_every_alignment(aj):
     r = run_pysim(jb, width=512)
     assert r["pixels"].tolist() == jb["pixels"].tolist()
     assert r["cycles"].tolist() == jb["cycles"].tolist()
+    # the double-banked DSLB: the frame's last pixel leaves when the schedule says
+    assert r["last_pixel"] == jb["last_pixel"] + 2

@@ -14,6 +14,7 @@ def test_small_frame_pysim_pixel_and_cycle_exact(aj):
     r = simulate_scene(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=2, pn=4, aj=aj)
     assert set(SIM_KEYS) <= set(r)
     assert r["pixels_compared"] == 64 * 16 and r["mismatches"] == 0 and r["cycle_mismatches"] == 0
+    assert r["last_pixel_mismatch"] == 0
     assert r["frame_cycles_busiest_pxp"] < r["cycles"]
 
 
@@ -30,4 +31,5 @@ def test_registered_and_bad_engine():
 def test_experts_1000_frame_on_verilator():
     r = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c")
     assert r["pixels_compared"] == 262144 and r["mismatches"] == 0 and r["cycle_mismatches"] == 0
+    assert r["last_pixel_mismatch"] == 0
     assert r["cycles_per_s"] > 1e6
