@@ -189,3 +189,36 @@ def stage_totals(fr: ExpertsFrame, *, sn: int = 1, pn: int = 1) -> dict[str, int
         if s in fr.costs:
             tot[s] = int(pxp_range_ops(fr, rb, (s,)).sum())
     return tot
+
+
+def pxp_range_cycles(fr: ExpertsFrame, bounds: np.ndarray, *, aj: str | None = None) -> np.ndarray:
+    """Resolve-side cycles of the PXP HDL for every (line, range), (H, Pn), from per-pixel counts.
+
+    ``G + 1 + 2 (segments reaching [glo, ghi)) + 2 (fragments in [glo, ghi)) + 1`` -- the
+    ``pxp_cycles.resolve_cycles`` of each range's clipped ASL plus its hand-over cycle, without
+    expanding the lists (``G``: the range, with A.J. its guard pixels too). The finish-time
+    counter the SLP reads when the drain keeps up.
+    """
+    aj = fr.aj if aj is None else aj
+    H, W = fr.height, fr.width
+    b = np.broadcast_to(np.asarray(bounds, dtype=np.int64), (H, np.shape(bounds)[-1]))
+    lo, hi = b[:, :-1], b[:, 1:]
+    if aj == "c":
+        glo, ghi = np.maximum(lo - 1, 0), np.minimum(hi + 1, W)
+    else:
+        glo, ghi = lo, hi
+    rows = np.arange(H)[:, None]
+    pc, ps = _cycle_prefix(fr)
+    frag = pc[rows, ghi] - pc[rows, glo]
+    segs = ps[rows, ghi] - ps[rows, glo] + np.where(glo > 0, fr.costs["_cross"][rows, np.minimum(glo, W - 1)], 0)
+    return (ghi - glo) + 1 + 2 * segs + 2 * frag + 1
+
+
+def _cycle_prefix(fr: ExpertsFrame) -> tuple[np.ndarray, np.ndarray]:
+    """Prefix sums along each line of the cover count and of the segment starts."""
+    H = fr.height
+    ds = fr.costs["depth_search"]
+    cover = np.where(ds > 0, (ds + 1) // 2, 0)      # depth search counts 2k - 1 per pixel
+    starts = fr.costs["start_values"] // 3           # 3 per segment starting at the pixel
+    z = np.zeros((H, 1), np.int64)
+    return np.concatenate([z, np.cumsum(cover, axis=1)], axis=1), np.concatenate([z, np.cumsum(starts, axis=1)], axis=1)

@@ -177,6 +177,11 @@ def _balance(out: list, sections: list, out_dir: Path, progress: bool) -> None:
                         out.append(make_row(SYS, "3.3", f"method {m}: mean max/mean PXP time over lines {lo}-{hi - 1}, "
                                             f"{name}, 1x8", paper=None, formula=None,
                                             measured=round(float(li[lo:hi].mean()), 4), unit="x", source="model"))
+        # the same balancing with the PXP HDL's own finish-time counters (resolve cycles per line)
+        for m in ("static", "i", "ii"):
+            r = run_parallel(f, 1, 8, band_method="pl", range_method=m, pxp_unit="cycles")
+            out.append(make_row(SYS, "3.3 / HDL", f"PXP max/mean time in PXP HDL cycles, {name}, 1x8, ranges {m}",
+                                paper=None, formula=None, measured=round(r.imbalance(), 4), unit="x", source="model"))
         for bm in ("equal", "pl", "i", "ii"):
             r = run_parallel(f, 8, 8, band_method=bm, range_method="ii", frames=6 if bm in ("i", "ii") else 1)
             out.append(make_row(SYS, "3.3", f"SLP group max/mean time, {name}, 8x8, bands {bm}"
