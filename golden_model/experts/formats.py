@@ -21,8 +21,10 @@ ASB di/dx           sQ(I-1).(16-I)  intensity per pixel (saturating)
 ASB dx/dy, dy/dx    sQ7.8      edge slopes, for anti-jagging only (saturating)
 SLP edge accum.     word+16    x, z, i stepped down an edge in 32 bits: the ASB word
                                plus 16 more fraction bits (SLP local memory)
-PXP running z       sQ16.4+1   z word + 4 fraction bits + a sign bit (work 1)
-PXP running i       ASB iL     i word (di/dx has the same fraction bits)
+PXP running z       Q16.4      z word + 4 fraction bits (work 1); the register is wide enough
+                               never to wrap (40 bits in the HDL), the comparator sees the
+                               16-bit key clamped to 0..65535
+PXP running i       ASB iL     i word (di/dx has the same fraction bits), clamped when shaded
 alpha (A.J.)        Q0.8       mixing ratio, 0..256
 ==================  =========  ===================================================
 

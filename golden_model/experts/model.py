@@ -23,7 +23,7 @@ __all__ = ["ExpertsFrame", "render_frame", "equal_bounds", "slp_band_ops", "pxp_
 
 SLP_STAGES = ("pl_read", "y_sort", "asl_build", "aj_setup", "asl_update", "l_sort", "x_merge",
               "block_lists", "dmm_p_write")
-PXP_STAGES = ("range_clip", "start_values", "span_cull", "depth_search", "smooth_shading",
+PXP_STAGES = ("range_clip", "start_values", "span_cull", "depth_search", "shadows", "smooth_shading",
               "anti_jagging", "dslb")
 #: the stages the paper's cost model counts (section 4: i)-iii) on the SLP, iv)-v) on the PXP)
 PAPER_SLP = ("y_sort", "x_merge", "l_sort")
@@ -49,6 +49,7 @@ class ExpertsFrame:
     lines: dict                 # per-line SLP counts (slp.l_sort_x_merge)
     costs: dict                 # per-pixel PXP counts (pxp.pixel_costs)
     win: np.ndarray | None = None   # (H*W,) winning record per pixel, -1 empty
+    shadowed: np.ndarray | None = None   # (H, W) in shadow (with shadows), else None
     aj_pixels: int = 0
     fragments: int = 0
     stats: dict = field(default_factory=dict)
@@ -59,8 +60,11 @@ class ExpertsFrame:
 
 
 def render_frame(tris: ScreenTriangles, *, model: str = "float", aj: str = "none",
-                 fmt: Formats | None = None) -> ExpertsFrame:
-    """Run the SLP and PXP stages over a frame (see the module docstring)."""
+                 fmt: Formats | None = None, shadows=None) -> ExpertsFrame:
+    """Run the SLP and PXP stages over a frame (see the module docstring).
+
+    ``shadows``: :class:`shadow.ShadowFaces` of the scene (our Crow shadow polygons) or None.
+    """
     if model not in MODELS:
         raise RasterhwError(f"experts: model must be one of {', '.join(MODELS)}, not {model!r}")
     if aj not in AJ_METHODS:
@@ -70,21 +74,30 @@ def render_frame(tris: ScreenTriangles, *, model: str = "float", aj: str = "none
     rec = slp.asl_update(st, W)
     lines = slp.l_sort_x_merge(rec, H)
     fr = pxp.fragments(st, rec, W)
-    win, k = pxp.depth_search(st, fr, W * H)
+    win, k, zwin = pxp.depth_search(st, fr, W * H)
     inten = pxp.smooth_shading(st, rec, win, W)
+    sh = None
+    if shadows is not None:
+        from .shadow import SHADOW_ATTEN, SHADOW_ATTEN_Q8
+        sh = pxp.shadow_count(st, rec, win, zwin, shadows, W)
+        s_ = sh["shadowed"]
+        inten[s_] = (inten[s_] * SHADOW_ATTEN_Q8) >> 8 if st.bit else inten[s_] * SHADOW_ATTEN
     fields = pxp.pixel_fields(st, rec, win, inten)
     info = None
     if aj != "none":
         fields, info = pxp.anti_jagging(st, rec, win, fields, W, H, aj)
-    costs = pxp.pixel_costs(st, rec, win, k, W, H, aj, info)
+    costs = pxp.pixel_costs(st, rec, win, k, W, H, aj, info, None if sh is None else sh["cost"])
     tri_id = np.where(win >= 0, st.keep[rec.tri[np.maximum(win, 0)]], -1).reshape(H, W)
     poly = np.where(win >= 0, st.poly[rec.tri[np.maximum(win, 0)]], -1).reshape(H, W)
     return ExpertsFrame(width=W, height=H, model=model, aj=aj, rgb8=pxp.to_rgb8(st, fields, H, W),
                         fields=fields, tri_id=tri_id, poly_id=poly, setup=st, records=rec, lines=lines,
-                        costs=costs, win=win, aj_pixels=info["pixels"] if info else 0, fragments=fr["F"],
+                        costs=costs, win=win, shadowed=None if sh is None else sh["shadowed"].reshape(H, W), aj_pixels=info["pixels"] if info else 0, fragments=fr["F"],
                         stats={"sat_dzdx": st.sat_dzdx, "sat_didx": st.sat_didx,
                                "triangles": int(tris.n_triangles), "kept": st.n,
-                               "crossings": crossings(rec, win, W, H)})
+                               "crossings": crossings(rec, win, W, H),
+                               **({} if sh is None else {"shadowed_pixels": int(sh["shadowed"].sum()),
+                                                         "shadow_segments": sh["segments"],
+                                                         "shadow_triangles": sh.get("triangles", 0)})})
 
 
 def crossings(rec: slp.Records, win: np.ndarray, W: int, H: int) -> int:
@@ -176,3 +189,36 @@ def stage_totals(fr: ExpertsFrame, *, sn: int = 1, pn: int = 1) -> dict[str, int
         if s in fr.costs:
             tot[s] = int(pxp_range_ops(fr, rb, (s,)).sum())
     return tot
+
+
+def pxp_range_cycles(fr: ExpertsFrame, bounds: np.ndarray, *, aj: str | None = None) -> np.ndarray:
+    """Resolve-side cycles of the PXP HDL for every (line, range), (H, Pn), from per-pixel counts.
+
+    ``G + 1 + 2 (segments reaching [glo, ghi)) + 2 (fragments in [glo, ghi)) + 1`` -- the
+    ``pxp_cycles.resolve_cycles`` of each range's clipped ASL plus its hand-over cycle, without
+    expanding the lists (``G``: the range, with A.J. its guard pixels too). The finish-time
+    counter the SLP reads when the drain keeps up.
+    """
+    aj = fr.aj if aj is None else aj
+    H, W = fr.height, fr.width
+    b = np.broadcast_to(np.asarray(bounds, dtype=np.int64), (H, np.shape(bounds)[-1]))
+    lo, hi = b[:, :-1], b[:, 1:]
+    if aj == "c":
+        glo, ghi = np.maximum(lo - 1, 0), np.minimum(hi + 1, W)
+    else:
+        glo, ghi = lo, hi
+    rows = np.arange(H)[:, None]
+    pc, ps = _cycle_prefix(fr)
+    frag = pc[rows, ghi] - pc[rows, glo]
+    segs = ps[rows, ghi] - ps[rows, glo] + np.where(glo > 0, fr.costs["_cross"][rows, np.minimum(glo, W - 1)], 0)
+    return (ghi - glo) + 1 + 2 * segs + 2 * frag + 1
+
+
+def _cycle_prefix(fr: ExpertsFrame) -> tuple[np.ndarray, np.ndarray]:
+    """Prefix sums along each line of the cover count and of the segment starts."""
+    H = fr.height
+    ds = fr.costs["depth_search"]
+    cover = np.where(ds > 0, (ds + 1) // 2, 0)      # depth search counts 2k - 1 per pixel
+    starts = fr.costs["start_values"] // 3           # 3 per segment starting at the pixel
+    z = np.zeros((H, 1), np.int64)
+    return np.concatenate([z, np.cumsum(cover, axis=1)], axis=1), np.concatenate([z, np.cumsum(starts, axis=1)], axis=1)

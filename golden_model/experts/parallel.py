@@ -139,7 +139,7 @@ class ParallelResult:
 
 
 def _group(fr: ExpertsFrame, y0: int, y1: int, pn: int, range_method: str, bal: Balance, P: np.ndarray,
-           cont: np.ndarray, start: np.ndarray, pl_cost: int):
+           cont: np.ndarray, start: np.ndarray, pl_cost: int, cyc_tables=None):
     W = fr.width
     cross, midrun = fr.costs["_cross"], fr.costs["_midrun"]
     from .pxp import CROSS_OPS, MIDRUN_OPS
@@ -157,9 +157,17 @@ def _group(fr: ExpertsFrame, y0: int, y1: int, pn: int, range_method: str, bal: 
         y = y0 + k
         b = _widths_to_bounds(widths)
         a = b[:-1]
-        c = P[y, b[1:]] - P[y, a]
-        inner = a > 0
-        c = c + np.where(inner, extra_c * cross[y, np.minimum(a, W - 1)] + extra_m * midrun[y, np.minimum(a, W - 1)], 0)
+        if cyc_tables is None:
+            c = P[y, b[1:]] - P[y, a]
+            inner = a > 0
+            c = c + np.where(inner, extra_c * cross[y, np.minimum(a, W - 1)]
+                             + extra_m * midrun[y, np.minimum(a, W - 1)], 0)
+        else:  # PXP HDL cycles (the finish-time counters of the PXP block)
+            pc, ps, guard = cyc_tables
+            glo = np.maximum(a - guard, 0)
+            ghi = np.minimum(b[1:] + guard, W)
+            segs = ps[y, ghi] - ps[y, glo] + np.where(glo > 0, cross[y, np.minimum(glo, W - 1)], 0)
+            c = (ghi - glo) + 2 + 2 * segs + 2 * (pc[y, ghi] - pc[y, glo])
         tp[k] = c
         ts[k] = start[y] if k == 0 else cont[y]
         s_start = max(s_end[k - 1] if k else t0, p_end[k - 2].max() if k >= 2 else 0.0)
@@ -175,9 +183,16 @@ def _group(fr: ExpertsFrame, y0: int, y1: int, pn: int, range_method: str, bal: 
 
 
 def run_parallel(fr: ExpertsFrame, sn: int, pn: int, *, band_method: str = "equal", range_method: str = "static",
-                 bal: Balance = Balance(), frames: int = 1, bands: np.ndarray | None = None) -> ParallelResult:
+                 bal: Balance = Balance(), frames: int = 1, bands: np.ndarray | None = None,
+                 pxp_unit: str = "ops") -> ParallelResult:
     """Time one frame on Sn SLP groups of Pn PXPs (``frames`` > 1: repeat the frame, the SLP bands
-    adapting frame to frame with band methods i / ii; the last frame is returned)."""
+    adapting frame to frame with band methods i / ii; the last frame is returned).
+
+    ``pxp_unit="cycles"``: PXP times are the PXP HDL's resolve cycles per line (its finish-time
+    counter, :func:`model.pxp_range_cycles`) instead of counted operations; the SLP stays in ops.
+    """
+    if pxp_unit not in ("ops", "cycles"):
+        raise RasterhwError(f"experts: pxp_unit must be ops or cycles, not {pxp_unit!r}")
     if range_method not in RANGE_METHODS:
         raise RasterhwError(f"experts: range method must be one of {', '.join(RANGE_METHODS)}, not {range_method!r}")
     if band_method not in BAND_METHODS:
@@ -188,6 +203,10 @@ def run_parallel(fr: ExpertsFrame, sn: int, pn: int, *, band_method: str = "equa
         bands = equal_bounds(H, sn) if band_method != "pl" else _bands_from_load(band_estimate(fr), sn)
     from .model import PXP_STAGES, _prefix
     P = _prefix(fr, PXP_STAGES)
+    tables = None
+    if pxp_unit == "cycles":
+        from .model import _cycle_prefix
+        tables = (*_cycle_prefix(fr), 1 if fr.aj == "c" else 0)
     cont, start = slp_line_costs(fr, pn)
     pl_cost = (13 + 2) * fr.setup.n
     for f in range(max(frames, 1)):
@@ -196,7 +215,7 @@ def run_parallel(fr: ExpertsFrame, sn: int, pn: int, *, band_method: str = "equa
         gt = np.zeros(sn)
         for s in range(sn):
             y0, y1 = int(bands[s]), int(bands[s + 1])
-            a, b_, g = _group(fr, y0, y1, pn, range_method, bal, P, cont, start, pl_cost)
+            a, b_, g = _group(fr, y0, y1, pn, range_method, bal, P, cont, start, pl_cost, tables)
             tp[y0:y1], ts[y0:y1], gt[s] = a, b_, g
         if f + 1 < frames and band_method in ("i", "ii"):
             bands = _widths_to_bounds(rebalance(np.diff(bands), gt, band_method, bal))

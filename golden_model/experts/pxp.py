@@ -80,9 +80,12 @@ def fragments(st: Setup, rec: Records, W: int) -> dict:
     return {"F": F, "rec": r, "col": col, "pix": pix, "z": zkey}
 
 
-def depth_search(st: Setup, fr: dict, npix: int) -> tuple[np.ndarray, np.ndarray]:
-    """Nearest segment per pixel (ties: lower PL index). Returns (winning record or -1, cover count k)."""
+def depth_search(st: Setup, fr: dict, npix: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Nearest segment per pixel (ties: lower PL index).
+
+    Returns (winning record or -1, cover count k, the winner's z key or +inf)."""
     win = np.full(npix, -1, dtype=np.int64)
+    zwin = np.full(npix, np.inf)
     k = np.bincount(fr["pix"], minlength=npix) if fr["F"] else np.zeros(npix, np.int64)
     if fr["F"]:
         o = np.lexsort((fr["rec"], fr["z"], fr["pix"]))  # records are in PL order
@@ -90,7 +93,36 @@ def depth_search(st: Setup, fr: dict, npix: int) -> tuple[np.ndarray, np.ndarray
         firsts = np.ones(p.size, bool)
         firsts[1:] = p[1:] != p[:-1]
         win[p[firsts]] = fr["rec"][o[firsts]]
-    return win, k
+        zwin[p[firsts]] = fr["z"][o[firsts]]
+    return win, k, zwin
+
+
+def shadow_count(st: Setup, rec: Records, win: np.ndarray, zwin: np.ndarray, shadows, W: int) -> dict:
+    """Crow's count: signed shadow faces in front of each visible point (see :mod:`shadow`).
+
+    The shadow faces are extra, invisible segments: each steps its z and compares it with the
+    visible point's (2 ops per pixel it spans, 3 to start it), adding its sign when nearer.
+    """
+    from . import slp as _slp
+    npix = win.size
+    sst = _slp.set_up(shadows.tris, bit=st.bit, fmt=st.fmt)
+    srec = _slp.asl_update(sst, W)
+    sfr = fragments(sst, srec, W)
+    cost = np.zeros(npix, np.int64)
+    if not sfr["F"]:
+        return {"shadowed": np.zeros(npix, bool), "cost": cost, "segments": 0, "fragments": 0}
+    t = sst.keep[srec.tri[sfr["rec"]]]
+    sign, owner = shadows.sign[t], shadows.owner[t]
+    pix = sfr["pix"]
+    vis = win[pix] >= 0
+    vpoly = np.where(vis, st.poly[rec.tri[np.maximum(win[pix], 0)]], -1)
+    m = vis & (sfr["z"] < zwin[pix]) & (owner != vpoly)
+    cnt = np.bincount(pix[m], weights=sign[m], minlength=npix)
+    np.add.at(cost, pix, 2)
+    ok = srec.c1 >= srec.c0
+    np.add.at(cost, srec.row[ok] * W + srec.c0[ok], 3)
+    return {"shadowed": cnt > 0.5, "cost": cost, "segments": int(ok.sum()), "fragments": int(sfr["F"]),
+            "triangles": int(sst.n)}
 
 
 def smooth_shading(st: Setup, rec: Records, win: np.ndarray, W: int) -> np.ndarray:
@@ -167,7 +199,11 @@ def anti_jagging(st: Setup, rec: Records, win: np.ndarray, fields: np.ndarray, W
         fl, frr = fields[yy * W + xx - 1], fields[yy * W + xx]
         val = al[:, None] * fl + (1 - al[:, None]) * frr
     qp = yy * W + q
-    out[qp] = val
+    # two boundaries may blend the same pixel (a one-pixel run): the later (right) one wins, as a
+    # PXP that walks the line left to right would have it
+    _, last = np.unique(qp[::-1], return_index=True)
+    keep = qp.size - 1 - last
+    out[qp[keep]] = val[keep]
     return out, {"pixels": int(qp.size), "shallow": shallow, "boundaries": int(np.count_nonzero(a != b)),
                  "qpix": qp, "shallow_mask": (np.abs(s) > (1 << SLOPE_FRAC if st.bit else 1))}
 
@@ -189,7 +225,7 @@ def pixel_words(st: Setup, fields: np.ndarray) -> np.ndarray:
 
 
 def pixel_costs(st: Setup, rec: Records, win: np.ndarray, k: np.ndarray, W: int, H: int,
-                aj: str, aj_info: dict | None) -> dict[str, np.ndarray]:
+                aj: str, aj_info: dict | None, shadow_cost: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Per-pixel PXP operation counts by stage, (H, W) arrays, plus the range-start extras.
 
     A range [a, b) of line y costs the sum of its pixels' entries, plus ``cross[y, a]`` times the
@@ -221,6 +257,8 @@ def pixel_costs(st: Setup, rec: Records, win: np.ndarray, k: np.ndarray, W: int,
         bnd = np.zeros((H, W), np.int64)
         bnd[:, 1:] = (w2[:, 1:] != w2[:, :-1])
         c["anti_jagging"] = a + PXP_OPS["aj_edge_test"] * bnd.ravel()
+    if shadow_cost is not None:
+        c["shadows"] = shadow_cost
     # segments covering x that started left of x: cover count minus starts at x
     cross = k - seg_at
     midrun = (vis & ~runstart).ravel().astype(np.int64)

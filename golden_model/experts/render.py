@@ -16,7 +16,7 @@ __all__ = ["render"]
 
 def render(scene: Scene, width: int, height: int, *, arch: str = "experts", aj: str | None = "c",
            model: str | None = "bit", sn: int | None = 8, pn: int | None = 8,
-           intensity_bits: int | None = 7) -> Rendered:
+           intensity_bits: int | None = 7, shadows: str | None = "none") -> Rendered:
     """One frame through the SLP/PXP golden model; stats carry the 8 x 8 (or Sn x Pn) timing.
 
     ``pixels_written`` counts DSLB writes (every pixel of every line, background included).
@@ -27,11 +27,20 @@ def render(scene: Scene, width: int, height: int, *, arch: str = "experts", aj: 
     pn = 8 if pn is None else pn
     if width > 1024 or height > 1024:
         raise RasterhwError(f"experts: frame {width}x{height} is larger than the Q10.6 coordinates allow (1024)")
+    shadows = "none" if shadows is None else shadows
+    if shadows not in ("none", "polygons"):
+        raise RasterhwError(f"experts: shadows must be none or polygons, not {shadows!r}")
     tris = run_geometry(scene, width, height, z_bits=Z_BITS)
-    f = render_frame(tris, model=model, aj=aj, fmt=Formats(7 if intensity_bits is None else intensity_bits))
+    sf = None
+    if shadows == "polygons":
+        from .shadow import shadow_faces
+        sf = shadow_faces(scene, width, height, z_bits=Z_BITS)
+    f = render_frame(tris, model=model, aj=aj, fmt=Formats(7 if intensity_bits is None else intensity_bits),
+                     shadows=sf)
     par = run_parallel(f, sn, pn, band_method="pl", range_method="ii")
     ops = stage_totals(f, sn=sn, pn=pn)
     return Rendered(f.rgb8, tris, width * height,
                     {"model": model, "aj": aj, "sn": sn, "pn": pn, "aj_pixels": f.aj_pixels,
                      "operations": int(sum(ops.values())), "frame_op_times": round(par.frame_time, 1),
-                     "pxp_imbalance": round(par.imbalance(), 4), "crossings": f.stats["crossings"]})
+                     "pxp_imbalance": round(par.imbalance(), 4), "crossings": f.stats["crossings"],
+                     "shadows": shadows, **({"shadowed_pixels": f.stats["shadowed_pixels"]} if sf else {})})

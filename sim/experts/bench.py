@@ -1,4 +1,4 @@
-"""EXPERTS bench: the golden model's speed on experts-1000 (no HDL block yet)."""
+"""EXPERTS bench: the golden model's speed, and (``hdl``) the experts-1000 frame through the PXP HDL on Verilator."""
 
 from __future__ import annotations
 
@@ -20,4 +20,15 @@ def bench(*, repeat: int = 3, hdl: bool = False, progress: bool = False) -> list
             best = min(best, time.perf_counter() - t)
         out.append({"name": f"experts golden {model} model, experts-tilt-1000 frame (A.J. c)", "value": round(best, 4),
                     "unit": "s", "note": f"best of {max(repeat, 1)}; whole 512x512 frame, every SLP/PXP stage"})
+    if hdl:
+        from rasterhw.sim.experts.pxp_sim import simulate_scene
+        r = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c")
+        note = (f"{r['pixels_compared']} pixels, {r['mismatches']} mismatches, {r['cycle_mismatches']} cycle "
+                f"mismatches; {r['pxp_cycles_per_line_mean']} PXP cycles per scan line (8 x 8)")
+        out += [{"name": "experts-1000 frame through the PXP HDL with A.J. (c) (Verilator), wall", "value": r["wall_s"], "unit": "s",
+                 "note": note + f"; build {r['build_s']} s (0 when warm)"},
+                {"name": "PXP HDL simulation rate (Verilator)", "value": r["cycles_per_s"], "unit": "cycles/s",
+                 "note": f"{r['cycles']} cycles in {r['run_s']} s (clock loop only)"},
+                {"name": "PXP cycles per scan line, experts-1000, 8 x 8", "value": r["pxp_cycles_per_line_mean"],
+                 "unit": "cycles", "note": "mean over the 4096 PXP lines"}]
     return out

@@ -1,6 +1,6 @@
-"""Registry entry of EXPERTS (seed 000): its arch, report and bench (no HDL block yet)."""
+"""Registry entry of EXPERTS (seed 000): its arch, PXP block and sim, report and bench."""
 
-from rasterhw.sim.registry import Arch, Machine, Option
+from rasterhw.sim.registry import Arch, Machine, Option, SimBlock
 
 MACHINE = Machine(
     name="experts",
@@ -13,10 +13,20 @@ MACHINE = Machine(
                                 "(c) along/across the scan line (EXPERTS)", "c", ("none", "a", "b", "c")),
                          Option("model", "float (ideal arithmetic) or bit (16-bit hardware formats)", "bit",
                                 ("float", "bit")),
+                         Option("shadows", "none, or shadow polygons in the scan line (Crow; our choice, "
+                                "the paper gives no method)", "none", ("none", "polygons")),
                          Option("sn", "SLPs (bands of scan lines) for the timing stats", 8, type=int),
                          Option("pn", "PXPs per SLP (ranges of each line) for the timing stats", 8, type=int))),),
+    blocks={"experts-pxp": "rasterhw.hdl.experts.pxp:ExpertsPxp",
+            "experts-dmm": "rasterhw.hdl.experts.dmm:ExpertsDmm",
+            "experts-pxp-unit": "rasterhw.hdl.experts.unit:ExpertsPxpUnit"},
+    sims=(SimBlock("pxp", "every PXP line of the frame through the PXP HDL, against the bit-accurate golden PXP "
+                   "(pixels and cycles)", "rasterhw.sim.experts.pxp_sim:simulate_scene", default_scene="experts-1000",
+                   options=(Option("sn", "SLPs (bands)", 8, type=int),
+                            Option("pn", "PXPs per SLP (ranges)", 8, type=int),
+                            Option("aj", "anti-jagging in the PXP: none or c", "c", ("none", "a", "b", "c")))),),
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",
     status="scan-line golden model split as SLP/PXP (float and 16-bit), Sn x Pn parallel model with "
-           "load balancing at both levels, fig. 4.1 cost model (golden; no HDL yet)",
+           "load balancing at both levels, fig. 4.1 cost model (golden); PXP datapath (HDL, bit- and cycle-exact)",
 )

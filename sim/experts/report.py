@@ -177,6 +177,11 @@ def _balance(out: list, sections: list, out_dir: Path, progress: bool) -> None:
                         out.append(make_row(SYS, "3.3", f"method {m}: mean max/mean PXP time over lines {lo}-{hi - 1}, "
                                             f"{name}, 1x8", paper=None, formula=None,
                                             measured=round(float(li[lo:hi].mean()), 4), unit="x", source="model"))
+        # the same balancing with the PXP HDL's own finish-time counters (resolve cycles per line)
+        for m in ("static", "i", "ii"):
+            r = run_parallel(f, 1, 8, band_method="pl", range_method=m, pxp_unit="cycles")
+            out.append(make_row(SYS, "3.3 / HDL", f"PXP max/mean time in PXP HDL cycles, {name}, 1x8, ranges {m}",
+                                paper=None, formula=None, measured=round(r.imbalance(), 4), unit="x", source="model"))
         for bm in ("equal", "pl", "i", "ii"):
             r = run_parallel(f, 8, 8, band_method=bm, range_method="ii", frames=6 if bm in ("i", "ii") else 1)
             out.append(make_row(SYS, "3.3", f"SLP group max/mean time, {name}, 8x8, bands {bm}"
@@ -224,8 +229,64 @@ def _tolerance(out: list, progress: bool) -> None:
                                 measured=t[key], unit="pixels", source="golden"))
 
 
+def _hdl(out: list, engine: str, progress: bool) -> None:
+    """PXP HDL rows: pysim on a sample of lines (always), the whole experts-1000 frame on Verilator
+    when ``engine == "verilator"``; the 30 frames/s PXP clock from the cycle model the HDL matched."""
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.sim.experts.pxp_sim import jobs, simulate_scene
+    small = simulate_scene(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=2, pn=4, aj="c")
+    out.append(make_row(SYS, "HDL", "PXP pixel mismatches with A.J. (c), experts-tilt-1000 at 64x16, 2x4 (pysim)", paper=None,
+                        formula=None, measured=small["mismatches"], unit="pixels", source="hdl:pysim"))
+    out.append(make_row(SYS, "HDL", "PXP lines whose cycles differ from the golden cycle model, experts-tilt-1000 "
+                        "at 64x16, 2x4 (pysim)", paper=None, formula=None, measured=small["cycle_mismatches"],
+                        unit="lines", source="hdl:pysim"))
+    fr = _frame("experts-1000", "bit", "c")
+    jb = jobs(fr, 8, 8)
+    busiest = int(jb["pxp_frame_cycles"].max())
+    if engine == "verilator":
+        if progress:
+            print("experts: experts-1000 through the PXP HDL on Verilator")
+        r = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c")
+        out.append(make_row(SYS, "HDL", "PXP pixel mismatches with A.J. (c), experts-1000, 8x8 (262,144 compared)",
+                            paper=None, formula=None, measured=r["mismatches"], unit="pixels", source="hdl:verilator"))
+        out.append(make_row(SYS, "HDL", "PXP lines whose cycles differ from the golden cycle model, experts-1000, 8x8",
+                            paper=None, formula=None, measured=r["cycle_mismatches"], unit="lines",
+                            source="hdl:verilator"))
+        out.append(make_row(SYS, "HDL", "PXP cycles per scan line (mean of 4096 PXP lines), experts-1000, 8x8",
+                            paper=None, formula=None, measured=r["pxp_cycles_per_line_mean"], unit="cycles",
+                            source="hdl:verilator"))
+    what = "cycle model, matched by the HDL line for line" + (" in this run" if engine == "verilator" else "")
+    meas = busiest
+    out.append(make_row(SYS, "5 / HDL", f"busiest PXP's cycles per frame, A.J. (c), experts-1000, 8x8 ({what})",
+                        paper=None, formula=None, measured=meas, unit="cycles", source="model"))
+    out.append(make_row(SYS, "5 / HDL", f"PXP clock for 30 frames/s of experts-1000 at 8x8 with A.J. (c), PXPs only "
+                        f"({what})", paper=None, formula=None, measured=round(meas * 30 / 1e6, 3), unit="MHz",
+                        source="model"))
+
+
+def _shadows(out: list, progress: bool) -> None:
+    """Crow shadow polygons (our choice): shadowed pixels, agreement with ray casting, extra work."""
+    from rasterhw.golden_model.experts import cost
+    from rasterhw.golden_model.experts.model import render_frame
+    from rasterhw.golden_model.experts.shadow import shadow_faces
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    for name in ("experts-solids", "sp5"):
+        sc = build_scene(name)
+        tris = run_geometry(sc, 512, 512, z_bits=16)
+        sf = shadow_faces(sc, 512, 512)
+        f = render_frame(tris, model="bit", shadows=sf)
+        base = cost.total_ops(render_frame(tris, model="bit"))
+        out.append(make_row(SYS, "2.1 c) (ours: Crow)", f"shadowed pixels, {name} ({sf.n_faces} shadow faces, "
+                            f"{f.stats['shadow_segments']} shadow segments)", paper=None, formula=None,
+                            measured=f.stats["shadowed_pixels"], unit="pixels", source="golden"))
+        out.append(make_row(SYS, "2.1 c) (ours: Crow)", f"PXP work with shadow polygons / without, {name}",
+                            paper=None, formula=None, measured=round(cost.total_ops(f) / base, 4), unit="x",
+                            source="golden"))
+
+
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, **known) -> tuple[list[dict], list[str]]:
-    """Every EXPERTS row (no HDL rows yet: ``engine`` is not used)."""
+    """Every EXPERTS row; ``engine="verilator"`` also runs the whole experts-1000 frame through the PXP HDL."""
     out_dir = Path(out_dir)
     out: list[dict] = []
     sections: list[str] = []
@@ -233,4 +294,6 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, **know
     _tables(out, sections, out_dir, progress)
     _balance(out, sections, out_dir, progress)
     _tolerance(out, progress)
+    _shadows(out, progress)
+    _hdl(out, engine, progress)
     return out, sections

@@ -211,3 +211,21 @@ def test_bad_input_is_a_one_line_error():
         render_frame(big)
     with pytest.raises(RasterhwError, match="parts"):
         equal_bounds(512, 0)
+
+
+def test_band_clip_keeps_only_the_bands_triangles():
+    """The SLP's clip of the broadcast PL: a band holds exactly the triangles whose lines reach it,
+    and every PL triangle is band-tested (the broadcast overhead)."""
+    f = _frame("experts-tilt-1000", "float")
+    st = f.setup
+    for band in ((0, 1), (100, 164), (448, 512)):
+        order, start, ops = slp.y_sort(st, band)
+        rows = [(int(st.r0[t]), int(st.r1[t])) for t in order]
+        assert all(r1 >= band[0] and r0 < band[1] for r0, r1 in rows)
+        inside = int(np.count_nonzero((st.r1 >= band[0]) & (st.r0 < band[1])))
+        assert order.size == inside and start[-1] == inside
+        assert ops["y_sort"] == 2 * st.n + 9 * inside
+    # bucket order: non-decreasing first line in the band
+    order, start, _ = slp.y_sort(st, (100, 164))
+    first = np.maximum(st.r0[order], 100)
+    assert np.all(np.diff(first) >= 0)

@@ -14,7 +14,7 @@ from rasterhw.sim.report import ROW_KEYS, SOURCES
 def test_registered():
     m = machines()["experts"]
     (a,) = m.archs
-    assert a.name == "experts" and {o.name for o in a.options} == {"aj", "model", "sn", "pn"}
+    assert a.name == "experts" and {o.name for o in a.options} == {"aj", "model", "shadows", "sn", "pn"}
     assert load(a.render) is render
     assert callable(load(m.report)) and callable(load(m.bench))
 
@@ -25,6 +25,10 @@ def test_render_arch():
     assert r.stats["aj_pixels"] > 0 and r.stats["sn"] == 2 and r.pixels_written == 512 * 512
     n = render(build_scene("experts-solids"), 512, 512, aj="none", model="bit", sn=2, pn=4)
     assert np.count_nonzero(np.any(n.rgb8 != r.rgb8, axis=2)) > 0
+    s = render(build_scene("experts-solids"), 512, 512, aj="c", model="bit", sn=2, pn=4, shadows="polygons")
+    assert s.stats["shadowed_pixels"] > 0 and int(s.rgb8.sum()) < int(r.rgb8.sum())
+    with pytest.raises(RasterhwError, match="shadows must be"):
+        render(build_scene("experts-solids"), 512, 512, shadows="volumes")
     with pytest.raises(RasterhwError, match="aj must be"):
         render(build_scene("experts-solids"), 512, 512, aj="z")
     with pytest.raises(RasterhwError, match="1024"):

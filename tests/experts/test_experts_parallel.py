@@ -75,3 +75,30 @@ def test_bad_parameters():
         run_parallel(f, 1, 2, band_method="x")
     with pytest.raises(RasterhwError, match="parts"):
         run_parallel(f, 1, 1000)
+
+
+@pytest.mark.parametrize("aj", ["none", "c"])
+def test_range_cycles_equal_the_hdl_cycle_model(aj):
+    """The parallel model's PXP times in HDL cycles (from per-pixel counts) equal the cycle model
+    run on each range's clipped ASL (the one the HDL matches)."""
+    from rasterhw.golden_model.experts.model import pxp_range_cycles
+    from rasterhw.golden_model.experts.pxp_cycles import line_segments, resolve_cycles
+    f = render_frame(run_geometry(build_scene("experts-tilt-1000"), 512, 512, z_bits=16), model="bit", aj=aj)
+    bounds = np.array([0, 1, 64, 100, 255, 256, 400, 511, 512])
+    cyc = pxp_range_cycles(f, bounds)
+    for y in (0, 57, 200, 389, 511):
+        for p in range(len(bounds) - 1):
+            lo, hi = int(bounds[p]), int(bounds[p + 1])
+            want = resolve_cycles(line_segments(f, y, lo, hi, aj=aj), lo, hi, aj=aj) + 1
+            assert cyc[y, p] == want, (y, lo, hi)
+
+
+def test_parallel_in_pxp_cycles_static_matches_the_range_cycles():
+    from rasterhw.golden_model.experts.model import pxp_range_cycles
+    f = _frame("experts-uneven")
+    r = run_parallel(f, 1, 8, range_method="static", pxp_unit="cycles")
+    assert np.array_equal(r.pxp_time, pxp_range_cycles(f, np.arange(9) * 64))
+    ii = run_parallel(f, 1, 8, range_method="ii", pxp_unit="cycles")
+    assert ii.imbalance() < r.imbalance()
+    with pytest.raises(RasterhwError, match="pxp_unit"):
+        run_parallel(f, 1, 8, pxp_unit="s")

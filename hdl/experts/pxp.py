@@ -1,0 +1,398 @@
+"""EXPERTS pixel processor (PXP) datapath: start values, z/i stepping, 16-bit depth compare, A.J. (c), DSLB.
+
+Paper (seed 000, 3.2): the PXP takes the ASL for its part of the scan line, computes the start
+values at its first pixel with its multiplier ("担当範囲の開始点における ... 初期データを計算する",
+"PXPにおいても ... 乗算が多数出現するため ... 乗算器を装備"), resolves hidden surfaces, shades and
+anti-jags up to its last pixel and writes its DSLB.
+
+This block resolves depth segment by segment into a line memory kept beside the DSLB (per pixel:
+z key, ASB address, pixel word, and with A.J. the segment's slot in a small segment table), which
+gives exactly the golden depth search's pixels (16-bit key, ties to the lower ASB address). With
+``aj="c"`` it then walks the line left to right and blends, by eq. (5) with method (c), every
+boundary between two polygons where the right run's left edge starts or the left run's right edge
+ends -- the golden model's rule (``golden_model/experts/pxp.py``); to see the boundaries at its
+range ends it also resolves one guard pixel on each side (``[lo-1, hi+1)`` within the frame) and
+outputs only ``[lo, hi)``. The DSLB is double-banked ("DSLBもDMM同様、2重系の構成とし、PXPによる
+書き込みと、FBへの転送のための読み出しとを並行して同時に行なう"): the next line is cleared and
+resolved in one bank while the other drains, the banks swapping by a hand-over once the drain is
+free. Bit- and cycle-exact with ``golden_model.experts.pxp_cycles``. Not in this block: shadows.
+
+Input protocol: per line, the clipped ASL segments (``SEG`` payloads with ``last = 0``) in ASL
+order, then one ``last = 1`` token; ``lo``/``hi`` (the range ``[lo, hi)``) are sampled when a line
+starts. Output: the line's ``hi - lo`` pixel words, left to right, after its last token.
+"""
+
+from __future__ import annotations
+
+from amaranth import Module, Mux, Signal, signed, unsigned
+from amaranth.lib import data, enum, stream, wiring
+from amaranth.lib.memory import Memory
+from amaranth.lib.wiring import In, Out
+from rasterhw.golden_model.experts.formats import (
+    ALPHA_BITS,
+    DZ_FRAC,
+    HUE_BITS,
+    SLOPE_FRAC,
+    X_FRAC,
+    Z_BITS,
+    Formats,
+)
+from rasterhw.golden_model.experts.pxp_cycles import ADDR_BITS, SLOT_BITS
+
+__all__ = ["ExpertsPxp", "seg_layout"]
+
+NONE = (1 << ADDR_BITS) - 1     # ASB address / polygon number of the background
+
+
+def seg_layout() -> data.StructLayout:
+    """One ASB as the PXP reads it (the fields it uses)."""
+    return data.StructLayout({
+        "last": unsigned(1),          # end of the line's list
+        "xl": unsigned(16),           # Q10.6
+        "xr": unsigned(16),           # Q10.6
+        "zl": unsigned(16),           # Q16.0, 0 = near
+        "il": unsigned(16),           # Q(I).(16-I)
+        "dzdx": signed(16),           # sQ11.4
+        "didx": signed(16),           # sQ(I-1).(16-I)
+        "hue": unsigned(3 * HUE_BITS),
+        "addr": unsigned(ADDR_BITS),  # ASB address = PL order: the tie-break
+        "poly": unsigned(ADDR_BITS),  # Tags: polygon number (A.J. only between polygons)
+        "sl": signed(16),             # left edge dx/dy, sQ7.8 (A.J.)
+        "ql": signed(16),             # left edge dy/dx, sQ7.8
+        "sr": signed(16),             # right edge dx/dy
+        "qr": signed(16),             # right edge dy/dx
+    })
+
+
+class _S(enum.Enum, shape=4):
+    CLEAR = 0
+    SEG = 1
+    START = 2
+    READ = 3
+    CMP = 4
+    DRD = 5       # drain: read the line memory
+    DOUT = 6      # drain without A.J.: offer the pixel
+    DSEG = 7      # drain with A.J.: read the segment table
+    DAJ = 8       # drain with A.J.: blend the boundary, offer the pixel on its left
+    FLUSH = 9     # drain with A.J.: offer the range's last pixel
+    HAND = 10     # resolve side: hand the bank to the drain (waits while the drain is busy)
+
+
+class ExpertsPxp(wiring.Component):
+    """One PXP: clipped ASL in, the range's pixel words out, line by line.
+
+    Parameters
+    ----------
+    width : int
+        Frame width (1..1024): depth of the line memory.
+    intensity_bits : int
+        Intensity field width (1..7); the pixel word is ``3 * 3 + intensity_bits`` bits.
+    aj : str
+        ``"none"`` or ``"c"`` (anti-jagging, method (c)).
+
+    Members
+    -------
+    i : In(stream.Signature(seg_layout()))
+    o : Out(stream.Signature(unsigned(9 + intensity_bits)))
+    lo, hi : In(10), In(11)
+        The range ``[lo, hi)``, sampled at the start of each line.
+    line_cycles : Out(16)
+        Finish-time counter: cycles of the last line from its first clear cycle to its hand-over to
+        the drain (waits for the drain included).
+    lines : Out(16)
+        Lines handed over.
+    slot_overflow : Out(1)
+        Sticky (A.J. only): a line had more segments than the segment table's 256 slots (the
+        DMM/P bank in front holds 256, so this cannot happen behind one).
+
+    Cycles with the input always valid and the output always ready: ``pxp_cycles.schedule``
+    (resolve ``G + sum(2 + 2 n) + 1`` and one hand-over cycle per line, overlapped with the drain
+    of the line before: ``2 R``, with A.J. ``3 G`` plus one at the frame's right edge).
+    """
+
+    def __init__(self, *, width: int = 512, intensity_bits: int = 7, aj: str = "none"):
+        if isinstance(width, bool) or not isinstance(width, int) or not 1 <= width <= 1024:
+            raise ValueError(f"width must be an integer in 1..1024, not {width!r}")
+        if aj not in ("none", "c"):
+            raise ValueError(f"aj must be 'none' or 'c', not {aj!r}")
+        self._fmt = Formats(intensity_bits)
+        self._width = width
+        self._aj = aj
+        super().__init__({
+            "i": In(stream.Signature(seg_layout())),
+            "o": Out(stream.Signature(unsigned(self._fmt.pixel_bits))),
+            "lo": In(10),
+            "hi": In(11),
+            "line_cycles": Out(16),
+            "lines": Out(16),
+            "slot_overflow": Out(1),
+        })
+
+    @property
+    def width(self) -> int:
+        return self._width
+
+    @property
+    def intensity_bits(self) -> int:
+        return self._fmt.intensity_bits
+
+    @property
+    def aj(self) -> str:
+        return self._aj
+
+    def elaborate(self, platform):
+        m = Module()
+        fmt = self._fmt
+        pb = fmt.pixel_bits
+        ib = fmt.intensity_bits
+        W = self._width
+        aj = self._aj == "c"
+        word = data.StructLayout({"z": unsigned(Z_BITS), "addr": unsigned(ADDR_BITS), "pix": unsigned(pb),
+                                  "slot": unsigned(SLOT_BITS)})
+        # the DSLB: two banks (bank = top address bit), one resolved while the other drains
+        m.submodules.mem = mem = Memory(shape=word, depth=2 * W, init=[])
+        rd = mem.read_port(transparent_for=())      # resolve side: read-compare-write
+        wr = mem.write_port()
+        drd = mem.read_port(transparent_for=())     # drain side
+        ab = (2 * W - 1).bit_length() - 1           # bank bit position
+        ent = data.StructLayout({"xl": unsigned(16), "xr": unsigned(16), "poly": unsigned(ADDR_BITS),
+                                 "sl": signed(16), "ql": signed(16), "sr": signed(16), "qr": signed(16)})
+        if aj:
+            m.submodules.tab = tab = Memory(shape=ent, depth=2 << SLOT_BITS, init=[])
+            trd = tab.read_port(transparent_for=())
+            twr = tab.write_port()
+
+        # ---------------------------------------------------------------- resolve side
+        state = Signal(_S)
+        rbank = Signal()
+        x = Signal(11)
+        end = Signal(11)          # last owned pixel of the segment
+        lo = Signal(10)
+        hi = Signal(11)
+        glo = Signal(11)          # resolved range, guards included
+        ghi = Signal(11)
+        seg = Signal(seg_layout())
+        slot = Signal(SLOT_BITS + 1)
+        zrun = Signal(signed(40))
+        irun = Signal(signed(40))
+        cyc = Signal(16)
+
+        def sample_range():
+            stmts = [lo.eq(self.lo), hi.eq(self.hi)]
+            if aj:
+                stmts += [glo.eq(Mux(self.lo > 0, self.lo - 1, 0)),
+                          ghi.eq(Mux(self.hi < W, self.hi + 1, self.hi)),
+                          x.eq(Mux(self.lo > 0, self.lo - 1, 0))]
+            else:
+                stmts += [glo.eq(self.lo), ghi.eq(self.hi), x.eq(self.lo)]
+            return stmts
+
+        c0 = Signal(signed(12))
+        c1 = Signal(signed(12))
+        s = Signal(signed(12))
+        e = Signal(signed(12))
+        m.d.comb += [
+            c0.eq((seg.xl + 31) >> X_FRAC),
+            c1.eq(((seg.xr + 31) >> X_FRAC) - 1),
+            s.eq(Mux(c0 > glo, c0, glo)),
+            e.eq(Mux(c1 < ghi - 1, c1, ghi - 1)),
+        ]
+        d = Signal(signed(20))
+        m.d.comb += d.eq((s << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl)
+        # the multiplier: start values at the first owned pixel
+        zstart = Signal(signed(40))
+        istart = Signal(signed(40))
+        m.d.comb += [
+            zstart.eq((seg.zl << DZ_FRAC) + ((d * seg.dzdx) >> X_FRAC)),
+            istart.eq(seg.il + ((d * seg.didx) >> X_FRAC)),
+        ]
+        # compare key (16-bit comparator on the clamped running z) and the shaded pixel
+        zk = Signal(signed(40))
+        key = Signal(Z_BITS)
+        m.d.comb += zk.eq(zrun >> DZ_FRAC)
+        m.d.comb += key.eq(Mux(zk < 0, 0, Mux(zk > (1 << Z_BITS) - 1, (1 << Z_BITS) - 1, zk)))
+        imax = fmt.i_max << fmt.i_frac
+        ic = Signal(16)
+        m.d.comb += ic.eq(Mux(irun < 0, 0, Mux(irun > imax, imax, irun)))
+        pix = Signal(pb)
+        m.d.comb += pix.eq((seg.hue << ib) | (ic >> fmt.i_frac))
+        stored = Signal(word)
+        m.d.comb += stored.eq(rd.data)
+        wins = Signal()
+        m.d.comb += wins.eq((key < stored.z) | ((key == stored.z) & (seg.addr < stored.addr)))
+        m.d.comb += [rd.en.eq(0), wr.en.eq(0), drd.en.eq(0), self.i.ready.eq(0), self.o.valid.eq(0)]
+        if aj:
+            m.d.comb += [trd.en.eq(0), twr.en.eq(0)]
+
+        # ---------------------------------------------------------------- drain side
+        dstate = Signal(_S)           # IDLE (= CLEAR value unused) / DRD / DOUT / DSEG / DAJ / FLUSH
+        dbusy = Signal()
+        dbank = Signal()
+        dx = Signal(11)
+        dlo = Signal(10)
+        dhi = Signal(11)
+        dghi = Signal(11)
+        dstored = Signal(word)
+        m.d.comb += dstored.eq(drd.data)
+        m.d.comb += self.o.payload.eq(dstored.pix)
+
+        if aj:
+            p_pix = Signal(pb)            # pixel dx-1 before A.J.
+            p_out = Signal(pb)            # pixel dx-1 as it will be output
+            p_addr = Signal(ADDR_BITS)
+            p_ent = Signal(ent)
+            p_ok = Signal()               # there is a pixel dx-1 in the walk
+            c_pix = Signal(pb)
+            c_addr = Signal(ADDR_BITS)
+            c_ent = Signal(ent)
+            m.d.comb += c_ent.eq(trd.data)
+            bg_c = Signal()
+            bg_p = Signal()
+            m.d.comb += [bg_c.eq(c_addr == NONE), bg_p.eq(p_addr == NONE)]
+            poly_c = Signal(ADDR_BITS)
+            poly_p = Signal(ADDR_BITS)
+            m.d.comb += [poly_c.eq(Mux(bg_c, NONE, c_ent.poly)), poly_p.eq(Mux(bg_p, NONE, p_ent.poly))]
+            cc0 = Signal(signed(12))
+            pc1 = Signal(signed(12))
+            m.d.comb += [cc0.eq((c_ent.xl + 31) >> X_FRAC), pc1.eq(((p_ent.xr + 31) >> X_FRAC) - 1)]
+            starts = Signal()
+            ends = Signal()
+            m.d.comb += [starts.eq(~bg_c & (dx == Mux(cc0 < 0, 0, cc0))),
+                         ends.eq(~bg_p & (dx - 1 == Mux(pc1 > W - 1, W - 1, pc1)))]
+            edge = Signal()
+            use_b = Signal()
+            use_a = Signal()
+            m.d.comb += [edge.eq(p_ok & (dx > 0) & (p_addr != c_addr) & (poly_p != poly_c)),
+                         use_b.eq(edge & starts), use_a.eq(edge & ~starts & ends)]
+            xe = Signal(16)
+            sl = Signal(signed(16))
+            qq = Signal(signed(16))
+            m.d.comb += [xe.eq(Mux(use_b, c_ent.xl, p_ent.xr)), sl.eq(Mux(use_b, c_ent.sl, p_ent.sr)),
+                         qq.eq(Mux(use_b, c_ent.ql, p_ent.qr))]
+            right = Signal()              # the blended pixel is dx (else dx - 1)
+            m.d.comb += right.eq((xe >> X_FRAC) >= dx)
+            q = Signal(11)
+            m.d.comb += q.eq(Mux(right, dx, dx - 1))
+            delta = Signal(signed(20))
+            m.d.comb += delta.eq(xe - ((q << X_FRAC) + (1 << (X_FRAC - 1))))
+            steep = Signal()
+            m.d.comb += steep.eq(Mux(sl < 0, -sl, sl) <= (1 << SLOPE_FRAC))
+            aq = Signal(17)
+            m.d.comb += aq.eq(Mux(qq < 0, -qq, qq))
+            araw = Signal(signed(40))
+            m.d.comb += araw.eq(Mux(steep, (1 << (ALPHA_BITS - 1)) + (delta << (ALPHA_BITS - X_FRAC)),
+                                    (1 << (ALPHA_BITS - 1)) + ((delta * aq) >> (X_FRAC + SLOPE_FRAC - ALPHA_BITS))))
+            one = 1 << ALPHA_BITS
+            alpha = Signal(ALPHA_BITS + 1)
+            m.d.comb += alpha.eq(Mux(araw < 0, 0, Mux(araw > one, one, araw)))
+            # eq. (5) per field (R, G, B, I), C = alpha C_L + (1 - alpha) C_R, Q0.8, rounded
+            blend = Signal(pb)
+            parts = []
+            for lsb, w in ((ib + 6, 3), (ib + 3, 3), (ib, 3), (0, ib)):
+                fl = p_pix[lsb:lsb + w]
+                fr = c_pix[lsb:lsb + w]
+                v = Signal(w, name=f"blend_{lsb}")
+                m.d.comb += v.eq((alpha * fl + (one - alpha) * fr + (one >> 1)) >> ALPHA_BITS)
+                parts.append((lsb, v))
+            m.d.comb += blend.eq(sum((v << lsb) for lsb, v in parts))
+            o_prev = Signal(pb)          # pixel dx-1's value after this boundary
+            o_cur = Signal(pb)           # pixel dx's value so far
+            m.d.comb += [o_prev.eq(Mux((use_a | use_b) & ~right, blend, p_out)),
+                         o_cur.eq(Mux((use_a | use_b) & right, blend, c_pix))]
+            emit = Signal()
+            m.d.comb += emit.eq(p_ok & (dx >= dlo + 1) & (dx <= dhi))
+
+        m.d.sync += cyc.eq(cyc + 1)
+        started = Signal()
+
+        with m.If(~started):
+            # out of reset: sample the first line's range
+            m.d.sync += [started.eq(1), cyc.eq(0), *sample_range()]
+        with m.Else(), m.Switch(state):
+            with m.Case(_S.CLEAR):
+                m.d.comb += [wr.addr.eq((rbank << ab) | x),
+                             wr.data.eq(word.const({"z": (1 << Z_BITS) - 1, "addr": NONE, "pix": 0, "slot": 0})),
+                             wr.en.eq(x < ghi)]
+                m.d.sync += x.eq(x + 1)
+                with m.If(x + 1 >= ghi):
+                    m.d.sync += [state.eq(_S.SEG), slot.eq(0)]
+            with m.Case(_S.SEG):
+                m.d.comb += self.i.ready.eq(1)
+                with m.If(self.i.valid):
+                    m.d.sync += seg.eq(self.i.payload)
+                    with m.If(self.i.payload.last):
+                        m.d.sync += state.eq(_S.HAND)
+                    with m.Else():
+                        m.d.sync += state.eq(_S.START)
+            with m.Case(_S.START):
+                if aj:
+                    m.d.comb += [twr.addr.eq((rbank << SLOT_BITS) | slot[:SLOT_BITS]),
+                                 twr.en.eq(slot < (1 << SLOT_BITS)),
+                                 twr.data.xl.eq(seg.xl), twr.data.xr.eq(seg.xr), twr.data.poly.eq(seg.poly),
+                                 twr.data.sl.eq(seg.sl), twr.data.ql.eq(seg.ql), twr.data.sr.eq(seg.sr),
+                                 twr.data.qr.eq(seg.qr)]
+                    with m.If(slot == (1 << SLOT_BITS)):
+                        m.d.sync += self.slot_overflow.eq(1)
+                with m.If(s > e):
+                    m.d.sync += [state.eq(_S.SEG), slot.eq(slot + 1)]
+                with m.Else():
+                    m.d.sync += [x.eq(s), end.eq(e), zrun.eq(zstart), irun.eq(istart), state.eq(_S.READ)]
+            with m.Case(_S.READ):
+                m.d.comb += [rd.addr.eq((rbank << ab) | x), rd.en.eq(1)]
+                m.d.sync += state.eq(_S.CMP)
+            with m.Case(_S.CMP):
+                with m.If(wins):
+                    m.d.comb += [wr.addr.eq((rbank << ab) | x), wr.en.eq(1), wr.data.z.eq(key),
+                                 wr.data.addr.eq(seg.addr), wr.data.pix.eq(pix), wr.data.slot.eq(slot)]
+                m.d.sync += [zrun.eq(zrun + seg.dzdx), irun.eq(irun + seg.didx), x.eq(x + 1)]
+                with m.If(x == end):
+                    m.d.sync += [state.eq(_S.SEG), slot.eq(slot + 1)]
+                with m.Else():
+                    m.d.sync += state.eq(_S.READ)
+            with m.Case(_S.HAND):
+                # swap handshake: the resolved bank goes to the drain once the drain is free
+                with m.If(~dbusy):
+                    m.d.sync += [dbusy.eq(1), dbank.eq(rbank), dlo.eq(lo), dhi.eq(hi), dghi.eq(ghi), dx.eq(glo),
+                                 dstate.eq(_S.DRD), rbank.eq(~rbank), state.eq(_S.CLEAR),
+                                 self.line_cycles.eq(cyc + 1), cyc.eq(0), self.lines.eq(self.lines + 1),
+                                 *sample_range()]
+                    if aj:
+                        m.d.sync += p_ok.eq(0)
+
+        with m.If(dbusy):
+            def drain_done():
+                return [dbusy.eq(0)]
+
+            with m.Switch(dstate):
+                with m.Case(_S.DRD):
+                    m.d.comb += [drd.addr.eq((dbank << ab) | dx), drd.en.eq(1)]
+                    m.d.sync += dstate.eq(_S.DSEG if aj else _S.DOUT)
+                with m.Case(_S.DOUT):
+                    m.d.comb += self.o.valid.eq(1)
+                    with m.If(self.o.ready):
+                        m.d.sync += dx.eq(dx + 1)
+                        with m.If(dx + 1 >= dhi):
+                            m.d.sync += drain_done()
+                        with m.Else():
+                            m.d.sync += dstate.eq(_S.DRD)
+                if aj:
+                    with m.Case(_S.DSEG):
+                        m.d.comb += [trd.addr.eq((dbank << SLOT_BITS) | dstored.slot), trd.en.eq(1)]
+                        m.d.sync += [c_pix.eq(dstored.pix), c_addr.eq(dstored.addr), dstate.eq(_S.DAJ)]
+                    with m.Case(_S.DAJ):
+                        m.d.comb += [self.o.valid.eq(emit), self.o.payload.eq(o_prev)]
+                        with m.If(~emit | self.o.ready):
+                            m.d.sync += [p_pix.eq(c_pix), p_out.eq(o_cur), p_addr.eq(c_addr), p_ent.eq(c_ent),
+                                         p_ok.eq(1), dx.eq(dx + 1)]
+                            with m.If(dx + 1 >= dghi):
+                                with m.If(dghi == dhi):
+                                    m.d.sync += dstate.eq(_S.FLUSH)
+                                with m.Else():
+                                    m.d.sync += drain_done()
+                            with m.Else():
+                                m.d.sync += dstate.eq(_S.DRD)
+                    with m.Case(_S.FLUSH):
+                        m.d.comb += [self.o.valid.eq(1), self.o.payload.eq(p_out)]
+                        with m.If(self.o.ready):
+                            m.d.sync += drain_done()
+        return m

