@@ -32,7 +32,8 @@ class LevelStage(wiring.Component):
     stalls : Out(32) — cycles a survivor waited for ``o.ready``.
     idle : Out(1) — no record held.
 
-    Throughput: 4 cycles per window plus one cycle to accept it; a header costs two cycles.
+    Throughput: 4 cycles per window (the next record is taken in the cycle of the last test);
+    a header costs two cycles.
     """
 
     def __init__(self, *, level: int, n: int, p: int, q: int, alpha: int = 2, beta: int = 2,
@@ -98,16 +99,22 @@ class LevelStage(wiring.Component):
             acc = acc & c
         m.d.comb += ok.eq(acc)
 
+        def accept():
+            m.d.comb += self.i.ready.eq(1)
+            with m.If(self.i.valid):
+                with m.If(self.i.payload.hdr):
+                    m.d.sync += hdr.eq(self.i.payload)
+                    m.next = "HDR"
+                with m.Else():
+                    m.d.sync += [win.eq(self.i.payload), child.eq(0)]
+                    m.next = "TEST"
+            with m.Else():
+                m.next = "IDLE"
+
         with m.FSM():
             with m.State("IDLE"):
-                m.d.comb += [self.i.ready.eq(1), self.idle.eq(1)]
-                with m.If(self.i.valid):
-                    with m.If(self.i.payload.hdr):
-                        m.d.sync += hdr.eq(self.i.payload)
-                        m.next = "HDR"
-                    with m.Else():
-                        m.d.sync += [win.eq(self.i.payload), child.eq(0)]
-                        m.next = "TEST"
+                m.d.comb += self.idle.eq(1)
+                accept()
             with m.State("HDR"):
                 m.d.comb += [self.o.valid.eq(1), self.o.payload.eq(hdr)]
                 with m.If(self.o.ready):
@@ -123,5 +130,5 @@ class LevelStage(wiring.Component):
                 with m.If(advance):
                     m.d.sync += [self.tests.eq(self.tests + 1), child.eq(child + 1)]
                     with m.If(child == 3):
-                        m.next = "IDLE"
+                        accept()  # the next record is taken in the last test's cycle: 4 cycles a window
         return m
