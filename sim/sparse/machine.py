@@ -18,7 +18,7 @@ MACHINE = Machine(
              render="rasterhw.golden_model.sparse.render:render",
              options=(_MATRIX,)),
     ),
-    blocks={"sparse-vp": "rasterhw.hdl.sparse.vp:make_vp"},
+    blocks={"sparse-vp": "rasterhw.hdl.sparse.vp:make_vp", "sparse-matrix": "rasterhw.hdl.sparse.matrix:make_matrix"},
     sims=(SimBlock(name="sparse", help="every video processor of the matrix in HDL, interleaved local memories "
                                        "against the bit-accurate golden model",
                    simulate="rasterhw.sim.sparse.sim:simulate", default_scene="c300", options=(_MATRIX,)),),
