@@ -7,7 +7,7 @@ from amaranth.lib import memory, stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import TRI_BITS, Z_FRAC_BITS
 
-from .layouts import RECORD
+from .layouts import HEADER, WINDOW
 
 __all__ = ["PixelProcessor"]
 
@@ -21,7 +21,7 @@ class PixelProcessor(wiring.Component):
 
     Members
     -------
-    i : In(stream RECORD).
+    i, i_hdr : In(stream WINDOW), In(stream HEADER).
     rd_addr : In(2n) — video-controller read port (one cycle latency);
     rd_z : Out(z_bits + 1), rd_tri : Out(TRI_BITS).
     writes : Out(32) — pixels written (passed the Z test).
@@ -33,7 +33,8 @@ class PixelProcessor(wiring.Component):
 
     def __init__(self, *, n: int, z_bits: int = 24):
         self._n, self._z_bits = n, z_bits
-        super().__init__({"i": In(stream.Signature(RECORD)), "rd_addr": In(2 * n),
+        super().__init__({"i": In(stream.Signature(WINDOW)), "i_hdr": In(stream.Signature(HEADER)),
+                          "rd_addr": In(2 * n),
                           "rd_z": Out(z_bits + 1), "rd_tri": Out(TRI_BITS), "writes": Out(32), "idle": Out(1)})
 
     def elaborate(self, platform):
@@ -58,11 +59,16 @@ class PixelProcessor(wiring.Component):
         a1, a2 = Signal(2 * n), Signal(2 * n)
         z1, z2 = Signal(zb + 1), Signal(zb + 1)
         t1, t2 = Signal(TRI_BITS), Signal(TRI_BITS)
-        m.d.comb += [self.i.ready.eq(1), self.idle.eq(~v1 & ~v2), zr.addr.eq(a1)]
-        take = self.i.valid & ~self.i.payload.hdr
-        with m.If(self.i.valid & self.i.payload.hdr):
-            m.d.sync += tri.eq(self.i.payload.tri)
-        m.d.sync += [v1.eq(take), a1.eq((self.i.payload.v << n) | self.i.payload.u), t1.eq(tri)]
+        need = self.i.payload.new
+        m.d.comb += [self.i.ready.eq(~need | self.i_hdr.valid), self.i_hdr.ready.eq(self.i.valid & need),
+                     self.idle.eq(~v1 & ~v2), zr.addr.eq(a1)]
+        take = self.i.valid & (~need | self.i_hdr.valid)
+        this_tri = Signal(TRI_BITS)
+        m.d.comb += this_tri.eq(tri)
+        with m.If(take & need):
+            m.d.comb += this_tri.eq(self.i_hdr.payload.tri)
+            m.d.sync += tri.eq(self.i_hdr.payload.tri)
+        m.d.sync += [v1.eq(take), a1.eq((self.i.payload.v << n) | self.i.payload.u), t1.eq(this_tri)]
         with m.If(sh < 0):
             m.d.sync += z1.eq(0)
         with m.Elif(sh > zmax):
