@@ -16,7 +16,7 @@ from rasterhw.golden_model.sparse.formats import (
     Z_ACC_BITS,
 )
 
-__all__ = ["BROADCAST", "RECORD", "Z_FRAC_BITS_HDL"]
+__all__ = ["BROADCAST", "HEADER", "WINDOW", "Z_FRAC_BITS_HDL"]
 
 from rasterhw.golden_model.sparse.formats import Z_FRAC_BITS as Z_FRAC_BITS_HDL  # noqa: E402
 
@@ -33,21 +33,26 @@ BROADCAST = data.StructLayout({
     "tri": unsigned(TRI_BITS),                          # triangle index (all ones reserved: empty)
 })
 
-#: what travels between the levels: a triangle header (``hdr = 1``: the processor's own edge
-#: and depth increments) followed by its windows (``hdr = 0``: corner values at the window's
-#: first sparse pixel)
-RECORD = data.StructLayout({
-    "hdr": unsigned(1),
-    "E": data.ArrayLayout(signed(EDGE_BITS), 3),        # window: edge values at (u, v)
-    "z": signed(Z_ACC_BITS),                            # window: depth at (u, v), Q.16
-    "u": unsigned(UV_BITS),                             # window: first sparse pixel
+#: what travels between the levels, on two streams: a triangle's header (the processor's own
+#: increments) goes into a header FIFO just before the triangle's first window at that level;
+#: windows (corner values at the window's first sparse pixel) go into a window FIFO, the first
+#: window of a triangle marked ``new`` (take the next header with it). A triangle with no window
+#: left at a level sends nothing further.
+HEADER = data.StructLayout({
+    "Ap": data.ArrayLayout(signed(EDGE_AB_BITS + MATRIX_LOG2_MAX), 3),  # p*A
+    "Bp": data.ArrayLayout(signed(EDGE_AB_BITS + MATRIX_LOG2_MAX), 3),  # q*B
+    "ext": data.ArrayLayout(unsigned(EXT_BITS), 3),     # (|A| alpha + |B| beta) / 2
+    "thr": data.ArrayLayout(unsigned(1), 3),
+    "bbox": data.ArrayLayout(signed(COORD_BITS), 4),
+    "zu": signed(Z_ACC_BITS),                           # p*zx
+    "zv": signed(Z_ACC_BITS),                           # q*zy
+    "tri": unsigned(TRI_BITS),
+})
+
+WINDOW = data.StructLayout({
+    "new": unsigned(1),                                 # first window of a triangle at this level
+    "E": data.ArrayLayout(signed(EDGE_BITS), 3),        # edge values at (u, v)
+    "z": signed(Z_ACC_BITS),                            # depth at (u, v), Q.16
+    "u": unsigned(UV_BITS),                             # first sparse pixel of the window
     "v": unsigned(UV_BITS),
-    "Ap": data.ArrayLayout(signed(EDGE_AB_BITS + MATRIX_LOG2_MAX), 3),  # header: p*A
-    "Bp": data.ArrayLayout(signed(EDGE_AB_BITS + MATRIX_LOG2_MAX), 3),  # header: q*B
-    "ext": data.ArrayLayout(unsigned(EXT_BITS), 3),     # header: (|A| alpha + |B| beta) / 2
-    "thr": data.ArrayLayout(unsigned(1), 3),            # header
-    "bbox": data.ArrayLayout(signed(COORD_BITS), 4),    # header
-    "zu": signed(Z_ACC_BITS),                           # header: p*zx
-    "zv": signed(Z_ACC_BITS),                           # header: q*zy
-    "tri": unsigned(TRI_BITS),                          # header
 })

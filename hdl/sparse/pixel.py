@@ -7,7 +7,7 @@ from amaranth.lib import memory, stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import TRI_BITS, Z_FRAC_BITS
 
-from .layouts import RECORD
+from .layouts import HEADER, WINDOW
 
 __all__ = ["PixelProcessor"]
 
@@ -21,18 +21,20 @@ class PixelProcessor(wiring.Component):
 
     Members
     -------
-    i : In(stream RECORD).
+    i, i_hdr : In(stream WINDOW), In(stream HEADER).
     rd_addr : In(2n) — video-controller read port (one cycle latency);
     rd_z : Out(z_bits + 1), rd_tri : Out(TRI_BITS).
     writes : Out(32) — pixels written (passed the Z test).
     idle : Out(1).
 
-    Throughput: one pixel per 3 cycles (accept, read, compare/write), no hazards.
+    Throughput: one pixel per cycle (accept, read, compare/write pipelined; the compare read is
+    transparent for the write, so back-to-back pixels at one address see each other).
     """
 
     def __init__(self, *, n: int, z_bits: int = 24):
         self._n, self._z_bits = n, z_bits
-        super().__init__({"i": In(stream.Signature(RECORD)), "rd_addr": In(2 * n),
+        super().__init__({"i": In(stream.Signature(WINDOW)), "i_hdr": In(stream.Signature(HEADER)),
+                          "rd_addr": In(2 * n),
                           "rd_z": Out(z_bits + 1), "rd_tri": Out(TRI_BITS), "writes": Out(32), "idle": Out(1)})
 
     def elaborate(self, platform):
@@ -42,37 +44,40 @@ class PixelProcessor(wiring.Component):
         m.submodules.zmem = zmem = memory.Memory(shape=unsigned(zb + 1), depth=depth, init=[1 << zb] * depth)
         m.submodules.tmem = tmem = memory.Memory(shape=unsigned(TRI_BITS), depth=depth,
                                                  init=[(1 << TRI_BITS) - 1] * depth)
-        zr = zmem.read_port()
+        # compare-port read is transparent for the write port: a pixel read in the cycle its
+        # address is written sees the new depth, so one pixel per cycle needs no stall
         zw, tw = zmem.write_port(), tmem.write_port()
+        zr = zmem.read_port(transparent_for=(zw,))
         zo, to = zmem.read_port(), tmem.read_port()
         m.d.comb += [zo.addr.eq(self.rd_addr), to.addr.eq(self.rd_addr), self.rd_z.eq(zo.data),
                      self.rd_tri.eq(to.data)]
         tri = Signal(TRI_BITS)
-        addr = Signal(2 * n)
-        zq = Signal(zb + 1)
         zmax = (1 << zb) - 1
         sh = self.i.payload.z >> Z_FRAC_BITS
-        m.d.comb += [zr.addr.eq(addr), zw.addr.eq(addr), tw.addr.eq(addr), zw.data.eq(zq), tw.data.eq(tri)]
-        with m.FSM():
-            with m.State("IDLE"):
-                m.d.comb += [self.i.ready.eq(1), self.idle.eq(1)]
-                with m.If(self.i.valid):
-                    with m.If(self.i.payload.hdr):
-                        m.d.sync += tri.eq(self.i.payload.tri)
-                    with m.Else():
-                        m.d.sync += addr.eq((self.i.payload.v << n) | self.i.payload.u)
-                        with m.If(sh < 0):
-                            m.d.sync += zq.eq(0)
-                        with m.Elif(sh > zmax):
-                            m.d.sync += zq.eq(zmax)
-                        with m.Else():
-                            m.d.sync += zq.eq(sh)
-                        m.next = "READ"
-            with m.State("READ"):
-                m.next = "CMP"
-            with m.State("CMP"):
-                with m.If(zq < zr.data):
-                    m.d.comb += [zw.en.eq(1), tw.en.eq(1)]
-                    m.d.sync += self.writes.eq(self.writes + 1)
-                m.next = "IDLE"
+        # stage 1: read issued; stage 2: compare and write
+        v1, v2 = Signal(), Signal()
+        a1, a2 = Signal(2 * n), Signal(2 * n)
+        z1, z2 = Signal(zb + 1), Signal(zb + 1)
+        t1, t2 = Signal(TRI_BITS), Signal(TRI_BITS)
+        need = self.i.payload.new
+        m.d.comb += [self.i.ready.eq(~need | self.i_hdr.valid), self.i_hdr.ready.eq(self.i.valid & need),
+                     self.idle.eq(~v1 & ~v2), zr.addr.eq(a1)]
+        take = self.i.valid & (~need | self.i_hdr.valid)
+        this_tri = Signal(TRI_BITS)
+        m.d.comb += this_tri.eq(tri)
+        with m.If(take & need):
+            m.d.comb += this_tri.eq(self.i_hdr.payload.tri)
+            m.d.sync += tri.eq(self.i_hdr.payload.tri)
+        m.d.sync += [v1.eq(take), a1.eq((self.i.payload.v << n) | self.i.payload.u), t1.eq(this_tri)]
+        with m.If(sh < 0):
+            m.d.sync += z1.eq(0)
+        with m.Elif(sh > zmax):
+            m.d.sync += z1.eq(zmax)
+        with m.Else():
+            m.d.sync += z1.eq(sh)
+        m.d.sync += [v2.eq(v1), a2.eq(a1), z2.eq(z1), t2.eq(t1)]
+        m.d.comb += [zw.addr.eq(a2), tw.addr.eq(a2), zw.data.eq(z2), tw.data.eq(t2)]
+        with m.If(v2 & (z2 < zr.data)):
+            m.d.comb += [zw.en.eq(1), tw.en.eq(1)]
+            m.d.sync += self.writes.eq(self.writes + 1)
         return m

@@ -7,7 +7,7 @@ from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import EDGE_BITS, MATRIX_LOG2_MAX, SUBPIXEL_BITS
 
-from .layouts import RECORD
+from .layouts import HEADER, WINDOW
 
 __all__ = ["LevelStage"]
 
@@ -15,24 +15,27 @@ __all__ = ["LevelStage"]
 class LevelStage(wiring.Component):
     """Level ``level`` (1..n) of processor ``(a, b)`` of a ``p x q`` matrix.
 
-    A triangle header is latched and passed on; each window record entering the level is split
+    A window marked ``new`` is taken together with the next triangle header; each window is split
     into its four sub-windows (``du, dv`` in 0, 1: corner values by the per-level increments
     ``A' * 2**(n-level)``, ``B' * 2**(n-level)``, depth likewise) and each sub-window gets one
     coverage test per cycle (τ = one cycle): below the pixel level the window rectangle
     ``[p(2**(n-i) - 1) + alpha] x [q(2**(n-i) - 1) + beta]`` against the three edges and (test
     ``"exact"``) the triangle's bounding box; at the pixel level the top-left point test.
-    Survivors go out in order ``(0,0), (1,0), (0,1), (1,1)``, as the golden model's.
+    Survivors go out in order ``(0,0), (1,0), (0,1), (1,1)``, as the golden model's; before a
+    triangle's first survivor its header goes out on ``o_hdr`` (one cycle, not a test).
 
     Members
     -------
     a, b : In(MATRIX_LOG2_MAX) — the processor's place in the matrix (only the exact test uses it).
-    i : In(stream RECORD) — headers and parent windows.
-    o : Out(stream RECORD) — headers and surviving sub-windows (pixels at the last level).
+    i, i_hdr : In(stream WINDOW), In(stream HEADER) — parent windows and their triangles' headers.
+    o, o_hdr : Out(stream WINDOW), Out(stream HEADER) — surviving sub-windows (pixels at the last
+        level) and their headers.
     tests : Out(32) — coverage tests made (one per busy cycle: the stage's ``t_i / τ``).
     stalls : Out(32) — cycles a survivor waited for ``o.ready``.
     idle : Out(1) — no record held.
 
-    Throughput: 4 cycles per window plus one cycle to accept it; a header costs two cycles.
+    Throughput: 4 cycles per window (the next window is taken in the cycle of the last test),
+    plus one cycle per triangle that has survivors here (its header).
     """
 
     def __init__(self, *, level: int, n: int, p: int, q: int, alpha: int = 2, beta: int = 2,
@@ -44,7 +47,8 @@ class LevelStage(wiring.Component):
         self._level, self._n, self._p, self._q = level, n, p, q
         self._alpha, self._beta, self._test = alpha, beta, test
         super().__init__({"a": In(MATRIX_LOG2_MAX), "b": In(MATRIX_LOG2_MAX),
-                          "i": In(stream.Signature(RECORD)), "o": Out(stream.Signature(RECORD)),
+                          "i": In(stream.Signature(WINDOW)), "i_hdr": In(stream.Signature(HEADER)),
+                          "o": Out(stream.Signature(WINDOW)), "o_hdr": Out(stream.Signature(HEADER)),
                           "tests": Out(32), "stalls": Out(32), "idle": Out(1)})
 
     @property
@@ -57,16 +61,18 @@ class LevelStage(wiring.Component):
         sh = n - lvl  # log2 of the sub-window side N
         N = 1 << sh
         last = lvl == n
-        hdr = Signal(RECORD)
-        win = Signal(RECORD)
+        hdr = Signal(HEADER)
+        win = Signal(WINDOW)
+        sent = Signal()   # this triangle's header has gone out of this level
+        fresh = Signal()  # ... and its first window has not
         child = Signal(2)
         du, dv = child[0], child[1]
-        out = Signal(RECORD)
+        out = Signal(WINDOW)
         ok = Signal()
         sub, half = 1 << SUBPIXEL_BITS, 1 << (SUBPIXEL_BITS - 1)
 
         # the sub-window: corner values by increments, no multiplier (N is a power of two)
-        m.d.comb += [out.eq(win), out.hdr.eq(0)]
+        m.d.comb += out.new.eq(fresh)
         for k in range(3):
             m.d.comb += out.E[k].eq(win.E[k] + (du * hdr.Ap[k] << sh) + (dv * hdr.Bp[k] << sh))
         m.d.comb += [out.z.eq(win.z + (du * hdr.zu << sh) + (dv * hdr.zv << sh)),
@@ -98,30 +104,38 @@ class LevelStage(wiring.Component):
             acc = acc & c
         m.d.comb += ok.eq(acc)
 
+        def accept():
+            need = self.i.payload.new
+            m.d.comb += [self.i.ready.eq(~need | self.i_hdr.valid), self.i_hdr.ready.eq(self.i.valid & need)]
+            with m.If(self.i.valid & (~need | self.i_hdr.valid)):
+                m.d.sync += [win.eq(self.i.payload), child.eq(0)]
+                with m.If(need):
+                    m.d.sync += [hdr.eq(self.i_hdr.payload), sent.eq(0), fresh.eq(0)]
+                m.next = "TEST"
+            with m.Else():
+                m.next = "IDLE"
+
         with m.FSM():
             with m.State("IDLE"):
-                m.d.comb += [self.i.ready.eq(1), self.idle.eq(1)]
-                with m.If(self.i.valid):
-                    with m.If(self.i.payload.hdr):
-                        m.d.sync += hdr.eq(self.i.payload)
-                        m.next = "HDR"
-                    with m.Else():
-                        m.d.sync += [win.eq(self.i.payload), child.eq(0)]
-                        m.next = "TEST"
-            with m.State("HDR"):
-                m.d.comb += [self.o.valid.eq(1), self.o.payload.eq(hdr)]
-                with m.If(self.o.ready):
-                    m.next = "IDLE"
+                m.d.comb += self.idle.eq(1)
+                accept()
             with m.State("TEST"):
                 advance = Signal()
-                with m.If(ok):
+                with m.If(ok & ~sent):
+                    # the triangle's header goes ahead of its first survivor at this level
+                    m.d.comb += [self.o_hdr.valid.eq(1), self.o_hdr.payload.eq(hdr)]
+                    with m.If(self.o_hdr.ready):
+                        m.d.sync += [sent.eq(1), fresh.eq(1)]
+                with m.Elif(ok):
                     m.d.comb += [self.o.valid.eq(1), self.o.payload.eq(out), advance.eq(self.o.ready)]
-                    with m.If(~self.o.ready):
+                    with m.If(self.o.ready):
+                        m.d.sync += fresh.eq(0)
+                    with m.Else():
                         m.d.sync += self.stalls.eq(self.stalls + 1)
                 with m.Else():
                     m.d.comb += advance.eq(1)
                 with m.If(advance):
                     m.d.sync += [self.tests.eq(self.tests + 1), child.eq(child + 1)]
                     with m.If(child == 3):
-                        m.next = "IDLE"
+                        accept()  # the next window is taken in the cycle of the last test: 4 cycles a window
         return m

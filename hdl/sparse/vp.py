@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from amaranth.hdl import Module, Signal
+from amaranth.hdl import Module, Mux, Signal
 from amaranth.lib import fifo, stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import MATRIX_LOG2_MAX, TRI_BITS
 
-from .layouts import BROADCAST, RECORD
+from .layouts import BROADCAST, HEADER, WINDOW
 from .pixel import PixelProcessor
 from .stage import LevelStage
 
@@ -27,8 +27,9 @@ class VideoProcessor(wiring.Component):
     The set-up rewrites each broadcast triangle for this processor's lattice — ``A' = pA``,
     ``B' = qB``, ``C' = C + aA + bB``, depth ``Z0 = z00 + a*zx + b*zy``, ``zu = p*zx``,
     ``zv = q*zy``, aperture growth ``(|A| alpha + |B| beta) / 2`` — and sends a header and the
-    root window into the input FIFO of level 1. Levels 1..n are :class:`LevelStage` s, each fed
-    by a FIFO (``fifo_depth`` records); the last one feeds the :class:`PixelProcessor`.
+    root window into the input FIFOs of level 1. Levels 1..n are :class:`LevelStage` s, each fed
+    by a window FIFO and a header FIFO (``fifo_depth`` entries each); the last one feeds the
+    :class:`PixelProcessor`.
 
     Members
     -------
@@ -86,9 +87,11 @@ class VideoProcessor(wiring.Component):
             m.submodules[f"level{lvl}"] = st
             stages.append(st)
         for k in range(n + 1):
-            f = fifo.SyncFIFOBuffered(width=RECORD.size, depth=self._depth)
+            f = fifo.SyncFIFOBuffered(width=WINDOW.size, depth=self._depth)
+            h = fifo.SyncFIFOBuffered(width=HEADER.size, depth=self._depth)
             m.submodules[f"fifo{k}"] = f
-            fifos.append(f)
+            m.submodules[f"hfifo{k}"] = h
+            fifos.append((f, h))
         m.submodules.pixel = px = PixelProcessor(n=n, z_bits=self._z_bits)
 
         def push(src, f):
@@ -97,21 +100,22 @@ class VideoProcessor(wiring.Component):
         def pop(f, dst):
             m.d.comb += [dst.payload.eq(f.r_data), dst.valid.eq(f.r_rdy), f.r_en.eq(dst.ready)]
 
-        # set-up: header, then the root window, into FIFO 0
-        setup_o = stream.Signature(RECORD).create()
+        # set-up: the header into header FIFO 0, then the root window (new = 1) into FIFO 0
+        setup_w = stream.Signature(WINDOW).create()
+        setup_h = stream.Signature(HEADER).create()
         bc = Signal(BROADCAST)
-        hdr = Signal(RECORD)
-        root = Signal(RECORD)
+        hdr = Signal(HEADER)
+        root = Signal(WINDOW)
         a, b, lp, lq = self.a, self.b, self._lp, self._lq
         for k in range(3):
-            absA = (bc.A[k] < 0).as_unsigned() * -bc.A[k] + (bc.A[k] >= 0).as_unsigned() * bc.A[k]
-            absB = (bc.B[k] < 0).as_unsigned() * -bc.B[k] + (bc.B[k] >= 0).as_unsigned() * bc.B[k]
+            absA = Mux(bc.A[k] < 0, -bc.A[k], bc.A[k])
+            absB = Mux(bc.B[k] < 0, -bc.B[k], bc.B[k])
             m.d.comb += [hdr.Ap[k].eq(bc.A[k] << lp), hdr.Bp[k].eq(bc.B[k] << lq), hdr.thr[k].eq(bc.thr[k]),
                          hdr.ext[k].eq((absA * self._alpha + absB * self._beta) >> 1),
                          root.E[k].eq(bc.C[k] + a * bc.A[k] + b * bc.B[k])]
         for k in range(4):
             m.d.comb += hdr.bbox[k].eq(bc.bbox[k])
-        m.d.comb += [hdr.hdr.eq(1), hdr.zu.eq(bc.zx << lp), hdr.zv.eq(bc.zy << lq), hdr.tri.eq(bc.tri),
+        m.d.comb += [hdr.zu.eq(bc.zx << lp), hdr.zv.eq(bc.zy << lq), hdr.tri.eq(bc.tri), root.new.eq(1),
                      root.z.eq(bc.z00 + a * bc.zx + b * bc.zy)]
         setup_idle = Signal()
         with m.FSM(name="setup"):
@@ -121,26 +125,30 @@ class VideoProcessor(wiring.Component):
                     m.d.sync += bc.eq(self.i.payload)
                     m.next = "HDR"
             with m.State("HDR"):
-                m.d.comb += [setup_o.valid.eq(1), setup_o.payload.eq(hdr)]
-                with m.If(setup_o.ready):
+                m.d.comb += [setup_h.valid.eq(1), setup_h.payload.eq(hdr)]
+                with m.If(setup_h.ready):
                     m.next = "ROOT"
             with m.State("ROOT"):
-                m.d.comb += [setup_o.valid.eq(1), setup_o.payload.eq(root)]
-                with m.If(setup_o.ready):
+                m.d.comb += [setup_w.valid.eq(1), setup_w.payload.eq(root)]
+                with m.If(setup_w.ready):
                     m.next = "IDLE"
-        push(setup_o, fifos[0])
+        push(setup_w, fifos[0][0])
+        push(setup_h, fifos[0][1])
         for k, st in enumerate(stages):
-            pop(fifos[k], st.i)
-            push(st.o, fifos[k + 1])
+            pop(fifos[k][0], st.i)
+            pop(fifos[k][1], st.i_hdr)
+            push(st.o, fifos[k + 1][0])
+            push(st.o_hdr, fifos[k + 1][1])
             m.d.comb += [getattr(self, f"tests_{k + 1}").eq(st.tests), getattr(self, f"stalls_{k + 1}").eq(st.stalls)]
-        pop(fifos[n], px.i)
+        pop(fifos[n][0], px.i)
+        pop(fifos[n][1], px.i_hdr)
         m.d.comb += [px.rd_addr.eq(self.rd_addr), self.rd_z.eq(px.rd_z), self.rd_tri.eq(px.rd_tri),
                      self.writes.eq(px.writes)]
         idle = setup_idle & px.idle
         for st in stages:
             idle = idle & st.idle
-        for f in fifos:
-            idle = idle & (f.level == 0)
+        for f, h in fifos:
+            idle = idle & (f.level == 0) & (h.level == 0)
         m.d.comb += self.busy.eq(~idle)
         return m
 

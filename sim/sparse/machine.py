@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
-from rasterhw.sim.registry import Arch, Machine, Option
+from rasterhw.sim.registry import Arch, Machine, Option, SimBlock
+
+_MATRIX = Option(name="matrix", help="matrix of video processors PxQ (powers of two; the raster must be "
+                                     "p*2^n x q*2^n)", default="4x4")
 
 MACHINE = Machine(
     name="sparse",
@@ -13,11 +16,14 @@ MACHINE = Machine(
              help="p x q matrix of video processors, recursive pixel search on sparse rasters "
                   "(image equals the reference)",
              render="rasterhw.golden_model.sparse.render:render",
-             options=(Option(name="matrix", help="matrix of video processors PxQ (powers of two; "
-                                                 "the raster must be p*2^n x q*2^n)",
-                             default="4x4"),)),
+             options=(_MATRIX,)),
     ),
+    blocks={"sparse-vp": "rasterhw.hdl.sparse.vp:make_vp", "sparse-matrix": "rasterhw.hdl.sparse.matrix:make_matrix"},
+    sims=(SimBlock(name="sparse", help="every video processor of the matrix in HDL, interleaved local memories "
+                                       "against the bit-accurate golden model",
+                   simulate="rasterhw.sim.sparse.sim:simulate", default_scene="c300", options=(_MATRIX,)),),
     report="rasterhw.sim.sparse.report:rows",
     bench="rasterhw.sim.sparse.bench:bench",
-    status="golden model (image = reference), formulas (1)-(12), Monte-Carlo window counts, figs. 3-6; no HDL yet",
+    status="golden model (image = reference), formulas (1)-(12), Monte-Carlo window counts, figs. 3-6; "
+           "video processor in Amaranth, bit-exact in pysim and Verilator",
 )

@@ -210,6 +210,9 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
                           f"[{inter.min():.3g}, {inter.max():.3g}], level n = {M_BITS - k} from S = "
                           f"{Sg[lv == M_BITS - k].min():.3g}" if inter.size else f"k = {k}: no intermediate level")
 
+    # ---------------------------------------------------------------- HDL cycles (t_i, R_p)
+    hdl_sec = _hdl_rows(row, engine, progress, hdl_scene=known.get("hdl_scene"))
+
     # ---------------------------------------------------------------- plots
     plots = _plots(out_dir, spr, mono, Sg, S_GRID)
 
@@ -230,9 +233,74 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
                          f"{d[0]:.4g} [{d[1]:.4g}, {d[2]:.4g}] |" for k, (e, d) in sk_meas.items()) + "\n")
     sec.append("## Limiting level in each regime\n")
     sec.append("\n".join(reg) + "\n\nFrom the formula on a fine grid (S = 0.1 … 1000): " + "; ".join(lim_ranges) + ".\n")
+    sec.extend(hdl_sec)
     sec.append("## Figures\n")
     sec.append("\n".join(f"![{t}]({fn})" for t, fn in plots) + "\n")
     return out, sec
+
+
+def _formula_frame(xy: np.ndarray, n: int, p: int) -> np.ndarray:
+    """Formula (1) summed over a frame's triangles (each with its own S and L): (n + 1,)."""
+    e1, e2 = xy[:, 1] - xy[:, 0], xy[:, 2] - xy[:, 0]
+    S = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    U = np.linalg.norm(xy - np.roll(xy, -1, 1), axis=2).sum(1)
+    good = S > 1e-6
+    tot = np.zeros(n + 1)
+    for s, u in zip(S[good], U[good], strict=True):
+        tot += th.windows(float(s), n, p, L=float(u / (2 * math.sqrt(math.pi * s))))
+    return tot
+
+
+def _hdl_rows(row, engine: str, progress: bool, hdl_scene=None) -> list[str]:
+    """Busy cycles per stage of the HDL video processors (τ = one cycle per coverage test)."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.reference import random_triangles
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.sim.sparse.sim import simulate_tris
+
+    if engine == "verilator":
+        name = hdl_scene or "c300"
+        tris = run_geometry(build_scene(name), 512, 512)
+        label = f"{name} 512x512"
+    elif engine == "pysim":  # pysim runs ~1 k cycles/s here: a small frame
+        tris = random_triangles(64, 64, 40, mean_area=30.0, seed=SEED)
+        label = "40 random triangles of 30 px, 64x64"
+    else:
+        return [f"## HDL cycles\n\nNo HDL rows: engine {engine!r} is not supported by the sparse video processor "
+                "(pysim or verilator).\n"]
+    p = 4
+    r = simulate_tris(tris, (p, p), engine=engine, progress=progress)
+    n = r["n"]
+    src = f"hdl:{engine}"
+    T = r["triangles"]
+    hdl_t = np.array(r["tests_per_level_hdl"], dtype=float) / (T * p * p)  # per triangle per processor
+    fw = _formula_frame(np.asarray(tris.xy), n, p)  # sums over triangles
+    ft = 4.0 * fw[:-1] / T  # the tests term of (5): tau * 4 w_(i-1)
+    row("HDL", f"{label}, 4x4: pixels differing from the bit-accurate golden model (of {r['pixels_compared']})",
+        paper=None, formula=0, measured=r["mismatches"], unit="pixels", source=src)
+    row("HDL", f"{label}, 4x4: busy cycles per stage equal the golden model's coverage tests (1 = yes)",
+        paper=None, formula=1, measured=int(r["tests_match_golden"]), unit="", source=src)
+    for i in range(1, n + 1):
+        row("(5) / HDL", f"{label}, 4x4: t_{i}/τ per triangle per processor (busy cycles of stage {i}; "
+            "formula: 4 w_(i-1) of (1))", paper=None, formula=round(float(ft[i - 1]), 4),
+            measured=round(float(hdl_t[i - 1]), 4), unit="cycles", source=src)
+    Rf0 = float(ft.sum() / (n * ft.max()))
+    tf1 = th.stage_times(fw)  # with the k_p/k_e = 1 term, for reference
+    Rf1 = float(tf1.sum() / (n * tf1.max()))
+    Rh = float(hdl_t.sum() / (n * hdl_t.max()))
+    row("(10) / HDL", f"{label}, 4x4: R_p of the frame, sum t_i / (n max t_i) (formula with k_p/k_e = 0 as our "
+        f"stage adds parameters in the test cycle; with k_p/k_e = 1: {Rf1:.3f})", paper=None, formula=round(Rf0, 4),
+        measured=round(Rh, 4), unit="", source=src)
+    row("(9) / HDL", f"{label}, 4x4: frame cycles (slowest processor) / busiest stage's tests", paper=None,
+        formula=1.0, measured=round(r["cycles"] / r["max_stage_tests_per_processor"], 4), unit="ratio", source=src)
+    return ["## HDL cycles\n",
+            f"`rasterhw sim sparse` run inside this report ({engine}): {label}, 4x4, every processor; "
+            f"{r['cycles']} cycles for the slowest processor, {r['sim_cycles']} cycles simulated in all at "
+            f"{r['cycles_per_s']} cycles/s; busy cycles (coverage tests) per level summed over processors: "
+            f"{r['tests_per_level_hdl']}. A stage makes one coverage test per busy cycle (τ = 1 cycle) and takes "
+            "the next window in the cycle of its last test; the frame still takes more cycles than its busiest "
+            "stage's tests because a header costs two cycles in every stage and a full FIFO stalls the stage "
+            "before it.\n"]
 
 
 def _plots(out_dir: Path, spr, mono, Sg, S_GRID):  # noqa: N803

@@ -48,3 +48,43 @@ def test_bad_parameters():
                {"n": 3, "z_bits": 0}):
         with pytest.raises(ValueError):
             VideoProcessor(**kw)
+
+
+def test_matrix_component_broadcast_and_interleaved_readout():
+    from amaranth.sim import Simulator
+    from rasterhw.golden_model.sparse.fixed import broadcast_records
+    from rasterhw.hdl.sparse.matrix import Matrix
+    from rasterhw.sim.harness import stream_put
+
+    tris = random_triangles(16, 16, 10, mean_area=16.0, seed=13)
+    g, zq = _golden(tris, "2x2")
+    dut = Matrix(n=3, p=2, q=2)
+    recs = broadcast_records(tris)
+    got_t = np.full((16, 16), -1, dtype=np.int64)
+    got_z = np.full((16, 16), -1, dtype=np.int64)
+    res = {}
+
+    async def bench(ctx):
+        for r in recs:
+            await stream_put(ctx, dut.i, r)
+        await ctx.tick()
+        while ctx.get(dut.busy):
+            await ctx.tick()
+        res["max_tests"] = ctx.get(dut.max_tests)
+        for y in range(16):
+            for x in range(16):
+                ctx.set(dut.rd_x, x)
+                ctx.set(dut.rd_y, y)
+                await ctx.tick()
+                await ctx.tick()  # registered processor select + the memory's read latency
+                t, z = ctx.get(dut.rd_tri), ctx.get(dut.rd_z)
+                if t != 0xFFFF:
+                    got_t[y, x], got_z[y, x] = t, z
+
+    sim = Simulator(dut)
+    sim.add_clock(1e-8)
+    sim.add_testbench(bench)
+    sim.run()
+    assert np.array_equal(got_t, g.tri_id)
+    assert np.array_equal(got_z, zq)
+    assert res["max_tests"] == int(g.tests_per_proc[:, 1:].max())

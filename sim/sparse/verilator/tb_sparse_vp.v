@@ -1,0 +1,70 @@
+// Timing-free Verilator bench for the generated `sparse_vp` (rasterhw.hdl.sparse.vp).
+// Plays the broadcast records of +in= (one BW-bit hex word per triangle, +ntri= of them) into
+// processor (+a=, +b=) with no gaps, waits until the processor is idle, then sweeps the local
+// memory's read port and writes {tri, z} per sparse pixel to +out= and the per-level tests,
+// stalls and the cycle count to +stats= (hex words).
+module tb_sparse_vp #(parameter N = 7, parameter BW = 600, parameter MAXT = 16384, parameter ZW = 25,
+                      parameter TW = 16) (input clk, output reg done, output reg [31:0] cycles);
+  reg [BW-1:0] rom [0:MAXT-1];
+  reg [TW+ZW-1:0] outmem [0:(1 << (2 * N)) - 1];
+  reg [31:0] stats [0:2 * N + 1];
+  reg [1023:0] in_file, out_file, stats_file;
+  integer ntri, pa, pb, i;
+  reg [31:0] idx;
+  reg rst;
+  reg [2:0] phase;  // 0 reset, 1 feed, 2 drain, 3 read-out, 4 done
+  reg [2*N+1:0] raddr;
+  reg [2*N-1:0] rd_addr;
+  wire busy, i_ready;
+  wire [ZW-1:0] rd_z;
+  wire [TW-1:0] rd_tri;
+  wire [31:0] writes;
+  wire [32 * N - 1:0] tests_v, stalls_v;
+  initial begin
+    if (!$value$plusargs("in=%s", in_file)) in_file = "in.hex";
+    if (!$value$plusargs("out=%s", out_file)) out_file = "out.hex";
+    if (!$value$plusargs("stats=%s", stats_file)) stats_file = "stats.hex";
+    if (!$value$plusargs("ntri=%d", ntri)) ntri = 0;
+    if (!$value$plusargs("a=%d", pa)) pa = 0;
+    if (!$value$plusargs("b=%d", pb)) pb = 0;
+    if (ntri > 0) $readmemh(in_file, rom, 0, ntri - 1);
+    idx = 0; phase = 0; done = 0; cycles = 0; raddr = 0; rd_addr = 0; rst = 1;
+  end
+  sparse_vp dut (.clk(clk), .rst(rst), .a(pa[5:0]), .b(pb[5:0]), .i__payload(rom[idx[13:0]]),
+                 .i__valid(phase == 1 && idx < ntri), .i__ready(i_ready), .rd_addr(rd_addr), .rd_z(rd_z),
+                 .rd_tri(rd_tri), .writes(writes), .busy(busy)
+`include "tb_sparse_vp_ports.vh"
+                 );
+  always @(posedge clk) begin
+    case (phase)
+      0: begin rst <= 0; phase <= 1; end
+      1: begin
+        cycles <= cycles + 1;
+        if (idx < ntri && i_ready) idx <= idx + 1;
+        if (idx >= ntri) phase <= 2;
+      end
+      2: begin
+        cycles <= cycles + 1;
+        if (!busy) phase <= 3;
+      end
+      3: begin  // rd_addr is registered here and the read port has one cycle of latency:
+                // the word for raddr - 2 arrives now
+        if (raddr >= 2) outmem[raddr - 2] <= {rd_tri, rd_z};
+        rd_addr <= raddr[2*N-1:0];
+        raddr <= raddr + 1;
+        if (raddr == (1 << (2 * N)) + 1) phase <= 4;
+      end
+      4: done <= 1;
+    endcase
+  end
+  final begin
+    for (i = 0; i < N; i = i + 1) begin
+      stats[i] = tests_v[32 * i +: 32];
+      stats[N + i] = stalls_v[32 * i +: 32];
+    end
+    stats[2 * N] = cycles;
+    stats[2 * N + 1] = writes;
+    $writememh(out_file, outmem);
+    $writememh(stats_file, stats);
+  end
+endmodule

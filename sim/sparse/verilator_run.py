@@ -1,0 +1,125 @@
+"""The sparse video processor's generated Verilog on plain Verilator (no cocotb, no ``--timing``).
+
+One build serves every processor of the matrix (its index ``(a, b)`` is an input): the bench
+``sim/sparse/verilator/tb_sparse_vp.v`` plays the broadcast records from a hex file with no gaps,
+waits until the processor is idle and dumps its local memory and per-level counters; the C++
+main (``main.cpp``) toggles the clock and times that loop. Builds go to
+``build/sparse-vp-<hash>/`` (hash of the Verilog, parameters and bench sources), so the second
+call with the same parameters only runs.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.sparse.formats import TRI_BITS
+from rasterhw.sim.runner import REPO_ROOT, verilator_bin_dir
+
+__all__ = ["build", "run_processor_verilator"]
+
+BENCH_DIR = Path(__file__).resolve().parent / "verilator"
+TOP = "tb_sparse_vp"
+ARGS = ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast", "-Wno-fatal", "-Wno-lint",
+        "-Wno-style", "--build-jobs", "2"]
+MAKE_VARS = "CFG_CXXFLAGS_PCH_I=-include OPT_FAST=-O2 OPT_SLOW=-O0 OPT_GLOBAL=-O2"
+MAXT = 16384
+
+
+_BUILT: dict = {}
+
+
+def build(*, n: int, p: int, q: int, z_bits: int = 24) -> tuple[Path, float]:
+    """Build once per parameter set; returns ``(binary, build seconds or 0 if reused)``."""
+    key = (n, p, q, z_bits)
+    if key in _BUILT and _BUILT[key].exists():
+        return _BUILT[key], 0.0
+    exe, secs = _build(n=n, p=p, q=q, z_bits=z_bits)
+    _BUILT[key] = exe
+    return exe, secs
+
+
+def _build(*, n: int, p: int, q: int, z_bits: int) -> tuple[Path, float]:
+    from amaranth.back import verilog
+    from rasterhw.hdl.sparse.layouts import BROADCAST
+    from rasterhw.hdl.sparse.vp import make_vp
+
+    src = verilog.convert(make_vp(n=n, p=p, q=q, z_bits=z_bits), name="sparse_vp")
+    params = {"N": n, "BW": BROADCAST.size, "MAXT": MAXT, "ZW": z_bits + 1, "TW": TRI_BITS}
+    h = hashlib.sha1(json.dumps({"args": ARGS, "make": MAKE_VARS, **params}, sort_keys=True).encode())
+    h.update(src.encode())
+    for f in ("tb_sparse_vp.v", "main.cpp"):
+        h.update((BENCH_DIR / f).read_bytes())
+    bdir = REPO_ROOT / "build" / f"sparse-vp-{h.hexdigest()[:10]}"
+    exe = bdir / "obj_dir" / f"V{TOP}"
+    if exe.exists():
+        return exe, 0.0
+    bdir.mkdir(parents=True, exist_ok=True)
+    (bdir / "sparse_vp.v").write_text(src)
+    (bdir / "tb_sparse_vp_ports.vh").write_text("".join(
+        f"  , .tests_{i + 1}(tests_v[{32 * i + 31}:{32 * i}]), .stalls_{i + 1}(stalls_v[{32 * i + 31}:{32 * i}])\n"
+        for i in range(n)))
+    env = dict(os.environ)
+    env["PATH"] = f"{verilator_bin_dir()}{os.pathsep}{env.get('PATH', '')}"
+    env["MAKEFLAGS"] = f"{env['MAKEFLAGS']} {MAKE_VARS}" if env.get("MAKEFLAGS") else MAKE_VARS
+    cmd = [str(verilator_bin_dir() / "verilator"), *ARGS, "--top-module", TOP, f"-I{bdir}",
+           *[f"-G{k}={v}" for k, v in params.items()], "--Mdir", str(bdir / "obj_dir"),
+           str(bdir / "sparse_vp.v"), str(BENCH_DIR / "tb_sparse_vp.v"), str(BENCH_DIR / "main.cpp")]
+    t0 = time.perf_counter()
+    r = subprocess.run(cmd, cwd=bdir, env=env, capture_output=True, text=True)
+    build_s = time.perf_counter() - t0
+    (bdir / "build.log").write_text(" ".join(cmd) + "\n" + r.stdout + r.stderr)
+    if r.returncode or not exe.exists():
+        raise RasterhwError(f"verilator build failed (see {bdir / 'build.log'}):\n{r.stderr[-2000:]}")
+    return exe, build_s
+
+
+def _read_hex(path: Path) -> np.ndarray:
+    words = [w for w in path.read_text().split() if not w.startswith("//")]
+    return np.array([int(w, 16) for w in words], dtype=object)
+
+
+def run_processor_verilator(recs: list[dict], *, n: int, p: int, q: int, a: int, b: int, z_bits: int = 24) -> dict:
+    """One processor on Verilator: the same keys as :func:`rasterhw.sim.sparse.hdl_run.run_processor`
+    plus ``run_s`` (the C++ clock loop) and ``build_s``."""
+    from rasterhw.hdl.sparse.layouts import BROADCAST
+
+    if len(recs) > MAXT:
+        raise RasterhwError(f"sparse verilator bench holds at most {MAXT} triangles, not {len(recs)}")
+    if not (0 <= a < p and 0 <= b < q):
+        raise RasterhwError(f"sparse HDL: processor ({a}, {b}) is outside a {p}x{q} matrix")
+    exe, build_s = build(n=n, p=p, q=q, z_bits=z_bits)
+    run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=exe.parent.parent))
+    digits = -(-BROADCAST.size // 4)
+    (run_dir / "in.hex").write_text("".join(f"{BROADCAST.const(r).as_bits():0{digits}x}\n" for r in recs))
+    N = 1 << n
+    maxcyc = 200 * (len(recs) + 10) * (1 + n) + 64 * N * N + 10_000_000
+    cmd = [str(exe), f"+in={run_dir / 'in.hex'}", f"+out={run_dir / 'out.hex'}", f"+stats={run_dir / 'stats.hex'}",
+           f"+ntri={len(recs)}", f"+a={a}", f"+b={b}", f"+maxcyc={maxcyc}"]
+    r = subprocess.run(cmd, cwd=run_dir, capture_output=True, text=True)
+    try:
+        meta = json.loads(r.stdout.strip().splitlines()[-1])
+    except (IndexError, json.JSONDecodeError) as e:
+        raise RasterhwError(f"{exe.name} failed ({r.returncode}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}") from e
+    if not meta["done"]:
+        raise RasterhwError(f"{exe.name}: not done within {maxcyc} cycles")
+    words = _read_hex(run_dir / "out.hex")
+    st = [int(v) for v in _read_hex(run_dir / "stats.hex")]
+    for f in run_dir.iterdir():
+        f.unlink()
+    run_dir.rmdir()
+    zmask = (1 << (z_bits + 1)) - 1
+    tri = np.array([int(w) >> (z_bits + 1) for w in words], dtype=np.int64)
+    zq = np.array([int(w) & zmask for w in words], dtype=np.int64)
+    empty = tri == (1 << TRI_BITS) - 1
+    tri[empty], zq[empty] = -1, -1
+    return {"tri": tri.reshape(N, N), "zq": zq.reshape(N, N), "tests": st[:n], "stalls": st[n:2 * n],
+            "cycles": st[2 * n], "writes": st[2 * n + 1], "sim_cycles": meta["sim_cycles"], "run_s": meta["run_s"],
+            "build_s": build_s}
