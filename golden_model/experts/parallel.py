@@ -126,6 +126,7 @@ class ParallelResult:
     frame_time: float            # max over groups (the frame's time)
     pxp_busy: np.ndarray         # (Sn, Pn) summed PXP time per processor
     slp_busy: np.ndarray         # (Sn,) summed SLP time
+    ranges: np.ndarray | None = None   # (H, Pn + 1) the PXP range boundaries used on each line
 
     def line_imbalance(self) -> np.ndarray:
         """max / mean PXP time, per line."""
@@ -148,6 +149,7 @@ def _group(fr: ExpertsFrame, y0: int, y1: int, pn: int, range_method: str, bal: 
     widths = np.diff(equal_bounds(W, pn))
     n = y1 - y0
     tp = np.zeros((n, pn))
+    tb = np.zeros((n, pn + 1), np.int64)
     ts = np.zeros(n)
     s_end = np.zeros(n)
     p_end = np.zeros((n, pn))
@@ -156,18 +158,26 @@ def _group(fr: ExpertsFrame, y0: int, y1: int, pn: int, range_method: str, bal: 
     for k in range(n):
         y = y0 + k
         b = _widths_to_bounds(widths)
+        tb[k] = b
         a = b[:-1]
         if cyc_tables is None:
             c = P[y, b[1:]] - P[y, a]
             inner = a > 0
             c = c + np.where(inner, extra_c * cross[y, np.minimum(a, W - 1)]
                              + extra_m * midrun[y, np.minimum(a, W - 1)], 0)
-        else:  # PXP HDL cycles (the finish-time counters of the PXP block)
+        else:  # PXP HDL cycles: the block's finish-time counters (pxp_cycles.schedule, per PXP)
             pc, ps, guard = cyc_tables
             glo = np.maximum(a - guard, 0)
             ghi = np.minimum(b[1:] + guard, W)
             segs = ps[y, ghi] - ps[y, glo] + np.where(glo > 0, cross[y, np.minimum(glo, W - 1)], 0)
-            c = (ghi - glo) + 2 + 2 * segs + 2 * (pc[y, ghi] - pc[y, glo])
+            r = (ghi - glo) + 1 + 2 * segs + 2 * (pc[y, ghi] - pc[y, glo])
+            if k == 0:
+                hs, hfree = np.zeros(pn, np.int64), np.zeros(pn, np.int64)
+            h = np.maximum(hs + r, hfree)
+            c = h - hs + 1
+            drain = np.where(guard > 0, 3 * (ghi - glo) + (ghi == b[1:]), 2 * (b[1:] - a))
+            hfree = h + drain + 1
+            hs = h + 1
         tp[k] = c
         ts[k] = start[y] if k == 0 else cont[y]
         s_start = max(s_end[k - 1] if k else t0, p_end[k - 2].max() if k >= 2 else 0.0)
@@ -179,7 +189,7 @@ def _group(fr: ExpertsFrame, y0: int, y1: int, pn: int, range_method: str, bal: 
         d_start = max(p_end[k].max(), d_end[k - 1] if k else 0.0)
         d_end[k] = d_start + bal.fb_cost * W
         widths = rebalance(widths, c, range_method, bal)
-    return tp, ts, float(d_end[-1])
+    return tp, ts, float(d_end[-1]), tb
 
 
 def run_parallel(fr: ExpertsFrame, sn: int, pn: int, *, band_method: str = "equal", range_method: str = "static",
@@ -211,16 +221,17 @@ def run_parallel(fr: ExpertsFrame, sn: int, pn: int, *, band_method: str = "equa
     pl_cost = (13 + 2) * fr.setup.n
     for f in range(max(frames, 1)):
         tp = np.zeros((H, pn))
+        rb = np.zeros((H, pn + 1), np.int64)
         ts = np.zeros(H)
         gt = np.zeros(sn)
         for s in range(sn):
             y0, y1 = int(bands[s]), int(bands[s + 1])
-            a, b_, g = _group(fr, y0, y1, pn, range_method, bal, P, cont, start, pl_cost, tables)
-            tp[y0:y1], ts[y0:y1], gt[s] = a, b_, g
+            a, b_, g, bb = _group(fr, y0, y1, pn, range_method, bal, P, cont, start, pl_cost, tables)
+            tp[y0:y1], ts[y0:y1], gt[s], rb[y0:y1] = a, b_, g, bb
         if f + 1 < frames and band_method in ("i", "ii"):
             bands = _widths_to_bounds(rebalance(np.diff(bands), gt, band_method, bal))
     busy = np.stack([tp[int(bands[s]):int(bands[s + 1])].sum(axis=0) for s in range(sn)])
     sb = np.array([ts[int(bands[s]):int(bands[s + 1])].sum() + pl_cost for s in range(sn)])
     return ParallelResult(sn=sn, pn=pn, band_method=band_method, range_method=range_method, bands=np.asarray(bands),
                           pxp_time=tp, slp_time=ts, group_time=gt, frame_time=float(gt.max()), pxp_busy=busy,
-                          slp_busy=sb)
+                          slp_busy=sb, ranges=rb)

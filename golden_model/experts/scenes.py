@@ -18,8 +18,6 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from ..scene import Camera, Light, Material, Scene
@@ -237,5 +235,3 @@ def build_uneven(seed: int, *, width: int = 512, height: int = 512) -> Scene:
                  nverts=np.full(n, 3, dtype=np.int64), lights=(Light(direction=(-0.3, -0.4, -1.0)),),
                  ambient=(0.2, 0.2, 0.2), material=Material(ka=1.0, kd=0.8, ks=0.0))
 
-
-_ = math  # (kept for recipes that need it)

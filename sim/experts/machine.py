@@ -24,7 +24,9 @@ MACHINE = Machine(
                    "(pixels and cycles)", "rasterhw.sim.experts.pxp_sim:simulate_scene", default_scene="experts-1000",
                    options=(Option("sn", "SLPs (bands)", 8, type=int),
                             Option("pn", "PXPs per SLP (ranges)", 8, type=int),
-                            Option("aj", "anti-jagging in the PXP: none or c", "c", ("none", "a", "b", "c")))),),
+                            Option("aj", "anti-jagging in the PXP: none or c", "c", ("none", "a", "b", "c")),
+                            Option("ranges", "PXP ranges: static, or set per line by method i / ii from the "
+                                   "previous line's finish-time counters", "static", ("static", "i", "ii")))),),
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",
     status="scan-line golden model split as SLP/PXP (float and 16-bit), Sn x Pn parallel model with "

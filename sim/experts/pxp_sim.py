@@ -60,21 +60,22 @@ def job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
             "lo0": todo[0][1], "hi0": todo[0][2], "lines": len(todo), "aj": aj}
 
 
-def jobs(fr: ExpertsFrame, sn: int, pn: int) -> dict:
-    """:func:`job_list` for every (line, PXP) of an equal static Sn x Pn split, in frame order,
-    plus each PXP's own frame time by the cycle model (its band's lines back to back, as that PXP
-    runs them): ``pxp_frame_cycles`` (Sn, Pn)."""
+def jobs(fr: ExpertsFrame, sn: int, pn: int, *, ranges: np.ndarray | None = None) -> dict:
+    """:func:`job_list` for every (line, PXP) of an Sn x Pn split, in frame order, plus each PXP's
+    own frame time by the cycle model (its band's lines back to back, as that PXP runs them):
+    ``pxp_frame_cycles`` (Sn, Pn). ``ranges`` (H, Pn + 1): per-line boundaries (balancing);
+    default the equal static split."""
     H = fr.height
     bands = equal_bounds(H, sn)
-    rb = equal_bounds(fr.width, pn)
-    todo = [(y, int(rb[p]), int(rb[p + 1])) for y in range(H) for p in range(pn)]
+    rbs = np.broadcast_to(equal_bounds(fr.width, pn) if ranges is None else np.asarray(ranges), (H, pn + 1))
+    todo = [(y, int(rbs[y, p]), int(rbs[y, p + 1])) for y in range(H) for p in range(pn)]
     jb = job_list(fr, todo)
     jb["owner"] = [(int(np.searchsorted(bands, y, side="right") - 1), p) for y in range(H) for p in range(pn)]
     per = np.zeros((sn, pn), np.int64)
     for sidx in range(sn):
         for p in range(pn):
-            lo, hi = int(rb[p]), int(rb[p + 1])
-            own = [(line_segments(fr, y, lo, hi, aj=fr.aj), lo, hi) for y in range(int(bands[sidx]), int(bands[sidx + 1]))]
+            own = [(line_segments(fr, y, int(rbs[y, p]), int(rbs[y, p + 1]), aj=fr.aj), int(rbs[y, p]),
+                    int(rbs[y, p + 1])) for y in range(int(bands[sidx]), int(bands[sidx + 1]))]
             per[sidx, p] = schedule(own, aj=fr.aj, width=fr.width)["last_pixel"] + 1
     jb["pxp_frame_cycles"] = per
     return jb
@@ -200,7 +201,8 @@ def run_verilator(jb: dict, *, width: int) -> dict:
 
 
 def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", progress: bool = False,
-                   sn: int | None = 8, pn: int | None = 8, aj: str | None = "c") -> dict:
+                   sn: int | None = 8, pn: int | None = 8, aj: str | None = "c",
+                   ranges: str | None = "static") -> dict:
     """Registry sim block ``pxp``: the whole frame through the PXP HDL, compared with the golden model."""
     from rasterhw.golden_model.pipeline import run_geometry
     if engine not in ENGINES:
@@ -211,8 +213,17 @@ def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", pro
     aj = "c" if aj is None else aj
     if aj not in ("none", "c"):
         raise RasterhwError(f"experts: sim pxp aj must be none or c (the PXP HDL has method (c)), not {aj!r}")
+    ranges = "static" if ranges is None else ranges
+    if ranges not in ("static", "i", "ii"):
+        raise RasterhwError(f"experts: sim pxp ranges must be static, i or ii, not {ranges!r}")
     fr = render_frame(run_geometry(scene, width, height, z_bits=16), model="bit", aj=aj)
-    jb = jobs(fr, sn, pn)
+    rb = None
+    if ranges != "static":
+        # ranges set line by line from the previous line's finish-time counters (the PXP HDL's
+        # resolve cycles, as the cycle model the HDL matches gives them)
+        from rasterhw.golden_model.experts.parallel import run_parallel
+        rb = run_parallel(fr, sn, pn, band_method="equal", range_method=ranges, pxp_unit="cycles").ranges
+    jb = jobs(fr, sn, pn, ranges=rb)
     if progress:
         print(f"experts: {jb['lines']} PXP lines, {len(jb['words'])} words, {int(jb['cycles'].sum()):,} cycles expected")
     res = run_pysim(jb, width=width) if engine == "pysim" else run_verilator(jb, width=width)
@@ -232,5 +243,5 @@ def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", pro
             "cycle_mismatches": cyc_mism, "frame_cycles_busiest_pxp": frame_cycles,
             "last_pixel_mismatch": int(total != jb["last_pixel"] + 2),
             "pxp_cycles_per_line_mean": round(float(cyc.mean()), 2) if cyc.size else 0.0,
-            "pxp_clock_for_30fps_hz": frame_cycles * 30, "sn": sn, "pn": pn, "aj": aj,
+            "pxp_clock_for_30fps_hz": frame_cycles * 30, "sn": sn, "pn": pn, "aj": aj, "ranges": ranges,
             "run_s": round(res["run_s"], 3), "build_s": round(res.get("build_s", 0.0), 2)}

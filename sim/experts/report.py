@@ -232,6 +232,7 @@ def _tolerance(out: list, progress: bool) -> None:
 def _hdl(out: list, engine: str, progress: bool) -> None:
     """PXP HDL rows: pysim on a sample of lines (always), the whole experts-1000 frame on Verilator
     when ``engine == "verilator"``; the 30 frames/s PXP clock from the cycle model the HDL matched."""
+    from rasterhw.golden_model.experts.parallel import run_parallel
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.sim.experts.pxp_sim import jobs, simulate_scene
     small = simulate_scene(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=2, pn=4, aj="c")
@@ -255,12 +256,26 @@ def _hdl(out: list, engine: str, progress: bool) -> None:
         out.append(make_row(SYS, "HDL", "PXP cycles per scan line (mean of 4096 PXP lines), experts-1000, 8x8",
                             paper=None, formula=None, measured=r["pxp_cycles_per_line_mean"], unit="cycles",
                             source="hdl:verilator"))
+    jb2 = jobs(fr, 8, 8, ranges=run_parallel(fr, 8, 8, range_method="ii", pxp_unit="cycles").ranges)
+    busiest_ii = int(jb2["pxp_frame_cycles"].max())
+    if engine == "verilator":
+        r2 = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c", ranges="ii")
+        out.append(make_row(SYS, "HDL", "PXP pixel + line-cycle mismatches, ranges by method ii from the HDL "
+                            "counters, experts-1000, 8x8", paper=None, formula=None,
+                            measured=r2["mismatches"] + r2["cycle_mismatches"], unit="pixels + lines",
+                            source="hdl:verilator"))
     what = "cycle model, matched by the HDL line for line" + (" in this run" if engine == "verilator" else "")
+    out.append(make_row(SYS, "3.3 / HDL", f"busiest PXP's cycles per frame, ranges static / method ii, experts-1000, "
+                        f"8x8 ({what})", paper=None, formula=None, measured=round(busiest / busiest_ii, 4), unit="x",
+                        source="model"))
     meas = busiest
     out.append(make_row(SYS, "5 / HDL", f"busiest PXP's cycles per frame, A.J. (c), experts-1000, 8x8 ({what})",
                         paper=None, formula=None, measured=meas, unit="cycles", source="model"))
     out.append(make_row(SYS, "5 / HDL", f"PXP clock for 30 frames/s of experts-1000 at 8x8 with A.J. (c), PXPs only "
                         f"({what})", paper=None, formula=None, measured=round(meas * 30 / 1e6, 3), unit="MHz",
+                        source="model"))
+    out.append(make_row(SYS, "5 / HDL", f"the same with ranges by method ii from the PXP counters ({what})",
+                        paper=None, formula=None, measured=round(busiest_ii * 30 / 1e6, 3), unit="MHz",
                         source="model"))
 
 

@@ -93,12 +93,19 @@ def test_range_cycles_equal_the_hdl_cycle_model(aj):
             assert cyc[y, p] == want, (y, lo, hi)
 
 
-def test_parallel_in_pxp_cycles_static_matches_the_range_cycles():
+def test_parallel_in_pxp_cycles_are_the_hdl_finish_time_counters():
+    """PXP times in cycles = what each PXP's counter reads line by line (its DSLB drain waits
+    included): the cycle model's schedule of that PXP's own lines, which the HDL matches."""
     from rasterhw.golden_model.experts.model import pxp_range_cycles
+    from rasterhw.golden_model.experts.pxp_cycles import line_segments, schedule
     f = _frame("experts-uneven")
-    r = run_parallel(f, 1, 8, range_method="static", pxp_unit="cycles")
-    assert np.array_equal(r.pxp_time, pxp_range_cycles(f, np.arange(9) * 64))
+    r = run_parallel(f, 8, 8, range_method="static", pxp_unit="cycles")
+    assert (r.pxp_time >= pxp_range_cycles(f, np.arange(9) * 64)).all()
+    for p in (0, 5):
+        own = [(line_segments(f, y, 64 * p, 64 * p + 64, aj="c"), 64 * p, 64 * p + 64) for y in range(64, 128)]
+        assert r.pxp_time[64:128, p].tolist() == schedule(own, aj="c")["line_cycles"]
+    st = run_parallel(f, 1, 8, range_method="static", pxp_unit="cycles")
     ii = run_parallel(f, 1, 8, range_method="ii", pxp_unit="cycles")
-    assert ii.imbalance() < r.imbalance()
+    assert ii.imbalance() < st.imbalance()
     with pytest.raises(RasterhwError, match="pxp_unit"):
         run_parallel(f, 1, 8, pxp_unit="s")

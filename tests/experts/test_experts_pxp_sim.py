@@ -18,6 +18,14 @@ def test_small_frame_pysim_pixel_and_cycle_exact(aj):
     assert r["frame_cycles_busiest_pxp"] < r["cycles"]
 
 
+def test_balanced_ranges_through_the_hdl():
+    """Ranges moved line by line by method ii from the finish-time counters: still exact."""
+    r = simulate_scene(build_scene("experts-uneven"), 128, 32, engine="pysim", sn=1, pn=4, aj="c", ranges="ii")
+    assert r["mismatches"] == 0 and r["cycle_mismatches"] == 0 and r["last_pixel_mismatch"] == 0
+    s = simulate_scene(build_scene("experts-uneven"), 128, 32, engine="pysim", sn=1, pn=4, aj="c")
+    assert r["frame_cycles_busiest_pxp"] <= s["frame_cycles_busiest_pxp"]
+
+
 def test_registered_and_bad_engine():
     m, b = sim_blocks()["pxp"]
     assert m.name == "experts" and b.default_scene == "experts-1000"
@@ -25,6 +33,8 @@ def test_registered_and_bad_engine():
         simulate_scene(build_scene("experts-tilt-1000"), 64, 16, engine="icarus")
     with pytest.raises(RasterhwError, match="aj must be"):
         simulate_scene(build_scene("experts-tilt-1000"), 64, 16, aj="b")
+    with pytest.raises(RasterhwError, match="ranges must be"):
+        simulate_scene(build_scene("experts-tilt-1000"), 64, 16, ranges="iii")
 
 
 @pytest.mark.slow
