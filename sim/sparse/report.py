@@ -298,9 +298,9 @@ def _hdl_rows(row, engine: str, progress: bool, hdl_scene=None) -> list[str]:
             f"{r['cycles']} cycles for the slowest processor, {r['sim_cycles']} cycles simulated in all at "
             f"{r['cycles_per_s']} cycles/s; busy cycles (coverage tests) per level summed over processors: "
             f"{r['tests_per_level_hdl']}. A stage makes one coverage test per busy cycle (τ = 1 cycle) and takes "
-            "the next window in the cycle of its last test; the frame still takes more cycles than its busiest "
-            "stage's tests because a header costs two cycles in every stage and a full FIFO stalls the stage "
-            "before it.\n"]
+            "the next window in the cycle of its last test; the frame still takes a little more than its busiest "
+            "stage's tests: a triangle's header costs one cycle at every level where it has survivors, and a "
+            "full FIFO stalls the stage before it.\n"]
 
 
 def _plots(out_dir: Path, spr, mono, Sg, S_GRID):  # noqa: N803

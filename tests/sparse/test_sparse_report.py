@@ -12,7 +12,7 @@ def report(tmp_path_factory):
     from rasterhw.sim.sparse.report import rows
 
     out = tmp_path_factory.mktemp("sparse_report")
-    return rows(samples=200, out_dir=out, scenes=("sp8",), s_grid=(0.1, 1.8, 10.0, 23.3, 100.0, 157.0, 1000.0),
+    return rows(samples=100, out_dir=out, scenes=("sp8",), s_grid=(0.1, 1.8, 10.0, 23.3, 100.0, 157.0, 1000.0),
                 engine="none"), out  # HDL rows: tests/sparse/test_sparse_vp_*.py
 
 
