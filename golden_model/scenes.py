@@ -318,7 +318,7 @@ def _build_experts(fr: int) -> Callable[[int], Scene]:
 def _experts_builder(fn: str, *args) -> Callable[[int], Scene]:
     """An EXPERTS builder from golden_model/experts/scenes.py, imported when first used."""
     def build(seed: int) -> Scene:
-        from .experts import scenes as ex
+        from rasterhw.golden_model.experts import scenes as ex
         f = getattr(ex, fn)
         return (f(*args) if args else f)(seed)
     return build

@@ -18,10 +18,16 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
-from ..screen import ScreenTriangles
-from .alpha import ALPHA, alpha_area
-from .model import PAPER_PXP, PAPER_SLP, ExpertsFrame, equal_bounds, pxp_range_ops, slp_band_ops
+from rasterhw.golden_model.experts.alpha import ALPHA, alpha_area
+from rasterhw.golden_model.experts.model import (
+    PAPER_PXP,
+    PAPER_SLP,
+    ExpertsFrame,
+    equal_bounds,
+    pxp_range_ops,
+    slp_band_ops,
+)
+from rasterhw.golden_model.screen import ScreenTriangles
 
 __all__ = ["q_seq", "q_s", "q_p", "q_par", "balance_pn", "measured_q", "alpha_error", "line_segments",
            "total_ops"]
@@ -66,7 +72,7 @@ def measured_q(f: ExpertsFrame, sn: int, pn: int) -> dict:
 
 def total_ops(f: ExpertsFrame) -> int:
     """Every SLP and PXP operation of the frame on one SLP and one PXP (A.J. overhead base)."""
-    from .model import stage_totals
+    from rasterhw.golden_model.experts.model import stage_totals
     return int(sum(stage_totals(f, sn=1, pn=1).values()))
 
 
@@ -118,8 +124,8 @@ def tolerance(tris: ScreenTriangles) -> dict:
     and to **z** (16-bit depth: Q16.0 zL, sQ11.4 dz/dx, the 16-bit comparator and its tie rule)
     when they agree on the cover but pick a different nearest one.
     """
-    from . import pxp
-    from .model import render_frame
+    from rasterhw.golden_model.experts import pxp
+    from rasterhw.golden_model.experts.model import render_frame
     fl, bt = render_frame(tris, model="float"), render_frame(tris, model="bit")
     npix = fl.width * fl.height
     T = int(tris.n_triangles) + 1

@@ -37,8 +37,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-
-from ..errors import RasterhwError
+from rasterhw.golden_model.errors import RasterhwError
 
 __all__ = ["WORD", "FRAME", "HUE_BITS", "X_FRAC", "Z_BITS", "DZ_FRAC", "SLOPE_FRAC", "ACC_EXTRA",
            "ALPHA_BITS", "ASB_WORDS", "Formats", "recip_rom", "rom_div", "sat", "wrap"]

@@ -12,11 +12,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-
-from ..errors import RasterhwError
-from ..screen import ScreenTriangles
-from . import pxp, slp
-from .formats import Formats
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.experts import pxp, slp
+from rasterhw.golden_model.experts.formats import Formats
+from rasterhw.golden_model.screen import ScreenTriangles
 
 __all__ = ["ExpertsFrame", "render_frame", "equal_bounds", "slp_band_ops", "pxp_range_ops",
            "SLP_STAGES", "PXP_STAGES", "PAPER_SLP", "PAPER_PXP", "AJ_METHODS", "MODELS"]
@@ -78,7 +77,7 @@ def render_frame(tris: ScreenTriangles, *, model: str = "float", aj: str = "none
     inten = pxp.smooth_shading(st, rec, win, W)
     sh = None
     if shadows is not None:
-        from .shadow import SHADOW_ATTEN, SHADOW_ATTEN_Q8
+        from rasterhw.golden_model.experts.shadow import SHADOW_ATTEN, SHADOW_ATTEN_Q8
         sh = pxp.shadow_count(st, rec, win, zwin, shadows, W)
         s_ = sh["shadowed"]
         inten[s_] = (inten[s_] * SHADOW_ATTEN_Q8) >> 8 if st.bit else inten[s_] * SHADOW_ATTEN
@@ -139,7 +138,7 @@ def slp_line_costs(fr: ExpertsFrame, pn: int) -> tuple[np.ndarray, np.ndarray]:
                + slp.SLP_OPS["plane_setup_per_triangle"] + 2 * slp.SLP_OPS["start_per_edge"])
     if fr.aj != "none":
         per_tri += 3 * slp.SLP_OPS["aj_slopes_per_edge"] + (3 * slp.SLP_OPS["aj_perp_per_edge"] if fr.aj == "b" else 0)
-    from .formats import ASB_WORDS
+    from rasterhw.golden_model.experts.formats import ASB_WORDS
     enter_tris = np.bincount(st.r0, minlength=H)[:H]
     mid = np.bincount(st.rmid[(st.rmid > st.r0) & (st.rmid <= st.r1)], minlength=H)[:H]
     common = ln["m"] + pn + ASB_WORDS * ln["m"] + 2 * pn + slp.SLP_OPS["mid_reload"] * mid

@@ -34,9 +34,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-
-from ..errors import RasterhwError
-from .model import ExpertsFrame, equal_bounds, slp_line_costs
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.experts.model import ExpertsFrame, equal_bounds, slp_line_costs
 
 __all__ = ["Balance", "rebalance", "band_estimate", "run_parallel", "ParallelResult", "RANGE_METHODS",
            "BAND_METHODS"]
@@ -143,7 +142,7 @@ def _group(fr: ExpertsFrame, y0: int, y1: int, pn: int, range_method: str, bal: 
            cont: np.ndarray, start: np.ndarray, pl_cost: int, cyc_tables=None):
     W = fr.width
     cross, midrun = fr.costs["_cross"], fr.costs["_midrun"]
-    from .pxp import CROSS_OPS, MIDRUN_OPS
+    from rasterhw.golden_model.experts.pxp import CROSS_OPS, MIDRUN_OPS
     extra_c = sum(CROSS_OPS.values())
     extra_m = sum(MIDRUN_OPS.values())
     widths = np.diff(equal_bounds(W, pn))
@@ -211,11 +210,11 @@ def run_parallel(fr: ExpertsFrame, sn: int, pn: int, *, band_method: str = "equa
     equal_bounds(W, pn)
     if bands is None:
         bands = equal_bounds(H, sn) if band_method != "pl" else _bands_from_load(band_estimate(fr), sn)
-    from .model import PXP_STAGES, _prefix
+    from rasterhw.golden_model.experts.model import PXP_STAGES, _prefix
     P = _prefix(fr, PXP_STAGES)
     tables = None
     if pxp_unit == "cycles":
-        from .model import _cycle_prefix
+        from rasterhw.golden_model.experts.model import _cycle_prefix
         tables = (*_cycle_prefix(fr), 1 if fr.aj == "c" else 0)
     cont, start = slp_line_costs(fr, pn)
     pl_cost = (13 + 2) * fr.setup.n

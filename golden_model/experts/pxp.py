@@ -34,10 +34,9 @@ Decisions written here (and in docs/experts.md):
 from __future__ import annotations
 
 import numpy as np
-
-from .alpha import ALPHA
-from .formats import ALPHA_BITS, DZ_FRAC, SLOPE_FRAC, X_FRAC, Z_BITS
-from .slp import Records, Setup
+from rasterhw.golden_model.experts.alpha import ALPHA
+from rasterhw.golden_model.experts.formats import ALPHA_BITS, DZ_FRAC, SLOPE_FRAC, X_FRAC, Z_BITS
+from rasterhw.golden_model.experts.slp import Records, Setup
 
 __all__ = ["PXP_OPS", "AJ_OPS", "fragments", "depth_search", "smooth_shading", "anti_jagging",
            "pixel_costs"]
@@ -103,7 +102,7 @@ def shadow_count(st: Setup, rec: Records, win: np.ndarray, zwin: np.ndarray, sha
     The shadow faces are extra, invisible segments: each steps its z and compares it with the
     visible point's (2 ops per pixel it spans, 3 to start it), adding its sign when nearer.
     """
-    from . import slp as _slp
+    from rasterhw.golden_model.experts import slp as _slp
     npix = win.size
     sst = _slp.set_up(shadows.tris, bit=st.bit, fmt=st.fmt)
     srec = _slp.asl_update(sst, W)

@@ -19,9 +19,8 @@ at the frame's right edge with A.J.).
 from __future__ import annotations
 
 import numpy as np
-
-from .model import ExpertsFrame
-from .pxp import pixel_words
+from rasterhw.golden_model.experts.model import ExpertsFrame
+from rasterhw.golden_model.experts.pxp import pixel_words
 
 __all__ = ["SEG_FIELDS", "line_segments", "line_pixels", "line_cycles", "ADDR_BITS"]
 

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 from rasterhw.golden_model.arch import Rendered
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.experts.formats import Z_BITS, Formats
+from rasterhw.golden_model.experts.model import render_frame, stage_totals
+from rasterhw.golden_model.experts.parallel import run_parallel
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scene import Scene
-
-from .formats import Z_BITS, Formats
-from .model import render_frame, stage_totals
-from .parallel import run_parallel
 
 __all__ = ["render"]
 
@@ -33,7 +32,7 @@ def render(scene: Scene, width: int, height: int, *, arch: str = "experts", aj: 
     tris = run_geometry(scene, width, height, z_bits=Z_BITS)
     sf = None
     if shadows == "polygons":
-        from .shadow import shadow_faces
+        from rasterhw.golden_model.experts.shadow import shadow_faces
         sf = shadow_faces(scene, width, height, z_bits=Z_BITS)
     f = render_frame(tris, model=model, aj=aj, fmt=Formats(7 if intensity_bits is None else intensity_bits),
                      shadows=sf)

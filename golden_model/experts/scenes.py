@@ -19,19 +19,18 @@
 from __future__ import annotations
 
 import numpy as np
-
-from ..scene import Camera, Light, Material, Scene
+from rasterhw.golden_model.scene import Camera, Light, Material, Scene
 
 __all__ = ["build_tilt", "build_solid", "build_solids", "build_uneven", "SOLIDS", "visible_edges"]
 
 
 def _screen(height: int = 512):
-    from ..scenes import _screen_camera
+    from rasterhw.golden_model.scenes import _screen_camera
     return _screen_camera(height)
 
 
 def _tilted(name: str, seed: int, fr: int, *, width=512, height=512, dc=3.0, tilt=0.08) -> Scene:
-    from ..scenes import _lift, _random_triangles, _unit
+    from rasterhw.golden_model.scenes import _lift, _random_triangles, _unit
     rng = np.random.default_rng(seed)
     cam, f = _screen(height)
     area = rng.uniform(0.5, 1.5, fr)
@@ -158,7 +157,7 @@ def _solid_polys(key: str, rng: np.random.Generator, centre, scale: float):
 def visible_edges(scene: Scene) -> int:
     """Edges of front-facing polygons (orthographic test along the camera axis is not used:
     the winding on screen decides, as in the pipeline)."""
-    from ..scenes import _project
+    from rasterhw.golden_model.scenes import _project
     sxy, _ = _project(scene, 512, 512)
     edges = set()
     for p in range(scene.n_polygons):
@@ -211,7 +210,7 @@ def build_solids(seed: int) -> Scene:
 
 
 def build_uneven(seed: int, *, width: int = 512, height: int = 512) -> Scene:
-    from ..scenes import _lift, _random_triangles
+    from rasterhw.golden_model.scenes import _lift, _random_triangles
     rng = np.random.default_rng(seed)
     cam, f = _screen(height)
     ns, nb = 850, 150

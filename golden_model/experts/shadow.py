@@ -20,10 +20,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-
-from ..pipeline import run_geometry
-from ..scene import Material, Scene
-from ..screen import ScreenTriangles
+from rasterhw.golden_model.pipeline import run_geometry
+from rasterhw.golden_model.scene import Material, Scene
+from rasterhw.golden_model.screen import ScreenTriangles
 
 __all__ = ["ShadowFaces", "shadow_faces", "SHADOW_ATTEN", "SHADOW_ATTEN_Q8"]
 

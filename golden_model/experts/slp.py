@@ -30,10 +30,17 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-
-from ..errors import RasterhwError
-from ..screen import SUBPIXEL_BITS, ScreenTriangles, snap
-from .formats import ACC_EXTRA, SLOPE_FRAC, X_FRAC, Z_BITS, Formats, rom_div, sat
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.experts.formats import (
+    ACC_EXTRA,
+    SLOPE_FRAC,
+    X_FRAC,
+    Z_BITS,
+    Formats,
+    rom_div,
+    sat,
+)
+from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles, snap
 
 __all__ = ["Setup", "Records", "set_up", "y_sort", "asl_update", "l_sort_x_merge", "slp_line_ops",
            "SLP_OPS"]
@@ -353,6 +360,6 @@ def slp_line_ops(st: Setup, lines: dict, band: tuple[int, int], *, aj: str, pn: 
     ops["x_merge"] = int(lines["xmerge"][sl].sum()) + int(lines["xmerge_start"][y0])
     m = lines["m"][y0:y1]
     ops["block_lists"] = int(m.sum()) + (y1 - y0) * pn
-    from .formats import ASB_WORDS
+    from rasterhw.golden_model.experts.formats import ASB_WORDS
     ops["dmm_p_write"] = ASB_WORDS * int(m.sum()) + 2 * pn * (y1 - y0)
     return ops

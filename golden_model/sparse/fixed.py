@@ -11,9 +11,8 @@ processor rewrites it for its lattice exactly as the edges: ``Z0 = Z00 + a*Zx + 
 from __future__ import annotations
 
 import numpy as np
-
-from ..screen import SUBPIXEL_BITS, ScreenTriangles, snap
-from .formats import Z_ACC_BITS, Z_FRAC_BITS, check_signed
+from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles, snap
+from rasterhw.golden_model.sparse.formats import Z_ACC_BITS, Z_FRAC_BITS, check_signed
 
 __all__ = ["broadcast_records", "depth_plane", "plane_full"]
 
@@ -64,7 +63,7 @@ def broadcast_records(tris: ScreenTriangles) -> list[dict]:
     full-raster pixel indices), ``bbox`` (Xmin, Xmax, Ymin, Ymax in sub-pixel units),
     ``z00, zx, zy`` (the depth plane, ``Z_FRAC_BITS`` fraction bits) and ``tri`` (input index).
     The HDL video processor takes exactly these fields (``hdl/sparse/layouts.py``)."""
-    from .search import edge_setup
+    from rasterhw.golden_model.sparse.search import edge_setup
 
     xy, _, _ = tris.validate(who="sparse broadcast", max_coord=float(1 << 13))
     es = edge_setup(xy)

@@ -36,9 +36,8 @@ in the same order), so its image equals the reference bit for bit.
 from __future__ import annotations
 
 import numpy as np
-
-from ..errors import RasterhwError
-from ..screen import SUBPIXEL_BITS
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.screen import SUBPIXEL_BITS
 
 __all__ = [
     "COORD_BITS",

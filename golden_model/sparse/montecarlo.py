@@ -28,8 +28,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-
-from ..errors import RasterhwError
+from rasterhw.golden_model.errors import RasterhwError
 
 __all__ = ["MCResult", "count_windows", "rectangles", "triangles_from_scene", "level_counts", "s_k_measured"]
 

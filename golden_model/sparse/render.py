@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from ..arch import Rendered
-from ..errors import RasterhwError
-from ..pipeline import run_geometry
-from ..scene import Scene
-from .formats import parse_matrix, sparse_geometry
-from .search import sparse_render
+from rasterhw.golden_model.arch import Rendered
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.pipeline import run_geometry
+from rasterhw.golden_model.scene import Scene
+from rasterhw.golden_model.sparse.formats import parse_matrix, sparse_geometry
+from rasterhw.golden_model.sparse.search import sparse_render
 
 __all__ = ["render"]
 
@@ -21,7 +21,7 @@ def render(scene, width: int, height: int, *, arch: str = "sparse", matrix: str 
     p, q = parse_matrix(matrix)
     sparse_geometry(width, height, p, q)  # fail before the geometry stage
     if isinstance(scene, str):
-        from ..scenes import build_scene
+        from rasterhw.golden_model.scenes import build_scene
 
         scene = build_scene(scene)
     if not isinstance(scene, Scene):

@@ -45,10 +45,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-
-from ..errors import RasterhwError
-from ..screen import SUBPIXEL_BITS, ScreenTriangles, snap
-from .formats import (
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles, snap
+from rasterhw.golden_model.sparse.formats import (
     EDGE_AB_BITS,
     EDGE_BITS,
     Z_FRAC_BITS,
@@ -287,7 +286,7 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
         zz += zt[2] * w2
         key = zz
     else:
-        from .fixed import depth_plane
+        from rasterhw.golden_model.sparse.fixed import depth_plane
 
         Z0, Zu, Zv = depth_plane(tris, es, p, q)  # (T, q, p), (T,), (T,)
         acc = Z0[rt, pb, pa] + Zu[rt] * u0 + Zv[rt] * v0

@@ -31,8 +31,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
-from ..errors import RasterhwError
+from rasterhw.golden_model.errors import RasterhwError
 
 __all__ = [
     "L_RECT_5_1",

@@ -31,11 +31,10 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-
-from ..errors import RasterhwError
-from ..pipeline import run_geometry
-from ..scene import Light, Material, Scene
-from ..screen import SUBPIXEL_BITS, ScreenTriangles, snap
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.pipeline import run_geometry
+from rasterhw.golden_model.scene import Light, Material, Scene
+from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles, snap
 
 __all__ = ["ControlBlock", "NormalBlock", "PolygonBlock", "ScreenPolygons", "VertexBlock",
            "Blocks", "blocks_from_scene", "ground_polygons", "quantise_rgbi", "setup"]

@@ -34,8 +34,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-
-from .segments import SegmentBlock, span_from_n, ylist
+from rasterhw.golden_model.vzbuf.segments import SegmentBlock, span_from_n, ylist
 
 __all__ = ["Counters", "algorithm1", "algorithm2", "new_buffers"]
 

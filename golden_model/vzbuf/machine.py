@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from ..arch import Rendered
-from ..errors import RasterhwError
-from ..scene import Scene
-from .render import DEFAULT_EPS, render_frame
+from rasterhw.golden_model.arch import Rendered
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.scene import Scene
+from rasterhw.golden_model.vzbuf.render import DEFAULT_EPS, render_frame
 
 __all__ = ["render"]
 

@@ -23,13 +23,17 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-
-from ..errors import RasterhwError
-from ..scene import Scene
-from .blocks import blocks_from_scene, quantise_rgbi, setup
-from .hsr import Counters, algorithm1, algorithm2, new_buffers
-from .segments import build_segments, concat_segments, split_segments
-from .shadows import light_polygons, light_space, shadow_map_test, shadow_polygons
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.scene import Scene
+from rasterhw.golden_model.vzbuf.blocks import blocks_from_scene, quantise_rgbi, setup
+from rasterhw.golden_model.vzbuf.hsr import Counters, algorithm1, algorithm2, new_buffers
+from rasterhw.golden_model.vzbuf.segments import build_segments, concat_segments, split_segments
+from rasterhw.golden_model.vzbuf.shadows import (
+    light_polygons,
+    light_space,
+    shadow_map_test,
+    shadow_polygons,
+)
 
 __all__ = ["Frame", "render_frame", "DEFAULT_EPS"]
 

@@ -13,11 +13,10 @@ import math
 import time
 
 import numpy as np
-
-from ..pipeline import frame_setup
-from ..scene import Scene
-from .blocks import SUB
-from .segments import SegmentBlock
+from rasterhw.golden_model.pipeline import frame_setup
+from rasterhw.golden_model.scene import Scene
+from rasterhw.golden_model.vzbuf.blocks import SUB
+from rasterhw.golden_model.vzbuf.segments import SegmentBlock
 
 __all__ = ["scalar_setup", "scalar_segments", "scalar_split", "scalar_alg1", "scalar_alg2",
            "scalar_transform", "scalar_run"]
@@ -370,8 +369,8 @@ def segments_to_scalar(seg: SegmentBlock) -> list:
 def scalar_run(scene: Scene, width: int, height: int, *, alg: int, shadows: str = "none", eps: float = 5e-3,
                shadow_quads=None) -> dict:
     """The whole frame one element at a time; returns the stage CPU times (s) like render_frame."""
-    from .blocks import blocks_from_scene
-    from .shadows import light_space, screen_to_light_matrix
+    from rasterhw.golden_model.vzbuf.blocks import blocks_from_scene
+    from rasterhw.golden_model.vzbuf.shadows import light_space, screen_to_light_matrix
 
     clock = time.process_time
     t0 = clock()
@@ -451,8 +450,8 @@ def scalar_run(scene: Scene, width: int, height: int, *, alg: int, shadows: str 
 
 def scalar_shadow_quads(scene: Scene) -> list:
     """Silhouette edges -> shadow quads (outward winding), one edge at a time."""
-    from .blocks import ground_polygons
-    from .shadows import face_normals
+    from rasterhw.golden_model.vzbuf.blocks import ground_polygons
+    from rasterhw.golden_model.vzbuf.shadows import face_normals
 
     lv = np.asarray(scene.lights[0].direction, float)
     lv = (lv / np.linalg.norm(lv)).tolist()
@@ -499,7 +498,7 @@ def scalar_shadow_quads(scene: Scene) -> list:
 def _quad_scene(scene: Scene, quads: list, reverse: bool) -> Scene:
     from dataclasses import replace
 
-    from .shadows import _unit_rows
+    from rasterhw.golden_model.vzbuf.shadows import _unit_rows
 
     lv = np.asarray(scene.lights[0].direction, float)
     lv = lv / np.linalg.norm(lv)
@@ -522,7 +521,7 @@ def _quad_scene(scene: Scene, quads: list, reverse: bool) -> Scene:
 
 def scalar_light_polys(scene: Scene, ls: dict) -> list:
     """Light-facing polygons to light space, one vertex at a time."""
-    from .shadows import face_normals
+    from rasterhw.golden_model.vzbuf.shadows import face_normals
 
     m = ls["matrix"].tolist()
     lv = ls["lv"].tolist()

@@ -30,8 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-
-from .blocks import SUB, ScreenPolygons
+from rasterhw.golden_model.vzbuf.blocks import SUB, ScreenPolygons
 
 __all__ = ["EdgeBlock", "SegmentBlock", "build_segments", "split_segments", "spans_at", "ylist"]
 

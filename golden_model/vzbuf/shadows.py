@@ -31,12 +31,15 @@ no shadow polygons, no buffer.
 from __future__ import annotations
 
 import numpy as np
-
-from ..errors import RasterhwError
-from ..pipeline import frame_setup, run_geometry
-from ..scene import Light, Material, Scene
-from ..screen import ScreenTriangles
-from .blocks import ScreenPolygons, ground_polygons, polygons_from_triangles
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.pipeline import frame_setup, run_geometry
+from rasterhw.golden_model.scene import Light, Material, Scene
+from rasterhw.golden_model.screen import ScreenTriangles
+from rasterhw.golden_model.vzbuf.blocks import (
+    ScreenPolygons,
+    ground_polygons,
+    polygons_from_triangles,
+)
 
 __all__ = ["edge_table", "light_space", "ray_shadow", "screen_to_world", "shadow_polygons",
            "shadow_map_test", "check_light"]

@@ -10,12 +10,17 @@ shadow rows count the shadow polygons (front and back) the same way.
 from __future__ import annotations
 
 import numpy as np
-
-from ..errors import RasterhwError
-from ..scene import Scene
-from .blocks import setup
-from .segments import SegmentBlock, build_segments, extents, spans_at, split_segments
-from .shadows import shadow_polygons
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.scene import Scene
+from rasterhw.golden_model.vzbuf.blocks import setup
+from rasterhw.golden_model.vzbuf.segments import (
+    SegmentBlock,
+    build_segments,
+    extents,
+    spans_at,
+    split_segments,
+)
+from rasterhw.golden_model.vzbuf.shadows import shadow_polygons
 
 __all__ = ["segment_pixels", "table1"]
 

@@ -12,11 +12,15 @@ from __future__ import annotations
 import time
 
 import numpy as np
-
-from ..scene import Scene
-from .blocks import blocks_from_scene, quantise_rgbi, setup
-from .segments import SegmentBlock, build_segments, concat_segments, spans_at
-from .shadows import shadow_polygons
+from rasterhw.golden_model.scene import Scene
+from rasterhw.golden_model.vzbuf.blocks import blocks_from_scene, quantise_rgbi, setup
+from rasterhw.golden_model.vzbuf.segments import (
+    SegmentBlock,
+    build_segments,
+    concat_segments,
+    spans_at,
+)
+from rasterhw.golden_model.vzbuf.shadows import shadow_polygons
 
 __all__ = ["fragments", "render_whole"]
 

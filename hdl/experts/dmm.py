@@ -19,8 +19,7 @@ from amaranth import Module, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
-
-from .pxp import seg_layout
+from rasterhw.hdl.experts.pxp import seg_layout
 
 __all__ = ["ExpertsDmm"]
 

@@ -5,9 +5,8 @@ from __future__ import annotations
 from amaranth import Module, unsigned
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
-
-from .dmm import ExpertsDmm
-from .pxp import ExpertsPxp, seg_layout
+from rasterhw.hdl.experts.dmm import ExpertsDmm
+from rasterhw.hdl.experts.pxp import ExpertsPxp, seg_layout
 
 __all__ = ["ExpertsPxpUnit"]
 

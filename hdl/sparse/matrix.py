@@ -6,9 +6,8 @@ from amaranth.hdl import Module, Mux, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import TRI_BITS
-
-from .layouts import BROADCAST
-from .vp import VideoProcessor
+from rasterhw.hdl.sparse.layouts import BROADCAST
+from rasterhw.hdl.sparse.vp import VideoProcessor
 
 __all__ = ["Matrix", "make_matrix"]
 

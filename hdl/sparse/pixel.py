@@ -6,8 +6,7 @@ from amaranth.hdl import Module, Signal, unsigned
 from amaranth.lib import memory, stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import TRI_BITS, Z_FRAC_BITS
-
-from .layouts import HEADER, WINDOW
+from rasterhw.hdl.sparse.layouts import HEADER, WINDOW
 
 __all__ = ["PixelProcessor"]
 

@@ -6,8 +6,7 @@ from amaranth.hdl import Module, Signal, signed
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import EDGE_BITS, MATRIX_LOG2_MAX, SUBPIXEL_BITS
-
-from .layouts import HEADER, WINDOW
+from rasterhw.hdl.sparse.layouts import HEADER, WINDOW
 
 __all__ = ["LevelStage"]
 

@@ -6,10 +6,9 @@ from amaranth.hdl import Module, Mux, Signal
 from amaranth.lib import fifo, stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import MATRIX_LOG2_MAX, TRI_BITS
-
-from .layouts import BROADCAST, HEADER, WINDOW
-from .pixel import PixelProcessor
-from .stage import LevelStage
+from rasterhw.hdl.sparse.layouts import BROADCAST, HEADER, WINDOW
+from rasterhw.hdl.sparse.pixel import PixelProcessor
+from rasterhw.hdl.sparse.stage import LevelStage
 
 __all__ = ["VideoProcessor", "make_vp"]
 

@@ -21,9 +21,9 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
     p, q = parse_matrix(matrix)
     n = sparse_geometry(tris.width, tris.height, p, q)
     if engine == "pysim":
-        from .hdl_run import run_processor as run
+        from rasterhw.sim.sparse.hdl_run import run_processor as run
     elif engine == "verilator":
-        from .verilator_run import run_processor_verilator as run
+        from rasterhw.sim.sparse.verilator_run import run_processor_verilator as run
     else:
         raise RasterhwError(f"sparse sim: engine must be 'pysim' or 'verilator', not {engine!r}")
     g = sparse_render(tris, (p, q), depth="fixed")

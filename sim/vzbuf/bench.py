@@ -14,10 +14,10 @@ import sys
 import time
 import tracemalloc
 
-from ...golden_model.scenes import build_scene
-from ...golden_model.vzbuf.render import render_frame
-from ...golden_model.vzbuf.wholearray import render_whole
-from .paper import COLS, T1, T5, VP200_T5_C300_FRAGMENTS_PER_S, VP200_T5_C300_MS
+from rasterhw.golden_model.scenes import build_scene
+from rasterhw.golden_model.vzbuf.render import render_frame
+from rasterhw.golden_model.vzbuf.wholearray import render_whole
+from rasterhw.sim.vzbuf.paper import COLS, T1, T5, VP200_T5_C300_FRAGMENTS_PER_S, VP200_T5_C300_MS
 
 
 def _time(fn, repeat):

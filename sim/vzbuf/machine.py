@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..registry import Arch, Machine, Option
+from rasterhw.sim.registry import Arch, Machine, Option
 
 _OPTIONS = (
     Option("shadows", "Shadows: none, Crow's shadow polygons, or ray casting with a shadow map.",

@@ -12,15 +12,14 @@ import sys
 from pathlib import Path
 
 import numpy as np
-
-from ...golden_model.reference import rasterise
-from ...golden_model.scenes import build_scene
-from ...golden_model.vzbuf.render import render_frame
-from ...golden_model.vzbuf.scalar import scalar_run
-from ...golden_model.vzbuf.shadows import ray_shadow
-from ...golden_model.vzbuf.stats import table1
-from ..report import make_row
-from .paper import COLS, CORRECTED, RUNS, T1, TABLES
+from rasterhw.golden_model.reference import rasterise
+from rasterhw.golden_model.scenes import build_scene
+from rasterhw.golden_model.vzbuf.render import render_frame
+from rasterhw.golden_model.vzbuf.scalar import scalar_run
+from rasterhw.golden_model.vzbuf.shadows import ray_shadow
+from rasterhw.golden_model.vzbuf.stats import table1
+from rasterhw.sim.report import make_row
+from rasterhw.sim.vzbuf.paper import COLS, CORRECTED, RUNS, T1, TABLES
 
 SYS = "vzbuf"
 W = H = 512
@@ -322,6 +321,6 @@ def _sections(t1, times, scenes) -> list[str]:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    from ..report import run_report
+    from rasterhw.sim.report import run_report
 
     run_report("vzbuf", out_dir=Path("docs/reproduction"), progress=True)
