@@ -1,6 +1,7 @@
 // The Verilog side of the verification harness, shared by every bench wrapper
 // (cocotb_tests/*/tb_*.v and the plain-Verilator mains):
 //
+//   rasterhw_two_clocks    the segment and merge clocks, half periods and phase from plusargs
 //   rasterhw_reset         holds a reset for CYCLES rising edges of its own clock, then releases
 //                          it DELAY ns after the next edge (away from every clock edge)
 //   rasterhw_stream_player plays words preloaded from a hex file (name from a plusarg) into a
@@ -10,6 +11,42 @@
 // Stimulus word: {gap[GW-1:0], payload[PW-1:0]}: the payload is offered `gap` clocks after the
 // clock following the previous transfer (the first `gap` clocks after reset) and held until
 // accepted.
+
+// +sync_half= / +merge_half= ns (default 5) and +merge_phase= ns (default 1), so one simulator
+// build serves every clock ratio. Equal clocks in phase (+merge_phase=0, the speed runs) toggle
+// in one process: one coroutine resumption per edge instead of two.
+module rasterhw_two_clocks (
+  output reg clk,
+  output reg mclk
+);
+  integer SYNC_HALF = 5, MERGE_HALF = 5, MERGE_PHASE = 1;
+  initial begin
+    clk = 1'b0;
+    mclk = 1'b0;
+    if (!$value$plusargs("sync_half=%d", SYNC_HALF)) SYNC_HALF = 5;
+    if (!$value$plusargs("merge_half=%d", MERGE_HALF)) MERGE_HALF = 5;
+    if (!$value$plusargs("merge_phase=%d", MERGE_PHASE)) MERGE_PHASE = 1;
+  end
+  wire one_clock = (MERGE_PHASE == 0) && (MERGE_HALF == SYNC_HALF);
+  initial begin
+    #1;  // let the plusargs be read first
+    if (one_clock)
+      forever begin
+        #(SYNC_HALF);
+        clk = ~clk;
+        mclk = ~mclk;
+      end
+    else
+      forever #(SYNC_HALF) clk = ~clk;
+  end
+  initial begin
+    #1;
+    if (!one_clock) begin
+      #(MERGE_PHASE);
+      forever #(MERGE_HALF) mclk = ~mclk;
+    end
+  end
+endmodule
 
 // Each reset is released by a process that counts only its own clock's edges, DELAY ns after a
 // rising edge of that clock: before its falling edge (half periods are >= 1 ns) and away from

@@ -23,12 +23,14 @@ from rasterhw.golden_model.errors import RasterhwError
 
 __all__ = [
     "HARNESS_V",
+    "PLAIN_MAIN",
     "LINT_WAIVERS",
     "REPO_ROOT",
     "SIMULATORS",
     "VERILATOR_BUILD_ARGS",
     "SimulatorUnavailable",
     "build_dir_for",
+    "build_plain_verilator",
     "get_sim",
     "lint_verilog",
     "run_cocotb",
@@ -39,6 +41,11 @@ __all__ = [
 REPO_ROOT = Path(__file__).resolve().parents[1]
 #: the Verilog side of the harness every bench wrapper uses (reset release, stream player, checker)
 HARNESS_V = REPO_ROOT / "cocotb_tests" / "harness.v"
+#: the C++ main every timing-free (plain Verilator) bench shares
+PLAIN_MAIN = REPO_ROOT / "cocotb_tests" / "plain_main.cpp"
+#: Verilator flags of the timing-free benches: C++ model with our main, built in one step
+VERILATOR_PLAIN_ARGS = ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast",
+                        "-Wno-fatal", "-Wno-lint", "-Wno-style", "--build-jobs", "2"]
 SIMULATORS = ("verilator", "icarus")
 
 # Verilator flags for building a bench:
@@ -158,6 +165,50 @@ def build_dir_for(block: str, sim: str, *, sources: Sequence[Path] = (), **param
         h.update(Path(s).read_bytes())
     digest = h.hexdigest()[:10]
     return REPO_ROOT / "build" / f"{block}-{sim}-{digest}"
+
+
+def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, params: Mapping[str, object],
+                          opt: str = "-O2", defines: Mapping[str, object] | None = None,
+                          generated: Mapping[str, str] | None = None) -> tuple[Path, float]:
+    """Build a timing-free Verilator model of ``top`` with :data:`PLAIN_MAIN`, once per content.
+
+    ``sources``: Verilog files; ``generated``: ``{file name: text}`` written into the build folder
+    first (generated Verilog, include files; ``.v`` ones are compiled, the folder is on the include
+    path); ``params``: ``-G`` top-level parameters; ``defines``: C++ ``-D`` for the main
+    (``RASTERHW_CYCLES``, ``RASTERHW_LINES``, ``RASTERHW_TAIL``); ``opt``: see
+    :func:`verilator_make_vars`. The folder ``build/<name>-<digest>`` is keyed on all of these and
+    the bytes of every source, so an unchanged design is never rebuilt and a changed one always is.
+    Returns ``(binary, build seconds, 0.0 if it was already built)``.
+    """
+    generated = dict(generated or {})
+    defines = {"RASTERHW_TOP": f"V{top}", **(defines or {})}
+    make = verilator_make_vars(opt)
+    h = hashlib.sha1(json.dumps({"top": top, "args": VERILATOR_PLAIN_ARGS, "make": make, "defines": defines,
+                                 "params": params}, sort_keys=True, default=str).encode())
+    for f in (*sources, PLAIN_MAIN):
+        h.update(Path(f).read_bytes())
+    for k in sorted(generated):
+        h.update(k.encode() + generated[k].encode())
+    bdir = REPO_ROOT / "build" / f"{name}-{h.hexdigest()[:10]}"
+    exe = bdir / "obj_dir" / f"V{top}"
+    if exe.exists():
+        return exe, 0.0
+    bdir.mkdir(parents=True, exist_ok=True)
+    for k, text in generated.items():
+        (bdir / k).write_text(text)
+    env = sim_env()
+    env["MAKEFLAGS"] = f"{env['MAKEFLAGS']} {make}" if env.get("MAKEFLAGS") else make
+    cflags = " ".join(f"-D{k}={v}" for k, v in defines.items())
+    cmd = [str(verilator_bin_dir() / "verilator"), *VERILATOR_PLAIN_ARGS, "--top-module", top, f"-I{bdir}",
+           "-CFLAGS", cflags, *[f"-G{k}={v}" for k, v in params.items()], "--Mdir", str(bdir / "obj_dir"),
+           *[str(bdir / k) for k in generated if k.endswith(".v")], *[str(f) for f in sources], str(PLAIN_MAIN)]
+    t0 = time.perf_counter()
+    r = subprocess.run(cmd, cwd=bdir, env=env, capture_output=True, text=True)
+    build_s = time.perf_counter() - t0
+    (bdir / "build.log").write_text(" ".join(cmd) + "\n" + r.stdout + r.stderr)
+    if r.returncode or not exe.exists():
+        raise RasterhwError(f"{name}: verilator build failed (see {bdir / 'build.log'}):\n{r.stderr[-2000:]}")
+    return exe, build_s
 
 
 def run_cocotb(

@@ -29,43 +29,18 @@ module tb_zbm_chip #(
   localparam NOUT = NPX * L;
 
   // run-time settings (plusargs, so one simulator build serves every clock ratio and pattern):
-  // +sync_half=/+merge_half= ns (default 5), +merge_phase= ns (1), +stall= 0..256 (ready low
+  // the clocks' (rasterhw_two_clocks, ../harness.v), +stall= 0..256 (ready low
   // when an 8-bit random number is below it; 0 = never), +seed=, +maxcyc= (watchdog), +repeat= (1)
-  integer SYNC_HALF = 5, MERGE_HALF = 5, MERGE_PHASE = 1, STALL = 0, SEED = 1;
+  integer STALL = 0, SEED = 1;
   integer MAXCYC = 100000000, REPEAT = 1;
   initial begin
-    if (!$value$plusargs("sync_half=%d", SYNC_HALF)) SYNC_HALF = 5;
-    if (!$value$plusargs("merge_half=%d", MERGE_HALF)) MERGE_HALF = 5;
-    if (!$value$plusargs("merge_phase=%d", MERGE_PHASE)) MERGE_PHASE = 1;
     if (!$value$plusargs("stall=%d", STALL)) STALL = 0;
     if (!$value$plusargs("seed=%d", SEED)) SEED = 1;
     if (!$value$plusargs("maxcyc=%d", MAXCYC)) MAXCYC = 100000000;
     if (!$value$plusargs("repeat=%d", REPEAT)) REPEAT = 1;
   end
-
-  reg clk = 1'b0;
-  reg mclk = 1'b0;
-  // Equal clocks in phase (+merge_phase=0, the speed runs) toggle in one process: one
-  // coroutine resumption per edge instead of two.
-  wire one_clock = (MERGE_PHASE == 0) && (MERGE_HALF == SYNC_HALF);
-  initial begin
-    #1;  // let the plusargs be read first
-    if (one_clock)
-      forever begin
-        #(SYNC_HALF);
-        clk = ~clk;
-        mclk = ~mclk;
-      end
-    else
-      forever #(SYNC_HALF) clk = ~clk;
-  end
-  initial begin
-    #1;
-    if (!one_clock) begin
-      #(MERGE_PHASE);
-      forever #(MERGE_HALF) mclk = ~mclk;
-    end
-  end
+  wire clk, mclk;
+  rasterhw_two_clocks clocks (.clk(clk), .mclk(mclk));
 
   reg [MW-1:0] frame [0:NOUT-1];
   reg [31:0] nseg, nup;

@@ -11,9 +11,7 @@ timing-free bench, ``sim/experts/verilator/``, built once per Verilog hash under
 
 from __future__ import annotations
 
-import hashlib
 import json
-import os
 import subprocess
 import tempfile
 import time
@@ -137,33 +135,12 @@ NSEG_MAX, NOUT_MAX, NLINE_MAX = 1 << 19, 1 << 18, 1 << 14
 def _build(width: int, aj: str) -> tuple[Path, float]:
     from amaranth.back import verilog
     from rasterhw.hdl.experts.pxp import ExpertsPxp
-    from rasterhw.sim.runner import REPO_ROOT, verilator_bin_dir
+    from rasterhw.sim.runner import build_plain_verilator
     src = verilog.convert(ExpertsPxp(width=width, aj=aj), name="experts_pxp")
-    args = ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast", "-Wno-fatal",
-            "-Wno-lint", "-Wno-style", "--build-jobs", "2"]
     params = {"NSEG": NSEG_MAX, "NOUT": NOUT_MAX, "NLINE": NLINE_MAX}
-    h = hashlib.sha1(json.dumps({"src": src, "args": args, **params}, sort_keys=True).encode())
-    for f in ("tb_experts_pxp.v", "main.cpp"):
-        h.update((BENCH_DIR / f).read_bytes())
-    bdir = REPO_ROOT / "build" / f"experts-pxp-{h.hexdigest()[:10]}"
-    exe = bdir / "obj_dir" / "Vtb_experts_pxp"
-    if exe.exists():
-        return exe, 0.0
-    bdir.mkdir(parents=True, exist_ok=True)
-    (bdir / "experts_pxp.v").write_text(src)
-    env = dict(os.environ)
-    env["PATH"] = f"{verilator_bin_dir()}{os.pathsep}{env.get('PATH', '')}"
-    mv = "CFG_CXXFLAGS_PCH_I=-include OPT_FAST=-O2 OPT_SLOW=-O0 OPT_GLOBAL=-O2"
-    env["MAKEFLAGS"] = f"{env['MAKEFLAGS']} {mv}" if env.get("MAKEFLAGS") else mv
-    cmd = [str(verilator_bin_dir() / "verilator"), *args, "--top-module", "tb_experts_pxp",
-           *[f"-G{k}={v}" for k, v in params.items()], "--Mdir", str(bdir / "obj_dir"),
-           str(bdir / "experts_pxp.v"), str(BENCH_DIR / "tb_experts_pxp.v"), str(BENCH_DIR / "main.cpp")]
-    t0 = time.perf_counter()
-    r = subprocess.run(cmd, cwd=bdir, env=env, capture_output=True, text=True)
-    (bdir / "build.log").write_text(" ".join(cmd) + "\n" + r.stdout + r.stderr)
-    if r.returncode or not exe.exists():
-        raise RasterhwError(f"experts: verilator build failed (see {bdir / 'build.log'})")
-    return exe, time.perf_counter() - t0
+    # 4 edges after done so the last line's finish-time counter is stored
+    return build_plain_verilator("experts-pxp", "tb_experts_pxp", [BENCH_DIR / "tb_experts_pxp.v"], params=params,
+                                 defines={"RASTERHW_TAIL": 4}, generated={"experts_pxp.v": src})
 
 
 def _read_hex(path: Path) -> np.ndarray:

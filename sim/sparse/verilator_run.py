@@ -3,33 +3,27 @@
 One build serves every processor of the matrix (its index ``(a, b)`` is an input): the bench
 ``sim/sparse/verilator/tb_sparse_vp.v`` plays the broadcast records from a hex file with no gaps,
 waits until the processor is idle and dumps its local memory and per-level counters; the C++
-main (``main.cpp``) toggles the clock and times that loop. Builds go to
+main (``cocotb_tests/plain_main.cpp``) toggles the clock and times that loop. Builds go to
 ``build/sparse-vp-<hash>/`` (hash of the Verilog, parameters and bench sources), so the second
 call with the same parameters only runs.
 """
 
 from __future__ import annotations
 
-import hashlib
 import json
-import os
 import subprocess
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.sparse.formats import TRI_BITS
-from rasterhw.sim.runner import REPO_ROOT, verilator_bin_dir
+from rasterhw.sim.runner import build_plain_verilator
 
 __all__ = ["build", "run_processor_verilator"]
 
 BENCH_DIR = Path(__file__).resolve().parent / "verilator"
 TOP = "tb_sparse_vp"
-ARGS = ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast", "-Wno-fatal", "-Wno-lint",
-        "-Wno-style", "--build-jobs", "2"]
-MAKE_VARS = "CFG_CXXFLAGS_PCH_I=-include OPT_FAST=-O2 OPT_SLOW=-O0 OPT_GLOBAL=-O2"
 MAXT = 16384
 
 
@@ -53,32 +47,11 @@ def _build(*, n: int, p: int, q: int, z_bits: int) -> tuple[Path, float]:
 
     src = verilog.convert(make_vp(n=n, p=p, q=q, z_bits=z_bits), name="sparse_vp")
     params = {"N": n, "BW": BROADCAST.size, "MAXT": MAXT, "ZW": z_bits + 1, "TW": TRI_BITS}
-    h = hashlib.sha1(json.dumps({"args": ARGS, "make": MAKE_VARS, **params}, sort_keys=True).encode())
-    h.update(src.encode())
-    for f in ("tb_sparse_vp.v", "main.cpp"):
-        h.update((BENCH_DIR / f).read_bytes())
-    bdir = REPO_ROOT / "build" / f"sparse-vp-{h.hexdigest()[:10]}"
-    exe = bdir / "obj_dir" / f"V{TOP}"
-    if exe.exists():
-        return exe, 0.0
-    bdir.mkdir(parents=True, exist_ok=True)
-    (bdir / "sparse_vp.v").write_text(src)
-    (bdir / "tb_sparse_vp_ports.vh").write_text("".join(
-        f"  , .tests_{i + 1}(tests_v[{32 * i + 31}:{32 * i}]), .stalls_{i + 1}(stalls_v[{32 * i + 31}:{32 * i}])\n"
-        for i in range(n)))
-    env = dict(os.environ)
-    env["PATH"] = f"{verilator_bin_dir()}{os.pathsep}{env.get('PATH', '')}"
-    env["MAKEFLAGS"] = f"{env['MAKEFLAGS']} {MAKE_VARS}" if env.get("MAKEFLAGS") else MAKE_VARS
-    cmd = [str(verilator_bin_dir() / "verilator"), *ARGS, "--top-module", TOP, f"-I{bdir}",
-           *[f"-G{k}={v}" for k, v in params.items()], "--Mdir", str(bdir / "obj_dir"),
-           str(bdir / "sparse_vp.v"), str(BENCH_DIR / "tb_sparse_vp.v"), str(BENCH_DIR / "main.cpp")]
-    t0 = time.perf_counter()
-    r = subprocess.run(cmd, cwd=bdir, env=env, capture_output=True, text=True)
-    build_s = time.perf_counter() - t0
-    (bdir / "build.log").write_text(" ".join(cmd) + "\n" + r.stdout + r.stderr)
-    if r.returncode or not exe.exists():
-        raise RasterhwError(f"verilator build failed (see {bdir / 'build.log'}):\n{r.stderr[-2000:]}")
-    return exe, build_s
+    ports = "".join(f"  , .tests_{i + 1}(tests_v[{32 * i + 31}:{32 * i}]), .stalls_{i + 1}(stalls_v[{32 * i + 31}:{32 * i}])\n"
+                    for i in range(n))
+    return build_plain_verilator("sparse-vp", TOP, [BENCH_DIR / "tb_sparse_vp.v"], params=params,
+                                 defines={"RASTERHW_CYCLES": 1},
+                                 generated={"sparse_vp.v": src, "tb_sparse_vp_ports.vh": ports})
 
 
 def _read_hex(path: Path) -> np.ndarray:

@@ -4,7 +4,7 @@
 ``scene``'s golden segments, empty upstream, no gaps or back-pressure, played ``repeat``
 times) on the generated ``zbm-chip`` Verilog inside ``cocotb_tests/zbm/fast/tb_zbm_fast.v``
 (both clock domains on one ``clk`` input port), driven by a small C++ main
-(``cocotb_tests/zbm/fast/main.cpp``) that toggles the clock until ``done`` and times that
+(``cocotb_tests/plain_main.cpp``, shared by every timing-free bench) that toggles the clock until ``done`` and times that
 loop. The last repetition's output is compared bit for bit with ``chip_stimulus``'s expected
 words. Builds go to ``build/zbm-fast-<hash>/`` (hash of the Verilog, parameters and bench
 sources), so the second call with the same parameters only runs.
@@ -12,19 +12,17 @@ sources), so the second call with the same parameters only runs.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import subprocess
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.sim.runner import HARNESS_V, REPO_ROOT, verilator_bin_dir, verilator_make_vars
+from rasterhw.sim.runner import HARNESS_V, REPO_ROOT, build_plain_verilator
 from rasterhw.sim.zbm.driver import (
     GAP_BITS,
     _cached,
@@ -38,8 +36,6 @@ __all__ = ["FAST_DIR", "build_fast", "run_chip_fast", "chip_speed_fast"]
 
 FAST_DIR = REPO_ROOT / "cocotb_tests" / "zbm" / "fast"
 TOP = "tb_zbm_fast"
-VERILATOR_FAST_ARGS = ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast",
-                       "-Wno-fatal", "-Wno-lint", "-Wno-style", "--build-jobs", "2"]
 
 
 def build_fast(*, interleave: int, width: int, lines: int, chip: int, nseg: int, nup: int,
@@ -53,29 +49,9 @@ def build_fast(*, interleave: int, width: int, lines: int, chip: int, nseg: int,
     src, _ = _cached("zbm-chip", lambda: generate_verilog("zbm-chip", **p), **p)
     params = {"I": interleave, "CHIP": chip, "W": width, "L": lines, "GW": GAP_BITS,
               "SDEPTH": _depth(nseg), "MDEPTH": _depth(nup)}
-    h = hashlib.sha1(json.dumps({"src": src.name, "args": VERILATOR_FAST_ARGS, "make": verilator_make_vars(opt), **params},
-                                sort_keys=True).encode())
-    for f in (FAST_DIR / "tb_zbm_fast.v", FAST_DIR / "main.cpp", HARNESS_V):
-        h.update(f.read_bytes())
-    bdir = REPO_ROOT / "build" / f"zbm-fast-{h.hexdigest()[:10]}"
-    exe = bdir / "obj_dir" / f"V{TOP}"
-    if exe.exists():
-        return exe, 0.0
-    bdir.mkdir(parents=True, exist_ok=True)
-    env = dict(os.environ)
-    env["PATH"] = f"{verilator_bin_dir()}{os.pathsep}{env.get('PATH', '')}"
-    mv = verilator_make_vars(opt)
-    env["MAKEFLAGS"] = f"{env['MAKEFLAGS']} {mv}" if env.get("MAKEFLAGS") else mv
-    cmd = [str(verilator_bin_dir() / "verilator"), *VERILATOR_FAST_ARGS, "--top-module", TOP,
-           *[f"-G{k}={v}" for k, v in params.items()], "--Mdir", str(bdir / "obj_dir"),
-           str(src), str(HARNESS_V), str(FAST_DIR / "tb_zbm_fast.v"), str(FAST_DIR / "main.cpp")]
-    t0 = time.perf_counter()
-    r = subprocess.run(cmd, cwd=bdir, env=env, capture_output=True, text=True)
-    build_s = time.perf_counter() - t0
-    (bdir / "build.log").write_text(" ".join(cmd) + "\n" + r.stdout + r.stderr)
-    if r.returncode or not exe.exists():
-        raise RasterhwError(f"verilator build failed (see {bdir / 'build.log'}):\n{r.stderr[-2000:]}")
-    return exe, build_s
+    # the chip's counter and line count come back in the main's JSON line
+    return build_plain_verilator("zbm-fast", TOP, [src, HARNESS_V, FAST_DIR / "tb_zbm_fast.v"], params=params,
+                                 opt=opt, defines={"RASTERHW_CYCLES": 1, "RASTERHW_LINES": 1})
 
 
 def run_chip_fast(seg_words: list[int], up_words: list[int], *, lines: int, chip: int, interleave: int,

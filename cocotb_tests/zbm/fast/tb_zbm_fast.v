@@ -1,5 +1,5 @@
 // Timing-free bench wrapper for one ZB/M chip (`zbm_chip`), for plain Verilator runs
-// (no cocotb, no --timing): the C++ main (main.cpp) drives `clk`, which clocks both the
+// (no cocotb, no --timing): the C++ main (../../plain_main.cpp) drives `clk`, which clocks both the
 // segment and the merge domain. Same stimulus/output scheme as ../zbm/tb_zbm_chip.v with
 // equal, in-phase clocks, no back-pressure and no stream checkers: segment words
 // (+seg=, {gap[GW-1:0], word[111:0]}) and upstream merge pixels (+up=, {gap, pixel[127:0]})

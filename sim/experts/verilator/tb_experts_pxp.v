@@ -1,4 +1,4 @@
-// Timing-free bench for one EXPERTS PXP (`experts_pxp`), for plain Verilator runs (main.cpp
+// Timing-free bench for one EXPERTS PXP (`experts_pxp`), for plain Verilator runs (cocotb_tests/plain_main.cpp
 // toggles `clk`). Memories are sized for a 512 x 512 frame at up to 16 x 64 PXP lines (one build
 // serves every scene). Stimulus (+seg=, +nseg= words of {next_hi[10:0], next_lo[9:0], payload[193:0]})
 // is played back to back; when an end-of-line token (payload bit 0) is taken, the range of the
