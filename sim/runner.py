@@ -31,6 +31,7 @@ __all__ = [
     "SimulatorUnavailable",
     "build_dir_for",
     "build_plain_verilator",
+    "run_plain_verilator",
     "get_sim",
     "lint_verilog",
     "run_cocotb",
@@ -209,6 +210,20 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
     if r.returncode or not exe.exists():
         raise RasterhwError(f"{name}: verilator build failed (see {bdir / 'build.log'}):\n{r.stderr[-2000:]}")
     return exe, build_s
+
+
+def run_plain_verilator(exe: Path, plusargs: Sequence[str], *, run_dir: Path, maxcyc: int) -> dict:
+    """Run a :func:`build_plain_verilator` binary in ``run_dir`` with ``plusargs`` and a
+    ``+maxcyc=`` watchdog; return its JSON line. A crash, no JSON or no ``done`` is a
+    :class:`RasterhwError` naming the binary."""
+    r = subprocess.run([str(exe), *plusargs, f"+maxcyc={maxcyc}"], cwd=run_dir, capture_output=True, text=True)
+    try:
+        meta = json.loads(r.stdout.strip().splitlines()[-1])
+    except (IndexError, json.JSONDecodeError) as e:
+        raise RasterhwError(f"{exe.name} failed ({r.returncode}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}") from e
+    if not meta["done"]:
+        raise RasterhwError(f"{exe.name}: no `done` within {maxcyc} cycles")
+    return meta
 
 
 def run_cocotb(

@@ -11,8 +11,6 @@ timing-free bench, ``sim/experts/verilator/``, built once per Verilog hash under
 
 from __future__ import annotations
 
-import json
-import subprocess
 import tempfile
 import time
 from pathlib import Path
@@ -22,6 +20,7 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.experts.model import ExpertsFrame, equal_bounds, render_frame
 from rasterhw.golden_model.experts.pxp import pixel_words
 from rasterhw.golden_model.experts.pxp_cycles import line_segments, schedule
+from rasterhw.sim.runner import run_plain_verilator
 
 __all__ = ["jobs", "run_pysim", "run_verilator", "simulate_scene", "ENGINES"]
 
@@ -160,15 +159,10 @@ def run_verilator(jb: dict, *, width: int) -> dict:
     exe, build_s = _build(width, jb["aj"])
     run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=exe.parent.parent))
     (run_dir / "seg.hex").write_text("\n".join(f"{w:x}" for w in jb["words"]) + "\n")
-    cmd = [str(exe), f"+seg={run_dir / 'seg.hex'}", f"+out={run_dir / 'out.hex'}", f"+cyc={run_dir / 'cyc.hex'}",
-           f"+nseg={nseg}", f"+nout={nout}", f"+lo0={jb['lo0']}", f"+hi0={jb['hi0']}", f"+maxcyc={int(jb['cycles'].sum()) * 2 + 10000}"]
-    r = subprocess.run(cmd, cwd=run_dir, capture_output=True, text=True)
-    try:
-        meta = json.loads(r.stdout.strip().splitlines()[-1])
-    except (IndexError, json.JSONDecodeError) as e:
-        raise RasterhwError(f"experts: {exe.name} failed ({r.returncode}): {r.stderr[-500:]}") from e
-    if not meta["done"]:
-        raise RasterhwError(f"experts: {exe.name} did not finish the frame")
+    meta = run_plain_verilator(exe, [f"+seg={run_dir / 'seg.hex'}", f"+out={run_dir / 'out.hex'}",
+                                     f"+cyc={run_dir / 'cyc.hex'}", f"+nseg={nseg}", f"+nout={nout}",
+                                     f"+lo0={jb['lo0']}", f"+hi0={jb['hi0']}"],
+                               run_dir=run_dir, maxcyc=int(jb["cycles"].sum()) * 2 + 10000)
     out = {"pixels": _read_hex(run_dir / "out.hex"), "cycles": _read_hex(run_dir / "cyc.hex"),
            "run_s": meta["run_s"], "sim_cycles": meta["sim_cycles"], "build_s": build_s}
     for f in run_dir.iterdir():

@@ -10,15 +10,13 @@ call with the same parameters only runs.
 
 from __future__ import annotations
 
-import json
-import subprocess
 import tempfile
 from pathlib import Path
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.sparse.formats import TRI_BITS
-from rasterhw.sim.runner import build_plain_verilator
+from rasterhw.sim.runner import build_plain_verilator, run_plain_verilator
 
 __all__ = ["build", "run_processor_verilator"]
 
@@ -74,15 +72,9 @@ def run_processor_verilator(recs: list[dict], *, n: int, p: int, q: int, a: int,
     (run_dir / "in.hex").write_text("".join(f"{BROADCAST.const(r).as_bits():0{digits}x}\n" for r in recs))
     N = 1 << n
     maxcyc = 200 * (len(recs) + 10) * (1 + n) + 64 * N * N + 10_000_000
-    cmd = [str(exe), f"+in={run_dir / 'in.hex'}", f"+out={run_dir / 'out.hex'}", f"+stats={run_dir / 'stats.hex'}",
-           f"+ntri={len(recs)}", f"+a={a}", f"+b={b}", f"+maxcyc={maxcyc}"]
-    r = subprocess.run(cmd, cwd=run_dir, capture_output=True, text=True)
-    try:
-        meta = json.loads(r.stdout.strip().splitlines()[-1])
-    except (IndexError, json.JSONDecodeError) as e:
-        raise RasterhwError(f"{exe.name} failed ({r.returncode}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}") from e
-    if not meta["done"]:
-        raise RasterhwError(f"{exe.name}: not done within {maxcyc} cycles")
+    meta = run_plain_verilator(exe, [f"+in={run_dir / 'in.hex'}", f"+out={run_dir / 'out.hex'}",
+                                     f"+stats={run_dir / 'stats.hex'}", f"+ntri={len(recs)}", f"+a={a}", f"+b={b}"],
+                               run_dir=run_dir, maxcyc=maxcyc)
     words = _read_hex(run_dir / "out.hex")
     st = [int(v) for v in _read_hex(run_dir / "stats.hex")]
     for f in run_dir.iterdir():

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import json
 import os
-import subprocess
 import tempfile
 from pathlib import Path
 
@@ -22,7 +21,7 @@ import numpy as np
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.sim.runner import HARNESS_V, REPO_ROOT, build_plain_verilator
+from rasterhw.sim.runner import HARNESS_V, REPO_ROOT, build_plain_verilator, run_plain_verilator
 from rasterhw.sim.zbm.driver import (
     GAP_BITS,
     _cached,
@@ -69,15 +68,9 @@ def run_chip_fast(seg_words: list[int], up_words: list[int], *, lines: int, chip
     _write_hex(run_dir / "up.hex", up_words, zero[len(seg_words):], F.PIXEL2.width)
     out = run_dir / "out.hex"
     maxcyc = repeat * (40 * len(seg_words) + 40 * lines * (npx + 16)) + 1000
-    cmd = [str(exe), f"+seg={run_dir / 'seg.hex'}", f"+up={run_dir / 'up.hex'}", f"+out={out}",
-           f"+nseg={len(seg_words)}", f"+nup={len(up_words)}", f"+repeat={repeat}", f"+maxcyc={maxcyc}"]
-    r = subprocess.run(cmd, cwd=run_dir, capture_output=True, text=True)
-    try:
-        meta = json.loads(r.stdout.strip().splitlines()[-1])
-    except (IndexError, json.JSONDecodeError) as e:
-        raise RasterhwError(f"{exe.name} failed ({r.returncode}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}") from e
-    if not meta["done"]:
-        raise RasterhwError(f"{exe.name}: no `done` within {maxcyc} cycles")
+    meta = run_plain_verilator(exe, [f"+seg={run_dir / 'seg.hex'}", f"+up={run_dir / 'up.hex'}", f"+out={out}",
+                                     f"+nseg={len(seg_words)}", f"+nup={len(up_words)}", f"+repeat={repeat}"],
+                               run_dir=run_dir, maxcyc=maxcyc)
     s0, s1 = read_hex_words(out)
     if s0.size != lines * npx:
         raise RasterhwError(f"{out}: {s0.size} words, expected {lines * npx}")
