@@ -32,6 +32,7 @@ from tqdm import tqdm
 __all__ = ["run_demo"]
 
 SIZE = (512, 512)
+_COLOUR_NOTE = ("Colour is compared as 8-bit RGB: machines with colour formats of their own (EXPERTS' 3/3/3 hue and intensity, the vector Z-buffer's RGBI 3/3/3/7) differ from the float reference in colour by design; coverage and the visible polygon of each machine are checked against the reference by its tests.")
 
 
 def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator") -> dict:
@@ -124,12 +125,12 @@ def _markdown(summary: dict) -> str:
           f"![{ref['scene']}]({ref['image']})", "",
           f"Reference: {ref.get('polygons_in')} polygons in, {ref.get('polygons_drawn')} drawn, "
           f"{ref['fragments']} fragments, {ref['pixels_written']} pixel writes, {ref['wall_s'] * 1e3:.1f} ms.", "",
-          "| machine | arch | pixel writes | pixels differing from the reference | ms | image |",
+          "| machine | arch | pixel writes | pixels whose RGB differs from the reference | ms | image |",
           "|---|---|---|---|---|---|"]
     for a in summary["archs"]:
         md.append(f"| {a['machine']} | {a['arch']} | {a['pixels_written']:,} | {a['differing_from_reference']:,} "
                   f"| {a['wall_s'] * 1e3:.1f} | [{a['image']}]({a['image']}) |")
-    md += ["", f"## HDL runs on {summary['engine']}", ""]
+    md += ["", _COLOUR_NOTE, "", f"## HDL runs on {summary['engine']}", ""]
     for s in summary["sims"]:
         md += [f"### {s['machine']} {s['block']} on {s['scene']}", "", f"- {_sim_line(s)}", ""]
         if s["image"]:
@@ -146,7 +147,7 @@ def _html(summary: dict) -> str:
     for a in summary["archs"]:
         cards.append(f"<figure><img src='{e(a['image'])}'><figcaption><b>{e(a['machine'])} / {e(a['arch'])}</b>"
                      f"<br>{e(a['help'])}<br>{a['pixels_written']:,} pixel writes; "
-                     f"{a['differing_from_reference']:,} px differ from the reference; {a['wall_s'] * 1e3:.1f} ms"
+                     f"{a['differing_from_reference']:,} px differ in RGB from the reference; {a['wall_s'] * 1e3:.1f} ms"
                      f"</figcaption></figure>")
     sims = []
     for s in summary["sims"]:
@@ -161,6 +162,7 @@ img{{width:300px;image-rendering:pixelated;border:1px solid #ccc}} figcaption{{f
 <body><h1>rasterhw demo</h1>
 <h2>{e(ref['scene'])} at {ref['width']}x{ref['height']}: the float reference and every machine's golden model</h2>
 {''.join(cards)}
+<p>{e(_COLOUR_NOTE)}</p>
 <h2>HDL runs on {e(summary['engine'])}, each compared bit for bit with its golden model</h2>
 {''.join(sims)}
 <p>Paper figures beside measured ones: <code>rasterhw report all</code> writes docs/reproduction/.</p>
