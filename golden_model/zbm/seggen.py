@@ -24,7 +24,7 @@ from rasterhw.golden_model.zbm.formats import (
     wrap,
 )
 
-__all__ = ["Segments", "max_active_edge_pairs", "segment_generator"]
+__all__ = ["Segments", "check_edge_pair_stream", "max_active_edge_pairs", "segment_generator"]
 
 
 @dataclass
@@ -57,6 +57,26 @@ class Segments:
 
     def line(self, y: int) -> slice:
         return slice(int(self.line_start[y]), int(self.line_start[y + 1]))
+
+
+def check_edge_pair_stream(eps: EdgePairs, height: int, *, who: str) -> None:
+    """The checks every consumer of an edge-pair stream makes (the golden segment generator and
+    the HDL drivers): ``len >= 0``, every pair's lines inside ``0..height-1`` (``h >= 1``), top
+    lines in FIFO order. ``RasterhwError`` naming ``who`` and the first bad pair otherwise."""
+    if len(eps) == 0:
+        return
+    if eps.len.min() < 0:
+        i = int(np.argmin(eps.len))
+        raise RasterhwError(f"{who}: edge pair {i} has len {int(eps.len[i])} < 0")
+    bad = np.flatnonzero((eps.y < 0) | (eps.h < 1) | (eps.y + eps.h > height))
+    if bad.size:
+        i = int(bad[0])
+        raise RasterhwError(f"{who}: edge pair {i} covers lines {int(eps.y[i])}.."
+                            f"{int(eps.y[i] + eps.h[i] - 1)}, outside 0..{height - 1}")
+    if np.any(np.diff(eps.y) < 0):
+        i = int(np.flatnonzero(np.diff(eps.y) < 0)[0]) + 1
+        raise RasterhwError(f"{who}: edge pair {i} (top line {int(eps.y[i])}) is out of "
+                            "FIFO order (top lines must not decrease)")
 
 
 def _px_ceil(xq: np.ndarray) -> np.ndarray:
@@ -106,19 +126,7 @@ def segment_generator(eps: EdgePairs, height: int, *, width: int = MAX_WIDTH,
         raise RasterhwError(f"segment generator: width must be in 1..{MAX_WIDTH}, not {width!r}")
     if not isinstance(capacity, (int, np.integer)) or capacity < 1:
         raise RasterhwError(f"segment generator: capacity must be a positive integer, not {capacity!r}")
-    if n:
-        if eps.len.min() < 0:
-            i = int(np.argmin(eps.len))
-            raise RasterhwError(f"segment generator: edge pair {i} has len {int(eps.len[i])} < 0")
-        bad = np.flatnonzero((eps.y < 0) | (eps.h < 1) | (eps.y + eps.h > height))
-        if bad.size:
-            i = int(bad[0])
-            raise RasterhwError(f"segment generator: edge pair {i} covers lines {int(eps.y[i])}.."
-                                f"{int(eps.y[i] + eps.h[i] - 1)}, outside 0..{height - 1}")
-        if np.any(np.diff(eps.y) < 0):
-            i = int(np.flatnonzero(np.diff(eps.y) < 0)[0]) + 1
-            raise RasterhwError(f"segment generator: edge pair {i} (top line {int(eps.y[i])}) is out of "
-                                "FIFO order (top lines must not decrease)")
+    check_edge_pair_stream(eps, height, who="segment generator")
     C = eps.val.shape[1]
     x = eps.x.copy()
     ln = eps.len.copy()

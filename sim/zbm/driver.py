@@ -31,6 +31,7 @@ import numpy as np
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
+from rasterhw.golden_model.zbm.seggen import check_edge_pair_stream
 from rasterhw.golden_model.zbm.words import (
     doublez_words,
     edge_pair_words,
@@ -110,28 +111,13 @@ def check_edge_pairs(eps: G.EdgePairs, width: int, height: int, *, units: int = 
     top lines out of FIFO order; more than ``capacity`` pairs active on one line in one unit
     (the loader would stall and segments would be lost: the frame would not be the scene).
     """
-    n = len(eps)
-    if n == 0:
+    if len(eps) == 0:
         return 0
-    if eps.len.min() < 0:
-        i = int(np.argmin(eps.len))
-        raise RasterhwError(f"ZB/M: edge pair {i} has len {int(eps.len[i])} < 0")
-    bad = np.flatnonzero((eps.y < 0) | (eps.h < 1) | (eps.y + eps.h > height))
-    if bad.size:
-        i = int(bad[0])
-        raise RasterhwError(f"ZB/M: edge pair {i} covers lines {int(eps.y[i])}..{int(eps.y[i] + eps.h[i] - 1)}, "
-                            f"outside 0..{height - 1}")
-    if np.any(np.diff(eps.y) < 0):
-        raise RasterhwError("ZB/M: edge pairs are out of FIFO order (top lines must not decrease)")
+    check_edge_pair_stream(eps, height, who="ZB/M")
     peak = 0
     for u in range(units):
-        sel = eps.tag % units == u
-        d = np.zeros(height + 1, np.int64)
-        np.add.at(d, eps.y[sel], 1)
-        np.add.at(d, eps.y[sel] + eps.h[sel], -1)
-        pu = int(np.cumsum(d).max(initial=0))
+        pu, line = G.max_active_edge_pairs(eps.take(np.flatnonzero(eps.tag % units == u)))
         if pu > capacity:
-            line = int(np.argmax(np.cumsum(d)))
             raise RasterhwError(f"ZB/M: unit {u} has {pu} edge pairs active on line {line}, more than the "
                                 f"active-edge-pair memory holds ({capacity}); use more units or a smaller scene")
         peak = max(peak, pu)
