@@ -23,20 +23,34 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
 
-__all__ = ["as_plain", "stream_get", "stream_protocol_checker", "stream_put", "stream_sink"]
+from amaranth.lib import data
+
+__all__ = ["as_plain", "random_gap", "stream_get", "stream_protocol_checker", "stream_put", "stream_sink"]
 
 
-async def stream_put(ctx, port, payload, *, gap: int = 0) -> None:
-    """Offer ``payload`` on stream ``port`` after ``gap`` idle clocks; hold until accepted.
+async def stream_put(ctx, port, payload, *, gap: int = 0, domain: str = "sync") -> None:
+    """Offer ``payload`` on stream ``port`` after ``gap`` idle clocks of ``domain``; hold it
+    until accepted. A plain integer on a struct-typed port is taken as the packed word.
 
     Returns in the clock after the one in which the transfer happened.
     """
     for _ in range(gap):
-        await ctx.tick()
-    ctx.set(port.payload, payload)
+        await ctx.tick(domain)
+    target = port.payload.as_value() if isinstance(port.payload, data.View) and isinstance(payload, int) \
+        else port.payload
+    ctx.set(target, payload)
     ctx.set(port.valid, 1)
-    await ctx.tick().until(port.ready)
+    await ctx.tick(domain).until(port.ready)
     ctx.set(port.valid, 0)
+
+
+def random_gap(rng, p_idle: float) -> int:
+    """Idle clocks before a word: each clock idle with probability ``p_idle`` (geometric), drawn
+    with one ``rng.random()`` per idle clock plus one (numpy Generator or ``random.Random``)."""
+    g = 0
+    while rng.random() < p_idle:
+        g += 1
+    return g
 
 
 async def stream_get(ctx, port, *, gap: int = 0):

@@ -14,6 +14,7 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import EdgePairs
 from rasterhw.golden_model.zbm import cycles as C
 from rasterhw.golden_model.zbm.formats import AEP_CAPACITY, INTERLEAVES
+from rasterhw.sim.harness import stream_put
 
 __all__ = ["run_unit_cycles", "measure_cycles_per_edge_pair", "table1_width"]
 
@@ -43,10 +44,7 @@ def run_unit_cycles(eps: EdgePairs, height: int, *, width: int, interleave: int,
 
     async def src(ctx):
         for w in words:
-            ctx.set(unit.i.payload, w)
-            ctx.set(unit.i.valid, 1)
-            await ctx.tick().until(unit.i.ready)
-        ctx.set(unit.i.valid, 0)
+            await stream_put(ctx, unit.i, w)
 
     async def bench(ctx):
         for c in range(interleave):

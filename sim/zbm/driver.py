@@ -40,7 +40,7 @@ from rasterhw.golden_model.zbm.words import (
     split_merge_words,
     words_to_doublez,
 )
-from rasterhw.sim.harness import stream_protocol_checker
+from rasterhw.sim.harness import stream_protocol_checker, stream_put
 from rasterhw.sim.runner import (
     HARNESS_V,
     REPO_ROOT,
@@ -424,10 +424,7 @@ def run_units_pysim(eps_per_unit: list[G.EdgePairs], *, width: int, height: int,
     def src(u, words):
         async def bench(ctx):
             for w in words:
-                ctx.set(u.i.payload, w)
-                ctx.set(u.i.valid, 1)
-                await ctx.tick().until(u.i.ready)
-                ctx.set(u.i.valid, 0)
+                await stream_put(ctx, u.i, w)
         return bench
 
     async def sink(ctx):

@@ -10,7 +10,7 @@ from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.stimulus import multi_line_segments, random_doublez
 from rasterhw.golden_model.zbm.words import pixel2_words, segment_words
 from rasterhw.hdl.zbm.chip import ZbmChip
-from rasterhw.sim.harness import stream_protocol_checker
+from rasterhw.sim.harness import random_gap, stream_protocol_checker, stream_put
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 
@@ -26,19 +26,11 @@ def run_chip(dut, words, merge_in, *, period_merge=1e-8, idle_p=0.0, stall_p=0.0
 
     async def seg_src(ctx):
         for w in words:
-            while rng.random() < idle_p:
-                await ctx.tick()
-            ctx.set(dut.i_seg.payload, w)
-            ctx.set(dut.i_seg.valid, 1)
-            await ctx.tick().until(dut.i_seg.ready)
-            ctx.set(dut.i_seg.valid, 0)
+            await stream_put(ctx, dut.i_seg, w, gap=random_gap(rng, idle_p))
 
     async def merge_src(ctx):
         for w in merge_in:
-            ctx.set(dut.i_merge.payload.as_value(), w)
-            ctx.set(dut.i_merge.valid, 1)
-            await ctx.tick("merge").until(dut.i_merge.ready)
-            ctx.set(dut.i_merge.valid, 0)
+            await stream_put(ctx, dut.i_merge, w, domain="merge")
 
     async def sink(ctx):
         r = np.random.default_rng(seed + 1)

@@ -11,7 +11,7 @@ from rasterhw.golden_model.zbm.stimulus import random_segments
 from rasterhw.golden_model.zbm.words import packets, pixel2_words
 from rasterhw.hdl.zbm.loop import LOOP_GAP, ZbmLoop
 from rasterhw.hdl.zbm.pixel import ZbmPixelProcessor
-from rasterhw.sim.harness import stream_protocol_checker
+from rasterhw.sim.harness import random_gap, stream_protocol_checker, stream_put
 
 
 def run_loop(interleave, chip, width, segs_list, *, idle_p=0.0, seed=0):
@@ -38,12 +38,7 @@ def run_loop(interleave, chip, width, segs_list, *, idle_p=0.0, seed=0):
         for segs in segs_list:
             n0 = len(accepted)
             for pkt in packets(segs, 0, chip, interleave):
-                while rng.random() < idle_p:
-                    await ctx.tick()
-                ctx.set(dut.i.payload, pkt)
-                ctx.set(dut.i.valid, 1)
-                await ctx.tick().until(dut.i.ready)
-                ctx.set(dut.i.valid, 0)
+                await stream_put(ctx, dut.i, pkt, gap=random_gap(rng, idle_p))
             entries.append(accepted[n0:])
             await ctx.tick().until(dut.idle)
             ctx.set(dut.swap, 1)

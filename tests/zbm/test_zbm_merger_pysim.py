@@ -8,7 +8,7 @@ import pytest
 from amaranth.lib import data
 from amaranth.sim import Simulator
 from rasterhw.hdl.zbm.merger import ZbmMerger
-from rasterhw.sim.harness import stream_protocol_checker
+from rasterhw.sim.harness import random_gap, stream_protocol_checker, stream_put
 
 # Background sources are closed mid-`until` when the sink finishes; that is expected.
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
@@ -45,23 +45,17 @@ def run(n, period_sync, period_merge, seed, stall_p=0.3):
 
     async def put_own(ctx):
         r = random.Random(seed + 1)
+        gap = 0                   # idle clocks after each transfer, drawn after it
         for w, la in zip(own, lasts, strict=True):
-            ctx.set(dut.i_own.payload, as_dict(w, la))
-            ctx.set(dut.i_own.valid, 1)
-            await ctx.tick("sync").until(dut.i_own.ready)
-            ctx.set(dut.i_own.valid, 0)
-            while r.random() < stall_p:
-                await ctx.tick("sync")
+            await stream_put(ctx, dut.i_own, as_dict(w, la), gap=gap)
+            gap = random_gap(r, stall_p)
 
     async def put_in(ctx):
         r = random.Random(seed + 2)
+        gap = 0
         for w in inp:
-            ctx.set(dut.i_merge.payload, as_dict(w))
-            ctx.set(dut.i_merge.valid, 1)
-            await ctx.tick("merge").until(dut.i_merge.ready)
-            ctx.set(dut.i_merge.valid, 0)
-            while r.random() < stall_p:
-                await ctx.tick("merge")
+            await stream_put(ctx, dut.i_merge, as_dict(w), gap=gap, domain="merge")
+            gap = random_gap(r, stall_p)
 
     async def get_out(ctx):
         r = random.Random(seed + 3)

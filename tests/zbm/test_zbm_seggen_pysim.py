@@ -11,7 +11,7 @@ from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.golden_model.zbm.words import edge_pair_words, segment_words
 from rasterhw.hdl.zbm.seggen import ZbmSegmentGenerator
-from rasterhw.sim.harness import stream_protocol_checker
+from rasterhw.sim.harness import random_gap, stream_protocol_checker, stream_put
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 
@@ -24,12 +24,7 @@ def run_seggen(dut, words, n_out, *, idle_p=0.0, stall_p=0.0, seed=0, cycles=200
 
     async def src(ctx):
         for w in words:
-            while rng.random() < idle_p:
-                await ctx.tick()
-            ctx.set(dut.i.payload, w)
-            ctx.set(dut.i.valid, 1)
-            await ctx.tick().until(dut.i.ready)
-            ctx.set(dut.i.valid, 0)
+            await stream_put(ctx, dut.i, w, gap=random_gap(rng, idle_p))
 
     async def sink(ctx):
         held = None
@@ -92,10 +87,7 @@ def test_seggen_overflow_stalls_without_loss():
 
     async def src(ctx):
         for wd in edge_pair_words(eps):
-            ctx.set(dut.i.payload, wd)
-            ctx.set(dut.i.valid, 1)
-            await ctx.tick().until(dut.i.ready)
-            ctx.set(dut.i.valid, 0)
+            await stream_put(ctx, dut.i, wd)
 
     async def sink(ctx):
         ctx.set(dut.o.ready, 1)

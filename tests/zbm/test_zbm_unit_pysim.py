@@ -13,7 +13,7 @@ from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.golden_model.zbm.words import edge_pair_words, pixel2_words
 from rasterhw.hdl.zbm.chain import ZbmChain
 from rasterhw.hdl.zbm.unit import ZbmUnit
-from rasterhw.sim.harness import stream_protocol_checker
+from rasterhw.sim.harness import stream_protocol_checker, stream_put
 from rasterhw.sim.zbm.cycles_hdl import measure_cycles_per_edge_pair, run_unit_cycles
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
@@ -32,10 +32,7 @@ def run_units(units, words_per_unit, n_lines, *, merge_period=1e-8, stall_p=0.0,
     def src(u, words):
         async def bench(ctx):
             for w in words:
-                ctx.set(u.i.payload, w)
-                ctx.set(u.i.valid, 1)
-                await ctx.tick().until(u.i.ready)
-                ctx.set(u.i.valid, 0)
+                await stream_put(ctx, u.i, w)
         return bench
 
     async def sink(ctx):      # samples at the clock edge, random back-pressure
