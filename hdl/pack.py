@@ -9,7 +9,6 @@ mappings (missing fields are 0), array layouts take sequences, plain shapes take
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
 from functools import cache
 
 from amaranth.hdl import Shape
@@ -38,22 +37,16 @@ def _plan(layout) -> tuple:
     return tuple(out)
 
 
-def _get(value, path):
-    for key in path:
-        if isinstance(value, Mapping):
-            if key not in value:
-                return 0
-            value = value[key]
-        elif isinstance(value, Sequence):
-            value = value[key]
-        else:
-            raise TypeError(f"cannot index {value!r} with {key!r}")
-    return value
-
-
 def pack(layout, value) -> int:
     """The bits of ``value`` in ``layout`` as an unsigned integer."""
     word = 0
     for path, off, width in _plan(layout):
-        word |= (int(_get(value, path)) & ((1 << width) - 1)) << off
+        v = value
+        for key in path:
+            try:
+                v = v[key]
+            except KeyError:
+                v = 0
+                break
+        word |= (int(v) & ((1 << width) - 1)) << off
     return word
