@@ -196,8 +196,8 @@ def load_mesh(path: str | Path, *, name: str | None = None, smooth: bool = True)
             verts = np.asarray(mesh.vertices, dtype=np.float64)
     except RasterhwError:
         raise
-    except (MemoryError, KeyboardInterrupt):
-        raise
+    except MemoryError:
+        raise RasterhwError(f"{path}: the {ext[1:].upper()} file describes more data than fits in memory") from None
     except Exception as exc:
         raise RasterhwError(f"{path}: not a readable {ext[1:].upper()} mesh ({_one_line(exc)})") from None
     finally:

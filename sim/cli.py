@@ -377,7 +377,8 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
         if "interleave" in kw and kw["interleave"] != interleave:
             raise RasterhwError(f"--interleave {interleave} contradicts -p interleave={kw['interleave']}")
         kw["interleave"] = interleave
-    info(f"generating Verilog for {block} ...")
+    if sys.stderr.isatty():  # progress for a person waiting; logs and pipes get only the result
+        info(f"generating Verilog for {block} ...")
     try:
         write_verilog(block, output, **kw)
     except RasterhwError:

@@ -70,7 +70,7 @@ def write_image(path: str | Path, rgb8: np.ndarray) -> Path:
     with atomic_path(path) as tmp:
         try:
             Image.fromarray(np.ascontiguousarray(rgb8)).save(tmp, format=fmt)
-        except (ValueError, OSError, KeyError) as e:  # e.g. a format that cannot hold RGB or this size
+        except (ValueError, OSError, KeyError, TypeError) as e:  # a format that cannot hold RGB or this size
             raise RasterhwError(f"cannot write {path} as {fmt}: {str(e).splitlines()[0] if str(e) else type(e).__name__}") from None
     return path
 

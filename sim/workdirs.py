@@ -116,6 +116,8 @@ def run_child(cmd: Sequence[str], *, timeout: float | None = None, **kw) -> subp
     """:func:`subprocess.run` (same keywords) whose child, in its own process group, is
     killed with that group if this process is interrupted, times out or dies."""
     linux = sys.platform.startswith("linux")
+    if kw.pop("capture_output", False):
+        kw["stdout"] = kw["stderr"] = subprocess.PIPE
     with subprocess.Popen(cmd, preexec_fn=_die_with_parent if linux else None, process_group=0, **kw) as p:
         try:
             out, err = p.communicate(timeout=timeout)
