@@ -57,19 +57,30 @@ def _read_hex(path: Path) -> np.ndarray:
     return np.array([int(w, 16) for w in words], dtype=object)
 
 
+_HEX: list = [None, ""]  # (records, their hex text): every processor of a matrix gets the same records
+
+
+def _records_hex(recs: list[dict]) -> str:
+    """The broadcast records as hex words, packed once per record list (an Amaranth constant
+    per record is milliseconds; the p x q processors of a frame share one list)."""
+    from rasterhw.hdl.sparse.layouts import BROADCAST
+
+    if _HEX[0] is not recs:
+        digits = -(-BROADCAST.size // 4)
+        _HEX[:] = [recs, "".join(f"{BROADCAST.const(r).as_bits():0{digits}x}\n" for r in recs)]
+    return _HEX[1]
+
+
 def run_processor_verilator(recs: list[dict], *, n: int, p: int, q: int, a: int, b: int, z_bits: int = 24) -> dict:
     """One processor on Verilator: the same keys as :func:`rasterhw.sim.sparse.hdl_run.run_processor`
     plus ``run_s`` (the C++ clock loop) and ``build_s``."""
-    from rasterhw.hdl.sparse.layouts import BROADCAST
-
     if len(recs) > MAXT:
         raise RasterhwError(f"sparse verilator bench holds at most {MAXT} triangles, not {len(recs)}")
     if not (0 <= a < p and 0 <= b < q):
         raise RasterhwError(f"sparse HDL: processor ({a}, {b}) is outside a {p}x{q} matrix")
     exe, build_s = build(n=n, p=p, q=q, z_bits=z_bits)
     run_dir = temp_run_folder(exe.parent.parent)
-    digits = -(-BROADCAST.size // 4)
-    (run_dir / "in.hex").write_text("".join(f"{BROADCAST.const(r).as_bits():0{digits}x}\n" for r in recs))
+    (run_dir / "in.hex").write_text(_records_hex(recs))
     N = 1 << n
     maxcyc = 200 * (len(recs) + 10) * (1 + n) + 64 * N * N + 10_000_000
     meta = run_plain_verilator(exe, [f"+in={run_dir / 'in.hex'}", f"+out={run_dir / 'out.hex'}",
