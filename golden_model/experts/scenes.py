@@ -21,7 +21,8 @@ from __future__ import annotations
 import numpy as np
 from rasterhw.golden_model.scene import Camera, Light, Material, Scene
 
-__all__ = ["build_tilt", "build_solid", "build_solids", "build_uneven", "SOLIDS", "visible_edges"]
+__all__ = ["build_tilt", "build_solid", "build_solids", "build_pyramid", "build_uneven", "SOLIDS",
+           "PYRAMID_FAMILY", "visible_edges"]
 
 
 def _screen(height: int = 512):
@@ -129,8 +130,14 @@ SOLIDS = {
 }
 
 
+#: ours, not the paper's: n-gonal pyramids seen from above their apex (all n sides and the base
+#: ring visible: 2n edges), the same size, so that only the number of edges varies
+PYRAMID_FAMILY = {f"pyramid-{n}": (f"{n}-gonal pyramid from above (ours)", lambda n=n: _pyramid(n, 1.2),
+                                   _view((0.0, 1.0, 0.3)), 2 * n) for n in (3, 4, 8, 10)}
+
+
 def _solid_polys(key: str, rng: np.random.Generator, centre, scale: float):
-    _, verts, view, _ = SOLIDS[key]
+    _, verts, view, _ = SOLIDS[key] if key in SOLIDS else PYRAMID_FAMILY[key]
     v = verts()
     v = v - (v.min(axis=0) + v.max(axis=0)) / 2
     v = v / np.abs(v).max()
@@ -198,6 +205,13 @@ def _solids_scene(name: str, seed: int, keys, centres, scale: float) -> Scene:
 def build_solid(key: str):
     def build(seed: int) -> Scene:
         return _solids_scene(f"experts-solid-{key}", seed, [key], [(0.0, 0.0, 0.0)], 2.2)
+    return build
+
+
+def build_pyramid(n: int):
+    """``experts-pyramid-{n}`` (ours): an n-gonal pyramid of the family :data:`PYRAMID_FAMILY`."""
+    def build(seed: int) -> Scene:
+        return _solids_scene(f"experts-pyramid-{n}", seed, [f"pyramid-{n}"], [(0.0, 0.0, 0.0)], 2.2)
     return build
 
 

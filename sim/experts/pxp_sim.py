@@ -30,25 +30,9 @@ BENCH_DIR = Path(__file__).resolve().parent / "verilator"
 SEG_BITS = 194          # seg_layout().size (checked in jobs)
 
 
-_FIELDS: dict[int, tuple] = {}
-
-
 def _pack(seg: dict, layout) -> int:
-    """``int(layout.const(seg).as_value().value)``, without building an Amaranth constant per
-    segment (3 ms each: most of a 512 x 512 frame's time): each field masked to its width (two's
-    complement for signed ones) at its offset, absent fields 0."""
-    fields = _FIELDS.get(id(layout))
-    if fields is None:
-        fields = _FIELDS[id(layout)] = (layout, tuple((name, f.offset, (1 << f.width) - 1) for name, f in layout))
-    v = 0
-    for name, off, mask in fields[1]:
-        x = seg.get(name)
-        if x:
-            v |= (int(x) & mask) << off
-    unknown = seg.keys() - {n for n, _, _ in fields[1]}
-    if unknown:
-        raise RasterhwError(f"experts: segment fields {sorted(unknown)} are not in the PXP layout")
-    return v
+    from rasterhw.hdl.pack import pack
+    return pack(layout, seg)
 
 
 def job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
@@ -59,7 +43,7 @@ def job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
         raise RasterhwError(f"experts: the bench expects {SEG_BITS}-bit segments, the PXP has {lay.size}")
     aj = fr.aj
     W = fr.width
-    words, exp_pix, lines = [], [], []
+    words, exp_pix, lines, per_job = [], [], [], []
     pix = pixel_words(fr.setup, fr.fields).reshape(fr.height, W)
     for k, (y, lo, hi) in enumerate(todo):
         segs = line_segments(fr, y, lo, hi, aj=aj)
@@ -68,11 +52,12 @@ def job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
         _, nlo, nhi = todo[k + 1] if k + 1 < len(todo) else todo[k]
         words.append((nhi << (SEG_BITS + 10)) | (nlo << SEG_BITS) | _pack({"last": 1}, lay))
         lines.append((segs, lo, hi))
+        per_job.append(segs)
         exp_pix.append(pix[y, lo:hi])
     sch = schedule(lines, aj=aj, width=W)
     return {"words": words, "pixels": np.concatenate(exp_pix).astype(np.int64) if exp_pix else np.zeros(0, np.int64),
             "cycles": np.array(sch["line_cycles"], np.int64), "last_pixel": sch["last_pixel"],
-            "lo0": todo[0][1], "hi0": todo[0][2], "lines": len(todo), "aj": aj}
+            "lo0": todo[0][1], "hi0": todo[0][2], "lines": len(todo), "aj": aj, "segments": per_job}
 
 
 def jobs(fr: ExpertsFrame, sn: int, pn: int, *, ranges: np.ndarray | None = None) -> dict:
@@ -89,8 +74,9 @@ def jobs(fr: ExpertsFrame, sn: int, pn: int, *, ranges: np.ndarray | None = None
     per = np.zeros((sn, pn), np.int64)
     for sidx in range(sn):
         for p in range(pn):
-            own = [(line_segments(fr, y, int(rbs[y, p]), int(rbs[y, p + 1]), aj=fr.aj), int(rbs[y, p]),
-                    int(rbs[y, p + 1])) for y in range(int(bands[sidx]), int(bands[sidx + 1]))]
+            # job k = y * pn + p (frame order): its segments were clipped once, in job_list
+            own = [(jb["segments"][y * pn + p], int(rbs[y, p]), int(rbs[y, p + 1]))
+                   for y in range(int(bands[sidx]), int(bands[sidx + 1]))]
             per[sidx, p] = schedule(own, aj=fr.aj, width=fr.width)["last_pixel"] + 1
     jb["pxp_frame_cycles"] = per
     return jb
@@ -150,10 +136,11 @@ NSEG_MAX, NOUT_MAX, NLINE_MAX = 1 << 19, 1 << 18, 1 << 14
 
 
 def _build(width: int, aj: str) -> tuple[Path, float]:
-    from amaranth.back import verilog
     from rasterhw.hdl.experts.pxp import ExpertsPxp
     from rasterhw.sim.runner import build_plain_verilator
-    src = verilog.convert(ExpertsPxp(width=width, aj=aj), name="experts_pxp")
+    from rasterhw.sim.verilog_cache import convert_cached
+    src = convert_cached("experts-pxp", lambda: ExpertsPxp(width=width, aj=aj), params={"width": width, "aj": aj},
+                         module="experts_pxp")
     params = {"NSEG": NSEG_MAX, "NOUT": NOUT_MAX, "NLINE": NLINE_MAX}
     # 4 edges after done so the last line's finish-time counter is stored
     return build_plain_verilator("experts-pxp", "tb_experts_pxp", [BENCH_DIR / "tb_experts_pxp.v"], params=params,

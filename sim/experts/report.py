@@ -119,6 +119,24 @@ def _tables(out: list, sections: list, out_dir: Path, progress: bool) -> None:
         out.append(make_row(SYS, "table 2.1", f"A.J. (c) increase, solid with {k} segments (experts-solid-{k}, "
                             f"{visible_edges(sc)} visible edges, {fc.aj_pixels} A.J. pixels)", paper=paper,
                             formula=None, measured=round(pct, 2), unit="%", source="golden"))
+        out.append(make_row(SYS, "table 2.1 (ours)", f"A.J. (c) extra operations per A.J. pixel, experts-solid-{k}",
+                            paper=None, formula=None, measured=round((c - a) / max(fc.aj_pixels, 1), 2), unit="ops",
+                            source="golden"))
+    # ours: a family in which only the number of edges varies (n-gonal pyramids from above, one size)
+    from rasterhw.golden_model.experts.scenes import PYRAMID_FAMILY, build_pyramid
+    fam = []
+    for key in PYRAMID_FAMILY:
+        nside = int(key.split("-")[1])
+        sc = build_pyramid(nside)(21)
+        tris = run_geometry(sc, 512, 512, z_bits=16)
+        a = cost.total_ops(render_frame(tris))
+        fc = render_frame(tris, aj="c")
+        pct = 100.0 * (cost.total_ops(fc) - a) / a
+        fam.append((visible_edges(sc), pct))
+        out.append(make_row(SYS, "table 2.1 (ours: pyramid family)",
+                            f"A.J. (c) increase, {nside}-gonal pyramid from above ({visible_edges(sc)} visible edges, "
+                            f"{fc.aj_pixels} A.J. pixels)", paper=None, formula=None, measured=round(pct, 2), unit="%",
+                            source="golden"))
     ls = cost.line_segments(8)
     base = cost.total_ops(render_frame(ls))
     rat = {}
@@ -151,6 +169,16 @@ def _tables(out: list, sections: list, out_dir: Path, progress: bool) -> None:
     sections.append("## Anti-jagging\n\n![alpha error](experts_alpha_error.png)\n\nOur curves: the error of (b) "
                     "and (c) against (a) over every offset at which the edge cuts the pixel, by edge angle. (c) is "
                     "exact for vertical edges and worst at the 45-degree switch.\n")
+    sections.append("## Table 2.1: what the A.J. overhead depends on\n\nThe paper's increase rises with the number of "
+                    "line segments (4.4 % at 5 to 12.4 % at 20); ours on the four solids does not. The rows above say "
+                    "why: every A.J. pixel costs the same extra operations (the `extra operations per A.J. pixel` rows "
+                    "agree within a few per cent on all four solids), so the increase is that constant times the A.J. "
+                    "pixels over the frame's base work, and A.J. pixels count scan-line crossings of edges (one per "
+                    "edge per line), not edges. Our dodecahedron's 20 edges are short, so it has fewer crossings than "
+                    "the octagonal pyramid's 15. In a family where only the edge count varies (ours: n-gonal pyramids "
+                    "of one size from above, `pyramid family` rows) the increase does rise with the edges, but more "
+                    "slowly than the paper's, since the sides meet at the apex. The paper's photographs that would fix "
+                    "the solids' sizes and views (写真1, 2) are not legible; we did not tune the solids to its column.\n")
 
 
 def _balance(out: list, sections: list, out_dir: Path, progress: bool) -> None:

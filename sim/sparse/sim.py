@@ -24,12 +24,16 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
     if engine == "pysim":
         from rasterhw.sim.sparse.hdl_run import run_processor as run
     elif engine == "verilator":
-        from rasterhw.sim.sparse.verilator_run import run_processor_verilator as run
+        from functools import partial
+
+        from rasterhw.sim.sparse.verilator_run import pack_records, run_processor_verilator
     else:
         raise RasterhwError(f"sparse sim: engine must be 'pysim' or 'verilator', not {engine!r}")
     g = sparse_render(tris, (p, q), depth="fixed")
     gz = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
     recs = broadcast_records(tris)
+    if engine == "verilator":
+        run = partial(run_processor_verilator, packed=pack_records(recs))
     N = 1 << n
     loc_t = np.full((q, p, N, N), -1, dtype=np.int64)
     loc_z = np.full((q, p, N, N), -1, dtype=np.int64)

@@ -18,7 +18,7 @@ from rasterhw.golden_model.sparse.formats import TRI_BITS
 from rasterhw.sim.runner import build_plain_verilator, run_plain_verilator
 from rasterhw.sim.workdirs import temp_run_folder
 
-__all__ = ["build", "run_processor_verilator"]
+__all__ = ["build", "pack_records", "run_processor_verilator"]
 
 BENCH_DIR = Path(__file__).resolve().parent / "verilator"
 TOP = "tb_sparse_vp"
@@ -39,11 +39,12 @@ def build(*, n: int, p: int, q: int, z_bits: int = 24) -> tuple[Path, float]:
 
 
 def _build(*, n: int, p: int, q: int, z_bits: int) -> tuple[Path, float]:
-    from amaranth.back import verilog
     from rasterhw.hdl.sparse.layouts import BROADCAST
     from rasterhw.hdl.sparse.vp import make_vp
+    from rasterhw.sim.verilog_cache import convert_cached
 
-    src = verilog.convert(make_vp(n=n, p=p, q=q, z_bits=z_bits), name="sparse_vp")
+    src = convert_cached("sparse-vp", lambda: make_vp(n=n, p=p, q=q, z_bits=z_bits),
+                         params={"n": n, "p": p, "q": q, "z_bits": z_bits}, module="sparse_vp")
     params = {"N": n, "BW": BROADCAST.size, "MAXT": MAXT, "ZW": z_bits + 1, "TW": TRI_BITS}
     ports = "".join(f"  , .tests_{i + 1}(tests_v[{32 * i + 31}:{32 * i}]), .stalls_{i + 1}(stalls_v[{32 * i + 31}:{32 * i}])\n"
                     for i in range(n))
@@ -57,30 +58,27 @@ def _read_hex(path: Path) -> np.ndarray:
     return np.array([int(w, 16) for w in words], dtype=object)
 
 
-_HEX: list = [None, ""]  # (records, their hex text): every processor of a matrix gets the same records
-
-
-def _records_hex(recs: list[dict]) -> str:
-    """The broadcast records as hex words, packed once per record list (an Amaranth constant
-    per record is milliseconds; the p x q processors of a frame share one list)."""
+def pack_records(recs: list[dict]) -> str:
+    """The bench's stimulus file: one hex word of the BROADCAST layout per triangle."""
+    from rasterhw.hdl.pack import pack
     from rasterhw.hdl.sparse.layouts import BROADCAST
 
-    if _HEX[0] is not recs:
-        digits = -(-BROADCAST.size // 4)
-        _HEX[:] = [recs, "".join(f"{BROADCAST.const(r).as_bits():0{digits}x}\n" for r in recs)]
-    return _HEX[1]
+    digits = -(-BROADCAST.size // 4)
+    return "".join(f"{pack(BROADCAST, r):0{digits}x}\n" for r in recs)
 
 
-def run_processor_verilator(recs: list[dict], *, n: int, p: int, q: int, a: int, b: int, z_bits: int = 24) -> dict:
+def run_processor_verilator(recs: list[dict], *, n: int, p: int, q: int, a: int, b: int, z_bits: int = 24,
+                            packed: str | None = None) -> dict:
     """One processor on Verilator: the same keys as :func:`rasterhw.sim.sparse.hdl_run.run_processor`
-    plus ``run_s`` (the C++ clock loop) and ``build_s``."""
+    plus ``run_s`` (the C++ clock loop) and ``build_s``. ``packed``: :func:`pack_records` of ``recs``
+    when the caller runs several processors on the same records."""
     if len(recs) > MAXT:
         raise RasterhwError(f"sparse verilator bench holds at most {MAXT} triangles, not {len(recs)}")
     if not (0 <= a < p and 0 <= b < q):
         raise RasterhwError(f"sparse HDL: processor ({a}, {b}) is outside a {p}x{q} matrix")
     exe, build_s = build(n=n, p=p, q=q, z_bits=z_bits)
     run_dir = temp_run_folder(exe.parent.parent)
-    (run_dir / "in.hex").write_text(_records_hex(recs))
+    (run_dir / "in.hex").write_text(pack_records(recs) if packed is None else packed)
     N = 1 << n
     maxcyc = 200 * (len(recs) + 10) * (1 + n) + 64 * N * N + 10_000_000
     meta = run_plain_verilator(exe, [f"+in={run_dir / 'in.hex'}", f"+out={run_dir / 'out.hex'}",

@@ -51,3 +51,25 @@ def test_line_segments_scene():
     f = render_frame(ls, aj="c")
     assert f.aj_pixels > 8 * 2 * 100   # both long sides of every segment are blended
     assert math.isfinite(cost.total_ops(f))
+
+
+def test_aj_cost_is_per_crossing_and_rises_with_edges_when_only_edges_vary():
+    """Table 2.1 analysis (docs/reproduction/experts.md): the extra work per A.J. pixel is one
+    constant on every solid, and in the pyramid family (one size, 6 to 20 edges) the increase rises."""
+    from rasterhw.golden_model.experts import cost
+    from rasterhw.golden_model.experts.model import render_frame
+    from rasterhw.golden_model.experts.scenes import build_pyramid
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+
+    def overhead(sc):
+        tris = run_geometry(sc, 512, 512, z_bits=16)
+        a = cost.total_ops(render_frame(tris))
+        fc = render_frame(tris, aj="c")
+        extra = cost.total_ops(fc) - a
+        return extra / a, extra / fc.aj_pixels
+
+    per_pixel = [overhead(build_scene(f"experts-solid-{k}"))[1] for k in (5, 9, 15, 20)]
+    assert max(per_pixel) / min(per_pixel) < 1.1, per_pixel
+    lo, hi = overhead(build_pyramid(3)(21))[0], overhead(build_pyramid(10)(21))[0]
+    assert hi > 1.2 * lo, (lo, hi)

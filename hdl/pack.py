@@ -1,0 +1,52 @@
+"""Pack a value into the bits of an Amaranth data layout, in plain Python.
+
+``pack(layout, value)`` equals ``layout.const(value).as_bits()`` (tested) at a fraction of the
+cost: benches that write thousands of stimulus words (the sparse broadcast records, EXPERTS
+segments) use it instead of building an Amaranth constant per word. Struct layouts take
+mappings (missing fields are 0), array layouts take sequences, plain shapes take integers
+(wrapped to their width, as a constant of a signed shape is).
+"""
+
+from __future__ import annotations
+
+from functools import cache
+
+from amaranth.hdl import Shape
+from amaranth.lib import data
+
+__all__ = ["pack"]
+
+
+@cache
+def _plan(layout) -> tuple:
+    """Flatten ``layout`` to ``((path, offset, width), ...)`` once per layout."""
+    out = []
+
+    def walk(shape, path, off):
+        if isinstance(shape, data.StructLayout):
+            for name, f in shape:
+                walk(f.shape, (*path, name), off + f.offset)
+        elif isinstance(shape, data.ArrayLayout):
+            w = Shape.cast(shape.elem_shape).width
+            for k in range(shape.length):
+                walk(shape.elem_shape, (*path, k), off + k * w)
+        else:
+            out.append((path, off, Shape.cast(shape).width))
+
+    walk(layout, (), 0)
+    return tuple(out)
+
+
+def pack(layout, value) -> int:
+    """The bits of ``value`` in ``layout`` as an unsigned integer."""
+    word = 0
+    for path, off, width in _plan(layout):
+        v = value
+        for key in path:
+            try:
+                v = v[key]
+            except KeyError:
+                v = 0
+                break
+        word |= (int(v) & ((1 << width) - 1)) << off
+    return word
