@@ -348,6 +348,9 @@ def run_cocotb(
         raise RasterhwError(f"cocotb: the simulator wrote no results (see {Path(results).parent / 'sim.log'})")
     n_tests, n_failed = get_results(results)
     if n_tests == 0 or n_failed:
+        from rasterhw.sim.workdirs import keep
+
+        keep(Path(results).parent)  # the one run folder left behind: the error below names its logs
         raise RasterhwError(f"cocotb: {n_failed} of {n_tests} tests failed (see {results} and "
                             f"{Path(results).parent / 'sim.log'})")
     return Path(results)

@@ -19,16 +19,20 @@ What a round randomises, per block:
   both double-Z samples of every pixel are compared.
 * ``pxp`` (EXPERTS PXP, 512 x 512, anti-jagging (c)): random EXPERTS / cube scenes (seeded),
   random Sn x Pn and range method (static, i, ii); every PXP pixel and every line's cycle
-  count are compared.
+  count are compared (timing-free bench: input never idles). Round 0 instead runs random
+  lines through the cocotb bench with random idle clocks on the input and random
+  back-pressure on the output (stream checkers, scoreboards).
 * ``sparse`` (sparse-raster video processors, 4 x 4 matrix, 256 x 256): random screen
   triangles (count, size) or a random cube scene; every processor's local memory (triangle
-  index and depth) is compared.
+  index and depth) is compared. Round 0 instead runs one random processor through the cocotb
+  bench with random idle clocks on its input.
 
 The vector Z-buffer machine has no HDL, so it has no round here.
 """
 
 from __future__ import annotations
 
+import inspect
 import sys
 import time
 from collections.abc import Callable
@@ -159,7 +163,36 @@ def _zbm_round(rng: np.random.Generator) -> dict:
 PXP_W, PXP_H = 512, 512
 
 
-def _pxp_round(rng: np.random.Generator) -> dict:
+def _pxp_cocotb_round(rng: np.random.Generator) -> dict:
+    """Random lines of a random frame through the PXP's cocotb bench: random idle clocks on the
+    segment stream, random back-pressure on the pixel stream, stream checkers, scoreboards."""
+    from rasterhw.golden_model.experts.model import render_frame
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.sim.experts.pxp_cocotb import run_cocotb_bench
+    from rasterhw.sim.experts.pxp_sim import job_list
+
+    name = str(rng.choice(["experts-1000", "experts-tilt-1000", "c100"]))
+    seed = int(rng.integers(0, 1 << 30))
+    fr = render_frame(run_geometry(build_scene(name, seed=seed), PXP_W, PXP_H, z_bits=16), model="bit", aj="c")
+    todo = []
+    for y in sorted(rng.choice(PXP_H, 6, replace=False).tolist()):
+        lo = int(rng.integers(0, PXP_W // 2))
+        todo.append((y, lo, int(rng.integers(lo + 1, PXP_W + 1))))
+    idle, stall = float(rng.choice([0.0, 0.2, 0.6])), float(rng.choice([0.0, 0.2, 0.6]))
+    jb = job_list(fr, todo)
+    what = f"cocotb: scene {name} seed={seed} lines={[t[0] for t in todo]} idle={idle} stall={stall}"
+    try:
+        run_cocotb_bench(jb, width=PXP_W, sim="verilator", idle=idle, stall=stall, seed=int(rng.integers(1 << 30)))
+        bad = 0
+    except RasterhwError as e:
+        bad, what = 1, f"{what}: {e}"
+    return {"pixels": int(jb["pixels"].size), "mismatches": bad, "run_s": 0.0, "settings": what}
+
+
+def _pxp_round(rng: np.random.Generator, k: int = 1) -> dict:
+    if k == 0:  # the first round of every soak: idle and back-pressure through the cocotb bench
+        return _pxp_cocotb_round(rng)
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.sim.experts.pxp_sim import simulate_scene
 
@@ -178,9 +211,31 @@ def _pxp_round(rng: np.random.Generator) -> dict:
 SP_W, SP_H = 256, 256
 
 
-def _sparse_round(rng: np.random.Generator) -> dict:
+def _sparse_cocotb_round(rng: np.random.Generator) -> dict:
+    """One random processor of the 4 x 4 matrix through its cocotb bench: random idle clocks on
+    the broadcast input, a stream checker, the local memory and per-level tests read back."""
+    from rasterhw.golden_model.reference import random_triangles
+    from rasterhw.sim.sparse.vp_cocotb import run_cocotb_bench
+
+    n, seed = int(rng.integers(5, 60)), int(rng.integers(0, 1 << 30))
+    a, b = int(rng.integers(0, 4)), int(rng.integers(0, 4))
+    idle = float(rng.choice([0.0, 0.3, 0.7]))
+    tris = random_triangles(SP_W, SP_H, n, mean_area=float(rng.uniform(20, 2000)), seed=seed)
+    what = f"cocotb: triangles n={n} seed={seed} processor=({a}, {b}) idle={idle}"
+    try:
+        r = run_cocotb_bench(tris, "4x4", a=a, b=b, sim="verilator", idle=idle, seed=int(rng.integers(1 << 30)))
+        px, bad = r["words_read"], 0
+    except RasterhwError as e:
+        px, bad, what = (SP_W // 4) * (SP_H // 4), 1, f"{what}: {e}"
+    return {"pixels": px, "mismatches": bad, "run_s": 0.0, "settings": what}
+
+
+def _sparse_round(rng: np.random.Generator, k: int = 1) -> dict:
     from rasterhw.golden_model.reference import random_triangles
     from rasterhw.sim.sparse.sim import simulate, simulate_tris
+
+    if k == 0:  # the first round of every soak: idle input through the cocotb bench
+        return _sparse_cocotb_round(rng)
 
     if rng.random() < 0.6:
         n = int(rng.integers(20, 600))
@@ -225,7 +280,8 @@ def run_soak(*, pixels: int, seed: int, blocks: list[str] | None = None, progres
         done = bad = k = 0
         failures = []
         while done < pixels and k < max_rounds:
-            r = BLOCKS[b](_rng(seed, b, k))
+            fn = BLOCKS[b]
+            r = fn(_rng(seed, b, k), k) if "k" in inspect.signature(fn).parameters else fn(_rng(seed, b, k))
             done += r["pixels"]
             bad += r["mismatches"]
             if r["mismatches"] and len(failures) < 5:

@@ -6,7 +6,8 @@
 * :func:`run_folder` — a fresh ``run-*`` folder for one run's stimulus and dumps, removed when
   the run ends however it ends (``with``), or, for code that only asks for a path, by
   :func:`cleanup` (the CLI calls it in ``finally``; ``atexit`` too). ``RASTERHW_KEEP=1`` keeps
-  them for debugging; :func:`keep` keeps one a caller asked to keep;
+  them for debugging; :func:`keep` keeps one a caller asked to keep (and the runner keeps the
+  folder of a simulation whose checks failed: its error names the logs there);
 * :func:`run_child` — ``subprocess.run`` whose child is killed with the parent: by the kernel
   if the parent dies (``PR_SET_PDEATHSIG``), and, with its whole process group (make,
   the compiler), if the parent is interrupted or fails while waiting.
