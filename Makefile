@@ -5,7 +5,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-stamp
 
-.PHONY: demo test bench report docs lint clean
+.PHONY: demo test bench soak report docs lint clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -21,6 +21,10 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(VENV)/bin/rasterhw bench
+
+# random differential runs, 10^8 output pixels per HDL block (hours; SEED=n reruns one)
+soak: $(STAMP)
+	$(VENV)/bin/rasterhw soak --pixels 100000000 $(if $(SEED),--seed $(SEED))
 
 docs: $(STAMP)
 	$(VENV)/bin/rasterhw report all

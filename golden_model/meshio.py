@@ -20,7 +20,7 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.scene import Camera, Light, Material, Scene
 
-__all__ = ["MESH_EXTENSIONS", "load_mesh", "load_scene"]
+__all__ = ["MESH_EXTENSIONS", "decode_text", "load_mesh", "load_scene"]
 
 MESH_EXTENSIONS = (".obj", ".ply")
 _COORD_LIMIT = 1e15  # the Scene validator's limit
@@ -33,19 +33,66 @@ def _one_line(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {msg}" if msg else type(exc).__name__
 
 
-def _check_obj_faces(path: Path) -> None:
-    """trimesh drops OBJ faces with fewer than 3 vertices silently: find them in the raw text."""
+#: byte-order marks, longest first (a UTF-32 LE mark starts with the UTF-16 LE one)
+_BOMS = ((b"\x00\x00\xfe\xff", "utf-32-be"), (b"\xff\xfe\x00\x00", "utf-32-le"),
+         (b"\xef\xbb\xbf", "utf-8"), (b"\xfe\xff", "utf-16-be"), (b"\xff\xfe", "utf-16-le"))
+
+
+def decode_text(raw: bytes) -> tuple[str, str]:
+    """Text of a mesh file whose encoding is not declared -> ``(text, encoding)``.
+
+    A byte-order mark decides (UTF-8, UTF-16, UTF-32; the mark is dropped). Without one, a
+    file with NUL bytes in every other position is UTF-16 (LE or BE by where they fall);
+    otherwise UTF-8 if it decodes, else Latin-1, which decodes any byte string (an OBJ's
+    numbers and keywords are ASCII, so only comments and names can be affected).
+    """
+    for bom, enc in _BOMS:
+        if raw.startswith(bom):
+            try:
+                return raw[len(bom):].decode(enc), enc
+            except UnicodeDecodeError:
+                break  # not really a mark: fall through to the guesses below
+    if len(raw) >= 2 and b"\x00" in raw:
+        even, odd = raw[0::2], raw[1::2]
+        enc = ("utf-16-le" if odd.count(0) > len(odd) // 2 else
+               "utf-16-be" if even.count(0) > len(even) // 2 else None)
+        if enc is not None:
+            try:
+                return raw[: len(raw) // 2 * 2].decode(enc), enc
+            except UnicodeDecodeError:
+                pass
     try:
-        with path.open("r", encoding="utf-8", errors="replace") as fh:
-            for lineno, line in enumerate(fh, 1):
-                if line.startswith("f") and line[1:2].isspace():
-                    n = len(line.split("#", 1)[0].split()) - 1
-                    if n < 3:
-                        raise RasterhwError(
-                            f"{path}: line {lineno}: face has {n} vertices (a face needs at least 3)"
-                        )
+        return raw.decode("utf-8"), "utf-8"
+    except UnicodeDecodeError:
+        return raw.decode("latin-1"), "latin-1"
+
+
+def _read_bytes(path: Path) -> bytes:
+    try:
+        return path.read_bytes()
     except OSError as exc:
         raise RasterhwError(f"cannot read {path}: {_one_line(exc)}") from None
+
+
+def _check_obj_faces(path: Path, text: str) -> None:
+    """What trimesh gets wrong silently in an OBJ's faces, found in the raw text: a face with
+    fewer than 3 vertices (dropped) and vertex index 0 (OBJ counts from 1; NumPy would read
+    0 - 1 as the last vertex). An index that is not an integer is an error too."""
+    for lineno, line in enumerate(text.splitlines(), 1):
+        if not (line.startswith("f") and line[1:2].isspace()):
+            continue
+        corners = line.split("#", 1)[0].split()[1:]
+        if len(corners) < 3:
+            raise RasterhwError(f"{path}: line {lineno}: face has {len(corners)} vertices (a face needs at least 3)")
+        for c in corners:
+            v = c.split("/", 1)[0]
+            try:
+                iv = int(v)
+            except ValueError:
+                raise RasterhwError(f"{path}: line {lineno}: face vertex {c[:40]!r} is not an integer index") from None
+            if iv == 0:
+                raise RasterhwError(f"{path}: line {lineno}: face vertex index 0 (OBJ indices start at 1, "
+                                    "or count back from -1)")
 
 
 def _check_ply_faces(path: Path, mesh) -> None:
@@ -122,8 +169,16 @@ def load_mesh(path: str | Path, *, name: str | None = None, smooth: bool = True)
         raise RasterhwError(f"{path}: no such file" if not path.exists() else f"{path}: not a file")
     if path.stat().st_size == 0:
         raise RasterhwError(f"{path}: file is empty")
+    raw = _read_bytes(path)
     if ext == ".obj":
-        _check_obj_faces(path)
+        # OBJ is text in no declared encoding: decode it here (UTF-8 with or without a BOM,
+        # UTF-16, Latin-1) and hand trimesh clean UTF-8, so it never guesses (its guesser
+        # needs an optional package) and a BOM never hides the first line.
+        text, _enc = decode_text(raw)
+        _check_obj_faces(path, text)
+        raw = text.encode("utf-8")
+
+    import io
 
     import trimesh
 
@@ -132,13 +187,17 @@ def load_mesh(path: str | Path, *, name: str | None = None, smooth: bool = True)
     old_level = log.level
     log.setLevel(logging.CRITICAL)
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore")
-            mesh = trimesh.load(str(path), force="mesh", process=False)
+            resolver = trimesh.resolvers.FilePathResolver(str(path.resolve()))
+            mesh = trimesh.load(io.BytesIO(raw), file_type=ext[1:], force="mesh", process=False,
+                                resolver=resolver)
             faces = np.asarray(mesh.faces, dtype=np.int64)
             verts = np.asarray(mesh.vertices, dtype=np.float64)
     except RasterhwError:
         raise
+    except MemoryError:
+        raise RasterhwError(f"{path}: the {ext[1:].upper()} file describes more data than fits in memory") from None
     except Exception as exc:
         raise RasterhwError(f"{path}: not a readable {ext[1:].upper()} mesh ({_one_line(exc)})") from None
     finally:

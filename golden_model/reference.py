@@ -52,7 +52,7 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles, snap
 
-__all__ = ["SUBPIXEL", "MAX_COORD", "Frame", "rasterise", "benchmark", "random_triangles", "snap"]
+__all__ = ["SUBPIXEL", "MAX_COORD", "Frame", "rasterise", "rasterise_rgb8", "rasterise_rgb8_memory", "benchmark", "random_triangles", "snap"]
 
 #: Sub-pixel grid: vertex coordinates are snapped to multiples of ``1 / SUBPIXEL`` px.
 SUBPIXEL = 1 << SUBPIXEL_BITS
@@ -158,8 +158,9 @@ def _setup(xy: np.ndarray, width: int, height: int) -> dict:
             "r1": r1[keep].astype(np.int64)}
 
 
-def _fragments(st: dict, lo_t: int, hi_t: int, width: int, z: np.ndarray) -> dict:
-    """Spans, fragments and fragment depths for kept triangles ``lo_t .. hi_t - 1``."""
+def _fragments(st: dict, lo_t: int, hi_t: int, width: int, z: np.ndarray, row0: int = 0) -> dict:
+    """Spans, fragments and fragment depths for kept triangles ``lo_t .. hi_t - 1``; pixel
+    indices count from row ``row0`` (the first row of the tile being rendered)."""
     r0, r1 = st["r0"][lo_t:hi_t], st["r1"][lo_t:hi_t]
     nrows = r1 - r0 + 1
     nr = int(nrows.sum())
@@ -207,7 +208,7 @@ def _fragments(st: dict, lo_t: int, hi_t: int, width: int, z: np.ndarray) -> dic
     def spread(v: np.ndarray, name: str, dtype=np.float64) -> np.ndarray:
         return np.take(v, rec, out=pool.get(name, F, dtype), mode="clip")
 
-    pix = spread(row[nz] * width + (lo - start), "pix", np.int64)
+    pix = spread((row[nz] - row0) * width + (lo - start), "pix", np.int64)
     pix += iota
     colf = spread((lo - start).astype(np.float64), "col")
     colf += iota  # exact: |col| < 2**31
@@ -340,8 +341,12 @@ def _fresh_block(nbytes: int) -> np.ndarray:
     return raw[off:off + nbytes]
 
 
-def _rasterise(tris, xy, z, vcol, pid, bg) -> Frame:
-    W, H = int(tris.width), int(tris.height)
+def _rasterise(tris, xy, z, vcol, pid, bg, st: dict | None = None, rows: tuple[int, int] | None = None) -> Frame:
+    """The frame, or only rows ``rows = (y0, y1)`` of it (a tile: ``st`` is then the set-up of
+    the whole frame, restricted here to the triangles that reach the tile)."""
+    W = int(tris.width)
+    y0, y1 = rows if rows is not None else (0, int(tris.height))
+    H = y1 - y0
     npix = W * H
     # The four outputs share one fresh block (a new one per call: a returned Frame is never
     # aliased by a later call).
@@ -361,8 +366,11 @@ def _rasterise(tris, xy, z, vcol, pid, bg) -> Frame:
     win, first = _scratch(npix)  # winning fragment per pixel (this chunk); layer scratch
     big = np.iinfo(np.int64).max
     fragments = written = 0
-    if xy.shape[0]:
+    if st is None and xy.shape[0]:
         st = _setup(xy, W, H)
+    elif st is not None:
+        st = _restrict(st, y0, y1)
+    if st is not None and st["keep"].size:
         keep = st["keep"]
         zk = z[keep].T.copy()  # (vertex, kept triangle)
         pk = pid[keep]
@@ -377,7 +385,7 @@ def _rasterise(tris, xy, z, vcol, pid, bg) -> Frame:
             nxt = int(np.searchsorted(cum, base + CHUNK_CANDIDATES, side="right"))
             bounds.append(max(nxt, bounds[-1] + 1))
         for c in range(len(bounds) - 1):
-            fr = _fragments(st, bounds[c], bounds[c + 1], W, zk)
+            fr = _fragments(st, bounds[c], bounds[c + 1], W, zk, y0)
             F = fr["F"]
             if F == 0:
                 continue
@@ -428,6 +436,69 @@ def _rasterise(tris, xy, z, vcol, pid, bg) -> Frame:
         pixels_written=int(written),
         pixels_covered=int(np.count_nonzero(tri_id >= 0)),
     )
+
+
+def _restrict(st: dict, y0: int, y1: int) -> dict:
+    """The set-up of the triangles whose rows reach ``y0 .. y1 - 1``, rows clipped to them
+    (submission order kept, so the tile's serial Z-buffer sees the same sequence)."""
+    sel = np.flatnonzero((st["r1"] >= y0) & (st["r0"] < y1))
+    return {"keep": st["keep"][sel], "table": st["table"][:, sel], "wtab": st["wtab"][:, sel],
+            "r0": np.maximum(st["r0"][sel], y0), "r1": np.minimum(st["r1"][sel], y1 - 1)}
+
+
+#: pixels per tile of :func:`rasterise_rgb8` (each tile costs ~100 bytes per pixel while it
+#: is rendered; the frame kept is 3 bytes per pixel)
+TILE_PIXELS = 1 << 21
+#: bytes per pixel :func:`rasterise` needs: the Frame (48), the per-pixel scratch (16), and
+#: ``to_rgb8`` of it (its float temporaries, 2 x 24, and the result, 3)
+FRAME_BYTES_PER_PIXEL = 48 + 16 + 48 + 3
+#: bytes per pixel of :func:`rasterise_rgb8` beyond its tiles: the image (3) and one copy of
+#: it for the PNG encoder (3)
+RGB8_BYTES_PER_PIXEL = 6
+
+
+def rasterise_rgb8_memory(width: int, height: int, n_triangles: int = 0) -> int:
+    """Bytes :func:`rasterise_rgb8` needs for a ``width x height`` frame (an estimate)."""
+    tile = min(width * height, max(width, TILE_PIXELS))
+    return (RGB8_BYTES_PER_PIXEL * width * height + FRAME_BYTES_PER_PIXEL * tile
+            + 40 * CHUNK_CANDIDATES * 8 + 600 * n_triangles)
+
+
+def rasterise_rgb8(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0), progress=None
+                   ) -> tuple[np.ndarray, dict]:
+    """:func:`rasterise` for frames too big to hold as a :class:`Frame`: the same pixels,
+    rendered in tiles of whole rows (about :data:`TILE_PIXELS` each), keeping only the
+    8-bit image.
+
+    Each pixel's serial Z-buffer sees the same triangles in the same order whatever the
+    tiling, so the image and the counts are exactly those of ``rasterise(tris)``.
+
+    Returns ``(rgb8 (H, W, 3) uint8, {"fragments", "pixels_written", "pixels_covered"})``.
+    ``progress``, if given, is called with the number of rows just finished (tiles are then at
+    most 1/32 of the frame, so a bar moves even on a frame of one tile).
+    """
+    xy, z, vcol, pid, bg = _check(tris, background)
+    W, H = int(tris.width), int(tris.height)
+    rgb8 = np.empty((H, W, 3), dtype=np.uint8)
+    counts = {"fragments": 0, "pixels_written": 0, "pixels_covered": 0}
+    st = _setup(xy, W, H) if xy.shape[0] else None
+    step = max(1, TILE_PIXELS // W)
+    if progress is not None:  # at least ~32 updates for a person watching (same pixels: see above)
+        step = max(1, min(step, -(-H // 32)))
+    try:
+        for y0 in range(0, H, step):
+            y1 = min(H, y0 + step)
+            fr = _rasterise(tris, xy, z, vcol, pid, bg, st=st, rows=(y0, y1))
+            rgb8[y0:y1] = fr.to_rgb8()
+            for k in counts:
+                counts[k] += int(getattr(fr, k))
+            del fr
+            if progress is not None:
+                progress(y1 - y0)
+    except BaseException:
+        _local.scratch = None
+        raise
+    return rgb8, counts
 
 
 def benchmark(tris: ScreenTriangles, repeat: int = 11) -> dict:

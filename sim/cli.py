@@ -111,14 +111,16 @@ def parse_params(params: tuple[str, ...], factory) -> dict:
 
 
 def parse_size(text: str | None) -> tuple[int, int] | None:
-    """``"512x512"`` -> (512, 512); raises RasterhwError on anything else."""
+    """``"512x512"`` -> (512, 512); raises RasterhwError on anything else (digits only: no
+    signs, no ``5_0``)."""
+    import re
+
     if text is None:
         return None
-    parts = text.lower().replace("*", "x").split("x")
-    try:
-        w, h = (int(p) for p in parts)
-    except ValueError:
-        raise RasterhwError(f"--size must look like 512x512, not {text!r}") from None
+    m = re.fullmatch(r"\s*([0-9]{1,9})\s*[xX*]\s*([0-9]{1,9})\s*", str(text))
+    if m is None:
+        raise RasterhwError(f"--size must look like 512x512, not {text!r}")
+    w, h = int(m.group(1)), int(m.group(2))
     if not (1 <= w <= 16384 and 1 <= h <= 16384):
         raise RasterhwError(f"--size {w}x{h}: width and height must be between 1 and 16384")
     return w, h
@@ -175,30 +177,62 @@ def scenes(as_json: bool) -> None:
         click.echo(f"{r['name']:<14}{r['polygons']:>9}  {size:<10} {r['description']}")
 
 
-def load_scene_and_size(scene: str, size: str | None):
+def load_scene_and_size(scene: str, size: str | None, *, bytes_per_pixel: int = 0, what: str = ""):
+    """The scene and frame size; the size is checked first (before a big mesh loads), and if
+    ``bytes_per_pixel`` is given, so is the memory the frame will need."""
     from rasterhw.golden_model.meshio import load_scene
     from rasterhw.golden_model.scenes import SCENES
 
-    sc = load_scene(scene)
     wh = parse_size(size)
     if wh is None:
         info_ = SCENES.get(scene)
         wh = (info_.default_width, info_.default_height) if info_ is not None else (512, 512)
+    if bytes_per_pixel:
+        from rasterhw.golden_model.memcheck import check_memory
+
+        check_memory(bytes_per_pixel * wh[0] * wh[1], f"{what} {wh[0]}x{wh[1]}".strip())
+    sc = load_scene(scene)
     return sc, wh
 
 
-def render_reference(scene: str, size: str | None, z_bits: int = 24):
-    """Scene -> (Scene, ScreenTriangles, Frame, seconds in geometry, seconds in raster)."""
+def render_reference(scene: str, size: str | None, z_bits: int = 24, *, progress: bool = False):
+    """Scene -> (Scene, ScreenTriangles, (rgb8, counts), seconds in geometry, seconds in raster).
+
+    The frame is rendered in tiles (``reference.rasterise_rgb8``: exactly ``rasterise``'s
+    pixels, ~6 bytes per pixel kept); its memory is checked before anything is allocated."""
+    from rasterhw.golden_model.memcheck import check_memory
     from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.reference import rasterise
+    from rasterhw.golden_model.reference import rasterise_rgb8, rasterise_rgb8_memory
 
     sc, (w, h) = load_scene_and_size(scene, size)
+    check_memory(rasterise_rgb8_memory(w, h, sc.n_polygons), f"render {w}x{h} (reference)")
     t0 = time.perf_counter()
     tris = run_geometry(sc, w, h, z_bits=z_bits)
     t1 = time.perf_counter()
-    frame = rasterise(tris)
+    bar = _progress_bar(h, "raster", "rows") if progress else None
+    try:
+        frame = rasterise_rgb8(tris, progress=bar.update if bar is not None else None)
+    finally:
+        if bar is not None:
+            bar.close()
     t2 = time.perf_counter()
     return sc, tris, frame, t1 - t0, t2 - t1
+
+
+def _progress_bar(total: int, desc: str, unit: str):
+    """A tqdm bar on stderr, shown only on a terminal (never in pipes, logs or tests)."""
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=desc, unit=unit, disable=None, file=sys.stderr, leave=False)
+
+
+def _warn_if_empty(tris, pixels_written: int) -> None:
+    """A frame with nothing drawn is almost always a surprise: say why."""
+    st = tris.stats
+    if pixels_written == 0 and int(st.get("polygons_in", 0)) > 0:
+        culled, clipped = int(st.get("polygons_culled", 0)), int(st.get("polygons_clipped_away", 0))
+        info(f"warning: nothing drawn: {st.get('polygons_in')} polygons in, {culled} back-facing (culled), "
+             f"{clipped} outside the view; the frame is background only")
 
 
 @cli.command()
@@ -227,26 +261,25 @@ def machines() -> None:
 def render(scene: str, arch: str, size: str | None, output: str | None, z_bits: int, as_json: bool,
            **arch_options) -> None:
     """Render SCENE (a built-in name or an .obj/.ply file) and write a PNG."""
+    from rasterhw.sim.outfile import check_image_output, write_image
+
+    out = check_image_output(output) or Path("out") / f"{Path(scene).stem}-{arch}.png"
     t0 = time.perf_counter()
     if arch == REFERENCE:
         _take_options(arch_options, (), "--arch reference")
-        sc, tris, frame, _, _ = render_reference(scene, size, z_bits)
-        rgb8 = frame.to_rgb8()
-        pixels_written = int(frame.pixels_written)
-        extra = {"fragments": int(frame.fragments), "pixels_covered": int(frame.pixels_covered)}
+        sc, tris, (rgb8, counts), _, _ = render_reference(scene, size, z_bits, progress=not as_json)
+        pixels_written = counts["pixels_written"]
+        extra = {"fragments": counts["fragments"], "pixels_covered": counts["pixels_covered"]}
     else:
         _machine, a = registry.archs()[arch]
         opts = _take_options(arch_options, a.options, f"--arch {arch}")
-        sc, (w, h) = load_scene_and_size(scene, size)
+        sc, (w, h) = load_scene_and_size(scene, size, bytes_per_pixel=a.bytes_per_pixel, what=f"render --arch {arch}")
         res = registry.load(a.render)(sc, w, h, arch=arch, **opts)
         rgb8, tris, pixels_written = res.rgb8, res.tris, int(res.pixels_written)
         extra = {**opts, **res.stats}
     wall = time.perf_counter() - t0
-    out = Path(output) if output else Path("out") / f"{Path(scene).stem}-{arch}.png"
-    out.parent.mkdir(parents=True, exist_ok=True)
-    from PIL import Image
-
-    Image.fromarray(rgb8).save(out)
+    write_image(out, rgb8)
+    _warn_if_empty(tris, pixels_written)
     result = {
         "scene": sc.name,
         "arch": arch,
@@ -275,18 +308,18 @@ def render(scene: str, arch: str, size: str | None, output: str | None, z_bits: 
 @click.option("--json", "as_json", is_flag=True)
 def compare(a: str, b: str, output: str | None, tolerance: int, as_json: bool) -> None:
     """Compare two images pixel by pixel; exit 1 if they differ beyond --tolerance."""
-    import numpy as np
-    from PIL import Image
-    from rasterhw.golden_model.compare import compare_images, write_diff_png
+    from rasterhw.golden_model.compare import compare_images, diff_image
+    from rasterhw.sim.imageio import read_rgb8_pair
+    from rasterhw.sim.outfile import check_image_output, write_image
 
-    ia = np.asarray(Image.open(a).convert("RGB"))
-    ib = np.asarray(Image.open(b).convert("RGB"))
-    if ia.shape != ib.shape:
-        raise RasterhwError(f"images differ in size: {ia.shape[1]}x{ia.shape[0]} vs {ib.shape[1]}x{ib.shape[0]}")
+    out = check_image_output(output)
+    if tolerance < 0:
+        raise RasterhwError(f"--tolerance must be 0 or more, not {tolerance}")
+    ia, ib = read_rgb8_pair(a, b, extra_bytes_per_pixel=3 if out else 0)
     res = compare_images(ia, ib, tolerance=tolerance)
-    if output:
-        write_diff_png(ia, ib, output)
-        res["diff_image"] = output
+    if out:
+        write_image(out, diff_image(ia, ib, tolerance=tolerance))
+        res["diff_image"] = str(out)
     if as_json:
         emit_json(res)
     else:
@@ -344,8 +377,12 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
         if "interleave" in kw and kw["interleave"] != interleave:
             raise RasterhwError(f"--interleave {interleave} contradicts -p interleave={kw['interleave']}")
         kw["interleave"] = interleave
+    if sys.stderr.isatty():  # progress for a person waiting; logs and pipes get only the result
+        info(f"generating Verilog for {block} ...")
     try:
         write_verilog(block, output, **kw)
+    except RasterhwError:
+        raise
     except (TypeError, ValueError) as e:
         raise RasterhwError(f"{block}: {e}") from None
     info(f"wrote {output}")
@@ -362,18 +399,17 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
 @click.option("--json", "as_json", is_flag=True)
 def sim_cmd(block, scene, size, engine, output, as_json, **block_options) -> None:
     """Run a scene through a block's HDL, compare with the golden model, write the frame."""
-    from PIL import Image
+    from rasterhw.sim.outfile import check_image_output, write_image
 
     _machine, b = registry.sim_blocks()[block]
     opts = _take_options(block_options, b.options, f"sim {block}")
     scene = scene or b.default_scene
-    sc, (w, h) = load_scene_and_size(scene, size)
+    out = check_image_output(output) or Path("out") / f"{Path(scene).stem}-{block}-{engine}.png"
+    sc, (w, h) = load_scene_and_size(scene, size, bytes_per_pixel=b.bytes_per_pixel, what=f"sim {block}")
     res = registry.load(b.simulate)(sc, w, h, engine=engine, progress=not as_json, **opts)
     frame = res.pop("frame_rgb", None)
-    out = Path(output) if output else Path("out") / f"{Path(scene).stem}-{block}-{engine}.png"
     if frame is not None:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        Image.fromarray(frame).save(out)
+        write_image(out, frame)
         res["image"] = str(out)
     res = {"block": block, "scene": sc.name, **res}
     if as_json:
@@ -418,6 +454,35 @@ def bench(as_json: bool, repeat: int, hdl: bool) -> None:
 
 
 @cli.command()
+@click.option("--pixels", type=int, default=1_000_000, show_default=True,
+              help="Output pixels to compare per block (the soak: 100000000).")
+@click.option("--seed", type=int, default=None, help="Seed of every round (default: a fresh one, printed).")
+@click.option("--block", "blocks", multiple=True, help="Only these blocks (repeatable; default: every block).")
+@click.option("--json", "as_json", is_flag=True)
+def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], as_json: bool) -> None:
+    """Random differential runs of every HDL block against its golden model on Verilator
+    (random scenes and stimulus, idle and back-pressure patterns, ZB/M clock ratios); exit 1
+    on any mismatch. The seed is printed; --seed reruns the same rounds."""
+    import secrets
+
+    from rasterhw.sim.soak import run_soak
+
+    seed = secrets.randbelow(1 << 31) if seed is None else seed
+    info(f"soak: seed {seed} (rerun: rasterhw soak --seed {seed} --pixels {pixels})")
+    rows = run_soak(pixels=pixels, seed=seed, blocks=list(blocks) or None, progress=not as_json)
+    if as_json:
+        emit_json(rows)
+    else:
+        for r in rows:
+            click.echo(f"{r['block']:<10} {r['rounds']:>5} rounds {r['pixels_compared']:>12,} pixels "
+                       f"{r['mismatches']:>6} mismatches {r['wall_s']:>8.1f} s")
+            for fl in r["failures"]:
+                click.echo(f"{'':10} round {fl['round']}: {fl['mismatches']} mismatches ({fl['settings']})")
+    if any(r["mismatches"] for r in rows):
+        sys.exit(1)
+
+
+@cli.command()
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), default="out", show_default=True)
 @click.option("--scene", default="c300", show_default=True, help="Scene for the reference render.")
 @click.option("--engine", type=click.Choice(ENGINES), default="verilator",
@@ -429,7 +494,29 @@ def demo(out_dir: str, scene: str, engine: str) -> None:
     run_demo(Path(out_dir), scene=scene, engine=engine)
 
 
+def _terminate(signum, _frame):
+    """SIGTERM/SIGHUP -> SystemExit, so ``finally`` blocks run (run folders removed,
+    simulator children killed) instead of the process vanishing."""
+    raise SystemExit(128 + signum)
+
+
 def main(argv: list[str] | None = None) -> None:
+    import signal
+
+    from rasterhw.sim import workdirs
+
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        try:
+            signal.signal(sig, _terminate)
+        except (ValueError, OSError):  # not the main thread
+            pass
+    try:
+        _main(argv)
+    finally:
+        workdirs.cleanup()
+
+
+def _main(argv: list[str] | None) -> None:
     try:
         rc = cli.main(args=argv, prog_name="rasterhw", standalone_mode=False)
     except RasterhwError as e:

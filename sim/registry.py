@@ -60,6 +60,7 @@ class Arch:
     help: str
     render: str                        # "module:function"
     options: tuple[Option, ...] = ()
+    bytes_per_pixel: int = 400         # peak memory per frame pixel (checked before a render starts)
 
 
 @dataclass(frozen=True)
@@ -71,6 +72,7 @@ class SimBlock:
     simulate: str                      # "module:function"
     default_scene: str
     options: tuple[Option, ...] = ()
+    bytes_per_pixel: int = 400         # peak memory per frame pixel (checked before a run starts)
 
 
 @dataclass(frozen=True)

@@ -22,6 +22,7 @@ from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import vlruntime
+from rasterhw.sim.workdirs import build_lock, run_child
 
 __all__ = [
     "HARNESS_V",
@@ -196,43 +197,63 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
     exe = bdir / "obj_dir" / f"V{top}"
     if exe.exists():
         return exe, 0.0
-    bdir.mkdir(parents=True, exist_ok=True)
-    for k, text in generated.items():
-        (bdir / k).write_text(text)
-    env = sim_env()
-    env["MAKEFLAGS"] = f"{env['MAKEFLAGS']} {make}" if env.get("MAKEFLAGS") else make
-    cflags = " ".join(f"-D{k}={v}" for k, v in defines.items())
-    cmd = [str(verilator_bin_dir() / "verilator"), *VERILATOR_PLAIN_ARGS, "--top-module", top, f"-I{bdir}",
-           "-CFLAGS", cflags, *[f"-G{k}={v}" for k, v in params.items()], "--Mdir", str(bdir / "obj_dir"),
-           *[str(bdir / k) for k in generated if k.endswith(".v")], *[str(f) for f in sources], str(PLAIN_MAIN)]
-    t0 = time.perf_counter()
-    # generate, put the shared runtime objects in (newer than the generated makefile, so make
-    # keeps them: sim/vlruntime.py), then compile
-    rt_flags = ["plain", make, cflags, *VERILATOR_PLAIN_ARGS]
-    r = subprocess.run(cmd, cwd=bdir, env=env, capture_output=True, text=True)
-    log = " ".join(cmd) + "\n" + r.stdout + r.stderr
-    if not r.returncode:
-        vlruntime.seed(bdir / "obj_dir", "plain", rt_flags)
-        mk = ["make", "-C", str(bdir / "obj_dir"), "-f", f"V{top}.mk", "-j", "2"]
-        r = subprocess.run(mk, cwd=bdir, env=env, capture_output=True, text=True)
-        log += " ".join(mk) + "\n" + r.stdout + r.stderr
-    build_s = time.perf_counter() - t0
-    (bdir / "build.log").write_text(log)
-    if r.returncode or not exe.exists():
-        raise RasterhwError(f"{name}: verilator build failed (see {bdir / 'build.log'}):\n{r.stderr[-2000:]}")
-    vlruntime.harvest(bdir / "obj_dir", "plain", rt_flags)
+    with build_lock(bdir, what=name):
+        if exe.exists():  # another process built it while we waited
+            return exe, 0.0
+        bdir.mkdir(parents=True, exist_ok=True)
+        for k, text in generated.items():
+            (bdir / k).write_text(text)
+        env = sim_env()
+        env["MAKEFLAGS"] = f"{env['MAKEFLAGS']} {make}" if env.get("MAKEFLAGS") else make
+        cflags = " ".join(f"-D{k}={v}" for k, v in defines.items())
+        cmd = [str(verilator_bin_dir() / "verilator"), *VERILATOR_PLAIN_ARGS, "--top-module", top, f"-I{bdir}",
+               "-CFLAGS", cflags, *[f"-G{k}={v}" for k, v in params.items()], "--Mdir", str(bdir / "obj_dir"),
+               *[str(bdir / k) for k in generated if k.endswith(".v")], *[str(f) for f in sources], str(PLAIN_MAIN)]
+        t0 = time.perf_counter()
+        # generate, put the shared runtime objects in (newer than the generated makefile, so make
+        # keeps them: sim/vlruntime.py), then compile
+        rt_flags = ["plain", make, cflags, *VERILATOR_PLAIN_ARGS]
+        r = run_child(cmd, cwd=bdir, env=env, capture_output=True, text=True)
+        log = " ".join(cmd) + "\n" + r.stdout + r.stderr
+        if not r.returncode:
+            vlruntime.seed(bdir / "obj_dir", "plain", rt_flags)
+            mk = ["make", "-C", str(bdir / "obj_dir"), "-f", f"V{top}.mk", "-j", "2"]
+            r = run_child(mk, cwd=bdir, env=env, capture_output=True, text=True)
+            log += " ".join(mk) + "\n" + r.stdout + r.stderr
+        build_s = time.perf_counter() - t0
+        (bdir / "build.log").write_text(log)
+        if r.returncode or not exe.exists():
+            raise RasterhwError(f"{name}: verilator build failed ({_first_error(log)}); "
+                                f"see {bdir / 'build.log'}")
+        vlruntime.harvest(bdir / "obj_dir", "plain", rt_flags)
     return exe, build_s
+
+
+def _first_error(text: str) -> str:
+    """The first error line of a compiler or simulator log, shortened (for one-line errors)."""
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    pick = next((ln for ln in lines if "%Error" in ln or "error:" in ln.lower()), lines[-1] if lines else "no output")
+    return pick[:200]
+
+
+def _execute_cmds_as_children(self, cmds, cwd, stdout=None) -> None:
+    """cocotb runner's ``_execute_cmds`` with :func:`run_child`: a simulator or compiler it
+    starts dies with this process (Ctrl-C, kill, an exception while it runs)."""
+    for cmd in cmds:
+        r = run_child(cmd, cwd=cwd, env=self.env, stdout=stdout, stderr=None if stdout is None else subprocess.STDOUT)
+        if r.returncode != 0:
+            raise RuntimeError(f"Command failed with return code: {r.returncode}")
 
 
 def run_plain_verilator(exe: Path, plusargs: Sequence[str], *, run_dir: Path, maxcyc: int) -> dict:
     """Run a :func:`build_plain_verilator` binary in ``run_dir`` with ``plusargs`` and a
     ``+maxcyc=`` watchdog; return its JSON line. A crash, no JSON or no ``done`` is a
     :class:`RasterhwError` naming the binary."""
-    r = subprocess.run([str(exe), *plusargs, f"+maxcyc={maxcyc}"], cwd=run_dir, capture_output=True, text=True)
+    r = run_child([str(exe), *plusargs, f"+maxcyc={maxcyc}"], cwd=run_dir, capture_output=True, text=True)
     try:
         meta = json.loads(r.stdout.strip().splitlines()[-1])
-    except (IndexError, json.JSONDecodeError) as e:
-        raise RasterhwError(f"{exe.name} failed ({r.returncode}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}") from e
+    except (IndexError, json.JSONDecodeError):
+        raise RasterhwError(f"{exe.name} failed (exit {r.returncode}: {_first_error(r.stdout + r.stderr)})") from None
     if not meta["done"]:
         raise RasterhwError(f"{exe.name}: no `done` within {maxcyc} cycles")
     return meta
@@ -271,6 +292,9 @@ def run_cocotb(
     os.environ["PATH"] = env["PATH"]  # the runner looks the simulator up in os.environ
     try:
         runner = get_runner(sim)
+        # the runner's own subprocess.run would leave the simulator running if we are
+        # interrupted or killed: run its commands as children that die with us
+        runner._execute_cmds = _execute_cmds_as_children.__get__(runner)
         build_args: list[str] = ([*VERILATOR_BUILD_ARGS, *map(str, verilator_args)] if sim == "verilator"
                                  else ["-g2005"])
         build_dir = Path(build_dir)
@@ -281,17 +305,22 @@ def run_cocotb(
         own = "CFG_CXXFLAGS_PCH_I" in os.environ.get("MAKEFLAGS", "")
         flags = verilator_make_flags("-O2", coroutines=True) if sim == "verilator" and not own \
             else contextlib.nullcontext()
-        with flags:
-            runner.build(
-                sources=[str(s) for s in sources],
-                hdl_toplevel=toplevel,
-                build_dir=str(build_dir),
-                parameters=dict(parameters or {}),
-                build_args=build_args,
-                timescale=("1ns", "1ps"),
-                waves=os.getenv("WAVES") == "1",
-                log_file=str(build_dir / "build.log"),
-            )
+        with build_lock(build_dir, what=toplevel), flags:
+            try:
+                runner.build(
+                    sources=[str(s) for s in sources],
+                    hdl_toplevel=toplevel,
+                    build_dir=str(build_dir),
+                    parameters=dict(parameters or {}),
+                    build_args=build_args,
+                    timescale=("1ns", "1ps"),
+                    waves=os.getenv("WAVES") == "1",
+                    log_file=str(build_dir / "build.log"),
+                )
+            except RuntimeError as e:  # "Command failed with return code: 2"
+                log = build_dir / "build.log"
+                first = _first_error(log.read_text(errors="replace")) if log.exists() else str(e)
+                raise RasterhwError(f"{toplevel}: {sim} build failed ({first}); see {log}") from None
         t1 = time.perf_counter()
         # the runner hands the simulator's Python this process's sys.path: add the
         # repository root so `cocotb_tests.<block>` imports there
@@ -301,7 +330,8 @@ def run_cocotb(
         test_env = dict(extra_env or {})
         results_xml = Path(test_dir or build_dir) / "results.xml"
         try:
-            results = runner.test(
+            results = _test_step(
+                runner,
                 test_module=test_module,
                 hdl_toplevel=toplevel,
                 build_dir=str(build_dir),
@@ -329,9 +359,21 @@ def run_cocotb(
         raise RasterhwError(f"cocotb: the simulator wrote no results (see {Path(results).parent / 'sim.log'})")
     n_tests, n_failed = get_results(results)
     if n_tests == 0 or n_failed:
+        from rasterhw.sim.workdirs import keep
+
+        keep(Path(results).parent)  # the one run folder left behind: the error below names its logs
         raise RasterhwError(f"cocotb: {n_failed} of {n_tests} tests failed (see {results} and "
                             f"{Path(results).parent / 'sim.log'})")
     return Path(results)
+
+
+def _test_step(runner, **kw):
+    """``runner.test(**kw)``; a simulator that crashes is a one-line error naming its log."""
+    try:
+        return runner.test(**kw)
+    except RuntimeError as e:
+        log = kw.get("log_file") or "the simulator's output"
+        raise RasterhwError(f"{kw.get('hdl_toplevel')}: simulation failed ({e}); see {log}") from None
 
 
 def lint_verilog(sources: Iterable[Path], top: str, *, waivers: Sequence[str] = LINT_WAIVERS) -> str:

@@ -8,10 +8,13 @@ component that instantiates hand-written Verilog returns that source from its
 
 from __future__ import annotations
 
+import gc
 import inspect
+import warnings
 from pathlib import Path
 
 from amaranth.back import verilog
+from amaranth.hdl import UnusedElaboratable
 from amaranth.lib import wiring
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.registry import blocks, load
@@ -34,12 +37,25 @@ def make_block(name: str, **params) -> wiring.Component:
     unknown = [k for k in params if k not in sig.parameters]
     if unknown:
         raise RasterhwError(f"block {name!r} has no parameter {unknown[0]!r}")
-    try:
-        return factory(**params)
-    except RasterhwError:
-        raise
-    except (ValueError, TypeError) as e:
-        raise RasterhwError(f"block {name!r}: {e}") from e
+    return _quietly(lambda: factory(**params), name)
+
+
+def _quietly(build, name: str):
+    """``build()``; a ValueError/TypeError becomes a one-line RasterhwError, with no Amaranth
+    warnings after it: a constructor or ``elaborate`` that raised leaves half-built
+    sub-components behind, and Amaranth warns about each (UnusedElaboratable) when it is
+    collected -- so they are collected here, with that warning ignored."""
+    msg = None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UnusedElaboratable)
+        try:
+            return build()
+        except RasterhwError as e:
+            msg = str(e)
+        except (ValueError, TypeError) as e:
+            msg = f"block {name!r}: {e}"
+        gc.collect()
+    raise RasterhwError(msg)
 
 
 def _module_name(name: str) -> str:
@@ -53,7 +69,7 @@ def generate_verilog(name: str, **params) -> str:
     streams flatten to ``<port>__valid``, ``<port>__ready``, ``<port>__payload``.
     """
     comp = make_block(name, **params)
-    text = verilog.convert(comp, name=_module_name(name), emit_src=False)
+    text = _quietly(lambda: verilog.convert(comp, name=_module_name(name), emit_src=False), name)
     # hand-written Verilog the block instantiates (e.g. a RAM model) travels with it
     extra = comp.extra_verilog() if hasattr(comp, "extra_verilog") else ""
     return text + ("\n" + extra if extra else "")
@@ -61,7 +77,6 @@ def generate_verilog(name: str, **params) -> str:
 
 def write_verilog(name: str, path: str | Path, **params) -> Path:
     """Write :func:`generate_verilog` output to ``path``; return the path."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(generate_verilog(name, **params))
-    return path
+    from rasterhw.sim.outfile import write_text
+
+    return write_text(path, generate_verilog(name, **params))  # whole or not at all

@@ -20,6 +20,7 @@ from rasterhw.hdl.snu.pixelbus_bank import (
     PixelBusBank,
     bank_write_layout,
     check_bank_params,
+    resolve_ram,
 )
 
 __all__ = ["Command", "PixelBus"]
@@ -52,7 +53,9 @@ class PixelBus(wiring.Component):
     mem_cycle : int
         Clocks per bank memory cycle (5 = 400 ns / 80 ns).
     ram : str
-        Bank RAM implementation, ``"memory"`` or ``"verilog"`` (see :class:`PixelBusBank`).
+        Bank RAM implementation, ``"auto"`` (default: ``"verilog"`` for banks above
+        ``AUTO_RAM_DEPTH`` words, so the full frame generates in seconds), ``"memory"`` or
+        ``"verilog"`` (see :class:`PixelBusBank`).
 
     Members
     -------
@@ -83,7 +86,7 @@ class PixelBus(wiring.Component):
         z_bits: int = Z_BITS,
         n_banks: int = N_BANKS,
         mem_cycle: int = MEM_CYCLE,
-        ram: str = "memory",
+        ram: str = "auto",
     ) -> None:
         for name, v in (("width", width), ("height", height)):
             if not isinstance(v, int) or v < 1:
@@ -93,7 +96,7 @@ class PixelBus(wiring.Component):
         if width * height < n_banks:
             raise ValueError(f"a {width}x{height} frame is smaller than {n_banks} banks")
         check_bank_params(z_bits=z_bits, mem_cycle=mem_cycle, ram=ram)
-        self._ram = ram
+        self._ram = resolve_ram(ram, -(-width * height // n_banks))
         self._width = width
         self._height = height
         self._z_bits = z_bits

@@ -7,14 +7,29 @@ from amaranth.lib import data, enum, memory, stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2
 from rasterhw.golden_model.snu.formats import (
+    FRAME_HEIGHT,
+    FRAME_WIDTH,
     MEM_CYCLE,
+    N_BANKS,
     RGB_BITS,
     Z_BITS,
 )
 
 __all__ = ["RAM_KINDS", "RAM_VERILOG", "Command", "PixelBusBank", "bank_write_layout"]
 
-RAM_KINDS = ("memory", "verilog")
+RAM_KINDS = ("auto", "memory", "verilog")
+#: ``ram="auto"`` uses an Amaranth Memory up to this many words per bank, the Verilog RAM
+#: model above (Amaranth writes every initial word of a Memory into the netlist: at the
+#: full 1280x1024 frame that is ~115 MB of Verilog and minutes of generation)
+AUTO_RAM_DEPTH = 4096
+#: words per bank of the full SNU frame (1280 x 1024 over 5 banks), the default depth
+FULL_BANK_DEPTH = -(-FRAME_WIDTH * FRAME_HEIGHT // N_BANKS)
+
+
+def resolve_ram(ram: str, depth: int) -> str:
+    """``"auto"`` -> ``"memory"`` for banks of at most :data:`AUTO_RAM_DEPTH` words, else
+    ``"verilog"``; any other kind unchanged."""
+    return ("memory" if depth <= AUTO_RAM_DEPTH else "verilog") if ram == "auto" else ram
 
 # One write port, read port 0 with enable (Z compare), read port 1 (read-back); both
 # read ports synchronous and not transparent (old data on a same-clock write), data
@@ -88,12 +103,13 @@ class PixelBusBank(wiring.Component):
     Parameters
     ----------
     depth : int
-        Words per bank (pixels held by this bank).
+        Words per bank (pixels held by this bank); default a fifth of the 1280 x 1024 frame.
     z_bits : int
         Width of Z (24 in the SNU system).
     mem_cycle : int
         Clocks per memory cycle, >= 2 (read-compare-write needs two clocks).
     ram : str
+        ``"auto"`` (default): ``"memory"`` up to :data:`AUTO_RAM_DEPTH` words, else ``"verilog"``;
         ``"memory"``: ``amaranth.lib.memory.Memory`` (pysim and small Verilog);
         ``"verilog"``: an ``Instance`` of :data:`RAM_VERILOG` (``rasterhw_pixelbus_ram``),
         same behaviour, for full-size Verilog -- Amaranth writes every word of a
@@ -121,10 +137,12 @@ class PixelBusBank(wiring.Component):
     the read-back port two clocks after its accept.
     """
 
-    def __init__(self, *, depth: int, z_bits: int = Z_BITS, mem_cycle: int = MEM_CYCLE, ram: str = "memory") -> None:
-        if not isinstance(depth, int) or depth < 1:
+    def __init__(self, *, depth: int = FULL_BANK_DEPTH, z_bits: int = Z_BITS, mem_cycle: int = MEM_CYCLE,
+                 ram: str = "auto") -> None:
+        if not isinstance(depth, int) or isinstance(depth, bool) or depth < 1:
             raise ValueError(f"depth must be a positive integer, not {depth!r}")
         check_bank_params(z_bits=z_bits, mem_cycle=mem_cycle, ram=ram)
+        ram = resolve_ram(ram, depth)
         self._depth = depth
         self._ram = ram
         self._z_bits = z_bits

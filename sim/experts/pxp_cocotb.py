@@ -8,11 +8,9 @@ back-pressure on the pixel stream, stream checkers on both ports, and in-order s
 
 from __future__ import annotations
 
-import tempfile
-from pathlib import Path
-
 import numpy as np
 from rasterhw.sim.runner import build_dir_for, get_sim, run_cocotb
+from rasterhw.sim.workdirs import temp_run_folder
 
 __all__ = ["run_cocotb_bench"]
 
@@ -32,7 +30,7 @@ def run_cocotb_bench(jb: dict, *, width: int = 512, sim: str | None = None, idle
     vpath = bdir / "experts_pxp.v"
     if not vpath.exists() or vpath.read_text() != text:
         vpath.write_text(text)  # unchanged text keeps the build's timestamps
-    run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=bdir))
+    run_dir = temp_run_folder(bdir)
     exp = run_dir / "expect.npz"
     np.savez(exp, words=np.array([f"{w:x}" for w in jb["words"]], dtype=str), pixels=jb["pixels"],
              cycles=jb["cycles"], lo0=jb["lo0"], hi0=jb["hi0"])

@@ -11,7 +11,7 @@ timing-free bench, ``sim/experts/verilator/``, built once per Verilog hash under
 
 from __future__ import annotations
 
-import tempfile
+import sys
 import time
 from pathlib import Path
 
@@ -21,6 +21,7 @@ from rasterhw.golden_model.experts.model import ExpertsFrame, equal_bounds, rend
 from rasterhw.golden_model.experts.pxp import pixel_words
 from rasterhw.golden_model.experts.pxp_cycles import line_segments, schedule
 from rasterhw.sim.runner import run_plain_verilator
+from rasterhw.sim.workdirs import temp_run_folder
 
 __all__ = ["jobs", "run_pysim", "run_verilator", "simulate_scene", "ENGINES"]
 
@@ -161,7 +162,7 @@ def run_verilator(jb: dict, *, width: int) -> dict:
         raise RasterhwError(f"experts: {nseg} words / {nout} pixels / {nline} lines exceed the bench's "
                             f"{NSEG_MAX} / {NOUT_MAX} / {NLINE_MAX}")
     exe, build_s = _build(width, jb["aj"])
-    run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=exe.parent.parent))
+    run_dir = temp_run_folder(exe.parent.parent)
     (run_dir / "seg.hex").write_text("\n".join(f"{w:x}" for w in jb["words"]) + "\n")
     meta = run_plain_verilator(exe, [f"+seg={run_dir / 'seg.hex'}", f"+out={run_dir / 'out.hex'}",
                                      f"+cyc={run_dir / 'cyc.hex'}", f"+nseg={nseg}", f"+nout={nout}",
@@ -200,7 +201,7 @@ def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", pro
         rb = run_parallel(fr, sn, pn, band_method="equal", range_method=ranges, pxp_unit="cycles").ranges
     jb = jobs(fr, sn, pn, ranges=rb)
     if progress:
-        print(f"experts: {jb['lines']} PXP lines, {len(jb['words'])} words, {int(jb['cycles'].sum()):,} cycles expected")
+        print(f"experts: {jb['lines']} PXP lines, {len(jb['words'])} words, {int(jb['cycles'].sum()):,} cycles expected", file=sys.stderr)
     res = run_pysim(jb, width=width) if engine == "pysim" else run_verilator(jb, width=width)
     got = res["pixels"]
     n = min(got.size, jb["pixels"].size)

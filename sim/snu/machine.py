@@ -7,7 +7,7 @@ MACHINE = Machine(
     title="SNU graphics system (Seoul Nat. Univ.)",
     seed="004_259eba1ba2ec22c5.txt",
     archs=(Arch("snu", "SNU fixed-point Gouraud scan converter into the pixel-bus frame buffer model",
-                "rasterhw.golden_model.snu.render:render"),),
+                "rasterhw.golden_model.snu.render:render", bytes_per_pixel=120),),  # measured ~88
     blocks={"pixelbus-bank": "rasterhw.hdl.snu.pixelbus_bank:PixelBusBank",
             "pixelbus": "rasterhw.hdl.snu.pixelbus:PixelBus"},
     sims=(SimBlock("pixelbus", "the scene's Gouraud pixel stream through the pixel-bus HDL (5 banks, 2 pipelines)",

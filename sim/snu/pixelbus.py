@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import os
 import shutil
-import tempfile
+import sys
 import time
 from pathlib import Path
 
@@ -24,7 +24,10 @@ from rasterhw.golden_model.snu.formats import RGB_BITS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.golden_model.snu.words import payload_words
 from rasterhw.sim.harness import stream_protocol_checker, stream_put
+from rasterhw.sim.outfile import write_text
 from rasterhw.sim.runner import HARNESS_V, REPO_ROOT, build_dir_for, get_sim, run_cocotb
+from rasterhw.sim.workdirs import keep as keep_run_folder
+from rasterhw.sim.workdirs import temp_run_folder
 
 __all__ = ["ENGINES", "GAP_BITS", "simulate_pixelbus", "run_pysim", "write_stimulus", "read_frame_dump"]
 
@@ -139,9 +142,11 @@ def read_frame_dump(path: Path, width: int, height: int) -> tuple[np.ndarray, np
 
 
 def _ram_for(width: int, height: int) -> str:
-    # Amaranth spells out every initial word of a Memory: fine for test frames, far too
-    # slow at 1280x1024 (see PixelBusBank) -- big frames use the equivalent Verilog RAM.
-    return "memory" if -(-width * height // golden.N_BANKS) <= 4096 else "verilog"
+    # the block's own choice (ram="auto"): Amaranth Memory for test frames, the equivalent
+    # Verilog RAM for big ones
+    from rasterhw.hdl.snu.pixelbus_bank import resolve_ram
+
+    return resolve_ram("auto", -(-width * height // golden.N_BANKS))
 
 
 def run_cocotb_bench(
@@ -172,12 +177,12 @@ def run_cocotb_bench(
     vpath = bdir / "pixelbus.v"
     text = generate_verilog("pixelbus", **params)
     if not vpath.exists() or vpath.read_text() != text:
-        vpath.write_text(text)  # unchanged text keeps the build's timestamps
+        write_text(vpath, text)  # whole or not at all (a concurrent run may read it); unchanged text keeps the build's timestamps
     if expect is None:
         acc = golden.pixelbus_accept_cycles(stream, gaps=gaps)
         rgb, z = golden.pixelbus_frame(stream, accept=acc)
         expect = {"rgb": rgb, "z": z, "cycles": int(acc.max()) + golden.MEM_CYCLE if len(stream) else 0}
-    run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=bdir))
+    run_dir = temp_run_folder(bdir)
     (stim0, stim1), (c0, c1) = write_stimulus(stream, gaps, run_dir, aw)
     exp_path = run_dir / "expect.npz"
     # payload words are up to 69 bits: stored as hex strings
@@ -210,7 +215,9 @@ def run_cocotb_bench(
     )
     t2 = time.perf_counter()
     rgb, z, cycles = read_frame_dump(out_path, w, h)
-    if os.environ.get("PIXELBUS_KEEP") != "1":  # full-frame dumps are ~20 MB each
+    if os.environ.get("PIXELBUS_KEEP") == "1":
+        keep_run_folder(run_dir)
+    else:  # full-frame dumps are ~20 MB each
         shutil.rmtree(run_dir, ignore_errors=True)
         run_dir = None
     return {"cycles": cycles, "rgb": rgb, "z": z, "prepare_s": t1 - t0, "build_s": timings["build_s"],
@@ -241,7 +248,7 @@ def simulate_pixelbus(stream: PixelStream, *, engine: str = "pysim", progress: b
     g_rgb, g_z = golden.pixelbus_frame(stream, accept=acc)
     g_cycles = int(acc.max()) + golden.MEM_CYCLE if len(stream) else 0
     if progress:
-        print(f"pixelbus: {len(stream)} writes, {stream.width}x{stream.height}, golden {g_cycles} cycles; running {engine}")
+        print(f"pixelbus: {len(stream)} writes, {stream.width}x{stream.height}, golden {g_cycles} cycles; running {engine}", file=sys.stderr)
     t1 = time.perf_counter()
     if engine == "pysim":
         r = run_pysim(stream)
@@ -256,7 +263,7 @@ def simulate_pixelbus(stream: PixelStream, *, engine: str = "pysim", progress: b
     size = stream.width * stream.height
     sim_cycles = r["cycles"] + size  # pixel phase + one read-back clock per pixel
     if progress:
-        print(f"pixelbus: {engine} {r['cycles']} cycles, {bad} mismatches, {wall:.1f} s")
+        print(f"pixelbus: {engine} {r['cycles']} cycles, {bad} mismatches, {wall:.1f} s", file=sys.stderr)
     return {
         "block": "pixelbus",
         "engine": engine,

@@ -16,12 +16,13 @@ MACHINE = Machine(
              help="p x q matrix of video processors, recursive pixel search on sparse rasters "
                   "(image equals the reference)",
              render="rasterhw.golden_model.sparse.render:render",
-             options=(_MATRIX,)),
+             options=(_MATRIX,), bytes_per_pixel=700),  # measured ~540 (peak RSS, 1024 x 1024)
     ),
     blocks={"sparse-vp": "rasterhw.hdl.sparse.vp:make_vp", "sparse-matrix": "rasterhw.hdl.sparse.matrix:make_matrix"},
     sims=(SimBlock(name="sparse", help="every video processor of the matrix in HDL, interleaved local memories "
                                        "against the bit-accurate golden model",
-                   simulate="rasterhw.sim.sparse.sim:simulate", default_scene="c300", options=(_MATRIX,)),),
+                   simulate="rasterhw.sim.sparse.sim:simulate", default_scene="c300", options=(_MATRIX,),
+                   bytes_per_pixel=700),),
     report="rasterhw.sim.sparse.report:rows",
     bench="rasterhw.sim.sparse.bench:bench",
     status="golden model (image = reference), formulas (1)-(12), Monte-Carlo window counts, figs. 3-6; "

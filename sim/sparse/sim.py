@@ -4,6 +4,7 @@ model pixel by pixel (triangle index and quantised depth)."""
 
 from __future__ import annotations
 
+import sys
 import time
 
 import numpy as np
@@ -48,7 +49,7 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
             run_s += r.get("run_s", r.get("wall_s", 0.0))
             sim_cycles += r.get("sim_cycles", r["cycles"])
             if progress:
-                print(f"processor ({a}, {b}): {r['cycles']} cycles, tests per level {r['tests']}", flush=True)
+                print(f"processor ({a}, {b}): {r['cycles']} cycles, tests per level {r['tests']}", file=sys.stderr, flush=True)
     wall = time.perf_counter() - t0
     ht, hz = interleave(loc_t), interleave(loc_z)
     mism = int(np.count_nonzero((ht != g.tri_id) | (hz != gz)))

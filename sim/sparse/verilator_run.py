@@ -10,13 +10,13 @@ call with the same parameters only runs.
 
 from __future__ import annotations
 
-import tempfile
 from pathlib import Path
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.sparse.formats import TRI_BITS
 from rasterhw.sim.runner import build_plain_verilator, run_plain_verilator
+from rasterhw.sim.workdirs import temp_run_folder
 
 __all__ = ["build", "pack_records", "run_processor_verilator"]
 
@@ -77,7 +77,7 @@ def run_processor_verilator(recs: list[dict], *, n: int, p: int, q: int, a: int,
     if not (0 <= a < p and 0 <= b < q):
         raise RasterhwError(f"sparse HDL: processor ({a}, {b}) is outside a {p}x{q} matrix")
     exe, build_s = build(n=n, p=p, q=q, z_bits=z_bits)
-    run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=exe.parent.parent))
+    run_dir = temp_run_folder(exe.parent.parent)
     (run_dir / "in.hex").write_text(pack_records(recs) if packed is None else packed)
     N = 1 << n
     maxcyc = 200 * (len(recs) + 10) * (1 + n) + 64 * N * N + 10_000_000

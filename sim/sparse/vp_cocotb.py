@@ -8,14 +8,12 @@ and reads the local memory back through the video-controller port.
 
 from __future__ import annotations
 
-import tempfile
-from pathlib import Path
-
 import numpy as np
 from rasterhw.golden_model.sparse.fixed import broadcast_records
 from rasterhw.golden_model.sparse.formats import TRI_BITS, parse_matrix, sparse_geometry
 from rasterhw.golden_model.sparse.search import sparse_render
 from rasterhw.sim.runner import build_dir_for, get_sim, run_cocotb
+from rasterhw.sim.workdirs import temp_run_folder
 
 __all__ = ["run_cocotb_bench"]
 
@@ -47,7 +45,7 @@ def run_cocotb_bench(tris, matrix="4x4", *, a: int = 0, b: int = 0, sim: str | N
     vpath = bdir / "sparse_vp.v"
     if not vpath.exists() or vpath.read_text() != text:
         vpath.write_text(text)
-    run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=bdir))
+    run_dir = temp_run_folder(bdir)
     exp = run_dir / "expect.npz"
     np.savez(exp, words=np.array([f"{pack(BROADCAST, r):x}" for r in recs], dtype=str), n=n, a=a, b=b,
              tri=want["tri"], zq=want["zq"], tests=np.asarray(want["tests"]), tri_bits=TRI_BITS)

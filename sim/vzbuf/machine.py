@@ -17,10 +17,10 @@ MACHINE = Machine(
     seed="001_96e5154526ae973d.txt",
     archs=(
         Arch("vz1", "Vector Z-buffer, algorithm 1: one-line Z-buffer, x-list, span-length vectors.",
-             "rasterhw.golden_model.vzbuf.machine:render", _OPTIONS),
+             "rasterhw.golden_model.vzbuf.machine:render", _OPTIONS, bytes_per_pixel=170),  # measured ~130
         Arch("vz2", "Vector Z-buffer, algorithm 2: split segments, full-frame Z-buffer, s-list "
              "(one segment per line), line-count vectors.",
-             "rasterhw.golden_model.vzbuf.machine:render", _OPTIONS),
+             "rasterhw.golden_model.vzbuf.machine:render", _OPTIONS, bytes_per_pixel=170),
     ),
     report="rasterhw.sim.vzbuf.report:rows",
     bench="rasterhw.sim.vzbuf.bench:bench",

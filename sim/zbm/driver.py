@@ -23,7 +23,6 @@ import json
 import os
 import shutil
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -49,6 +48,8 @@ from rasterhw.sim.runner import (
     run_cocotb,
     verilator_make_flags,
 )
+from rasterhw.sim.workdirs import keep as keep_run_folder
+from rasterhw.sim.workdirs import temp_run_folder
 
 __all__ = [
     "CLOCK_HZ", "ENGINES", "GAP_BITS",
@@ -270,7 +271,7 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
     params = {"I": interleave, "U": units, "W": width, "H": height, "GW": GAP_BITS, "SDEPTH": sdepth}
     bdir = build_dir_for("zbm-unit", sim, sources=[*srcs, HARNESS_V, BENCH_DIR / "tb_zbm_unit.v"], **params)
     bdir.mkdir(parents=True, exist_ok=True)
-    run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=bdir))
+    run_dir = temp_run_folder(bdir)
     flat, index, base = [], [], 0
     gaps = random_gaps(total, gap_seed)
     for w in words:
@@ -306,7 +307,9 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
     res = {"s0": s0.reshape(height, width), "s1": s1.reshape(height, width), **meta,
            "prepare_s": t1 - t0, "build_s": timings["build_s"], "run_s": timings["test_s"],
            "total_s": t2 - t0, "run_dir": run_dir if keep else None}
-    if not keep and os.environ.get("ZBM_KEEP") != "1":
+    if keep or os.environ.get("ZBM_KEEP") == "1":
+        keep_run_folder(run_dir)
+    else:
         shutil.rmtree(run_dir, ignore_errors=True)
     return res
 
@@ -349,7 +352,7 @@ def run_chip_bench(seg_words: list[int], up_words: list[int], *, lines: int, chi
               "SDEPTH": _depth(len(seg_words)), "MDEPTH": _depth(len(up_words))}
     bdir = build_dir_for("zbm-chip", sim, sources=[src, HARNESS_V, BENCH_DIR / "tb_zbm_chip.v"], **params)
     bdir.mkdir(parents=True, exist_ok=True)
-    run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=bdir))
+    run_dir = temp_run_folder(bdir)
     g = random_gaps(len(seg_words) + len(up_words), gap_seed)
     _write_hex(run_dir / "seg.hex", seg_words, g[:len(seg_words)], F.LOOP_BITS)
     _write_hex(run_dir / "up.hex", up_words, g[len(seg_words):], F.PIXEL2.width)
@@ -532,18 +535,24 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
         from tqdm import tqdm
         bar = tqdm(total=5, desc=f"zbm {engine}", unit="step", file=sys.stderr)
 
-    def step(msg):
-        if bar is not None:
-            bar.set_postfix_str(msg)
-            bar.update(1)
+    started = []
 
+    def step(msg):
+        """The bar names the step now running (not the one just finished)."""
+        if bar is not None:
+            if started:
+                bar.update(1)
+            started.append(msg)
+            bar.set_postfix_str(msg)
+
+    step("geometry + edge pairs")
     tris = run_geometry(scene, width, height)
     eps = G.edge_pairs(tris)
     peak = check_edge_pairs(eps, width, height, units=units)
-    step("geometry + edge pairs")
+    step("golden model")
     gold = G.render_zbm(tris, interleave=interleave, units=units)
     g0, g1 = doublez_words(gold.pixels)
-    step("golden model")
+    step("HDL build + simulation" if engine != "pysim" else "HDL simulation (pysim)")
     per_unit = [eps.take(np.flatnonzero(eps.tag % units == k)) for k in range(units)]
     t1 = time.perf_counter()
     if engine == "pysim":
@@ -556,15 +565,15 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
         sim_s, build_s = r["run_s"], r["prepare_s"] + r["build_s"]
         if r.get("timeout"):
             raise RasterhwError(f"ZB/M {engine}: the bench's watchdog fired after {r['cycles']} cycles")
-    step("HDL simulation")
+    step("compare + composite")
     bad = (r["s0"] != g0) | (r["s1"] != g1)
     mismatches = int(np.count_nonzero(bad))
     px = words_to_doublez(r["s0"], r["s1"])
     rgb8 = G.composite(px)
-    step("compare + composite")
-    tol = float_tolerance(tris, px, rgb8, eps, gold.pixels.tag)
     step("float tolerance")
+    tol = float_tolerance(tris, px, rgb8, eps, gold.pixels.tag)
     if bar is not None:
+        bar.update(1)
         bar.close()
     wall = time.perf_counter() - t0
     cycles = int(r["cycles"])

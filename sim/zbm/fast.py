@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +21,8 @@ from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.sim.runner import HARNESS_V, REPO_ROOT, build_plain_verilator, run_plain_verilator
+from rasterhw.sim.workdirs import keep as keep_run_folder
+from rasterhw.sim.workdirs import temp_run_folder
 from rasterhw.sim.zbm.driver import (
     GAP_BITS,
     _cached,
@@ -62,7 +63,7 @@ def run_chip_fast(seg_words: list[int], up_words: list[int], *, lines: int, chip
     exe, build_s = build_fast(interleave=interleave, width=width, lines=lines, chip=chip,
                               nseg=len(seg_words), nup=len(up_words), opt=opt)
     npx = -(-(width - chip) // interleave)
-    run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=exe.parent.parent))
+    run_dir = temp_run_folder(exe.parent.parent)
     zero = np.zeros(len(seg_words) + len(up_words), np.int64)
     _write_hex(run_dir / "seg.hex", seg_words, zero[:len(seg_words)], F.LOOP_BITS)
     _write_hex(run_dir / "up.hex", up_words, zero[len(seg_words):], F.PIXEL2.width)
@@ -76,7 +77,9 @@ def run_chip_fast(seg_words: list[int], up_words: list[int], *, lines: int, chip
         raise RasterhwError(f"{out}: {s0.size} words, expected {lines * npx}")
     res = {"s0": s0.reshape(lines, npx), "s1": s1.reshape(lines, npx), **meta, "build_s": build_s,
            "run_dir": run_dir if keep else None}
-    if not keep and os.environ.get("ZBM_KEEP") != "1":
+    if keep or os.environ.get("ZBM_KEEP") == "1":
+        keep_run_folder(run_dir)
+    else:
         for f in run_dir.iterdir():
             f.unlink()
         run_dir.rmdir()
