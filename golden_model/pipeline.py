@@ -355,6 +355,33 @@ def clip(
     """
     o = _ops(ops)
     n_p, k, n_c = corners.shape
+    nv = np.asarray(nverts, dtype=np.int64)
+    # Polygons with every corner inside every plane (most of a scene) come out unchanged: the
+    # planes' compares are counted for them as the loop below would count them (one per corner
+    # per plane), and only the rest go through Sutherland-Hodgman. Same corners, same counts.
+    used = np.arange(k)[None, :] < nv[:, None]
+    w = corners[..., _W]
+    inside = np.ones((n_p, k), dtype=bool)
+    for _name, axis, side in _PLANES:
+        a = corners[..., axis]
+        inside &= (a >= 0.0) if side == 0 else (a <= w) if side > 0 else (a >= -w)
+    trivial = np.all(inside | ~used, axis=1)
+    o.count("cmp", len(_PLANES) * int(nv[trivial].sum()))
+    out = np.zeros((n_p, k + 6, n_c))
+    out[:, :k] = corners
+    n_out = nv.copy()
+    cut = np.zeros(n_p, dtype=bool)
+    hard = np.flatnonzero(~trivial)
+    if hard.size:
+        out[hard], n_out[hard], cut[hard] = _clip_planes(corners[hard], nv[hard], near, o)
+    n_out[n_out < 3] = 0
+    return out, n_out, cut
+
+
+def _clip_planes(corners: np.ndarray, nverts: np.ndarray, near: float, o: OpCounter
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The plane-by-plane Sutherland-Hodgman loop of :func:`clip` (every polygon through every plane)."""
+    n_p, k, n_c = corners.shape
     m = k + 6
     out = np.zeros((n_p, m, n_c))
     out[:, :k] = corners
@@ -411,7 +438,6 @@ def clip(
         fresh[qk, start[qk, sk] + crossing[qk, sk]] = px[qk, sk]
         out[polys] = fresh
         n_out[polys] = new_n
-    n_out[n_out < 3] = 0
     return out, n_out, cut
 
 

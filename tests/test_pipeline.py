@@ -386,3 +386,31 @@ def test_bad_scene_content_raises():
     with pytest.raises(RasterhwError, match="front-facing"):
         ops_per_triangle(make_scene(tri[::-1]))
     assert math.isfinite(run_geometry(make_scene(tri), 8, 8).z.sum())
+
+
+@pytest.mark.parametrize(("seed", "near"), [(5, 0.5), (6, 1.0), (7, 0.1)])
+def test_clip_fast_path_equals_every_polygon_through_every_plane(seed, near):
+    """clip() sends only polygons with a corner outside a plane through Sutherland-Hodgman; the
+    corners, counts and compares equal the plane loop run on every polygon."""
+    from rasterhw.golden_model import pipeline as pl
+    from rasterhw.golden_model.opcount import OpCounter
+
+    rng = np.random.default_rng(seed)
+    # corners in clip space around the view volume: many inside, many crossing, some outside
+    n = 3000
+    k = 3   # triangles: convex whatever the corners
+    corners = np.zeros((n, k, 7))
+    corners[:, :, 3] = rng.uniform(0.5, 2.0, (n, 1))
+    corners[:, :, :3] = rng.normal(0.0, 0.7, (n, k, 3)) * corners[:, :, 3:4]
+    corners[:, :, 4:] = rng.random((n, k, 3))
+    nverts = np.full(n, 3)
+    fast, slow = OpCounter(), OpCounter()
+    with fast.stage("clip"):
+        a = pl.clip(corners, nverts, near, ops=fast)
+    with slow.stage("clip"):
+        b = pl._clip_planes(corners, nverts, near, slow)
+    b[1][b[1] < 3] = 0
+    assert np.array_equal(a[1], b[1]) and np.array_equal(a[2], b[2])
+    assert np.array_equal(a[0], b[0])
+    assert fast.as_dict() == slow.as_dict()
+    assert 0 < int(np.count_nonzero(a[2])) < n   # both paths were exercised
