@@ -569,7 +569,10 @@ def run_geometry(
         clipped, n_clip, cut = clip(corners, scene.nverts[fidx], setup.near, ops=o)
     drawn = np.flatnonzero(n_clip > 0)
     n_draw = n_clip[drawn]
-    flat = clipped[drawn][np.arange(clipped.shape[1])[None, :] < n_draw[:, None]]
+    # the used corners of the drawn polygons, in order (one gather, not a copy and a mask)
+    rows = np.repeat(drawn, n_draw)
+    cols = np.arange(rows.size) - np.repeat(np.cumsum(n_draw) - n_draw, n_draw)
+    flat = clipped[rows, cols]
 
     with o.stage("perspective_divide"):
         ndc = perspective_divide(flat[:, :4], ops=o)
