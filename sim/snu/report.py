@@ -33,12 +33,12 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
 def golden_rows() -> list[dict]:
     """Table 1, traversal and inner-loop rows: measured by running the golden models."""
     from rasterhw.golden_model.opcount import ops_per_triangle
+    from rasterhw.golden_model.snu import i860, recipe
     from rasterhw.golden_model.snu.balance import table1_rows
     from rasterhw.golden_model.snu.gouraud import inner_loop_ops
     from rasterhw.golden_model.snu.traversal import RECORD_BYTES, traversal_bandwidth
 
-    counts = ops_per_triangle()
-    out = table1_rows(counts)
+    out = table1_rows(recipe.ops_per_triangle(), ops_per_triangle(), i860.table1_model())
     out.append(make_row("snu", "text 4.1", "traversal record per triangle (3 x 9 float32)", paper=108,
                         formula=3 * 9 * 4, measured=3 * RECORD_BYTES, unit="bytes", source="golden"))
     out.append(make_row("snu", "text 4.1", "traversal bandwidth at 100 K polygons/s", paper=10e6,
