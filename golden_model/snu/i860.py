@@ -52,7 +52,7 @@ from dataclasses import dataclass, field
 
 from rasterhw.golden_model.errors import RasterhwError
 
-__all__ = ["EXTRA_STAGES", "I860", "NEWTON_STEPS", "Program", "STAGES", "inner_loop_clocks", "program_counts", "schedule",
+__all__ = ["EXTRA_STAGES", "I860", "NEWTON_STEPS", "Program", "STAGES", "inner_loop_clocks", "program_counts", "scan_clocks", "schedule", "setup_program",
            "stage_clocks", "stage_program", "table1_model"]
 
 #: Newton-Raphson steps after an ``frcp``/``frsqr`` seed (about 7 good bits) for single precision.
@@ -206,6 +206,63 @@ def stage_program(stage: str, *, newton_steps: int = NEWTON_STEPS) -> Program:
     else:
         raise RasterhwError(f"unknown stage {stage!r}; stages are {', '.join(STAGES + EXTRA_STAGES)}")
     return p
+
+
+def setup_program(kind: str, *, newton_steps: int = NEWTON_STEPS) -> Program:
+    """The scan converter's per-triangle and per-scan-line work (``gouraud.setup_spans``), as
+    i860 instructions -- our sketch of what that code does, not the paper's (it gives none).
+
+    ``"triangle"``: sort the corners by y (3 compares), twice the area (5 add, 2 mul), its
+    reciprocal, the r, g, b, z plane gradients (per attribute 2 differences, then
+    ``(da1 dy2 - da2 dy1) / den`` and the same for y: 6 mul + 4 add), three edge slopes
+    (reciprocal + multiply each), per trapezoid the anchor value of each attribute (2 mul +
+    2 add), and 16 float -> fixed conversions (scale, ``fix``, ``fxfr``).
+    ``"span"``: one scan line of the outer loop: two Bresenham edge steps (add, compare,
+    branch, conditional add on the core), four accumulator steps (graphics unit), the pixel
+    count and the line's first address (core), the loop branch.
+    """
+    p = Program(newton_steps=newton_steps)
+    if kind == "triangle":
+        for _ in range(3):
+            p.cmp()
+        d = [p.add() for _ in range(4)]
+        area = p.add(p.mul(d[0], d[1]), p.mul(d[2], d[3]))
+        inv = p.recip(area, counted=None)
+        for _ in range(4):
+            da1, da2 = p.add(), p.add()
+            for _axis in range(2):
+                p.mul(p.add(p.mul(da1), p.mul(da2)), inv)
+        for _ in range(3):
+            p.mul(p.recip(p.add(), counted=None))
+        for _ in range(2 * 4):
+            p.add(p.mul(), p.add(p.mul()))
+        for _ in range(16):
+            p.op("C", "fxfr", None, p.op("A", "fix", None, p.mul()))
+    elif kind == "span":
+        for _ in range(2):  # edge: error += slope; if error >= 1: x += 1, error -= 1
+            e = p.op("C", "adds", None)
+            b = p.op("C", "bc", None, e)
+            p.op("C", "addu", None, b)
+        for _ in range(4):
+            p.op("G", "faddz", None)
+        n = p.op("C", "subs", None)
+        a = p.op("C", "addu", None)
+        p.op("C", "bla", None, n, a)
+    else:
+        raise RasterhwError(f"setup_program kind must be 'triangle' or 'span', not {kind!r}")
+    return p
+
+
+def scan_clocks(cpu: I860 | None = None) -> dict:
+    """i860 clocks of the scan converter: ``triangle`` (set-up per triangle), ``span`` (per
+    scan line) from :func:`setup_program`, scheduled; ``pixel`` (per pixel) from
+    :func:`inner_loop_clocks` on the counts of one executed pixel."""
+    cpu = cpu or I860()
+    one = {"pixels": 1, **{k: 1 for k in ("add_addr", "add_count", "store", "branch",
+                                         "add_r", "add_g", "add_b", "add_z")}}
+    return {"triangle": schedule(setup_program("triangle", newton_steps=cpu.newton_steps), cpu)["clocks"],
+            "span": schedule(setup_program("span", newton_steps=cpu.newton_steps), cpu)["clocks"],
+            "pixel": inner_loop_clocks(one, cpu)}
 
 
 def program_counts(p: Program) -> dict:
