@@ -162,19 +162,15 @@ def golden_schedule(stream: PixelStream, gaps: np.ndarray, first_work: list[floa
             "cycles": t_pix + 2, "accept": acc, "first_bench_gap": first_bench}
 
 
-def _hex_words(fields: list[tuple[np.ndarray, int]]) -> bytes:
-    """Rows of fixed-width hex: each field (values, nibbles), most significant field first."""
-    digits = np.frombuffer(b"0123456789abcdef", dtype=np.uint8)
-    n = fields[0][0].size
-    width = sum(k for _, k in fields) + 1
-    out = np.empty((n, width), dtype=np.uint8)
-    col = 0
-    for v, k in fields:
+def _stim_bytes(gap, z, rgb, addr) -> bytes:
+    """12 bytes per write, big-endian {gap[15:0], z[23:0], rgb[23:0], addr[31:0]} (the bench's
+    $fread layout); one zero word for an empty pipeline."""
+    n = len(gap)
+    out = np.zeros((max(n, 1), 12), dtype=np.uint8)
+    for col, (v, nbytes) in zip((0, 2, 5, 8), ((gap, 2), (z, 3), (rgb, 3), (addr, 4)), strict=True):
         v = np.asarray(v, dtype=np.uint64)
-        for i in range(k):
-            out[:, col + i] = digits[((v >> np.uint64(4 * (k - 1 - i))) & np.uint64(15)).astype(np.intp)]
-        col += k
-    out[:, -1] = ord("\n")
+        for k in range(nbytes):
+            out[:n, col + k] = (v >> np.uint64(8 * (nbytes - 1 - k))) & np.uint64(255)
     return out.tobytes()
 
 
@@ -220,12 +216,11 @@ def run_frame_hdl(stream: PixelStream, gaps: np.ndarray, first_bench_gap: list[i
         i = idx[p]
         if i.size:
             g[i[0]] = first_bench_gap[p]
-        data = _hex_words([(g[i], 4), (stream.z[i], 6), (stream.rgb[i], 6), (stream.addr[i], 8)]) if i.size else b"0\n"
-        (run_dir / f"stim{p}.hex").write_bytes(data)
+        (run_dir / f"stim{p}.bin").write_bytes(_stim_bytes(g[i], stream.z[i], stream.rgb[i], stream.addr[i]))
         counts.append(int(i.size))
     t1 = time.perf_counter()
     maxcyc = clear_cycles(w, h) + 8 * (len(stream) + int(g.sum())) + npix + 10_000
-    meta = run_plain_verilator(exe, [f"+stim0={run_dir / 'stim0.hex'}", f"+stim1={run_dir / 'stim1.hex'}",
+    meta = run_plain_verilator(exe, [f"+stim0={run_dir / 'stim0.bin'}", f"+stim1={run_dir / 'stim1.bin'}",
                                      f"+n0={counts[0]}", f"+n1={counts[1]}", f"+out={run_dir / 'frame.hex'}",
                                      f"+meta={run_dir / 'meta.txt'}"], run_dir=run_dir, maxcyc=maxcyc)
     t2 = time.perf_counter()

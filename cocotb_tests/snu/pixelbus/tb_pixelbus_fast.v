@@ -9,8 +9,9 @@
 //   4. the display buffer (the frame just drawn) and Z are read back through the read port
 //      into `frame`, dumped by the `final` block to +out= ($writememh, {rgb, z} per pixel).
 //
-// Stimulus word (+stim0=, +stim1=, hex): {gap[15:0], z[23:0], rgb[23:0], addr[31:0]}, every
-// field on a nibble boundary so that Python can write it with NumPy. +meta= receives
+// Stimulus (+stim0=, +stim1=, binary, read with $fread): 12 bytes per write, big-endian
+// {gap[15:0], z[23:0], rgb[23:0], addr[31:0]} -- written by NumPy, read without parsing text
+// (a text $readmemh of 10 million words takes longer than simulating them). +meta= receives
 // "t_clear t_start t_pixels_done t_swap cycles" (values of the DUT's `cycle` counter: CLEAR
 // accepted, first clock the players run, both drained and idle, SWAP accepted, frame done).
 module tb_pixelbus_fast #(
@@ -60,12 +61,10 @@ module tb_pixelbus_fast #(
 
   wire v0, v1, r0, r1, done0, done1;
   wire [PW-1:0] p0, p1;
-  rasterhw_stream_player #(.PW(PW), .GW(GW), .DEPTH(SDEPTH), .FILE_ARG("stim0=%s")) player0 (
-    .clk(clk), .rst(prst), .base(32'd0), .count(n0), .repeats(32'd1),
-    .valid(v0), .ready(r0), .payload(p0), .done(done0));
-  rasterhw_stream_player #(.PW(PW), .GW(GW), .DEPTH(SDEPTH), .FILE_ARG("stim1=%s")) player1 (
-    .clk(clk), .rst(prst), .base(32'd0), .count(n1), .repeats(32'd1),
-    .valid(v1), .ready(r1), .payload(p1), .done(done1));
+  snu_fread_player #(.DEPTH(SDEPTH), .FILE_ARG("stim0=%s")) player0 (
+    .clk(clk), .rst(prst), .count(n0), .valid(v0), .ready(r0), .payload(p0), .done(done0));
+  snu_fread_player #(.DEPTH(SDEPTH), .FILE_ARG("stim1=%s")) player1 (
+    .clk(clk), .rst(prst), .count(n1), .valid(v1), .ready(r1), .payload(p1), .done(done1));
 
   wire [31:0] cycle;
   wire idle, busy, draw_buf, cmd_ready;
@@ -124,6 +123,51 @@ module tb_pixelbus_fast #(
         end
         default: ;
       endcase
+    end
+  end
+endmodule
+
+// rasterhw_stream_player (../../harness.v) with a binary $fread instead of $readmemh: plays
+// `count` words {gap[15:0], payload[79:0]}, each `gap` idle clocks after the previous transfer.
+module snu_fread_player #(
+  parameter DEPTH = 1024,
+  parameter FILE_ARG = "stim=%s"
+) (
+  input wire clk,
+  input wire rst,
+  input wire [31:0] count,
+  output wire valid,
+  input wire ready,
+  output wire [79:0] payload,
+  output wire done
+);
+  reg [95:0] mem [0:DEPTH-1];
+  reg [8*512-1:0] fname;
+  integer fd, got;
+  initial begin
+    if (!$value$plusargs(FILE_ARG, fname)) $fatal(1, "snu_fread_player: +%s missing", FILE_ARG);
+    fd = $fopen(fname, "rb");
+    if (fd == 0) $fatal(1, "snu_fread_player: cannot open %0s", fname);
+    got = $fread(mem, fd);
+    $fclose(fd);
+  end
+
+  reg [31:0] ptr;
+  reg [15:0] wt;
+  wire [95:0] cur = mem[ptr];
+  wire [95:0] nxt = mem[ptr + 32'd1];
+  assign done = (ptr >= count);
+  assign valid = !rst && !done && (wt == 16'd0);
+  assign payload = cur[79:0];
+  always @(posedge clk) begin
+    if (rst) begin
+      ptr <= 32'd0;
+      wt <= mem[0][95:80];
+    end else if (valid && ready) begin
+      ptr <= ptr + 32'd1;
+      wt <= nxt[95:80];
+    end else if (wt != 16'd0) begin
+      wt <= wt - 16'd1;
     end
   end
 endmodule
