@@ -243,7 +243,7 @@ def _expand(spans: dict) -> tuple[np.ndarray, np.ndarray]:
 
 
 def scan_convert(tris: ScreenTriangles, *, frac_bits: int = 16, n_pipes: int = 2,
-                 counts: dict | None = None) -> PixelStream:
+                 counts: dict | None = None, spans: dict | None = None) -> PixelStream:
     """Bit-accurate Gouraud scan conversion of ``tris`` into the two pipelines' pixel writes.
 
     Parameters
@@ -254,6 +254,8 @@ def scan_convert(tris: ScreenTriangles, *, frac_bits: int = 16, n_pipes: int = 2
     n_pipes : pipelines; triangle ``i`` is issued by pipeline ``i % n_pipes``.
     counts : if a dict, it receives what the inner loop executed (:data:`EXECUTED`, plus
         ``pixels`` and ``spans``); :func:`inner_loop_ops` turns it into operations per pixel.
+    spans : ``setup_spans(tris, frac_bits=frac_bits)`` if the caller already has it (not checked
+        beyond its ``frac_bits``).
 
     Returns
     -------
@@ -261,7 +263,10 @@ def scan_convert(tris: ScreenTriangles, *, frac_bits: int = 16, n_pipes: int = 2
     """
     _check(tris, frac_bits, n_pipes)
     f = int(frac_bits)
-    spans = setup_spans(tris, frac_bits=f)
+    if spans is None:
+        spans = setup_spans(tris, frac_bits=f)
+    elif spans.get("frac_bits") != f:
+        raise RasterhwError(f"spans were set up with frac_bits={spans.get('frac_bits')!r}, not {f}")
     w = int(tris.width)
     out = _inner_loop(spans, w, counts)
     r, g, b = ((out[c] >> f) & 0xFF for c in ("r", "g", "b"))

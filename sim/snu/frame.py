@@ -57,7 +57,7 @@ def clear_cycles(width: int, height: int, n_banks: int = N_BANKS) -> int:
 
 
 def producer_gaps(tris, stream: PixelStream, cpu: i860.I860 | None = None, *, n_pipes: int = 2,
-                  clock_hz: float = CLOCK_HZ) -> dict:
+                  clock_hz: float = CLOCK_HZ, spans: dict | None = None) -> dict:
     """Idle bus clocks before each write, from the scan-converting i860's time on the model.
 
     Between two stores of one pipeline the processor spends ``pixel`` clocks (the inner loop),
@@ -83,7 +83,7 @@ def producer_gaps(tris, stream: PixelStream, cpu: i860.I860 | None = None, *, n_
               ("clip", "perspective_divide", "screen_map")]
     group_clocks = [sum(geo[s]["clocks"] for s in g) for g in groups]
     ratio = cpu.clock_hz / clock_hz
-    spans = setup_spans(tris)
+    spans = setup_spans(tris) if spans is None else spans
     n_tri = tris.n_triangles
     n = len(stream)
     # per scan line (in emission order) its triangle and pixel count; stream = lines expanded
@@ -241,16 +241,17 @@ def frame_run(scene, width: int, height: int, *, cpu: i860.I860 | None = None, p
     frame time, each stage's busy time and share, and the limiting bound."""
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.snu.formats import Z_BITS
-    from rasterhw.golden_model.snu.gouraud import inner_loop_ops, scan_convert
+    from rasterhw.golden_model.snu.gouraud import inner_loop_ops, scan_convert, setup_spans
     from rasterhw.golden_model.snu.traversal import RECORD_BYTES
 
     cpu = cpu or i860.I860()
     t0 = time.perf_counter()
     tris = run_geometry(scene, width, height, z_bits=Z_BITS, z_far_is_zero=True)
     ran: dict = {}
-    stream = scan_convert(tris, counts=ran)
+    spans = setup_spans(tris)
+    stream = scan_convert(tris, counts=ran, spans=spans)
     t_geo = time.perf_counter()
-    prod = producer_gaps(tris, stream, cpu)
+    prod = producer_gaps(tris, stream, cpu, spans=spans)
     sched = golden_schedule(stream, prod["gaps"], prod["first_work"], ratio=prod["ratio"])
     g_rgb, g_z = golden.pixelbus_frame(stream, accept=sched["accept"])
     t_gold = time.perf_counter()
