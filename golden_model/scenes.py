@@ -276,7 +276,8 @@ def _build_zbm(seed: int, *, n: int = 1000, width: int = 512, height: int = 512)
                  ambient=(0.2, 0.2, 0.2), material=Material(ka=1.0, kd=0.8, ks=0.0))
 
 
-def _build_snu(seed: int, *, n: int = 2000, width: int = 1280, height: int = 1024, area: float = 100.0) -> Scene:
+def _build_snu(seed: int, *, n: int = 2000, width: int = 1280, height: int = 1024, area: float = 100.0,
+               name: str = "snu-100px") -> Scene:
     """Gouraud triangles of exactly ``area`` px each, random vertex colours, random depths."""
     rng = np.random.default_rng(seed)
     cam, f = _screen_camera(height)
@@ -287,7 +288,7 @@ def _build_snu(seed: int, *, n: int = 2000, width: int = 1280, height: int = 102
     pos = _lift(tri + c[:, None, :], dist[:, None], width, height, f, cam.eye[2])
     nrm = np.broadcast_to(np.array([0.0, 0.0, 1.0]), pos.shape).copy()
     col = rng.random((n, 3, 3))
-    return Scene(name="snu-100px", seed=seed, camera=cam, positions=pos, normals=nrm, colours=col,
+    return Scene(name=name, seed=seed, camera=cam, positions=pos, normals=nrm, colours=col,
                  nverts=np.full(n, 3, dtype=np.int64), lights=(Light(direction=(0.0, 0.0, -1.0)),),
                  ambient=(0.2, 0.2, 0.2), material=Material(ka=1.0, kd=0.8, ks=0.0))
 
@@ -348,6 +349,9 @@ SCENES: dict[str, SceneInfo] = {
                      (512, 512), _build_zbm, 3, 1000),
     "snu-100px": _info("snu-100px", "2000 Gouraud triangles of 100 px, random vertex colours (SNU target)",
                        (1280, 1024), _build_snu, 4, 2000),
+    "snu-100k": _info("snu-100k", "100,000 Gouraud triangles of 100 px, random vertex colours: the SNU headline "
+                      "frame (one second's work)", (1280, 1024),
+                      lambda seed: _build_snu(seed, n=100_000, name="snu-100k"), 100, 100_000),
     "experts-1000": _info("experts-1000", "Fr = 1000 front-facing triangles at depth complexity 3 (EXPERTS fig. 4.1)",
                           (512, 512), _build_experts(1000), 1000, 1000),
     "experts-2000": _info("experts-2000", "Fr = 2000 front-facing triangles at depth complexity 3 (EXPERTS fig. 4.1)",

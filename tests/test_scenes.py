@@ -14,7 +14,7 @@ from rasterhw.golden_model.scenes import SCENES, _project, build_scene, list_sce
 EXPECTED = {
     "c50": 301, "c100": 601, "c150": 901, "c200": 1201, "c250": 1501, "c300": 1801,
     "sp27": 2701, "sp5": 2001, "sp8": 1354,
-    "zbm-5x5": 1000, "snu-100px": 2000, "experts-1000": 1000, "experts-2000": 2000,
+    "zbm-5x5": 1000, "snu-100px": 2000, "snu-100k": 100_000, "experts-1000": 1000, "experts-2000": 2000,
     "experts-tilt-1000": 1000, "experts-tilt-2000": 2000, "experts-solid-5": 4, "experts-solid-9": 6,
     "experts-solid-15": 9, "experts-solid-20": 12, "experts-solids": 31, "experts-uneven": 1000,
 }

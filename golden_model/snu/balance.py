@@ -9,10 +9,11 @@ second normal-vector normalisation and lighting, the last clipping, projection a
 mapping."
 
 This module holds the paper's table as labelled constants, the per-vertex operation mix the
-paper's *text* (4.2.1-4.2.5) gives for each stage, a per-operation i860 clock-cost model
-*derived* from those two (see :data:`I860_COST` and ``docs/snu_geometry.md``), and the
-arithmetic that turns per-stage counts (the paper's, or the ones ``golden_model/opcount.py``
-measures) into a clock column, the three-processor balance and the Mflops column.
+paper's *text* (4.2.1-4.2.5) gives for each stage, and the arithmetic that turns counts and
+clocks into the three-processor balance, the Mflops column and report rows. The counts come
+from running the golden geometry (``golden_model/snu/recipe.py``, ``golden_model/opcount.py``);
+the clocks from the i860 timing model (``golden_model/snu/i860.py``), which takes nothing from
+the table.
 """
 
 from __future__ import annotations
@@ -25,14 +26,11 @@ from rasterhw.golden_model.errors import RasterhwError
 __all__ = [
     "CLOCK_HZ",
     "GROUPS",
-    "I860_COST",
     "OP_KINDS",
     "PAPER_TABLE1",
     "PAPER_TEXT_COUNTS",
     "STAGES",
     "balance",
-    "clocks_from_ops",
-    "cost_derivation",
     "extra_stages",
     "mflops",
     "per_triangle",
@@ -93,44 +91,6 @@ GROUPS: dict[str, tuple[str, ...]] = {
 }
 
 
-def _derive_costs() -> dict[str, Fraction]:
-    """Clocks per operation implied by table 1's clock column and the text's op mixes.
-
-    Per vertex (table clocks / 3):
-      vertex transform   12 mul + 12 add              = 20
-      normal transform    9 mul +  6 add              = 13   -> mul = 1, add = 2/3
-      perspective divide  1 div +  3 mul              =  6   -> div = 3
-      clip                6 cmp                       =  8   -> cmp = 4/3
-      normalise           6 mul + 2 add + sqrt + div  = 27   -> sqrt = 50/3
-    ``lookup`` appears only in lighting, whose row the solved costs already exceed without it
-    (12 + 20/3 + 4 = 22.7 > 20), so it cannot be derived; it is set to 1 clock (one cached
-    load) -- an assumption. ``cvt`` (float -> integer, counted by ``opcount``) never appears in
-    the paper's counts; it is given the add cost (the i860's ``ftrunc`` runs in the adder
-    pipeline) -- an assumption.
-    """
-    t = {s: Fraction(PAPER_TABLE1[s]["clocks"]) / 3 for s in STAGES}
-    c = PAPER_TEXT_COUNTS
-    # 12m + 12a = t_vt ; 9m + 6a = t_nt  -> solve the 2x2 system exactly
-    a11, a12, b1 = c["vertex_transform"]["mul"], c["vertex_transform"]["add"], t["vertex_transform"]
-    a21, a22, b2 = c["normal_transform"]["mul"], c["normal_transform"]["add"], t["normal_transform"]
-    det = Fraction(a11 * a22 - a12 * a21)
-    mul = (b1 * a22 - a12 * b2) / det
-    add = (a11 * b2 - a21 * b1) / det
-    div = t["perspective_divide"] - c["perspective_divide"]["mul"] * mul
-    cmp = t["clip"] / c["clip"]["cmp"]
-    n = c["normalise"]
-    sqrt = t["normalise"] - n["mul"] * mul - n["add"] * add - n["div"] * div
-    return {"mul": mul, "add": add, "cmp": cmp, "div": div, "sqrt": sqrt, "lookup": Fraction(1),
-            "cvt": add}
-
-
-#: Clocks per operation on the i860 (exact fractions), derived by :func:`_derive_costs`.
-I860_COST: dict[str, Fraction] = _derive_costs()
-#: Rows whose clocks the derived cost set reproduces by construction / cannot reproduce.
-DERIVED_FROM = ("vertex_transform", "normal_transform", "normalise", "clip", "perspective_divide")
-NOT_EXPLAINED = ("light", "screen_map")
-
-
 def _check_counts(counts: dict) -> None:
     if not isinstance(counts, dict):
         raise RasterhwError(f"op counts must be a dict of stage -> counts, not {type(counts).__name__}")
@@ -156,26 +116,6 @@ def per_triangle(counts_per_vertex: dict) -> dict:
         r = {k: 3 * row.get(k, 0) for k in OP_KINDS}
         r["total"] = sum(r.values())
         out[stage] = r
-    return out
-
-
-def clocks_from_ops(counts: dict, cost: dict | None = None) -> dict:
-    """i860 clocks per stage from per-triangle op counts: ``sum(count[k] * cost[k])``.
-
-    ``counts`` maps every stage of :data:`STAGES` to a dict with any of :data:`OP_KINDS`
-    (missing kinds count 0; extra keys such as ``total`` are ignored). Returns stage -> clocks
-    (float) for every stage given, plus ``"total"`` over the paper's seven :data:`STAGES`
-    (a stage the paper does not have, e.g. ``backface_cull``, gets its clocks but stays out
-    of the total; a ``"total"`` stage in ``counts`` is skipped).
-    """
-    _check_counts(counts)
-    cost = I860_COST if cost is None else cost
-    out: dict[str, float] = {}
-    for stage, row in counts.items():
-        if stage == "total" or not isinstance(row, dict):
-            continue
-        out[stage] = float(sum(Fraction(row.get(k, 0)) * Fraction(cost[k]) for k in OP_KINDS))
-    out["total"] = sum(out[s] for s in STAGES)
     return out
 
 
@@ -228,75 +168,70 @@ def mflops(ops: dict, polys_per_s: float = 100_000) -> dict:
     return out
 
 
-def cost_derivation() -> list[dict]:
-    """Per stage: the paper's clocks, the clocks the derived costs give for the text's mix,
-    the residual, and the paper's implied clocks per operation (table clocks / table ops)."""
-    rows = []
-    model = clocks_from_ops(per_triangle(PAPER_TEXT_COUNTS))
-    for s in STAGES:
-        p = PAPER_TABLE1[s]
-        rows.append({"stage": s, "paper_clocks": p["clocks"], "model_clocks": model[s],
-                     "residual": model[s] - p["clocks"],
-                     "paper_clocks_per_op": p["clocks"] / p["ops"],
-                     "explained": s in DERIVED_FROM})
-    return rows
-
-
-def table1_rows(measured_counts: dict | None = None, *, clock_hz: float = CLOCK_HZ) -> list[dict]:
+def table1_rows(recipe_counts: dict, full_counts: dict | None = None, model: dict | None = None, *,
+                clock_hz: float = CLOCK_HZ) -> list[dict]:
     """Report rows for table 1 and the three-stage balance (keys of ``sim/report.py``).
 
-    ``paper``: the paper's printed value; ``formula``: our arithmetic on the paper's *text*
-    op mixes (ops) and the derived i860 costs (clocks); ``measured``: the same arithmetic on
-    ``measured_counts`` (per-triangle counts from ``opcount.ops_per_triangle()``), or None.
+    ``recipe_counts``: per-triangle counts of the paper's recipe (``recipe.ops_per_triangle()``),
+    rows ``source="golden"``: ``paper`` = table 1, ``formula`` = the text's per-vertex mix x 3,
+    ``measured`` = the recipe's counted operations. ``full_counts``: the same for our full
+    pipeline (``opcount.ops_per_triangle()``). ``model``: ``i860.table1_model()``; its clock rows
+    are ``source="model"``: ``paper`` = table 1's clocks, ``measured`` = the i860 model's clocks
+    (nothing in the model is taken from the table).
     """
-    if measured_counts is not None:
-        _check_counts(measured_counts)
+    _check_counts(recipe_counts)
+    if full_counts is not None:
+        _check_counts(full_counts)
     text = per_triangle(PAPER_TEXT_COUNTS)
-    f_clk = clocks_from_ops(text)
-    m_clk = clocks_from_ops(measured_counts) if measured_counts is not None else None
-
-    def m_ops(s):
-        if measured_counts is None:
-            return None
-        r = measured_counts[s]
-        return float(r["total"]) if "total" in r else float(sum(r.get(k, 0) for k in OP_KINDS))
-
     rows: list[dict] = []
 
-    def row(quantity, paper, formula, measured, unit, figure="table 1"):
+    def row(quantity, paper, formula, measured, unit, figure="table 1", source="golden"):
         rows.append({"system": "snu", "figure": figure, "quantity": quantity, "paper": paper,
-                     "formula": formula, "measured": measured, "unit": unit, "source": "golden"})
+                     "formula": formula, "measured": measured, "unit": unit, "source": source})
+
+    def tot(r):
+        return float(r["total"]) if "total" in r else float(sum(r.get(k, 0) for k in OP_KINDS))
 
     for s in STAGES:
-        p = PAPER_TABLE1[s]
-        row(f"{s}: operations per triangle", p["ops"], float(text[s]["total"]), m_ops(s), "ops")
-        row(f"{s}: i860 clocks per triangle", p["clocks"], f_clk[s],
-            None if m_clk is None else m_clk[s], "clocks")
-        row(f"{s}: share of clocks", p["percent"], 100 * f_clk[s] / f_clk["total"],
-            None if m_clk is None else 100 * m_clk[s] / m_clk["total"], "%")
-    for s in extra_stages(measured_counts or {}):
-        row(f"{s}: operations per triangle (not in the paper)", None, None, m_ops(s), "ops")
-        row(f"{s}: i860 clocks per triangle (not in the paper)", None, None, m_clk[s], "clocks")
-    row("total operations per triangle", PAPER_TOTAL_OPS, float(sum(text[s]["total"] for s in STAGES)),
-        None if measured_counts is None else sum(m_ops(s) for s in STAGES), "ops")
-    row("total i860 clocks per triangle", PAPER_TOTAL_CLOCKS, f_clk["total"],
-        None if m_clk is None else m_clk["total"], "clocks")
-    f_mf = mflops(text)
-    m_mf = mflops({s: m_ops(s) for s in STAGES}) if measured_counts is not None else None
+        row(f"{s}: operations per triangle, paper's recipe (formula = the text)", PAPER_TABLE1[s]["ops"],
+            float(text[s]["total"]), tot(recipe_counts[s]), "ops")
+    row("total operations per triangle, paper's recipe", PAPER_TOTAL_OPS,
+        float(sum(text[s]["total"] for s in STAGES)), sum(tot(recipe_counts[s]) for s in STAGES), "ops")
+    if full_counts is not None:
+        for s in STAGES:
+            row(f"{s}: operations per triangle, our full pipeline", PAPER_TABLE1[s]["ops"], None,
+                tot(full_counts[s]), "ops")
+        for s in extra_stages(full_counts):
+            row(f"{s}: operations per triangle, our full pipeline (not in the paper)", None, None,
+                tot(full_counts[s]), "ops")
+        row("total operations per triangle, our full pipeline", PAPER_TOTAL_OPS, None,
+            sum(tot(full_counts[s]) for s in STAGES), "ops")
+    m_mf = mflops({s: tot(recipe_counts[s]) for s in STAGES})
     for s in STAGES:
-        row(f"{s}: Mflops for 100 K polygons/s", PAPER_MFLOPS[s], f_mf[s],
-            None if m_mf is None else m_mf[s], "Mflops", figure="text 4.2")
+        row(f"{s}: Mflops for 100 K polygons/s, paper's recipe", PAPER_MFLOPS[s],
+            float(text[s]["total"]) * 0.1, m_mf[s], "Mflops", figure="text 4.2")
+    if model is None:
+        return rows
+    clk = {s: float(model[s]["clocks"]) for s in STAGES}
+    total = sum(clk.values())
+    for s in STAGES:
+        row(f"{s}: i860 clocks per triangle (i860 model, one triangle)", PAPER_TABLE1[s]["clocks"], None,
+            clk[s], "clocks", source="model")
+        row(f"{s}: share of clocks (i860 model)", PAPER_TABLE1[s]["percent"], None, 100 * clk[s] / total, "%",
+            source="model")
+    row("total i860 clocks per triangle (i860 model, one triangle per stage)", PAPER_TOTAL_CLOCKS, None, total,
+        "clocks", source="model")
+    row("total i860 clocks per triangle (i860 model, software-pipelined over 16 triangles)", PAPER_TOTAL_CLOCKS,
+        None, float(sum(model[s]["stream"] for s in STAGES)), "clocks", source="model")
     paper_bal = balance({s: PAPER_TABLE1[s]["clocks"] for s in STAGES}, clock_hz=clock_hz)
-    f_bal = balance(f_clk, clock_hz=clock_hz)
-    m_bal = balance(m_clk, clock_hz=clock_hz) if m_clk is not None else None
+    m_bal = balance(clk, clock_hz=clock_hz)
     for g in GROUPS:
         # The paper prints no group sums; "paper" is the sum of its own table 1 clocks.
-        row(f"{g}: clocks per triangle (sum of table 1)", paper_bal["groups"][g], f_bal["groups"][g],
-            None if m_bal is None else m_bal["groups"][g], "clocks", figure="text 4.5")
-    row(f"polygons/s per 3-processor pipeline at {clock_hz / 1e6:g} MHz (assumed clock)",
-        None, f_bal["polys_per_s_pipeline"], None if m_bal is None else m_bal["polys_per_s_pipeline"],
-        "polygons/s", figure="text 4.5")
-    row("geometry-bound polygons/s, 2 pipelines of 3 i860s (paper: 100 K target)", 100_000,
-        f_bal["polys_per_s_system"],
-        None if m_bal is None else m_bal["polys_per_s_system"], "polygons/s", figure="abstract")
+        row(f"{g}: clocks per triangle (paper = sum of table 1)", paper_bal["groups"][g], None,
+            m_bal["groups"][g], "clocks", figure="text 4.5", source="model")
+    row(f"polygons/s per 3-processor pipeline at {clock_hz / 1e6:g} MHz (assumed clock; paper = its table)",
+        paper_bal["polys_per_s_pipeline"], None, m_bal["polys_per_s_pipeline"], "polygons/s", figure="text 4.5",
+        source="model")
+    row("geometry-bound polygons/s, 2 pipelines of 3 i860s (paper: 100 K target)", 100_000, None,
+        m_bal["polys_per_s_system"], "polygons/s", figure="abstract", source="model")
     return rows

@@ -26,10 +26,11 @@ What this module does (decisions the paper leaves open are marked *ours*; see
   output is a plain truncation ``acc >> frac_bits`` (the store takes the register's upper
   bits, no rounding add per pixel);
 * **outer loop** (per scan line): the span-start accumulators step by
-  ``dA/dy + (cs(row+1) - cs(row)) * dA/dx`` (integer adds), **inner loop** (per pixel): the
-  8 operations of :data:`INNER_LOOP`. Both loops are evaluated in closed form
-  (``start + k * inc`` in ``np.int64``), which is bit-identical to the repeated adds because
-  integer addition is exact; ``tests/snu/test_snu_gouraud.py`` checks this against a literal loop;
+  ``dA/dy + (cs(row+1) - cs(row)) * dA/dx`` (integer adds, evaluated in closed form, which is
+  bit-identical because integer addition is exact), **inner loop** (per pixel): run pass by
+  pass -- store, step address, r, g, b, z, count, branch -- and *counted as it runs*
+  (``counts``, :data:`EXECUTED`); ``tests/snu/test_snu_gouraud.py`` checks it against a closed
+  form and a literal one-pixel-at-a-time loop;
 * **output** -- the 8-bit channels and the ``z_bits`` Z are the accumulators' integer parts,
   masked to their widths as the hardware store would (no clamp: no clamp is in the paper's
   8-operation loop; with ``frac_bits >= 12`` the error bound keeps every covered pixel in
@@ -54,7 +55,7 @@ from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles, snap
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 
 __all__ = [
-    "INNER_LOOP",
+    "EXECUTED",
     "SUBPIXEL_BITS",
     "error_bound_lsb",
     "inner_loop_ops",
@@ -67,46 +68,27 @@ __all__ = [
 #: Vertices are snapped to 1/2**SUBPIXEL_BITS px (round half up) before coverage is decided:
 #: the float reference's grid (``reference.SUBPIXEL = 256``, docs/reference.md).
 
-#: The inner loop the model implements, one entry per i860 operation per pixel:
-#: (kind, operand). The accumulators stepped by :func:`scan_convert` are exactly the
-#: ``"add"`` operands of this table, in this order; :func:`inner_loop_ops` counts it.
-INNER_LOOP: tuple[tuple[str, str], ...] = (
-    ("add", "addr"),  # pixel address += 1
-    ("add", "r"),  # r += dr/dx   (Q8.F)
-    ("add", "g"),  # g += dg/dx   (Q8.F)
-    ("add", "b"),  # b += db/dx   (Q8.F)
-    ("add", "z"),  # z += dz/dx   (Q24.F, 64-bit register)
-    ("add", "count"),  # pixels left -= 1
-    ("mem", "store"),  # write (addr, r>>F, g>>F, b>>F, z>>F) to the pixel bus
-    ("branch", "count"),  # loop while pixels left != 0
-)
+#: What the inner loop executes per pixel, the keys of the ``counts`` :func:`scan_convert`
+#: fills: adds on the pixel address, r, g, b, z (Q8.F colour, Q24.F Z in a 64-bit register)
+#: and the pixel count, the store to the pixel bus, the loop branch.
+EXECUTED = ("add_addr", "add_r", "add_g", "add_b", "add_z", "add_count", "store", "branch")
 
 _CHANNELS = ("r", "g", "b", "z")
 _MAX_COORD = float(1 << 15)  # px; keeps snapped products well inside int64
 
 
-def inner_loop_ops() -> dict:
-    """Per-pixel operation counts of :data:`INNER_LOOP`, beside the paper's figures.
+def inner_loop_ops(counts: dict) -> dict:
+    """Operations per pixel from what :func:`scan_convert` executed (its ``counts``).
 
-    Returns a dict with ``add``, ``mem``, ``branch``, ``total`` (counted from the loop table),
-    ``clocks_dual_issue`` (``ceil(total / 2)``: the i860 in dual-instruction mode issues one
-    core and one floating-point/graphics instruction per clock -- our reading of the paper's
-    "4 clocks per pixel in dual-instruction mode with a separate Z comparator"),
-    ``paper_total`` = 8 and ``paper_clocks`` = 4 (the paper's words, labelled as such), and
-    ``mops_for_10_mpixel`` (``total * 10``, the paper's 80 MOPS).
+    Returns ``add``, ``mem``, ``branch`` and ``total`` per pixel (means over the pixels
+    written), plus ``pixels`` and ``spans`` (scan lines that entered the loop).
     """
-    counts = {"add": 0, "mem": 0, "branch": 0}
-    for kind, _ in INNER_LOOP:
-        counts[kind] += 1
-    total = sum(counts.values())
-    return {
-        **counts,
-        "total": total,
-        "clocks_dual_issue": -(-total // 2),
-        "paper_total": 8,
-        "paper_clocks": 4,
-        "mops_for_10_mpixel": total * 10,
-    }
+    px = counts.get("pixels", 0) if isinstance(counts, dict) else 0
+    if px <= 0:
+        raise RasterhwError("inner_loop_ops needs the counts of at least one pixel")
+    add = sum(counts[k] for k in EXECUTED if k.startswith("add_"))
+    return {"add": add / px, "mem": counts["store"] / px, "branch": counts["branch"] / px,
+            "total": sum(counts[k] for k in EXECUTED) / px, "pixels": px, "spans": counts["spans"]}
 
 
 def error_bound_lsb(frac_bits: int, width: int, height: int) -> float:
@@ -260,7 +242,8 @@ def _expand(spans: dict) -> tuple[np.ndarray, np.ndarray]:
     return span, k
 
 
-def scan_convert(tris: ScreenTriangles, *, frac_bits: int = 16, n_pipes: int = 2) -> PixelStream:
+def scan_convert(tris: ScreenTriangles, *, frac_bits: int = 16, n_pipes: int = 2,
+                 counts: dict | None = None, spans: dict | None = None) -> PixelStream:
     """Bit-accurate Gouraud scan conversion of ``tris`` into the two pipelines' pixel writes.
 
     Parameters
@@ -269,6 +252,10 @@ def scan_convert(tris: ScreenTriangles, *, frac_bits: int = 16, n_pipes: int = 2
     frac_bits : fraction bits of the colour and Z accumulators (8..28; the paper asks for
         "16 bits or more including the fraction"; 16 is the default, see the module docstring).
     n_pipes : pipelines; triangle ``i`` is issued by pipeline ``i % n_pipes``.
+    counts : if a dict, it receives what the inner loop executed (:data:`EXECUTED`, plus
+        ``pixels`` and ``spans``); :func:`inner_loop_ops` turns it into operations per pixel.
+    spans : ``setup_spans(tris, frac_bits=frac_bits)`` if the caller already has it (not checked
+        beyond its ``frac_bits``).
 
     Returns
     -------
@@ -276,24 +263,55 @@ def scan_convert(tris: ScreenTriangles, *, frac_bits: int = 16, n_pipes: int = 2
     """
     _check(tris, frac_bits, n_pipes)
     f = int(frac_bits)
-    spans = setup_spans(tris, frac_bits=f)
-    span, k = _expand(spans)
+    if spans is None:
+        spans = setup_spans(tris, frac_bits=f)
+    elif spans.get("frac_bits") != f:
+        raise RasterhwError(f"spans were set up with frac_bits={spans.get('frac_bits')!r}, not {f}")
     w = int(tris.width)
-
-    # The inner loop: every "add" operand of INNER_LOOP is an accumulator start + k * increment.
-    start = {"addr": spans["row"] * w + spans["col"], "count": spans["n"]}
-    step = {"addr": np.ones_like(spans["n"]), "count": -np.ones_like(spans["n"])}
-    for c, name in enumerate(_CHANNELS):
-        start[name], step[name] = spans["acc"][:, c], spans["inc"][:, c]
-    regs = {name: start[name][span] + k * step[name][span]
-            for kind, name in INNER_LOOP if kind == "add"}
-    assert np.all(regs["count"] > 0)  # the branch never falls through early
-
-    r, g, b = ((regs[c] >> f) & 0xFF for c in ("r", "g", "b"))
-    z = (regs["z"] >> f) & ((1 << int(tris.z_bits)) - 1)
-    return PixelStream(width=w, height=int(tris.height), addr=regs["addr"],
+    out = _inner_loop(spans, w, counts)
+    r, g, b = ((out[c] >> f) & 0xFF for c in ("r", "g", "b"))
+    z = (out["z"] >> f) & ((1 << int(tris.z_bits)) - 1)
+    return PixelStream(width=w, height=int(tris.height), addr=out["addr"],
                        rgb=(r << 16) | (g << 8) | b, z=z,
-                       pipe=spans["tri"][span] % int(n_pipes), z_bits=int(tris.z_bits))
+                       pipe=out["tri"] % int(n_pipes), z_bits=int(tris.z_bits))
+
+
+def _inner_loop(spans: dict, w: int, counts: dict | None) -> dict:
+    """Run the inner loop: in each pass every span still in the loop stores its pixel, steps its
+    six registers and tests its count (vectorised across spans, one pixel per pass). Spans go
+    longest first, so the spans still looping are always a prefix. ``counts`` (a dict or None)
+    receives what ran (:data:`EXECUTED`, ``pixels``, ``spans``)."""
+    n = spans["n"]
+    order = np.argsort(-n, kind="stable")
+    n_o = n[order]
+    regs = {"addr": (spans["row"] * w + spans["col"])[order], "count": n_o.copy()}
+    inc = {"addr": np.ones_like(n_o)}
+    for c, name in enumerate(_CHANNELS):
+        regs[name], inc[name] = spans["acc"][order, c].copy(), spans["inc"][order, c]
+    pos = (np.cumsum(n) - n)[order]  # where each span's next pixel goes in the stream (bookkeeping)
+    total = int(n.sum())
+    out = {name: np.empty(total, dtype=np.int64) for name in ("addr", *_CHANNELS)}
+    out["tri"] = np.repeat(spans["tri"], n)
+    ran = dict.fromkeys(EXECUTED, 0)
+    live = int(np.count_nonzero(n_o > 0))
+    ran["spans"] = live
+    while live:
+        p = pos[:live]
+        for name in ("addr", *_CHANNELS):  # one store: the address and the four accumulators
+            out[name][p] = regs[name][:live]
+        ran["store"] += live
+        pos[:live] += 1
+        for name in ("addr", *_CHANNELS):
+            regs[name][:live] += inc[name][:live]
+            ran[f"add_{name}"] += live
+        regs["count"][:live] -= 1
+        ran["add_count"] += live
+        ran["branch"] += live  # loop while count != 0
+        live = int(np.count_nonzero(regs["count"][:live] > 0))
+    ran["pixels"] = total
+    if counts is not None:
+        counts.update(ran)
+    return out
 
 
 def scan_convert_float(tris: ScreenTriangles, *, n_pipes: int = 2) -> PixelStream:

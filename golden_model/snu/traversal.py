@@ -43,6 +43,7 @@ __all__ = [
     "Structure",
     "TraversalOutput",
     "css_from_scene",
+    "measure_traversal",
     "scene_triangles",
     "traversal_bandwidth",
 ]
@@ -242,6 +243,38 @@ def traversal_bandwidth(polys_per_s: float = 100_000) -> float:
     if not np.isfinite(polys_per_s) or polys_per_s < 0:
         raise RasterhwError(f"polys_per_s must be a finite number >= 0, not {polys_per_s!r}")
     return float(polys_per_s) * 3 * RECORD_BYTES
+
+
+#: The dual-port memories between the stages (3.1): "256 KByte RAM, 16 bits at a time".
+DPM_BYTES = 256 * 1024
+DPM_WIDTH_BYTES = 2
+
+
+def measure_traversal(scene: Scene, *, polys_per_s: float = 100_000, polys_per_object: int = 6,
+                      clock_hz: float = 40e6, bus_clocks_per_transfer: int = 2) -> dict:
+    """Build the scene's structure store, ``post`` it, and measure what the traversal emits.
+
+    Returns ``triangles``, ``bytes`` (the records really emitted), ``bytes_per_triangle``,
+    ``bandwidth`` (bytes/s at ``polys_per_s``), ``post_s`` (host seconds of the traversal model,
+    not an i860 figure) and the dual-port memory beside it: ``dpm_rate`` (one 16-bit transfer
+    per i860 bus cycle of ``bus_clocks_per_transfer`` clocks -- our assumption, the paper gives
+    no memory timing), ``dpm_triangles`` (records that fit in 256 KB) and ``elements`` visited.
+    """
+    import time
+
+    css = css_from_scene(scene, polys_per_object=polys_per_object)
+    t0 = time.perf_counter()
+    out = css.post(0)
+    post_s = time.perf_counter() - t0
+    t = out.n_triangles
+    if t == 0:
+        raise RasterhwError(f"scene {scene.name!r}: the traversal emitted no triangles")
+    per = out.nbytes / t
+    return {"triangles": t, "bytes": out.nbytes, "bytes_per_triangle": per, "bandwidth": per * polys_per_s,
+            "post_s": post_s, "elements": sum(out.stats[k] for k in _KINDS),
+            "structures": out.stats["structures"],
+            "dpm_rate": DPM_WIDTH_BYTES * clock_hz / bus_clocks_per_transfer,
+            "dpm_triangles": DPM_BYTES // int(per)}
 
 
 def _translate(t) -> np.ndarray:

@@ -324,8 +324,18 @@ if __name__ == "__main__":
 
 
 def simulate_scene(scene, width: int, height: int, *, engine: str = "verilator", progress: bool = False) -> dict:
-    """``rasterhw sim pixelbus``: geometry and the golden Gouraud scan converter make the pixel
-    stream of ``scene``; :func:`simulate_pixelbus` runs it through the HDL."""
+    """``rasterhw sim pixelbus``: the scene's frame through the pixel-bus HDL.
+
+    ``engine="verilator"``: the whole frame as the machine draws it (``sim/snu/frame.py``): clear,
+    the two pipelines' Gouraud streams with the producers' timing from the i860 model, swap, on
+    plain Verilator; ``frame`` in the result holds the frame time and each stage's share.
+    ``pysim``/``icarus``: the pixel stream alone (no clear, no swap, no producer gaps) through
+    :func:`simulate_pixelbus`.
+    """
+    if engine == "verilator":
+        from rasterhw.sim.snu.frame import frame_run
+
+        return frame_run(scene, width, height, progress=progress)
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.snu.formats import Z_BITS
     from rasterhw.golden_model.snu.gouraud import scan_convert

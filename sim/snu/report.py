@@ -1,13 +1,13 @@
 """Report rows for the SNU graphics system (seed 004).
 
-* Table 1 — operations and i860 clocks per triangle per stage, ``measured`` from the
-  instrumented golden geometry pipeline (:func:`~rasterhw.golden_model.opcount.ops_per_triangle`),
-  clocks through the per-operation cost model of :mod:`~rasterhw.golden_model.snu.balance`.
-* Section 4.1 — traversal bandwidth from the records the PHIGS traversal model really emits.
-* Section 4.3 — Gouraud inner-loop operations per pixel, from the loop the golden model runs.
-* Section 3.2 — pixel-bus rate for scan-line, vertical and random patterns, ``measured`` from
-  HDL cycle counts (``source`` ``hdl:<engine>``), and the polygons/s of ``snu-100px`` through the
-  pixel bus.
+* Table 1 — operations per triangle per stage counted by running the paper's recipe
+  (``golden_model/snu/recipe.py``) and our full pipeline (``golden_model/opcount.py``); i860
+  clocks from the timing model ``golden_model/snu/i860.py`` (``source`` ``model``).
+* Section 4.1 — traversal bytes and bandwidth from posting snu-100k's structure store.
+* Section 4.3 — Gouraud inner-loop operations per pixel, counted as the scan converter ran.
+* Section 3.2 — pixel-bus rate for scan-line, vertical and random patterns from HDL cycles.
+* Abstract — the snu-100k frame end to end (``sim/snu/frame.py``): pixel bus in HDL on plain
+  Verilator with clear and swap, producers' timing from the i860 model.
 """
 
 from __future__ import annotations
@@ -16,45 +16,82 @@ from pathlib import Path
 
 from rasterhw.sim.report import make_row
 
-PAPER_BUS_RATE = 12.5e6  # 1 / 80 ns; the paper's text rounds it to "12 Mpixel/sec"
+PAPER_BUS_RATE = 12e6  # 3.2: "화소 버스의 통신속은 12 Mpixel/sec" (as printed)
+FORMULA_BUS_RATE = 5 / 400e-9  # 400 ns memory cycle / 5 banks = 80 ns per pixel = 12.5 Mpixel/s
+CLOCK = 12.5e6  # bus clock, one 80 ns slot
 PAPER_POLYS_PER_S = 100_000  # abstract and conclusion: 100-pixel Gouraud polygons
 PATTERN_PIXELS = 2000  # writes per access pattern; enough for a steady state
 PATTERN_SIZE = (40, 25)  # a small frame whose width is a multiple of 5, as the paper's 1280
 
 
+HEADLINE = "snu-100k"  # 100,000 Gouraud triangles of 100 px at 1280x1024: the paper's one second
+PAPER_FRAME_S = 1.0
+
+
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
-         snu_100px: tuple | None = None) -> tuple[list[dict], list[str]]:
-    """All SNU rows. ``snu_100px``: ``(triangles, pixel stream, simulate_pixelbus result)`` of the
-    snu-100px frame if the caller has already run it in HDL (the demo), else it is run here."""
-    out = golden_rows() + pixelbus_rows(engine=engine, progress=progress, snu_100px=snu_100px)
-    return out, _plot_table1(out, out_dir)
+         frame: dict | None = None) -> tuple[list[dict], list[str]]:
+    """All SNU rows. ``frame``: a ``frame.frame_run`` result of snu-100k if the caller already
+    ran it (the demo), else it is run here (plain Verilator)."""
+    if frame is None:
+        from rasterhw.golden_model.scenes import build_scene
+        from rasterhw.sim.snu.frame import frame_run
+
+        frame = frame_run(build_scene(HEADLINE), 1280, 1024, progress=progress, bus_only_bound=True)
+    out = golden_rows(HEADLINE, frame=frame) + pixelbus_rows(engine=engine, progress=progress) + frame_rows(frame)
+    return out, _plot_table1(out, out_dir) + _model_section()
 
 
-def golden_rows() -> list[dict]:
-    """Table 1, traversal and inner-loop rows: measured by running the golden models."""
+def golden_rows(scene_name: str = HEADLINE, *, frame: dict | None = None) -> list[dict]:
+    """Table 1 (counted by the golden geometry, clocked by the i860 model), the traversal of
+    ``scene_name``'s structure store, the Gouraud inner loop counted as the scan converter ran it."""
     from rasterhw.golden_model.opcount import ops_per_triangle
-    from rasterhw.golden_model.snu.balance import table1_rows
-    from rasterhw.golden_model.snu.gouraud import inner_loop_ops
-    from rasterhw.golden_model.snu.traversal import RECORD_BYTES, traversal_bandwidth
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import SCENES, build_scene
+    from rasterhw.golden_model.snu import i860, recipe
+    from rasterhw.golden_model.snu.balance import PAPER_TABLE1, table1_rows
+    from rasterhw.golden_model.snu.gouraud import inner_loop_ops, scan_convert
+    from rasterhw.golden_model.snu.traversal import measure_traversal
 
-    counts = ops_per_triangle()
-    out = table1_rows(counts)
-    out.append(make_row("snu", "text 4.1", "traversal record per triangle (3 x 9 float32)", paper=108,
-                        formula=3 * 9 * 4, measured=3 * RECORD_BYTES, unit="bytes", source="golden"))
-    out.append(make_row("snu", "text 4.1", "traversal bandwidth at 100 K polygons/s", paper=10e6,
-                        formula=108 * 100_000, measured=traversal_bandwidth(100_000), unit="bytes/s",
+    model = i860.table1_model()
+    out = table1_rows(recipe.ops_per_triangle(), ops_per_triangle(), model)
+    to_int = i860.stage_clocks("to_integer")["clocks"]
+    out.append(make_row("snu", "table 1", "screen_map + float -> integer (outside the paper's count): i860 clocks "
+                        "(model)", paper=PAPER_TABLE1["screen_map"]["clocks"], formula=None,
+                        measured=model["screen_map"]["clocks"] + to_int, unit="clocks", source="model"))
+    for label, cpu in (("without dual-operation instructions", i860.I860(dual_operation=False)),
+                       ("with one Newton step (14-bit reciprocals)", i860.I860(newton_steps=1))):
+        m = i860.table1_model(cpu)
+        out.append(make_row("snu", "table 1", f"total i860 clocks per triangle (model {label})", paper=309,
+                            formula=None, measured=m["total"]["clocks"], unit="clocks", source="model"))
+    sc = build_scene(scene_name)
+    w, h = SCENES[scene_name].size
+    tv = measure_traversal(sc)
+    out.append(make_row("snu", "text 4.1", f"traversal record per triangle ({scene_name}: CSS posted, bytes emitted "
+                        "/ triangles)", paper=108, formula=3 * 9 * 4, measured=tv["bytes_per_triangle"], unit="bytes",
                         source="golden"))
-    loop = inner_loop_ops()
-    out.append(make_row("snu", "text 4.3", "Gouraud inner loop, integer operations per pixel", paper=8,
-                        formula=6 + 1 + 1, measured=loop["total"], unit="ops", source="golden"))
+    out.append(make_row("snu", "text 4.1", "traversal bandwidth at 100 K polygons/s", paper=10e6,
+                        formula=108 * 100_000, measured=tv["bandwidth"], unit="bytes/s", source="golden"))
+    out.append(make_row("snu", "text 3.1", "dual-port memory rate, 16 bits per i860 bus cycle (2 clocks at 40 MHz)",
+                        paper=None, formula=None, measured=tv["dpm_rate"], unit="bytes/s", source="model"))
+    out.append(make_row("snu", "text 3.1", "triangle records one 256 KB dual-port memory holds", paper=None,
+                        formula=256 * 1024 // 108, measured=tv["dpm_triangles"], unit="triangles", source="golden"))
+    if frame is not None and "inner_loop" in frame.get("frame", {}):
+        loop = frame["frame"]["inner_loop"]
+    else:
+        ran: dict = {}
+        scan_convert(run_geometry(sc, w, h, z_bits=24, z_far_is_zero=True), counts=ran)
+        loop = inner_loop_ops(ran)
+    out.append(make_row("snu", "text 4.3", f"Gouraud inner loop, integer operations per pixel (executed on {scene_name})",
+                        paper=8, formula=6 + 1 + 1, measured=loop["total"], unit="ops", source="golden"))
+    px = {k: loop["pixels"] for k in ("add_addr", "add_r", "add_g", "add_b", "add_z", "add_count", "store", "branch")}
+    out.append(make_row("snu", "text 4.3", "Gouraud inner loop, i860 clocks per pixel (dual-instruction mode)",
+                        paper=4, formula=None, measured=i860.inner_loop_clocks({"pixels": loop["pixels"], **px}),
+                        unit="clocks", source="model"))
     return out
 
 
-def pixelbus_rows(*, engine: str, progress: bool, snu_100px: tuple | None = None) -> list[dict]:
-    """Bus rates measured from HDL cycles on synthetic patterns and on snu-100px."""
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.snu.gouraud import scan_convert
+def pixelbus_rows(*, engine: str, progress: bool) -> list[dict]:
+    """Bus rates measured from HDL cycles on synthetic patterns."""
     from rasterhw.golden_model.snu.pixelbus import CLOCK_HZ, pattern_stream, pixels_per_second
     from rasterhw.sim.snu.pixelbus import simulate_pixelbus
 
@@ -69,30 +106,53 @@ def pixelbus_rows(*, engine: str, progress: bool, snu_100px: tuple | None = None
         if res["mismatches"]:
             raise RuntimeError(f"pixel bus HDL differs from the golden model on the {pattern} pattern")
         rate = pixels_per_second(len(stream), res["cycles"], CLOCK_HZ)
-        # formula: the paper's only timing facts are 80 ns per slot and a 400 ns memory cycle.
-        # Scan line: every slot used, 1 / 80 ns. Vertical: each pipeline stays on one bank, so
-        # each gets one write per 400 ns memory cycle. Random: no closed form from the paper.
+        # paper: "12 Mpixel/sec" (3.2). formula: 400 ns memory / 5 banks = 80 ns per pixel. Scan
+        # line: every slot used. Vertical: each pipeline stays on one bank, one write per 400 ns.
         paper = PAPER_BUS_RATE if pattern == "scanline" else None
-        formula = {"scanline": PAPER_BUS_RATE, "vertical": 2 / 400e-9, "random": None}[pattern]
+        formula = {"scanline": FORMULA_BUS_RATE, "vertical": 2 / 400e-9, "random": None}[pattern]
         out.append(make_row("snu", "text 3.2", f"pixel-bus rate, {note}", paper=paper, formula=formula,
                             measured=rate, unit="pixels/s", source=src))
-    if snu_100px is None:
-        tris = run_geometry(build_scene("snu-100px"), 1280, 1024, z_bits=24, z_far_is_zero=True)
-        stream = scan_convert(tris)
-        res = simulate_pixelbus(stream, engine=engine if engine != "pysim" else "verilator", progress=progress)
-    else:
-        tris, stream, res = snu_100px
-    if res["mismatches"]:
-        raise RuntimeError("pixel bus HDL differs from the golden model on snu-100px")
-    seconds = res["cycles"] / CLOCK_HZ
-    src_scene = f"hdl:{res['engine']}"
-    out.append(make_row("snu", "abstract", "snu-100px: ~100-pixel Gouraud polygons/s through the pixel bus",
-                        paper=PAPER_POLYS_PER_S, formula=PAPER_BUS_RATE / 100, measured=tris.n_triangles / seconds,
-                        unit="polygons/s", source=src_scene))
-    out.append(make_row("snu", "abstract", "snu-100px: pixel writes/s through the pixel bus", paper=None,
-                        formula=PAPER_BUS_RATE, measured=len(stream) / seconds, unit="pixels/s",
-                        source=src_scene))
     return out
+
+
+def frame_rows(frame: dict) -> list[dict]:
+    """The snu-100k frame through the pixel-bus HDL (plain Verilator), producers on the i860 model."""
+    f = frame["frame"]
+    if frame["mismatches"]:
+        raise RuntimeError(f"snu-100k frame: {frame['mismatches']} mismatches between the HDL and the golden model")
+    src = f"hdl:{frame['engine']}"
+    out = [
+        make_row("snu", "abstract", "snu-100k frame time: clear + 100,000 Gouraud triangles (~100 px) + swap "
+                 f"(formula = clear + the limiting resource alone: {f['limiting']})",
+                 paper=PAPER_FRAME_S, formula=f["bound_s"], measured=f["frame_s"], unit="s", source=src),
+        make_row("snu", "abstract", "snu-100k polygons/s (whole frame)", paper=PAPER_POLYS_PER_S,
+                 formula=f["triangles"] / f["bound_s"], measured=f["polygons_per_s"], unit="polygons/s", source=src),
+        make_row("snu", "abstract", "snu-100k pixel writes/s (whole frame)", paper=None, formula=FORMULA_BUS_RATE,
+                 measured=f["pixels_per_s"], unit="pixels/s", source=src),
+        make_row("snu", "abstract", "snu-100k share of bus slots carrying a pixel", paper=None, formula=None,
+                 measured=100 * f["bus_share_of_frame"], unit="%", source=src),
+        make_row("snu", "abstract", "snu-100k pixel-bus mismatches (pixels + schedule numbers) vs golden",
+                 paper=None, formula=0, measured=frame["mismatches"], unit="count", source=src),
+    ]
+    for k, v in f["share_of_frame"].items():
+        out.append(make_row("snu", "abstract", f"snu-100k share of the frame: {k}", paper=None, formula=None,
+                            measured=100 * v, unit="%", source=_share_source(k, src)))
+    return out
+
+
+def _share_source(name: str, src: str) -> str:
+    if "golden" in name:
+        return "golden"
+    return src if "pixel bus" in name else "model"
+
+
+def _model_section() -> list[str]:
+    return ["## Where the numbers come from", "",
+            "Operations: counted by running the paper's recipe (`golden_model/snu/recipe.py`) and our full "
+            "pipeline (`golden_model/pipeline.py`). i860 clocks: `golden_model/snu/i860.py`, a list scheduler "
+            "over each stage's instructions with the documented pipelines (no parameter taken from table 1). "
+            "The snu-100k frame: `sim/snu/frame.py` (pixel bus in HDL on plain Verilator, producers' timing "
+            "from the i860 model). See `docs/snu_geometry.md` and `docs/snu.md` for every gap.", ""]
 
 
 def _plot_table1(rows: list[dict], out_dir: Path) -> list[str]:
@@ -101,12 +161,12 @@ def _plot_table1(rows: list[dict], out_dir: Path) -> list[str]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    clk = [r for r in rows if r["figure"] == "table 1" and r["quantity"].endswith("i860 clocks per triangle")]
+    clk = [r for r in rows if r["figure"] == "table 1" and r["quantity"].endswith("(i860 model, one triangle)")]
     names = [r["quantity"].split(":")[0] for r in clk]
     x = range(len(names))
     fig, ax = plt.subplots(figsize=(8, 3.6))
     ax.bar([i - 0.2 for i in x], [r["paper"] for r in clk], width=0.4, label="paper (table 1)")
-    ax.bar([i + 0.2 for i in x], [r["measured"] for r in clk], width=0.4, label="measured (golden pipeline)")
+    ax.bar([i + 0.2 for i in x], [r["measured"] for r in clk], width=0.4, label="i860 model")
     ax.set_xticks(list(x), [n.replace("_", "\n") for n in names], fontsize=8)
     ax.set_ylabel("i860 clocks per triangle")
     ax.set_title("SNU table 1: clocks per triangle by stage")
@@ -116,6 +176,5 @@ def _plot_table1(rows: list[dict], out_dir: Path) -> list[str]:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return ["## Plots", "", f"![table 1 clocks]({path.name})", "",
-            "Clocks come from counted operations times per-operation i860 costs derived from the paper's own "
-            "columns (see `docs/snu_geometry.md`); where a measured count differs from the paper's, "
-            "`docs/pipeline.md` says why, stage by stage."]
+            "Clocks: the i860 timing model scheduling each stage's instructions (paper's recipe); where it "
+            "differs from table 1, `docs/snu_geometry.md` says why, stage by stage.", ""]

@@ -3,8 +3,6 @@
 
 from __future__ import annotations
 
-from fractions import Fraction
-
 import numpy as np
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
@@ -33,39 +31,6 @@ def test_text_op_mixes_against_the_table():
     assert sum(per_tri[s]["total"] for s in b.STAGES) == 270
 
 
-# ------------------------------------------------------------------ clock-cost model
-
-
-def test_derived_costs():
-    c = b.I860_COST
-    assert c["mul"] == 1 and c["add"] == Fraction(2, 3)
-    assert c["div"] == 3 and c["cmp"] == Fraction(4, 3) and c["sqrt"] == Fraction(50, 3)
-
-
-def test_paper_counts_reproduce_309_where_the_derivation_allows():
-    clk = b.clocks_from_ops(b.per_triangle(b.PAPER_TEXT_COUNTS))
-    for s in b.DERIVED_FROM:  # vertex, normal, normalise, clip, projection: exact
-        assert clk[s] == b.PAPER_TABLE1[s]["clocks"], s
-    # One cost set cannot explain lighting (71 vs 60) or screen mapping (13 vs 27).
-    assert set(b.NOT_EXPLAINED) == {"light", "screen_map"}
-    assert clk["light"] == 71 and clk["screen_map"] == 13
-    assert clk["total"] == 306
-    # Substituting the paper's own clocks for the two unexplained rows gives 309 exactly.
-    assert clk["total"] - clk["light"] - clk["screen_map"] + 60 + 27 == 309
-    rows = {r["stage"]: r for r in b.cost_derivation()}
-    assert [s for s, r in rows.items() if r["residual"] != 0] == ["light", "screen_map"]
-
-
-def test_clocks_scale_linearly_and_ignore_total_key():
-    counts = b.per_triangle(b.PAPER_TEXT_COUNTS)
-    double = {s: {k: 2 * v for k, v in r.items()} for s, r in counts.items()}
-    double["total"] = {"mul": 999}
-    one, two = b.clocks_from_ops(counts), b.clocks_from_ops(double)
-    for s in b.STAGES:
-        assert two[s] == pytest.approx(2 * one[s])
-    assert "total" in two and two["total"] == pytest.approx(2 * one["total"])
-
-
 # ------------------------------------------------------------------ balance and Mflops
 
 
@@ -85,28 +50,25 @@ def test_mflops_on_paper_ops():
     assert b.mflops(b.per_triangle(b.PAPER_TEXT_COUNTS))["clip"] == pytest.approx(b.PAPER_MFLOPS["clip"])
 
 
-def test_table1_rows_without_and_with_measured():
-    rows = b.table1_rows()
+def test_table1_rows():
+    from rasterhw.golden_model.opcount import ops_per_triangle as full_ops
+    from rasterhw.golden_model.snu import i860, recipe
+
+    rows = b.table1_rows(recipe.ops_per_triangle(), full_ops(), i860.table1_model())
     keys = ("system", "figure", "quantity", "paper", "formula", "measured", "unit", "source")
     assert all(tuple(r) == keys for r in rows)
-    assert all(r["source"] == "golden" and r["system"] == "snu" and r["measured"] is None for r in rows)
-    fake = b.per_triangle(b.PAPER_TEXT_COUNTS)
-    fake["backface_cull"] = {"mul": 9, "add": 5, "cmp": 1, "total": 15}
-    rows = b.table1_rows(fake)
     by_q = {r["quantity"]: r for r in rows}
-    assert by_q["vertex_transform: i860 clocks per triangle"]["measured"] == 60
-    assert by_q["total i860 clocks per triangle"]["measured"] == 306  # culling stays out
-    assert by_q["backface_cull: operations per triangle (not in the paper)"]["measured"] == 15
-
-
-def test_table1_rows_from_opcount_when_available():
-    opcount = pytest.importorskip("rasterhw.golden_model.opcount")
-    counts = opcount.ops_per_triangle()
-    rows = b.table1_rows(counts)
-    meas = {r["quantity"]: r["measured"] for r in rows}
-    clk = b.clocks_from_ops(counts)
-    assert meas["total i860 clocks per triangle"] == pytest.approx(clk["total"])
-    assert all(v is not None for q, v in meas.items() if "operations" in q or "clocks" in q)
+    assert by_q["total operations per triangle, paper's recipe"]["measured"] == 270
+    assert by_q["light: operations per triangle, paper's recipe (formula = the text)"]["measured"] == 78
+    assert by_q["light: operations per triangle, paper's recipe (formula = the text)"]["paper"] == 72
+    assert by_q["backface_cull: operations per triangle, our full pipeline (not in the paper)"]["measured"] == 15
+    clocks = [r for r in rows if "i860 clocks" in r["quantity"]]
+    assert clocks and all(r["source"] == "model" for r in clocks)
+    ops = [r for r in rows if r["unit"] == "ops"]
+    assert all(r["source"] == "golden" for r in ops)
+    # the model's shares add up to 100 %
+    share = [r["measured"] for r in rows if "share of clocks" in r["quantity"]]
+    assert sum(share) == pytest.approx(100.0)
 
 
 @pytest.mark.parametrize("bad,match", [
@@ -118,7 +80,7 @@ def test_table1_rows_from_opcount_when_available():
 ])
 def test_bad_counts(bad, match):
     with pytest.raises(RasterhwError, match=match):
-        b.clocks_from_ops(bad)
+        b.table1_rows(bad)
 
 
 def test_bad_balance_parameters():

@@ -167,8 +167,9 @@ def test_deterministic():
         assert getattr(a, f).tobytes() == getattr(b, f).tobytes()
 
 
-def test_closed_form_equals_literal_inner_loop():
-    # Run INNER_LOOP literally, one add at a time, from the set-up's span accumulators.
+def test_inner_loop_equals_literal_loop_and_closed_form():
+    # One pixel at a time in plain Python from the set-up's span accumulators, and the closed
+    # form start + k * increment: both must give the converter's stream bit for bit.
     t = random_scene(13, 25, 48, 40, 9)
     f = 16
     spans = g.setup_spans(t, frac_bits=f)
@@ -181,21 +182,34 @@ def test_closed_form_equals_literal_inner_loop():
         while regs["count"] != 0:
             out.append((regs["addr"], ((regs["r"] >> f) << 16) | ((regs["g"] >> f) << 8) | (regs["b"] >> f),
                         regs["z"] >> f))
-            for kind, name in g.INNER_LOOP:
-                if kind == "add":
-                    regs[name] += inc[name]
+            for name in ("addr", "r", "g", "b", "z", "count"):
+                regs[name] += inc[name]
     s = g.scan_convert(t, frac_bits=f)
     assert len(out) == len(s) > 500
     assert [o[0] for o in out] == s.addr.tolist()
     assert [o[1] for o in out] == s.rgb.tolist()
     assert [o[2] for o in out] == s.z.tolist()
+    span, k = g._expand(spans)
+    zc = (spans["acc"][span, 3] + k * spans["inc"][span, 3]) >> f
+    assert np.array_equal(zc, s.z)
 
 
-def test_inner_loop_ops():
-    ops = g.inner_loop_ops()
+def test_inner_loop_is_counted_as_it_runs():
+    t = random_scene(13, 25, 48, 40, 9)
+    counts: dict = {}
+    s = g.scan_convert(t, counts=counts)
+    spans = g.setup_spans(t)
+    assert counts["pixels"] == len(s) == int(spans["n"].sum())
+    assert counts["spans"] == int(np.count_nonzero(spans["n"] > 0))
+    for k in g.EXECUTED:  # every executed operation runs once per pixel written
+        assert counts[k] == len(s), k
+    ops = g.inner_loop_ops(counts)
     assert (ops["add"], ops["mem"], ops["branch"], ops["total"]) == (6, 1, 1, 8)
-    assert ops["clocks_dual_issue"] == 4 == ops["paper_clocks"]
-    assert ops["mops_for_10_mpixel"] == 80
+    empty: dict = {}
+    g.scan_convert(random_scene(1, 0, 16, 16, 4), counts=empty)
+    assert empty["pixels"] == 0 and empty["store"] == 0
+    with pytest.raises(RasterhwError, match="at least one pixel"):
+        g.inner_loop_ops(empty)
 
 
 # ------------------------------------------------------------------ tolerance vs float
