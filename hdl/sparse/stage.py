@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from amaranth.hdl import Module, Signal, signed
+from amaranth.hdl import Module, Mux, Signal, signed
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import EDGE_BITS, MATRIX_LOG2_MAX, SUBPIXEL_BITS
@@ -68,13 +68,14 @@ class LevelStage(wiring.Component):
         du, dv = child[0], child[1]
         out = Signal(WINDOW)
         ok = Signal()
-        sub, half = 1 << SUBPIXEL_BITS, 1 << (SUBPIXEL_BITS - 1)
+        half = 1 << (SUBPIXEL_BITS - 1)
 
         # the sub-window: corner values by increments, no multiplier (N is a power of two)
         m.d.comb += out.new.eq(fresh)
+        # (a child bit selects the increment: a multiplexer, not a multiplier)
         for k in range(3):
-            m.d.comb += out.E[k].eq(win.E[k] + (du * hdr.Ap[k] << sh) + (dv * hdr.Bp[k] << sh))
-        m.d.comb += [out.z.eq(win.z + (du * hdr.zu << sh) + (dv * hdr.zv << sh)),
+            m.d.comb += out.E[k].eq(win.E[k] + Mux(du, hdr.Ap[k] << sh, 0) + Mux(dv, hdr.Bp[k] << sh, 0))
+        m.d.comb += [out.z.eq(win.z + Mux(du, hdr.zu << sh, 0) + Mux(dv, hdr.zv << sh, 0)),
                      out.u.eq(win.u + (du << sh)), out.v.eq(win.v + (dv << sh))]
         conds = []
         for k in range(3):
@@ -83,8 +84,7 @@ class LevelStage(wiring.Component):
             else:
                 mx = Signal(signed(EDGE_BITS + 2), name=f"mx{k}")
                 pos = Signal(signed(EDGE_BITS), name=f"pos{k}")
-                m.d.comb += pos.eq((hdr.Ap[k] > 0).as_unsigned() * hdr.Ap[k]
-                                   + (hdr.Bp[k] > 0).as_unsigned() * hdr.Bp[k])
+                m.d.comb += pos.eq(Mux(hdr.Ap[k] > 0, hdr.Ap[k], 0) + Mux(hdr.Bp[k] > 0, hdr.Bp[k], 0))
                 m.d.comb += mx.eq(out.E[k] + (pos << sh) - pos + hdr.ext[k])
                 val = mx
             conds.append(val >= hdr.thr[k])
@@ -93,10 +93,11 @@ class LevelStage(wiring.Component):
             vs = Signal(signed(24))
             m.d.comb += [us.eq(out.u), vs.eq(out.v)]
             a, b, al, be = self.a, self.b, self._alpha, self._beta
-            x0 = (us * p + a) * sub + half - al * half
-            x1 = ((us + (N - 1)) * p + a) * sub + half + al * half
-            y0 = (vs * q + b) * sub + half - be * half
-            y1 = ((vs + (N - 1)) * q + b) * sub + half + be * half
+            lp, lq, ls = p.bit_length() - 1, q.bit_length() - 1, SUBPIXEL_BITS   # p, q, sub: powers of two
+            x0 = (((us << lp) + a) << ls) + half - al * half
+            x1 = ((((us + (N - 1)) << lp) + a) << ls) + half + al * half
+            y0 = (((vs << lq) + b) << ls) + half - be * half
+            y1 = ((((vs + (N - 1)) << lq) + b) << ls) + half + be * half
             conds += [x1 >= hdr.bbox[0], x0 <= hdr.bbox[1], y1 >= hdr.bbox[2], y0 <= hdr.bbox[3]]
         acc = conds[0]
         for c in conds[1:]:
