@@ -60,11 +60,14 @@ FPGA_BLOCKS = ("pixelbus-bank", "zbm-merger", "zbm-pixel", "zbm-loop", "zbm-chip
 #: the clock each paper names for a block: block prefix -> (domain, what, Hz)
 PAPER_CLOCKS: dict[str, list[tuple[str, str, float]]] = {
     "pixelbus": [("sync", "SNU pixel-bus slot 80 ns (bank memory cycle 400 ns = 5 slots)", 12.5e6)],
-    "zbm-merger": [("merge", "ZB/M merge clock (paper: independent of the segment clock; "
-                    "taken as 25 MHz)", 25e6)],
-    "zbm": [("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6),
-            ("merge", "ZB/M merge clock (independent; taken as 25 MHz)", 25e6)],
-    "experts": [("sync", "EXPERTS PXP clock: none given (30 frames/s from the cycle model)", None)],
+    "zbm-merger": [("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6),
+                   ("merge", "ZB/M merge clock (independent of the segment clock; taken as 25 MHz)", 25e6)],
+    "zbm": [("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6)],
+    "zbm-chip": [("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6),
+                 ("merge", "ZB/M merge clock (independent; taken as 25 MHz)", 25e6)],
+    "zbm-unit": [("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6),
+                 ("merge", "ZB/M merge clock (independent; taken as 25 MHz)", 25e6)],
+    "experts": [("sync", "EXPERTS: no clock given", None)],
     "sparse": [("sync", "sparse video processor clock: none given", None)],
 }
 
@@ -189,3 +192,44 @@ def fpga_summary(r: dict) -> str:
         beside = "" if c is None or c["mhz"] is None else f"  (paper: {c['mhz']:g} MHz, {c['what']})"
         lines.append(f"  Fmax {dom:<6} {f:7.1f} MHz{beside}")
     return "\n".join(lines)
+
+
+def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool = False):
+    """Report rows: per block of :data:`FPGA_BLOCKS`, ECP5 LUTs, flip-flops, block RAMs and
+    Fmax per clock beside the paper's clock (``source`` ``hdl:nextpnr``). ``fast``: the rows
+    stay, unmeasured (place and route takes minutes)."""
+    import sys
+
+    from rasterhw.sim.report import FAST_SKIP, make_row
+
+    out = []
+    for block in FPGA_BLOCKS:
+        params = {**FPGA_PARAMS.get(block, {})}
+        cfg = ", ".join(f"{k} {v}" for k, v in params.items()) or "defaults"
+        r = None
+        if not fast:
+            if progress:
+                print(f"fpga: placing {block} ({cfg}) on ECP5 ...", file=sys.stderr, flush=True)
+            r = place_and_route(block, family="ecp5")
+        why = FAST_SKIP if r is None else None
+        system = block.split("-")[0].replace("pixelbus", "snu")
+        fig = f"{block} on ECP5-85F ({cfg})"
+
+        def row(q, measured, unit, paper=None, fig=fig, system=system, why=why):
+            return make_row(system, fig, q, paper=paper, formula=None, measured=measured, unit=unit,
+                            source="hdl:nextpnr", reason=why)
+
+        out += [row("LUT4s", None if r is None else r["luts"], "LUT4"),
+                row("flip-flops", None if r is None else r["ffs"], "flip-flops"),
+                row("block RAMs (DP16KD, 18 Kbit)", None if r is None else r["brams"], "DP16KD")]
+        for dom, what, hz in paper_clock(block):
+            f = None if r is None else r["fmax_mhz"].get(dom)
+            if r is not None and f is None:
+                continue  # the block has no such clock (e.g. the loop has no merge clock)
+            out.append(row(f"Fmax, {dom} clock (paper: {what})", f, "MHz",
+                           paper=None if hz is None else hz / 1e6))
+    sections = ["", "Place and route: `rasterhw fpga BLOCK` (Yosys `synth_ecp5` + nextpnr-ecp5 from PyPI, "
+                "out of context: no I/O buffers, no global clock network, so Fmax is a lower bound). "
+                "`paper` is the clock the paper names for the block; `ratio` = Fmax / paper clock "
+                "(above 1: the block meets the paper's clock on a 2016 FPGA). See `sim/fpga.py`."]
+    return out, sections

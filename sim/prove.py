@@ -198,10 +198,10 @@ class Proof:
 PROOFS: dict[str, Proof] = {
     "zbm-merger": Proof(
         "zbm-merger", MergerHarness, {"fifo_depth": 4, "z_bits": 3, "colour_bits": 1},
-        mode="bmc", depth=40, multiclock=True,
+        mode="bmc", depth=24, multiclock=True,
         what="stream rules on o_merge; output k = merge(own k, merge-input k) for every k < 32, "
-             "no output without both inputs; two unrelated clocks, 40 steps of the global clock "
-             "(16-20 transfers through a 4-word clock-crossing FIFO)"),
+             "no output without both inputs; two unrelated clocks, 24 steps of the global clock "
+             "(each a clock edge of either domain or none)"),
     "pixelbus-bank": Proof(
         "pixelbus-bank", BankHarness, {"depth": 4, "z_bits": 3, "mem_cycle": 5, "ram": "memory"},
         mode="prove", depth=12,
