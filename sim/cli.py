@@ -361,16 +361,22 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
 @click.option("--engine", type=click.Choice(ENGINES), default="verilator", show_default=True)
 @_click_options(_SIM_OPTIONS)
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="PNG of the HDL frame.")
+@click.option("--waves", type=click.Path(dir_okay=False), default=None,
+              help="Write a trace of the run (pysim: .vcd; cocotb on Verilator: .fst). Off by default.")
 @click.option("--json", "as_json", is_flag=True)
-def sim_cmd(block, scene, size, engine, output, as_json, **block_options) -> None:
+def sim_cmd(block, scene, size, engine, output, waves, as_json, **block_options) -> None:
     """Run a scene through a block's HDL, compare with the golden model, write the frame."""
     from PIL import Image
+    from rasterhw.sim.waves import recording
 
     _machine, b = registry.sim_blocks()[block]
     opts = _take_options(block_options, b.options, f"sim {block}")
     scene = scene or b.default_scene
     sc, (w, h) = load_scene_and_size(scene, size)
-    res = registry.load(b.simulate)(sc, w, h, engine=engine, progress=not as_json, **opts)
+    with recording(waves, engine) as traces:
+        res = registry.load(b.simulate)(sc, w, h, engine=engine, progress=not as_json, **opts)
+    if traces:
+        res["waves"] = [str(t) for t in traces]
     frame = res.pop("frame_rgb", None)
     out = Path(output) if output else Path("out") / f"{Path(scene).stem}-{block}-{engine}.png"
     if frame is not None:

@@ -52,10 +52,9 @@ FPGA_PARAMS: dict[str, dict] = {
     "zbm-merger": {"fifo_depth": 16},
 }
 
-#: what ``rasterhw report fpga`` places, in order (small and medium blocks; the ZB/M unit
-#: and the sparse matrix take long: ``rasterhw fpga zbm-unit`` runs them on request)
-FPGA_BLOCKS = ("pixelbus-bank", "zbm-merger", "zbm-pixel", "zbm-loop", "zbm-chip", "zbm-seggen",
-               "experts-dmm", "experts-pxp")
+#: what ``rasterhw report fpga`` places, in order; the other blocks (the ZB/M unit, loop and
+#: segment generator, the sparse matrix, the EXPERTS PXP) take long: ``rasterhw fpga BLOCK``
+FPGA_BLOCKS = ("pixelbus-bank", "zbm-merger", "zbm-pixel", "zbm-chip", "experts-dmm")
 
 #: the clock each paper names for a block: block prefix -> (domain, what, Hz)
 PAPER_CLOCKS: dict[str, list[tuple[str, str, float]]] = {
