@@ -15,6 +15,7 @@ from pathlib import Path
 import click
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
+from rasterhw.sim.report import systems as _report_systems
 
 #: the float reference rasteriser is shared by every machine; the rest come from the registry
 REFERENCE = "reference"
@@ -328,21 +329,22 @@ def compare(a: str, b: str, output: str | None, tolerance: int, as_json: bool) -
 
 
 @cli.command()
-@click.argument("system", type=click.Choice([*(m.name for m in registry.machines().values() if m.report), "all"]))
+@click.argument("system", type=click.Choice([*_report_systems(), "all"]))
 @click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON on stdout.")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), default="docs/reproduction", show_default=True,
               help="Where SYSTEM.md and its plots are written.")
 @click.option("--engine", type=click.Choice(ENGINES), default="verilator",
               show_default=True, help="HDL simulator for rows measured from HDL cycles (full frames always "
               "run on a compiled simulator).")
-def report(system: str, as_json: bool, out_dir: str, engine: str) -> None:
+@click.option("--fast", is_flag=True, help="Keep slow rows (synthesis, place and route) unmeasured.")
+def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool) -> None:
     """Reproduce a paper's figures: paper value, formula value, measured value, ratio."""
     from rasterhw.sim.report import run_report, systems
 
     names = systems() if system == "all" else [system]
     rows = []
     for name in names:
-        rows += run_report(name, out_dir=Path(out_dir), engine=engine, progress=not as_json)
+        rows += run_report(name, out_dir=Path(out_dir), engine=engine, progress=not as_json, fast=fast)
     if as_json:
         emit_json(rows)
     else:
@@ -396,17 +398,23 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
 @click.option("--engine", type=click.Choice(ENGINES), default="verilator", show_default=True)
 @_click_options(_SIM_OPTIONS)
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="PNG of the HDL frame.")
+@click.option("--waves", type=click.Path(dir_okay=False), default=None,
+              help="Write a trace of the run (pysim: .vcd; cocotb on Verilator: .fst). Off by default.")
 @click.option("--json", "as_json", is_flag=True)
-def sim_cmd(block, scene, size, engine, output, as_json, **block_options) -> None:
+def sim_cmd(block, scene, size, engine, output, waves, as_json, **block_options) -> None:
     """Run a scene through a block's HDL, compare with the golden model, write the frame."""
     from rasterhw.sim.outfile import check_image_output, write_image
+    from rasterhw.sim.waves import recording
 
     _machine, b = registry.sim_blocks()[block]
     opts = _take_options(block_options, b.options, f"sim {block}")
     scene = scene or b.default_scene
     out = check_image_output(output) or Path("out") / f"{Path(scene).stem}-{block}-{engine}.png"
     sc, (w, h) = load_scene_and_size(scene, size, bytes_per_pixel=b.bytes_per_pixel, what=f"sim {block}")
-    res = registry.load(b.simulate)(sc, w, h, engine=engine, progress=not as_json, **opts)
+    with recording(waves, engine) as traces:
+        res = registry.load(b.simulate)(sc, w, h, engine=engine, progress=not as_json, **opts)
+    if traces:
+        res["waves"] = [str(t) for t in traces]
     frame = res.pop("frame_rgb", None)
     if frame is not None:
         write_image(out, frame)
@@ -418,23 +426,6 @@ def sim_cmd(block, scene, size, engine, output, as_json, **block_options) -> Non
         info(" ".join(f"{k}={v}" for k, v in res.items()))
     if res.get("mismatches", 0):
         sys.exit(1)
-
-
-@cli.command()
-@click.argument("block")
-@click.option("-p", "--param", "params", multiple=True, metavar="NAME=VALUE",
-              help="Block parameter, e.g. -p interleave=8 (repeatable).")
-@click.option("--memory", type=click.Choice(["keep", "map"]), default="keep", show_default=True,
-              help="keep: memories as RAM blocks (counted as RAM bits); map: memories to flip-flops.")
-def synth(block: str, params: tuple[str, ...], memory: str) -> None:
-    """Synthesise BLOCK with Yosys and print gate equivalents, flip-flops and RAM bits."""
-    from rasterhw.sim.synth import synth_report
-    from rasterhw.sim.verilog import block_names
-
-    if block not in block_names():
-        raise RasterhwError(f"unknown block {block!r}; blocks: {', '.join(block_names())}")
-    kw = parse_params(params, registry.load(registry.blocks()[block]))
-    click.echo(synth_report(block, memory=memory, **kw))
 
 
 @cli.command()
@@ -492,6 +483,12 @@ def demo(out_dir: str, scene: str, engine: str) -> None:
     from rasterhw.sim.demo import run_demo
 
     run_demo(Path(out_dir), scene=scene, engine=engine)
+
+
+# synth, fpga, prove: the hardware flow (sim/flow_cli.py)
+from rasterhw.sim.flow_cli import add_commands  # noqa: E402
+
+add_commands(cli)
 
 
 def _terminate(signum, _frame):

@@ -15,27 +15,98 @@ A row is a dict with the keys of :data:`ROW_KEYS`:
               ``hdl:yosys`` / ``hdl:nextpnr`` (the generated Verilog was synthesised / placed)
 
 Each machine names a function ``rows(engine, progress, out_dir, **known) -> (rows, sections)``
-in its registry entry (``Machine.report``); :func:`run_report` runs it, writes ``docs/reproduction/SYSTEM.md`` with the
-table (plus a ratio column) and whatever plots the system drew.
+in its registry entry (``Machine.report``); reports not tied to one machine are named in
+:data:`EXTRA_REPORTS` (``fpga``: place and route of every machine's blocks). :func:`run_report`
+runs it, writes ``docs/reproduction/SYSTEM.md`` with the table (plus a ratio column) and
+whatever plots the system drew.
+
+Reports never shrink silently. A row that cannot be measured in this run stays, with
+``measured`` ``None`` and a ``reason`` (listed under the table); a tool that is missing fails
+the report with one line naming it (:class:`~rasterhw.sim.tools.ToolUnavailable`). And
+:func:`run_report` refuses to overwrite a committed table with one that lacks any of its rows
+(:func:`row_key`: figure and quantity, numbers in the label ignored). A rows function that
+takes ``fast`` returns its slow rows (synthesis, place and route) unmeasured when
+``fast=True``: ``tests/test_reports_committed.py`` regenerates every report that way and
+compares it with the committed tables.
 """
 
 from __future__ import annotations
 
+import inspect
 import math
+import re
+from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
+
+from rasterhw.golden_model.errors import RasterhwError
 
 ROW_KEYS = ("system", "figure", "quantity", "paper", "formula", "measured", "unit", "source")
 SOURCES = ("golden", "model", "formula", "hdl:pysim", "hdl:verilator", "hdl:icarus", "hdl:yosys",
            "hdl:nextpnr")
 
+#: reports not tied to one machine: name -> "module:rows"
+EXTRA_REPORTS: dict[str, str] = {"fpga": "rasterhw.sim.fpga:rows"}
+
+#: ``reason`` of a row a fast run leaves unmeasured
+FAST_SKIP = "slow row: not measured in a fast run (rasterhw report without --fast measures it)"
+
+
 def make_row(system: str, figure: str, quantity: str, *, paper, formula, measured, unit: str,
-             source: str) -> dict:
-    """Build one row, checking the source label."""
+             source: str, reason: str | None = None) -> dict:
+    """Build one row, checking the source label.
+
+    ``measured=None`` needs a ``reason`` (why this run could not measure it): a row is never
+    dropped for lack of a tool or of time, it is kept unmeasured.
+    """
     if source not in SOURCES:
         raise ValueError(f"source must be one of {SOURCES}, not {source!r}")
-    return {"system": system, "figure": figure, "quantity": quantity, "paper": paper,
-            "formula": formula, "measured": measured, "unit": unit, "source": source}
+    if measured is None and not reason:
+        raise ValueError(f"row {quantity!r}: measured is None, so say why (reason=...)")
+    row = {"system": system, "figure": figure, "quantity": quantity, "paper": paper,
+           "formula": formula, "measured": measured, "unit": unit, "source": source}
+    if reason:
+        row["reason"] = reason
+    return row
+
+
+def row_key(row: dict) -> tuple[str, str, str]:
+    """What identifies a row across runs: system, figure and quantity with its numbers masked
+    (labels such as "mean segment 12.5 px" carry measured values; whole numbers such as
+    "interleave 8" are kept)."""
+    q = re.sub(r"\d+(?:[.,]\d+)+", "#", row["quantity"])
+    return row["system"], row["figure"], q
+
+
+def parse_table(text: str) -> list[dict]:
+    """The first report table of a ``docs/reproduction/SYSTEM.md``, as rows of strings."""
+    lines = text.splitlines()
+    head = ["system", "figure", "quantity", "paper", "formula", "measured", "ratio", "unit", "source"]
+    try:
+        start = next(i for i, ln in enumerate(lines)
+                     if [c.strip() for c in ln.strip().strip("|").split("|")] == head)
+    except StopIteration:
+        return []
+    out = []
+    for ln in lines[start + 2:]:
+        if not ln.startswith("|"):
+            break
+        cells = [c.strip().replace("\\|", "|") for c in re.split(r"(?<!\\)\|", ln.strip())[1:-1]]
+        out.append(dict(zip(head, cells, strict=True)))
+    return out
+
+
+def missing_rows(old: list[dict], new: list[dict]) -> list[dict]:
+    """Rows of ``old`` (e.g. the committed table) that ``new`` lacks, by :func:`row_key`."""
+    have = Counter(row_key(r) for r in new)
+    out = []
+    for r in old:
+        k = row_key(r)
+        if have[k]:
+            have[k] -= 1
+        else:
+            out.append(r)
+    return out
 
 
 def ratio(row: dict) -> float | None:
@@ -79,38 +150,55 @@ def format_table(rows: list[dict], *, markdown: bool = False) -> str:
 
 
 def systems() -> list[str]:
-    """Every machine with a report (the registry's order)."""
+    """Every report: each machine with one (the registry's order), then :data:`EXTRA_REPORTS`."""
     from rasterhw.sim.registry import machines
 
-    return [m.name for m in machines().values() if m.report]
+    return [m.name for m in machines().values() if m.report] + list(EXTRA_REPORTS)
 
 
 def _load(system: str) -> Callable:
     from rasterhw.sim.registry import load, machine
 
+    if system in EXTRA_REPORTS:
+        return load(EXTRA_REPORTS[system])
     m = machine(system)
     if not m.report:
-        from rasterhw.golden_model.errors import RasterhwError
-
         raise RasterhwError(f"machine {system!r} has no report; reports: {', '.join(systems())}")
     return load(m.report)
 
 
 def run_report(system: str, *, out_dir: Path = Path("docs/reproduction"), engine: str = "pysim",
-               progress: bool = False, **known) -> list[dict]:
+               progress: bool = False, fast: bool = False, **known) -> list[dict]:
     """Measure every row of SYSTEM, write ``out_dir/SYSTEM.md`` and its plots, return the rows.
 
-    Keyword arguments beyond these are passed to the system's rows function (see its docstring).
+    ``fast``: slow rows are kept unmeasured (for systems whose rows function takes ``fast``).
+    Raises ``RasterhwError`` (and writes nothing) if ``out_dir/SYSTEM.md`` exists and has a
+    row this run did not produce. Keyword arguments beyond these are passed to the system's
+    rows function (see its docstring).
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
+    fn = _load(system)
+    if fast and "fast" in inspect.signature(fn).parameters:
+        known["fast"] = True
     # ``known``: results the caller already measured in this run (e.g. the demo's snu-100px
     # simulation), handed to the system's rows function so the work is not done twice
-    rows, sections = _load(system)(engine=engine, progress=progress, out_dir=out_dir, **known)
+    rows, sections = fn(engine=engine, progress=progress, out_dir=out_dir, **known)
     for r in rows:
         missing = [k for k in ROW_KEYS if k not in r]
         if missing:
             raise ValueError(f"report row lacks {missing}: {r}")
+        if r["measured"] is None and not r.get("reason"):
+            raise ValueError(f"report row {r['quantity']!r} is unmeasured and says not why")
+    path = out_dir / f"{system}.md"
+    if path.exists():
+        lost = missing_rows(parse_table(path.read_text()), rows)
+        if lost:
+            raise RasterhwError(
+                f"report {system} would drop {len(lost)} row(s) of {path}, first: "
+                f"{lost[0]['figure']} / {lost[0]['quantity']}; a row that cannot be measured stays "
+                "(measured None, with the reason); delete the file to accept a smaller table")
+    unmeasured = [r for r in rows if r["measured"] is None]
     md = [f"# Reproduction: {system}", "",
           f"Generated by `rasterhw report {system}` (simulator requested for HDL rows: `{engine}`; "
           "each row's `source` names the model that measured it). "
@@ -118,6 +206,10 @@ def run_report(system: str, *, out_dir: Path = Path("docs/reproduction"), engine
           "`measured` what our model produced in this run (`source` says which model). "
           "Do not edit by hand: run the command again.", "",
           format_table(rows, markdown=True), ""]
+    if unmeasured:
+        md += ["Not measured in this run (the rows stay, `measured` is empty):", ""]
+        md += [f"- {r['figure']} / {r['quantity']}: {r['reason']}" for r in unmeasured]
+        md += [""]
     md += sections
-    (out_dir / f"{system}.md").write_text("\n".join(md) + "\n")
+    path.write_text("\n".join(md) + "\n")
     return rows

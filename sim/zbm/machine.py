@@ -13,7 +13,11 @@ MACHINE = Machine(
                 "rasterhw.golden_model.zbm.render:render_scene", options=(_INTERLEAVE, _UNITS)),),
     blocks={"zbm-chip": "rasterhw.hdl.zbm.chip:ZbmChip",
             "zbm-seggen": "rasterhw.hdl.zbm.seggen:ZbmSegmentGenerator",
-            "zbm-unit": "rasterhw.hdl.zbm.unit:ZbmUnit"},
+            "zbm-unit": "rasterhw.hdl.zbm.unit:ZbmUnit",
+            # parts of the chip, for synth / fpga / prove (sim/zbm/blocks.py)
+            "zbm-loop": "rasterhw.sim.zbm.blocks:loop",
+            "zbm-merger": "rasterhw.sim.zbm.blocks:merger",
+            "zbm-pixel": "rasterhw.sim.zbm.blocks:pixel"},
     sims=(SimBlock("zbm", "the scene's edge pairs through a ZB/M unit (segment generator + chips) in HDL",
                    "rasterhw.sim.zbm.driver:simulate_zbm", default_scene="c300", options=(_INTERLEAVE, _UNITS)),),
     report="rasterhw.sim.zbm.report:rows",

