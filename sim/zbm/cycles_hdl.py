@@ -26,7 +26,8 @@ def table1_width(interleave: int) -> int:
 
 
 def run_unit_cycles(eps: EdgePairs, height: int, *, width: int, interleave: int,
-                    capacity: int = AEP_CAPACITY, max_cycles: int = 200_000) -> dict:
+                    capacity: int = AEP_CAPACITY, schedule: str = "overlap",
+                    max_cycles: int = 200_000) -> dict:
     """Run one head ``ZbmUnit`` in pysim: edge-pair words offered one per cycle from cycle 0,
     merge outputs always ready, merge clock = segment clock (the assumptions of
     ``zbm.cycles.hdl_cycles``). Returns ``cycles`` = value of ``ZbmUnit.cycles`` in the first
@@ -36,7 +37,8 @@ def run_unit_cycles(eps: EdgePairs, height: int, *, width: int, interleave: int,
     from rasterhw.hdl.zbm.unit import ZbmUnit
 
     words = [w for i in range(len(eps)) for w in eps.words(i)] + [0]   # h == 0: end of frame
-    unit = ZbmUnit(interleave=interleave, width=width, height=height, capacity=capacity, head=True)
+    unit = ZbmUnit(interleave=interleave, width=width, height=height, capacity=capacity, head=True,
+                   schedule=schedule)
     sim = Simulator(unit)
     sim.add_clock(1e-8, domain="sync")
     sim.add_clock(1e-8, domain="merge")
@@ -62,7 +64,7 @@ def run_unit_cycles(eps: EdgePairs, height: int, *, width: int, interleave: int,
 
 
 def measure_cycles_per_edge_pair(interleave: int, *, n_edge_pairs: int = 8,
-                                 engine: str = "pysim") -> dict:
+                                 engine: str = "pysim", schedule: str = "overlap") -> dict:
     """Cycles per edge pair of one unit on the paper's workload, from HDL simulation.
 
     Returns ``cycles`` (HDL, whole frame: first word offered .. every chip done), ``edge_pairs``,
@@ -79,17 +81,17 @@ def measure_cycles_per_edge_pair(interleave: int, *, n_edge_pairs: int = 8,
     width = table1_width(interleave)
     eps = C.paper_workload(n_edge_pairs, width=width)
     height = 5 * n_edge_pairs
-    model = C.hdl_cycles(eps, height, width=width, interleave=interleave)
+    model = C.hdl_cycles(eps, height, width=width, interleave=interleave, schedule=schedule)
     more = C.hdl_cycles(C.paper_workload(n_edge_pairs + 1, width=width), height + 5, width=width,
-                        interleave=interleave)
-    hdl = run_unit_cycles(eps, height, width=width, interleave=interleave)
+                        interleave=interleave, schedule=schedule)
+    hdl = run_unit_cycles(eps, height, width=width, interleave=interleave, schedule=schedule)
     if hdl["overflow"] or hdl["lines"] != height:
         raise RasterhwError(f"ZB/M unit did not finish the frame: {hdl}")
     return {"interleave": interleave, "cycles": int(hdl["cycles"]), "edge_pairs": n_edge_pairs,
             "cycles_per_edge_pair": hdl["cycles"] / n_edge_pairs, "model_cycles": model["cycles"],
             "marginal_cycles_per_edge_pair": more["cycles"] - model["cycles"],
             "paper_formula": C.formula_cycles_per_edge_pair(interleave), "width": width,
-            "height": height}
+            "height": height, "schedule": schedule}
 
 
 if __name__ == "__main__":
