@@ -24,7 +24,15 @@ from amaranth.lib import data, enum, fifo, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.hdl.zbm.layouts import EP_CHANNEL, EP_HEADER, FLIT, GAP, SEG_HEADER, check_schedule, paper_lead
+from rasterhw.hdl.zbm.layouts import (
+    EP_CHANNEL,
+    EP_HEADER,
+    FLIT,
+    GAP,
+    SEG_HEADER,
+    check_schedule,
+    paper_lead,
+)
 
 __all__ = ["ZbmSegmentGenerator", "EP_WORD_BITS"]
 
