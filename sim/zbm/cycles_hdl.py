@@ -156,7 +156,7 @@ def measure_table1(interleave: int, *, schedule: str = "overlap", engine: str = 
 
         g0, g1 = unit_golden_words(eps, height, width=width, interleave=interleave)
         r = run_unit_bench([eps], width=width, height=height, interleave=interleave, sim=engine,
-                           phase=0, speed_run=True, schedule=schedule, line_log=True)
+                           phase=0, speed_run=True, schedule=schedule, line_log=True, opt="-O0")
         if r.get("timeout"):
             raise RasterhwError(f"ZB/M {engine}: the bench's watchdog fired")
         marks = r["line_cycles"]

@@ -248,7 +248,8 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
                    stall: int = 0, seed: int = 1, gap_seed: int | None = None,
                    expect: tuple[np.ndarray, np.ndarray] | None = None, speed_run: bool = False,
                    check_protocol: bool = False,
-                   keep: bool = False, phase: int = 1, schedule: str = "overlap", line_log: bool = False) -> dict:
+                   keep: bool = False, phase: int = 1, schedule: str = "overlap", line_log: bool = False,
+                   opt: str = "-O1") -> dict:
     """Run a chain of units (unit k gets ``eps_per_unit[k]``) on the generated Verilog.
 
     ``ratio`` = (segment, merge) clock half periods in ns; ``stall`` = back-pressure level
@@ -258,7 +259,8 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
     golden words the cocotb test itself compares every scan line and (``check_protocol``)
     runs the Python stream checkers and in-order scoreboards. Without ``expect`` the caller must say
     ``speed_run=True`` (it compares the returned dump itself); else RasterhwError.
-    ``line_log``: also return ``line_cycles`` (H,): unit 0's segment-clock count in the merge
+    ``opt``: C++ optimisation of the per-cycle code (``-O0`` for the small timing benches, whose
+    build dominates). ``line_log``: also return ``line_cycles`` (H,): unit 0's segment-clock count in the merge
     cycle in which the last chip slot finished each merge output line.
     Returns ``{"s0", "s1": (H, W) uint64, "cycles", "proto_errors", "build_s", "run_s", ...}``.
     """
@@ -295,7 +297,7 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
     maxcyc = 200 * (total + 64) + 40 * height * (width + 64)
     t1 = time.perf_counter()
     timings: dict = {}
-    with verilator_make_flags("-O1", coroutines=True):
+    with verilator_make_flags(opt, coroutines=True):
         run_cocotb(sources=[*srcs, HARNESS_V, BENCH_DIR / "tb_zbm_unit.v"], toplevel="tb_zbm_unit",
                    test_module=TEST_MODULE, testcase="zbm_unit_frame", build_dir=bdir, test_dir=run_dir, sim=sim,
                    parameters=params,

@@ -84,7 +84,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path) -> tup
                         f"{UNITS_SECOND_LEVEL} x the paper's per-unit arithmetic)",
                         paper=PAPER_64_UNITS, formula=UNITS_SECOND_LEVEL * polygons_per_s(min(PAPER_CYCLES.values())),
                         measured=None, unit="polygons/s", source="formula"))
-    out += extra_rows(progress)
+    out += extra_rows(progress, "verilator" if hdl_engine == "pysim" else hdl_engine)
     out += scene_rows(progress)
     area, area_note = area_rows()
     out += area
@@ -94,11 +94,12 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path) -> tup
     return out, sections
 
 
-def extra_rows(progress: bool) -> list[dict]:
-    """Pixel rate against interleave, condition 7's skew and chained units (sim/zbm/scaling.py)."""
+def extra_rows(progress: bool, engine: str) -> list[dict]:
+    """Pixel rate against interleave (pysim), condition 7's skew and chained units (``engine``:
+    the unit bench needs Verilator or Icarus), from ``sim/zbm/scaling.py``."""
     from rasterhw.sim.zbm import scaling
 
-    return scaling.report_rows(progress=progress)
+    return scaling.report_rows(progress=progress, engine=engine)
 
 
 def scene_rows(progress: bool) -> list[dict]:

@@ -80,7 +80,7 @@ def skew(*, interleave: int = 8, offset: int = 2, n_edge_pairs: int = 4, schedul
     res = {}
     for name, per_unit in (("alone", [a]), ("pair", [a, b])):
         r = run_unit_bench(per_unit, width=width, height=height, interleave=interleave, sim=engine, phase=0,
-                           speed_run=True, schedule=schedule, line_log=True)
+                           speed_run=True, schedule=schedule, line_log=True, opt="-O0")
         gold = _chain_golden(per_unit, height, width, interleave)
         bad = int(((r["s0"] != gold[0]) | (r["s1"] != gold[1])).sum())
         if bad or r.get("timeout"):
@@ -124,7 +124,7 @@ def chain(units: int, *, interleave: int = 2, width: int = 64, height: int = 48,
     g0, g1 = doublez_words(gold.pixels)
     per_unit = [eps.take(np.flatnonzero(eps.tag % units == k)) for k in range(units)]
     r = run_unit_bench(per_unit, width=width, height=height, interleave=interleave, sim=engine, phase=0,
-                       speed_run=True, schedule=schedule)
+                       speed_run=True, schedule=schedule, opt="-O0")
     if r.get("timeout"):
         raise RasterhwError("ZB/M chain: the bench's watchdog fired")
     bad = int(((r["s0"] != np.asarray(g0).reshape(height, width)) |

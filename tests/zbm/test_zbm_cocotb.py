@@ -97,3 +97,27 @@ def test_bench_rejects_bad_settings():
         Z._plusargs((0, 5), 0, 1, 10)
     with pytest.raises(RasterhwError, match="phase"):
         Z._plusargs((5, 5), 0, 1, 10, phase=2)
+
+
+def test_unit_paper_schedule_verilator_protocol():
+    """The paper-schedule unit under random gaps, back-pressure and a 3:2 clock ratio: same words."""
+    tris = _scene(5)
+    gold = G.render_zbm(tris, interleave=2)
+    exp = doublez_words(gold.pixels)
+    r = Z.run_unit_bench([G.edge_pairs(tris)], width=W, height=H, interleave=2, sim="verilator", ratio=(3, 2),
+                         stall=60, seed=5, gap_seed=5, expect=exp, check_protocol=True, schedule="paper")
+    assert np.array_equal(r["s0"], exp[0]) and np.array_equal(r["s1"], exp[1]) and r["proto_errors"] == 0
+
+
+@pytest.mark.parametrize("interleave", [1, 8])
+def test_table1_paper_schedule_verilator(interleave):
+    """Table 1 from Verilator, paper schedule: 74 / 54 cycles per edge pair (= the paper's formula
+    and the exact model), every merge word equal to the golden model's."""
+    from rasterhw.golden_model.zbm.cycles import formula_cycles_per_edge_pair
+    from rasterhw.sim.zbm.cycles_hdl import measure_table1
+
+    r = measure_table1(interleave, schedule="paper", engine="verilator", n_edge_pairs=2)
+    assert r["mismatches"] == 0
+    assert r["per_edge_pair"] == r["model_marginal"] == formula_cycles_per_edge_pair(interleave)
+    ours = measure_table1(interleave, schedule="overlap", engine="verilator", n_edge_pairs=2)
+    assert ours["per_edge_pair"] == {1: 70, 8: 54}[interleave] and ours["mismatches"] == 0

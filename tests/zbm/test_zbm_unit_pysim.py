@@ -151,3 +151,23 @@ def test_cycles_per_edge_pair_sweep(interleave):
 if __name__ == "__main__":    # python tests/zbm/test_zbm_unit_pysim.py -> the Table 1 measurement
     for i in F.INTERLEAVES:
         print(measure_cycles_per_edge_pair(i))
+
+
+def test_line_log_steady_state_equals_model():
+    """measure_table1's one-run steady state (pysim) == the model's marginal, both schedules, I = 2."""
+    from rasterhw.sim.zbm.cycles_hdl import measure_table1
+
+    for sched, want in (("paper", 64), ("overlap", 62)):
+        r = measure_table1(2, schedule=sched, n_edge_pairs=2)
+        assert r["per_edge_pair"] == r["model_marginal"] == want
+
+
+@pytest.mark.parametrize("interleave", [1, 4])
+def test_pixel_rate_scales_with_interleave(interleave):
+    """Merge-bound lines: a chip sends its ceil(W / I) pixels per line plus 2 cycles of swap and
+    reader start, so the unit's output rate is W / (W / I + 2) pixels per clock."""
+    from rasterhw.sim.zbm.scaling import pixel_rate
+
+    r = pixel_rate(interleave, width=32, height=10)
+    assert r["cycles_per_line"] == 32 // interleave + 2
+    assert r["pixels_per_cycle"] == pytest.approx(32 / (32 // interleave + 2))
