@@ -129,3 +129,24 @@ def test_table1_overlap_verilator(interleave):
 
     r = measure_table1(interleave, schedule="overlap", engine="verilator", n_edge_pairs=4)
     assert r["per_edge_pair"] == r["model_marginal"] == {1: 70, 8: 54}[interleave] and r["mismatches"] == 0
+
+
+@pytest.mark.slow
+def test_chain_scaling_verilator():
+    """Chained units on Verilator (the report's runs): golden words, more units -> fewer cycles,
+    never below the merge bus's own bound."""
+    from rasterhw.sim.zbm.scaling import chain
+
+    a, b = chain(1), chain(2)
+    assert a["mismatches"] == b["mismatches"] == 0
+    assert b["cycles"] < a["cycles"] and b["cycles"] >= b["merge_bound_cycles"]
+    assert 0 < a["merge_occupancy"] < b["merge_occupancy"] <= 1
+
+
+@pytest.mark.slow
+def test_skew_two_neighbours_verilator():
+    """Condition 7 simulated: two neighbouring units with offset loads lose less than the paper's half."""
+    from rasterhw.sim.zbm.scaling import skew
+
+    s = skew()
+    assert s["pair"] >= s["alone"] == 74 and 0 <= s["loss"] < 0.5
