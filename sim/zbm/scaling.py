@@ -66,8 +66,9 @@ def skew(*, interleave: int = 1, offset: int = 2, n_edge_pairs: int = 4, schedul
     """Two neighbouring units (chained), the paper's workload in each, the second offset by
     ``offset`` lines; steady cycles per edge pair of each unit, beside one unit alone.
 
-    Both runs use the same frame (``10 n + offset`` lines) and the bench's per-line log of the
-    last unit's merge output: (t(line 5n + offset + 5n - 1) - t(line 5n + offset - 1)) / n.
+    Both runs use the same frame (``2 n`` pairs per unit, ``10 n + offset`` lines) and the bench's
+    per-line log of the last unit's merge output over a window of ``5 n`` lines in the middle,
+    where both units are busy: (t(line w0 + 5n - 1) - t(line w0 - 1)) / n, w0 = 5 (n // 2).
     """
     from rasterhw.sim.zbm.cycles_hdl import table1_width
     from rasterhw.sim.zbm.driver import run_unit_bench
@@ -77,7 +78,8 @@ def skew(*, interleave: int = 1, offset: int = 2, n_edge_pairs: int = 4, schedul
     height = 10 * n + offset
     a = _offset_workload(2 * n, width, 0)
     b = _offset_workload(2 * n, width, offset)
-    lo, hi = 5 * n + offset - 1, 10 * n + offset - 1
+    lo = 5 * (n // 2) - 1
+    hi = lo + 5 * n
     res = {}
     for name, per_unit in (("alone", [a]), ("pair", [a, b])):
         r = run_unit_bench(per_unit, width=width, height=height, interleave=interleave, sim=engine, phase=0,
