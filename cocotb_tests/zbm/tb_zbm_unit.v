@@ -116,6 +116,7 @@ module tb_zbm_unit #(
   endfunction
 
   wire [I-1:0] slot_done;
+  wire [32*I-1:0] slot_y;
   wire [32*I-1:0] faddr;
   wire [32*I-1:0] out_err;
   genvar c;
@@ -129,6 +130,7 @@ module tb_zbm_unit #(
       wire [MW-1:0] p = o_payload[c*MW +: MW];
       assign o_ready[c] = r;
       assign slot_done[c] = (y == H);
+      assign slot_y[32*c +: 32] = y;
       assign faddr[32*c +: 32] = y * W + q * I + c;
       always @(posedge mclk) begin
         if (mrst) begin
@@ -172,12 +174,34 @@ module tb_zbm_unit #(
     for (e = 0; e < U; e = e + 1) all_frames = all_frames && (dut_frames[16*e +: 16] == 16'd1);
   end
 
+  // --- per-line log (optional, +lines=FILE): line_t[y] = unit 0's segment-clock count in the
+  // merge cycle in which the last chip slot finished merge output line y (steady-state timing).
+  reg [31:0] line_t [0:H-1];
+  reg [8*512-1:0] flines;
+  reg log_lines;
+  reg [31:0] ymin, ylog;
+  integer e2;
+  initial begin
+    log_lines = $value$plusargs("lines=%s", flines);
+    ylog = 32'd0;
+  end
+  always @(*) begin
+    ymin = H;
+    for (e2 = 0; e2 < I; e2 = e2 + 1) if (slot_y[32*e2 +: 32] < ymin) ymin = slot_y[32*e2 +: 32];
+  end
+
   always @(posedge mclk) begin
+    // blocking: the dump below, in the same clock edge, must see the last line's entry
+    if (!mrst && ylog < ymin) begin
+      line_t[ylog] = dut_cycles[31:0];
+      ylog = ylog + 32'd1;
+    end
     if (!mrst && !finished && ((&slot_done) || timeout || (|dut_overflow))) begin
       cycles <= dut_cycles[31:0];
       overflow <= |dut_overflow;
       frames_ok <= all_frames;
       $writememh(fout, frame);
+      if (log_lines) $writememh(flines, line_t);
       finished <= 1'b1;
     end
   end

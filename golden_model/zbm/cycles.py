@@ -49,7 +49,7 @@ from rasterhw.golden_model.zbm.formats import (
 
 __all__ = ["PAPER_TABLE1_KPOLYS", "PAPER_LEN_CHIP", "len_chip", "formula_cycles_per_edge_pair",
            "formula_polygons_per_s", "paper_table1", "event_cycles", "paper_workload", "hdl_cycles",
-           "FIFO_LATENCY"]
+           "FIFO_LATENCY", "SCHEDULES", "paper_lead", "check_schedule"]
 
 #: Table 1 of the paper, K polygons/s per unit, by interleave.
 PAPER_TABLE1_KPOLYS = {1: 84.5, 2: 97.7, 4: 105.9, 8: 115.8, 16: 115.8}
@@ -150,6 +150,26 @@ def paper_workload(n_pairs: int, *, interleave_phase: int = 0, lines_apart: int 
 #: cycles from a word's write into the segment generator's input FIFO (``SyncFIFOBuffered``)
 #: until the generator can read it
 FIFO_LATENCY = 2
+#: ``"overlap"``: our design (the chip buffers a packet, loads overlap the loop's work);
+#: ``"paper"``: the paper's sec. 6.1 schedule (a load leaves the loop idle 9 cycles, nothing
+#: runs ahead of the loop), see ``docs/zbm.md#paper-schedule``.
+SCHEDULES = ("overlap", "paper")
+#: ring gap value meaning "a packet is pending in the chip" (larger than any real gap)
+GAP_PENDING = 1023
+
+
+def check_schedule(schedule: str) -> str:
+    if schedule not in SCHEDULES:
+        raise RasterhwError(f"schedule must be 'overlap' or 'paper', not {schedule!r}")
+    return schedule
+
+
+def paper_lead(mode: int) -> int:
+    """Cycles from a chip accepting a segment header to that packet's header entering the
+    ring (``1 + channels`` words into the initial processor, one cycle into the segment
+    processor): 7 (colour), 8 (mapping). In the paper schedule a chip accepts a header only
+    when its ring gap is at most this, so the packet starts exactly when the ring frees."""
+    return len(CHANNELS[mode]) + 2
 
 
 def _line_entries(eps: EdgePairs, segs, height: int) -> list[list[tuple[int, int, int]]]:
@@ -165,7 +185,8 @@ def _line_entries(eps: EdgePairs, segs, height: int) -> list[list[tuple[int, int
 
 
 def hdl_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: int = 8,
-               capacity: int = AEP_CAPACITY, max_cycles: int = 10_000_000) -> dict:
+               capacity: int = AEP_CAPACITY, schedule: str = "overlap",
+               max_cycles: int = 10_000_000) -> dict:
     """Cycle-exact count of one ``hdl/zbm/unit.py`` unit on ``eps`` (one frame).
 
     A cycle-stepped model of the control of ``ZbmSegmentGenerator``, the unit's broadcast
@@ -177,9 +198,18 @@ def hdl_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: int
     waits). Returns ``cycles`` = the first cycle in which every chip has swapped the last
     line (``ZbmUnit.lines == height``), ``seggen_done`` = cycle of the last end-of-line word,
     and per-cause counts of the generator's cycles.
+
+    ``schedule="paper"`` models the paper-schedule configuration (``schedule="paper"`` of the
+    HDL blocks): a chip takes a segment header only when its ring gap (cycles until the ring
+    could start a packet; ``GAP_PENDING`` while a packet waits in the chip) is at most
+    ``paper_lead(mode)``, and the generator starts a load only when every chip's gap is at
+    most ``paper_lead(mode) + 1`` -- the 9 load cycles then leave the ring idle for exactly 9
+    cycles (``count["wait_zbm"]`` counts the generator's cycles waiting for that).
     """
     if interleave not in INTERLEAVES:
         raise RasterhwError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+    paper = check_schedule(schedule) == "paper"
+    lead = paper_lead(int(eps.mode))
     segs = segment_generator(eps, height, width=width, capacity=capacity)   # raises if over capacity
     lines = _line_entries(eps, segs, height)
     n_words = 9 * len(eps) + 1
@@ -204,7 +234,7 @@ def hdl_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: int
     q = list(npx)
     dv = [0] * ni
     nlines = [0] * ni
-    count = {"check": 0, "load": 0, "seg_words": 0, "empty": 0, "eol": 0, "wait_chips": 0}
+    count = {"check": 0, "load": 0, "seg_words": 0, "empty": 0, "eol": 0, "wait_chips": 0, "wait_zbm": 0}
     t = 0
     while min(nlines) < height:
         if t >= max_cycles:
@@ -214,7 +244,10 @@ def hdl_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: int
         ent = lines[y][r - 1] if st in ("SEG", "FLIT") else None
         o_valid = (st == "SEG" and ent[1] > 0) or st in ("FLIT", "EOL")
         # ---------------- chips: comb
-        i_ready = [not pkt_valid[ch] and eol[ch] != 2 for ch in range(ni)]
+        gap = [GAP_PENDING if pkt_valid[ch] or (full[ch] and inj[ch] == 0) else wait[ch] for ch in range(ni)]
+        hdr_word = st == "SEG"          # a segment header is offered (o_valid checked below)
+        i_ready = [not pkt_valid[ch] and eol[ch] != 2 and not (paper and hdr_word and gap[ch] > lead)
+                   for ch in range(ni)]
         all_ready = all(i_ready)
         xfer = o_valid and all_ready
         swap = [eol[ch] != 0 and not full[ch] and wait[ch] <= 1 and q[ch] == npx[ch] and not dv[ch]
@@ -278,9 +311,12 @@ def hdl_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: int
                 i = k // 9
                 if not marker and eps.y[i] <= y:
                     assert n_mem < capacity
-                    k += 1
-                    word = 1
-                    st = "LOAD"
+                    if paper and max(gap) > lead + 1:
+                        count["wait_zbm"] += 1      # cond. 5: load only when the ZB/M runs dry
+                    else:
+                        k += 1
+                        word = 1
+                        st = "LOAD"
                 elif n_mem == 0:
                     st = "EOL"
                 else:

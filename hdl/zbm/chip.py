@@ -11,12 +11,12 @@ finished line, ``ceil((width - chip) / interleave)`` double-Z words, down the me
 
 from __future__ import annotations
 
-from amaranth import Module, Signal, unsigned
+from amaranth import Module, Mux, Signal, unsigned
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.hdl.zbm.initial import ZbmInitialProcessor
-from rasterhw.hdl.zbm.layouts import PIXEL2, check_interleave
+from rasterhw.hdl.zbm.layouts import GAP, GAP_PENDING, PIXEL2, check_interleave, check_schedule
 from rasterhw.hdl.zbm.loop import ZbmLoop
 from rasterhw.hdl.zbm.merger import ZbmMerger
 
@@ -36,6 +36,9 @@ class ZbmChip(wiring.Component):
         Screen width, 1..512.
     fifo_depth : int
         Depth of the merge-bus clock-crossing FIFO.
+    schedule : str
+        ``"overlap"`` (ours) or ``"paper"`` (sec. 6.1: see ``ZbmInitialProcessor`` and
+        ``docs/zbm.md#paper-schedule``).
 
     Members
     -------
@@ -51,6 +54,10 @@ class ZbmChip(wiring.Component):
         Segment-clock cycles in which the chip held or processed a segment (input not idle).
     lines : Out(16)
         End-of-line records handled (pixel-memory swaps).
+    gap : Out(GAP)
+        (Added.) Cycles until the ring could start a new packet (``ZbmLoop.gap``),
+        ``GAP_PENDING`` while a packet waits in the chip; the paper-schedule generator loads
+        only when every chip's gap is small enough.
 
     Timing: a segment is received in ``1 + channels`` cycles, overlapping the loop; packets
     enter the loop ``len_chip + 8`` cycles apart (``ZbmLoop``); a segment with no pixel on this
@@ -63,8 +70,10 @@ class ZbmChip(wiring.Component):
     """
 
     def __init__(self, *, interleave: int = 1, chip: int = 0, width: int = F.MAX_WIDTH,
-                 fifo_depth: int = 16):
+                 fifo_depth: int = 16, schedule: str = "overlap"):
         check_interleave(interleave, chip)
+        check_schedule(schedule)
+        self._schedule = schedule
         if not (isinstance(width, int) and chip < width <= F.MAX_WIDTH):
             raise ValueError(f"width must be in {chip + 1}..{F.MAX_WIDTH}, not {width!r}")
         self._interleave = interleave
@@ -79,7 +88,12 @@ class ZbmChip(wiring.Component):
             "cycles": Out(32),
             "busy_cycles": Out(32),
             "lines": Out(16),
+            "gap": Out(GAP),
         })
+
+    @property
+    def schedule(self) -> str:
+        return self._schedule
 
     @property
     def interleave(self) -> int:
@@ -109,7 +123,11 @@ class ZbmChip(wiring.Component):
         m.d.sync += self.cycles.eq(self.cycles + 1)
 
         # ---- initial processor: segment words -> one packet for this chip's interleave slot
-        m.submodules.initial = ip = ZbmInitialProcessor(interleave=n_int, chip=self._chip)
+        m.submodules.initial = ip = ZbmInitialProcessor(interleave=n_int, chip=self._chip,
+                                                        schedule=self._schedule)
+        if self._schedule == "paper":
+            m.d.comb += ip.gap.eq(loop.gap)
+        m.d.comb += self.gap.eq(Mux(ip.o.valid, GAP_PENDING, loop.gap))
         wiring.connect(m, wiring.flipped(self.i_seg), ip.i)
         eol = Signal(2)          # end-of-line records seen whose swap is pending (0..2)
         # The next line's segment may be received while a swap is pending: a held packet

@@ -11,7 +11,16 @@ from amaranth import Module, Mux, Signal, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.hdl.zbm.layouts import FLIT, PACKET, PKT_HEADER, SEG_HEADER, check_interleave
+from rasterhw.hdl.zbm.layouts import (
+    FLIT,
+    GAP,
+    PACKET,
+    PKT_HEADER,
+    SEG_HEADER,
+    check_interleave,
+    check_schedule,
+    paper_lead,
+)
 
 __all__ = ["ZbmInitialProcessor"]
 
@@ -31,6 +40,10 @@ class ZbmInitialProcessor(wiring.Component):
         Chips per unit: 1, 2, 4, 8 or 16.
     chip : int
         This chip's slot, ``0 <= chip < interleave``.
+    schedule : str
+        ``"overlap"`` (ours: a segment is taken whenever no packet waits here) or ``"paper"``
+        (a segment header is taken only when ``gap <= paper_lead(mode)``, so its packet
+        reaches the ring exactly when the ring frees and nothing is buffered ahead of it).
 
     Members
     -------
@@ -45,22 +58,33 @@ class ZbmInitialProcessor(wiring.Component):
         While high, no input is accepted (the chip has two ends of line pending).
     busy : Out(1)
         A segment is being received or a packet waits on ``o``.
+    gap : In(GAP) (``schedule="paper"`` only)
+        The loop's ring gap (``ZbmLoop.gap``).
 
     Timing: a segment is received in ``1 + channels`` cycles; the packet is offered the cycle
     after its last channel word; no input is taken while a packet waits.
     """
 
-    def __init__(self, *, interleave: int = 1, chip: int = 0):
+    def __init__(self, *, interleave: int = 1, chip: int = 0, schedule: str = "overlap"):
         check_interleave(interleave, chip)
+        check_schedule(schedule)
         self._interleave = interleave
         self._chip = chip
-        super().__init__({
+        self._schedule = schedule
+        members = {
             "i": In(stream.Signature(unsigned(F.LOOP_BITS))),
             "o": Out(stream.Signature(PACKET)),
             "eol": Out(1),
             "hold": In(1),
             "busy": Out(1),
-        })
+        }
+        if schedule == "paper":
+            members["gap"] = In(GAP)
+        super().__init__(members)
+
+    @property
+    def schedule(self) -> str:
+        return self._schedule
 
     @property
     def interleave(self) -> int:
@@ -81,8 +105,13 @@ class ZbmInitialProcessor(wiring.Component):
         keep = Signal()
         seg_hdr = data.View(SEG_HEADER, self.i.payload)
         seg_flit = data.View(FLIT, self.i.payload)
+        if self._schedule == "paper":
+            lead = Mux(seg_hdr.mode == F.MODE_MAPPING, paper_lead(F.MODE_MAPPING), paper_lead(F.MODE_COLOUR))
+            early = (recv == 0) & (seg_hdr.len != 0) & (self.gap > lead)   # ring not free in time
+        else:
+            early = 0
         m.d.comb += [
-            self.i.ready.eq(~pkt_valid & ~self.hold),
+            self.i.ready.eq(~pkt_valid & ~self.hold & ~early),
             self.o.valid.eq(pkt_valid),
             self.o.payload.eq(pkt),
             self.busy.eq((recv != 0) | pkt_valid),

@@ -11,10 +11,11 @@ from __future__ import annotations
 from amaranth import signed, unsigned
 from amaranth.lib import data
 from rasterhw.golden_model.zbm import formats as F
+from rasterhw.golden_model.zbm.cycles import GAP_PENDING, SCHEDULES, paper_lead
 
 __all__ = [
     "check_interleave", "struct_of", "EP_HEADER", "EP_CHANNEL", "SEG_HEADER", "FLIT", "PKT_HEADER",
-    "SAMPLE", "PIXEL2", "PACKET",
+    "SAMPLE", "PIXEL2", "PACKET", "check_schedule", "GAP", "GAP_PENDING", "paper_lead",
 ]
 
 
@@ -41,6 +42,17 @@ PIXEL2 = struct_of(F.PIXEL2, sub={"s0": SAMPLE, "s1": SAMPLE})   # s0 nearer or 
 #: one segment packet as the initial processor hands it over: 8 flits of the 112-bit loop,
 #: flit 0 = PKT_HEADER
 PACKET = data.ArrayLayout(unsigned(F.LOOP_BITS), F.PACKET_FLITS)
+
+
+#: a chip's ring gap: cycles until its segment processor could start a new packet,
+#: ``GAP_PENDING`` while a packet waits in the chip (``ZbmLoop.gap``, ``ZbmChip.gap``)
+GAP = unsigned(GAP_PENDING.bit_length())
+
+
+def check_schedule(schedule) -> None:
+    """``schedule`` is ``"overlap"`` (ours) or ``"paper"`` (sec. 6.1's schedule); else ``ValueError``."""
+    if schedule not in SCHEDULES:
+        raise ValueError(f"schedule must be 'overlap' or 'paper', not {schedule!r}")
 
 
 def check_interleave(interleave, chip=None) -> None:

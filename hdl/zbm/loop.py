@@ -13,7 +13,7 @@ from amaranth import Module, Mux, Signal, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.hdl.zbm.layouts import PACKET, PIXEL2, PKT_HEADER, check_interleave
+from rasterhw.hdl.zbm.layouts import GAP, GAP_PENDING, PACKET, PIXEL2, PKT_HEADER, check_interleave
 from rasterhw.hdl.zbm.pixel import ZbmPixelProcessor
 
 __all__ = ["ZbmLoop", "PACKET", "LOOP_GAP"]
@@ -46,6 +46,9 @@ class ZbmLoop(wiring.Component):
         at the end of this cycle: a ``swap`` now is safe. High one cycle before ``idle``, so
         the first packet of the next line can enter ``len + LOOP_GAP`` cycles after the last
         one of this line, as within a line.
+    gap : Out(GAP)
+        (Added, for the paper schedule.) Cycles until a new packet could start on the ring: the
+        spacing counter, or ``GAP_PENDING`` while a held packet has not started.
     mb_addr : In(range(chip pixels)), mb_rd : In(1), mb_data : Out(PIXEL2)
         The merge bus: chip pixel ``q`` (processor ``q % 8``, address ``q // 8``) appears on
         ``mb_data`` one cycle after ``mb_rd`` and is cleared for the next line.
@@ -69,6 +72,7 @@ class ZbmLoop(wiring.Component):
             "swap": In(1),
             "idle": Out(1),
             "swap_ok": Out(1),
+            "gap": Out(GAP),
             "mb_addr": In(range(self._npx)),
             "mb_rd": In(1),
             "mb_data": Out(PIXEL2),
@@ -131,6 +135,7 @@ class ZbmLoop(wiring.Component):
                 pp.mb_rd.eq(self.mb_rd & (self.mb_addr[:3] == k)),
             ]
         m.d.comb += self.idle.eq(~full & (wait == 0))
+        m.d.comb += self.gap.eq(Mux(full & (inj == 0), GAP_PENDING, wait))
         # The last flit (7) of a packet started in cycle t0 writes its last pixel (hop len - 1)
         # in cycle t0 + len + 6; wait == 1 in cycle t0 + len + 7.
         m.d.comb += self.swap_ok.eq(~full & (wait <= 1))

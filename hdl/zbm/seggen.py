@@ -24,7 +24,15 @@ from amaranth.lib import data, enum, fifo, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.hdl.zbm.layouts import EP_CHANNEL, EP_HEADER, FLIT, SEG_HEADER
+from rasterhw.hdl.zbm.layouts import (
+    EP_CHANNEL,
+    EP_HEADER,
+    FLIT,
+    GAP,
+    SEG_HEADER,
+    check_schedule,
+    paper_lead,
+)
 
 __all__ = ["ZbmSegmentGenerator", "EP_WORD_BITS"]
 
@@ -61,6 +69,11 @@ class ZbmSegmentGenerator(wiring.Component):
         Active-edge-pair memory depth (golden ``AEP_CAPACITY`` = 256; paper silent).
     fifo_depth : int
         Input FIFO depth in 168-bit words.
+    schedule : str
+        ``"overlap"`` (ours: a due edge pair is loaded at once, while the chips still work) or
+        ``"paper"`` (sec. 6.1 cond. 4-5: a due pair is loaded only when every chip's ring gap
+        ``zbm_gap`` is at most ``paper_lead(mode) + 1``, so the 9 load cycles leave the ring
+        idle for exactly 9 cycles).
 
     Members
     -------
@@ -76,6 +89,8 @@ class ZbmSegmentGenerator(wiring.Component):
         Sticky: a line needs more active edge pairs than ``capacity``. The generator then
         stops (no word of that line is emitted; the input FIFO fills and ``i.ready`` falls)
         until reset. Nothing is ever dropped.
+    zbm_gap : In(GAP) (``schedule="paper"`` only)
+        The largest ring gap of the unit's chips (``ZbmChip.gap``).
 
     Timing (segment clock, every word held until the chips accept it): per line, 1 cycle
     (CHECK: the FIFO head is examined and, if no pair is due, the first active pair is read in
@@ -87,7 +102,9 @@ class ZbmSegmentGenerator(wiring.Component):
     """
 
     def __init__(self, *, width: int = F.MAX_WIDTH, height: int = F.MAX_HEIGHT,
-                 capacity: int = F.AEP_CAPACITY, fifo_depth: int = 32):
+                 capacity: int = F.AEP_CAPACITY, fifo_depth: int = 32, schedule: str = "overlap"):
+        check_schedule(schedule)
+        self._schedule = schedule
         if not (isinstance(width, int) and 1 <= width <= F.MAX_WIDTH):
             raise ValueError(f"width must be 1..{F.MAX_WIDTH}, not {width!r}")
         if not (isinstance(height, int) and 1 <= height <= F.MAX_HEIGHT):
@@ -96,13 +113,20 @@ class ZbmSegmentGenerator(wiring.Component):
             raise ValueError(f"capacity must be 1..1024, not {capacity!r}")
         self._width, self._height, self._capacity = width, height, capacity
         self._fifo_depth = fifo_depth
-        super().__init__({
+        members = {
             "i": In(stream.Signature(unsigned(EP_WORD_BITS))),
             "o": Out(stream.Signature(unsigned(F.LOOP_BITS))),
             "line": Out(9),
             "frames": Out(16),
             "overflow": Out(1),
-        })
+        }
+        if schedule == "paper":
+            members["zbm_gap"] = In(GAP)
+        super().__init__(members)
+
+    @property
+    def schedule(self) -> str:
+        return self._schedule
 
     @property
     def width(self) -> int:
@@ -178,8 +202,16 @@ class ZbmSegmentGenerator(wiring.Component):
             with m.Case(_State.CHECK):
                 with m.If(fq.r_rdy):
                     with m.If((head.h != 0) & (head.y <= y)):
+                        if self._schedule == "paper":   # cond. 5: load only as the ZB/M runs dry
+                            lead = Mux(head.mode == F.MODE_MAPPING, paper_lead(F.MODE_MAPPING),
+                                       paper_lead(F.MODE_COLOUR))
+                            zbm_busy = self.zbm_gap > lead + 1
+                        else:
+                            zbm_busy = 0
                         with m.If(n_mem == cap):             # due but no room: cannot make line y
                             m.d.sync += [state.eq(_State.OVERFLOW), self.overflow.eq(1)]
+                        with m.Elif(zbm_busy):
+                            pass
                         with m.Else():
                             m.d.comb += fq.r_en.eq(1)
                             m.d.sync += [rec.eq(0), rec.y.eq(head.y), rec.left.eq(head.h),

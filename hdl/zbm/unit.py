@@ -14,7 +14,7 @@ from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.hdl.broadcast import StreamBroadcast
 from rasterhw.hdl.zbm.chip import ZbmChip
-from rasterhw.hdl.zbm.layouts import PIXEL2, check_interleave
+from rasterhw.hdl.zbm.layouts import PIXEL2, check_interleave, check_schedule
 from rasterhw.hdl.zbm.pixel import EMPTY_PIXEL2
 from rasterhw.hdl.zbm.seggen import EP_WORD_BITS, ZbmSegmentGenerator
 
@@ -34,6 +34,10 @@ class ZbmUnit(wiring.Component):
         Active-edge-pair memory depth.
     head : bool
         First unit of a chain: no merge input ports, chips merge against empty pixels.
+    schedule : str
+        ``"overlap"`` (ours) or ``"paper"`` (the paper's sec. 6.1 schedule: the generator
+        loads only as the chips run dry, the chips take a segment only when their ring frees;
+        ``docs/zbm.md#paper-schedule``).
 
     Members
     -------
@@ -58,8 +62,10 @@ class ZbmUnit(wiring.Component):
     """
 
     def __init__(self, *, interleave: int = 8, width: int = F.MAX_WIDTH, height: int = F.MAX_HEIGHT,
-                 capacity: int = F.AEP_CAPACITY, head: bool = True):
+                 capacity: int = F.AEP_CAPACITY, head: bool = True, schedule: str = "overlap"):
         check_interleave(interleave)
+        check_schedule(schedule)
+        self._schedule = schedule
         if not (isinstance(width, int) and interleave <= width <= F.MAX_WIDTH):
             raise ValueError(f"width must be {interleave}..{F.MAX_WIDTH}, not {width!r}")
         self._interleave, self._width, self._height = interleave, width, height
@@ -84,6 +90,10 @@ class ZbmUnit(wiring.Component):
     def head(self) -> bool:
         return self._head
 
+    @property
+    def schedule(self) -> str:
+        return self._schedule
+
     def chip_pixels(self, chip: int) -> int:
         return -(-(self._width - chip) // self._interleave)
 
@@ -91,9 +101,9 @@ class ZbmUnit(wiring.Component):
         m = Module()
         n = self._interleave
         m.submodules.seggen = sg = ZbmSegmentGenerator(width=self._width, height=self._height,
-                                                       capacity=self._capacity)
+                                                       capacity=self._capacity, schedule=self._schedule)
         wiring.connect(m, wiring.flipped(self.i), sg.i)
-        chips = [ZbmChip(interleave=n, chip=c, width=self._width) for c in range(n)]
+        chips = [ZbmChip(interleave=n, chip=c, width=self._width, schedule=self._schedule) for c in range(n)]
         m.submodules.broadcast = bc = StreamBroadcast(sg.o.payload.shape(), n=n)
         wiring.connect(m, sg.o, bc.i)
         for c, chip in enumerate(chips):
@@ -111,4 +121,9 @@ class ZbmUnit(wiring.Component):
         for chip in chips[1:]:
             low = Mux(chip.lines < low, chip.lines, low)
         m.d.comb += self.lines.eq(low)
+        if self._schedule == "paper":
+            gap = chips[0].gap
+            for chip in chips[1:]:
+                gap = Mux(chip.gap > gap, chip.gap, gap)
+            m.d.comb += sg.zbm_gap.eq(gap)
         return m

@@ -30,6 +30,7 @@ import numpy as np
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
+from rasterhw.golden_model.zbm.cycles import check_schedule
 from rasterhw.golden_model.zbm.seggen import check_edge_pair_stream
 from rasterhw.golden_model.zbm.words import (
     doublez_words,
@@ -191,7 +192,7 @@ def _adapter(interleave: int, units: int, has_overflow: bool) -> str:
 
 
 def chain_verilog(*, interleave: int, width: int, height: int, units: int = 1,
-                  capacity: int = F.AEP_CAPACITY) -> list[Path]:
+                  capacity: int = F.AEP_CAPACITY, schedule: str = "overlap") -> list[Path]:
     """Verilog sources of ``units`` chained ``zbm-unit``\\s (``generate_verilog``), cached.
 
     The head unit is the generated ``zbm_unit``; the others (``head=False``, with merge
@@ -199,7 +200,7 @@ def chain_verilog(*, interleave: int, width: int, height: int, units: int = 1,
     """
     from rasterhw.sim.verilog import generate_verilog
 
-    p = {"interleave": interleave, "width": width, "height": height, "capacity": capacity}
+    p = {"interleave": interleave, "width": width, "height": height, "capacity": capacity, "schedule": schedule}
     head, _ = _cached("zbm-unit", lambda: generate_verilog("zbm-unit", head=True, **p), head=True, **p)
     srcs = [head]
     if units > 1:
@@ -248,7 +249,8 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
                    stall: int = 0, seed: int = 1, gap_seed: int | None = None,
                    expect: tuple[np.ndarray, np.ndarray] | None = None, speed_run: bool = False,
                    check_protocol: bool = False,
-                   keep: bool = False, phase: int = 1) -> dict:
+                   keep: bool = False, phase: int = 1, schedule: str = "overlap", line_log: bool = False,
+                   opt: str = "-O1") -> dict:
     """Run a chain of units (unit k gets ``eps_per_unit[k]``) on the generated Verilog.
 
     ``ratio`` = (segment, merge) clock half periods in ns; ``stall`` = back-pressure level
@@ -258,13 +260,17 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
     golden words the cocotb test itself compares every scan line and (``check_protocol``)
     runs the Python stream checkers and in-order scoreboards. Without ``expect`` the caller must say
     ``speed_run=True`` (it compares the returned dump itself); else RasterhwError.
+    ``opt``: C++ optimisation of the per-cycle code (``-O0`` for the small timing benches, whose
+    build dominates). ``line_log``: also return ``line_cycles`` (H,): unit 0's segment-clock count in the merge
+    cycle in which the last chip slot finished each merge output line.
     Returns ``{"s0", "s1": (H, W) uint64, "cycles", "proto_errors", "build_s", "run_s", ...}``.
     """
     exp_env = _expect_env(expect, speed_run)   # before any work
     sim = get_sim(sim)
     units = len(eps_per_unit)
     t0 = time.perf_counter()
-    srcs = chain_verilog(interleave=interleave, width=width, height=height, units=units, capacity=capacity)
+    srcs = chain_verilog(interleave=interleave, width=width, height=height, units=units, capacity=capacity,
+                         schedule=schedule)
     words = [edge_pair_words(e) for e in eps_per_unit]
     total = sum(len(w) for w in words)
     sdepth = _depth(total)
@@ -292,12 +298,13 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
     maxcyc = 200 * (total + 64) + 40 * height * (width + 64)
     t1 = time.perf_counter()
     timings: dict = {}
-    with verilator_make_flags("-O1", coroutines=True):
+    with verilator_make_flags(opt, coroutines=True):
         run_cocotb(sources=[*srcs, HARNESS_V, BENCH_DIR / "tb_zbm_unit.v"], toplevel="tb_zbm_unit",
                    test_module=TEST_MODULE, testcase="zbm_unit_frame", build_dir=bdir, test_dir=run_dir, sim=sim,
                    parameters=params,
                    plusargs=[f"+stim={run_dir / 'stim.hex'}", f"+index={run_dir / 'index.hex'}", f"+out={out_path}",
-                             *_plusargs(ratio, stall, seed, maxcyc, phase)],
+                             *_plusargs(ratio, stall, seed, maxcyc, phase),
+                             *([f"+lines={run_dir / 'lines.hex'}"] if line_log else [])],
                    extra_env=env, timings=timings, verilator_args=VERILATOR_ARGS)
     t2 = time.perf_counter()
     meta = json.loads((run_dir / "result.json").read_text())
@@ -307,6 +314,9 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
     res = {"s0": s0.reshape(height, width), "s1": s1.reshape(height, width), **meta,
            "prepare_s": t1 - t0, "build_s": timings["build_s"], "run_s": timings["test_s"],
            "total_s": t2 - t0, "run_dir": run_dir if keep else None}
+    if line_log:
+        res["line_cycles"] = [int(v, 16) for v in (run_dir / "lines.hex").read_text().split()
+                              if not v.startswith("//")]
     if keep or os.environ.get("ZBM_KEEP") == "1":
         keep_run_folder(run_dir)
     else:
@@ -407,15 +417,16 @@ def chip_speed(*, interleave: int = 8, width: int = 512, height: int = 512, scen
 
 # ====================================================================== pysim
 def run_units_pysim(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, interleave: int,
-                    capacity: int = F.AEP_CAPACITY, max_cycles: int = 2_000_000) -> dict:
+                    capacity: int = F.AEP_CAPACITY, max_cycles: int = 2_000_000,
+                    schedule: str = "overlap") -> dict:
     """The same chain in the Amaranth simulator (small frames): returns ``{"s0", "s1", "cycles",
     "proto_errors"}`` (stream-rule violations counted by checkers on every input and output)."""
     from amaranth.sim import Simulator
     from rasterhw.hdl.zbm.chain import ZbmChain
     from rasterhw.hdl.zbm.unit import ZbmUnit
 
-    units = [ZbmUnit(interleave=interleave, width=width, height=height, capacity=capacity, head=(k == 0))
-             for k in range(len(eps_per_unit))]
+    units = [ZbmUnit(interleave=interleave, width=width, height=height, capacity=capacity, head=(k == 0),
+                     schedule=schedule) for k in range(len(eps_per_unit))]
     sim = Simulator(ZbmChain(units))
     sim.add_clock(1e-8, domain="sync")
     sim.add_clock(1e-8, domain="merge")
@@ -503,7 +514,7 @@ def float_tolerance(tris, px: G.DoubleZ, rgb8: np.ndarray, eps: G.EdgePairs, tag
 
 # ====================================================================== the driver
 def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: int = 1,
-                 engine: str = "verilator", progress: bool = False) -> dict:
+                 engine: str = "verilator", schedule: str = "overlap", progress: bool = False) -> dict:
     """Run ``scene`` through ``units`` ZB/M units (``interleave`` chips each) in HDL and check it.
 
     Pipeline: ``run_geometry`` -> ``edge_pairs`` -> checks (:func:`check_edge_pairs`: bad or
@@ -511,7 +522,10 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
     units round-robin (triangle i -> unit i % units, as ``render_zbm``) -> HDL -> every line's
     double-Z pixels compared with ``render_zbm(...).pixels`` bit for bit -> composite.
 
-    Returns ``{"block": "zbm", "engine", "interleave", "units", "cycles" (segment clocks until
+    ``schedule``: ``"overlap"`` (ours) or ``"paper"`` (the paper's sec. 6.1 schedule; the image is
+    the same, only the timing differs).
+
+    Returns ``{"block": "zbm", "engine", "interleave", "units", "schedule", "cycles" (segment clocks until
     the last merge word left the chain), "clock_hz": 25e6, "pixels_compared", "mismatches"
     (pixels whose 128-bit double-Z word differs), "wall_s" (the whole call), "cycles_per_s"
     (simulated cycles per second of simulator run, build excluded), "edge_pairs", "triangles",
@@ -525,6 +539,7 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
         raise RasterhwError(f"engine must be one of {', '.join(ENGINES)}, not {engine!r}")
     if interleave not in F.INTERLEAVES:
         raise RasterhwError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+    check_schedule(schedule)
     if not isinstance(units, (int, np.integer)) or isinstance(units, bool) or not 1 <= units <= 16:
         raise RasterhwError(f"units must be an integer in 1..16, not {units!r}")
     for name, v, lo in (("width", width, interleave), ("height", height, 1)):
@@ -556,12 +571,12 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
     per_unit = [eps.take(np.flatnonzero(eps.tag % units == k)) for k in range(units)]
     t1 = time.perf_counter()
     if engine == "pysim":
-        r = run_units_pysim(per_unit, width=width, height=height, interleave=interleave)
+        r = run_units_pysim(per_unit, width=width, height=height, interleave=interleave, schedule=schedule)
         sim_s, build_s = time.perf_counter() - t1, 0.0
     else:
         # compared with the golden frame below, in Python
         r = run_unit_bench(per_unit, width=width, height=height, interleave=interleave, sim=engine, phase=0,
-                           speed_run=True)
+                           speed_run=True, schedule=schedule)
         sim_s, build_s = r["run_s"], r["prepare_s"] + r["build_s"]
         if r.get("timeout"):
             raise RasterhwError(f"ZB/M {engine}: the bench's watchdog fired after {r['cycles']} cycles")
@@ -583,6 +598,7 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
         "engine": engine,
         "interleave": interleave,
         "units": units,
+        "schedule": schedule,
         "width": width,
         "height": height,
         "cycles": cycles,

@@ -4,6 +4,8 @@ from rasterhw.sim.registry import Arch, Machine, Option, SimBlock
 
 _INTERLEAVE = Option("interleave", "ZB/M chips per scan line (1, 2, 4, 8 or 16)", default=8, type=int)
 _UNITS = Option("units", "ZB/M units chained by merge ports", default=1, type=int)
+_SCHEDULE = Option("schedule", "ZB/M timing: overlap (ours) or paper (sec. 6.1's schedule)", default="overlap",
+                   choices=("overlap", "paper"))
 
 MACHINE = Machine(
     name="zbm",
@@ -19,7 +21,7 @@ MACHINE = Machine(
             "zbm-merger": "rasterhw.sim.zbm.blocks:merger",
             "zbm-pixel": "rasterhw.sim.zbm.blocks:pixel"},
     sims=(SimBlock("zbm", "the scene's edge pairs through a ZB/M unit (segment generator + chips) in HDL",
-                   "rasterhw.sim.zbm.driver:simulate_zbm", default_scene="c300", options=(_INTERLEAVE, _UNITS)),),
+                   "rasterhw.sim.zbm.driver:simulate_zbm", default_scene="c300", options=(_INTERLEAVE, _UNITS, _SCHEDULE)),),
     report="rasterhw.sim.zbm.report:rows",
     bench="rasterhw.sim.zbm.bench:bench",
     status="segment generator, ZB/M chip (8 pixel processors on a segment loop, double Z, merger on its own "

@@ -97,3 +97,56 @@ def test_bench_rejects_bad_settings():
         Z._plusargs((0, 5), 0, 1, 10)
     with pytest.raises(RasterhwError, match="phase"):
         Z._plusargs((5, 5), 0, 1, 10, phase=2)
+
+
+def test_unit_paper_schedule_verilator_protocol():
+    """The paper-schedule unit under random gaps, back-pressure and a 3:2 clock ratio: same words."""
+    tris = _scene(5)
+    gold = G.render_zbm(tris, interleave=2)
+    exp = doublez_words(gold.pixels)
+    r = Z.run_unit_bench([G.edge_pairs(tris)], width=W, height=H, interleave=2, sim="verilator", ratio=(3, 2),
+                         stall=60, seed=5, gap_seed=5, expect=exp, check_protocol=True, schedule="paper")
+    assert np.array_equal(r["s0"], exp[0]) and np.array_equal(r["s1"], exp[1]) and r["proto_errors"] == 0
+
+
+@pytest.mark.parametrize("interleave", [1, 8])
+def test_table1_paper_schedule_verilator(interleave):
+    """Table 1 from Verilator, paper schedule: 74 / 54 cycles per edge pair (= the paper's formula
+    and the exact model), every merge word equal to the golden model's."""
+    from rasterhw.golden_model.zbm.cycles import formula_cycles_per_edge_pair
+    from rasterhw.sim.zbm.cycles_hdl import measure_table1
+
+    r = measure_table1(interleave, schedule="paper", engine="verilator", n_edge_pairs=4)   # the report's runs
+    assert r["mismatches"] == 0
+    assert r["per_edge_pair"] == r["model_marginal"] == formula_cycles_per_edge_pair(interleave)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("interleave", [1, 8])
+def test_table1_overlap_verilator(interleave):
+    """Ours on Verilator: 70 / 54 (4 L + max(L, 18)), = the model, golden words."""
+    from rasterhw.sim.zbm.cycles_hdl import measure_table1
+
+    r = measure_table1(interleave, schedule="overlap", engine="verilator", n_edge_pairs=4)
+    assert r["per_edge_pair"] == r["model_marginal"] == {1: 70, 8: 54}[interleave] and r["mismatches"] == 0
+
+
+@pytest.mark.slow
+def test_chain_scaling_verilator():
+    """Chained units on Verilator (the report's runs): golden words, more units -> fewer cycles,
+    never below the merge bus's own bound."""
+    from rasterhw.sim.zbm.scaling import chain
+
+    a, b = chain(1), chain(2)
+    assert a["mismatches"] == b["mismatches"] == 0
+    assert b["cycles"] < a["cycles"] and b["cycles"] >= b["merge_bound_cycles"]
+    assert 0 < a["merge_occupancy"] < b["merge_occupancy"] <= 1
+
+
+@pytest.mark.slow
+def test_skew_two_neighbours_verilator():
+    """Condition 7 simulated: two neighbouring units with offset loads lose less than the paper's half."""
+    from rasterhw.sim.zbm.scaling import skew
+
+    s = skew()
+    assert s["pair"] >= s["alone"] == 74 and 0 <= s["loss"] < 0.5

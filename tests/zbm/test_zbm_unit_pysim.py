@@ -3,6 +3,8 @@ golden_model.zbm.render_zbm; and the cycles-per-edge-pair measurement of Table 1
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from amaranth.sim import Simulator
@@ -63,14 +65,17 @@ def run_units(units, words_per_unit, n_lines, *, merge_period=1e-8, stall_p=0.0,
     return got
 
 
-@pytest.mark.parametrize("interleave,n_units,merge_period", [(2, 1, 1e-8), (4, 2, 1.9e-8)])
-def test_units_match_render_zbm(interleave, n_units, merge_period):
+@pytest.mark.parametrize("interleave,n_units,merge_period,schedule",
+                         [(2, 1, 1e-8, "overlap"), (4, 2, 1.9e-8, "overlap"), (2, 1, 1e-8, "paper"),
+                          (4, 2, 1.9e-8, "paper")])
+def test_units_match_render_zbm(interleave, n_units, merge_period, schedule):
     w, h = 32, 10
     rng = np.random.default_rng(interleave)
     tris = random_triangles(rng, 8, w, h, size=8)
     res = G.render_zbm(tris, interleave=interleave, units=n_units)
     eps = G.edge_pairs(tris)
-    units = [ZbmUnit(interleave=interleave, width=w, height=h, head=(k == 0)) for k in range(n_units)]
+    units = [ZbmUnit(interleave=interleave, width=w, height=h, head=(k == 0), schedule=schedule)
+             for k in range(n_units)]
     words = [edge_pair_words(eps.take(np.flatnonzero(eps.tag % n_units == k))) for k in range(n_units)]
     got = run_units(units, words, h, merge_period=merge_period, stall_p=0.3)
     exp_all = np.array(pixel2_words(res.pixels), dtype=object).reshape(h, w)
@@ -83,20 +88,36 @@ def test_units_match_render_zbm(interleave, n_units, merge_period):
 def test_unit_bad_parameters():
     with pytest.raises(ValueError, match="interleave must be 1, 2, 4, 8 or 16, not 5"):
         ZbmUnit(interleave=5)
+    with pytest.raises(ValueError, match="schedule must be 'overlap' or 'paper', not 'fast'"):
+        ZbmUnit(interleave=2, width=16, schedule="fast")
 
 
-@pytest.mark.parametrize("interleave,seed", [(1, 0), (2, 1), (8, 2)])
-def test_cycle_model_is_exact(interleave, seed):
+@pytest.mark.parametrize("interleave,seed,schedule,mode", [
+    (1, 0, "overlap", F.MODE_COLOUR), (2, 1, "overlap", F.MODE_COLOUR), (8, 2, "overlap", F.MODE_COLOUR),
+    (1, 0, "paper", F.MODE_COLOUR), (2, 1, "paper", F.MODE_MAPPING), (8, 2, "paper", F.MODE_COLOUR)])
+def test_cycle_model_is_exact(interleave, seed, schedule, mode):
     """HDL cycles == golden_model.zbm.cycles.hdl_cycles on random small streams (empty and
-    clipped segments, several pairs per line, loads on many lines)."""
+    clipped segments, several pairs per line, loads on many lines), both schedules."""
     w, h = 8 * interleave if interleave > 1 else 24, 10
     rng = np.random.default_rng(seed)
     eps = G.edge_pairs(random_triangles(rng, 6, w, h, size=10))
-    model = C.hdl_cycles(eps, h, width=w, interleave=interleave)
+    if mode == F.MODE_MAPPING:      # cycles do not depend on the channel values: 6 zero channels
+        z = np.zeros((len(eps), len(F.CHANNELS[mode])), np.int64)
+        eps = dataclasses.replace(eps, mode=mode, val=z, ddy=z.copy(), ddx=z.copy())
+    model = C.hdl_cycles(eps, h, width=w, interleave=interleave, schedule=schedule)
     assert G.max_active_edge_pairs(eps)[0] >= 2 and len(eps) >= 5 and model["generator"]["empty"] > 0
-    hdl = run_unit_cycles(eps, h, width=w, interleave=interleave)
+    hdl = run_unit_cycles(eps, h, width=w, interleave=interleave, schedule=schedule)
     assert hdl["overflow"] == 0 and hdl["lines"] == h
     assert hdl["cycles"] == model["cycles"], (hdl, model)
+
+
+@pytest.mark.parametrize("interleave", [1, 8])
+def test_paper_schedule_table1(interleave):
+    """Paper schedule: HDL steady state = the paper's 9 + (len_chip + 8) * 5 exactly."""
+    a = measure_cycles_per_edge_pair(interleave, n_edge_pairs=2, schedule="paper")
+    b = measure_cycles_per_edge_pair(interleave, n_edge_pairs=3, schedule="paper")
+    assert a["cycles"] == a["model_cycles"] and b["cycles"] == b["model_cycles"]
+    assert b["cycles"] - a["cycles"] == C.formula_cycles_per_edge_pair(interleave) == {1: 74, 8: 54}[interleave]
 
 
 def test_unit_overflow_flag():
@@ -130,3 +151,23 @@ def test_cycles_per_edge_pair_sweep(interleave):
 if __name__ == "__main__":    # python tests/zbm/test_zbm_unit_pysim.py -> the Table 1 measurement
     for i in F.INTERLEAVES:
         print(measure_cycles_per_edge_pair(i))
+
+
+def test_line_log_steady_state_equals_model():
+    """measure_table1's one-run steady state (pysim) == the model's marginal, both schedules, I = 2."""
+    from rasterhw.sim.zbm.cycles_hdl import measure_table1
+
+    for sched, want in (("paper", 64), ("overlap", 62)):
+        r = measure_table1(2, schedule=sched, n_edge_pairs=2)
+        assert r["per_edge_pair"] == r["model_marginal"] == want
+
+
+@pytest.mark.parametrize("interleave", [1, 4])
+def test_pixel_rate_scales_with_interleave(interleave):
+    """Merge-bound lines: a chip sends its ceil(W / I) pixels per line plus 2 cycles of swap and
+    reader start, so the unit's output rate is W / (W / I + 2) pixels per clock."""
+    from rasterhw.sim.zbm.scaling import pixel_rate
+
+    r = pixel_rate(interleave, width=32, height=10)
+    assert r["cycles_per_line"] == 32 // interleave + 2
+    assert r["pixels_per_cycle"] == pytest.approx(32 / (32 // interleave + 2))
