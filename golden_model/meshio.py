@@ -67,6 +67,20 @@ def decode_text(raw: bytes) -> tuple[str, str]:
         return raw.decode("latin-1"), "latin-1"
 
 
+def _ascii_ply_header(raw: bytes) -> bytes:
+    """A PLY header is ASCII keywords, but comments may hold any bytes (trimesh decodes the
+    header as UTF-8 and fails on a Latin-1 comment): non-ASCII header text becomes ``?``;
+    the body (binary or ASCII numbers) is left as it is."""
+    end = raw.find(b"end_header")
+    if end < 0:
+        return raw
+    head = raw[:end]
+    if head.isascii():
+        return raw
+    text, _enc = decode_text(head)
+    return text.encode("ascii", errors="replace") + raw[end:]
+
+
 def _read_bytes(path: Path) -> bytes:
     try:
         return path.read_bytes()
@@ -177,6 +191,8 @@ def load_mesh(path: str | Path, *, name: str | None = None, smooth: bool = True)
         text, _enc = decode_text(raw)
         _check_obj_faces(path, text)
         raw = text.encode("utf-8")
+    elif ext == ".ply":
+        raw = _ascii_ply_header(raw)
 
     import io
 

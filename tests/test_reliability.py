@@ -68,6 +68,16 @@ def test_obj_in_any_common_encoding_loads_like_plain_utf8(tmp_path, encode):
     assert np.array_equal(a.positions, b.positions) and a.positions.shape == (1, 3, 3)
 
 
+def test_ply_with_a_latin1_comment_loads(tmp_path):
+    from rasterhw.golden_model.meshio import load_mesh
+
+    head = ("ply\nformat ascii 1.0\ncomment caf\u00e9\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n")
+    p = tmp_path / "l1.ply"
+    p.write_bytes(head.encode("latin-1") + b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
+    assert load_mesh(p).positions.shape == (1, 3, 3)
+
+
 def test_decode_text_guesses():
     from rasterhw.golden_model.meshio import decode_text
 

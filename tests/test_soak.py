@@ -4,6 +4,7 @@ time (printed; ``RASTERHW_SEED=n`` reruns it). ``make soak`` runs 10**8 per bloc
 
 from __future__ import annotations
 
+import json
 import os
 import secrets
 
@@ -20,5 +21,9 @@ def test_random_differential_rounds_match_golden(block):
     seed = int(os.environ.get("RASTERHW_SEED") or secrets.randbelow(1 << 31))
     print(f"soak {block}: seed {seed} (rerun: RASTERHW_SEED={seed} or rasterhw soak --seed {seed} --block {block})")
     (row,) = run_soak(pixels=PIXELS, seed=seed, blocks=[block], progress=False)
+    if os.environ.get("SOAK_REPORT"):  # a folder: one JSON row per block (pixels, rounds, seconds)
+        os.makedirs(os.environ["SOAK_REPORT"], exist_ok=True)
+        with open(os.path.join(os.environ["SOAK_REPORT"], f"{block}.json"), "w") as fh:
+            json.dump(row, fh)
     assert row["pixels_compared"] >= PIXELS
     assert row["mismatches"] == 0, f"seed {seed}: {row['failures']}"
