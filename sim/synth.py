@@ -173,9 +173,10 @@ def _split_extra(extra: str) -> tuple[str, str]:
 
 
 def stable_text(verilog: str) -> str:
-    """The Verilog's lines, sorted: Amaranth orders clock-domain ports by Python's string hash,
-    which changes from process to process, so the text itself is no stable cache key."""
-    return "\n".join(sorted(verilog.splitlines()))
+    """The Verilog with the order of its lines and of the words in each line normalised:
+    Amaranth orders clock-domain ports by Python's string hash, which changes from process to
+    process, so the text itself is no stable cache key."""
+    return "\n".join(sorted(" ".join(sorted(re.split(r"[\s,()]+", ln))) for ln in verilog.splitlines()))
 
 
 def _param_int(v) -> int:
