@@ -5,7 +5,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-stamp
 
-.PHONY: demo test bench soak report docs lint clean
+.PHONY: demo test slow bench soak report docs lint clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -17,7 +17,11 @@ demo: $(STAMP)
 	$(VENV)/bin/rasterhw demo --out out
 
 test: $(STAMP)
-	$(PY) -m pytest -q -n 2
+	$(PY) -m pytest -q -n 2 -m "not slow" --durations=15
+
+# long sweeps (marked slow): a benchmark-sized run, not part of CI
+slow: $(STAMP)
+	$(PY) -m pytest -q -n 2 -m slow --durations=15
 
 bench: $(STAMP)
 	$(VENV)/bin/rasterhw bench
