@@ -47,7 +47,7 @@ def run_mapper_pysim(words: list[int], texture, illum) -> tuple[list[int], dict]
         while len(got) < len(words):
             if k < len(words):
                 ctx.set(dut.i.valid, 1)
-                ctx.set(dut.i.payload, words[k])
+                ctx.set(dut.i.payload.as_value(), words[k])
             else:
                 ctx.set(dut.i.valid, 0)
             _, _, rdy, v, p = await ctx.tick().sample(dut.i.ready, dut.o.valid, dut.o.payload)

@@ -67,3 +67,15 @@ def test_mapper_matches_map_samples():
 def test_mapper_bad_maps():
     with pytest.raises(ValueError, match="texture must be"):
         ZbmMapper(texture=np.zeros((4, 4, 3)), illum=np.zeros((256, 256)))
+
+
+def test_mapping_driver_full_rate():
+    """sim/zbm/mapping_hdl.run_mapper_pysim: one pixel per clock, latency 2, same words."""
+    from rasterhw.sim.zbm.mapping_hdl import run_mapper_pysim
+
+    px = random_doublez(np.random.default_rng(2), 40)
+    tex, il = default_maps(1)
+    want, stats = map_samples(px, tex, il)
+    got, hw = run_mapper_pysim(pixel2_words(px), tex, il)
+    assert got == pixel2_words(want) and hw["texture_lookups"] == stats["texture_lookups"]
+    assert hw["cycles"] == 40 + 2
