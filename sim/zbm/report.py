@@ -183,7 +183,7 @@ def _plot(measured: dict[str, dict[int, float]], out_dir: Path, engine: str) -> 
     ax.plot(xs, [polygons_per_s(measured["paper"][i]) / 1e3 for i in xs], "s-",
             label=f"paper schedule (HDL cycles, {engine})")
     ax.plot(xs, [polygons_per_s(measured["overlap"][i]) / 1e3 for i in xs], "^-",
-            label=f"overlapped, ours (HDL cycles, {engine})")
+            label="overlapped, ours (HDL cycles, pysim)")
     ax.set_xscale("log", base=2)
     ax.set_xticks(xs, [str(i) for i in xs])
     ax.set_xlabel("chips interleaved on a scan line")
@@ -195,7 +195,7 @@ def _plot(measured: dict[str, dict[int, float]], out_dir: Path, engine: str) -> 
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return ["## Plots", "", f"![throughput against interleave]({path.name})", "",
-            f"Measured: one ZB/M unit ({engine}) on the paper's workload, {2 * N_PAIRS} edge pairs in one run; "
+            f"Measured: one ZB/M unit (paper schedule: {engine}; ours: pysim) on the paper's workload, {2 * N_PAIRS} edge pairs in one run; "
             f"(cycle line {10 * N_PAIRS} done - cycle line {5 * N_PAIRS} done) / {N_PAIRS}; equal to the exact "
             "cycle model's marginal cost (`golden_model/zbm/cycles.py: hdl_cycles`) or the report stops. "
             "Polygons/s apply the paper's arithmetic (25 MHz, x1/2 skew, 2 edge pairs per polygon) to those cycles. "

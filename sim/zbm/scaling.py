@@ -170,7 +170,7 @@ def report_rows(*, progress: bool = False, engine: str = "verilator") -> list[di
         if c["mismatches"]:
             raise RasterhwError(f"ZB/M chain of {u}: {c['mismatches']} merge words differ")
         one = one or c["polygons_per_s"]
-        tag = (f"{u} chained units, interleave {c['interleave']}, {c['triangles']} triangles on "
+        tag = (f"{u} chained unit{'s' if u > 1 else ''}, interleave {c['interleave']}, {c['triangles']} triangles on "
                f"{c['width']}x{c['height']}")
         out.append(make_row("zbm", "6.1 (chain)", f"{tag}: speed-up over 1 unit", paper=float(u),
                             formula=float(u), measured=c["polygons_per_s"] / one, unit="x", source=f"hdl:{engine}"))
