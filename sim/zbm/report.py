@@ -87,7 +87,10 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
     out.append(make_row("zbm", "6.1", f"{UNITS_SECOND_LEVEL} units, best interleave (not simulated: "
                         f"{UNITS_SECOND_LEVEL} x the paper's per-unit arithmetic)",
                         paper=PAPER_64_UNITS, formula=UNITS_SECOND_LEVEL * polygons_per_s(min(PAPER_CYCLES.values())),
-                        measured=None, unit="polygons/s", source="formula"))
+                        measured=None, unit="polygons/s", source="formula",
+                        reason=f"{UNITS_SECOND_LEVEL} units are not simulated here: chains of 1-8 units of "
+                               "interleave 1 are (rows 'chain'); an interleave-16 unit alone takes ~21 min "
+                               "to verilate on this machine"))
     out += extra_rows(progress, "verilator" if hdl_engine == "pysim" else hdl_engine)
     out += scene_rows(progress)
     area, area_note = area_rows(fast=fast, progress=progress)
