@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import cocotb
-from cocotb.triggers import FallingEdge
+from cocotb.triggers import FallingEdge, RisingEdge
 
-__all__ = ["check_stream_protocol", "to_int"]
+__all__ = ["check_stream_protocol", "send", "to_int"]
 
 
 def to_int(handle) -> int:
@@ -59,3 +59,24 @@ async def check_stream_protocol(
 def start_checker(*args, **kwargs):
     """``cocotb.start_soon(check_stream_protocol(*args, **kwargs))``."""
     return cocotb.start_soon(check_stream_protocol(*args, **kwargs))
+
+
+async def send(clk, valid, ready, payload, value: int) -> int:
+    """Offer ``value`` on a stream until it is taken; returns the clocks it waited.
+
+    Call just after a rising edge: inputs change only there, and ``ready`` is read at the
+    falling edge (settled), where :func:`check_stream_protocol` reads it too, so no coroutine
+    writes at a falling edge. Returns just after the rising edge that took the word, with
+    ``valid`` low again."""
+    payload.value = value
+    valid.value = 1
+    waited = 0
+    while True:
+        await FallingEdge(clk)
+        taken = to_int(ready)
+        await RisingEdge(clk)
+        if taken:
+            break
+        waited += 1
+    valid.value = 0
+    return waited

@@ -81,3 +81,12 @@ def write_text(path: str | Path, text: str) -> Path:
     with atomic_path(path) as tmp:
         tmp.write_text(text)
     return path
+
+
+def write_if_changed(path: str | Path, text: str) -> Path:
+    """:func:`write_text` unless ``path`` already holds ``text``: an unchanged generated source
+    keeps its timestamp, so the build that uses it is not redone."""
+    path = Path(path)
+    if not path.exists() or path.read_text() != text:
+        write_text(path, text)
+    return path

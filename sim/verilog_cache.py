@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import tempfile
 from collections.abc import Callable, Mapping
 from functools import cache
 from pathlib import Path
@@ -55,10 +53,8 @@ def convert_cached(name: str, factory: Callable[[], object], *, params: Mapping[
 
         def convert(design, mod):
             return verilog.convert(design, name=mod)
+    from rasterhw.sim.outfile import write_text
+
     text = convert(factory(), module)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=path.name, dir=path.parent)
-    with os.fdopen(fd, "w") as f:
-        f.write(text)
-    os.replace(tmp, path)
+    write_text(path, text)
     return text

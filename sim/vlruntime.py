@@ -19,7 +19,6 @@ import hashlib
 import os
 import re
 import shutil
-import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -72,6 +71,8 @@ def seed(obj_dir: Path, kind: str, flags: Iterable[str]) -> int:
 
 def harvest(obj_dir: Path, kind: str, flags: Iterable[str]) -> int:
     """Keep ``obj_dir``'s runtime objects (after a successful build); returns how many were new."""
+    from rasterhw.sim.outfile import atomic_path
+
     if not _enabled():
         return 0
     dst = cache_dir(kind, flags)
@@ -79,10 +80,7 @@ def harvest(obj_dir: Path, kind: str, flags: Iterable[str]) -> int:
     for name in RUNTIME_OBJECTS:
         f = obj_dir / name
         if f.exists() and not (dst / name).exists():
-            dst.mkdir(parents=True, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(prefix=name, dir=dst)
-            os.close(fd)
-            shutil.copyfile(f, tmp)
-            os.replace(tmp, dst / name)
+            with atomic_path(dst / name) as tmp:
+                shutil.copyfile(f, tmp)
             n += 1
     return n

@@ -21,7 +21,7 @@ import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, RisingEdge, with_timeout
 
-from cocotb_tests.common import start_checker, to_int
+from cocotb_tests.common import send, start_checker, to_int
 
 SEG_BITS = 194
 
@@ -53,21 +53,11 @@ async def pxp_lines(dut):
     start_checker(dut.clk, dut.i__valid, dut.i__ready, dut.i__payload, name="i", log=got_in, reset=dut.rst)
     start_checker(dut.clk, dut.o__valid, dut.o__ready, dut.o__payload, name="o", log=got_out, reset=dut.rst)
 
-    # Inputs change only just after a rising edge; handshakes are read at the falling edge
-    # (settled), where the checkers read them too: no coroutine writes at a falling edge.
     async def feed():
         for w in words:
             while rng.random() < idle:
                 await RisingEdge(dut.clk)
-            dut.i__payload.value = w & mask
-            dut.i__valid.value = 1
-            while True:
-                await FallingEdge(dut.clk)
-                taken = to_int(dut.i__ready)
-                await RisingEdge(dut.clk)
-                if taken:
-                    break
-            dut.i__valid.value = 0
+            await send(dut.clk, dut.i__valid, dut.i__ready, dut.i__payload, w & mask)
             if w & 1:  # end-of-line token: the next line's range, sampled as the line ends
                 dut.lo.value = (w >> SEG_BITS) & 0x3FF
                 dut.hi.value = (w >> (SEG_BITS + 10)) & 0x7FF

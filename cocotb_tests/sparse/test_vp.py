@@ -20,7 +20,7 @@ import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, RisingEdge
 
-from cocotb_tests.common import start_checker, to_int
+from cocotb_tests.common import send, start_checker, to_int
 
 
 @cocotb.test()
@@ -43,20 +43,10 @@ async def vp_frame(dut):
     taken: list[int] = []
     start_checker(dut.clk, dut.i__valid, dut.i__ready, dut.i__payload, name="i", log=taken, reset=dut.rst)
     waited = 0
-    # inputs change just after a rising edge; the handshake is read at the falling edge (settled)
     for w in words:
         while rng.random() < idle:
             await RisingEdge(dut.clk)
-        dut.i__payload.value = w
-        dut.i__valid.value = 1
-        while True:
-            await FallingEdge(dut.clk)
-            ok = to_int(dut.i__ready)
-            await RisingEdge(dut.clk)
-            if ok:
-                break
-            waited += 1
-        dut.i__valid.value = 0
+        waited += await send(dut.clk, dut.i__valid, dut.i__ready, dut.i__payload, w)
     budget = 400 * (len(words) + 10) * (n + 1) + 100_000
     for _ in range(budget):
         await FallingEdge(dut.clk)

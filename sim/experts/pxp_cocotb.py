@@ -9,8 +9,9 @@ back-pressure on the pixel stream, stream checkers on both ports, and in-order s
 from __future__ import annotations
 
 import numpy as np
+from rasterhw.sim.outfile import write_if_changed
 from rasterhw.sim.runner import build_dir_for, get_sim, run_cocotb
-from rasterhw.sim.workdirs import temp_run_folder
+from rasterhw.sim.workdirs import release, temp_run_folder
 
 __all__ = ["run_cocotb_bench"]
 
@@ -28,8 +29,7 @@ def run_cocotb_bench(jb: dict, *, width: int = 512, sim: str | None = None, idle
     bdir = build_dir_for("experts-pxp-cocotb", sim, width=width, aj=jb["aj"])
     bdir.mkdir(parents=True, exist_ok=True)
     vpath = bdir / "experts_pxp.v"
-    if not vpath.exists() or vpath.read_text() != text:
-        vpath.write_text(text)  # unchanged text keeps the build's timestamps
+    write_if_changed(vpath, text)
     run_dir = temp_run_folder(bdir)
     exp = run_dir / "expect.npz"
     np.savez(exp, words=np.array([f"{w:x}" for w in jb["words"]], dtype=str), pixels=jb["pixels"],
@@ -40,7 +40,5 @@ def run_cocotb_bench(jb: dict, *, width: int = 512, sim: str | None = None, idle
                build_dir=bdir, test_dir=run_dir, sim=sim, timings=timings,
                extra_env={"PXP_EXPECT": str(exp), "PXP_IDLE": str(idle), "PXP_STALL": str(stall),
                           "PXP_SEED": str(seed)})
-    for f in sorted(run_dir.rglob("*"), reverse=True):
-        f.unlink() if f.is_file() or f.is_symlink() else f.rmdir()
-    run_dir.rmdir()
+    release(run_dir)
     return {"words": len(jb["words"]), "pixels": int(jb["pixels"].size), "lines": jb["lines"], **timings}

@@ -21,7 +21,7 @@ from rasterhw.golden_model.experts.model import ExpertsFrame, equal_bounds, rend
 from rasterhw.golden_model.experts.pxp import pixel_words
 from rasterhw.golden_model.experts.pxp_cycles import line_segments, schedule
 from rasterhw.sim.runner import run_plain_verilator
-from rasterhw.sim.workdirs import temp_run_folder
+from rasterhw.sim.workdirs import release, temp_run_folder
 
 __all__ = ["jobs", "run_pysim", "run_verilator", "simulate_scene", "ENGINES"]
 
@@ -170,9 +170,7 @@ def run_verilator(jb: dict, *, width: int) -> dict:
                                run_dir=run_dir, maxcyc=int(jb["cycles"].sum()) * 2 + 10000)
     out = {"pixels": _read_hex(run_dir / "out.hex"), "cycles": _read_hex(run_dir / "cyc.hex"),
            "run_s": meta["run_s"], "sim_cycles": meta["sim_cycles"], "build_s": build_s}
-    for f in run_dir.iterdir():
-        f.unlink()
-    run_dir.rmdir()
+    release(run_dir)
     return out
 
 

@@ -24,7 +24,7 @@ from rasterhw.golden_model.snu.formats import RGB_BITS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.golden_model.snu.words import payload_words
 from rasterhw.sim.harness import stream_protocol_checker, stream_put
-from rasterhw.sim.outfile import write_text
+from rasterhw.sim.outfile import write_if_changed
 from rasterhw.sim.runner import HARNESS_V, REPO_ROOT, build_dir_for, get_sim, run_cocotb
 from rasterhw.sim.workdirs import keep as keep_run_folder
 from rasterhw.sim.workdirs import temp_run_folder
@@ -176,8 +176,7 @@ def run_cocotb_bench(
     t0 = time.perf_counter()
     vpath = bdir / "pixelbus.v"
     text = generate_verilog("pixelbus", **params)
-    if not vpath.exists() or vpath.read_text() != text:
-        write_text(vpath, text)  # whole or not at all (a concurrent run may read it); unchanged text keeps the build's timestamps
+    write_if_changed(vpath, text)  # whole or not at all: a concurrent run may read it
     if expect is None:
         acc = golden.pixelbus_accept_cycles(stream, gaps=gaps)
         rgb, z = golden.pixelbus_frame(stream, accept=acc)

@@ -16,7 +16,7 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.sparse.formats import TRI_BITS
 from rasterhw.sim.runner import build_plain_verilator, run_plain_verilator
-from rasterhw.sim.workdirs import temp_run_folder
+from rasterhw.sim.workdirs import release, temp_run_folder
 
 __all__ = ["build", "pack_records", "run_processor_verilator"]
 
@@ -86,9 +86,7 @@ def run_processor_verilator(recs: list[dict], *, n: int, p: int, q: int, a: int,
                                run_dir=run_dir, maxcyc=maxcyc)
     words = _read_hex(run_dir / "out.hex")
     st = [int(v) for v in _read_hex(run_dir / "stats.hex")]
-    for f in run_dir.iterdir():
-        f.unlink()
-    run_dir.rmdir()
+    release(run_dir)
     zmask = (1 << (z_bits + 1)) - 1
     tri = np.array([int(w) >> (z_bits + 1) for w in words], dtype=np.int64)
     zq = np.array([int(w) & zmask for w in words], dtype=np.int64)

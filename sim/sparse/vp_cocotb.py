@@ -12,8 +12,9 @@ import numpy as np
 from rasterhw.golden_model.sparse.fixed import broadcast_records
 from rasterhw.golden_model.sparse.formats import TRI_BITS, parse_matrix, sparse_geometry
 from rasterhw.golden_model.sparse.search import sparse_render
+from rasterhw.sim.outfile import write_if_changed
 from rasterhw.sim.runner import build_dir_for, get_sim, run_cocotb
-from rasterhw.sim.workdirs import temp_run_folder
+from rasterhw.sim.workdirs import release, temp_run_folder
 
 __all__ = ["run_cocotb_bench"]
 
@@ -43,8 +44,7 @@ def run_cocotb_bench(tris, matrix="4x4", *, a: int = 0, b: int = 0, sim: str | N
     bdir = build_dir_for("sparse-vp-cocotb", sim, **params)
     bdir.mkdir(parents=True, exist_ok=True)
     vpath = bdir / "sparse_vp.v"
-    if not vpath.exists() or vpath.read_text() != text:
-        vpath.write_text(text)
+    write_if_changed(vpath, text)
     run_dir = temp_run_folder(bdir)
     exp = run_dir / "expect.npz"
     np.savez(exp, words=np.array([f"{pack(BROADCAST, r):x}" for r in recs], dtype=str), n=n, a=a, b=b,
@@ -54,7 +54,5 @@ def run_cocotb_bench(tris, matrix="4x4", *, a: int = 0, b: int = 0, sim: str | N
     run_cocotb(sources=[vpath], toplevel="sparse_vp", test_module="cocotb_tests.sparse.test_vp", build_dir=bdir,
                test_dir=run_dir, sim=sim, timings=timings,
                extra_env={"VP_EXPECT": str(exp), "VP_IDLE": str(idle), "VP_SEED": str(seed)})
-    for f in sorted(run_dir.rglob("*"), reverse=True):
-        f.unlink() if f.is_file() or f.is_symlink() else f.rmdir()
-    run_dir.rmdir()
+    release(run_dir)
     return {"records": len(recs), "words_read": int(local_t.size), "n": n, **timings}
