@@ -5,10 +5,12 @@ runs the whole frame through ``units`` chained ``ZbmUnit``\\s (``interleave`` ch
 and compares every scan line's double-Z pixels (both samples, Z and colour: the whole
 128-bit merge word) with ``golden_model.zbm.render_zbm``, then composites.
 
-Engines: ``pysim`` (Amaranth simulator, small frames) and ``verilator`` / ``icarus``: the
-generated Verilog inside ``cocotb_tests/zbm/tb_zbm_unit.v`` (Verilog-side clocks, edge pairs
-preloaded from a hex file and played out at full speed, merge words collected into a frame
-memory and dumped), run under cocotb through :mod:`rasterhw.sim.runner`.  The same benches
+Engines: ``pysim`` (Amaranth simulator, small frames), ``verilator`` (the generated Verilog
+inside ``cocotb_tests/zbm/fast/tb_zbm_unit_fast.v`` on plain Verilator with a C++ main:
+:func:`rasterhw.sim.zbm.fast.run_unit_fast`) and ``icarus``: the generated Verilog inside
+``cocotb_tests/zbm/tb_zbm_unit.v`` (Verilog-side clocks, edge pairs preloaded from a hex file
+and played out at full speed, merge words collected into a frame memory and dumped), run under
+cocotb through :mod:`rasterhw.sim.runner` (``run_unit_bench``, also on Verilator).  The same benches
 (with random idle gaps, back-pressure, clock ratios and the Python stream checkers) are the
 cocotb tests, ``tests/zbm/test_zbm_cocotb.py``.
 
@@ -18,6 +20,7 @@ digest of the ZB/M HDL sources, so a changed HDL file regenerates it.
 
 from __future__ import annotations
 
+import binascii
 import hashlib
 import json
 import os
@@ -94,6 +97,18 @@ def _write_hex(path: Path, words, gaps, pw: int) -> None:
 
 def read_hex_words(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """A $writememh dump of 128-bit words -> (s0, s1) uint64 arrays (low, high 64 bits)."""
+    raw = Path(path).read_bytes()
+    if raw and raw.count(b"\n") * 33 == len(raw) and raw[32::33] == b"\n" * (len(raw) // 33):
+        # the usual dump: one 32-digit word per line, nothing else (decoded in C)
+        try:
+            w = np.frombuffer(binascii.unhexlify(raw.replace(b"\n", b"")), ">u8").reshape(-1, 2)
+        except binascii.Error:   # X or Z digits: the text path names them
+            return _read_hex_words_text(path)
+        return w[:, 1].astype(np.uint64), w[:, 0].astype(np.uint64)
+    return _read_hex_words_text(path)
+
+
+def _read_hex_words_text(path: Path) -> tuple[np.ndarray, np.ndarray]:
     lines = [ln.strip() for ln in Path(path).read_text().split("\n")]
     lines = [ln for ln in lines if ln and not ln.startswith("//") and not ln.startswith("@")]
     if any(("x" in ln or "X" in ln or "z" in ln) for ln in lines):
@@ -128,11 +143,11 @@ def check_edge_pairs(eps: G.EdgePairs, width: int, height: int, *, units: int = 
 
 # ====================================================================== Verilog
 def _digest(**params) -> str:
+    from rasterhw.sim.verilog_cache import source_digest
+
+    # every source the generated Verilog can depend on (the HDL, the formats, the generator)
     h = hashlib.sha1(json.dumps(params, sort_keys=True, default=str).encode())
-    # every source the generated Verilog can depend on: the HDL, the ZB/M formats, the generator
-    for p in sorted([*(REPO_ROOT / "hdl").rglob("*.py"), *(REPO_ROOT / "golden_model" / "zbm").glob("*.py"),
-                     REPO_ROOT / "sim" / "verilog.py"]):
-        h.update(p.read_bytes())
+    h.update(source_digest().encode())
     return h.hexdigest()[:12]
 
 
@@ -573,6 +588,13 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
     if engine == "pysim":
         r = run_units_pysim(per_unit, width=width, height=height, interleave=interleave, schedule=schedule)
         sim_s, build_s = time.perf_counter() - t1, 0.0
+    elif engine == "verilator":
+        # plain Verilator, no cocotb (held bit- and cycle-exact with the cocotb bench by
+        # tests/zbm/test_zbm_unit_fast.py); compared with the golden frame below, in Python
+        from rasterhw.sim.zbm.fast import run_unit_fast
+
+        r = run_unit_fast(per_unit, width=width, height=height, interleave=interleave, schedule=schedule)
+        sim_s, build_s = r["run_s"], r["build_s"]
     else:
         # compared with the golden frame below, in Python
         r = run_unit_bench(per_unit, width=width, height=height, interleave=interleave, sim=engine, phase=0,

@@ -1,4 +1,11 @@
-"""ZB/M chip speed on plain Verilator: no cocotb, no ``--timing``.
+"""ZB/M on plain Verilator: no cocotb, no ``--timing``.
+
+``run_unit_fast`` is the scene-run path of ``rasterhw sim zbm --engine verilator`` (and of the
+bench and the soak): the chained units of :func:`rasterhw.sim.zbm.run_unit_bench` inside
+``cocotb_tests/zbm/fast/tb_zbm_unit_fast.v``, both clock domains on the main's one ``clk``
+(what the cocotb bench does with equal, in-phase clocks), the same stimulus files, sinks,
+seeded back-pressure and frame dump. ``tests/zbm/test_zbm_unit_fast.py`` holds it bit- and
+cycle-exact with the cocotb bench.
 
 ``chip_speed_fast`` runs the same workload as :func:`rasterhw.sim.zbm.chip_speed` (chip 0,
 ``scene``'s golden segments, empty upstream, no gaps or back-pressure, played ``repeat``
@@ -22,17 +29,19 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.sim.runner import HARNESS_V, REPO_ROOT, build_plain_verilator, run_plain_verilator
 from rasterhw.sim.workdirs import keep as keep_run_folder
-from rasterhw.sim.workdirs import temp_run_folder
+from rasterhw.sim.workdirs import release, temp_run_folder
 from rasterhw.sim.zbm.driver import (
     GAP_BITS,
     _cached,
     _depth,
     _write_hex,
+    chain_verilog,
     chip_stimulus,
+    random_gaps,
     read_hex_words,
 )
 
-__all__ = ["FAST_DIR", "build_fast", "run_chip_fast", "chip_speed_fast"]
+__all__ = ["FAST_DIR", "build_fast", "run_chip_fast", "chip_speed_fast", "build_unit_fast", "run_unit_fast"]
 
 FAST_DIR = REPO_ROOT / "cocotb_tests" / "zbm" / "fast"
 TOP = "tb_zbm_fast"
@@ -83,6 +92,69 @@ def run_chip_fast(seg_words: list[int], up_words: list[int], *, lines: int, chip
         for f in run_dir.iterdir():
             f.unlink()
         run_dir.rmdir()
+    return res
+
+
+def build_unit_fast(*, interleave: int, width: int, height: int, units: int, nwords: int,
+                    capacity: int = F.AEP_CAPACITY, schedule: str = "overlap", opt: str = "-O2") -> tuple[Path, float]:
+    """Build (once per parameter set and source content) the timing-free unit-chain bench;
+    returns (binary, build seconds, 0 if reused)."""
+    srcs = chain_verilog(interleave=interleave, width=width, height=height, units=units, capacity=capacity,
+                         schedule=schedule)
+    params = {"I": interleave, "U": units, "W": width, "H": height, "GW": GAP_BITS, "SDEPTH": _depth(nwords)}
+    return build_plain_verilator("zbm-unit-fast", "tb_zbm_unit_fast",
+                                 [*srcs, HARNESS_V, FAST_DIR / "tb_zbm_unit_fast.v"], params=params, opt=opt,
+                                 defines={"RASTERHW_CYCLES": 1})
+
+
+def run_unit_fast(eps_per_unit: list, *, width: int, height: int, interleave: int,
+                  capacity: int = F.AEP_CAPACITY, schedule: str = "overlap", stall: int = 0, seed: int = 1,
+                  gap_seed: int | None = None, line_log: bool = False, opt: str = "-O2",
+                  keep: bool = False) -> dict:
+    """Run a chain of units (unit k gets ``eps_per_unit[k]``) on plain Verilator.
+
+    Same arguments and result keys as :func:`rasterhw.sim.zbm.run_unit_bench` run with equal,
+    in-phase clocks (``ratio=(5, 5)``, ``phase=0``) and ``speed_run=True``: ``{"s0", "s1": (H, W)
+    uint64, "cycles", "overflow", "frames_ok", "proto_errors", "build_s", "run_s" (the C++ clock
+    loop only), "sim_cycles", ["line_cycles"]}``."""
+    from rasterhw.golden_model.zbm.words import edge_pair_words
+
+    if not 0 <= stall <= 255:
+        raise RasterhwError(f"stall must be in 0..255, not {stall!r}")
+    words = [edge_pair_words(e) for e in eps_per_unit]
+    total = sum(len(w) for w in words)
+    exe, build_s = build_unit_fast(interleave=interleave, width=width, height=height, units=len(words),
+                                   nwords=total, capacity=capacity, schedule=schedule, opt=opt)
+    run_dir = temp_run_folder(exe.parent.parent)
+    try:
+        flat, index, base = [], [], 0
+        for w in words:
+            index += [base, len(w)]
+            base += len(w)
+            flat += w
+        _write_hex(run_dir / "stim.hex", flat, random_gaps(total, gap_seed), F.EP_WORD_BITS)
+        (run_dir / "index.hex").write_text("\n".join(f"{v:x}" for v in index) + "\n")
+        out = run_dir / "frame.hex"
+        plus = [f"+stim={run_dir / 'stim.hex'}", f"+index={run_dir / 'index.hex'}", f"+out={out}",
+                f"+meta={run_dir / 'meta.json'}", f"+stall={stall}", f"+seed={seed}",
+                *([f"+lines={run_dir / 'lines.hex'}"] if line_log else [])]
+        # the cocotb bench's watchdog, scaled by the back-pressure
+        maxcyc = (200 * (total + 64) + 40 * height * (width + 64)) * (1 + stall // 32)
+        meta = run_plain_verilator(exe, plus, run_dir=run_dir, maxcyc=maxcyc)
+        meta.update(json.loads((run_dir / "meta.json").read_text()))
+        s0, s1 = read_hex_words(out)
+        if s0.size != width * height:
+            raise RasterhwError(f"{out}: {s0.size} words, expected {width * height}")
+        res = {"s0": s0.reshape(height, width), "s1": s1.reshape(height, width), **meta, "build_s": build_s,
+               "run_dir": run_dir if keep else None}
+        if line_log:
+            res["line_cycles"] = [int(v, 16) for v in (run_dir / "lines.hex").read_text().split()
+                                  if not v.startswith("//")]
+    finally:
+        if keep or os.environ.get("ZBM_KEEP") == "1":
+            keep_run_folder(run_dir)
+        else:
+            release(run_dir)
     return res
 
 
