@@ -14,7 +14,7 @@ from rasterhw.golden_model.zbm.formats import (
     pack_samples,
 )
 
-__all__ = ["DoubleZ"]
+__all__ = ["DoubleZ", "arrival_layers"]
 
 
 @dataclass
@@ -43,3 +43,25 @@ class DoubleZ:
 
     def copy(self) -> DoubleZ:
         return DoubleZ(self.z.copy(), self.a.copy(), self.c.copy(), self.tag.copy())
+
+
+def arrival_layers(pos: np.ndarray) -> list[np.ndarray]:
+    """Fragments in arrival order (``pos[i]`` = pixel of fragment ``i``) split into layers:
+    layer ``r`` holds, for every pixel, its ``r``-th fragment (indices into ``pos``, ascending).
+
+    Each layer touches every pixel at most once, so inserting the layers in order, each as one
+    vectorised step, gives exactly what inserting the fragments one by one in arrival order
+    gives (per pixel the arrivals keep their order; pixels do not interact).
+    """
+    pos = np.asarray(pos)
+    if pos.size == 0:
+        return []
+    order = np.argsort(pos, kind="stable")
+    sp = pos[order]
+    first = np.ones(sp.size, bool)
+    first[1:] = sp[1:] != sp[:-1]
+    start = np.maximum.accumulate(np.where(first, np.arange(sp.size), 0))
+    rank = np.arange(sp.size) - start
+    by_rank = np.argsort(rank, kind="stable")
+    bounds = np.searchsorted(rank[by_rank], np.arange(int(rank.max()) + 2))
+    return [np.sort(order[by_rank[bounds[r]:bounds[r + 1]]]) for r in range(int(rank.max()) + 1)]

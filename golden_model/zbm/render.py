@@ -25,7 +25,7 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.screen import ScreenTriangles, snap
 from rasterhw.golden_model.zbm.composite import composite
-from rasterhw.golden_model.zbm.doublez import DoubleZ
+from rasterhw.golden_model.zbm.doublez import DoubleZ, arrival_layers
 from rasterhw.golden_model.zbm.edgepair import _attributes, edge_pairs
 from rasterhw.golden_model.zbm.formats import (
     AEP_CAPACITY,
@@ -39,7 +39,7 @@ from rasterhw.golden_model.zbm.initial import _check_interleave
 from rasterhw.golden_model.zbm.mapping import default_maps, map_samples
 from rasterhw.golden_model.zbm.merger import merge_chain
 from rasterhw.golden_model.zbm.seggen import segment_generator
-from rasterhw.golden_model.zbm.unit import _unit_frame_fast, unit_scanline
+from rasterhw.golden_model.zbm.unit import _unit_frame_fast, segment_fragments, unit_scanline
 
 __all__ = ["ZbmResult", "render_zbm", "render_zbm_float", "render_scene"]
 
@@ -115,27 +115,29 @@ def render_zbm_float(tris: ScreenTriangles, *, alpha=None, background=(0.0, 0.0,
     X = snap(xy[..., 0]) / SUB
     Y = snap(xy[..., 1]) / SUB
     att = _attributes(tris, MODE_COLOUR, alpha) / np.array([Z_SCALE, 255, 255, 255, 255])
-    zb = np.full((H, W, 2), np.inf)
-    cb = np.zeros((H, W, 2, 4))
-    tg = np.full((H, W, 2), -1, np.int64)
-    for s in range(segs.y.shape[0]):
-        t = segs.tag[s]
-        xc = segs.x[s] + np.arange(segs.len[s]) + 0.5
-        yc = segs.y[s] + 0.5
-        x0, y0 = X[t], Y[t]
-        det = (x0[1] - x0[0]) * (y0[2] - y0[0]) - (x0[2] - x0[0]) * (y0[1] - y0[0])
-        w1 = ((xc - x0[0]) * (y0[2] - y0[0]) - (x0[2] - x0[0]) * (yc - y0[0])) / det
-        w2 = ((x0[1] - x0[0]) * (yc - y0[0]) - (xc - x0[0]) * (y0[1] - y0[0])) / det
-        v = att[t, 0] + w1[:, None] * (att[t, 1] - att[t, 0]) + w2[:, None] * (att[t, 2] - att[t, 0])
-        xs = segs.x[s] + np.arange(segs.len[s])
-        y = segs.y[s]
-        z = v[:, 0]
-        f = z < zb[y, xs, 0]
-        sc = (~f) & (z < zb[y, xs, 1])
-        xf, xsc = xs[f], xs[sc]
-        zb[y, xf, 1], cb[y, xf, 1], tg[y, xf, 1] = zb[y, xf, 0], cb[y, xf, 0], tg[y, xf, 0]
-        zb[y, xf, 0], cb[y, xf, 0], tg[y, xf, 0] = z[f], v[f, 1:], t
-        zb[y, xsc, 1], cb[y, xsc, 1], tg[y, xsc, 1] = z[sc], v[sc, 1:], t
+    zb = np.full((H * W, 2), np.inf)
+    cb = np.zeros((H * W, 2, 4))
+    tg = np.full((H * W, 2), -1, np.int64)
+    seg, k = segment_fragments(segs)
+    t = segs.tag[seg]
+    xc = (segs.x[seg] + k) + 0.5
+    yc = segs.y[seg] + 0.5
+    x0, y0 = X[t], Y[t]
+    det = (x0[:, 1] - x0[:, 0]) * (y0[:, 2] - y0[:, 0]) - (x0[:, 2] - x0[:, 0]) * (y0[:, 1] - y0[:, 0])
+    w1 = ((xc - x0[:, 0]) * (y0[:, 2] - y0[:, 0]) - (x0[:, 2] - x0[:, 0]) * (yc - y0[:, 0])) / det
+    w2 = ((x0[:, 1] - x0[:, 0]) * (yc - y0[:, 0]) - (xc - x0[:, 0]) * (y0[:, 1] - y0[:, 0])) / det
+    at = att[t]
+    v = at[:, 0] + w1[:, None] * (at[:, 1] - at[:, 0]) + w2[:, None] * (at[:, 2] - at[:, 0])
+    pos = segs.y[seg] * W + segs.x[seg] + k
+    for ly in arrival_layers(pos):   # in emission order: strict <, the earlier segment wins ties
+        p, z, vv, tt = pos[ly], v[ly, 0], v[ly, 1:], t[ly]
+        f = z < zb[p, 0]
+        sc = (~f) & (z < zb[p, 1])
+        pf, psc = p[f], p[sc]
+        zb[pf, 1], cb[pf, 1], tg[pf, 1] = zb[pf, 0], cb[pf, 0], tg[pf, 0]
+        zb[pf, 0], cb[pf, 0], tg[pf, 0] = z[f], vv[f], tt[f]
+        zb[psc, 1], cb[psc, 1], tg[psc, 1] = z[sc], vv[sc], tt[sc]
+    zb, cb, tg = zb.reshape(H, W, 2), cb.reshape(H, W, 2, 4), tg.reshape(H, W, 2)
     bg = np.asarray(background, np.float64)
     v0 = np.isfinite(zb[..., 0])[..., None]
     v1 = np.isfinite(zb[..., 1])[..., None]

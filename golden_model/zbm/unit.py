@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import numpy as np
 from rasterhw.golden_model.zbm.chip import _insert, _samples, chip_scanline
-from rasterhw.golden_model.zbm.doublez import DoubleZ
+from rasterhw.golden_model.zbm.doublez import DoubleZ, arrival_layers
 from rasterhw.golden_model.zbm.formats import (
     wrap,
 )
 from rasterhw.golden_model.zbm.seggen import Segments
 
-__all__ = ["unit_scanline"]
+__all__ = ["unit_scanline", "segment_fragments"]
 
 
 def unit_scanline(segs: Segments, y: int, interleave: int, width: int) -> tuple[DoubleZ, dict]:
@@ -40,12 +40,22 @@ def _unit_frame_fast(segs: Segments, height: int, width: int) -> tuple[DoubleZ, 
     """
     buf = DoubleZ.empty((height, width))
     flat = DoubleZ(buf.z.reshape(-1, 2), buf.a.reshape(-1, 2), buf.c.reshape(-1, 2, 4), buf.tag.reshape(-1, 2))
-    pixels = writes = 0
-    for s in range(segs.y.shape[0]):
-        k = np.arange(segs.len[s])
-        vals = wrap(segs.val[s][None, :] + k[:, None] * segs.inc[s][None, :])
-        z, a, c = _samples(vals, segs.mode)
-        pos = segs.y[s] * width + segs.x[s] + k
-        writes += _insert(flat, pos, z, a, c, np.full(k.size, segs.tag[s]))
-        pixels += int(k.size)
-    return buf, {"pixels": pixels, "writes": writes, "packets": None}
+    seg, k = segment_fragments(segs)
+    # the same int64 operations as one segment at a time (products wrap mod 2**64, then to 56 bits)
+    vals = wrap(segs.val[seg] + k[:, None] * segs.inc[seg])
+    z, a, c = _samples(vals, segs.mode)
+    pos = segs.y[seg] * width + segs.x[seg] + k
+    tag = segs.tag[seg]
+    writes = 0
+    for ly in arrival_layers(pos):   # fragments in emission order, one vectorised step per layer
+        writes += _insert(flat, pos[ly], z[ly], a[ly], c[ly], tag[ly])
+    return buf, {"pixels": int(k.size), "writes": writes, "packets": None}
+
+
+def segment_fragments(segs: Segments) -> tuple[np.ndarray, np.ndarray]:
+    """Every covered pixel of every segment in emission order: (segment index, pixel offset
+    ``k`` in ``0..len-1``), both (N,) int64."""
+    n = np.asarray(segs.len, np.int64)
+    seg = np.repeat(np.arange(n.size), n)
+    start = np.cumsum(n) - n
+    return seg, np.arange(seg.size, dtype=np.int64) - start[seg]
