@@ -3,9 +3,10 @@
 ``amaranth.back.verilog.convert`` of a large block takes tens of seconds (the sparse video
 processor ~25 s, the ZB/M unit more); a scene run whose Verilator model is already built
 should not pay it again. :func:`convert_cached` keys the text on the block name, its
-parameters, the Amaranth version and the bytes of every Python file under ``hdl/`` and
-``golden_model/`` (the formats modules the HDL takes its widths from live there), so any
-change to the design gives a fresh conversion and an unchanged design never converts twice.
+parameters, the Amaranth version and the bytes of every Python file the design can depend on
+(:func:`design_sources`: ``hdl/``, the generator and every module of ours they import, such as
+the formats modules the HDL takes its widths from), so any change to the design gives a fresh
+conversion and an unchanged design never converts twice.
 Files go to ``build/verilog/<name>-<digest>.v``, written atomically.
 """
 
@@ -17,21 +18,68 @@ from collections.abc import Callable, Mapping
 from functools import cache
 from pathlib import Path
 
-__all__ = ["convert_cached", "source_digest"]
+__all__ = ["convert_cached", "design_sources", "source_digest"]
 
 PKG_ROOT = Path(__file__).resolve().parent.parent
 
 
+def _module_file(mod: str) -> Path | None:
+    """The file of module ``rasterhw.<...>`` (a package's ``__init__.py``), None if not ours."""
+    parts = mod.split(".")
+    if parts[0] != "rasterhw":
+        return None
+    base = PKG_ROOT.joinpath(*parts[1:])
+    for f in (base.with_suffix(".py"), base / "__init__.py"):
+        if f.is_file():
+            return f
+    return None
+
+
+def _imported_files(f: Path) -> set[Path]:
+    """Our modules that ``f`` imports (anywhere in it: lazy imports count), by name: for
+    ``from pkg import name`` the submodule ``pkg.name`` if it is one, else ``pkg``."""
+    import ast
+
+    out: set[Path] = set()
+    for node in ast.walk(ast.parse(f.read_bytes(), str(f))):
+        if isinstance(node, ast.Import):
+            mods = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            mods = []
+            for a in node.names:
+                sub = _module_file(f"{node.module}.{a.name}")
+                mods.append(f"{node.module}.{a.name}" if sub is not None else node.module)
+        else:
+            continue
+        out |= {m for m in map(_module_file, mods) if m is not None}
+    return out
+
+
+def design_sources() -> list[Path]:
+    """Every Python file the generated Verilog can depend on: all of ``hdl/``, the Verilog
+    generator (``sim/verilog.py``) and, transitively, every module of ours they import (the
+    formats modules in ``golden_model/`` the HDL takes its widths from), and nothing else, so
+    an edit to the golden model's algorithms does not regenerate (or rebuild) the HDL."""
+    todo = [*sorted((PKG_ROOT / "hdl").rglob("*.py")), PKG_ROOT / "sim" / "verilog.py"]
+    seen: set[Path] = set()
+    while todo:
+        f = todo.pop()
+        if f in seen:
+            continue
+        seen.add(f)
+        todo += sorted(_imported_files(f) - seen)
+    return sorted(seen)
+
+
 @cache
 def source_digest() -> str:
-    """Digest of every ``.py`` file under ``hdl/`` and ``golden_model/`` (once per process)."""
+    """Digest of the Amaranth version and every file of :func:`design_sources` (once per process)."""
     import amaranth
 
     h = hashlib.sha1(amaranth.__version__.encode())
-    for sub in ("hdl", "golden_model"):
-        for f in sorted((PKG_ROOT / sub).rglob("*.py")):
-            h.update(str(f.relative_to(PKG_ROOT)).encode())
-            h.update(f.read_bytes())
+    for f in design_sources():
+        h.update(str(f.relative_to(PKG_ROOT)).encode())
+        h.update(f.read_bytes())
     return h.hexdigest()
 
 

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 
-__all__ = ["WORD", "FRAME", "HUE_BITS", "X_FRAC", "Z_BITS", "DZ_FRAC", "SLOPE_FRAC", "ACC_EXTRA",
+__all__ = ["ADDR_BITS", "SLOT_BITS", "WORD", "FRAME", "HUE_BITS", "X_FRAC", "Z_BITS", "DZ_FRAC", "SLOPE_FRAC", "ACC_EXTRA",
            "ALPHA_BITS", "ASB_WORDS", "Formats", "recip_rom", "rom_div", "sat", "wrap"]
 
 WORD = 16
@@ -136,3 +136,7 @@ def rom_div(num, den, shift: int) -> np.ndarray:
         sh = s - shift
         q = (p + (np.int64(1) << (sh - 1))) >> sh
     return np.where(den == 0, 0, sign * q)
+
+# the PXP's address and segment-table widths (the HDL and the cycle model take them from here)
+ADDR_BITS = 12   # ASB address (PL order) and polygon number: up to 4095 (4095 = none)
+SLOT_BITS = 8    # the A.J. segment table: 256 segments per line (= a DMM/P bank)

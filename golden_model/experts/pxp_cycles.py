@@ -19,14 +19,13 @@ at the frame's right edge with A.J.).
 from __future__ import annotations
 
 import numpy as np
+from rasterhw.golden_model.experts.formats import ADDR_BITS
 from rasterhw.golden_model.experts.model import ExpertsFrame
 from rasterhw.golden_model.experts.pxp import pixel_words
 
 __all__ = ["SEG_FIELDS", "line_segments", "line_pixels", "line_cycles", "ADDR_BITS"]
 
 SEG_FIELDS = ("xl", "xr", "zl", "il", "dzdx", "didx", "hue", "addr", "poly", "sl", "ql", "sr", "qr")
-ADDR_BITS = 12   # ASB address (PL order) and polygon number: up to 4095 (4095 = none)
-SLOT_BITS = 8    # the A.J. segment table: 256 segments per line (= a DMM/P bank)
 
 
 def guarded(lo: int, hi: int, width: int, aj: str) -> tuple[int, int]:

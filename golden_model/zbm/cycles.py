@@ -43,8 +43,11 @@ from rasterhw.golden_model.zbm.formats import (
     AEP_CAPACITY,
     CHANNELS,
     EP_LOAD_CYCLES,
+    GAP_PENDING,
     INTERLEAVES,
     PACKET_FLITS,
+    SCHEDULES,
+    paper_lead,
 )
 
 __all__ = ["PAPER_TABLE1_KPOLYS", "PAPER_LEN_CHIP", "len_chip", "formula_cycles_per_edge_pair",
@@ -153,23 +156,10 @@ FIFO_LATENCY = 2
 #: ``"overlap"``: our design (the chip buffers a packet, loads overlap the loop's work);
 #: ``"paper"``: the paper's sec. 6.1 schedule (a load leaves the loop idle 9 cycles, nothing
 #: runs ahead of the loop), see ``docs/zbm.md#paper-schedule``.
-SCHEDULES = ("overlap", "paper")
-#: ring gap value meaning "a packet is pending in the chip" (larger than any real gap)
-GAP_PENDING = 1023
-
-
 def check_schedule(schedule: str) -> str:
     if schedule not in SCHEDULES:
         raise RasterhwError(f"schedule must be 'overlap' or 'paper', not {schedule!r}")
     return schedule
-
-
-def paper_lead(mode: int) -> int:
-    """Cycles from a chip accepting a segment header to that packet's header entering the
-    ring (``1 + channels`` words into the initial processor, one cycle into the segment
-    processor): 7 (colour), 8 (mapping). In the paper schedule a chip accepts a header only
-    when its ring gap is at most this, so the packet starts exactly when the ring frees."""
-    return len(CHANNELS[mode]) + 2
 
 
 def _line_entries(eps: EdgePairs, segs, height: int) -> list[list[tuple[int, int, int]]]:

@@ -36,6 +36,7 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.screen import SUBPIXEL_BITS
 
 __all__ = [
+    "SCHEDULES", "GAP_PENDING", "paper_lead",
     "MAX_WIDTH", "MAX_HEIGHT", "SUBPIX_BITS", "COORD_LIMIT", "X_FRAC", "ATTR_FRAC", "OFF_FRAC",
     "SLOT_BITS", "Z_BITS", "Z_EMPTY", "Z_MAX_SAMPLE", "COLOUR_BITS", "TEX_BITS",
     "EP_WORDS", "EP_LOAD_CYCLES", "LOOP_BITS", "PACKET_FLITS", "PP_PER_CHIP", "INTERLEAVES",
@@ -304,3 +305,18 @@ Z_SCALE = (1 << Z_BITS) - 1     # float z in [0, 1] -> Z LSBs (same as ScreenTri
 TEX = 1 << TEX_BITS
 INC_LIMIT = (1 << 47) - 1       # attribute increments saturate here (keeps offset * inc in int64)
 VAL_LIMIT = (1 << 53) - 1       # attribute start values saturate here (room for 511 line steps)
+
+
+# ---------------------------------------------------------------- schedules (sec. 6.1; the HDL and
+# the cycle model both take them from here)
+SCHEDULES = ("overlap", "paper")
+#: ring gap value meaning "a packet is pending in the chip" (larger than any real gap)
+GAP_PENDING = 1023
+
+
+def paper_lead(mode: int) -> int:
+    """Cycles from a chip accepting a segment header to that packet's header entering the
+    ring (``1 + channels`` words into the initial processor, one cycle into the segment
+    processor): 7 (colour), 8 (mapping). In the paper schedule a chip accepts a header only
+    when its ring gap is at most this, so the packet starts exactly when the ring frees."""
+    return len(CHANNELS[mode]) + 2

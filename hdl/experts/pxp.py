@@ -29,15 +29,16 @@ from amaranth.lib import data, enum, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.experts.formats import (
+    ADDR_BITS,
     ALPHA_BITS,
     DZ_FRAC,
     HUE_BITS,
     SLOPE_FRAC,
+    SLOT_BITS,
     X_FRAC,
     Z_BITS,
     Formats,
 )
-from rasterhw.golden_model.experts.pxp_cycles import ADDR_BITS, SLOT_BITS
 
 __all__ = ["ExpertsPxp", "seg_layout"]
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 from amaranth import signed, unsigned
 from amaranth.lib import data
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.golden_model.zbm.cycles import GAP_PENDING, SCHEDULES, paper_lead
+from rasterhw.golden_model.zbm.formats import GAP_PENDING, SCHEDULES, paper_lead
 
 __all__ = [
     "check_interleave", "struct_of", "EP_HEADER", "EP_CHANNEL", "SEG_HEADER", "FLIT", "PKT_HEADER",
