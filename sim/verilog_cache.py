@@ -18,7 +18,7 @@ from collections.abc import Callable, Mapping
 from functools import cache
 from pathlib import Path
 
-__all__ = ["convert_cached", "design_sources", "source_digest"]
+__all__ = ["convert_cached", "design_sources", "generate_cached", "source_digest"]
 
 PKG_ROOT = Path(__file__).resolve().parent.parent
 
@@ -106,3 +106,11 @@ def convert_cached(name: str, factory: Callable[[], object], *, params: Mapping[
     text = convert(factory(), module)
     write_text(path, text)
     return text
+
+
+def generate_cached(block: str, **params) -> str:
+    """``rasterhw.sim.verilog.generate_verilog(block, **params)``, cached like :func:`convert_cached`."""
+    from rasterhw.sim.verilog import generate_verilog
+
+    return convert_cached(block, lambda: None, params=params, module=block,
+                          convert=lambda _design, _module: generate_verilog(block, **params))

@@ -38,6 +38,7 @@ from rasterhw.golden_model.snu import i860
 from rasterhw.golden_model.snu import pixelbus as golden
 from rasterhw.golden_model.snu.formats import CLOCK_HZ, MEM_CYCLE, N_BANKS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
+from rasterhw.sim.memh import memh_uint64, read_memh
 from rasterhw.sim.runner import HARNESS_V, REPO_ROOT, build_plain_verilator, run_plain_verilator
 
 __all__ = ["BENCH", "clear_cycles", "frame_run", "golden_schedule", "producer_gaps", "run_frame_hdl"]
@@ -175,26 +176,17 @@ def _stim_bytes(gap, z, rgb, addr) -> bytes:
 
 
 def _read_frame(path: Path, npix: int) -> tuple[np.ndarray, np.ndarray]:
-    raw = Path(path).read_bytes()
-    lines = [ln for ln in raw.split(b"\n") if ln and not ln.startswith(b"//") and not ln.startswith(b"@")]
-    if len(lines) != npix:
-        raise RasterhwError(f"{path}: {len(lines)} words, expected {npix}")
-    wmax = max(len(ln) for ln in lines)
-    if any(c in raw for c in (b"x", b"X", b"z", b"Z")):
-        raise RasterhwError(f"{path}: the dump holds X or Z bits")
-    a = np.frombuffer(b"".join(ln.rjust(wmax, b"0") for ln in lines), dtype=np.uint8).reshape(npix, wmax)
-    nib = np.where(a >= ord("a"), a - ord("a") + 10, a - ord("0")).astype(np.uint64)
-    val = np.zeros(npix, dtype=np.uint64)
-    for i in range(wmax):
-        val = (val << np.uint64(4)) | nib[:, i]
-    return (val >> np.uint64(24)).astype(np.int64), (val & np.uint64((1 << 24) - 1)).astype(np.int64)
+    """The bench's {rgb, z} dump -> (rgb, z) int64 (npix,)."""
+    b = read_memh(path, npix)
+    b = np.concatenate([np.zeros((npix, max(0, 6 - b.shape[1])), np.uint8), b], axis=1)[:, -6:]
+    return memh_uint64(b, 0, 3).astype(np.int64), memh_uint64(b, 3, 6).astype(np.int64)
 
 
 def run_frame_hdl(stream: PixelStream, gaps: np.ndarray, first_bench_gap: list[int]) -> dict:
     """Build (once) and run tb_pixelbus_fast.v on ``stream``; returns the schedule numbers, the
     displayed frame (rgb, z) and timings."""
     from amaranth.utils import ceil_log2
-    from rasterhw.sim.verilog import generate_verilog
+    from rasterhw.sim.verilog_cache import generate_cached
 
     w, h = stream.width, stream.height
     npix = w * h
@@ -205,7 +197,7 @@ def run_frame_hdl(stream: PixelStream, gaps: np.ndarray, first_bench_gap: list[i
     sdepth = max(1024, 1 << ceil_log2(max(len(i) for i in idx) + 2))
     t0 = time.perf_counter()
     ram = "memory" if -(-npix // N_BANKS) <= 4096 else "verilog"
-    text = generate_verilog("pixelbus", width=w, height=h, z_bits=stream.z_bits, ram=ram)
+    text = generate_cached("pixelbus", width=w, height=h, z_bits=stream.z_bits, ram=ram)
     exe, build_s = build_plain_verilator("snu-pixelbus-fast", TOP, [HARNESS_V, BENCH],
                                          params={"AW": aw, "ZW": stream.z_bits, "NPIX": npix, "SDEPTH": sdepth},
                                          generated={"pixelbus.v": text}, defines={"RASTERHW_CYCLES": 1})

@@ -160,7 +160,7 @@ def run_cocotb_bench(
 ) -> dict:
     """Run ``stream`` on the generated Verilog under cocotb; return cycles, frame, timings."""
     from amaranth.utils import ceil_log2
-    from rasterhw.sim.verilog import generate_verilog
+    from rasterhw.sim.verilog_cache import generate_cached
 
     sim = get_sim(sim)
     w, h = stream.width, stream.height
@@ -175,7 +175,7 @@ def run_cocotb_bench(
     bdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     vpath = bdir / "pixelbus.v"
-    text = generate_verilog("pixelbus", **params)
+    text = generate_cached("pixelbus", **params)
     write_if_changed(vpath, text)  # whole or not at all: a concurrent run may read it
     if expect is None:
         acc = golden.pixelbus_accept_cycles(stream, gaps=gaps)

@@ -20,7 +20,6 @@ digest of the ZB/M HDL sources, so a changed HDL file regenerates it.
 
 from __future__ import annotations
 
-import binascii
 import hashlib
 import json
 import os
@@ -44,6 +43,7 @@ from rasterhw.golden_model.zbm.words import (
     words_to_doublez,
 )
 from rasterhw.sim.harness import stream_protocol_checker, stream_put
+from rasterhw.sim.memh import memh_uint64, read_memh
 from rasterhw.sim.runner import (
     HARNESS_V,
     REPO_ROOT,
@@ -97,26 +97,11 @@ def _write_hex(path: Path, words, gaps, pw: int) -> None:
 
 def read_hex_words(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """A $writememh dump of 128-bit words -> (s0, s1) uint64 arrays (low, high 64 bits)."""
-    raw = Path(path).read_bytes()
-    if raw and raw.count(b"\n") * 33 == len(raw) and raw[32::33] == b"\n" * (len(raw) // 33):
-        # the usual dump: one 32-digit word per line, nothing else (decoded in C)
-        try:
-            w = np.frombuffer(binascii.unhexlify(raw.replace(b"\n", b"")), ">u8").reshape(-1, 2)
-        except binascii.Error:   # X or Z digits: the text path names them
-            return _read_hex_words_text(path)
-        return w[:, 1].astype(np.uint64), w[:, 0].astype(np.uint64)
-    return _read_hex_words_text(path)
-
-
-def _read_hex_words_text(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    lines = [ln.strip() for ln in Path(path).read_text().split("\n")]
-    lines = [ln for ln in lines if ln and not ln.startswith("//") and not ln.startswith("@")]
-    if any(("x" in ln or "X" in ln or "z" in ln) for ln in lines):
-        raise RasterhwError(f"{path}: the dump holds X or Z bits")
-    s = np.array([ln.rjust(32, "0") for ln in lines], dtype="U32")
-    lo = np.array([int(v[16:], 16) for v in s.tolist()], dtype=np.uint64)
-    hi = np.array([int(v[:16], 16) for v in s.tolist()], dtype=np.uint64)
-    return lo, hi
+    b = read_memh(path)
+    if b.shape[1] > 16:
+        raise RasterhwError(f"{path}: words wider than 128 bits")
+    b = np.concatenate([np.zeros((b.shape[0], 16 - b.shape[1]), np.uint8), b], axis=1)
+    return memh_uint64(b, 8, 16), memh_uint64(b, 0, 8)
 
 
 def check_edge_pairs(eps: G.EdgePairs, width: int, height: int, *, units: int = 1,
