@@ -48,6 +48,8 @@ facts above.
 
 from __future__ import annotations
 
+import copy
+import functools
 from dataclasses import dataclass, field
 
 from rasterhw.golden_model.errors import RasterhwError
@@ -371,8 +373,13 @@ def stage_clocks(stage: str, cpu: I860 | None = None, *, stream_triangles: int =
 
 
 def table1_model(cpu: I860 | None = None) -> dict:
-    """Stage -> :func:`stage_clocks` for table 1's seven stages, plus ``total`` clocks."""
-    cpu = cpu or I860()
+    """Stage -> :func:`stage_clocks` for table 1's seven stages, plus ``total`` clocks.
+    (Scheduled once per processor configuration; each call gets its own copy.)"""
+    return copy.deepcopy(_table1_model(cpu or I860()))
+
+
+@functools.lru_cache(maxsize=32)
+def _table1_model(cpu: I860) -> dict:
     rows = {s: stage_clocks(s, cpu) for s in STAGES}
     rows["total"] = {k: sum(r[k] for r in rows.values()) for k in ("clocks", "stream", "serial", "bound")}
     return rows
