@@ -211,14 +211,16 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
                *[str(bdir / k) for k in generated if k.endswith(".v")], *[str(f) for f in sources], str(PLAIN_MAIN)]
         t0 = time.perf_counter()
         # generate, put the shared runtime objects in (newer than the generated makefile, so make
-        # keeps them: sim/vlruntime.py), then compile
+        # keeps them: sim/vlruntime.py), then compile; both steps' memory peaks are recorded
         rt_flags = ["plain", make, cflags, *VERILATOR_PLAIN_ARGS]
-        r = run_child(cmd, cwd=bdir, env=env, capture_output=True, text=True)
+        peak = [bdir / "verilate.peak", bdir / "compile.peak"]
+        r = run_child([*_peak_rss(peak[0]), *cmd], cwd=bdir, env=env, capture_output=True, text=True)
         log = " ".join(cmd) + "\n" + r.stdout + r.stderr
+        t1 = time.perf_counter()
         if not r.returncode:
             vlruntime.seed(bdir / "obj_dir", "plain", rt_flags)
             mk = ["make", "-C", str(bdir / "obj_dir"), "-f", f"V{top}.mk", "-j", "2"]
-            r = run_child(mk, cwd=bdir, env=env, capture_output=True, text=True)
+            r = run_child([*_peak_rss(peak[1]), *mk], cwd=bdir, env=env, capture_output=True, text=True)
             log += " ".join(mk) + "\n" + r.stdout + r.stderr
         build_s = time.perf_counter() - t0
         (bdir / "build.log").write_text(log)
@@ -226,7 +228,30 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
             raise RasterhwError(f"{name}: verilator build failed ({_first_error(log)}); "
                                 f"see {bdir / 'build.log'}")
         vlruntime.harvest(bdir / "obj_dir", "plain", rt_flags)
+        mb = [float(p.read_text()) if p.exists() else None for p in peak]
+        (bdir / "build.json").write_text(json.dumps({
+            "model": name, "top": top, "params": params, "opt": opt, "build_s": round(build_s, 2),
+            "verilate_s": round(t1 - t0, 2), "compile_s": round(build_s - (t1 - t0), 2),
+            "verilate_peak_mb": mb[0], "compile_peak_mb": mb[1], "built": time.strftime("%Y-%m-%d %H:%M:%S")},
+            default=str) + "\n")
     return exe, build_s
+
+
+def _peak_rss(path: Path) -> list[str]:
+    """Command prefix that runs a command and writes its (and its descendants') peak RSS to ``path``."""
+    return [sys.executable, "-m", "rasterhw.sim.peakrss", str(path)]
+
+
+def build_records() -> list[dict]:
+    """What :func:`build_plain_verilator` recorded of every build under ``build/`` (cold build
+    seconds, verilate and compile steps, their memory peaks in MB), newest first."""
+    out = []
+    for f in (REPO_ROOT / "build").glob("*/build.json"):
+        try:
+            out.append({**json.loads(f.read_text()), "dir": f.parent.name})
+        except (OSError, ValueError):
+            continue
+    return sorted(out, key=lambda r: r.get("built", ""), reverse=True)
 
 
 def _first_error(text: str) -> str:

@@ -7,7 +7,7 @@ import subprocess
 
 import pytest
 from rasterhw.sim import vlruntime
-from rasterhw.sim.runner import build_plain_verilator
+from rasterhw.sim.runner import build_plain_verilator, build_records
 
 COUNTER = """module tb_count_{k} #(parameter N = 10) (input clk, output reg done, output reg [31:0] cycles);
   initial begin done = 0; cycles = 0; end
@@ -32,6 +32,10 @@ def test_second_model_build_reuses_the_runtime(tmp_path, monkeypatch):
         built.append(("verilated.cpp" in log.split("verilated.mk")[-1], log))
         out = json.loads(subprocess.run([str(exe)], capture_output=True, text=True).stdout.strip().splitlines()[-1])
         assert out["done"] == 1 and out["cycles"] >= 50 * k
+        # the build's record: time and the compiler's memory peak (a C++ compiler needs > 10 MB)
+        rec = json.loads((exe.parent.parent / "build.json").read_text())
+        assert rec["model"] == f"vlrt-test-{k}" and rec["build_s"] > 0 and rec["compile_peak_mb"] > 10
+        assert exe.parent.parent.name in {r["dir"] for r in build_records()}
     assert built[0][0], "the first build compiles the runtime"
     assert not built[1][0], "the second build compiled verilated.cpp again"
     assert (vlruntime.RUNTIME_OBJECTS[0] in {p.name for p in (tmp_path / "rt").rglob("*.o")})

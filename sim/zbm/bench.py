@@ -17,8 +17,10 @@ def bench(*, repeat: int = 11, hdl: bool = True, progress: bool = False) -> list
     small = simulate_zbm(build_scene("c50"), 64, 64, interleave=8, engine="pysim")
     return [
         {"name": "ZB/M unit, c300 512x512, interleave 8, Verilator, wall", "value": res["wall_s"], "unit": "s",
-         "note": f"target < 60 s; build {res.get('build_s', 0):.0f} s of it; {res['mismatches']} mismatches"},
-        {"name": "ZB/M unit, Verilator simulation rate", "value": res["cycles_per_s"], "unit": "cycles/s"},
+         "note": f"target < 5 s warm; build {res.get('build_s', 0):.0f} s of it; {res['mismatches']} mismatches"},
+        {"name": "ZB/M unit, plain Verilator + C++ main, simulation rate", "value": res["cycles_per_s"],
+         "unit": "cycles/s", "note": f"target >= 1e6; {res['cycles']} segment clocks of 8 chips + generator in "
+                                     f"{res['sim_s']:.2f} s of clock loop"},
         {"name": "ZB/M chip, preloaded c300 segments, Verilator + C++ main", "value": fast["cycles_per_s"],
          "unit": "cycles/s", "note": f"target >= 1e6; clock loop only; {fast['mismatches']} mismatches"},
         {"name": "ZB/M chip, same stimulus, Verilator under cocotb", "value": chip["cycles_per_s"],

@@ -1,0 +1,25 @@
+"""``python -m rasterhw.sim.peakrss FILE CMD...``: run CMD, then write to FILE the largest resident
+set (MB) of CMD and every descendant it waited for (``RUSAGE_CHILDREN``; for ``make`` that is the
+biggest compiler process), and exit with CMD's status. Used by the Verilator builds to print
+their compiler memory peak."""
+
+from __future__ import annotations
+
+import resource
+import subprocess
+import sys
+from pathlib import Path
+
+
+def main(argv: list[str]) -> int:
+    if len(argv) < 2:
+        print("usage: python -m rasterhw.sim.peakrss FILE CMD...", file=sys.stderr)
+        return 2
+    rc = subprocess.call(argv[1:])
+    peak_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    Path(argv[0]).write_text(f"{peak_kb / 1024:.1f}\n")
+    return rc
+
+
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv[1:]))
