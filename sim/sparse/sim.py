@@ -4,6 +4,7 @@ model pixel by pixel (triangle index and quantised depth)."""
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 
@@ -41,15 +42,32 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
     per = []
     run_s = 0.0
     sim_cycles = 0
-    for b in range(q):
-        for a in range(p):
-            r = run(recs, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits)
+    procs = [(a, b) for b in range(q) for a in range(p)]
+    if engine == "verilator":
+        # the processors are independent simulator processes: two at a time on this machine's
+        # cores (the build first, once); results are taken in processor order
+        from concurrent.futures import ThreadPoolExecutor
+
+        from rasterhw.sim.sparse.verilator_run import build
+
+        build(n=n, p=p, q=q, z_bits=tris.z_bits)
+        pool = ThreadPoolExecutor(max_workers=max(1, min(2, os.cpu_count() or 1)))
+        futures = [pool.submit(run, recs, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits) for a, b in procs]
+        results = (f.result() for f in futures)
+    else:
+        pool = None
+        results = (run(recs, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits) for a, b in procs)
+    try:
+        for (a, b), r in zip(procs, results, strict=True):
             loc_t[b, a], loc_z[b, a] = r["tri"], r["zq"]
             per.append(r)
             run_s += r.get("run_s", r.get("wall_s", 0.0))
             sim_cycles += r.get("sim_cycles", r["cycles"])
             if progress:
                 print(f"processor ({a}, {b}): {r['cycles']} cycles, tests per level {r['tests']}", file=sys.stderr, flush=True)
+    finally:
+        if pool is not None:
+            pool.shutdown(wait=True, cancel_futures=True)
     wall = time.perf_counter() - t0
     ht, hz = interleave(loc_t), interleave(loc_z)
     mism = int(np.count_nonzero((ht != g.tri_id) | (hz != gz)))
