@@ -24,8 +24,9 @@ What a round randomises, per block:
   lines through the cocotb bench with random idle clocks on the input and random
   back-pressure on the output (stream checkers, scoreboards).
 * ``sparse`` (sparse-raster video processors, 4 x 4 matrix, 256 x 256): random screen
-  triangles (count, size) or a random cube scene; every processor's local memory (triangle
-  index and depth) is compared. Round 0 instead runs one random processor through the cocotb
+  triangles (count, size; random idle clocks on every processor's input in most of these
+  rounds) or a random cube scene; every processor's local memory (triangle index and depth) and
+  per-level test counts are compared. Round 0 instead runs one random processor through the cocotb
   bench with random idle clocks on its input.
 
 The vector Z-buffer machine has no HDL, so it has no round here.
@@ -252,8 +253,10 @@ def _sparse_round(rng: np.random.Generator, k: int = 1) -> dict:
         n = int(rng.integers(20, 600))
         area = float(rng.uniform(5, 400))
         seed = int(rng.integers(0, 1 << 30))
-        r = simulate_tris(random_triangles(SP_W, SP_H, n, mean_area=area, seed=seed), "4x4", engine="verilator")
-        what = f"triangles n={n} area={area:.0f} seed={seed}"
+        idle = int(rng.choice([0, 0, 40, 128, 220]))
+        r = simulate_tris(random_triangles(SP_W, SP_H, n, mean_area=area, seed=seed), "4x4", engine="verilator",
+                          idle=idle, seed=int(rng.integers(1, 1 << 20)))
+        what = f"triangles n={n} area={area:.0f} seed={seed} idle={idle}"
     else:
         from rasterhw.golden_model.scenes import build_scene
 

@@ -18,8 +18,12 @@ from rasterhw.golden_model.sparse.search import interleave, sparse_render
 __all__ = ["simulate", "simulate_tris"]
 
 
-def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bool = False) -> dict:
-    """Run every processor on ``tris``; returns the ``rasterhw sim`` keys plus per-level tests."""
+def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bool = False, idle: int = 0,
+                  seed: int = 1) -> dict:
+    """Run every processor on ``tris``; returns the ``rasterhw sim`` keys plus per-level tests.
+    ``idle``, ``seed`` (Verilator only): random idle clocks on every processor's input (see
+    :func:`rasterhw.sim.sparse.verilator_run.run_processor_verilator`; processor ``(a, b)`` uses
+    seed ``seed + 64 * b + a``)."""
     p, q = parse_matrix(matrix)
     n = sparse_geometry(tris.width, tris.height, p, q)
     if engine == "pysim":
@@ -30,11 +34,13 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
         from rasterhw.sim.sparse.verilator_run import pack_records, run_processor_verilator
     else:
         raise RasterhwError(f"sparse sim: engine must be 'pysim' or 'verilator', not {engine!r}")
+    if idle and engine != "verilator":
+        raise RasterhwError("sparse sim: idle input clocks are a Verilator bench setting")
     g = sparse_render(tris, (p, q), depth="fixed")
     gz = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
     recs = broadcast_records(tris)
     if engine == "verilator":
-        run = partial(run_processor_verilator, packed=pack_records(recs))
+        run = partial(run_processor_verilator, packed=pack_records(recs), idle=idle)
     N = 1 << n
     loc_t = np.full((q, p, N, N), -1, dtype=np.int64)
     loc_z = np.full((q, p, N, N), -1, dtype=np.int64)
@@ -52,7 +58,8 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
 
         build(n=n, p=p, q=q, z_bits=tris.z_bits)
         pool = ThreadPoolExecutor(max_workers=max(1, min(2, os.cpu_count() or 1)))
-        futures = [pool.submit(run, recs, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits) for a, b in procs]
+        futures = [pool.submit(run, recs, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits, seed=seed + 64 * b + a)
+                   for a, b in procs]
         results = (f.result() for f in futures)
     else:
         pool = None

@@ -68,10 +68,14 @@ def pack_records(recs: list[dict]) -> str:
 
 
 def run_processor_verilator(recs: list[dict], *, n: int, p: int, q: int, a: int, b: int, z_bits: int = 24,
-                            packed: str | None = None) -> dict:
+                            packed: str | None = None, idle: int = 0, seed: int = 1) -> dict:
     """One processor on Verilator: the same keys as :func:`rasterhw.sim.sparse.hdl_run.run_processor`
     plus ``run_s`` (the C++ clock loop) and ``build_s``. ``packed``: :func:`pack_records` of ``recs``
-    when the caller runs several processors on the same records."""
+    when the caller runs several processors on the same records. ``idle`` (0..255): random idle
+    clocks on the input (a record is offered when a seeded 8-bit random number is >= ``idle``);
+    the frame and the per-level tests do not depend on it, the cycle count does."""
+    if not (isinstance(idle, int) and 0 <= idle <= 255):
+        raise RasterhwError(f"sparse verilator bench: idle must be an integer in 0..255, not {idle!r}")
     if len(recs) > MAXT:
         raise RasterhwError(f"sparse verilator bench holds at most {MAXT} triangles, not {len(recs)}")
     if not (0 <= a < p and 0 <= b < q):
@@ -80,9 +84,10 @@ def run_processor_verilator(recs: list[dict], *, n: int, p: int, q: int, a: int,
     run_dir = temp_run_folder(exe.parent.parent)
     (run_dir / "in.hex").write_text(pack_records(recs) if packed is None else packed)
     N = 1 << n
-    maxcyc = 200 * (len(recs) + 10) * (1 + n) + 64 * N * N + 10_000_000
+    maxcyc = (200 * (len(recs) + 10) * (1 + n) + 64 * N * N + 10_000_000) * (1 + idle // 16)
     meta = run_plain_verilator(exe, [f"+in={run_dir / 'in.hex'}", f"+out={run_dir / 'out.hex'}",
-                                     f"+stats={run_dir / 'stats.hex'}", f"+ntri={len(recs)}", f"+a={a}", f"+b={b}"],
+                                     f"+stats={run_dir / 'stats.hex'}", f"+ntri={len(recs)}", f"+a={a}", f"+b={b}",
+                                     f"+idle={idle}", f"+seed={seed}"],
                                run_dir=run_dir, maxcyc=maxcyc)
     words = _read_hex(run_dir / "out.hex")
     st = [int(v) for v in _read_hex(run_dir / "stats.hex")]

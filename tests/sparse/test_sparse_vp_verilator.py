@@ -23,3 +23,20 @@ def test_bad_engine():
     tris = random_triangles(32, 32, 2, seed=8)
     with pytest.raises(RasterhwError):
         simulate_tris(tris, "4x4", engine="icarus")
+
+
+def test_verilator_matrix_idle_input_same_frame_more_cycles():
+    """Random idle clocks on every processor's input: the same frame and per-level tests (they do
+    not depend on timing), a longer frame time; bad idle levels are one-line errors."""
+    from rasterhw.golden_model.errors import RasterhwError
+
+    tris = random_triangles(32, 32, 40, mean_area=20.0, seed=9)
+    free = simulate_tris(tris, "4x4", engine="verilator")
+    slow = simulate_tris(tris, "4x4", engine="verilator", idle=200, seed=5)
+    assert slow["mismatches"] == 0 and slow["tests_match_golden"] and slow["writes"] == slow["pixels_written_golden"]
+    assert slow["tests_per_level_hdl"] == free["tests_per_level_hdl"]
+    assert slow["cycles"] > free["cycles"]
+    with pytest.raises(RasterhwError, match="idle"):
+        simulate_tris(tris, "4x4", engine="verilator", idle=300)
+    with pytest.raises(RasterhwError, match="idle"):
+        simulate_tris(tris, "4x4", engine="pysim", idle=10)

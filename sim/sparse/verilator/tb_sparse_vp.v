@@ -1,6 +1,8 @@
 // Timing-free Verilator bench for the generated `sparse_vp` (rasterhw.hdl.sparse.vp).
 // Plays the broadcast records of +in= (one BW-bit hex word per triangle, +ntri= of them) into
-// processor (+a=, +b=) with no gaps, waits until the processor is idle, then sweeps the local
+// processor (+a=, +b=) -- with no gaps, or (+idle=K, 1..255, +seed=S) with random idle clocks:
+// a record not yet offered is offered only when a seeded 8-bit xorshift number is >= K, and an
+// offered one is held until taken (the stream rules) -- waits until the processor is idle, then sweeps the local
 // memory's read port and writes {tri, z} per sparse pixel to +out= and the per-level tests,
 // stalls and the cycle count to +stats= (hex words).
 module tb_sparse_vp #(parameter N = 7, parameter BW = 600, parameter MAXT = 16384, parameter ZW = 25,
@@ -9,7 +11,9 @@ module tb_sparse_vp #(parameter N = 7, parameter BW = 600, parameter MAXT = 1638
   reg [TW+ZW-1:0] outmem [0:(1 << (2 * N)) - 1];
   reg [31:0] stats [0:2 * N + 1];
   reg [1023:0] in_file, out_file, stats_file;
-  integer ntri, pa, pb, i;
+  integer ntri, pa, pb, i, IDLE, SEED;
+  reg offer;
+  reg [31:0] lf;
   reg [31:0] idx;
   reg rst;
   reg [2:0] phase;  // 0 reset, 1 feed, 2 drain, 3 read-out, 4 done
@@ -27,20 +31,34 @@ module tb_sparse_vp #(parameter N = 7, parameter BW = 600, parameter MAXT = 1638
     if (!$value$plusargs("ntri=%d", ntri)) ntri = 0;
     if (!$value$plusargs("a=%d", pa)) pa = 0;
     if (!$value$plusargs("b=%d", pb)) pb = 0;
+    if (!$value$plusargs("idle=%d", IDLE)) IDLE = 0;
+    if (!$value$plusargs("seed=%d", SEED)) SEED = 1;
     if (ntri > 0) $readmemh(in_file, rom, 0, ntri - 1);
+    offer = 1; lf = 32'h9E3779B9 ^ (SEED * 32'd7919 + 32'd1);
     idx = 0; phase = 0; done = 0; cycles = 0; raddr = 0; rd_addr = 0; rst = 1;
   end
   sparse_vp dut (.clk(clk), .rst(rst), .a(pa[5:0]), .b(pb[5:0]), .i__payload(rom[idx[13:0]]),
-                 .i__valid(phase == 1 && idx < ntri), .i__ready(i_ready), .rd_addr(rd_addr), .rd_z(rd_z),
+                 .i__valid(phase == 1 && idx < ntri && offer), .i__ready(i_ready), .rd_addr(rd_addr), .rd_z(rd_z),
                  .rd_tri(rd_tri), .writes(writes), .busy(busy)
 `include "tb_sparse_vp_ports.vh"
                  );
+  function [31:0] xorshift(input [31:0] x);
+    reg [31:0] t;
+    begin
+      t = x ^ (x << 13);
+      t = t ^ (t >> 17);
+      xorshift = t ^ (t << 5);
+    end
+  endfunction
+
   always @(posedge clk) begin
     case (phase)
       0: begin rst <= 0; phase <= 1; end
       1: begin
         cycles <= cycles + 1;
-        if (idx < ntri && i_ready) idx <= idx + 1;
+        lf <= xorshift(lf);
+        if (!offer || i_ready) offer <= (lf[7:0] >= IDLE);
+        if (idx < ntri && offer && i_ready) idx <= idx + 1;
         if (idx >= ntri) phase <= 2;
       end
       2: begin
