@@ -128,27 +128,48 @@ class Llvmpipe:
         return rgba.reshape(self.height, self.width, 4), ids.reshape(self.height, self.width) - 1
 
 
-def llvmpipe_bench(tris: ScreenTriangles, repeat: int, reference=None) -> dict:
-    """Time llvmpipe on ``tris``; compare its coverage with the reference's.
+def compare(tris: ScreenTriangles, repeat: int, ours) -> dict:
+    """Time llvmpipe and ``ours`` (a callable rendering ``tris``, returning a reference
+    :class:`~rasterhw.golden_model.reference.Frame`) side by side: ``repeat`` rounds, each
+    one run of ours then one draw of llvmpipe, so both see the same machine load; medians.
 
-    ``reference`` is a :class:`~rasterhw.golden_model.reference.Frame` of the same triangles
-    (rendered by the caller; compared, not timed). Returns ``{"median_s", "min_s", "repeat",
-    "renderer", "coverage_diff", "winner_diff", "threads"}``; raises :class:`Unavailable`."""
+    Returns ``{"ours_s", "llvmpipe_s", "ratio", "repeat", "ours_cpu_s", "llvmpipe_cpu_s",
+    "renderer", "threads", "coverage_diff", "winner_diff"}``: wall-clock medians, and
+    medians of the CPU time of the whole process (all llvmpipe's threads counted; a fairer
+    comparison on a loaded machine, where a single-threaded NumPy run waits for a core); ``coverage_diff`` counts pixels covered by one
+    renderer and not the other, ``winner_diff`` pixels whose visible triangle differs (depth
+    is interpolated in float32 there, so near-ties may go either way; reported, not
+    asserted). Raises :class:`Unavailable` when there is no moderngl or EGL."""
     gl = Llvmpipe(tris.width, tris.height)
     try:
         verts = gl.load(tris)
-        gl.draw(verts)  # warm-up: first draw compiles the rasteriser's shader variant
-        times = []
+        gl.draw(verts)  # warm-up: the first draw compiles llvmpipe's shader variants
+        frame = ours()
+        t_ours, t_gl, c_ours, c_gl = [], [], [], []
+        ids = None
         for _ in range(repeat):
-            t0 = time.perf_counter()
+            c0, t0 = time.process_time(), time.perf_counter()
+            frame = ours()
+            c1, t1 = time.process_time(), time.perf_counter()
             _, ids = gl.draw(verts)
-            times.append(time.perf_counter() - t0)
-        out = {"median_s": statistics.median(times), "min_s": min(times), "repeat": repeat,
-               "renderer": gl.renderer, "threads": os.environ.get("LP_NUM_THREADS", f"default ({os.cpu_count()} CPUs)")}
-        if reference is not None:
-            ours = np.asarray(reference.tri_id)
-            out["coverage_diff"] = int(np.count_nonzero((ours >= 0) != (ids >= 0)))
-            out["winner_diff"] = int(np.count_nonzero(ours != ids))
-        return out
+            c2, t2 = time.process_time(), time.perf_counter()
+            t_ours.append(t1 - t0)
+            t_gl.append(t2 - t1)
+            c_ours.append(c1 - c0)
+            c_gl.append(c2 - c1)
+        if ids is None:
+            _, ids = gl.draw(verts)
+        mine = np.asarray(frame.tri_id)
+        m_ours, m_gl = statistics.median(t_ours), statistics.median(t_gl)
+        return {"ours_s": m_ours, "llvmpipe_s": m_gl, "ratio": m_ours / m_gl, "repeat": repeat,
+                "ours_cpu_s": statistics.median(c_ours), "llvmpipe_cpu_s": statistics.median(c_gl),
+                "renderer": gl.renderer, "threads": threads(),
+                "coverage_diff": int(np.count_nonzero((mine >= 0) != (ids >= 0))),
+                "winner_diff": int(np.count_nonzero(mine != ids))}
     finally:
         gl.close()
+
+
+def threads() -> str:
+    """llvmpipe's rasteriser threads: ``LP_NUM_THREADS`` if set, else its default (one per CPU)."""
+    return os.environ.get("LP_NUM_THREADS", f"{os.cpu_count()} (one per CPU, Mesa's default)")
