@@ -409,10 +409,13 @@ def _rasterise(tris, xy, z, vcol, pid, bg, st: dict | None = None, rows: tuple[i
     poly = block[16 * npix:24 * npix].view(np.int64)
     colour = block[24 * npix:].view(np.float64).reshape(npix, 3)
     depth.fill(np.inf)
-    tri_id.fill(-1)  # while rendering: the kept-triangle index of the pixel's winner
-    # While rendering, colour[:, 0] and colour[:, 1] hold the winner's weights w1, w2; the
-    # colour is computed once per covered pixel at the end, in pixel order.
-    w1_px, w2_px = colour[:, 0], colour[:, 1]
+    tri_id.fill(-1)
+    poly.fill(-1)
+    # Background (a broadcast over a length-3 axis is slow: fill, or copy whole rows).
+    if bg.tobytes() == bg[:1].tobytes() * 3:  # same bits in all channels (-0.0 is not 0.0)
+        colour.fill(bg[0])
+    else:
+        np.copyto(colour.reshape(H, 3 * W), np.tile(bg, W))
     cnt = _scratch(npix)  # fragments per pixel in a chunk (all zero between chunks)
     fragments = written = 0
     if st is None and xy.shape[0]:
@@ -447,33 +450,17 @@ def _rasterise(tris, xy, z, vcol, pid, bg, st: dict | None = None, rows: tuple[i
             wf = np.flatnonzero(won)
             wp = np.take(pix, wf)
             depth[wp] = np.take(zz, wf)
-            tri_id[wp] = np.take(fr["rt"], np.take(fr["rec"], wf))
-            w1_px[wp] = np.take(fr["w"][1], wf)
-            w2_px[wp] = np.take(fr["w"][2], wf)
-    # Per covered pixel (ascending: sequential reads and writes): ids, then the colour
-    # w0*c0 + w1*c1 + w2*c2 with w0 = (1 - w1) - w2 exactly as for the fragment.
-    cov = np.flatnonzero(tri_id >= 0)
-    poly.fill(-1)
-    if cov.size:
-        wt = np.take(tri_id, cov)
-        tri_id[cov] = np.take(keep, wt)
-        poly[cov] = np.take(pk, wt)
-        w1 = np.take(w1_px, cov)
-        w2 = np.take(w2_px, cov)
-        w0 = np.subtract(1.0, w1)
-        w0 -= w2
-        rgb = np.empty((cov.size, 3))
-        for ch in range(3):
-            v = w0 * np.take(ctab[ch], wt)
-            v += w1 * np.take(ctab[3 + ch], wt)
-            np.add(v, w2 * np.take(ctab[6 + ch], wt), out=rgb[:, ch])
-    # Background (a broadcast over a length-3 axis is slow: fill, or copy whole rows).
-    if bg.tobytes() == bg[:1].tobytes() * 3:  # same bits in all channels (-0.0 is not 0.0)
-        colour.fill(bg[0])
-    else:
-        np.copyto(colour.reshape(H, 3 * W), np.tile(bg, W))
-    if cov.size:
-        colour.view(_RGB)[cov, 0] = rgb.view(_RGB)[:, 0]  # one scatter of whole RGB triples
+            wt = np.take(fr["rt"], np.take(fr["rec"], wf))
+            tri_id[wp] = np.take(keep, wt)
+            poly[wp] = np.take(pk, wt)
+            w0, w1, w2 = (np.take(w, wf) for w in fr["w"])
+            rgb = np.empty((wf.size, 3))
+            for ch in range(3):
+                v = w0 * np.take(ctab[ch], wt)
+                v += w1 * np.take(ctab[3 + ch], wt)
+                np.add(v, w2 * np.take(ctab[6 + ch], wt), out=rgb[:, ch])
+            # One scatter of whole RGB triples (24-byte items).
+            colour.view(_RGB)[wp, 0] = rgb.view(_RGB)[:, 0]
     return Frame(
         colour=colour.reshape(H, W, 3),
         depth=depth.reshape(H, W),
