@@ -298,8 +298,11 @@ def light(
             spec = term if spec is None else o.add(spec, term)
     col = o.mul(base, diffuse)
     if spec is not None:
-        col = o.add(col, spec)
-    return o.minimum(col, 1.0)
+        np.add(col, spec, out=col)  # in place: fresh pages cost more than the arithmetic
+        o.count("add", col.size)
+    np.minimum(col, 1.0, out=col)
+    o.count("cmp", col.size)
+    return col
 
 
 def backface_cull(clip_corners: np.ndarray, *, ops: OpCounter | None = None) -> np.ndarray:
@@ -541,10 +544,18 @@ def screen_map(
     """
     o = _ops(ops)
     hw, hh = 0.5 * width, 0.5 * height
-    sx = o.add(o.mul(ndc[:, 0], hw), hw)
-    sy = o.add(o.mul(ndc[:, 1], -hh), hh)
-    sx = o.minimum(o.maximum(sx, 0.0), float(width))
-    sy = o.minimum(o.maximum(sy, 0.0), float(height))
+    # x, y computed in place in their columns of the result (fresh pages cost more than the
+    # arithmetic): per column 1 mul, 1 add, 2 cmp, as the formulas read.
+    xy = np.empty((ndc.shape[0], 2))
+    for c, scale, off, hi in ((0, hw, hw, float(width)), (1, -hh, hh, float(height))):
+        v = xy[:, c]
+        np.multiply(ndc[:, c], scale, out=v)
+        v += off
+        np.maximum(v, 0.0, out=v)
+        np.minimum(v, hi, out=v)
+        o.count("mul", v.size)
+        o.count("add", v.size)
+        o.count("cmp", 2 * v.size)
     # z >= 0 already: clipping leaves z_clip >= 0 and w > 0, and the product of two
     # non-negative floats is non-negative, so only the top needs a clamp.
     z = o.minimum(ndc[:, 2], 1.0)
@@ -552,7 +563,7 @@ def screen_map(
     zq = o.minimum(o.rint_int(o.mul(z, float(1 << z_bits))), top)
     if z_far_is_zero:
         zq = o.sub(top, zq)
-    return np.stack([sx, sy], axis=-1), z, zq.astype(np.int64)
+    return xy, z, zq.astype(np.int64)
 
 
 def fan_triangulate(nverts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
