@@ -133,7 +133,8 @@ def compare(tris: ScreenTriangles, repeat: int, ours) -> dict:
     :class:`~rasterhw.golden_model.reference.Frame`) side by side: ``repeat`` rounds, each
     one run of ours then one draw of llvmpipe, so both see the same machine load; medians.
 
-    Returns ``{"ours_s", "llvmpipe_s", "ratio", "repeat", "ours_cpu_s", "llvmpipe_cpu_s",
+    Returns ``{"ours_s", "llvmpipe_s", "ratio", "repeat", "ours_min_s", "llvmpipe_min_s",
+    "ours_cpu_s", "llvmpipe_cpu_s",
     "renderer", "threads", "coverage_diff", "winner_diff"}``: wall-clock medians, and
     medians of the CPU time of the whole process (all llvmpipe's threads counted; a fairer
     comparison on a loaded machine, where a single-threaded NumPy run waits for a core); ``coverage_diff`` counts pixels covered by one
@@ -162,6 +163,7 @@ def compare(tris: ScreenTriangles, repeat: int, ours) -> dict:
         mine = np.asarray(frame.tri_id)
         m_ours, m_gl = statistics.median(t_ours), statistics.median(t_gl)
         return {"ours_s": m_ours, "llvmpipe_s": m_gl, "ratio": m_ours / m_gl, "repeat": repeat,
+                "ours_min_s": min(t_ours), "llvmpipe_min_s": min(t_gl),
                 "ours_cpu_s": statistics.median(c_ours), "llvmpipe_cpu_s": statistics.median(c_gl),
                 "renderer": gl.renderer, "threads": threads(),
                 "coverage_diff": int(np.count_nonzero((mine >= 0) != (ids >= 0))),
