@@ -25,11 +25,11 @@ How it is vectorised (no per-triangle Python loop):
 3. the spans are expanded to fragments (each per-record value is gathered on the record
    index of every fragment) and the weights and depth of every fragment are computed as
    whole-array operations;
-4. Z resolve by layers: layer 0 is the earliest fragment of every pixel (``np.minimum.at``
-   on the fragment index), layer 1 the next one, ... Each layer touches every pixel at most
-   once, so a layer is one vectorised step of a serial Z-buffer; running the layers in order
-   gives exactly what a serial Z-buffer writes (``pixels_written``) and the final winner per
-   pixel;
+4. Z resolve (:func:`_resolve`): a fragment alone at its pixel in the chunk is decided by
+   one comparison with the depth held there; the others are sorted by (pixel, submission
+   order), one sort of packed integer keys, and each pixel's running minimum is carried
+   down its run. That is exactly what a serial Z-buffer writes (``pixels_written``) and
+   the final winner per pixel;
 5. colour is computed only for the winners.
 
 Triangles are processed in chunks of at most about ``CHUNK_CANDIDATES`` bounding-box pixels,
