@@ -216,6 +216,18 @@ def frame_setup(scene: Scene, width: int, height: int) -> FrameSetup:
 
 
 # ----------------------------------------------------------------------------- stages
+def _scale_rows(o: OpCounter, a: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """``a * s[:, None]`` for (V, d) ``a`` and (V,) ``s``, counted as V*d mul: computed one
+    column at a time (same values; a broadcast over a short last axis runs NumPy's inner
+    loop once per row)."""
+    out = np.empty(np.broadcast_shapes(np.shape(a), (np.shape(s)[0], 1)))
+    a = np.broadcast_to(a, out.shape)
+    for c in range(out.shape[1]):
+        np.multiply(a[:, c], s, out=out[:, c])
+    o.count("mul", out.size)
+    return out
+
+
 def vertex_transform(
     positions: np.ndarray, mvp: np.ndarray, *, ops: OpCounter | None = None
 ) -> np.ndarray:
@@ -240,7 +252,7 @@ def normalise(v: np.ndarray, *, ops: OpCounter | None = None) -> np.ndarray:
     """
     o = _ops(ops)
     inv = o.recip(o.sqrt(o.dot(v, v)))
-    return o.mul(v, inv[:, None])
+    return _scale_rows(o, v, inv)
 
 
 def light(
@@ -269,18 +281,28 @@ def light(
         ndl = o.dot(normals, lighting.to_light[li])
         lit = o.gt(ndl, 0.0)
         ndl = np.where(lit, ndl, 0.0)
-        diffuse = o.add(diffuse, o.mul(ndl[:, None], lighting.diffuse[li]))
+        term = _scale_rows(o, lighting.diffuse[li][None, :], ndl)
+        if li == 0:  # ambient (a broadcast row) + term, one column at a time
+            for c in range(3):
+                np.add(diffuse[:, c], term[:, c], out=term[:, c])
+            o.count("add", term.size)
+            diffuse = term
+        else:
+            diffuse = o.add(diffuse, term)
         if lighting.has_specular:
             ndh = o.dot(normals, lighting.half[li])
             on = lit & o.gt(ndh, 0.0)
             idx = o.rint_int(o.mul(np.where(on, ndh, 0.0), SPEC_LUT_SIZE - 1))
             s = np.where(on, o.lookup(lighting.lut, idx), 0.0)
-            term = o.mul(s[:, None], lighting.specular[li])
+            term = _scale_rows(o, lighting.specular[li][None, :], s)
             spec = term if spec is None else o.add(spec, term)
     col = o.mul(base, diffuse)
     if spec is not None:
-        col = o.add(col, spec)
-    return o.minimum(col, 1.0)
+        np.add(col, spec, out=col)  # in place: fresh pages cost more than the arithmetic
+        o.count("add", col.size)
+    np.minimum(col, 1.0, out=col)
+    o.count("cmp", col.size)
+    return col
 
 
 def backface_cull(clip_corners: np.ndarray, *, ops: OpCounter | None = None) -> np.ndarray:
@@ -356,26 +378,83 @@ def clip(
     o = _ops(ops)
     n_p, k, n_c = corners.shape
     nv = np.asarray(nverts, dtype=np.int64)
-    # Polygons with every corner inside every plane (most of a scene) come out unchanged: the
-    # planes' compares are counted for them as the loop below would count them (one per corner
-    # per plane), and only the rest go through Sutherland-Hodgman. Same corners, same counts.
-    used = np.arange(k)[None, :] < nv[:, None]
+    hard = _clip_trivial(corners, nv, o)
+    out = np.zeros((n_p, k + 6, n_c))
+    out[:, :k] = corners
+    n_out = nv.copy()
+    cut = np.zeros(n_p, dtype=bool)
+    if hard.size:
+        out[hard], n_out[hard], cut[hard] = _clip_planes(corners[hard], nv[hard], near, o)
+    n_out[n_out < 3] = 0
+    return out, n_out, cut
+
+
+def _clip_trivial(corners: np.ndarray, nv: np.ndarray, o: OpCounter) -> np.ndarray:
+    """The polygons that cross a clip plane (indices); the rest come out of :func:`clip`
+    unchanged.
+
+    Polygons with every corner inside every plane (most of a scene) are not cut: the planes'
+    compares are counted for them as the plane loop would count them (one per corner per
+    plane), and only the rest go through Sutherland-Hodgman. Same corners, same counts."""
+    n_p, k, _ = corners.shape
     w = corners[..., _W]
     inside = np.ones((n_p, k), dtype=bool)
     for _name, axis, side in _PLANES:
         a = corners[..., axis]
         inside &= (a >= 0.0) if side == 0 else (a <= w) if side > 0 else (a >= -w)
-    trivial = np.all(inside | ~used, axis=1)
-    o.count("cmp", len(_PLANES) * int(nv[trivial].sum()))
-    out = np.zeros((n_p, k + 6, n_c))
-    out[:, :k] = corners
+    if nv.size == 0 or int(nv.min()) == k:  # every slot used (k-gons); columns, not a short axis
+        trivial = inside[:, 0].copy()
+        for j in range(1, k):
+            trivial &= inside[:, j]
+    else:
+        trivial = np.all(inside | ~(np.arange(k)[None, :] < nv[:, None]), axis=1)
+    n_trivial = int(nv.sum()) - int(nv[~trivial].sum())
+    o.count("cmp", len(_PLANES) * n_trivial)
+    return np.flatnonzero(~trivial)
+
+
+def _clip_flat(corners: np.ndarray, nverts: np.ndarray, near: float, o: OpCounter,
+               hard: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`clip` followed by the gather of the used corners of the polygons that survive,
+    back to back in polygon order, without building the padded ``(P, K + 6, C)`` array:
+    only polygons that cross a plane are clipped (and copied).
+
+    Returns ``(flat (V, C), n_clip (P,) corners per polygon (0 = clipped away), cut (P,))``,
+    exactly what ``clip`` and that gather give. ``hard`` is :func:`_clip_trivial` of the
+    corners (already counted)."""
+    n_p, k, n_c = corners.shape
+    nv = np.asarray(nverts, dtype=np.int64)
     n_out = nv.copy()
     cut = np.zeros(n_p, dtype=bool)
-    hard = np.flatnonzero(~trivial)
+    if hard.size == 0 and (nv.size == 0 or int(nv.min()) == k):  # nothing to clip, all slots used
+        return corners.reshape(n_p * k, n_c), n_out, cut
+    sub = None
     if hard.size:
-        out[hard], n_out[hard], cut[hard] = _clip_planes(corners[hard], nv[hard], near, o)
+        sub, n_out[hard], cut[hard] = _clip_planes(corners[hard], nv[hard], near, o)
     n_out[n_out < 3] = 0
-    return out, n_out, cut
+    first = np.cumsum(n_out) - n_out
+    flat = np.empty((int(n_out.sum()), n_c))
+    easy = np.ones(n_p, dtype=bool)
+    easy[hard] = False
+    _gather_used(flat, first, corners, np.flatnonzero(easy), n_out)
+    if sub is not None:
+        live = np.flatnonzero(n_out[hard] > 0)
+        _gather_used(flat, first[hard[live]], sub, live, n_out[hard[live]], rows_are_local=True)
+    return flat, n_out, cut
+
+
+def _gather_used(flat: np.ndarray, first: np.ndarray, src: np.ndarray, polys: np.ndarray,
+                 n: np.ndarray, rows_are_local: bool = False) -> None:
+    """Copy the first ``n[p]`` corners of ``src[p]`` for ``p`` in ``polys`` to
+    ``flat[first[p]:]`` (``first`` and ``n`` indexed like ``polys`` when ``rows_are_local``,
+    else by polygon)."""
+    if polys.size == 0:
+        return
+    cnt = n if rows_are_local else n[polys]
+    dst0 = first if rows_are_local else first[polys]
+    rows = np.repeat(polys, cnt)
+    cols = np.arange(rows.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+    flat[np.repeat(dst0, cnt) + cols] = src[rows, cols]
 
 
 def _clip_planes(corners: np.ndarray, nverts: np.ndarray, near: float, o: OpCounter
@@ -445,7 +524,7 @@ def perspective_divide(clip_xyzw: np.ndarray, *, ops: OpCounter | None = None) -
     """(V, 4) clip -> (V, 3) normalised device coordinates: 1 recip + 3 mul per vertex."""
     o = _ops(ops)
     inv_w = o.recip(clip_xyzw[:, _W])
-    return o.mul(clip_xyzw[:, :3], inv_w[:, None])
+    return _scale_rows(o, clip_xyzw[:, :3], inv_w)
 
 
 def screen_map(
@@ -465,10 +544,18 @@ def screen_map(
     """
     o = _ops(ops)
     hw, hh = 0.5 * width, 0.5 * height
-    sx = o.add(o.mul(ndc[:, 0], hw), hw)
-    sy = o.add(o.mul(ndc[:, 1], -hh), hh)
-    sx = o.minimum(o.maximum(sx, 0.0), float(width))
-    sy = o.minimum(o.maximum(sy, 0.0), float(height))
+    # x, y computed in place in their columns of the result (fresh pages cost more than the
+    # arithmetic): per column 1 mul, 1 add, 2 cmp, as the formulas read.
+    xy = np.empty((ndc.shape[0], 2))
+    for c, scale, off, hi in ((0, hw, hw, float(width)), (1, -hh, hh, float(height))):
+        v = xy[:, c]
+        np.multiply(ndc[:, c], scale, out=v)
+        v += off
+        np.maximum(v, 0.0, out=v)
+        np.minimum(v, hi, out=v)
+        o.count("mul", v.size)
+        o.count("add", v.size)
+        o.count("cmp", 2 * v.size)
     # z >= 0 already: clipping leaves z_clip >= 0 and w > 0, and the product of two
     # non-negative floats is non-negative, so only the top needs a clamp.
     z = o.minimum(ndc[:, 2], 1.0)
@@ -476,7 +563,7 @@ def screen_map(
     zq = o.minimum(o.rint_int(o.mul(z, float(1 << z_bits))), top)
     if z_far_is_zero:
         zq = o.sub(top, zq)
-    return np.stack([sx, sy], axis=-1), z, zq.astype(np.int64)
+    return xy, z, zq.astype(np.int64)
 
 
 def fan_triangulate(nverts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -526,11 +613,19 @@ def run_geometry(
         raise RasterhwError(f"run_geometry needs a Scene, got {type(scene).__name__}")
     scene.validate()
     n_p, k = scene.n_polygons, scene.max_corners
+    # A scene of k-gons (every corner slot used, e.g. all triangles) takes reshapes where a
+    # mixed one takes boolean gathers of the used slots; same values, same order.
+    full = int(scene.nverts.min()) == k
     used = np.arange(k)[None, :] < scene.nverts[:, None]
-    cols = scene.colours[used]
+
+    def used_of(a: np.ndarray) -> np.ndarray:  # (P, K, d) -> (corners in use, d)
+        return a.reshape(-1, a.shape[-1]) if full else a[used]
+
+    cols = used_of(scene.colours)
     if np.any(cols < 0.0) or np.any(cols > 1.0):
         raise RasterhwError(f"scene {scene.name!r}: vertex colours must be in [0, 1]")
-    nn = np.einsum("ij,ij->i", scene.normals[used], scene.normals[used])
+    nrm = used_of(scene.normals)
+    nn = np.einsum("ij,ij->i", nrm, nrm)
     if not np.all((nn > 1e-200) & (nn < 1e200)):
         raise RasterhwError(
             f"scene {scene.name!r}: a vertex normal has zero or absurd length; rescale it"
@@ -539,43 +634,66 @@ def run_geometry(
     o = OpCounter()
 
     with o.stage("vertex_transform"):
-        clip_used = vertex_transform(scene.positions[used], setup.mvp, ops=o)
-    clip_pos = np.zeros((n_p, k, 4))
-    clip_pos[used] = clip_used
-    # Padding slots repeat the last corner so every slot stays finite.
-    last = clip_pos[np.arange(n_p), scene.nverts - 1]
-    clip_pos[~used] = np.broadcast_to(last[:, None, :], clip_pos.shape)[~used]
+        clip_used = vertex_transform(used_of(scene.positions), setup.mvp, ops=o)
+    if full:
+        clip_pos = clip_used.reshape(n_p, k, 4)
+    else:
+        clip_pos = np.zeros((n_p, k, 4))
+        clip_pos[used] = clip_used
+        # Padding slots repeat the last corner so every slot stays finite.
+        last = clip_pos[np.arange(n_p), scene.nverts - 1]
+        clip_pos[~used] = np.broadcast_to(last[:, None, :], clip_pos.shape)[~used]
 
     with o.stage("backface_cull"):
         front = backface_cull(clip_pos[:, :3], ops=o)
     fidx = np.flatnonzero(front)
-    fused = used[fidx]
+    every = fidx.size == n_p
+
+    def front_of(a: np.ndarray) -> np.ndarray:  # (P, ...) -> front polygons only
+        return a if every else a[fidx]
 
     with o.stage("normal_transform"):
-        n_eye = normal_transform(scene.normals[fidx][fused], setup.normal_matrix, ops=o)
+        n_f = front_of(scene.normals)
+        n_eye = normal_transform(n_f.reshape(-1, 3) if full else n_f[used[fidx]],
+                                 setup.normal_matrix, ops=o)
     with o.stage("normalise"):
         n_unit = normalise(n_eye, ops=o)
     with o.stage("light"):
-        lit = light(n_unit, scene.colours[fidx][fused], setup.lighting, ops=o)
+        c_f = front_of(scene.colours)
+        lit = light(n_unit, c_f.reshape(-1, 3) if full else c_f[used[fidx]], setup.lighting, ops=o)
 
     n_attr = 7 + (2 if scene.uv is not None else 0)
-    corners = np.zeros((fidx.size, k, n_attr))
-    corners[:, :, :4] = clip_pos[fidx]
-    corners[:, :, _RGB][fused] = lit
-    if scene.uv is not None:
-        corners[:, :, 7:9] = scene.uv[fidx]
-
+    clip_f = front_of(clip_pos)
     with o.stage("clip"):
-        clipped, n_clip, cut = clip(corners, scene.nverts[fidx], setup.near, ops=o)
+        hard = _clip_trivial(clip_f, scene.nverts[fidx], o)
+    if full and hard.size == 0:
+        # nothing crosses a plane and every slot is used: the corners go on as they are
+        # (what clip and the gather of used corners would give, without the copies)
+        n_clip = scene.nverts[fidx].astype(np.int64)
+        cut = np.zeros(fidx.size, dtype=bool)
+        xyzw = clip_f.reshape(-1, 4)
+        rgb = lit
+        uv = front_of(scene.uv).reshape(-1, 2) if scene.uv is not None else None
+    else:
+        corners = np.zeros((fidx.size, k, n_attr))
+        corners[:, :, :4] = clip_f
+        if full:
+            corners[:, :, _RGB] = lit.reshape(fidx.size, k, 3)
+        else:
+            corners[:, :, _RGB][used[fidx]] = lit
+        if scene.uv is not None:
+            corners[:, :, 7:9] = front_of(scene.uv)
+        with o.stage("clip"):
+            # the used corners of the polygons that survive, back to back (only polygons
+            # that cross a plane are clipped; see clip)
+            flat, n_clip, cut = _clip_flat(corners, scene.nverts[fidx], setup.near, o, hard)
+        xyzw, rgb = flat[:, :4], flat[:, _RGB]
+        uv = flat[:, 7:9] if scene.uv is not None else None
     drawn = np.flatnonzero(n_clip > 0)
     n_draw = n_clip[drawn]
-    # the used corners of the drawn polygons, in order (one gather, not a copy and a mask)
-    rows = np.repeat(drawn, n_draw)
-    cols = np.arange(rows.size) - np.repeat(np.cumsum(n_draw) - n_draw, n_draw)
-    flat = clipped[rows, cols]
 
     with o.stage("perspective_divide"):
-        ndc = perspective_divide(flat[:, :4], ops=o)
+        ndc = perspective_divide(xyzw, ops=o)
     with o.stage("screen_map"):
         xy, z, zq = screen_map(
             ndc, width, height, z_bits=z_bits, z_far_is_zero=z_far_is_zero, ops=o
@@ -583,6 +701,13 @@ def run_geometry(
 
     tri, tri_poly = fan_triangulate(n_draw)
     poly_id = fidx[drawn][tri_poly]
+    if tri.shape[0] * 3 == xyzw.shape[0] and drawn.size == tri.shape[0]:
+        # triangles only: the fan is the identity, (T, 3) corners back to back
+        def corners_of(a: np.ndarray) -> np.ndarray:
+            return a.reshape(tri.shape[0], 3, *a.shape[1:])
+    else:
+        def corners_of(a: np.ndarray) -> np.ndarray:
+            return a[tri]
     ops = o.as_dict()
     ops["polygons"] = n_p
     ops["vertices"] = int(scene.nverts.sum())
@@ -598,12 +723,12 @@ def run_geometry(
     return ScreenTriangles(
         width=width,
         height=height,
-        xy=xy[tri],
-        z=z[tri],
-        zq=zq[tri],
-        colour=flat[:, _RGB][tri],
+        xy=corners_of(xy),
+        z=corners_of(z),
+        zq=corners_of(zq),
+        colour=np.ascontiguousarray(corners_of(rgb)),
         poly_id=poly_id.astype(np.int64),
-        uv=flat[:, 7:9][tri] if scene.uv is not None else None,
+        uv=np.ascontiguousarray(corners_of(uv)) if uv is not None else None,
         z_bits=z_bits,
         z_far_is_zero=bool(z_far_is_zero),
         stats=stats,

@@ -25,11 +25,11 @@ How it is vectorised (no per-triangle Python loop):
 3. the spans are expanded to fragments (each per-record value is gathered on the record
    index of every fragment) and the weights and depth of every fragment are computed as
    whole-array operations;
-4. Z resolve by layers: layer 0 is the earliest fragment of every pixel (``np.minimum.at``
-   on the fragment index), layer 1 the next one, ... Each layer touches every pixel at most
-   once, so a layer is one vectorised step of a serial Z-buffer; running the layers in order
-   gives exactly what a serial Z-buffer writes (``pixels_written``) and the final winner per
-   pixel;
+4. Z resolve (:func:`_resolve`): a fragment alone at its pixel in the chunk is decided by
+   one comparison with the depth held there; the others are sorted by (pixel, submission
+   order), one sort of packed integer keys, and each pixel's running minimum is carried
+   down its run. That is exactly what a serial Z-buffer writes (``pixels_written``) and
+   the final winner per pixel;
 5. colour is computed only for the winners.
 
 Triangles are processed in chunks of at most about ``CHUNK_CANDIDATES`` bounding-box pixels,
@@ -290,16 +290,69 @@ def _pool() -> _Pool:
 _RGB = np.dtype((np.void, 24))  # one pixel's colour (three float64) as a single item
 
 
-def _scratch(npix: int) -> tuple[np.ndarray, np.ndarray]:
-    """Two per-pixel int64 scratch arrays, kept between calls (per thread) because touching
-    fresh memory costs more than the work done in it. ``first`` is returned all ``int64 max``
-    (every use restores it); ``win`` holds garbage."""
+def _scratch(npix: int) -> np.ndarray:
+    """A per-pixel int64 count array, all zero (every use restores it), kept between calls
+    (per thread) because touching fresh memory costs more than the work done in it."""
     cached = getattr(_local, "scratch", None)
-    if cached is None or cached.shape[1] != npix:
-        cached = np.empty((2, npix), dtype=np.int64)
-        cached[1].fill(np.iinfo(np.int64).max)
+    if cached is None or cached.size != npix:
+        cached = np.zeros(npix, dtype=np.int64)
         _local.scratch = cached
-    return cached[0], cached[1]
+    return cached
+
+
+def _resolve(pix: np.ndarray, zz: np.ndarray, F: int, depth: np.ndarray, cnt: np.ndarray
+             ) -> tuple[np.ndarray, int]:
+    """The serial Z-buffer over one chunk's fragments (in submission order), vectorised.
+
+    A fragment is written when its depth is below the depth held at its pixel, which is the
+    smaller of the depth before the chunk and the depths of the chunk's earlier fragments
+    there; the pixel's winner is the last fragment written. Fragments alone at their pixel
+    in the chunk (most of them) are decided by one comparison. The others are sorted by
+    (pixel, submission order) with one sort of packed integer keys, and each pixel's running
+    minimum is carried down its run: step ``k`` takes the ``k``-th fragment of every pixel
+    that has more than ``k`` (runs sorted by length, so that is a prefix of them), so the
+    steps together touch each of these fragments once.
+
+    Returns (a mask of the winning fragments, one per pixel that was written, and the
+    number of writes). ``depth`` is read, not written; ``cnt`` is used as scratch and left zero.
+    """
+    np.add.at(cnt, pix, 1)
+    alone = np.take(cnt, pix) == 1
+    cnt[pix] = 0
+    held = np.take(depth, pix)  # depth held at each fragment's pixel before the chunk
+    won = zz < held
+    won &= alone  # a fragment alone at its pixel is written iff it passes against ``held``
+    nw = int(np.count_nonzero(won))
+    m = np.flatnonzero(~alone)
+    if m.size == 0:
+        return won, nw
+    bits = max(int(F - 1).bit_length(), 1)
+    key = np.take(pix, m) << bits
+    key |= m
+    key.sort()
+    mi = key & ((1 << bits) - 1)  # fragment, in (pixel, order) order
+    head = np.empty(mi.size, dtype=bool)
+    head[0] = True
+    np.not_equal(key[1:] >> bits, key[:-1] >> bits, out=head[1:])
+    starts = np.flatnonzero(head)
+    lens = np.diff(starts, append=mi.size)
+    by = np.argsort(-lens, kind="stable")
+    starts, lens = starts[by], lens[by]
+    zm = np.take(zz, mi)
+    run = np.take(held, np.take(mi, starts))  # depth held at each pixel, carried down its run
+    win = np.full(starts.size, -1, dtype=np.int64)
+    n_at = np.searchsorted(-lens, -np.arange(1, int(lens[0]) + 1), side="right")  # runs longer than k
+    for k in range(int(lens[0])):
+        n = int(n_at[k])
+        at = starts[:n] + k
+        zk = np.take(zm, at)
+        r = run[:n]
+        hit = zk < r
+        nw += int(np.count_nonzero(hit))
+        np.copyto(r, zk, where=hit)
+        np.copyto(win[:n], at, where=hit)
+    won[np.take(mi, win[win >= 0])] = True
+    return won, nw
 
 
 def rasterise(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0)) -> Frame:
@@ -363,8 +416,7 @@ def _rasterise(tris, xy, z, vcol, pid, bg, st: dict | None = None, rows: tuple[i
         colour.fill(bg[0])
     else:
         np.copyto(colour.reshape(H, 3 * W), np.tile(bg, W))
-    win, first = _scratch(npix)  # winning fragment per pixel (this chunk); layer scratch
-    big = np.iinfo(np.int64).max
+    cnt = _scratch(npix)  # fragments per pixel in a chunk (all zero between chunks)
     fragments = written = 0
     if st is None and xy.shape[0]:
         st = _setup(xy, W, H)
@@ -391,40 +443,22 @@ def _rasterise(tris, xy, z, vcol, pid, bg, st: dict | None = None, rows: tuple[i
                 continue
             fragments += F
             pix, zz = fr["pix"], fr["z"]
-            # Serial Z-buffer, one layer at a time: a layer is the earliest remaining fragment
-            # of every pixel, so no pixel appears twice in it and its Z test is one vector op.
-            win[pix] = -1
-            idx = idx0 = _pool().iota(F)
-            rp = pix
-            while idx.size:
-                np.minimum.at(first, rp, idx)
-                isfirst = first[rp] == idx
-                f, p = idx[isfirst], rp[isfirst]
-                first[p] = big
-                zf = zz[f]
-                ok = zf < depth[p]
-                if not ok.all():
-                    f, p, zf = f[ok], p[ok], zf[ok]
-                written += f.size
-                depth[p] = zf
-                win[p] = f
-                if f.size == idx.size:
-                    break
-                rest = ~isfirst
-                idx, rp = idx[rest], rp[rest]
-            # Winners in fragment order (sequential gathers), then colour only for them. A
-            # fragment won its pixel if it was the last one written there in this chunk.
-            wf = np.flatnonzero(win[pix] == idx0)
-            wp = pix[wf]
-            wt = fr["rt"][fr["rec"][wf]]
-            tri_id[wp] = keep[wt]
-            poly[wp] = pk[wt]
-            w0, w1, w2 = (w[wf] for w in fr["w"])
+            won, nw = _resolve(pix, zz, F, depth, cnt)
+            written += nw
+            # Colour only for the winners (at most one per pixel in a chunk), gathered in
+            # fragment order (ascending indices: sequential reads).
+            wf = np.flatnonzero(won)
+            wp = np.take(pix, wf)
+            depth[wp] = np.take(zz, wf)
+            wt = np.take(fr["rt"], np.take(fr["rec"], wf))
+            tri_id[wp] = np.take(keep, wt)
+            poly[wp] = np.take(pk, wt)
+            w0, w1, w2 = (np.take(w, wf) for w in fr["w"])
             rgb = np.empty((wf.size, 3))
             for ch in range(3):
-                v = w0 * ctab[ch][wt]
-                v += w1 * ctab[3 + ch][wt]
-                np.add(v, w2 * ctab[6 + ch][wt], out=rgb[:, ch])
+                v = w0 * np.take(ctab[ch], wt)
+                v += w1 * np.take(ctab[3 + ch], wt)
+                np.add(v, w2 * np.take(ctab[6 + ch], wt), out=rgb[:, ch])
             # One scatter of whole RGB triples (24-byte items).
             colour.view(_RGB)[wp, 0] = rgb.view(_RGB)[:, 0]
     return Frame(
