@@ -130,13 +130,20 @@ class Scene:
             )
         if int(self.nverts.max()) > p.shape[1]:
             raise RasterhwError(f"scene {self.name!r}: nverts exceeds the corner slots K={p.shape[1]}")
-        used = np.arange(p.shape[1])[None, :] < self.nverts[:, None]
-        # checked on whole arrays and masked afterwards (a boolean gather of every corner is slower)
-        for what, arr in (("position", p), ("normal", self.normals), ("colour", self.colours)):
-            if np.any(~np.isfinite(arr).all(axis=-1) & used):
-                raise RasterhwError(f"scene {self.name!r}: a vertex {what} is NaN or infinite")
         limit = 1e15
-        mag = float(np.where(used, np.abs(p).max(axis=-1), 0.0).max())
+        if int(self.nverts.min()) == p.shape[1]:
+            # every corner slot is used (triangle meshes, k-gon scenes): whole-array reductions
+            for what, arr in (("position", p), ("normal", self.normals), ("colour", self.colours)):
+                if not np.isfinite(arr).all():
+                    raise RasterhwError(f"scene {self.name!r}: a vertex {what} is NaN or infinite")
+            mag = float(np.abs(p).max())
+        else:
+            used = np.arange(p.shape[1])[None, :] < self.nverts[:, None]
+            # checked on whole arrays and masked afterwards (a boolean gather of every corner is slower)
+            for what, arr in (("position", p), ("normal", self.normals), ("colour", self.colours)):
+                if np.any(~np.isfinite(arr).all(axis=-1) & used):
+                    raise RasterhwError(f"scene {self.name!r}: a vertex {what} is NaN or infinite")
+            mag = float(np.where(used, np.abs(p).max(axis=-1), 0.0).max())
         if mag > limit:
             raise RasterhwError(
                 f"scene {self.name!r}: a vertex coordinate has magnitude {mag:.3g} "

@@ -9,6 +9,7 @@ are not, the llvmpipe rows are printed with no value and the reason.
 
 from __future__ import annotations
 
+import json
 import os
 import statistics
 import time
@@ -116,4 +117,27 @@ def run_bench(*, repeat: int = 11, hdl: bool = True, progress: bool = True) -> l
         step(name)
         rows += fn(repeat=repeat, hdl=hdl, progress=progress)
     bar.close()
+    if hdl:
+        rows += build_rows()
+    return rows
+
+
+def build_rows() -> list[dict]:
+    """The cold build of every plain-Verilator model under ``build/`` (newest per model), as
+    recorded when it was built (``runner.build_records``): seconds, and the memory peaks of the
+    Verilator and compiler steps."""
+    from rasterhw.sim.runner import build_records
+
+    rows, seen = [], set()
+    for r in build_records():
+        key = (r.get("model"), json.dumps(r.get("params"), sort_keys=True))
+        if key in seen or str(r.get("model", "")).startswith("vlrt-test"):
+            continue
+        seen.add(key)
+        params = ", ".join(f"{k}={v}" for k, v in (r.get("params") or {}).items())
+        peaks = [r.get("verilate_peak_mb"), r.get("compile_peak_mb")]
+        rows.append({"name": f"cold build: {r['model']} ({params})", "value": r.get("build_s"), "unit": "s",
+                     "note": f"target < 30 s, < 4 GB; verilate {r.get('verilate_s')} s, compile {r.get('compile_s')} s "
+                             f"at {r.get('opt')}; peak memory {peaks[0]} / {peaks[1]} MB; built {r.get('built')} "
+                             f"(build/{r.get('dir')})"})
     return rows

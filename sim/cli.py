@@ -441,7 +441,8 @@ def bench(as_json: bool, repeat: int, hdl: bool) -> None:
         emit_json(rows)
     else:
         for r in rows:
-            click.echo(f"{r['name']:<52} {r['value']:>12.4g} {r['unit']:<10} {r.get('note', '')}")
+            value = "-" if r["value"] is None else f"{r['value']:>12.4g}"
+            click.echo(f"{r['name']:<52} {value:>12} {r['unit']:<10} {r.get('note', '')}")
 
 
 @cli.command()

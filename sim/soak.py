@@ -100,9 +100,10 @@ def _pixelbus_round(rng: np.random.Generator) -> dict:
 
 # ---------------------------------------------------------------- ZB/M unit
 ZBM_W, ZBM_H, ZBM_I = 256, 256, 2
-#: the bench's stimulus memory (a build parameter) is 1024 words up to 1021 edge pairs:
-#: rounds stay below that, so every round runs on one build
+#: rounds keep at most this many edge pairs (9 loader words each, plus the end marker) and pass
+#: one stimulus depth that holds them, so every round runs on one build of each bench
 ZBM_MAX_EDGE_PAIRS = 1021
+ZBM_SDEPTH = 16384
 #: every this many rounds (from round 0) runs two clocks at a random ratio under cocotb; the
 #: others run equal clocks on plain Verilator (several times faster per round)
 ZBM_RATIO_EVERY = 4
@@ -158,13 +159,13 @@ def _zbm_round(rng: np.random.Generator, k: int = 1) -> dict:
     seed = int(rng.integers(0, 1 << 30))
     if k % ZBM_RATIO_EVERY == 0:   # two clocks at a random ratio: the cocotb bench (Verilator --timing)
         r = Z.run_unit_bench([eps], width=ZBM_W, height=ZBM_H, interleave=ZBM_I, sim="verilator", ratio=ratio,
-                             stall=stall, seed=seed, gap_seed=gap_seed, expect=exp)
+                             stall=stall, seed=seed, gap_seed=gap_seed, expect=exp, sdepth=ZBM_SDEPTH)
     else:   # equal clocks: the plain-Verilator bench (held cycle-exact with the cocotb one)
         from rasterhw.sim.zbm.fast import run_unit_fast
 
         ratio = (5, 5)
         r = run_unit_fast([eps], width=ZBM_W, height=ZBM_H, interleave=ZBM_I, stall=stall, seed=seed,
-                          gap_seed=gap_seed)
+                          gap_seed=gap_seed, sdepth=ZBM_SDEPTH)
     bad = int(np.count_nonzero((r["s0"] != exp[0]) | (r["s1"] != exp[1])))
     bad += int(r.get("proto_errors", 0)) + int(not r.get("frames_ok", True))
     return {"pixels": ZBM_W * ZBM_H, "mismatches": bad, "run_s": r["run_s"],

@@ -57,7 +57,7 @@ from rasterhw.sim.workdirs import temp_run_folder
 
 __all__ = [
     "CLOCK_HZ", "ENGINES", "GAP_BITS",
-    "check_edge_pairs", "chain_verilog", "chip_stimulus", "float_tolerance", "random_gaps",
+    "check_edge_pairs", "chain_verilog", "stimulus_depth", "chip_stimulus", "float_tolerance", "random_gaps",
     "read_hex_words", "run_chip_bench", "run_unit_bench", "run_units_pysim", "simulate_zbm",
     "chip_speed",
 ]
@@ -243,6 +243,17 @@ def _depth(n: int) -> int:
     return max(1024, 1 << int(n + 2).bit_length())
 
 
+def stimulus_depth(words: int, depth: int | None = None) -> int:
+    """A bench's stimulus memory depth for ``words`` words: ``depth`` if given (it must hold them),
+    else the smallest power of two (>= 1024) that does."""
+    need = _depth(words)
+    if depth is None:
+        return need
+    if not isinstance(depth, int) or depth < words + 2:
+        raise RasterhwError(f"stimulus depth {depth!r} does not hold {words} words")
+    return depth
+
+
 # ====================================================================== unit bench
 def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, interleave: int,
                    sim: str | None = None, capacity: int = F.AEP_CAPACITY, ratio: tuple[int, int] = (5, 5),
@@ -250,7 +261,7 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
                    expect: tuple[np.ndarray, np.ndarray] | None = None, speed_run: bool = False,
                    check_protocol: bool = False,
                    keep: bool = False, phase: int = 1, schedule: str = "overlap", line_log: bool = False,
-                   opt: str = "-O1") -> dict:
+                   opt: str = "-O1", sdepth: int | None = None) -> dict:
     """Run a chain of units (unit k gets ``eps_per_unit[k]``) on the generated Verilog.
 
     ``ratio`` = (segment, merge) clock half periods in ns; ``stall`` = back-pressure level
@@ -262,7 +273,9 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
     ``speed_run=True`` (it compares the returned dump itself); else RasterhwError.
     ``opt``: C++ optimisation of the per-cycle code (``-O0`` for the small timing benches, whose
     build dominates). ``line_log``: also return ``line_cycles`` (H,): unit 0's segment-clock count in the merge
-    cycle in which the last chip slot finished each merge output line.
+    cycle in which the last chip slot finished each merge output line. ``sdepth``: the bench's
+    stimulus memory depth (a build parameter; default the smallest that holds the words): runs of
+    different sizes that pass the same depth share one build.
     Returns ``{"s0", "s1": (H, W) uint64, "cycles", "proto_errors", "build_s", "run_s", ...}``.
     """
     exp_env = _expect_env(expect, speed_run)   # before any work
@@ -273,7 +286,7 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
                          schedule=schedule)
     words = [edge_pair_words(e) for e in eps_per_unit]
     total = sum(len(w) for w in words)
-    sdepth = _depth(total)
+    sdepth = stimulus_depth(total, sdepth)
     params = {"I": interleave, "U": units, "W": width, "H": height, "GW": GAP_BITS, "SDEPTH": sdepth}
     bdir = build_dir_for("zbm-unit", sim, sources=[*srcs, HARNESS_V, BENCH_DIR / "tb_zbm_unit.v"], **params)
     bdir.mkdir(parents=True, exist_ok=True)

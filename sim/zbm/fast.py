@@ -39,6 +39,7 @@ from rasterhw.sim.zbm.driver import (
     chip_stimulus,
     random_gaps,
     read_hex_words,
+    stimulus_depth,
 )
 
 __all__ = ["FAST_DIR", "build_fast", "run_chip_fast", "chip_speed_fast", "build_unit_fast", "run_unit_fast"]
@@ -96,13 +97,15 @@ def run_chip_fast(seg_words: list[int], up_words: list[int], *, lines: int, chip
 
 
 def build_unit_fast(*, interleave: int, width: int, height: int, units: int, nwords: int,
-                    capacity: int = F.AEP_CAPACITY, schedule: str = "overlap", opt: str = "-O1") -> tuple[Path, float]:
+                    capacity: int = F.AEP_CAPACITY, schedule: str = "overlap", opt: str = "-O1",
+                    sdepth: int | None = None) -> tuple[Path, float]:
     """Build (once per parameter set and source content) the timing-free unit-chain bench;
     returns (binary, build seconds, 0 if reused). ``-O1`` by default: the I = 8 unit's per-cycle
     code is megabytes, and -O2 doubles its compile time for a few per cent of run speed."""
     srcs = chain_verilog(interleave=interleave, width=width, height=height, units=units, capacity=capacity,
                          schedule=schedule)
-    params = {"I": interleave, "U": units, "W": width, "H": height, "GW": GAP_BITS, "SDEPTH": _depth(nwords)}
+    params = {"I": interleave, "U": units, "W": width, "H": height, "GW": GAP_BITS,
+              "SDEPTH": stimulus_depth(nwords, sdepth)}
     return build_plain_verilator("zbm-unit-fast", "tb_zbm_unit_fast",
                                  [*srcs, HARNESS_V, FAST_DIR / "tb_zbm_unit_fast.v"], params=params, opt=opt,
                                  defines={"RASTERHW_CYCLES": 1})
@@ -111,7 +114,7 @@ def build_unit_fast(*, interleave: int, width: int, height: int, units: int, nwo
 def run_unit_fast(eps_per_unit: list, *, width: int, height: int, interleave: int,
                   capacity: int = F.AEP_CAPACITY, schedule: str = "overlap", stall: int = 0, seed: int = 1,
                   gap_seed: int | None = None, line_log: bool = False, opt: str = "-O1",
-                  keep: bool = False) -> dict:
+                  keep: bool = False, sdepth: int | None = None) -> dict:
     """Run a chain of units (unit k gets ``eps_per_unit[k]``) on plain Verilator.
 
     Same arguments and result keys as :func:`rasterhw.sim.zbm.run_unit_bench` run with equal,
@@ -125,7 +128,7 @@ def run_unit_fast(eps_per_unit: list, *, width: int, height: int, interleave: in
     words = [edge_pair_words(e) for e in eps_per_unit]
     total = sum(len(w) for w in words)
     exe, build_s = build_unit_fast(interleave=interleave, width=width, height=height, units=len(words),
-                                   nwords=total, capacity=capacity, schedule=schedule, opt=opt)
+                                   nwords=total, capacity=capacity, schedule=schedule, opt=opt, sdepth=sdepth)
     run_dir = temp_run_folder(exe.parent.parent)
     try:
         flat, index, base = [], [], 0

@@ -56,3 +56,10 @@ def test_two_units_fast_equals_cocotb_bench():
 def test_unit_fast_rejects_bad_stall():
     with pytest.raises(RasterhwError, match="stall"):
         ZF.run_unit_fast([], width=W, height=H, interleave=2, stall=300)
+
+
+def test_stimulus_depth_shared_by_runs_of_different_sizes():
+    assert Z.stimulus_depth(10) == 1024 and Z.stimulus_depth(5000) == 8192
+    assert Z.stimulus_depth(10, 16384) == Z.stimulus_depth(9000, 16384) == 16384
+    with pytest.raises(RasterhwError, match="does not hold"):
+        Z.stimulus_depth(9000, 4096)
