@@ -19,10 +19,11 @@ What a round randomises, per block:
   (half periods 2..7 ns each, the cocotb bench with Verilog-side clocks), the others equal
   clocks on the plain-Verilator bench; both double-Z samples of every pixel are compared.
 * ``pxp`` (EXPERTS PXP, 512 x 512, anti-jagging (c)): random EXPERTS / cube scenes (seeded),
-  random Sn x Pn and range method (static, i, ii); every PXP pixel and every line's cycle
-  count are compared (timing-free bench: input never idles). Round 0 instead runs random
-  lines through the cocotb bench with random idle clocks on the input and random
-  back-pressure on the output (stream checkers, scoreboards).
+  random Sn x Pn and range method (static, i, ii); every PXP pixel is compared, and every
+  line's cycle count: equal to the model's in half the rounds (input back to back, output
+  always ready), no faster than the model's in the other half (random idle clocks on the
+  input, random back-pressure on the output of the plain bench). Round 0 instead runs random
+  lines through the cocotb bench with the same kinds of timing (stream checkers, scoreboards).
 * ``sparse`` (sparse-raster video processors, 4 x 4 matrix, 256 x 256): random screen
   triangles (count, size; random idle clocks on every processor's input in most of these
   rounds) or a random cube scene; every processor's local memory (triangle index and depth) and
@@ -213,11 +214,14 @@ def _pxp_round(rng: np.random.Generator, k: int = 1) -> dict:
     seed = int(rng.integers(0, 1 << 30))
     sn, pn = int(rng.choice([1, 2, 4, 8])), int(rng.choice([1, 2, 4, 8]))
     ranges = str(rng.choice(["static", "i", "ii"]))
+    # half the rounds cycle-exact (every line's finish time equal to the model's), half with random
+    # input idle clocks and output back-pressure (pixels equal, no line faster than the model)
+    idle, stall = (0, 0) if rng.random() < 0.5 else (int(rng.integers(0, 230)), int(rng.integers(0, 230)))
     r = simulate_scene(build_scene(name, seed=seed), PXP_W, PXP_H, engine="verilator", sn=sn, pn=pn, aj="c",
-                       ranges=ranges)
+                       ranges=ranges, idle=idle, stall=stall, seed=int(rng.integers(1, 1 << 20)))
     bad = r["mismatches"] + r["cycle_mismatches"]
     return {"pixels": r["pixels_compared"], "mismatches": bad, "run_s": r["run_s"],
-            "settings": f"scene {name} seed={seed} sn={sn} pn={pn} ranges={ranges}"}
+            "settings": f"scene {name} seed={seed} sn={sn} pn={pn} ranges={ranges} idle={idle} stall={stall}"}
 
 
 # ---------------------------------------------------------------- sparse video processors

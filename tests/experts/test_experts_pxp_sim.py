@@ -43,3 +43,19 @@ def test_experts_1000_frame_on_verilator():
     assert r["pixels_compared"] == 262144 and r["mismatches"] == 0 and r["cycle_mismatches"] == 0
     assert r["last_pixel_mismatch"] == 0
     assert r["cycles_per_s"] > 1e6
+
+
+def test_verilator_idle_and_backpressure_same_pixels_no_line_faster():
+    """Random input idle clocks and output back-pressure on the plain-Verilator PXP bench: every
+    pixel still equals the golden model and no line finishes faster than the cycle model, while
+    the run takes more clocks than the cycle-exact one; bad settings are one-line errors."""
+    sc = build_scene("experts-tilt-1000")
+    exact = simulate_scene(sc, 512, 512, engine="verilator", sn=2, pn=2, aj="c")
+    timed = simulate_scene(sc, 512, 512, engine="verilator", sn=2, pn=2, aj="c", idle=90, stall=120, seed=3)
+    assert exact["mismatches"] == 0 and exact["cycle_mismatches"] == 0 and exact["last_pixel_mismatch"] == 0
+    assert timed["mismatches"] == 0 and timed["pixels_compared"] == exact["pixels_compared"] == 512 * 512
+    assert timed["cycle_mismatches"] == 0 and timed["cycles"] > exact["cycles"]
+    with pytest.raises(RasterhwError, match="stall"):
+        simulate_scene(sc, 512, 512, engine="verilator", stall=256)
+    with pytest.raises(RasterhwError, match="Verilator bench"):
+        simulate_scene(sc, 64, 16, engine="pysim", idle=5)

@@ -5,6 +5,10 @@
 // next line (next_lo, next_hi) is put on lo/hi, which the PXP samples as the line ends. The first
 // line's range comes from +lo0= / +hi0=. Every pixel word is stored in order (dumped to +out=),
 // every line's finish-time counter too (+cyc=). `done` rises on the edge after the +nout=-th pixel.
+// Optional random timing (+seed=S): +idle=K (1..255) -- a word not yet offered is offered only when
+// a seeded 8-bit xorshift number is >= K, and an offered word is held until taken (the stream
+// rules); +stall=K -- the output's ready is low when another such number is below K. Both 0 (the
+// default): input back to back and output always ready, the cycle-exact run.
 module tb_experts_pxp #(
   parameter NSEG = 1 << 19,
   parameter NOUT = 1 << 18,
@@ -22,6 +26,9 @@ module tb_experts_pxp #(
   reg [9:0] lo;
   reg [10:0] hi;
   reg [31:0] p, q, nl, nseg, nout;
+  integer IDLE, STALL, SEED;
+  reg offer;
+  reg [31:0] lfi, lfo;
   initial begin
     done = 1'b0;
     cycles = 64'd0;
@@ -35,6 +42,12 @@ module tb_experts_pxp #(
     if (!$value$plusargs("nout=%d", nout)) $fatal(1, "tb_experts_pxp: +nout= missing");
     if (!$value$plusargs("lo0=%d", lo0)) lo0 = 0;
     if (!$value$plusargs("hi0=%d", hi0)) hi0 = 1;
+    if (!$value$plusargs("idle=%d", IDLE)) IDLE = 0;
+    if (!$value$plusargs("stall=%d", STALL)) STALL = 0;
+    if (!$value$plusargs("seed=%d", SEED)) SEED = 1;
+    offer = 1'b1;
+    lfi = 32'h9E3779B9 ^ (SEED * 32'd7919 + 32'd1);
+    lfo = 32'h7F4A7C15 ^ (SEED * 32'd104729 + 32'd3);
     lo = lo0[9:0];
     hi = hi0[10:0];
     $readmemh(fseg, stim);
@@ -45,19 +58,32 @@ module tb_experts_pxp #(
   end
 
   wire [214:0] w = stim[p];
-  wire iv = (p < nseg);
+  function [31:0] xorshift(input [31:0] x);
+    reg [31:0] t;
+    begin
+      t = x ^ (x << 13);
+      t = t ^ (t >> 17);
+      xorshift = t ^ (t << 5);
+    end
+  endfunction
+
+  wire iv = (p < nseg) && offer;
+  wire ordy = (lfo[7:0] >= STALL);
   wire ir, ov;
   wire [15:0] opl;
   wire [15:0] line_cycles, lines;
   experts_pxp dut (
     .clk(clk), .rst(1'b0),
     .i__valid(iv), .i__ready(ir), .i__payload(w[193:0]),
-    .o__valid(ov), .o__ready(1'b1), .o__payload(opl),
+    .o__valid(ov), .o__ready(ordy), .o__payload(opl),
     .lo(lo), .hi(hi), .line_cycles(line_cycles), .lines(lines)
   );
   reg [15:0] seen = 16'd0;
   always @(posedge clk) begin
     cycles <= cycles + 64'd1;
+    lfi <= xorshift(lfi);
+    lfo <= xorshift(lfo);
+    if (!offer || ir) offer <= (lfi[7:0] >= IDLE);
     if (iv && ir) begin
       p <= p + 1;
       if (w[0]) begin
@@ -65,7 +91,7 @@ module tb_experts_pxp #(
         hi <= w[214:204];
       end
     end
-    if (ov) begin
+    if (ov && ordy) begin
       frame[q] <= opl;
       q <= q + 1;
       if (q + 1 == nout) done <= 1'b1;
