@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.sparse.formats import TRI_BITS
+from rasterhw.sim.memh import memh_uint64, read_memh
 from rasterhw.sim.runner import build_plain_verilator, run_plain_verilator
 from rasterhw.sim.workdirs import release, temp_run_folder
 
@@ -58,17 +59,18 @@ def _read_hex(path: Path) -> np.ndarray:
     return np.array([int(w, 16) for w in words], dtype=object)
 
 
-def pack_records(recs: list[dict]) -> str:
-    """The bench's stimulus file: one hex word of the BROADCAST layout per triangle."""
+def pack_records(recs: list[dict]) -> bytes:
+    """The bench's stimulus file: one big-endian word of the BROADCAST layout per triangle
+    (``ceil(BROADCAST.size / 8)`` bytes, read with ``$fread``)."""
     from rasterhw.hdl.pack import pack
     from rasterhw.hdl.sparse.layouts import BROADCAST
 
-    digits = -(-BROADCAST.size // 4)
-    return "".join(f"{pack(BROADCAST, r):0{digits}x}\n" for r in recs)
+    nbytes = -(-BROADCAST.size // 8)
+    return b"".join(pack(BROADCAST, r).to_bytes(nbytes, "big") for r in recs)
 
 
 def run_processor_verilator(recs: list[dict], *, n: int, p: int, q: int, a: int, b: int, z_bits: int = 24,
-                            packed: str | None = None, idle: int = 0, seed: int = 1) -> dict:
+                            packed: bytes | None = None, idle: int = 0, seed: int = 1) -> dict:
     """One processor on Verilator: the same keys as :func:`rasterhw.sim.sparse.hdl_run.run_processor`
     plus ``run_s`` (the C++ clock loop) and ``build_s``. ``packed``: :func:`pack_records` of ``recs``
     when the caller runs several processors on the same records. ``idle`` (0..255): random idle
@@ -82,19 +84,21 @@ def run_processor_verilator(recs: list[dict], *, n: int, p: int, q: int, a: int,
         raise RasterhwError(f"sparse HDL: processor ({a}, {b}) is outside a {p}x{q} matrix")
     exe, build_s = build(n=n, p=p, q=q, z_bits=z_bits)
     run_dir = temp_run_folder(exe.parent.parent)
-    (run_dir / "in.hex").write_text(pack_records(recs) if packed is None else packed)
+    (run_dir / "in.bin").write_bytes(pack_records(recs) if packed is None else packed)
     N = 1 << n
     maxcyc = (200 * (len(recs) + 10) * (1 + n) + 64 * N * N + 10_000_000) * (1 + idle // 16)
-    meta = run_plain_verilator(exe, [f"+in={run_dir / 'in.hex'}", f"+out={run_dir / 'out.hex'}",
+    meta = run_plain_verilator(exe, [f"+in={run_dir / 'in.bin'}", f"+out={run_dir / 'out.hex'}",
                                      f"+stats={run_dir / 'stats.hex'}", f"+ntri={len(recs)}", f"+a={a}", f"+b={b}",
                                      f"+idle={idle}", f"+seed={seed}"],
                                run_dir=run_dir, maxcyc=maxcyc)
-    words = _read_hex(run_dir / "out.hex")
+    b_out = read_memh(run_dir / "out.hex", N * N)
     st = [int(v) for v in _read_hex(run_dir / "stats.hex")]
     release(run_dir)
-    zmask = (1 << (z_bits + 1)) - 1
-    tri = np.array([int(w) >> (z_bits + 1) for w in words], dtype=np.int64)
-    zq = np.array([int(w) & zmask for w in words], dtype=np.int64)
+    if b_out.shape[1] > 8:
+        raise RasterhwError(f"sparse bench: {b_out.shape[1]}-byte memory words, expected at most 8")
+    words = memh_uint64(b_out, 0, b_out.shape[1]).astype(np.int64)
+    tri = words >> (z_bits + 1)
+    zq = words & ((1 << (z_bits + 1)) - 1)
     empty = tri == (1 << TRI_BITS) - 1
     tri[empty], zq[empty] = -1, -1
     return {"tri": tri.reshape(N, N), "zq": zq.reshape(N, N), "tests": st[:n], "stalls": st[n:2 * n],

@@ -1,5 +1,5 @@
 // Timing-free Verilator bench for the generated `sparse_vp` (rasterhw.hdl.sparse.vp).
-// Plays the broadcast records of +in= (one BW-bit hex word per triangle, +ntri= of them) into
+// Plays the broadcast records of +in= (binary: one BW-bit big-endian word per triangle, +ntri= of them) into
 // processor (+a=, +b=) -- with no gaps, or (+idle=K, 1..255, +seed=S) with random idle clocks:
 // a record not yet offered is offered only when a seeded 8-bit xorshift number is >= K, and an
 // offered one is held until taken (the stream rules) -- waits until the processor is idle, then sweeps the local
@@ -11,7 +11,7 @@ module tb_sparse_vp #(parameter N = 7, parameter BW = 600, parameter MAXT = 1638
   reg [TW+ZW-1:0] outmem [0:(1 << (2 * N)) - 1];
   reg [31:0] stats [0:2 * N + 1];
   reg [1023:0] in_file, out_file, stats_file;
-  integer ntri, pa, pb, i, IDLE, SEED;
+  integer ntri, pa, pb, i, IDLE, SEED, fd, got;
   reg offer;
   reg [31:0] lf;
   reg [31:0] idx;
@@ -33,7 +33,14 @@ module tb_sparse_vp #(parameter N = 7, parameter BW = 600, parameter MAXT = 1638
     if (!$value$plusargs("b=%d", pb)) pb = 0;
     if (!$value$plusargs("idle=%d", IDLE)) IDLE = 0;
     if (!$value$plusargs("seed=%d", SEED)) SEED = 1;
-    if (ntri > 0) $readmemh(in_file, rom, 0, ntri - 1);
+    if (ntri > 0) begin  // binary, BW / 8 bytes per record, big-endian (a $readmemh parse costs more
+                         // than the run's clock loop)
+      fd = $fopen(in_file, "rb");
+      if (fd == 0) $fatal(1, "tb_sparse_vp: cannot open %0s", in_file);
+      got = $fread(rom, fd);
+      $fclose(fd);
+      if (got != ntri * ((BW + 7) / 8)) $fatal(1, "tb_sparse_vp: %0s holds %0d bytes, not %0d records", in_file, got, ntri);
+    end
     offer = 1; lf = 32'h9E3779B9 ^ (SEED * 32'd7919 + 32'd1);
     idx = 0; phase = 0; done = 0; cycles = 0; raddr = 0; rd_addr = 0; rst = 1;
   end
