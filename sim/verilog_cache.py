@@ -55,12 +55,19 @@ def _imported_files(f: Path) -> set[Path]:
     return out
 
 
-def design_sources() -> list[Path]:
-    """Every Python file the generated Verilog can depend on: all of ``hdl/``, the Verilog
-    generator (``sim/verilog.py``) and, transitively, every module of ours they import (the
-    formats modules in ``golden_model/`` the HDL takes its widths from), and nothing else, so
-    an edit to the golden model's algorithms does not regenerate (or rebuild) the HDL."""
-    todo = [*sorted((PKG_ROOT / "hdl").rglob("*.py")), PKG_ROOT / "sim" / "verilog.py"]
+def design_sources(block: str | None = None) -> list[Path]:
+    """Every Python file the generated Verilog of ``block`` (a ``rasterhw verilog --list`` name)
+    can depend on: the module of its factory, the Verilog generator (``sim/verilog.py``) and,
+    transitively, every module of ours they import (its HDL submodules, the formats modules in
+    ``golden_model/`` the HDL takes its widths from), and nothing else, so an edit to another
+    block or to a golden algorithm does not regenerate (or rebuild) it. ``block=None`` (or a name
+    that is not a registered block): all of ``hdl/`` as the roots."""
+    from rasterhw.sim.registry import blocks
+
+    ref = blocks().get(block) if block else None
+    root = _module_file(ref.split(":")[0]) if ref else None
+    todo = [root] if root is not None else sorted((PKG_ROOT / "hdl").rglob("*.py"))
+    todo.append(PKG_ROOT / "sim" / "verilog.py")
     seen: set[Path] = set()
     while todo:
         f = todo.pop()
@@ -68,16 +75,20 @@ def design_sources() -> list[Path]:
             continue
         seen.add(f)
         todo += sorted(_imported_files(f) - seen)
-    return sorted(seen)
+    # importing a module runs its packages' __init__ files too: their bytes count, but what they
+    # import for convenience (a package's whole golden model) does not reach the HDL
+    inits = {d / "__init__.py" for f in seen for d in f.parents
+             if PKG_ROOT in (d, *d.parents) and (d / "__init__.py").is_file()}
+    return sorted(seen | inits)
 
 
 @cache
-def source_digest() -> str:
+def source_digest(block: str | None = None) -> str:
     """Digest of the Amaranth version and every file of :func:`design_sources` (once per process)."""
     import amaranth
 
     h = hashlib.sha1(amaranth.__version__.encode())
-    for f in design_sources():
+    for f in design_sources(block):
         h.update(str(f.relative_to(PKG_ROOT)).encode())
         h.update(f.read_bytes())
     return h.hexdigest()
@@ -92,7 +103,7 @@ def convert_cached(name: str, factory: Callable[[], object], *, params: Mapping[
     from rasterhw.sim.runner import REPO_ROOT
 
     key = json.dumps({"name": name, "module": module, "params": dict(params)}, sort_keys=True, default=str)
-    digest = hashlib.sha1((source_digest() + key).encode()).hexdigest()[:16]
+    digest = hashlib.sha1((source_digest(name) + key).encode()).hexdigest()[:16]
     path = REPO_ROOT / "build" / "verilog" / f"{name}-{digest}.v"
     if path.exists():
         return path.read_text()

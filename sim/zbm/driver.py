@@ -130,9 +130,11 @@ def check_edge_pairs(eps: G.EdgePairs, width: int, height: int, *, units: int = 
 def _digest(**params) -> str:
     from rasterhw.sim.verilog_cache import source_digest
 
-    # every source the generated Verilog can depend on (the HDL, the formats, the generator)
+    # every source the block's generated Verilog can depend on (its HDL, the formats, the
+    # generator); the tail unit and the chain adapter go with the unit
+    block = str(params.get("block", ""))
     h = hashlib.sha1(json.dumps(params, sort_keys=True, default=str).encode())
-    h.update(source_digest().encode())
+    h.update(source_digest({"zbm-unit-tail": "zbm-unit", "zbm-chain-flat": "zbm-unit"}.get(block, block)).encode())
     return h.hexdigest()[:12]
 
 

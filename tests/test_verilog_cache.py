@@ -1,0 +1,31 @@
+"""sim/verilog_cache.py: a block's generated Verilog is keyed on exactly the sources it imports."""
+
+from __future__ import annotations
+
+from rasterhw.sim.verilog_cache import PKG_ROOT, design_sources, source_digest
+
+
+def _rel(block):
+    return {str(f.relative_to(PKG_ROOT)) for f in design_sources(block)}
+
+
+def test_a_block_depends_on_its_hdl_and_formats_only():
+    unit = _rel("zbm-unit")
+    assert {"hdl/zbm/unit.py", "hdl/zbm/chip.py", "hdl/zbm/seggen.py", "golden_model/zbm/formats.py",
+            "sim/verilog.py", "hdl/zbm/__init__.py"} <= unit
+    # golden algorithms, other machines' HDL and tests do not regenerate the unit
+    assert not {"golden_model/zbm/render.py", "golden_model/zbm/unit.py", "golden_model/zbm/cycles.py",
+                "hdl/sparse/vp.py", "hdl/snu/pixelbus.py"} & unit
+    sparse = _rel("sparse-vp")
+    assert "hdl/sparse/stage.py" in sparse and "golden_model/sparse/formats.py" in sparse
+    assert not any(f.startswith("hdl/zbm/") for f in sparse)
+
+
+def test_unknown_name_falls_back_to_all_hdl():
+    every = _rel(None)
+    assert {str(f.relative_to(PKG_ROOT)) for f in (PKG_ROOT / "hdl").rglob("*.py")} <= every
+    assert _rel("not-a-block") == every
+
+
+def test_digests_differ_by_block():
+    assert len({source_digest(b) for b in ("zbm-unit", "zbm-chip", "sparse-vp", "pixelbus", None)}) == 5
