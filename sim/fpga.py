@@ -283,6 +283,14 @@ FPGA_CONFIGS: tuple[tuple[str, dict, str], ...] = (
     ("zbm-unit", {}, "full"),
     ("zbm-unit", {"interleave": 2, "width": 64, "height": 64, "capacity": 16}, "reduced"),
 )
+#: what the report also places on an iCE40 HX8K (7,680 logic cells, 32 block RAMs of 4 Kbit): the
+#: blocks that fit it (the others are several times its size on the ECP5)
+ICE40_CONFIGS: tuple[tuple[str, dict, str], ...] = (
+    ("experts-dmm", {}, "full"),
+    ("pixelbus-bank", {"ram": "memory", "depth": 1024}, "reduced"),
+    ("zbm-merger", {"fifo_depth": 16}, "full"),
+    ("zbm-pixel", {"interleave": 8, "width": 512}, "full"),
+)
 #: blocks whose full configuration is measured against the device by synthesis (their frame
 #: memory as Amaranth memories would spell out every word of a 1280 x 1024 frame)
 DEMAND_FROM_SYNTH = {"pixelbus", "pixelbus-bank"}
@@ -328,19 +336,19 @@ def _cfg(block: str, params: dict, kind: str) -> str:
     return f"{kind}: {shown}"
 
 
-def _measure(block, params, *, fast, progress, timeout):
+def _measure(block, params, *, fast, progress, timeout, family="ecp5"):
     """One configuration: a place_and_route / synth_demand result, or None in a fast run."""
     import sys
 
     if fast:
         return None
     if progress:
-        print(f"fpga: {block} ({params or 'defaults'}) on ECP5 ...", file=sys.stderr, flush=True)
-    if block in DEMAND_FROM_SYNTH and not params:
+        print(f"fpga: {block} ({params or 'defaults'}) on {family} ...", file=sys.stderr, flush=True)
+    if block in DEMAND_FROM_SYNTH and not params and family == "ecp5":
         d = synth_demand(block)
         if not d["fits"]:
             return {**d, "finished": True, "luts": None, "ffs": None, "brams": None, "fmax_mhz": {}}
-    return place_and_route(block, family="ecp5", timeout=timeout, **params)
+    return place_and_route(block, family=family, timeout=timeout, **params)
 
 
 def _reason(r) -> str | None:
@@ -416,6 +424,30 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
                            paper=None if hz is None else hz / 1e6))
         if r is not None:
             walls.append((block, params, kind, r))
+
+    ice = DEVICE_NAMES["ice40"]["hx8k"]
+    for block, params, kind in ICE40_CONFIGS:
+        r = _measure(block, params, fast=fast, progress=progress, timeout=timeout, family="ice40")
+        why = _reason(r)
+        ok = why is None
+        system = block.split("-")[0].replace("pixelbus", "snu")
+        fig = f"{block} on {ice} ({_cfg(block, params, kind)})"
+
+        def row(q, measured, unit, paper=None, fig=fig, system=system, why=why):
+            return make_row(system, fig, q, paper=paper, formula=None, measured=measured, unit=unit,
+                            source="hdl:nextpnr", reason=why)
+
+        out += [row("logic cells (ICESTORM_LC)", r["luts"] if ok else None, "LC"),
+                row("flip-flops", r["ffs"] if ok else None, "flip-flops"),
+                row("block RAMs (4 Kbit)", r["brams"] if ok else None, "ICESTORM_RAM")]
+        for dom, what, hz in paper_clock(block):
+            f = r["fmax_mhz"].get(dom) if ok else None
+            if ok and f is None:
+                continue
+            out.append(row(f"Fmax, {dom} clock (paper: {what})", f, "MHz",
+                           paper=None if hz is None else hz / 1e6))
+        if r is not None:
+            walls.append((block, params, kind + ", iCE40 HX8K", r))
 
     points = []
     for i in CHIP_SWEEP:
