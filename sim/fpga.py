@@ -93,12 +93,16 @@ def _clock_domain(net: str) -> str:
 
 
 def place_and_route(block: str, *, family: str = "ecp5", device: str | None = None, seed: int = 1,
-                    timeout: float = 3600.0, cache: bool = True, **params) -> dict:
+                    timeout: float = 3600.0, cache: bool = True, cached_only: bool = False,
+                    **params) -> dict | None:
     """Synthesise and place ``block`` for ``family``; return resources and Fmax per clock.
 
     ``params`` go on top of :data:`FPGA_PARAMS` (and the synthesis defaults). Raises
     ``RasterhwError`` for an unknown block or family, a tool failure (log in the build folder),
-    or a design that does not fit the device (``error`` names the resource).
+    A design that needs more cells of a kind than the device has comes back with ``fits``
+    False, ``over`` (kind -> (needed, available)) and ``reason``; a tool that runs out of
+    ``timeout`` with ``finished`` False and ``reason`` (both cached). ``cached_only``: return
+    the cached result or None, run nothing.
     """
     if family not in FAMILIES:
         raise RasterhwError(f"family must be one of {', '.join(FAMILIES)}, not {family!r}")
@@ -139,6 +143,8 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
         # a run that did not finish stays cached with its time limit (``cache=False`` tries again)
         if old.get("digest") == digest:
             return {**res, "build_dir": bdir, "cached": True}
+    if cached_only:
+        return None
 
     class _Timeout(RasterhwError):
         pass
@@ -336,7 +342,11 @@ def _cfg(block: str, params: dict, kind: str) -> str:
     return f"{kind}: {shown}"
 
 
-def _measure(block, params, *, fast, progress, timeout, family="ecp5"):
+_NOT_RUN = ("not placed in the run that made this table (it ran from the results cached by the "
+            "session's place-and-route runs); measure it with `rasterhw fpga {block}{args}`")
+
+
+def _measure(block, params, *, fast, progress, timeout, family="ecp5", cached_only=False):
     """One configuration: a place_and_route / synth_demand result, or None in a fast run."""
     import sys
 
@@ -348,7 +358,12 @@ def _measure(block, params, *, fast, progress, timeout, family="ecp5"):
         d = synth_demand(block)
         if not d["fits"]:
             return {**d, "finished": True, "luts": None, "ffs": None, "brams": None, "fmax_mhz": {}}
-    return place_and_route(block, family=family, timeout=timeout, **params)
+    r = place_and_route(block, family=family, timeout=timeout, cached_only=cached_only, **params)
+    if r is None:  # cached_only and never run
+        args = "".join(f" -p {k}={v}" for k, v in params.items()) + ("" if family == "ecp5" else f" --family {family}")
+        return {"block": block, "params": params, "finished": False, "reason": _NOT_RUN.format(block=block, args=args),
+                "luts": None, "ffs": None, "brams": None, "fmax_mhz": {}}
+    return r
 
 
 def _reason(r) -> str | None:
@@ -388,12 +403,13 @@ def chip_plot(points: list[tuple[int, dict]], path) -> None:
 
 
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool = False,
-         timeout: float = REPORT_TIMEOUT_S):
+         timeout: float = REPORT_TIMEOUT_S, cached_only: bool = False):
     """Report rows: per configuration of :data:`FPGA_CONFIGS`, ECP5 LUTs, flip-flops, block RAMs
     and Fmax per clock beside the paper's clock (``source`` ``hdl:nextpnr``; the SNU blocks' full
     frame memory: ``hdl:yosys``), and the ZB/M chip's Fmax at each interleave of
     :data:`CHIP_SWEEP` with a plot. ``fast``: the rows stay, unmeasured (place and route takes
-    minutes to an hour per block)."""
+    minutes to an hour per block). ``cached_only``: use the results cached in ``build/pnr-*`` and
+    run nothing (a configuration never run stays unmeasured, saying so)."""
     from pathlib import Path
 
     from rasterhw.sim.report import make_row
@@ -402,7 +418,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
     dev = DEVICE_NAMES["ecp5"]["85k"]
     walls = []
     for block, params, kind in FPGA_CONFIGS:
-        r = _measure(block, params, fast=fast, progress=progress, timeout=timeout)
+        r = _measure(block, params, fast=fast, progress=progress, timeout=timeout, cached_only=cached_only)
         why = _reason(r)
         ok = why is None
         system = block.split("-")[0].replace("pixelbus", "snu")
@@ -427,7 +443,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
 
     ice = DEVICE_NAMES["ice40"]["hx8k"]
     for block, params, kind in ICE40_CONFIGS:
-        r = _measure(block, params, fast=fast, progress=progress, timeout=timeout, family="ice40")
+        r = _measure(block, params, fast=fast, progress=progress, timeout=timeout, family="ice40",
+                     cached_only=cached_only)
         why = _reason(r)
         ok = why is None
         system = block.split("-")[0].replace("pixelbus", "snu")
@@ -452,7 +469,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
     points = []
     for i in CHIP_SWEEP:
         params = {"interleave": i, "width": CHIP_SWEEP_WIDTH}
-        r = _measure("zbm-chip", params, fast=fast, progress=progress, timeout=timeout)
+        r = _measure("zbm-chip", params, fast=fast, progress=progress, timeout=timeout, cached_only=cached_only)
         why = _reason(r)
         if why is None:
             points.append((i, r))
