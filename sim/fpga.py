@@ -493,6 +493,11 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
                 "マージクロックで動作\") and its frequency is not given; SNU: 80 ns pixel-bus slot, the bank's "
                 "400 ns memory cycle being 5 slots; EXPERTS and the sparse video processor's paper name no "
                 "clock (docs/experts.md: times in operation times; docs/sparse.md)."]
+    if cached_only:
+        sections += ["", "This table was made from the cached runs (`build/pnr-*`) of one session's place-and-route "
+                     "queue, one run at a time under `nice -n 10`, each with a time limit: "
+                     "`python -c \"from rasterhw.sim.report import run_report; run_report('fpga', cached_only=True)\"`; "
+                     "`rasterhw report fpga` runs the missing ones."]
     if not fast:
         chip_plot(points, Path(out_dir) / plot)
         sections += ["", f"![ZB/M chip Fmax against interleave]({plot})", "",
