@@ -342,6 +342,8 @@ def _cfg(block: str, params: dict, kind: str) -> str:
     return f"{kind}: {shown}"
 
 
+_MAIN_KINDS = {"TRELLIS_COMB", "TRELLIS_FF", "TRELLIS_RAMW", "DP16KD", "MULT18X18D",
+               "ICESTORM_LC", "ICESTORM_RAM", "ICESTORM_DSP"}
 _NOT_RUN = ("not placed in the run that made this table (it ran from the results cached by the "
             "session's place-and-route runs); measure it with `rasterhw fpga {block}{args}`")
 
@@ -371,6 +373,13 @@ def _reason(r) -> str | None:
 
     if r is None:
         return FAST_SKIP
+    if r.get("fits") is False and r.get("over") and r.get("utilization"):
+        # the packed demand of the main kinds against the device, the ones over it first
+        kinds = sorted(r["utilization"], key=lambda k: (k not in r["over"], k))
+        shown = [f"{k} {r['utilization'][k]:,} needed of {r['available'][k]:,}" for k in kinds
+                 if k in r["over"] or (k in _MAIN_KINDS and r["utilization"][k])]
+        dev = DEVICE_NAMES[r["family"]][r["device"]]
+        return f"does not fit {dev} (nextpnr --pack-only after {SYNTH_CMD[r['family']]}): " + "; ".join(shown)
     if r.get("fits") is False or r.get("finished") is False:
         return r["reason"]
     return None
