@@ -344,8 +344,7 @@ def _cfg(block: str, params: dict, kind: str) -> str:
 
 _MAIN_KINDS = {"TRELLIS_COMB", "TRELLIS_FF", "TRELLIS_RAMW", "DP16KD", "MULT18X18D",
                "ICESTORM_LC", "ICESTORM_RAM", "ICESTORM_DSP"}
-_NOT_RUN = ("not placed in the run that made this table (it ran from the results cached by the "
-            "session's place-and-route runs); measure it with `rasterhw fpga {block}{args}`")
+_NOT_RUN = "not run in the session that made this table (time): `rasterhw fpga {block}{args}`"
 
 
 def _measure(block, params, *, fast, progress, timeout, family="ecp5", cached_only=False):
