@@ -384,8 +384,9 @@ def _reason(r) -> str | None:
     return None
 
 
-def chip_plot(points: list[tuple[int, dict]], path) -> None:
-    """Fmax (segment and merge clock) of the ZB/M chip against interleave, with the paper's 25 MHz."""
+def chip_plot(points: list[tuple[int, dict]], path, missing: dict[int, str] | None = None) -> None:
+    """Fmax (segment and merge clock) of the ZB/M chip against interleave, with the paper's 25 MHz;
+    ``missing``: interleave -> why it has no point (written at the bottom of the plot)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -403,6 +404,10 @@ def chip_plot(points: list[tuple[int, dict]], path) -> None:
     ax.set_xlabel("interleave (chips per unit)")
     ax.set_ylabel("Fmax (MHz)")
     ax.set_ylim(bottom=0)
+    ax.set_xlim(0.8, 20)
+    for i, why in (missing or {}).items():
+        ax.annotate(why, (i, 0), xytext=(0, 4), textcoords="offset points", rotation=90, fontsize=7,
+                    ha="center", va="bottom", color="firebrick")
     ax.set_title(f"ZB/M chip on ECP5-85F, {CHIP_SWEEP_WIDTH}-pixel line, out of context", fontsize=9)
     ax.legend(fontsize=8)
     fig.tight_layout()
@@ -474,13 +479,18 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
         if r is not None:
             walls.append((block, params, kind + ", iCE40 HX8K", r))
 
-    points = []
+    points, missing = [], {}
     for i in CHIP_SWEEP:
         params = {"interleave": i, "width": CHIP_SWEEP_WIDTH}
         r = _measure("zbm-chip", params, fast=fast, progress=progress, timeout=timeout, cached_only=cached_only)
         why = _reason(r)
         if why is None:
             points.append((i, r))
+        elif r is not None:
+            missing[i] = ("did not finish" if r.get("finished") is False and r.get("stage") else
+                          "not run" if r.get("finished") is False else "does not fit")
+            if r.get("stage"):
+                missing[i] += f" in {r['timeout_s'] / 60:.0f} min"
         for dom, what in (("sync", "segment clock"), ("merge", "merge clock")):
             f = r["fmax_mhz"].get(dom) if why is None else None
             out.append(make_row("zbm", f"zbm-chip Fmax against interleave on {dev} (width {CHIP_SWEEP_WIDTH})",
@@ -507,7 +517,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
                      "`python -c \"from rasterhw.sim.report import run_report; run_report('fpga', cached_only=True)\"`; "
                      "`rasterhw report fpga` runs the missing ones."]
     if not fast:
-        chip_plot(points, Path(out_dir) / plot)
+        chip_plot(points, Path(out_dir) / plot, missing)
         sections += ["", f"![ZB/M chip Fmax against interleave]({plot})", "",
                      "ZB/M chip Fmax against interleave (rows `zbm-chip Fmax against interleave`): what the "
                      "interleave changes in the chip is the initial processor's slot arithmetic and the pixel "
