@@ -22,6 +22,7 @@ import json
 import re
 import subprocess
 import time
+from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.runner import REPO_ROOT
@@ -379,6 +380,15 @@ def _reason(r) -> str | None:
                  if k in r["over"] or (k in _MAIN_KINDS and r["utilization"][k])]
         dev = DEVICE_NAMES[r["family"]][r["device"]]
         return f"does not fit {dev} (nextpnr --pack-only after {SYNTH_CMD[r['family']]}): " + "; ".join(shown)
+    if r.get("finished") is False and r.get("stage") == "place and route" and r.get("build_dir"):
+        # where nextpnr was when its time ran out (router2 prints its overused wires per iteration)
+        log = Path(r["build_dir"]) / "nextpnr.log"
+        last = re.findall(r"iter=(\d+) wires=\d+ overused=(\d+)", log.read_text(errors="replace")) if log.exists() else []
+        demand = ", ".join(f"{k} {r['utilization'][k]:,}" for k in sorted(r.get("utilization", {}))
+                           if k in _MAIN_KINDS and r["utilization"][k])
+        where = (f"; placed, router at iteration {last[-1][0]} with {int(last[-1][1]):,} wires overused"
+                 if last else "; in placement")
+        return f"{r['reason']} (packed {demand}{where})"
     if r.get("fits") is False or r.get("finished") is False:
         return r["reason"]
     return None
