@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import gc
 import inspect
+import re
 import warnings
 from pathlib import Path
 
@@ -19,7 +20,7 @@ from amaranth.lib import wiring
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.registry import blocks, load
 
-__all__ = ["block_names", "generate_verilog", "write_verilog", "make_block"]
+__all__ = ["block_names", "canonical_port_lists", "generate_verilog", "write_verilog", "make_block"]
 
 
 def block_names() -> list[str]:
@@ -62,6 +63,24 @@ def _module_name(name: str) -> str:
     return name.replace("-", "_")
 
 
+_MODULE_HEADER = re.compile(r"^module (\S+)(\s*)\(([^;]*?)\);", re.MULTILINE | re.DOTALL)
+
+
+def canonical_port_lists(text: str) -> str:
+    """Every ``module NAME(ports);`` header with its port names sorted, on one line.
+
+    Amaranth orders a module's ports partly by iterating a set of domain names, so the order
+    (and nothing else: every port is declared by name below the header and every instance is
+    connected by name) changes with Python's string-hash seed from one process to the next. The
+    caches of generated Verilog, simulator builds, synthesis and place-and-route are keyed on
+    the text, so the text must not depend on the process."""
+    def fix(m: re.Match) -> str:
+        # (an escaped name such as ``\\top.sub`` ends at the white space kept before the list)
+        ports = [p.strip() for p in m.group(3).replace("\n", " ").split(",") if p.strip()]
+        return f"module {m.group(1)}{m.group(2)}({', '.join(sorted(ports))});"
+    return _MODULE_HEADER.sub(fix, text)
+
+
 def generate_verilog(name: str, **params) -> str:
     """Verilog text of block ``name``; the top module is ``name`` with ``-`` -> ``_``.
 
@@ -69,7 +88,8 @@ def generate_verilog(name: str, **params) -> str:
     streams flatten to ``<port>__valid``, ``<port>__ready``, ``<port>__payload``.
     """
     comp = make_block(name, **params)
-    text = _quietly(lambda: verilog.convert(comp, name=_module_name(name), emit_src=False), name)
+    text = canonical_port_lists(_quietly(lambda: verilog.convert(comp, name=_module_name(name), emit_src=False),
+                                         name))
     # hand-written Verilog the block instantiates (e.g. a RAM model) travels with it
     extra = comp.extra_verilog() if hasattr(comp, "extra_verilog") else ""
     return text + ("\n" + extra if extra else "")

@@ -109,9 +109,10 @@ def convert_cached(name: str, factory: Callable[[], object], *, params: Mapping[
         return path.read_text()
     if convert is None:
         from amaranth.back import verilog
+        from rasterhw.sim.verilog import canonical_port_lists
 
         def convert(design, mod):
-            return verilog.convert(design, name=mod)
+            return canonical_port_lists(verilog.convert(design, name=mod))
     from rasterhw.sim.outfile import write_text
 
     text = convert(factory(), module)
