@@ -75,9 +75,11 @@ def canonical_port_lists(text: str) -> str:
     caches of generated Verilog, simulator builds, synthesis and place-and-route are keyed on
     the text, so the text must not depend on the process."""
     def fix(m: re.Match) -> str:
-        # (an escaped name such as ``\\top.sub`` ends at the white space kept before the list)
-        ports = [p.strip() for p in m.group(3).replace("\n", " ").split(",") if p.strip()]
-        return f"module {m.group(1)}{m.group(2)}({', '.join(sorted(ports))});"
+        # (an escaped name such as ``\\top.sub`` ends at the white space kept before the list,
+        # and so does an escaped port name: it keeps a space before the comma that follows it)
+        ports = sorted(p.strip() for p in m.group(3).replace("\n", " ").split(",") if p.strip())
+        return f"module {m.group(1)}{m.group(2)}(" + ", ".join(p + " " if p.startswith("\\") else p
+                                                              for p in ports) + ");"
     return _MODULE_HEADER.sub(fix, text)
 
 

@@ -48,6 +48,7 @@ def test_generated_verilog_does_not_depend_on_the_hash_seed(tmp_path):
 def test_canonical_port_lists_sorts_plain_and_escaped_headers():
     from rasterhw.sim.verilog import canonical_port_lists
 
-    text = "module top(b, a,\n  c);\n  input a;\nendmodule\nmodule \\top.sub (y, x);\nendmodule\n"
+    text = "module top(b, a,\n  c);\n  input a;\nendmodule\nmodule \\top.sub (y, \\x$1 );\nendmodule\n"
+    # an escaped name ends at white space: the one after \x$1 stays before the closing parenthesis
     assert canonical_port_lists(text) == ("module top(a, b, c);\n  input a;\nendmodule\n"
-                                          "module \\top.sub (x, y);\nendmodule\n")
+                                          "module \\top.sub (\\x$1 , y);\nendmodule\n")
