@@ -175,7 +175,7 @@ def mapping_rows(*, fast: bool = False, progress: bool = False) -> list[dict]:
 
 #: the paper gives no scan-line length; every area row (and docs/zbm.md, docs/zbm_area.md) uses this
 #: one: 512-pixel lines at the paper's interleave 8 (64 pixels per chip), the longest line our chip
-#: holds (10-bit x / len fields) and the frame every ZB/M scene here renders at
+#: and golden model hold (formats.MAX_WIDTH) and the frame every ZB/M scene here renders at
 AREA_PARAMS = {"interleave": 8, "width": 512}
 #: what the area rows synthesise: (block, label, parameters, schedule)
 AREA_BLOCKS = (
