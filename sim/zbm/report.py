@@ -232,7 +232,9 @@ def area_rows(*, fast: bool = False, progress: bool = False) -> tuple[list[dict]
         if not fast:
             if progress:
                 print(f"ZB/M area: synthesising {block} ({cfg}) with Yosys ...", file=sys.stderr, flush=True)
-            r = synthesise(block, **params, schedule=sched)
+            # the overlapped schedule is the blocks' default: not passed, so its synthesis cache
+            # (keyed by the parameters given) is the one `rasterhw synth zbm-chip` fills
+            r = synthesise(block, **params, **({"schedule": sched} if sched != "overlap" else {}))
         why = FAST_SKIP if r is None else None
 
         def get(key, r=r):
