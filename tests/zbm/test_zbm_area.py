@@ -59,6 +59,38 @@ def test_ram_formula_and_paper_candidates():
     assert not [r for t in (49 * 1024, 48 * 1024) for r in paper_ram_candidates(t) if r["width"] == 1280]
 
 
+def test_paper_ram_value_is_one_number():
+    """The report's paper value for "49 Kbit" is 49,152 (docs/zbm.md#area), the 96-bit-sample
+    reading of the table above; nothing else in the report says otherwise."""
+    from rasterhw.sim.zbm import report
+
+    assert report.PAPER_RAM_BITS == 49_152 == 48 * 1024
+    assert {"width": 1024, "interleave": 8, "pixels_per_chip": 128, "sample_bits": 96} in \
+        paper_ram_candidates(report.PAPER_RAM_BITS)
+
+
+def test_register_flipflops_counts_named_registers(tmp_path):
+    """A hand-made netlist: 3 enabled flip-flops drive initial.pkt, 1 drives loop.buf[2], 2 drive
+    other nets (one of them a name that only starts like a register's)."""
+    import json
+
+    from rasterhw.sim.zbm.report import register_flipflops
+
+    def ff(q, kind="$_SDFFE_PP0P_"):
+        return {"type": kind, "connections": {"D": [99], "Q": [q]}}
+
+    netlist = {"modules": {"top": {
+        "netnames": {"initial.pkt": {"bits": [2, 3, 4]}, "loop.buf[2]": {"bits": [5]},
+                     "loop.buffer": {"bits": [6]}, "o__payload": {"bits": [2, 3]}, "x": {"bits": [7]}},
+        "cells": {"a": ff(2), "b": ff(3), "c": ff(4), "d": ff(5, "$_DFF_P_"), "e": ff(6), "f": ff(7),
+                  "g": {"type": "$_AND_", "connections": {"A": [2], "B": [3], "Y": [8]}}},
+    }}}
+    (tmp_path / "netlist.json").write_text(json.dumps(netlist))
+    n, ge = register_flipflops(tmp_path)
+    assert n == 4 and ge == 3 * (6 + 3 + 1) + 6
+    assert register_flipflops(tmp_path, ("loop.buf",)) == (1, 6.0)
+
+
 def synth_chip(width: int, interleave: int = 8) -> dict:
     from rasterhw.sim.synth import synthesise
 

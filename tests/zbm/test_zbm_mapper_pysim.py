@@ -70,7 +70,9 @@ def test_mapper_bad_maps():
 
 
 def test_mapping_driver_full_rate():
-    """sim/zbm/mapping_hdl.run_mapper_pysim: one pixel per clock, latency 2, same words."""
+    """sim/zbm/mapping_hdl.run_mapper_pysim: mapper -> compositor, one pixel per clock, latency
+    2 + 2, the same words as map_samples and the same pixels as composite."""
+    from rasterhw.golden_model.zbm.composite import composite
     from rasterhw.sim.zbm.mapping_hdl import run_mapper_pysim
 
     px = random_doublez(np.random.default_rng(2), 40)
@@ -78,4 +80,6 @@ def test_mapping_driver_full_rate():
     want, stats = map_samples(px, tex, il)
     got, hw = run_mapper_pysim(pixel2_words(px), tex, il)
     assert got == pixel2_words(want) and hw["texture_lookups"] == stats["texture_lookups"]
-    assert hw["cycles"] == 40 + 2
+    assert hw["cycles"] == 40 + 2 + 2
+    img = composite(want).astype(np.int64)
+    assert hw["rgb"] == [int(v) for v in img[:, 0] | img[:, 1] << 8 | img[:, 2] << 16]
