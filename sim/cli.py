@@ -409,7 +409,7 @@ def sim_cmd(block, scene, size, engine, output, waves, as_json, **block_options)
     _machine, b = registry.sim_blocks()[block]
     opts = _take_options(block_options, b.options, f"sim {block}")
     scene = scene or b.default_scene
-    out = check_image_output(output) or Path("out") / f"{Path(scene).stem}-{block}-{engine}.png"
+    out = check_image_output(output) or sim_image_name(scene, block, engine, block_options)
     sc, (w, h) = load_scene_and_size(scene, size, bytes_per_pixel=b.bytes_per_pixel, what=f"sim {block}")
     with recording(waves, engine) as traces:
         res = registry.load(b.simulate)(sc, w, h, engine=engine, progress=not as_json, **opts)
@@ -536,3 +536,11 @@ def _main(argv: list[str] | None) -> None:
 
 if __name__ == "__main__":
     main()
+
+def sim_image_name(scene: str, block: str, engine: str, options: dict) -> Path:
+    """The default image of ``rasterhw sim``: the options given on the command line are in the
+    name, so runs of one scene in two configurations (``--schedule paper`` / ``overlap``) do not
+    overwrite each other."""
+    given = "".join(f"-{k}-{v}" for k, v in sorted(options.items()) if v is not None)
+    return Path("out") / f"{Path(scene).stem}-{block}-{engine}{given}.png"
+

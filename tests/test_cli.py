@@ -139,3 +139,15 @@ def test_machines_lists_every_machine():
     assert r.returncode == 0
     for name in ("snu", "zbm"):
         assert name in r.stdout
+
+
+def test_sim_image_name_carries_the_options_given():
+    """Two configurations of one scene (e.g. --schedule paper / overlap) get two default images."""
+    from pathlib import Path
+
+    from rasterhw.sim.cli import sim_image_name
+
+    a = sim_image_name("c300", "zbm", "verilator", {"interleave": 8, "schedule": "paper", "units": None})
+    b = sim_image_name("c300", "zbm", "verilator", {"interleave": 8, "schedule": "overlap", "units": None})
+    assert a == Path("out/c300-zbm-verilator-interleave-8-schedule-paper.png") and a != b
+    assert sim_image_name("x/scene.obj", "pixelbus", "pysim", {}) == Path("out/scene-pixelbus-pysim.png")
