@@ -173,9 +173,18 @@ def _split_extra(extra: str) -> tuple[str, str]:
 
 
 def stable_text(verilog: str) -> str:
-    """The Verilog with the order of its lines and of the words in each line normalised:
-    Amaranth orders clock-domain ports by Python's string hash, which changes from process to
-    process, so the text itself is no stable cache key."""
+    """The Verilog with its module headers made canonical (one line, ports sorted:
+    ``sim.verilog.canonical_port_lists``) and the order of its lines and of the words in each
+    line normalised: Amaranth orders clock-domain ports by Python's string hash, which changed
+    from process to process (and wraps long headers), so the raw text is no stable cache key."""
+    from rasterhw.sim.verilog import canonical_port_lists
+
+    return "\n".join(sorted(" ".join(sorted(re.split(r"[\s,()]+", ln)))
+                             for ln in canonical_port_lists(verilog).splitlines()))
+
+
+def _stable_text_v1(verilog: str) -> str:
+    """:func:`stable_text` before module headers were made canonical (to re-key old caches)."""
     return "\n".join(sorted(" ".join(sorted(re.split(r"[\s,()]+", ln))) for ln in verilog.splitlines()))
 
 
