@@ -19,11 +19,12 @@ __all__ = ["simulate", "simulate_tris"]
 
 
 def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bool = False, idle: int = 0,
-                  seed: int = 1) -> dict:
+                  seed: int = 1, workers: int = 2) -> dict:
     """Run every processor on ``tris``; returns the ``rasterhw sim`` keys plus per-level tests.
     ``idle``, ``seed`` (Verilator only): random idle clocks on every processor's input (see
     :func:`rasterhw.sim.sparse.verilator_run.run_processor_verilator`; processor ``(a, b)`` uses
-    seed ``seed + 64 * b + a``)."""
+    seed ``seed + 64 * b + a``). ``workers``: Verilator processors run at once (at most the
+    machine's cores)."""
     p, q = parse_matrix(matrix)
     n = sparse_geometry(tris.width, tris.height, p, q)
     if engine == "pysim":
@@ -57,7 +58,7 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
         from rasterhw.sim.sparse.verilator_run import build
 
         build(n=n, p=p, q=q, z_bits=tris.z_bits)
-        pool = ThreadPoolExecutor(max_workers=max(1, min(2, os.cpu_count() or 1)))
+        pool = ThreadPoolExecutor(max_workers=max(1, min(int(workers), os.cpu_count() or 1)))
         futures = [pool.submit(run, recs, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits, seed=seed + 64 * b + a)
                    for a, b in procs]
         results = (f.result() for f in futures)
