@@ -11,7 +11,7 @@ from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.composite import composite
 from rasterhw.golden_model.zbm.words import pixel2_words
 from rasterhw.hdl.zbm.compositor import ZbmCompositor
-from rasterhw.sim.harness import stream_protocol_checker, stream_put
+from rasterhw.sim.harness import stream_protocol_checker, stream_put, stream_sink
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 
@@ -47,18 +47,17 @@ def run_compositor(words, *, background=(0, 0, 0), seed=0, p_stall=0.3, p_gap=0.
         for w, g in zip(words, gaps, strict=True):
             await stream_put(ctx, dut.i, w, gap=g)
 
-    async def sink(ctx):
-        r = np.random.default_rng(seed + 1)
+    r = np.random.default_rng(seed + 1)
+    ready = (int(r.random() >= p_stall) for _ in iter(int, 1))   # random back-pressure, every clock
+
+    async def wait(ctx):
         while len(got) < len(words):
-            rdy = r.random() >= p_stall
-            ctx.set(dut.o.ready, rdy)
-            _, _, v, p = await ctx.tick().sample(dut.o.valid, dut.o.payload)
-            if v and rdy:
-                got.append(p.as_value().value)
+            await ctx.tick()
 
     sim.add_testbench(src, background=True)
     sim.add_testbench(stream_protocol_checker(dut.o, "o"), background=True)
-    sim.add_testbench(sink)
+    sim.add_testbench(stream_sink(dut.o, got, ready=ready), background=True)
+    sim.add_testbench(wait)
     sim.run()
     return got
 
