@@ -257,6 +257,19 @@ def stimulus_depth(words: int, depth: int | None = None) -> int:
 
 
 # ====================================================================== unit bench
+def write_unit_stimulus(run_dir: Path, words: list[list[int]], gap_seed: int | None) -> tuple[list[int], list[int]]:
+    """The unit benches' stimulus files (tb_zbm_unit.v, fast/tb_zbm_unit_fast.v): every unit's
+    loader words in one ``stim.hex`` (with random idle gaps from ``gap_seed``, None: none) and
+    ``index.hex``, two lines per unit (first word, number of words). Returns (words, index)."""
+    flat, index = [], []
+    for w in words:
+        index += [len(flat), len(w)]
+        flat += w
+    _write_hex(run_dir / "stim.hex", flat, random_gaps(len(flat), gap_seed), F.EP_WORD_BITS)
+    (run_dir / "index.hex").write_text("\n".join(f"{v:x}" for v in index) + "\n")
+    return flat, index
+
+
 def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, interleave: int,
                    sim: str | None = None, capacity: int = F.AEP_CAPACITY, ratio: tuple[int, int] = (5, 5),
                    stall: int = 0, seed: int = 1, gap_seed: int | None = None,
@@ -293,14 +306,7 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
     bdir = build_dir_for("zbm-unit", sim, sources=[*srcs, HARNESS_V, BENCH_DIR / "tb_zbm_unit.v"], **params)
     bdir.mkdir(parents=True, exist_ok=True)
     run_dir = temp_run_folder(bdir)
-    flat, index, base = [], [], 0
-    gaps = random_gaps(total, gap_seed)
-    for w in words:
-        index += [base, len(w)]
-        base += len(w)
-        flat += w
-    _write_hex(run_dir / "stim.hex", flat, gaps, F.EP_WORD_BITS)
-    (run_dir / "index.hex").write_text("\n".join(f"{v:x}" for v in index) + "\n")
+    flat, index = write_unit_stimulus(run_dir, words, gap_seed)
     out_path = run_dir / "frame.hex"
     env = {"ZBM_BENCH": "unit", "ZBM_OUT": str(out_path), "ZBM_CHECK_PROTOCOL": "1" if check_protocol else "0",
            **exp_env, **_SIM_ENV}

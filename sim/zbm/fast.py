@@ -37,9 +37,9 @@ from rasterhw.sim.zbm.driver import (
     _write_hex,
     chain_verilog,
     chip_stimulus,
-    random_gaps,
     read_hex_words,
     stimulus_depth,
+    write_unit_stimulus,
 )
 
 __all__ = ["FAST_DIR", "build_fast", "run_chip_fast", "chip_speed_fast", "build_unit_fast", "run_unit_fast"]
@@ -131,13 +131,7 @@ def run_unit_fast(eps_per_unit: list, *, width: int, height: int, interleave: in
                                    nwords=total, capacity=capacity, schedule=schedule, opt=opt, sdepth=sdepth)
     run_dir = temp_run_folder(exe.parent.parent)
     try:
-        flat, index, base = [], [], 0
-        for w in words:
-            index += [base, len(w)]
-            base += len(w)
-            flat += w
-        _write_hex(run_dir / "stim.hex", flat, random_gaps(total, gap_seed), F.EP_WORD_BITS)
-        (run_dir / "index.hex").write_text("\n".join(f"{v:x}" for v in index) + "\n")
+        write_unit_stimulus(run_dir, words, gap_seed)
         out = run_dir / "frame.hex"
         plus = [f"+stim={run_dir / 'stim.hex'}", f"+index={run_dir / 'index.hex'}", f"+out={out}",
                 f"+meta={run_dir / 'meta.json'}", f"+stall={stall}", f"+seed={seed}",
