@@ -6,6 +6,8 @@
 //   {"sim_cycles": rising edges before done, "done", "run_s"[, "cycles"][, "lines"]}
 // where "cycles" / "lines" are the top's outputs of those names when the build defines
 // RASTERHW_CYCLES / RASTERHW_LINES. `final` blocks (the benches' dumps) run at the end.
+// A build with --trace-fst or --trace (waves on request: sim/waves.py) writes the run's trace to
+// the file named by +waves=PATH, two time steps per clock (rising edges at odd steps).
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -16,6 +18,13 @@
 #define RASTERHW_XSTR(x) RASTERHW_STR(x)
 #include RASTERHW_XSTR(RASTERHW_TOP.h)
 #include "verilated.h"
+#if VM_TRACE_FST
+#include "verilated_fst_c.h"
+using RasterhwTrace = VerilatedFstC;
+#elif VM_TRACE_VCD
+#include "verilated_vcd_c.h"
+using RasterhwTrace = VerilatedVcdC;
+#endif
 
 #ifndef RASTERHW_TAIL
 #define RASTERHW_TAIL 0
@@ -25,30 +34,56 @@ int main(int argc, char** argv) {
     const auto ctx = std::make_unique<VerilatedContext>();
     ctx->commandArgs(argc, argv);
     uint64_t maxcyc = 4000000000ull;
-    for (int i = 1; i < argc; ++i)
+    const char* waves = nullptr;
+    for (int i = 1; i < argc; ++i) {
         if (!std::strncmp(argv[i], "+maxcyc=", 8)) maxcyc = std::strtoull(argv[i] + 8, nullptr, 10);
+        if (!std::strncmp(argv[i], "+waves=", 7)) waves = argv[i] + 7;
+    }
+#if VM_TRACE
+    std::unique_ptr<RasterhwTrace> tfp;
+    if (waves) ctx->traceEverOn(true);
+#endif
     const auto top = std::make_unique<RASTERHW_TOP>(ctx.get());
     top->clk = 0;
     top->eval();  // initial blocks: plusargs, $readmemh
-    uint64_t n = 0;
-    const auto t0 = std::chrono::steady_clock::now();
-    while (!top->done && n < maxcyc && !ctx->gotFinish()) {
+#if VM_TRACE
+    if (waves) {
+        tfp = std::make_unique<RasterhwTrace>();
+        top->trace(tfp.get(), 99);
+        tfp->open(waves);
+        tfp->dump(0);
+    }
+#define RASTERHW_DUMP(t) \
+    if (tfp) tfp->dump(t)
+#else
+    if (waves) {
+        std::fprintf(stderr, "+waves given, but this model was built without tracing\n");
+        return 3;
+    }
+#define RASTERHW_DUMP(t)
+#endif
+    uint64_t n = 0, steps = 0;
+    const auto edge = [&]() {
         top->clk = 1;
         top->eval();
+        RASTERHW_DUMP(++steps);
         top->clk = 0;
         top->eval();
+        RASTERHW_DUMP(++steps);
+    };
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!top->done && n < maxcyc && !ctx->gotFinish()) {
+        edge();
         ++n;
     }
     const auto t1 = std::chrono::steady_clock::now();
-    for (int k = 0; k < RASTERHW_TAIL; ++k) {
-        top->clk = 1;
-        top->eval();
-        top->clk = 0;
-        top->eval();
-    }
+    for (int k = 0; k < RASTERHW_TAIL; ++k) edge();
     const double s = std::chrono::duration<double>(t1 - t0).count();
     const unsigned done = top->done;
     top->final();
+#if VM_TRACE
+    if (tfp) tfp->close();
+#endif
     std::printf("{\"sim_cycles\": %llu, \"done\": %u, \"run_s\": %.9f", (unsigned long long)n, done, s);
 #ifdef RASTERHW_CYCLES
     std::printf(", \"cycles\": %u", (unsigned)top->cycles);

@@ -399,7 +399,7 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
 @_click_options(_SIM_OPTIONS)
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="PNG of the HDL frame.")
 @click.option("--waves", type=click.Path(dir_okay=False), default=None,
-              help="Write a trace of the run (pysim: .vcd; cocotb on Verilator: .fst). Off by default.")
+              help="Write a trace of the run to this .vcd (.fst where Verilator can write FST); several simulators: NAME.1.vcd, ... Off by default.")
 @click.option("--json", "as_json", is_flag=True)
 def sim_cmd(block, scene, size, engine, output, waves, as_json, **block_options) -> None:
     """Run a scene through a block's HDL, compare with the golden model, write the frame."""

@@ -184,10 +184,17 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
     the bytes of every source, so an unchanged design is never rebuilt and a changed one always is.
     Returns ``(binary, build seconds, 0.0 if it was already built)``.
     """
+    from rasterhw.sim import waves
+
     generated = dict(generated or {})
     defines = {"RASTERHW_TOP": f"V{top}", **(defines or {})}
     make = verilator_make_vars(opt)
-    h = hashlib.sha1(json.dumps({"top": top, "args": VERILATOR_PLAIN_ARGS, "make": make, "defines": defines,
+    # waves on request (sim/waves.py): a traced model, in its own build folder
+    trace = waves.plain_trace_format()
+    args = [*VERILATOR_PLAIN_ARGS, *({"fst": ["--trace-fst"], "vcd": ["--trace"]}.get(trace, []))]
+    if trace:
+        name = f"{name}-trace-{trace}"
+    h = hashlib.sha1(json.dumps({"top": top, "args": args, "make": make, "defines": defines,
                                  "params": params}, sort_keys=True, default=str).encode())
     for f in (*sources, PLAIN_MAIN):
         h.update(Path(f).read_bytes())
@@ -206,13 +213,13 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
         env = sim_env()
         env["MAKEFLAGS"] = f"{env['MAKEFLAGS']} {make}" if env.get("MAKEFLAGS") else make
         cflags = " ".join(f"-D{k}={v}" for k, v in defines.items())
-        cmd = [str(verilator_bin_dir() / "verilator"), *VERILATOR_PLAIN_ARGS, "--top-module", top, f"-I{bdir}",
+        cmd = [str(verilator_bin_dir() / "verilator"), *args, "--top-module", top, f"-I{bdir}",
                "-CFLAGS", cflags, *[f"-G{k}={v}" for k, v in params.items()], "--Mdir", str(bdir / "obj_dir"),
                *[str(bdir / k) for k in generated if k.endswith(".v")], *[str(f) for f in sources], str(PLAIN_MAIN)]
         t0 = time.perf_counter()
         # generate, put the shared runtime objects in (newer than the generated makefile, so make
         # keeps them: sim/vlruntime.py), then compile; both steps' memory peaks are recorded
-        rt_flags = ["plain", make, cflags, *VERILATOR_PLAIN_ARGS]
+        rt_flags = ["plain", make, cflags, *args]
         peak = [bdir / "verilate.peak", bdir / "compile.peak"]
         r = run_child([*_peak_rss(peak[0]), *cmd], cwd=bdir, env=env, capture_output=True, text=True)
         log = " ".join(cmd) + "\n" + r.stdout + r.stderr
@@ -274,7 +281,11 @@ def run_plain_verilator(exe: Path, plusargs: Sequence[str], *, run_dir: Path, ma
     """Run a :func:`build_plain_verilator` binary in ``run_dir`` with ``plusargs`` and a
     ``+maxcyc=`` watchdog; return its JSON line. A crash, no JSON or no ``done`` is a
     :class:`RasterhwError` naming the binary."""
-    r = run_child([str(exe), *plusargs, f"+maxcyc={maxcyc}"], cwd=run_dir, capture_output=True, text=True)
+    from rasterhw.sim import waves
+
+    trace = waves.next_plain_trace() if "-trace-" in exe.parent.parent.name else None
+    plus = [*plusargs, f"+maxcyc={maxcyc}", *([f"+waves={trace}"] if trace else [])]
+    r = run_child([str(exe), *plus], cwd=run_dir, capture_output=True, text=True)
     try:
         meta = json.loads(r.stdout.strip().splitlines()[-1])
     except (IndexError, json.JSONDecodeError):
