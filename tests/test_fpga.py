@@ -75,3 +75,27 @@ def test_bad_input():
         place_and_route("zbm-merger", device="1k")
     with pytest.raises(RasterhwError, match="black box"):
         place_and_route("pixelbus-bank", depth=16, ram="verilog")
+
+
+def test_a_recorded_run_stands_in_for_the_build_cache_only_for_the_same_design(tmp_path, monkeypatch):
+    """``fpga_runs.json`` (written with the report): a run whose build folder is gone (a fresh
+    machine) comes back from the record, keyed by its digest; another design does not."""
+    import shutil
+
+    from rasterhw.sim import fpga
+
+    kw = dict(family="ecp5", device="25k", fifo_depth=4, z_bits=8, colour_bits=2)
+    r = place_and_route("zbm-merger", **kw)
+    assert r["digest"] and r["ran"]
+    rec = fpga.write_run_record([r, r, {"block": "pixelbus", "fits": False}], tmp_path / "fpga_runs.json")
+    monkeypatch.setattr(fpga, "RUN_RECORD", rec)
+    assert len(__import__("json").loads(rec.read_text())["runs"]) == 1   # deduplicated, no digest dropped
+    shutil.rmtree(r["build_dir"])                                         # the build cache is gone
+    back = place_and_route("zbm-merger", cached_only=True, **kw)
+    assert back is not None and back["cached"] and back["build_dir"] is None
+    assert (back["luts"], back["ffs"], back["fmax_mhz"]) == (r["luts"], r["ffs"], r["fmax_mhz"])
+    other = dict(kw, fifo_depth=8)
+    assert place_and_route("zbm-merger", cached_only=True, **other) is None   # another design: not in it
+    assert fpga.recorded_run("0" * 40) is None
+    rec.write_text("not json")
+    assert place_and_route("zbm-merger", cached_only=True, **kw) is None      # a broken record is no record
