@@ -390,6 +390,14 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
     info(f"wrote {output}")
 
 
+def sim_image_name(scene: str, block: str, engine: str, options: dict) -> Path:
+    """The default image of ``rasterhw sim``: the options given on the command line are in the
+    name, so runs of one scene in two configurations (``--schedule paper`` / ``overlap``) do not
+    overwrite each other."""
+    given = "".join(f"-{k}-{v}" for k, v in sorted(options.items()) if v is not None)
+    return Path("out") / f"{Path(scene).stem}-{block}-{engine}{given}.png"
+
+
 @cli.command("sim")
 @click.argument("block", type=click.Choice(SIM_BLOCKS))
 @click.option("--scene", default=None, help="Built-in scene or .obj/.ply (default: the block's own, "
@@ -536,11 +544,3 @@ def _main(argv: list[str] | None) -> None:
 
 if __name__ == "__main__":
     main()
-
-def sim_image_name(scene: str, block: str, engine: str, options: dict) -> Path:
-    """The default image of ``rasterhw sim``: the options given on the command line are in the
-    name, so runs of one scene in two configurations (``--schedule paper`` / ``overlap``) do not
-    overwrite each other."""
-    given = "".join(f"-{k}-{v}" for k, v in sorted(options.items()) if v is not None)
-    return Path("out") / f"{Path(scene).stem}-{block}-{engine}{given}.png"
-

@@ -10,7 +10,7 @@ from rasterhw.golden_model.zbm.mapping import default_maps, map_samples
 from rasterhw.golden_model.zbm.stimulus import random_doublez
 from rasterhw.golden_model.zbm.words import pixel2_words
 from rasterhw.hdl.zbm.mapper import ZbmMapper
-from rasterhw.sim.harness import stream_protocol_checker, stream_put
+from rasterhw.sim.harness import stream_protocol_checker, stream_put, stream_sink
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 
@@ -27,20 +27,19 @@ def run_mapper(words, tex, il, *, seed=0, p_stall=0.3, p_gap=0.3):
         for w, g in zip(words, gaps, strict=True):
             await stream_put(ctx, dut.i, w, gap=g)
 
-    async def sink(ctx):
-        r = np.random.default_rng(seed + 1)
+    r = np.random.default_rng(seed + 1)
+    ready = (int(r.random() >= p_stall) for _ in iter(int, 1))   # random back-pressure, every clock
+
+    async def wait(ctx):
         while len(got) < len(words):
-            rdy = r.random() >= p_stall
-            ctx.set(dut.o.ready, rdy)
-            _, _, v, p = await ctx.tick().sample(dut.o.valid, dut.o.payload)
-            if v and rdy:
-                got.append(p.as_value().value)
+            await ctx.tick()
         await ctx.tick()
         out["tex"], out["il"] = ctx.get(dut.texture_lookups), ctx.get(dut.illum_lookups)
 
     sim.add_testbench(src, background=True)
     sim.add_testbench(stream_protocol_checker(dut.o, "o"), background=True)
-    sim.add_testbench(sink)
+    sim.add_testbench(stream_sink(dut.o, got, ready=ready), background=True)
+    sim.add_testbench(wait)
     sim.run()
     return got, out
 
