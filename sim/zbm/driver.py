@@ -270,6 +270,17 @@ def write_unit_stimulus(run_dir: Path, words: list[list[int]], gap_seed: int | N
     return flat, index
 
 
+def unit_watchdog(total_words: int, *, width: int, height: int, stall: int = 0,
+                  ratio: tuple[int, int] = (5, 5)) -> int:
+    """The unit benches' watchdog in segment clocks (cocotb and plain Verilator alike): generously
+    above any frame this design can take with ready always high and equal clocks, times the
+    expected slow-down of the back-pressure (ready high in ``256 - stall`` of 256 merge clocks) and
+    of a merge clock slower than the segment clock (``ratio`` = half periods, segment : merge)."""
+    base = 200 * (total_words + 64) + 40 * height * (width + 64)
+    slow = 256 / max(1, 256 - stall) * max(1.0, ratio[1] / ratio[0])
+    return min(int(base * max(1.0, slow)), 2**31 - 1)   # the bench's MAXCYC is a Verilog integer
+
+
 def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, interleave: int,
                    sim: str | None = None, capacity: int = F.AEP_CAPACITY, ratio: tuple[int, int] = (5, 5),
                    stall: int = 0, seed: int = 1, gap_seed: int | None = None,
@@ -315,8 +326,7 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
         np.savez(exp_path, s0=expect[0], s1=expect[1], interleave=interleave, units=units,
                  stim=np.array([f"{x:x}" for x in flat]), index=np.array(index, np.int64))
         env["ZBM_EXPECT"] = str(exp_path)
-    # watchdog: generously above any frame this design can take
-    maxcyc = 200 * (total + 64) + 40 * height * (width + 64)
+    maxcyc = unit_watchdog(total, width=width, height=height, stall=stall, ratio=ratio)
     t1 = time.perf_counter()
     timings: dict = {}
     with verilator_make_flags(opt, coroutines=True):

@@ -39,6 +39,7 @@ from rasterhw.sim.zbm.driver import (
     chip_stimulus,
     read_hex_words,
     stimulus_depth,
+    unit_watchdog,
     write_unit_stimulus,
 )
 
@@ -136,8 +137,7 @@ def run_unit_fast(eps_per_unit: list, *, width: int, height: int, interleave: in
         plus = [f"+stim={run_dir / 'stim.hex'}", f"+index={run_dir / 'index.hex'}", f"+out={out}",
                 f"+meta={run_dir / 'meta.json'}", f"+stall={stall}", f"+seed={seed}",
                 *([f"+lines={run_dir / 'lines.hex'}"] if line_log else [])]
-        # the cocotb bench's watchdog, scaled by the back-pressure
-        maxcyc = (200 * (total + 64) + 40 * height * (width + 64)) * (1 + stall // 32)
+        maxcyc = unit_watchdog(total, width=width, height=height, stall=stall)   # the cocotb bench's
         meta = run_plain_verilator(exe, plus, run_dir=run_dir, maxcyc=maxcyc)
         meta.update(json.loads((run_dir / "meta.json").read_text()))
         s0, s1 = read_hex_words(out)

@@ -20,15 +20,16 @@ pytestmark = pytest.mark.cocotb
 W, H = 64, 16
 
 
-def _compare(units: int, stall: int, gap_seed, seed: int):
+def _compare(units: int, stall: int, gap_seed, seed: int, schedule: str = "overlap"):
     tris = random_triangles(np.random.default_rng(seed), 30, W, H, size=10)
     gold = doublez_words(G.render_zbm(tris, interleave=2, units=units).pixels)
     eps = G.edge_pairs(tris)
     per = [eps.take(np.flatnonzero(eps.tag % units == k)) for k in range(units)]
     fast = ZF.run_unit_fast(per, width=W, height=H, interleave=2, stall=stall, seed=seed, gap_seed=gap_seed,
-                            line_log=True, opt="-O1")
+                            line_log=True, opt="-O1", schedule=schedule)
     ref = Z.run_unit_bench(per, width=W, height=H, interleave=2, sim="verilator", ratio=(5, 5), phase=0,
-                           stall=stall, seed=seed, gap_seed=gap_seed, speed_run=True, line_log=True)
+                           stall=stall, seed=seed, gap_seed=gap_seed, speed_run=True, line_log=True,
+                           schedule=schedule)
     assert np.array_equal(fast["s0"], gold[0]) and np.array_equal(fast["s1"], gold[1])
     assert np.array_equal(ref["s0"], gold[0]) and np.array_equal(ref["s1"], gold[1])
     assert fast["cycles"] == ref["cycles"] > H
@@ -49,8 +50,11 @@ def test_unit_fast_backpressure_costs_cycles():
 
 
 @pytest.mark.slow
-def test_two_units_fast_equals_cocotb_bench():
-    _compare(2, 40, 5, seed=4)
+@pytest.mark.parametrize("schedule", ["overlap", "paper"])
+def test_two_units_fast_equals_cocotb_bench(schedule):
+    """Chains (the report's chain and skew rows run on the plain bench): the same words, cycles and
+    per-line log as the cocotb bench, in both schedules."""
+    _compare(2, 40, 5, seed=4, schedule=schedule)
 
 
 def test_unit_fast_rejects_bad_stall():
@@ -63,3 +67,22 @@ def test_stimulus_depth_shared_by_runs_of_different_sizes():
     assert Z.stimulus_depth(10, 16384) == Z.stimulus_depth(9000, 16384) == 16384
     with pytest.raises(RasterhwError, match="does not hold"):
         Z.stimulus_depth(9000, 4096)
+
+
+def test_watchdog_covers_heavy_backpressure_and_a_slow_merge_clock():
+    """Soak seed 20261203 round 1100: stall 254 (ready high 2 clocks in 256) with a merge clock
+    3.5 x slower than the segment clock outran the cocotb bench's watchdog, which had no term for
+    either (the plain bench's had one for the stall only). The same on a small frame: it finishes,
+    every word golden, well inside the shared watchdog."""
+    tris = random_triangles(np.random.default_rng(5), 30, W, H, size=10)
+    eps = G.edge_pairs(tris)
+    gold = doublez_words(G.render_zbm(tris, interleave=2).pixels)
+    total = len(eps) * 9 + 1
+    r = Z.run_unit_bench([eps], width=W, height=H, interleave=2, sim="verilator", ratio=(2, 7), stall=254,
+                         seed=3, speed_run=True)
+    assert np.array_equal(r["s0"], gold[0]) and np.array_equal(r["s1"], gold[1])
+    old = 200 * (total + 64) + 40 * H * (W + 64)          # the cocotb bench's watchdog before
+    assert old < r["cycles"] < Z.unit_watchdog(total, width=W, height=H, stall=254, ratio=(2, 7))
+    assert Z.unit_watchdog(total, width=W, height=H) == old   # unchanged for free-running runs
+    fast = ZF.run_unit_fast([eps], width=W, height=H, interleave=2, stall=255, seed=3)
+    assert np.array_equal(fast["s0"], gold[0])
