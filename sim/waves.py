@@ -102,20 +102,20 @@ def recording(path: str | Path | None, engine: str) -> Iterator[list[Path]]:
         yield []
         return
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    if engine == "pysim" and path.suffix != ".vcd":
+        raise RasterhwError(f"--waves {path}: Amaranth pysim writes VCD; name a .vcd file")
+    if path.suffix not in (".fst", ".vcd"):
+        raise RasterhwError(f"--waves {path}: name a .vcd file (or .fst where Verilator can write FST)")
+    if engine != "pysim" and path.suffix == ".fst" and not fst_writer_available():
+        raise RasterhwError(f"--waves {path}: Verilator's FST writer needs lz4.h and zlib.h, not installed here "
+                            "(Debian: liblz4-dev zlib1g-dev); name a .vcd file")
+    path.parent.mkdir(parents=True, exist_ok=True)   # only once the name is good
     if engine == "pysim":
-        if path.suffix != ".vcd":
-            raise RasterhwError(f"--waves {path}: Amaranth pysim writes VCD; name a .vcd file")
         with _pysim(path) as written:
             yield written
         if not written:
             raise RasterhwError("--waves: this run started no Amaranth simulation")
         return
-    if path.suffix not in (".fst", ".vcd"):
-        raise RasterhwError(f"--waves {path}: name a .vcd file (or .fst where Verilator can write FST)")
-    if path.suffix == ".fst" and not fst_writer_available():
-        raise RasterhwError(f"--waves {path}: Verilator's FST writer needs lz4.h and zlib.h, not installed here "
-                            "(Debian: liblz4-dev zlib1g-dev); name a .vcd file")
     global _plain
     t0 = time.time()
     old = os.environ.get("WAVES")
