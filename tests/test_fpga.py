@@ -17,14 +17,35 @@ from rasterhw.sim.fpga import (
 from rasterhw.sim.verilog import block_names
 
 
-def test_merger_places_on_ecp5_with_both_clocks():
-    r = place_and_route("zbm-merger", family="ecp5", device="25k", fifo_depth=4, z_bits=8, colour_bits=2)
+def test_merger_places_on_ecp5_with_both_clocks(tmp_path, monkeypatch):
+    """One real place and route (the only one in the test run), its cache, and its record:
+    ``fpga_runs.json`` (written with the report) stands in for a build folder that is gone (a
+    fresh machine) when the run's digest is the same, and only then. One test, so no two test
+    workers place the same design in one folder."""
+    import json
+
+    from rasterhw.sim import fpga
+
+    kw = dict(family="ecp5", device="25k", fifo_depth=4, z_bits=8, colour_bits=2)
+    r = place_and_route("zbm-merger", **kw)
     assert r["luts"] > 0 and r["ffs"] > 0
     assert set(r["fmax_mhz"]) == {"sync", "merge"}   # the two clocks of the crossing
     assert all(f > 25 for f in r["fmax_mhz"].values())  # the paper's 25 MHz, on a 2016 FPGA
     assert {c["domain"] for c in r["paper_clocks"]} == {"sync", "merge"}
-    again = place_and_route("zbm-merger", family="ecp5", device="25k", fifo_depth=4, z_bits=8, colour_bits=2)
-    assert again["cached"] and again["luts"] == r["luts"]
+    again = place_and_route("zbm-merger", **kw)
+    assert again["cached"] and again["luts"] == r["luts"] and again["digest"] == r["digest"] and r["ran"]
+    # the record: deduplicated, results without a digest (never run, synthesis only) left out
+    rec = fpga.write_run_record([r, again, {"block": "pixelbus", "fits": False}], tmp_path / "fpga_runs.json")
+    assert len(json.loads(rec.read_text())["runs"]) == 1
+    monkeypatch.setattr(fpga, "RUN_RECORD", rec)
+    monkeypatch.setattr(fpga, "REPO_ROOT", tmp_path)                   # a machine with an empty build/
+    back = place_and_route("zbm-merger", cached_only=True, **kw)
+    assert back is not None and back["cached"] and back["build_dir"] is None
+    assert (back["luts"], back["ffs"], back["fmax_mhz"]) == (r["luts"], r["ffs"], r["fmax_mhz"])
+    assert place_and_route("zbm-merger", cached_only=True, **dict(kw, fifo_depth=8)) is None   # another design
+    assert fpga.recorded_run("0" * 40) is None
+    rec.write_text("not json")
+    assert place_and_route("zbm-merger", cached_only=True, **kw) is None   # a broken record is no record
 
 
 def test_paper_clocks_and_blocks():
@@ -75,27 +96,3 @@ def test_bad_input():
         place_and_route("zbm-merger", device="1k")
     with pytest.raises(RasterhwError, match="black box"):
         place_and_route("pixelbus-bank", depth=16, ram="verilog")
-
-
-def test_a_recorded_run_stands_in_for_the_build_cache_only_for_the_same_design(tmp_path, monkeypatch):
-    """``fpga_runs.json`` (written with the report): a run whose build folder is gone (a fresh
-    machine) comes back from the record, keyed by its digest; another design does not."""
-    import shutil
-
-    from rasterhw.sim import fpga
-
-    kw = dict(family="ecp5", device="25k", fifo_depth=4, z_bits=8, colour_bits=2)
-    r = place_and_route("zbm-merger", **kw)
-    assert r["digest"] and r["ran"]
-    rec = fpga.write_run_record([r, r, {"block": "pixelbus", "fits": False}], tmp_path / "fpga_runs.json")
-    monkeypatch.setattr(fpga, "RUN_RECORD", rec)
-    assert len(__import__("json").loads(rec.read_text())["runs"]) == 1   # deduplicated, no digest dropped
-    shutil.rmtree(r["build_dir"])                                         # the build cache is gone
-    back = place_and_route("zbm-merger", cached_only=True, **kw)
-    assert back is not None and back["cached"] and back["build_dir"] is None
-    assert (back["luts"], back["ffs"], back["fmax_mhz"]) == (r["luts"], r["ffs"], r["fmax_mhz"])
-    other = dict(kw, fifo_depth=8)
-    assert place_and_route("zbm-merger", cached_only=True, **other) is None   # another design: not in it
-    assert fpga.recorded_run("0" * 40) is None
-    rec.write_text("not json")
-    assert place_and_route("zbm-merger", cached_only=True, **kw) is None      # a broken record is no record
