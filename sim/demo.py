@@ -17,7 +17,9 @@ from __future__ import annotations
 
 import html
 import json
+import multiprocessing
 import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
@@ -35,8 +37,17 @@ SIZE = (512, 512)
 _COLOUR_NOTE = ("Colour is compared as 8-bit RGB: machines with colour formats of their own (EXPERTS' 3/3/3 hue and intensity, the vector Z-buffer's RGBI 3/3/3/7) differ from the float reference in colour by design; coverage and the visible polygon of each machine are checked against the reference by its tests.")
 
 
-def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator") -> dict:
-    """Run the demo into ``out``; raises SystemExit if any HDL run differs from its golden model."""
+def _run_sim(machine: str, block: str, engine: str) -> dict:
+    """One HDL sim block on its default scene and options (run in a worker process)."""
+    b = next(s for s in registry.machines()[machine].sims if s.name == block)
+    w, h = SCENES[b.default_scene].size
+    defaults = {o.name: o.default for o in b.options}
+    return registry.load(b.simulate)(build_scene(b.default_scene), w, h, engine=engine, progress=False, **defaults)
+
+
+def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator", workers: int = 2) -> dict:
+    """Run the demo into ``out``; raises SystemExit if any HDL run differs from its golden model.
+    ``workers``: HDL runs at once (each in its own process)."""
     out.mkdir(parents=True, exist_ok=True)
     archs = [(m, a) for m in registry.machines().values() for a in m.archs]
     sims = [(m, b) for m in registry.machines().values() for b in m.sims]
@@ -73,19 +84,31 @@ def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator") -> di
                                  "stats": _plain(res.stats)})
         bar.update(1)
 
-    for m, b in sims:
+    # The HDL runs, two at a time, each in its own process (a first run verilates and compiles its
+    # model: minutes of compiler work that two cores share; Amaranth elaborates in each process
+    # alone). Results are kept in registry order.
+    bar.set_postfix_str(f"HDL on {engine}, {min(workers, len(sims)) or 1} at a time (a first run builds the models)")
+    results: dict[int, dict] = {}
+    if sims:
+        ctx = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(max_workers=max(1, min(workers, len(sims))), mp_context=ctx) as pool:
+            jobs = {pool.submit(_run_sim, m.name, b.name, engine): k for k, (m, b) in enumerate(sims)}
+            for fut in as_completed(jobs):
+                k = jobs[fut]
+                results[k] = fut.result()
+                m, b = sims[k]
+                bar.set_postfix_str(f"{b.default_scene}: {m.name} {b.name} HDL on {engine} done")
+                bar.update(1)
+    for k, (m, b) in enumerate(sims):
         s_name = b.default_scene
-        bar.set_postfix_str(f"{s_name}: {m.name} {b.name} HDL on {engine} (a first run builds the model)")
-        w, h = SCENES[s_name].size
+        res = results[k]
         defaults = {o.name: o.default for o in b.options}
-        res = registry.load(b.simulate)(build_scene(s_name), w, h, engine=engine, progress=False, **defaults)
         png = out / f"{s_name}-{b.name}-{engine}.png"
         frame_rgb = res.pop("frame_rgb", None)
         if frame_rgb is not None:
             Image.fromarray(frame_rgb).save(png)
         summary["sims"].append({"machine": m.name, "block": b.name, "scene": s_name, "help": b.help,
                                 **defaults, **_plain(res), "image": png.name if frame_rgb is not None else None})
-        bar.update(1)
     bar.close()
 
     (out / "summary.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
