@@ -87,11 +87,12 @@ def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator", worke
     # The HDL runs, two at a time, each in its own process (a first run verilates and compiles its
     # model: minutes of compiler work that two cores share; Amaranth elaborates in each process
     # alone). Results are kept in registry order.
-    bar.set_postfix_str(f"HDL on {engine}, {min(workers, len(sims)) or 1} at a time (a first run builds the models)")
+    n_workers = max(1, min(workers, len(sims)))
+    bar.set_postfix_str(f"HDL on {engine}, {n_workers} at a time (a first run builds the models)")
     results: dict[int, dict] = {}
     if sims:
         ctx = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(max_workers=max(1, min(workers, len(sims))), mp_context=ctx) as pool:
+        with ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx) as pool:
             jobs = {pool.submit(_run_sim, m.name, b.name, engine): k for k, (m, b) in enumerate(sims)}
             for fut in as_completed(jobs):
                 k = jobs[fut]

@@ -153,18 +153,10 @@ def measure_table1(interleave: int, *, schedule: str = "overlap", engine: str = 
         marks, mism = r["line_cycles"], None
     else:
         g0, g1 = unit_golden_words(eps, height, width=width, interleave=interleave)
-        if engine == "verilator":
-            # the plain-Verilator bench (equal, in-phase clocks), held word-, cycle- and line-log
-            # exact with the cocotb bench by tests/zbm/test_zbm_unit_fast.py; it builds faster
-            from rasterhw.sim.zbm.fast import run_unit_fast
+        from rasterhw.sim.zbm.fast import run_units_equal_clocks
 
-            r = run_unit_fast([eps], width=width, height=height, interleave=interleave, schedule=schedule,
-                              line_log=True, opt="-O0")
-        else:
-            from rasterhw.sim.zbm.driver import run_unit_bench
-
-            r = run_unit_bench([eps], width=width, height=height, interleave=interleave, sim=engine,
-                               phase=0, speed_run=True, schedule=schedule, line_log=True, opt="-O0")
+        r = run_units_equal_clocks([eps], width=width, height=height, interleave=interleave, engine=engine,
+                                   schedule=schedule, line_log=True)
         if r.get("timeout"):
             raise RasterhwError(f"ZB/M {engine}: the bench's watchdog fired")
         marks = r["line_cycles"]

@@ -156,6 +156,21 @@ def run_unit_fast(eps_per_unit: list, *, width: int, height: int, interleave: in
     return res
 
 
+def run_units_equal_clocks(per_unit: list, *, width: int, height: int, interleave: int, engine: str,
+                           schedule: str, line_log: bool = False) -> dict:
+    """A chain of units with equal, in-phase clocks (the Table 1, skew and chain runs): on
+    Verilator the plain bench (:func:`run_unit_fast`, held word-, cycle- and line-log-exact with
+    the cocotb bench by ``tests/zbm/test_zbm_unit_fast.py``; it builds and runs several times
+    faster), on Icarus the cocotb bench. ``-O0``: these frames are small, the build is what costs."""
+    if engine == "verilator":
+        return run_unit_fast(per_unit, width=width, height=height, interleave=interleave, schedule=schedule,
+                             line_log=line_log, opt="-O0")
+    from rasterhw.sim.zbm.driver import run_unit_bench
+
+    return run_unit_bench(per_unit, width=width, height=height, interleave=interleave, sim=engine, phase=0,
+                          speed_run=True, schedule=schedule, line_log=line_log, opt="-O0")
+
+
 def chip_speed_fast(*, interleave: int = 8, width: int = 512, height: int = 512, scene: str = "c300",
                     repeat: int = 8) -> dict:
     """Segment-clock cycles per second of one chip (chip 0) on the stimulus of

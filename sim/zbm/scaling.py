@@ -71,6 +71,7 @@ def skew(*, interleave: int = 1, offset: int = 2, n_edge_pairs: int = 4, schedul
     where both units are busy: (t(line w0 + 5n - 1) - t(line w0 - 1)) / n, w0 = 5 (n // 2).
     """
     from rasterhw.sim.zbm.cycles_hdl import table1_width
+    from rasterhw.sim.zbm.fast import run_units_equal_clocks
 
     n = n_edge_pairs
     width = table1_width(interleave)
@@ -81,8 +82,8 @@ def skew(*, interleave: int = 1, offset: int = 2, n_edge_pairs: int = 4, schedul
     hi = lo + 5 * n
     res = {}
     for name, per_unit in (("alone", [a]), ("pair", [a, b])):
-        r = _run_units(per_unit, width=width, height=height, interleave=interleave, engine=engine,
-                       schedule=schedule, line_log=True)
+        r = run_units_equal_clocks(per_unit, width=width, height=height, interleave=interleave, engine=engine,
+                                   schedule=schedule, line_log=True)
         gold = _chain_golden(per_unit, height, width, interleave)
         bad = int(((r["s0"] != gold[0]) | (r["s1"] != gold[1])).sum())
         if bad or r.get("timeout"):
@@ -92,23 +93,6 @@ def skew(*, interleave: int = 1, offset: int = 2, n_edge_pairs: int = 4, schedul
     return {"interleave": interleave, "offset": offset, "schedule": schedule, "engine": engine,
             "width": width, "height": height, "alone": res["alone"], "pair": res["pair"],
             "loss": 1 - res["alone"] / res["pair"], "paper_loss": 0.5}
-
-
-def _run_units(per_unit: list[G.EdgePairs], *, width: int, height: int, interleave: int, engine: str,
-               schedule: str, line_log: bool = False) -> dict:
-    """A chain of units with equal, in-phase clocks: on Verilator the plain bench
-    (``sim/zbm/fast.py``, held word- and cycle-exact with the cocotb bench by
-    ``tests/zbm/test_zbm_unit_fast.py``; it builds and runs several times faster), on Icarus the
-    cocotb bench. ``-O0``: these frames are small, the build is what costs."""
-    if engine == "verilator":
-        from rasterhw.sim.zbm.fast import run_unit_fast
-
-        return run_unit_fast(per_unit, width=width, height=height, interleave=interleave, schedule=schedule,
-                             line_log=line_log, opt="-O0")
-    from rasterhw.sim.zbm.driver import run_unit_bench
-
-    return run_unit_bench(per_unit, width=width, height=height, interleave=interleave, sim=engine, phase=0,
-                          speed_run=True, schedule=schedule, line_log=line_log, opt="-O0")
 
 
 def _chain_golden(eps_per_unit: list[G.EdgePairs], height: int, width: int, interleave: int):
@@ -133,6 +117,8 @@ def chain(units: int, *, interleave: int = 1, width: int = 64, height: int = 48,
     ``render_zbm`` word for word. Returns cycles, polygons/s at 25 MHz, the merge-bus occupancy
     (merge words per clock on a slot's link: ``chip_pixels * height / cycles``) and the merge
     bound ``height * (chip_pixels + 2)`` (the bus alone, measured per line by ``pixel_rate``)."""
+    from rasterhw.sim.zbm.fast import run_units_equal_clocks
+
     if not (isinstance(units, int) and 1 <= units <= 16):
         raise RasterhwError(f"units must be 1..16, not {units!r}")
     tris = random_triangles(np.random.default_rng(seed), triangles, width, height, size=10)
@@ -140,7 +126,7 @@ def chain(units: int, *, interleave: int = 1, width: int = 64, height: int = 48,
     gold = G.render_zbm(tris, interleave=interleave, units=units)
     g0, g1 = doublez_words(gold.pixels)
     per_unit = [eps.take(np.flatnonzero(eps.tag % units == k)) for k in range(units)]
-    r = _run_units(per_unit, width=width, height=height, interleave=interleave, engine=engine, schedule=schedule)
+    r = run_units_equal_clocks(per_unit, width=width, height=height, interleave=interleave, engine=engine, schedule=schedule)
     if r.get("timeout"):
         raise RasterhwError("ZB/M chain: the bench's watchdog fired")
     bad = int(((r["s0"] != np.asarray(g0).reshape(height, width)) |
