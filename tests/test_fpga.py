@@ -96,3 +96,53 @@ def test_bad_input():
         place_and_route("zbm-merger", device="1k")
     with pytest.raises(RasterhwError, match="black box"):
         place_and_route("pixelbus-bank", depth=16, ram="verilog")
+
+
+def test_router2_out_of_time_falls_back_to_router1_and_both_are_recorded(tmp_path, monkeypatch):
+    """router2 diverges on the ZB/M segment generator (docs/hwflow.md): a run it does not finish
+    goes to router1 with the same netlist; the result says so, and the record keeps both runs."""
+    import json
+
+    from rasterhw.sim import fpga
+
+    calls = []
+
+    def fake(block, *, router, timeout, **kw):
+        calls.append(router)
+        base = {"block": block, "family": "ecp5", "device": "85k", "params": {}, "router": router,
+                "timeout_s": timeout, "digest": router * 5, "utilization": {"TRELLIS_COMB": 6235},
+                "stage": "place and route"}
+        if router == "router2" or outcome == "neither":
+            return {**base, "finished": False, "reason": f"nextpnr did not finish in {timeout / 60:.0f} min",
+                    "progress": f"placed, {router} at iteration 20 with 7,356 wires overused"}
+        return {**base, "finished": True, "fits": True, "luts": 6000, "fmax_mhz": {"sync": 30.0}}
+
+    monkeypatch.setattr(fpga, "_place_and_route", fake)
+    outcome = "router1"
+    r = place_and_route("zbm-seggen", timeout=60)
+    assert calls == ["router2", "router1"] and r["router"] == "router1" and r["luts"] == 6000
+    assert r["first_try"]["router"] == "router2" and fpga._reason(r) is None
+    rec = json.loads(fpga.write_run_record([r], tmp_path / "runs.json").read_text())["runs"]
+    assert sorted(x["result"]["router"] for x in rec) == ["router1", "router2"]
+    assert all("first_try" not in x["result"] for x in rec)
+    outcome = "neither"
+    r = place_and_route("zbm-seggen", timeout=60)
+    why = fpga._reason(r)
+    assert r["finished"] is False and "with router1, nor with router2 before it" in why
+    assert "router1 at iteration 20 with 7,356 wires overused" in why and "TRELLIS_COMB 6,235" in why
+    calls.clear()
+    monkeypatch.setattr(fpga, "_place_and_route", lambda block, *, router, **kw: calls.append(router) or
+                        {"block": block, "finished": True, "fits": True, "router": router})
+    assert place_and_route("zbm-merger")["router"] == "router2" and calls == ["router2"]   # no second run
+
+
+def test_router_progress_parser():
+    from rasterhw.sim.fpga import _progress
+
+    r2 = "Info:     iter=1 wires=135739 overused=12907 overuse=16088 archfail=NA\n" \
+         "Info:     iter=2 wires=141278 overused=9321 overuse=10412 archfail=NA\n"
+    assert _progress(r2, "router2") == "placed, router2 at iteration 2 with 9,321 wires overused"
+    r1 = ("Info:      54000 |    15873      37689 |  463   537 |      7020|      12.95     363.61|\n"
+          "Info:      55000 |    16376      38186 |  503   497 |      6928|      18.71     382.32|\n")
+    assert _progress(r1, "router1") == "placed, router1 after 55,000 iterations with 6,928 arcs queued"
+    assert _progress("Info: Running placer\n", "router2") == "in placement"
