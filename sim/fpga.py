@@ -331,7 +331,10 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
 def fpga_summary(r: dict) -> str:
     """Human-readable lines of one :func:`place_and_route` result."""
     shown = ", ".join(f"{k}={v}" for k, v in r["params"].items())
-    lines = [f"{r['block']} ({shown}) on {r['family']} {r['device']} (out of context)",
+    head = f"{r['block']} ({shown}) on {r['family']} {r['device']} (out of context)"
+    if r.get("finished") is False or r.get("fits") is False:   # not placed, or out of time
+        return f"{head}\n  not measured: {_reason(r)}"
+    lines = [head,
              f"  {' / '.join(r['tools'])}; synth {r['synth_s']:.1f} s, place and route {r['pnr_s']:.1f} s",
              f"  LUT4s {r['luts']}, flip-flops {r['ffs']}, block RAMs {r['brams']}, DSPs {r['dsps']}"]
     if r.get("first_try"):

@@ -146,3 +146,13 @@ def test_router_progress_parser():
           "Info:      55000 |    16376      38186 |  503   497 |      6928|      18.71     382.32|\n")
     assert _progress(r1, "router1") == "placed, router1 after 55,000 iterations with 6,928 arcs queued"
     assert _progress("Info: Running placer\n", "router2") == "in placement"
+
+
+def test_summary_of_a_run_that_did_not_finish_names_why():
+    from rasterhw.sim.fpga import fpga_summary
+
+    r = {"block": "zbm-seggen", "params": {}, "family": "ecp5", "device": "85k", "finished": False,
+         "stage": "place and route", "reason": "nextpnr did not finish in 60 min", "synth_s": None,
+         "utilization": {"DP16KD": 38}, "progress": "placed, router1 after 9 iterations with 5 arcs queued"}
+    text = fpga_summary(r)
+    assert "not measured: nextpnr did not finish in 60 min (packed DP16KD 38; placed, router1" in text
