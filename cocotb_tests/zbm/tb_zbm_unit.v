@@ -25,13 +25,10 @@ module tb_zbm_unit #(
   output reg finished,
   output reg timeout,
   output reg [31:0] cycles,
-  output reg [31:0] proto_errors,
+  output [31:0] proto_errors,
   output reg frames_ok,
   output reg overflow
 );
-  localparam EW = 168;
-  localparam MW = 128;
-  localparam NPIX = W * H;
 
   // run-time settings (plusargs, so one simulator build serves every clock ratio and pattern):
   // the clocks' (rasterhw_two_clocks, ../harness.v), +stall= 0..256 (ready low
@@ -46,133 +43,29 @@ module tb_zbm_unit #(
   wire clk, mclk;
   rasterhw_two_clocks clocks (.clk(clk), .mclk(mclk));
 
-  reg [31:0] idx [0:2*U-1];
-  reg [MW-1:0] frame [0:NPIX-1];
-  reg [8*512-1:0] findex, fout;
-  integer k0;
-
+  reg [8*512-1:0] fout;
   initial begin
     finished = 1'b0;
     timeout = 1'b0;
     cycles = 32'd0;
     frames_ok = 1'b0;
     overflow = 1'b0;
-    if (!$value$plusargs("index=%s", findex)) $fatal(1, "tb_zbm_unit: +index= missing");
     if (!$value$plusargs("out=%s", fout)) $fatal(1, "tb_zbm_unit: +out= missing");
-    $readmemh(findex, idx);
-    for (k0 = 0; k0 < NPIX; k0 = k0 + 1) frame[k0] = {MW{1'b1}};
   end
 
   wire rst, mrst;
   rasterhw_reset #(.CYCLES(6), .DELAY(0.5)) seg_reset (.clk(clk), .rst(rst));
   rasterhw_reset #(.CYCLES(6), .DELAY(0.5)) merge_reset (.clk(mclk), .rst(mrst));
 
-  // --- device under test ----------------------------------------------------------------
-  wire [U-1:0] i_valid, i_ready;
-  wire [EW*U-1:0] i_payload;
-  wire [I-1:0] o_valid, o_ready;
-  wire [MW*I-1:0] o_payload;
-  wire [32*U-1:0] dut_cycles;
-  wire [16*U-1:0] dut_frames;
-  wire [U-1:0] dut_overflow;
-
-  zbm_chain_flat dut (
-    .clk(clk), .rst(rst), .merge_clk(mclk), .merge_rst(mrst),
-    .i_valid(i_valid), .i_ready(i_ready), .i_payload(i_payload),
-    .o_valid(o_valid), .o_ready(o_ready), .o_payload(o_payload),
-    .cycles(dut_cycles), .frames(dut_frames), .overflow(dut_overflow)
-  );
-
-  // --- one player per unit input stream ---------------------------------------------------
-  wire [32*U-1:0] in_err;
-  genvar k;
-  generate
-    for (k = 0; k < U; k = k + 1) begin : player
-      wire [31:0] base = idx[2*k];
-      wire [31:0] count = idx[2*k+1];
-      wire v, done;
-      wire r = i_ready[k];
-      wire [EW-1:0] p;
-      assign i_valid[k] = v;
-      assign i_payload[k*EW +: EW] = p;
-      // every player loads the whole stimulus file and plays its own unit's words
-      rasterhw_stream_player #(.PW(EW), .GW(GW), .DEPTH(SDEPTH), .FILE_ARG("stim=%s")) u (
-        .clk(clk), .rst(rst), .base(base), .count(count), .repeats(32'd1),
-        .valid(v), .ready(r), .payload(p), .done(done));
-      wire [31:0] transfers;
-      rasterhw_stream_check #(.PW(EW)) chk (.clk(clk), .rst(rst), .valid(v), .ready(r), .payload(p),
-                                       .errors(in_err[32*k +: 32]), .transfers(transfers));
-    end
-  endgenerate
-
-  // --- one sink per merge slot: random back-pressure, frame address from arrival order ---
-  function [31:0] xorshift(input [31:0] x);
-    reg [31:0] a;
-    begin
-      a = x ^ (x << 13);
-      a = a ^ (a >> 17);
-      xorshift = a ^ (a << 5);
-    end
-  endfunction
-
+  // --- the units, their players and the merge-slot sinks (tb_zbm_unit_core.v) -------------
   wire [I-1:0] slot_done;
   wire [32*I-1:0] slot_y;
-  wire [32*I-1:0] faddr;
-  wire [32*I-1:0] out_err;
-  genvar c;
-  generate
-    for (c = 0; c < I; c = c + 1) begin : slot
-      localparam integer NPX = (W - c + I - 1) / I;
-      reg [31:0] lf;
-      reg [31:0] q, y;
-      wire v = o_valid[c];
-      wire r = !mrst && (lf[7:0] >= STALL);
-      wire [MW-1:0] p = o_payload[c*MW +: MW];
-      assign o_ready[c] = r;
-      assign slot_done[c] = (y == H);
-      assign slot_y[32*c +: 32] = y;
-      assign faddr[32*c +: 32] = y * W + q * I + c;
-      always @(posedge mclk) begin
-        if (mrst) begin
-          lf <= 32'h9E3779B9 ^ (SEED * 32'd7919 + c * 32'd104729 + 32'd1);
-          q <= 32'd0;
-          y <= 32'd0;
-        end else begin
-          lf <= xorshift(lf);
-          if (v && r && y < H) begin
-            if (q == NPX - 1) begin
-              q <= 32'd0;
-              y <= y + 32'd1;
-            end else begin
-              q <= q + 32'd1;
-            end
-          end
-        end
-      end
-      wire [31:0] transfers;
-      rasterhw_stream_check #(.PW(MW)) chk (.clk(mclk), .rst(mrst), .valid(v), .ready(r), .payload(p),
-                                       .errors(out_err[32*c +: 32]), .transfers(transfers));
-    end
-  endgenerate
-
-  integer s;
-  always @(posedge mclk) begin
-    if (!mrst) begin
-      for (s = 0; s < I; s = s + 1)
-        if (o_valid[s] && o_ready[s] && !slot_done[s]) frame[faddr[32*s +: 32]] <= o_payload[s*MW +: MW];
-    end
-  end
-
-  // --- completion ---------------------------------------------------------------------------
-  integer e;
-  reg all_frames;
-  always @(*) begin
-    proto_errors = 32'd0;
-    for (e = 0; e < U; e = e + 1) proto_errors = proto_errors + in_err[32*e +: 32];
-    for (e = 0; e < I; e = e + 1) proto_errors = proto_errors + out_err[32*e +: 32];
-    all_frames = 1'b1;
-    for (e = 0; e < U; e = e + 1) all_frames = all_frames && (dut_frames[16*e +: 16] == 16'd1);
-  end
+  wire [31:0] cycles0;
+  wire any_overflow, all_frames;
+  tb_zbm_unit_core #(.I(I), .U(U), .W(W), .H(H), .GW(GW), .SDEPTH(SDEPTH)) core (
+    .clk(clk), .rst(rst), .mclk(mclk), .mrst(mrst), .stall(STALL), .seed(SEED),
+    .slot_done(slot_done), .slot_y(slot_y), .cycles0(cycles0), .any_overflow(any_overflow),
+    .all_frames(all_frames), .proto_errors(proto_errors));
 
   // --- per-line log (optional, +lines=FILE): line_t[y] = unit 0's segment-clock count in the
   // merge cycle in which the last chip slot finished merge output line y (steady-state timing).
@@ -190,24 +83,25 @@ module tb_zbm_unit #(
     for (e2 = 0; e2 < I; e2 = e2 + 1) if (slot_y[32*e2 +: 32] < ymin) ymin = slot_y[32*e2 +: 32];
   end
 
+  // --- completion ---------------------------------------------------------------------------
   always @(posedge mclk) begin
     // blocking: the dump below, in the same clock edge, must see the last line's entry
     if (!mrst && ylog < ymin) begin
-      line_t[ylog] = dut_cycles[31:0];
+      line_t[ylog] = cycles0;
       ylog = ylog + 32'd1;
     end
-    if (!mrst && !finished && ((&slot_done) || timeout || (|dut_overflow))) begin
-      cycles <= dut_cycles[31:0];
-      overflow <= |dut_overflow;
+    if (!mrst && !finished && ((&slot_done) || timeout || any_overflow)) begin
+      cycles <= cycles0;
+      overflow <= any_overflow;
       frames_ok <= all_frames;
-      $writememh(fout, frame);
+      $writememh(fout, core.frame);
       if (log_lines) $writememh(flines, line_t);
       finished <= 1'b1;
     end
   end
 
   always @(posedge clk) begin
-    if (!rst && !finished && dut_cycles[31:0] >= MAXCYC) begin
+    if (!rst && !finished && cycles0 >= MAXCYC) begin
       timeout <= 1'b1;
     end
   end

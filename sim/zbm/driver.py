@@ -73,6 +73,9 @@ TEST_MODULE = "cocotb_tests.zbm.test_zbm"
 # (the 357 s first build and 5.5 k cycles/s of the c300 unit run). The benches read only the
 # wrappers' own signals: zbm_public.vlt makes those (read-only) public and nothing else.
 VERILATOR_ARGS = ("--no-public-flat-rw", str(BENCH_DIR / "zbm_public.vlt"))
+#: the unit bench's Verilog beside the generated units: its top, the part it shares with the plain
+#: bench (fast/tb_zbm_unit_fast.v), and the harness
+UNIT_BENCH = (HARNESS_V, BENCH_DIR / "tb_zbm_unit_core.v", BENCH_DIR / "tb_zbm_unit.v")
 # The cocotb test module imports NumPy inside the simulator process: one BLAS thread, so that
 # idle OpenBLAS workers do not compete with the simulation for this machine's 2 cores.
 _SIM_ENV = {"OPENBLAS_NUM_THREADS": "1"}
@@ -314,7 +317,8 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
     total = sum(len(w) for w in words)
     sdepth = stimulus_depth(total, sdepth)
     params = {"I": interleave, "U": units, "W": width, "H": height, "GW": GAP_BITS, "SDEPTH": sdepth}
-    bdir = build_dir_for("zbm-unit", sim, sources=[*srcs, HARNESS_V, BENCH_DIR / "tb_zbm_unit.v"], **params)
+    # the .vlt is a build input too: a change to it must give a fresh build
+    bdir = build_dir_for("zbm-unit", sim, sources=[*srcs, *UNIT_BENCH, BENCH_DIR / "zbm_public.vlt"], **params)
     bdir.mkdir(parents=True, exist_ok=True)
     run_dir = temp_run_folder(bdir)
     flat, index = write_unit_stimulus(run_dir, words, gap_seed)
@@ -330,7 +334,7 @@ def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, 
     t1 = time.perf_counter()
     timings: dict = {}
     with verilator_make_flags(opt, coroutines=True):
-        run_cocotb(sources=[*srcs, HARNESS_V, BENCH_DIR / "tb_zbm_unit.v"], toplevel="tb_zbm_unit",
+        run_cocotb(sources=[*srcs, *UNIT_BENCH], toplevel="tb_zbm_unit",
                    test_module=TEST_MODULE, testcase="zbm_unit_frame", build_dir=bdir, test_dir=run_dir, sim=sim,
                    parameters=params,
                    plusargs=[f"+stim={run_dir / 'stim.hex'}", f"+index={run_dir / 'index.hex'}", f"+out={out_path}",
@@ -391,7 +395,8 @@ def run_chip_bench(seg_words: list[int], up_words: list[int], *, lines: int, chi
     npx = -(-(width - chip) // interleave)
     params = {"I": interleave, "CHIP": chip, "W": width, "L": lines, "GW": GAP_BITS,
               "SDEPTH": _depth(len(seg_words)), "MDEPTH": _depth(len(up_words))}
-    bdir = build_dir_for("zbm-chip", sim, sources=[src, HARNESS_V, BENCH_DIR / "tb_zbm_chip.v"], **params)
+    bdir = build_dir_for("zbm-chip", sim, sources=[src, HARNESS_V, BENCH_DIR / "tb_zbm_chip.v", BENCH_DIR / "zbm_public.vlt"],
+                         **params)
     bdir.mkdir(parents=True, exist_ok=True)
     run_dir = temp_run_folder(bdir)
     g = random_gaps(len(seg_words) + len(up_words), gap_seed)

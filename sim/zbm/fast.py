@@ -108,7 +108,8 @@ def build_unit_fast(*, interleave: int, width: int, height: int, units: int, nwo
     params = {"I": interleave, "U": units, "W": width, "H": height, "GW": GAP_BITS,
               "SDEPTH": stimulus_depth(nwords, sdepth)}
     return build_plain_verilator("zbm-unit-fast", "tb_zbm_unit_fast",
-                                 [*srcs, HARNESS_V, FAST_DIR / "tb_zbm_unit_fast.v"], params=params, opt=opt,
+                                 [*srcs, HARNESS_V, FAST_DIR.parent / "tb_zbm_unit_core.v", FAST_DIR / "tb_zbm_unit_fast.v"],
+                                 params=params, opt=opt,
                                  defines={"RASTERHW_CYCLES": 1})
 
 
