@@ -17,6 +17,7 @@ from rasterhw.sim.fpga import (
 from rasterhw.sim.verilog import block_names
 
 
+@pytest.mark.heavy
 def test_merger_places_on_ecp5_with_both_clocks(tmp_path, monkeypatch):
     """One real place and route (the only one in the test run), its cache, and its record:
     ``fpga_runs.json`` (written with the report) stands in for a build folder that is gone (a

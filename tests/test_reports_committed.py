@@ -54,6 +54,7 @@ def _compare(system: str, tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("system", [s for s in systems() if s not in SLOW_SYSTEMS])
+@pytest.mark.heavy(3)
 def test_fast_report_keeps_every_committed_row(system, tmp_path):
     _compare(system, tmp_path)
 

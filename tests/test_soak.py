@@ -17,6 +17,7 @@ PIXELS = int(float(os.environ.get("SOAK_PIXELS", "1e6")))
 
 
 @pytest.mark.parametrize("block", sorted(BLOCKS))
+@pytest.mark.heavy(2)
 def test_random_differential_rounds_match_golden(block):
     seed = int(os.environ.get("RASTERHW_SEED") or secrets.randbelow(1 << 31))
     print(f"soak {block}: seed {seed} (rerun: RASTERHW_SEED={seed} or rasterhw soak --seed {seed} --block {block})")

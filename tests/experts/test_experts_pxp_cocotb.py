@@ -32,6 +32,7 @@ def _jobs(name="experts-tilt-1000", aj="c", lines=range(200, 206)):
 
 
 @pytest.mark.parametrize("sim", SIMS)
+@pytest.mark.heavy
 def test_cocotb_pxp_cycle_exact_free_running(sim):
     r = run_cocotb_bench(_jobs(), sim=sim)
     assert r["pixels"] == 6 * (64 + 129 + 64) and r["lines"] == 18

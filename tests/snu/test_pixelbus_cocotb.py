@@ -28,6 +28,7 @@ def random_stream(seed, w=40, h=16, n=400):
 
 
 @pytest.mark.parametrize("sim", SIMS)
+@pytest.mark.heavy
 def test_cocotb_random_stream_with_idle_and_protocol(sim):
     s, gaps = random_stream(7)
     # the cocotb test itself asserts protocol, in-order transfers, frame and cycles;

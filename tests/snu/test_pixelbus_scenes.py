@@ -97,6 +97,7 @@ SIMS = ["verilator", pytest.param("icarus", marks=pytest.mark.skipif(
 
 @pytest.mark.cocotb
 @pytest.mark.parametrize("sim", SIMS)
+@pytest.mark.heavy
 def test_scene_stream_cocotb(sim):
     s = scene_stream("sp27", 80, 64)
     gaps = gap_pattern("random", len(s))

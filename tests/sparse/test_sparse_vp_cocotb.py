@@ -20,6 +20,7 @@ SIMS = ["verilator", pytest.param("icarus", marks=pytest.mark.skipif(
 
 @pytest.mark.parametrize("sim", SIMS)
 @pytest.mark.parametrize(("a", "b", "idle"), [(0, 0, 0.0), (3, 2, 0.5)])
+@pytest.mark.heavy
 def test_cocotb_vp_local_memory_and_tests_exact(sim, a, b, idle):
     tris = random_triangles(32, 32, 40, mean_area=20.0, seed=8)
     r = run_cocotb_bench(tris, "4x4", a=a, b=b, sim=sim, idle=idle, seed=a + 7)

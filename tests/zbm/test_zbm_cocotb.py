@@ -50,6 +50,7 @@ def _unit_run(sim, interleave, units, ratio, stall, seed):
 
 
 @pytest.mark.parametrize("ratio", RATIOS)
+@pytest.mark.heavy
 def test_unit_verilator_ratios(ratio):
     _unit_run("verilator", 2, 1, ratio, stall=80, seed=sum(ratio))
 
@@ -81,6 +82,7 @@ def _chip_run(sim, ratio, stall, seed, interleave=4, chip=1):
 
 
 @pytest.mark.parametrize("ratio", RATIOS)
+@pytest.mark.heavy
 def test_chip_verilator_ratios(ratio):
     _chip_run("verilator", ratio, stall=80, seed=ratio[0] * 7 + ratio[1])
 
@@ -99,6 +101,7 @@ def test_bench_rejects_bad_settings():
         Z._plusargs((5, 5), 0, 1, 10, phase=2)
 
 
+@pytest.mark.heavy
 def test_unit_paper_schedule_verilator_protocol():
     """The paper-schedule unit under random gaps, back-pressure and a 3:2 clock ratio: same words."""
     tris = _scene(5)
@@ -110,6 +113,7 @@ def test_unit_paper_schedule_verilator_protocol():
 
 
 @pytest.mark.parametrize("interleave", [1, 8])
+@pytest.mark.heavy
 def test_table1_paper_schedule_verilator(interleave):
     """Table 1 from Verilator, paper schedule: 74 / 54 cycles per edge pair (= the paper's formula
     and the exact model), every merge word equal to the golden model's."""

@@ -1,0 +1,14 @@
+"""Test-run order: tests marked ``heavy`` (minutes on a cold machine: Verilator builds, report
+regeneration, soak rounds) are handed out first, so that ``pytest -n 2`` does not end with one
+worker running a long test alone while the other is idle; ``heavy(n)`` with a larger ``n`` goes
+earlier still (the longest ones). Nothing else changes order."""
+
+from __future__ import annotations
+
+
+def pytest_collection_modifyitems(config, items):
+    def rank(item):
+        m = item.get_closest_marker("heavy")
+        return 0 if m is None else -(m.args[0] if m.args else 1)
+
+    items.sort(key=rank)   # stable: the rest keep their order
