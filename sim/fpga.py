@@ -123,7 +123,12 @@ def write_run_record(results: list[dict], record: Path | None = None) -> Path:
         if not r.get("digest") or r["digest"] in seen:
             continue
         seen.add(r["digest"])
-        keep = {k: v for k, v in r.items() if k not in ("build_dir", "cached", "digest", "first_try")}
+        keep = {k: v for k, v in r.items() if k not in ("build_dir", "cached", "digest", "first_try",
+                                                          "display_reason", "fallback_pending")}
+        if keep.get("finished") is False and not keep.get("progress") and r.get("build_dir"):
+            log = Path(r["build_dir"]) / "nextpnr.log"   # older results: where nextpnr stopped, from its log
+            if log.exists():
+                keep["progress"] = _progress(log.read_text(errors="replace"), keep.get("router", ROUTER))
         runs.append({"digest": r["digest"], "block": r["block"], "params": r.get("params", {}), "result": keep})
     runs.sort(key=lambda x: (x["block"], json.dumps(x["params"], sort_keys=True, default=str)))
     path = record or RUN_RECORD
@@ -164,8 +169,8 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
         return first
     second = _place_and_route(block, family=family, device=device, seed=seed, timeout=timeout, cache=cache,
                               cached_only=cached_only, router=FALLBACK_ROUTER, **params)
-    if second is None:
-        return first
+    if second is None:   # cached_only: the fallback has not run on this machine or in the record
+        return {**first, "fallback_pending": True}
     if second.get("finished") is False:
         second = {**second, "reason": f"{second['reason']} with {FALLBACK_ROUTER}, nor with {ROUTER} before it"}
     return {**second, "first_try": first}
@@ -446,10 +451,13 @@ def _measure(block, params, *, fast, progress, timeout, family="ecp5", cached_on
         if not d["fits"]:
             return {**d, "finished": True, "luts": None, "ffs": None, "brams": None, "fmax_mhz": {}}
     r = place_and_route(block, family=family, timeout=timeout, cached_only=cached_only, **params)
+    args = "".join(f" -p {k}={v}" for k, v in params.items()) + ("" if family == "ecp5" else f" --family {family}")
     if r is None:  # cached_only and never run
-        args = "".join(f" -p {k}={v}" for k, v in params.items()) + ("" if family == "ecp5" else f" --family {family}")
         return {"block": block, "params": params, "finished": False, "reason": _NOT_RUN.format(block=block, args=args),
                 "luts": None, "ffs": None, "brams": None, "fmax_mhz": {}}
+    if r.pop("fallback_pending", False):
+        # shown in the table; the record keeps the run's own reason
+        r["display_reason"] = f"{_reason(r)}; {FALLBACK_ROUTER} " + _NOT_RUN.format(block=block, args=args)
     return r
 
 
@@ -471,6 +479,8 @@ def _reason(r) -> str | None:
 
     if r is None:
         return FAST_SKIP
+    if r.get("display_reason"):
+        return r["display_reason"]
     if r.get("fits") is False and r.get("over") and r.get("utilization"):
         # the packed demand of the main kinds against the device, the ones over it first
         kinds = sorted(r["utilization"], key=lambda k: (k not in r["over"], k))
@@ -640,6 +650,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
                      "| block | configuration | ran | synthesis s | nextpnr s | result |", "|---|---|---|---|---|---|"]
         for block, params, kind, r in walls:
             res = r.get("reason") or "placed and routed"
+            if r.get("display_reason"):
+                res += f"; {FALLBACK_ROUTER} not run yet"
             if r.get("first_try") and r.get("finished"):
                 res += (f" by {r.get('router')} ({ROUTER} did not finish in "
                         f"{r['first_try'].get('timeout_s', 0) / 60:.0f} min: {_reason(r['first_try'])})")

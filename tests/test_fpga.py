@@ -131,6 +131,15 @@ def test_router2_out_of_time_falls_back_to_router1_and_both_are_recorded(tmp_pat
     why = fpga._reason(r)
     assert r["finished"] is False and "with router1, nor with router2 before it" in why
     assert "router1 at iteration 20 with 7,356 wires overused" in why and "TRELLIS_COMB 6,235" in why
+    # a report made from records only, where router1 has not run: router2's reason, and that
+    monkeypatch.setattr(fpga, "_place_and_route", lambda block, *, router, **kw: None if router == "router1"
+                        else fake(block, router=router, **kw))
+    r = fpga._measure("zbm-seggen", {}, fast=False, progress=False, timeout=60, cached_only=True)
+    assert fpga._reason(r).endswith("router1 not run in the session that made this table (time): "
+                                    "`rasterhw fpga zbm-seggen`")
+    assert "router2 at iteration 20" in fpga._reason(r)
+    rec = json.loads(fpga.write_run_record([r], tmp_path / "runs.json").read_text())["runs"]
+    assert rec[0]["result"]["reason"] == "nextpnr did not finish in 1 min"   # the record keeps the run's own
     calls.clear()
     monkeypatch.setattr(fpga, "_place_and_route", lambda block, *, router, **kw: calls.append(router) or
                         {"block": block, "finished": True, "fits": True, "router": router})
