@@ -32,6 +32,11 @@ How it is vectorised (no per-triangle Python loop):
    the final winner per pixel;
 5. colour is computed only for the winners.
 
+Frames of at least ``THREAD_MIN_PIXELS`` pixels are rendered as ``THREADS`` row bands (one per
+CPU, at most 2) in threads at once, each into its rows of the outputs: NumPy's loops release the
+GIL, and a band gives exactly the pixels and counts of the whole frame's rows (each pixel's
+serial Z-buffer sees the same triangles in the same order), which a test holds bit for bit.
+
 Triangles are processed in chunks of at most about ``CHUNK_CANDIDATES`` bounding-box pixels,
 carrying the depth buffer from chunk to chunk, so memory stays bounded for large frames.
 Fresh memory is expensive here (a page fault per 4 kB page), so the fragment arrays live in a
@@ -41,6 +46,8 @@ new block per call, aligned so that it is backed by 2 MiB pages.
 
 from __future__ import annotations
 
+import itertools
+import os
 import statistics
 import threading
 import time
@@ -370,11 +377,73 @@ def rasterise(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0)) -> Frame:
     Frame
     """
     xy, z, vcol, pid, bg = _check(tris, background)
+    W, H = int(tris.width), int(tris.height)
+    bands = _bands(W, H, xy.shape[0])
+    if len(bands) == 1:
+        return _guarded(_rasterise, tris, xy, z, vcol, pid, bg)
+    # Row bands in threads (NumPy's loops release the GIL): each pixel's serial Z-buffer sees the
+    # same triangles in the same order in its band as in the whole frame (see rasterise_rgb8),
+    # so the pixels and counts are exactly those of one band; each band writes its rows of one
+    # set of output arrays.
+    st = _setup(xy, W, H)
+    out = _outputs(W * H)
+    parts = list(_executor().map(
+        lambda rows: _guarded(_rasterise, tris, xy, z, vcol, pid, bg, st=st, rows=rows,
+                              into=tuple(a[rows[0] * W:rows[1] * W] for a in out)), bands))
+    depth, tri_id, poly, colour = out
+    return Frame(
+        colour=colour.reshape(H, W, 3),
+        depth=depth.reshape(H, W),
+        tri_id=tri_id.reshape(H, W),
+        poly_id=poly.reshape(H, W),
+        fragments=sum(f.fragments for f in parts),
+        pixels_written=sum(f.pixels_written for f in parts),
+        pixels_covered=sum(f.pixels_covered for f in parts),
+    )
+
+
+#: Frames of at least this many pixels, with at least this many triangles, are rendered as
+#: :data:`THREADS` row bands at once (smaller ones cost more in hand-over than they gain).
+THREAD_MIN_PIXELS = 1 << 16
+THREAD_MIN_TRIANGLES = 64
+#: threads for the row bands: one per CPU, at most 2 (the machines this runs on; llvmpipe,
+#: which the bench compares with, also runs one rasteriser thread per CPU)
+THREADS = max(1, min(2, os.cpu_count() or 1))
+_pool_lock = threading.Lock()
+_exec = None
+
+
+def _bands(W: int, H: int, n_tris: int) -> list[tuple[int, int]]:
+    """Row bands of a frame for :func:`rasterise`: one, or :data:`THREADS` of equal height."""
+    n = THREADS if (W * H >= THREAD_MIN_PIXELS and n_tris >= THREAD_MIN_TRIANGLES and H >= THREADS) else 1
+    cuts = [H * k // n for k in range(n + 1)]
+    return list(itertools.pairwise(cuts))
+
+
+def _executor():
+    global _exec
+    with _pool_lock:
+        if _exec is None:
+            from concurrent.futures import ThreadPoolExecutor
+
+            _exec = ThreadPoolExecutor(THREADS, thread_name_prefix="rasterise")
+        return _exec
+
+
+def _guarded(fn, *args, **kw):
     try:
-        return _rasterise(tris, xy, z, vcol, pid, bg)
+        return fn(*args, **kw)
     except BaseException:
-        _local.scratch = None  # an interrupted layer loop may leave the scratch dirty
+        _local.scratch = None  # an interrupted layer loop may leave this thread's scratch dirty
         raise
+
+
+def _outputs(npix: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(depth, tri_id, poly_id, colour (npix, 3)) for ``npix`` pixels, sharing one fresh block
+    (a new one per call: a returned Frame is never aliased by a later call)."""
+    block = _fresh_block(48 * npix)
+    return (block[:8 * npix].view(np.float64), block[8 * npix:16 * npix].view(np.int64),
+            block[16 * npix:24 * npix].view(np.int64), block[24 * npix:].view(np.float64).reshape(npix, 3))
 
 
 def _fresh_block(nbytes: int) -> np.ndarray:
@@ -394,20 +463,16 @@ def _fresh_block(nbytes: int) -> np.ndarray:
     return raw[off:off + nbytes]
 
 
-def _rasterise(tris, xy, z, vcol, pid, bg, st: dict | None = None, rows: tuple[int, int] | None = None) -> Frame:
+def _rasterise(tris, xy, z, vcol, pid, bg, st: dict | None = None, rows: tuple[int, int] | None = None,
+               into: tuple | None = None) -> Frame:
     """The frame, or only rows ``rows = (y0, y1)`` of it (a tile: ``st`` is then the set-up of
-    the whole frame, restricted here to the triangles that reach the tile)."""
+    the whole frame, restricted here to the triangles that reach the tile). ``into``: the
+    tile's (depth, tri_id, poly_id, colour) arrays to write, else new ones (:func:`_outputs`)."""
     W = int(tris.width)
     y0, y1 = rows if rows is not None else (0, int(tris.height))
     H = y1 - y0
     npix = W * H
-    # The four outputs share one fresh block (a new one per call: a returned Frame is never
-    # aliased by a later call).
-    block = _fresh_block(48 * npix)
-    depth = block[:8 * npix].view(np.float64)
-    tri_id = block[8 * npix:16 * npix].view(np.int64)
-    poly = block[16 * npix:24 * npix].view(np.int64)
-    colour = block[24 * npix:].view(np.float64).reshape(npix, 3)
+    depth, tri_id, poly, colour = into if into is not None else _outputs(npix)
     depth.fill(np.inf)
     tri_id.fill(-1)
     poly.fill(-1)

@@ -87,6 +87,34 @@ def test_matches_brute_force(seed):
     np.testing.assert_array_equal(frame.poly_id, np.where(tri_id >= 0, tri_id + 100, -1))
 
 
+@pytest.mark.parametrize("threads", [2, 3])
+def test_row_bands_in_threads_equal_one_band(threads, monkeypatch):
+    """Frames rendered as row bands in threads: bit for bit the one-band frame and counts, and
+    the brute-force answer (bands forced on small frames here; by default from 256 x 256)."""
+    tris = random_triangles(256, 256, 900, mean_area=90, seed=7)
+    assert len(reference._bands(256, 256, tris.n_triangles)) == reference.THREADS   # the default path
+    monkeypatch.setattr(reference, "THREADS", 1)
+    one = rasterise(tris)
+    monkeypatch.setattr(reference, "THREADS", threads)
+    monkeypatch.setattr(reference, "_exec", None)   # a pool of this size
+    banded = rasterise(tris)
+    assert len(reference._bands(256, 256, tris.n_triangles)) == threads
+    for name in ("colour", "depth", "tri_id", "poly_id"):
+        np.testing.assert_array_equal(getattr(one, name), getattr(banded, name))
+    assert (one.fragments, one.pixels_written, one.pixels_covered) == \
+        (banded.fragments, banded.pixels_written, banded.pixels_covered)
+    monkeypatch.setattr(reference, "THREAD_MIN_PIXELS", 1)
+    monkeypatch.setattr(reference, "THREAD_MIN_TRIANGLES", 1)
+    for seed in range(3):
+        tris = random_scene(seed)
+        frame = rasterise(tris)
+        tri_id, depth, written = brute_visible(tris)
+        np.testing.assert_array_equal(frame.tri_id, tri_id)
+        np.testing.assert_array_equal(frame.depth, depth)
+        assert frame.pixels_written == written
+    monkeypatch.setattr(reference, "_exec", None)
+
+
 def test_horizontal_edges_match_brute_force():
     """Horizontal top and bottom edges, on pixel centres and off them, in both windings: a
     horizontal edge admits a whole row or none of it, whatever the sign of its zero slope."""
