@@ -372,7 +372,6 @@ FPGA_CONFIGS: tuple[tuple[str, dict, str], ...] = (
     ("pixelbus-bank", {}, "full"),
     ("pixelbus-bank", {"ram": "memory", "depth": 4096}, "reduced"),
     ("sparse-matrix", {}, "full"),
-    ("sparse-matrix", {"n": 3}, "reduced"),
     ("sparse-vp", {}, "full"),
     ("zbm-chip", {"interleave": 8, "width": 512}, "full"),
     ("zbm-loop", {"interleave": 8, "width": 512}, "full"),
