@@ -70,7 +70,10 @@ def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: b
 @click.option("--device", default=None, help="ecp5: 85k (default) or 25k; ice40: hx8k (default) or up5k.")
 @click.option("--json", "as_json", is_flag=True)
 def fpga(block: str, params: tuple[str, ...], family: str, device: str | None, as_json: bool) -> None:
-    """Place and route BLOCK with nextpnr: LUTs, flip-flops, block RAMs, Fmax beside the paper's clock."""
+    """Place and route BLOCK with nextpnr: LUTs, flip-flops, block RAMs, Fmax beside the paper's clock.
+
+    Routes with router2, and again with router1 on the same netlist when router2 does not finish
+    in the time limit; results are cached in build/pnr-* and docs/reproduction/fpga_runs.json."""
     from rasterhw.sim.fpga import fpga_summary, place_and_route
 
     r = place_and_route(block, family=family, device=device, **_params(block, params))
