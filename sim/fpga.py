@@ -378,6 +378,7 @@ FPGA_CONFIGS: tuple[tuple[str, dict, str], ...] = (
     ("zbm-merger", {"fifo_depth": 16}, "full"),
     ("zbm-pixel", {"interleave": 8, "width": 512}, "full"),
     ("zbm-seggen", {}, "full"),
+    ("zbm-seggen", {"capacity": 16}, "reduced"),
     ("zbm-unit", {}, "full"),
     ("zbm-unit", {"interleave": 2, "width": 64, "height": 64, "capacity": 16}, "reduced"),
 )
