@@ -125,10 +125,8 @@ def write_run_record(results: list[dict], record: Path | None = None) -> Path:
         seen.add(r["digest"])
         keep = {k: v for k, v in r.items() if k not in ("build_dir", "cached", "digest", "first_try",
                                                           "display_reason", "fallback_pending")}
-        if keep.get("finished") is False and not keep.get("progress") and r.get("build_dir"):
-            log = Path(r["build_dir"]) / "nextpnr.log"   # older results: where nextpnr stopped, from its log
-            if log.exists():
-                keep["progress"] = _progress(log.read_text(errors="replace"), keep.get("router", ROUTER))
+        if keep.get("finished") is False and keep.get("stage") == "place and route" and not keep.get("progress"):
+            keep["progress"] = _stopped_at(r)   # older results: from the log in the build folder
         runs.append({"digest": r["digest"], "block": r["block"], "params": r.get("params", {}), "result": keep})
     runs.sort(key=lambda x: (x["block"], json.dumps(x["params"], sort_keys=True, default=str)))
     path = record or RUN_RECORD
@@ -474,6 +472,17 @@ def _progress(log: str, router: str) -> str:
     return "in placement"
 
 
+def _stopped_at(r: dict) -> str | None:
+    """Where an unfinished run's nextpnr stopped: kept with the result, or (older results) read
+    from the log in its build folder; None when neither is there."""
+    if r.get("progress"):
+        return r["progress"]
+    if not r.get("build_dir"):
+        return None
+    log = Path(r["build_dir"]) / "nextpnr.log"
+    return _progress(log.read_text(errors="replace") if log.exists() else "", r.get("router", ROUTER))
+
+
 def _reason(r) -> str | None:
     from rasterhw.sim.report import FAST_SKIP
 
@@ -488,11 +497,8 @@ def _reason(r) -> str | None:
                  if k in r["over"] or (k in _MAIN_KINDS and r["utilization"][k])]
         dev = DEVICE_NAMES[r["family"]][r["device"]]
         return f"does not fit {dev} (nextpnr --pack-only after {SYNTH_CMD[r['family']]}): " + "; ".join(shown)
-    if r.get("finished") is False and r.get("stage") == "place and route" and (r.get("progress") or r.get("build_dir")):
-        # where nextpnr was when its time ran out (kept with the result; older results: from the log)
-        log = Path(r["build_dir"]) / "nextpnr.log" if r.get("build_dir") else None
-        where = r.get("progress") or _progress(log.read_text(errors="replace") if log and log.exists() else "",
-                                               r.get("router", ROUTER))
+    where = _stopped_at(r) if r.get("finished") is False and r.get("stage") == "place and route" else None
+    if where:
         demand = ", ".join(f"{k} {r['utilization'][k]:,}" for k in sorted(r.get("utilization", {}))
                            if k in _MAIN_KINDS and r["utilization"][k])
         return f"{r['reason']} (packed {demand}; {where})"
