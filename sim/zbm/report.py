@@ -104,7 +104,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
                         reason=f"{UNITS_SECOND_LEVEL} units are not simulated here: chains of 1-8 units of "
                                "interleave 1 are (rows 'chain'); an interleave-16 unit alone takes ~21 min "
                                "to verilate on this machine"))
-    out += extra_rows(progress, "verilator" if hdl_engine == "pysim" else hdl_engine)
+    out += extra_rows(progress, "verilator" if hdl_engine == "pysim" else hdl_engine, fast=fast)
     out += scene_rows(progress)
     out += mapping_rows(fast=fast, progress=progress)
     area, area_note = area_rows(fast=fast, progress=progress)
@@ -115,12 +115,12 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
     return out, sections
 
 
-def extra_rows(progress: bool, engine: str) -> list[dict]:
+def extra_rows(progress: bool, engine: str, *, fast: bool = False) -> list[dict]:
     """Pixel rate against interleave (pysim), condition 7's skew and chained units (``engine``:
     the unit bench needs Verilator or Icarus), from ``sim/zbm/scaling.py``."""
     from rasterhw.sim.zbm import scaling
 
-    return scaling.report_rows(progress=progress, engine=engine)
+    return scaling.report_rows(progress=progress, engine=engine, fast=fast)
 
 
 def scene_rows(progress: bool) -> list[dict]:
