@@ -20,10 +20,11 @@ def _scene():
 
 
 def test_simulate_zbm_pysim_tiny_frame():
-    r = Z.simulate_zbm(_scene(), 32, 16, interleave=2, engine="pysim")
+    # 32 x 8 (not 16): pysim runs ~1,000 clocks per line of c300 here; Verilator runs the bigger frames
+    r = Z.simulate_zbm(_scene(), 32, 8, interleave=2, engine="pysim")
     assert r["block"] == "zbm" and r["engine"] == "pysim" and r["units"] == 1
-    assert r["pixels_compared"] == 32 * 16 and r["mismatches"] == 0
-    assert r["edge_pairs"] > 0 and r["cycles"] > 0 and r["frame_rgb"].shape == (16, 32, 3)
+    assert r["pixels_compared"] == 32 * 8 and r["mismatches"] == 0
+    assert r["edge_pairs"] > 0 and r["cycles"] > 0 and r["frame_rgb"].shape == (8, 32, 3)
     assert r["frame_rgb"].dtype == np.uint8 and r["frame_rgb"].any()
     assert r["float_tolerance"]["ok"], r["float_tolerance"]
 
