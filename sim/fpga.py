@@ -202,10 +202,7 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
                      sort_keys=True, default=str)
     sdir = REPO_ROOT / "build" / f"pnr-{family}-{block}-{hashlib.sha1(key.encode()).hexdigest()[:10]}"
     bdir = sdir if router == ROUTER else sdir / router
-    bdir.mkdir(parents=True, exist_ok=True)
-    (sdir / f"{top}.v").write_text(text)
     script = f"read_verilog {top}.v\n{synth_cmd} -top {top} -json {top}.json\ntee -q -o stat.json stat -json\n"
-    (sdir / "synth.ys").write_text(script)
     netlist = f"{top}.json" if bdir == sdir else f"../{top}.json"
     # nextpnr-ice40 has no out-of-context mode: there the block's ports take I/O pins (SB_IO)
     ooc = ["--out-of-context"] if family == "ecp5" else []
@@ -227,6 +224,10 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
         return {**rec, "build_dir": None, "cached": True, "digest": digest}
     if cached_only:
         return None
+    # files are written only for a run (a report made from the record leaves build/ alone)
+    bdir.mkdir(parents=True, exist_ok=True)
+    (sdir / f"{top}.v").write_text(text)
+    (sdir / "synth.ys").write_text(script)
 
     class _Timeout(RasterhwError):
         pass

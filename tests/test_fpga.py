@@ -44,6 +44,7 @@ def test_merger_places_on_ecp5_with_both_clocks(tmp_path, monkeypatch):
     assert back is not None and back["cached"] and back["build_dir"] is None
     assert (back["luts"], back["ffs"], back["fmax_mhz"]) == (r["luts"], r["ffs"], r["fmax_mhz"])
     assert place_and_route("zbm-merger", cached_only=True, **dict(kw, fifo_depth=8)) is None   # another design
+    assert not (tmp_path / "build").exists()   # looking results up (record, or nothing) writes no build folder
     assert fpga.recorded_run("0" * 40) is None
     rec.write_text("not json")
     assert place_and_route("zbm-merger", cached_only=True, **kw) is None   # a broken record is no record
