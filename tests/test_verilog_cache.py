@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pytest
 from rasterhw.sim.verilog_cache import PKG_ROOT, design_sources, source_digest
 
 
@@ -33,8 +34,9 @@ def test_digests_differ_by_block():
 
 def test_generated_verilog_does_not_depend_on_the_hash_seed(tmp_path):
     """Amaranth orders module ports by iterating a set of names: with the port lists made
-    canonical, two processes with different string-hash seeds write the same text. Seeds 1 and
-    3 give different raw text (checked here, so the test can fail), the same canonical text."""
+    canonical, two processes with different string-hash seeds write the same text. The seeds
+    compared give different raw text (seeds 1 and 3 with Amaranth 0.5.10; checked here, so the
+    test can fail), and the same generated text."""
     import os
     import subprocess
     import sys
@@ -47,13 +49,21 @@ def test_generated_verilog_does_not_depend_on_the_hash_seed(tmp_path):
             "raw = V.generate_verilog('zbm-chip', interleave=2, chip=0, width=32); "
             "V.canonical_port_lists = canon; "
             "sys.stdout.write(raw + '\\0' + V.generate_verilog('zbm-chip', interleave=2, chip=0, width=32))")
-    # two processes at once (three one after another cost 10 s of the test suite)
-    procs = [subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
-                              env={**os.environ, "PYTHONHASHSEED": seed}) for seed in ("1", "3")]
-    outs = [p.communicate()[0].split("\0") for p in procs]
-    assert [p.returncode for p in procs] == [0, 0]
-    (raw1, gen1), (raw3, gen3) = outs
-    assert raw1 != raw3, "seeds 1 and 3 no longer order Amaranth's ports differently: pick two that do"
+
+    def texts(seeds):
+        # processes at once (three one after another cost 10 s of the test suite)
+        procs = [subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
+                                  env={**os.environ, "PYTHONHASHSEED": seed}) for seed in seeds]
+        outs = [p.communicate()[0].split("\0") for p in procs]
+        assert [p.returncode for p in procs] == [0] * len(seeds)
+        return outs
+
+    (raw1, gen1), (raw3, gen3) = texts(["1", "3"])
+    if raw1 == raw3:   # another Amaranth release may order them otherwise: look for a seed that differs
+        other = [o for o in texts([str(k) for k in range(4, 10)]) if o[0] != raw1]
+        if not other:
+            pytest.skip("Amaranth's raw port order no longer depends on the hash seed (seeds 1, 3-9)")
+        raw3, gen3 = other[0]
     assert gen1 == gen3 == canonical_port_lists(raw1) == canonical_port_lists(raw3)
     assert "module zbm_chip(" in gen1
 
