@@ -270,11 +270,28 @@ def _first_error(text: str) -> str:
 
 def _execute_cmds_as_children(self, cmds, cwd, stdout=None) -> None:
     """cocotb runner's ``_execute_cmds`` with :func:`run_child`: a simulator or compiler it
-    starts dies with this process (Ctrl-C, kill, an exception while it runs)."""
+    starts dies with this process (Ctrl-C, kill, an exception while it runs).
+
+    Verilator's ``make -f Vtop.mk`` step gets the shared runtime objects first and gives them
+    back after a good build (sim/vlruntime.py), like the plain builds."""
     for cmd in cmds:
+        rt = _cocotb_runtime_key(cmd, self.env)
+        if rt:
+            vlruntime.seed(*rt)
         r = run_child(cmd, cwd=cwd, env=self.env, stdout=stdout, stderr=None if stdout is None else subprocess.STDOUT)
         if r.returncode != 0:
             raise RuntimeError(f"Command failed with return code: {r.returncode}")
+        if rt:
+            vlruntime.harvest(*rt)
+
+
+def _cocotb_runtime_key(cmd: Sequence[str], env: Mapping[str, str]) -> tuple[Path, str, list[str]] | None:
+    """``(build folder, "cocotb", flags)`` if ``cmd`` is the make step of a cocotb Verilator build."""
+    cmd = [str(c) for c in cmd]
+    if not cmd or Path(cmd[0]).name != "make" or "Vtop.mk" not in cmd or "-C" not in cmd:
+        return None
+    bdir = Path(cmd[cmd.index("-C") + 1])
+    return bdir, "cocotb", vlruntime.cocotb_flags(bdir, cmd, env.get("MAKEFLAGS", ""))
 
 
 def run_plain_verilator(exe: Path, plusargs: Sequence[str], *, run_dir: Path, maxcyc: int) -> dict:

@@ -7,10 +7,12 @@ compiler flags, so after a successful plain build (``runner.build_plain_verilato
 every scene run) they are kept in ``build/verilator-runtime/<key>/`` and copied into the next
 build folder between Verilator's code generation and make; the copies are newer than the
 generated makefile (``$(VK_GLOBAL_OBJS): $(VM_PREFIX).mk`` in verilated.mk), so make keeps them.
-cocotb builds are left alone: cocotb's runner runs Verilator and make in one call. The key digests
-the Verilator version, the kind of build and every flag that reaches the compiler (the make
-variables, the Verilator arguments, the C flags), minus the plain bench's own ``-DRASTERHW_*``
-defines, which only its main reads. Set ``RASTERHW_VL_RUNTIME=0`` to build without the cache.
+cocotb builds do the same between the two commands of cocotb's runner (``verilator`` then
+``make -f Vtop.mk``: ``runner._execute_cmds_as_children``), keyed by :func:`cocotb_flags`. The key
+digests the Verilator version, the kind of build and every flag that reaches the compiler (the
+make variables, the Verilator arguments, the C flags), minus the plain bench's own
+``-DRASTERHW_*`` defines, which only its main reads. Set ``RASTERHW_VL_RUNTIME=0`` to build
+without the cache.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ import shutil
 from collections.abc import Iterable
 from pathlib import Path
 
-__all__ = ["RUNTIME_OBJECTS", "cache_dir", "harvest", "seed"]
+__all__ = ["RUNTIME_OBJECTS", "cache_dir", "cocotb_flags", "harvest", "seed"]
 
 #: design-independent objects of the Verilator runtime (the benches' mains include the model's
 #: header, so plain_main.o and cocotb's verilator.o are not among them)
@@ -50,6 +52,48 @@ def cache_dir(kind: str, flags: Iterable[str]) -> Path:
         h.update(" ".join(re.sub(r"-DRASTERHW_\w+=\S+", "", str(f)).split()).encode() + b"\0")
     root = Path(os.environ.get("RASTERHW_VL_RUNTIME_DIR", REPO_ROOT / "build" / "verilator-runtime"))
     return root / h.hexdigest()[:12]
+
+
+#: makefile variables of a cocotb build that do not reach the runtime's compile lines: the
+#: design's own files and the bench's executable
+_DESIGN_VARS = ("VM_CLASSES_FAST", "VM_CLASSES_SLOW", "VM_SUPPORT_FAST", "VM_SUPPORT_SLOW", "VM_USER_CLASSES",
+                "VM_USER_DIR", "VM_USER_LDLIBS")
+
+
+def _mk_assignments(text: str) -> list[str]:
+    """``NAME = value`` / ``NAME += list`` assignments of a generated makefile, continuation lines
+    joined, in order; rules, includes and comments left out."""
+    out, cur = [], None
+    for line in text.splitlines():
+        if cur is not None:
+            cur += " " + line.strip().rstrip("\\").strip()
+            if not line.rstrip().endswith("\\"):
+                out.append(" ".join(cur.split()))
+                cur = None
+            continue
+        m = re.match(r"^([A-Z_][A-Z0-9_]*)\s*[+?]?=", line)
+        if not m:
+            continue
+        if line.rstrip().endswith("\\"):
+            cur = line.rstrip().rstrip("\\")
+        else:
+            out.append(" ".join(line.split()))
+    return [a for a in out if a.split()[0] not in _DESIGN_VARS]
+
+
+def cocotb_flags(build_dir: Path, make_cmd: Iterable[str], makeflags: str) -> list[str]:
+    """What a cocotb Verilator build passes to the runtime's compile lines: the generated
+    ``Vtop.mk`` and ``Vtop_classes.mk`` assignments (C flags, tracing, timing, coverage, the
+    runtime file list, Verilator's root) without the design's own files, the ``make`` command's
+    variables (``VM_TRACE=...``) and ``MAKEFLAGS`` (``OPT_FAST`` and the rest)."""
+    build_dir = Path(build_dir)
+    flags = []
+    for name in ("Vtop.mk", "Vtop_classes.mk"):
+        f = build_dir / name
+        flags += _mk_assignments(f.read_text()) if f.exists() else [f"missing {name}"]
+    flags += [a for a in make_cmd if "=" in str(a)]
+    flags.append(" ".join(makeflags.split()))
+    return flags
 
 
 def seed(obj_dir: Path, kind: str, flags: Iterable[str]) -> int:
