@@ -86,17 +86,22 @@ def fpga(block: str, params: tuple[str, ...], family: str, device: str | None, a
 @click.command()
 @click.argument("block")
 @click.option("--depth", type=int, default=None, help="Steps (BMC) or induction length (default: the proof's own).")
+@click.option("--fresh", is_flag=True, help="Prove again even if build/ holds this exact proof's result.")
 @click.option("--json", "as_json", is_flag=True)
-def prove(block: str, depth: int | None, as_json: bool) -> None:
-    """Prove BLOCK's stream rules and pixel order formally (SymbiYosys); exit 1 with a VCD trace if one fails."""
+def prove(block: str, depth: int | None, fresh: bool, as_json: bool) -> None:
+    """Prove BLOCK's stream rules and pixel order formally (SymbiYosys); exit 1 with a VCD trace if one fails.
+
+    A proof whose harness, script and tool versions are unchanged is read back from build/ (said
+    in the output); --fresh runs SymbiYosys again."""
     from rasterhw.sim.prove import prove as run
 
-    r = run(block, depth=depth)
+    r = run(block, depth=depth, fresh=fresh)
     if as_json:
         _emit(r)
     else:
         bound = f"k-induction, {r['depth']} steps" if r["mode"] == "prove" else f"all inputs up to {r['depth']} steps"
-        click.echo(f"{r['block']}: {r['status']} ({r['engine']}, {bound}, {r['wall_s']:.1f} s)")
+        when = f"cached, proved in {r['wall_s']:.1f} s" if r.get("cached") else f"{r['wall_s']:.1f} s"
+        click.echo(f"{r['block']}: {r['status']} ({r['engine']}, {bound}, {when})")
         click.echo(f"  {r['what']}")
         click.echo(f"  parameters: {', '.join(f'{k}={v}' for k, v in r['params'].items())}; files in {r['workdir']}")
         if r["trace"]:

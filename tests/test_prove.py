@@ -69,6 +69,19 @@ def test_block_proof_passes(block):
     assert r["trace"] is None
 
 
+def test_a_finished_proof_is_read_back_and_fresh_proves_again():
+    a = prove("pixelbus-bank")
+    b = prove("pixelbus-bank")
+    assert b["cached"] and (b["status"], b["workdir"], b["wall_s"]) == (a["status"], a["workdir"], a["wall_s"])
+    c = prove("pixelbus-bank", fresh=True)
+    assert not c["cached"] and c["status"] == "PASS" and (c["workdir"] / "sby.log").exists()
+    # a broken variant's record points at its trace; without the trace it is proved again
+    f = prove("pixelbus-bank", dut_factory=ForgetfulBank, tag="broken")
+    f["trace"].unlink()
+    g = prove("pixelbus-bank", dut_factory=ForgetfulBank, tag="broken")
+    assert not g["cached"] and g["status"] == "FAIL" and g["trace"].exists()
+
+
 @pytest.mark.parametrize("block, broken", [("zbm-merger", LossyMerger), ("pixelbus-bank", ForgetfulBank)])
 def test_broken_variant_fails_with_a_trace(block, broken):
     r = prove(block, dut_factory=broken, tag="broken")
