@@ -28,7 +28,8 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.runner import REPO_ROOT
 from rasterhw.sim.synth import SYNTH_DEFAULTS, _split_extra, stable_text
 from rasterhw.sim.tools import tool, tool_version
-from rasterhw.sim.verilog import block_names, generate_verilog, make_block
+from rasterhw.sim.verilog import block_names, make_block
+from rasterhw.sim.verilog_cache import generate_cached
 
 __all__ = ["CHIP_SWEEP", "DEVICES", "FAMILIES", "FPGA_BLOCKS", "FPGA_CONFIGS", "FPGA_PARAMS", "PAPER_CLOCKS", "paper_clock",
            "place_and_route"]
@@ -190,7 +191,7 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
               **FPGA_PARAMS.get(block, {}), **params}
     comp = make_block(block, **params)
     top = block.replace("-", "_")
-    text = generate_verilog(block, **params)
+    text = generate_cached(block, **params)
     extra = comp.extra_verilog() if hasattr(comp, "extra_verilog") else ""
     keep_extra, stubs = _split_extra(extra)
     if stubs:

@@ -50,7 +50,8 @@ from pathlib import Path
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.runner import REPO_ROOT
 from rasterhw.sim.tools import ToolUnavailable, tool, tool_version
-from rasterhw.sim.verilog import block_names, generate_verilog, make_block
+from rasterhw.sim.verilog import block_names, make_block
+from rasterhw.sim.verilog_cache import generate_cached
 
 __all__ = [
     "GATE_WEIGHTS",
@@ -297,7 +298,7 @@ def synthesise(
     comp = make_block(block, **params)
     top = top or block.replace("-", "_")
 
-    text = generate_verilog(block, **params)
+    text = generate_cached(block, **params)
     extra = comp.extra_verilog() if hasattr(comp, "extra_verilog") else ""
     if extra:
         if not text.endswith("\n" + extra):

@@ -98,7 +98,10 @@ def generate_verilog(name: str, **params) -> str:
 
 
 def write_verilog(name: str, path: str | Path, **params) -> Path:
-    """Write :func:`generate_verilog` output to ``path``; return the path."""
+    """Write :func:`generate_verilog` output to ``path`` (from the cache of generated Verilog,
+    ``sim/verilog_cache.py``, when this design and these parameters were converted before);
+    return the path."""
     from rasterhw.sim.outfile import write_text
+    from rasterhw.sim.verilog_cache import generate_cached
 
-    return write_text(path, generate_verilog(name, **params))  # whole or not at all
+    return write_text(path, generate_cached(name, **params))  # whole or not at all

@@ -22,10 +22,10 @@ def run_cocotb_bench(jb: dict, *, width: int = 512, sim: str | None = None, idle
 
     Raises :class:`~rasterhw.golden_model.errors.RasterhwError` if the bench's checks fail
     (a pixel, a line's cycles, the stream rules, the order of transfers)."""
-    from rasterhw.sim.verilog import generate_verilog
+    from rasterhw.sim.verilog_cache import generate_cached
 
     sim = get_sim(sim)
-    text = generate_verilog("experts-pxp", width=width, aj=jb["aj"])
+    text = generate_cached("experts-pxp", width=width, aj=jb["aj"])
     bdir = build_dir_for("experts-pxp-cocotb", sim, width=width, aj=jb["aj"])
     bdir.mkdir(parents=True, exist_ok=True)
     vpath = bdir / "experts_pxp.v"
