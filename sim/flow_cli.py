@@ -100,7 +100,7 @@ def prove(block: str, depth: int | None, fresh: bool, as_json: bool) -> None:
         _emit(r)
     else:
         bound = f"k-induction, {r['depth']} steps" if r["mode"] == "prove" else f"all inputs up to {r['depth']} steps"
-        when = f"cached, proved in {r['wall_s']:.1f} s" if r.get("cached") else f"{r['wall_s']:.1f} s"
+        when = f"cached, proved in {r['wall_s']:.1f} s" if r["cached"] else f"{r['wall_s']:.1f} s"
         click.echo(f"{r['block']}: {r['status']} ({r['engine']}, {bound}, {when})")
         click.echo(f"  {r['what']}")
         click.echo(f"  parameters: {', '.join(f'{k}={v}' for k, v in r['params'].items())}; files in {r['workdir']}")

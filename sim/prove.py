@@ -49,8 +49,10 @@ from amaranth.back import rtlil
 from amaranth.hdl import Assert, Assume, ClockDomain
 from amaranth.hdl._ast import AnyConst, AnySeq
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim.outfile import atomic_path
 from rasterhw.sim.runner import REPO_ROOT
 from rasterhw.sim.tools import tool
+from rasterhw.sim.workdirs import build_lock
 
 __all__ = ["PROOFS", "Proof", "prove"]
 
@@ -260,8 +262,6 @@ def prove(block: str, *, dut_factory: Callable | None = None, depth: int | None 
     text = rtlil.convert(top, name="top", ports=top.ports)
     key = hashlib.sha1((text + _sby_text(p, depth) + _tool_versions()).encode()).hexdigest()[:10]
     bdir = REPO_ROOT / "build" / f"prove-{block}{'-' + tag if tag else ''}-{key}"
-    from rasterhw.sim.workdirs import build_lock
-
     with build_lock(bdir, what=f"proof of {block}"):   # a second process waits, then reads it back
         return _run_proof(p, block, bdir, text, depth, timeout, fresh)
 
@@ -305,8 +305,6 @@ def _run_proof(p: Proof, block: str, bdir: Path, text: str, depth: int, timeout:
            "depth": depth, "params": p.params, "what": p.what,
            "wall_s": wall, "workdir": bdir, "trace": traces[0] if (status == "FAIL" and traces) else None,
            "failed": failed, "cached": False}
-    from rasterhw.sim.outfile import atomic_path
-
     with atomic_path(done) as tmp:   # written last: a folder without it is an unfinished proof
         tmp.write_text(json.dumps({k: v for k, v in out.items() if k not in ("params", "workdir")},
                                   default=str) + "\n")

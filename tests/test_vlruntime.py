@@ -114,5 +114,12 @@ def test_cocotb_make_step_reuses_the_runtime(tmp_path, monkeypatch):
     assert build("b", design="y").count("kept") == 2, "another design with the same flags reuses it"
     assert build("c", design="x", timing=1).count("compiled") == 2, "--timing changes the runtime"
     assert build("d", design="x", makeflags="OPT_FAST=-O0").count("compiled") == 2, "so does OPT_FAST"
-    # not a make step of a cocotb build: nothing seeded, nothing kept
-    assert _execute_cmds_as_children(runner, [["true", "-C", str(tmp_path / "a")]], cwd=str(tmp_path)) is None
+    # not a make step (the verilator step, say): nothing goes into its folder, though the
+    # runtime of these very flags is kept
+    e = tmp_path / "e"
+    e.mkdir()
+    (e / "Vtop.mk").write_text(VTOP_MK.format(exe="e"))
+    (e / "Vtop_classes.mk").write_text(VTOP_CLASSES_MK.format(timing=0, design="x"))
+    runner.env["MAKEFLAGS"] = "OPT_FAST=-O2"
+    _execute_cmds_as_children(runner, [["true", "-C", str(e), "-f", "Vtop.mk", "VM_TRACE=0"]], cwd=str(tmp_path))
+    assert not list(e.glob("*.o"))
