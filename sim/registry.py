@@ -18,7 +18,9 @@ Contracts of the named callables:
 * sim block: ``simulate(scene, width, height, *, engine, progress, **options) -> dict`` with at
   least the keys of :data:`SIM_KEYS` and optionally ``frame_rgb``;
 * report: ``rows(*, engine, progress, out_dir, **known) -> (rows, markdown sections)``;
-* bench: ``bench(*, repeat, hdl, progress) -> list of {"name", "value", "unit", "note"}``.
+* bench: ``bench(*, repeat, hdl, progress) -> list of {"name", "value", "unit", "note"}``;
+* soak round: ``round(rng, k) -> {"pixels", "mismatches", "run_s", "settings"}`` for round ``k``
+  (:mod:`rasterhw.sim.soak`).
 """
 
 from __future__ import annotations
@@ -87,6 +89,7 @@ class Machine:
     sims: tuple[SimBlock, ...] = ()
     report: str | None = None          # "module:rows"
     bench: str | None = None           # "module:bench"
+    soak: dict[str, str] = field(default_factory=dict)     # soak block -> "module:round" (sim/soak.py)
     status: str = ""                   # one line for the README / index page
 
 

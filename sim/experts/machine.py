@@ -29,6 +29,7 @@ MACHINE = Machine(
                                    "previous line's finish-time counters", "static", ("static", "i", "ii")))),),
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",
+    soak={"pxp": "rasterhw.sim.experts.soak:pxp_round"},
     status="scan-line golden model split as SLP/PXP (float and 16-bit), Sn x Pn parallel model with "
            "load balancing at both levels, fig. 4.1 cost model (golden); PXP datapath (HDL, bit- and cycle-exact)",
 )

@@ -25,6 +25,7 @@ MACHINE = Machine(
                    bytes_per_pixel=700),),
     report="rasterhw.sim.sparse.report:rows",
     bench="rasterhw.sim.sparse.bench:bench",
+    soak={"sparse": "rasterhw.sim.sparse.soak:sparse_round"},
     status="golden model (image = reference), formulas (1)-(12), Monte-Carlo window counts, figs. 3-6; "
            "video processor in Amaranth, bit-exact in pysim and Verilator",
 )

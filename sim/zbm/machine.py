@@ -24,6 +24,7 @@ MACHINE = Machine(
                    "rasterhw.sim.zbm.driver:simulate_zbm", default_scene="c300", options=(_INTERLEAVE, _UNITS, _SCHEDULE)),),
     report="rasterhw.sim.zbm.report:rows",
     bench="rasterhw.sim.zbm.bench:bench",
+    soak={"zbm": "rasterhw.sim.zbm.soak:zbm_round"},
     status="segment generator, ZB/M chip (8 pixel processors on a segment loop, double Z, merger on its own "
            "clock), unit, chained units (HDL, bit- and cycle-exact)",
 )
