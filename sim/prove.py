@@ -13,22 +13,13 @@ construction (``valid`` raised from a free choice, never from ``ready``; ``valid
 ``payload`` held until the transfer), with free (``AnySeq``) choices, so the proof covers every
 legal traffic pattern. On every output stream the proof asserts the same two rules. Then:
 
-``zbm-merger`` (two clocks: segment ``sync`` and ``merge``, free-running and unrelated; SBY
-``multiclock on``): pick a symbolic transfer number ``k`` (``AnyConst``); record the ``k``-th
-own word (segment side) and the ``k``-th merge-input word; the ``k``-th output word must be the
-nearest-2-of-4 merge of those two (:func:`rasterhw.hdl.zbm.merger.merge_words`), and there are
-never more outputs than inputs on either side. As ``k`` is arbitrary and the payloads are
-free, no word is lost, duplicated, reordered or paired with the wrong neighbour word across the
-clock crossing.
-
-``pixelbus-bank``: pick a symbolic address ``A``; a shadow register holds what the bank must hold
-at ``A`` after every accepted write in order (written if its Z is nearer, the Z test of the
-paper); two clocks after the last accept the read-back port at ``A`` must show the shadow
-value, and ``i.ready`` must be low while a memory cycle is in progress (writes are held back,
-never dropped). Commands are not offered in this proof (CLEAR/SWAP have their own pysim tests).
+A machine declares its proofs in its registry entry (``Machine.proofs``: block name ->
+``"module:PROOF"``, a :class:`Proof` whose harness is a :class:`Harness` built on
+:func:`drive_source` and :func:`sink_rules`); the module states what the proof shows
+(``sim/zbm/proof.py``, ``sim/snu/proof.py``). This module knows no machine.
 
 The proofs run at reduced widths (the blocks compare and move words, they never compute on
-them, so the widths do not change the behaviour): :data:`PROOFS` states each one's parameters.
+them, so the widths do not change the behaviour): :class:`Proof` states each one's parameters.
 """
 
 from __future__ import annotations
@@ -47,17 +38,18 @@ from pathlib import Path
 from amaranth import Elaboratable, Module, Signal
 from amaranth.back import rtlil
 from amaranth.hdl import Assert, Assume, ClockDomain
-from amaranth.hdl._ast import AnyConst, AnySeq
+from amaranth.hdl._ast import AnySeq
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim import registry
 from rasterhw.sim.outfile import atomic_path
 from rasterhw.sim.runner import REPO_ROOT
 from rasterhw.sim.tools import tool
 from rasterhw.sim.workdirs import build_lock
 
-__all__ = ["PROOFS", "Proof", "prove"]
+__all__ = ["Harness", "Proof", "drive_source", "prove", "proofs", "sink_rules"]
 
 
-def _source(m: Module, domain: str, port, name: str) -> None:
+def drive_source(m: Module, domain: str, port, name: str) -> None:
     """Drive stream ``port`` (an ``In`` stream of the block) like a legal sender: a free
     choice raises ``valid`` and picks ``payload``; both hold until ``ready``."""
     valid = Signal(name=f"{name}_valid")
@@ -67,7 +59,7 @@ def _source(m: Module, domain: str, port, name: str) -> None:
     m.d.comb += [port.valid.eq(valid), port.payload.eq(payload)]
 
 
-def _sink_rules(m: Module, domain: str, port, name: str) -> None:
+def sink_rules(m: Module, domain: str, port, name: str) -> None:
     """Free ``ready`` on output stream ``port``; assert: once ``valid`` it stays high with the
     same ``payload`` until ``ready`` (valid never withdrawn, payload held)."""
     m.d.comb += port.ready.eq(AnySeq(1))
@@ -78,7 +70,7 @@ def _sink_rules(m: Module, domain: str, port, name: str) -> None:
                        f"{name}: valid and payload held until ready")
 
 
-class _Harness(Elaboratable):
+class Harness(Elaboratable):
     """A proof's top level: the block inside; its clocks and resets are the only ports
     (free in SBY: every clock edge is the solver's choice). Registers start at their ``init``
     values and resets are held low: the proof starts from the reset state."""
@@ -98,92 +90,6 @@ class _Harness(Elaboratable):
         return m
 
 
-class MergerHarness(_Harness):
-    """``ZbmMerger`` under the stream rules and the transfer-``k`` ordering property."""
-
-    domains = ("sync", "merge")
-
-    def __init__(self, dut_factory: Callable, *, count_bits: int = 3):
-        super().__init__(dut_factory)
-        self._count_bits = count_bits
-
-    def elaborate(self, platform):
-        from rasterhw.hdl.zbm.merger import merge_words
-
-        m = self._start()
-        m.submodules.dut = dut = self._dut_factory()
-        layout = dut.word_layout
-        _source(m, "sync", dut.i_own, "own")
-        _source(m, "merge", dut.i_merge, "mrg")
-        _sink_rules(m, "merge", dut.o_merge, "out")
-
-        w = self._count_bits
-        k = AnyConst(w)
-        n_own, n_mrg, n_out = Signal(w + 1), Signal(w + 1), Signal(w + 1)
-        own_k = Signal(layout)
-        mrg_k = Signal(layout)
-        own_t = dut.i_own.valid & dut.i_own.ready
-        mrg_t = dut.i_merge.valid & dut.i_merge.ready
-        out_t = dut.o_merge.valid & dut.o_merge.ready
-        # counters saturate at 2**w (past every k): the property is about transfer k < 2**w
-        with m.If(own_t & ~n_own[w]):
-            m.d.sync += n_own.eq(n_own + 1)
-            with m.If(n_own == k):
-                m.d.sync += own_k.eq(dut.i_own.payload)
-        with m.If(mrg_t & ~n_mrg[w]):
-            m.d.merge += n_mrg.eq(n_mrg + 1)
-            with m.If(n_mrg == k):
-                m.d.merge += mrg_k.eq(dut.i_merge.payload)
-        with m.If(out_t & ~n_out[w]):
-            m.d.merge += n_out.eq(n_out + 1)
-        s0, s1 = merge_words(mrg_k, own_k)
-        expect = Signal(layout)
-        m.d.comb += [expect.eq(own_k), expect.s0.eq(s0), expect.s1.eq(s1)]
-        m.d.comb += [
-            Assert(n_out <= n_own, "no output without an own word (none duplicated)"),
-            Assert(n_out <= n_mrg, "no output without a merge-input word (none duplicated)"),
-        ]
-        with m.If(out_t & (n_out == k)):
-            m.d.comb += [
-                Assert((n_own > k) & (n_mrg > k), "output k comes after input k"),
-                Assert(dut.o_merge.payload.as_value() == expect.as_value(),
-                       "output k = merge of own word k and merge word k (none lost or reordered)"),
-            ]
-        return m
-
-
-class BankHarness(_Harness):
-    """``PixelBusBank`` (Amaranth memories) against a one-address shadow Z buffer."""
-
-    def elaborate(self, platform):
-        m = self._start()
-        m.submodules.dut = dut = self._dut_factory()
-        _source(m, "sync", dut.i, "i")
-        m.d.comb += dut.i_cmd.valid.eq(0)
-        a = AnyConst(dut.addr_bits)
-        m.d.comb += Assume(a < dut.depth)
-        m.d.comb += [dut.rd_addr.eq(a), dut.rd_buf.eq(0)]
-        ref_z, ref_rgb = Signal(dut.z_bits), Signal(24)
-        accept = dut.i.valid & dut.i.ready
-        p = dut.i.payload
-        with m.If(accept & (p.addr == a) & (p.z > ref_z)):
-            m.d.sync += [ref_z.eq(p.z), ref_rgb.eq(p.rgb)]
-        quiet = Signal(2, init=0)  # clocks since the last accept, saturating at 2
-        with m.If(accept):
-            m.d.sync += quiet.eq(0)
-        with m.Elif(quiet != 2):
-            m.d.sync += quiet.eq(quiet + 1)
-        busy_prev = Signal()
-        m.d.sync += busy_prev.eq(dut.busy)
-        m.d.comb += Assert(~dut.busy | ~dut.i.ready, "no write accepted during a memory cycle")
-        with m.If(quiet == 2):
-            m.d.comb += [
-                Assert(dut.rd_z == ref_z, "stored Z = every accepted write, in order, Z-tested"),
-                Assert(dut.rd_rgb == ref_rgb, "stored RGB = the nearest accepted write"),
-            ]
-        return m
-
-
 @dataclass(frozen=True)
 class Proof:
     """One block's proof: harness, the block's parameters, SBY mode and engine."""
@@ -198,19 +104,15 @@ class Proof:
     what: str = ""
 
 
-PROOFS: dict[str, Proof] = {
-    "zbm-merger": Proof(
-        "zbm-merger", MergerHarness, {"fifo_depth": 4, "z_bits": 3, "colour_bits": 0},
-        mode="bmc", depth=16, multiclock=True,
-        what="stream rules on o_merge; output k = merge(own k, merge-input k) for every k < 8, "
-             "no output without both inputs; two unrelated clocks, every step of the global clock an "
-             "edge of either, both or neither (the first output can appear at step 12)"),
-    "pixelbus-bank": Proof(
-        "pixelbus-bank", BankHarness, {"depth": 4, "z_bits": 3, "mem_cycle": 5, "ram": "memory"},
-        mode="prove", depth=12,
-        what="unbounded (k-induction): the word at any address = the Z-tested result of every accepted "
-             "write to it, in order; no write accepted during a memory cycle"),
-}
+def proofs() -> dict[str, Proof]:
+    """Every block with a proof -> its :class:`Proof` (``Machine.proofs`` of each machine)."""
+    out: dict[str, Proof] = {}
+    for m in registry.machines().values():
+        for name, ref in m.proofs.items():
+            if name in out:
+                raise RuntimeError(f"proof of {name!r} registered twice")
+            out[name] = registry.load(ref)
+    return out
 
 
 def _sby_text(p: Proof, depth: int) -> str:
@@ -251,11 +153,12 @@ def prove(block: str, *, dut_factory: Callable | None = None, depth: int | None 
     ``dut_factory`` replaces the registered block (tests use it for a broken variant);
     ``tag`` names the work folder for such a variant.
     """
-    if block not in PROOFS:
-        raise RasterhwError(f"no proof for block {block!r}; proofs: {', '.join(PROOFS)}")
+    known = proofs()
+    if block not in known:
+        raise RasterhwError(f"no proof for block {block!r}; proofs: {', '.join(known)}")
     from rasterhw.sim.verilog import make_block
 
-    p = PROOFS[block]
+    p = known[block]
     depth = depth or p.depth
     factory = dut_factory or (lambda: make_block(block, **p.params))
     top = p.harness(factory)

@@ -90,6 +90,7 @@ class Machine:
     report: str | None = None          # "module:rows"
     bench: str | None = None           # "module:bench"
     soak: dict[str, str] = field(default_factory=dict)     # soak block -> "module:round" (sim/soak.py)
+    proofs: dict[str, str] = field(default_factory=dict)   # verilog block -> "module:PROOF" (sim/prove.py)
     status: str = ""                   # one line for the README / index page
 
 

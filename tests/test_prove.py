@@ -8,7 +8,7 @@ import pytest
 from amaranth import Module, Signal
 from amaranth.lib import wiring
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.prove import PROOFS, prove
+from rasterhw.sim.prove import proofs, prove
 from rasterhw.sim.verilog import make_block
 
 
@@ -17,7 +17,7 @@ class LossyMerger(wiring.Component):
     is not ready the register is overwritten -- a word lost, and a payload changed while valid."""
 
     def __init__(self):
-        self._inner = make_block("zbm-merger", **PROOFS["zbm-merger"].params)
+        self._inner = make_block("zbm-merger", **proofs()["zbm-merger"].params)
         super().__init__(self._inner.signature)
 
     @property
@@ -42,7 +42,7 @@ class ForgetfulBank(wiring.Component):
     the last clock of a memory cycle is acknowledged and dropped)."""
 
     def __init__(self):
-        self._inner = make_block("pixelbus-bank", **PROOFS["pixelbus-bank"].params)
+        self._inner = make_block("pixelbus-bank", **proofs()["pixelbus-bank"].params)
         for k in ("depth", "z_bits", "addr_bits"):
             setattr(self, k, getattr(self._inner, k))
         super().__init__(self._inner.signature)

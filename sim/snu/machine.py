@@ -15,6 +15,7 @@ MACHINE = Machine(
     report="rasterhw.sim.snu.report:rows",
     bench="rasterhw.sim.snu.bench:bench",
     soak={"pixelbus": "rasterhw.sim.snu.soak:pixelbus_round"},
+    proofs={"pixelbus-bank": "rasterhw.sim.snu.proof:PROOF"},
     status="pixel-bus controller with Z comparator over a 5-bank frame buffer (HDL, bit- and cycle-exact); "
            "i860 timing model, the paper's geometry recipe, Gouraud scan converter, PHIGS traversal (golden); "
            "snu-100k frame end to end (pixel bus on Verilator with clear and swap)",

@@ -25,6 +25,7 @@ MACHINE = Machine(
     report="rasterhw.sim.zbm.report:rows",
     bench="rasterhw.sim.zbm.bench:bench",
     soak={"zbm": "rasterhw.sim.zbm.soak:zbm_round"},
+    proofs={"zbm-merger": "rasterhw.sim.zbm.proof:PROOF"},
     status="segment generator, ZB/M chip (8 pixel processors on a segment loop, double Z, merger on its own "
            "clock), unit, chained units (HDL, bit- and cycle-exact)",
 )
