@@ -9,7 +9,9 @@ Winding: every polygon is counter-clockwise seen from the side its normal points
 outside a closed solid), so back-face culling by screen-space winding and by ``N . view``
 agree.
 
-Pixel-exact scenes (``zbm-5x5``, ``snu-100px``, ``experts-*``) are built in screen
+Each machine's own scenes live in ``golden_model/NAME/scenes.py`` (a ``SCENES`` table of
+:class:`SceneInfo`), found by :data:`SCENES` on first use. Pixel-exact scenes (``zbm-5x5``,
+``snu-100px``, ``experts-*``) are built in screen
 coordinates and lifted into the world through the camera: a point meant for pixel position
 ``(sx, sy)`` at eye distance ``d`` goes to ``X = (sx - w/2) d / F``, ``Y = (h/2 - sy) d / F``,
 ``Z = D - d`` with the eye at ``(0, 0, D)`` looking down ``-z`` and
@@ -21,13 +23,16 @@ centres in x (and on integer rows in y) so that rounding never decides coverage.
 
 from __future__ import annotations
 
+import importlib
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.scene import Camera, Light, Material, Scene
+from rasterhw.golden_model.scenekit import project
 
 __all__ = ["SCENES", "SceneInfo", "build_scene", "list_scenes", "screen_stats"]
 
@@ -50,10 +55,6 @@ class SceneInfo:
 
 
 # --------------------------------------------------------------------------- helpers
-
-
-def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
 def _orbit_camera(target, *, azimuth_deg: float, elevation_deg: float, distance: float,
@@ -142,40 +143,6 @@ def _uv_sphere(centre: np.ndarray, radius: float, slices: int, stacks: int):
     return pos.reshape(-1, 4, 3), nrm.reshape(-1, 4, 3), np.tile(nv.ravel(), ns)
 
 
-def _focal_px(height: int, fovy_deg: float) -> float:
-    return (height / 2) / math.tan(math.radians(fovy_deg) / 2)
-
-
-def _lift(sxy: np.ndarray, dist: np.ndarray, width: int, height: int, f: float, eye_z: float) -> np.ndarray:
-    """Screen points (…, 2) in pixels at eye distance ``dist`` (… broadcast) -> world (…, 3)."""
-    x = (sxy[..., 0] - width / 2) * dist / f
-    y = (height / 2 - sxy[..., 1]) * dist / f
-    z = np.broadcast_to(eye_z - dist, x.shape)
-    return np.stack([x, y, z], axis=-1)
-
-
-def _screen_camera(height: int, fovy_deg: float = 45.0) -> tuple[Camera, float]:
-    f = _focal_px(height, fovy_deg)
-    cam = Camera(eye=(0.0, 0.0, f), target=(0.0, 0.0, 0.0), up=(0.0, 1.0, 0.0),
-                 fovy_deg=fovy_deg, near=0.25 * f, far=2.0 * f)
-    return cam, f
-
-
-def _random_triangles(rng: np.random.Generator, n: int, area_px: np.ndarray) -> np.ndarray:
-    """``n`` roughly equilateral triangle outlines centred on 0 with exact ``area_px`` (n,).
-
-    Returned (n, 3, 2) in *screen* pixels (y down), counter-clockwise as seen on the monitor
-    with y up, i.e. counter-clockwise seen from the camera.
-    """
-    ang = rng.uniform(0, 2 * np.pi, (n, 1)) + (2 * np.pi / 3) * np.arange(3)[None, :]
-    ang = ang + rng.uniform(-0.35, 0.35, (n, 3))
-    rad = rng.uniform(0.7, 1.3, (n, 3))
-    ox, oy = rad * np.cos(ang), rad * np.sin(ang)  # y up
-    a = 0.5 * ((ox[:, 1] - ox[:, 0]) * (oy[:, 2] - oy[:, 0]) - (ox[:, 2] - ox[:, 0]) * (oy[:, 1] - oy[:, 0]))
-    k = np.sqrt(area_px / a)[:, None]
-    return np.stack([ox * k, -oy * k], axis=-1)  # screen y down
-
-
 # --------------------------------------------------------------------------- scenes
 
 # c-series recipe (docs/scenes.md): the camera looks level along -z from height _C_EYE_Y above
@@ -258,121 +225,58 @@ def _grid(nx: int, ny: int, nz: int, spacing: float = 2.0) -> np.ndarray:
 _SP5_CENTRES = np.array([[-7.5, 1.0, -7.5], [7.5, 1.0, -7.5], [0.0, 1.0, 0.0], [-7.5, 1.0, 7.5], [7.5, 1.0, 7.5]])
 
 
-def _build_zbm(seed: int, *, n: int = 1000, width: int = 512, height: int = 512) -> Scene:
-    """Screen-facing diamonds 10 px wide and 10 px tall: two edge pairs of 5 rows x 25 px each."""
-    rng = np.random.default_rng(seed)
-    cam, f = _screen_camera(height)
-    cx = rng.integers(5, width - 5, n) + 0.25  # 0.25 px off the pixel centres' x
-    ty = rng.integers(0, height - 10 + 1, n).astype(float)
-    # Counter-clockwise seen from the camera: top -> left -> bottom -> right.
-    sxy = np.stack([np.stack([cx, ty], 1), np.stack([cx - 5, ty + 5], 1),
-                    np.stack([cx, ty + 10], 1), np.stack([cx + 5, ty + 5], 1)], axis=1)
-    dist = rng.uniform(0.5 * f, 1.5 * f, n)
-    pos = _lift(sxy, dist[:, None], width, height, f, cam.eye[2])
-    nrm = np.broadcast_to(np.array([0.0, 0.0, 1.0]), pos.shape).copy()
-    col = rng.uniform(0.1, 1.0, (n, 4, 3))
-    return Scene(name="zbm-5x5", seed=seed, camera=cam, positions=pos, normals=nrm, colours=col,
-                 nverts=np.full(n, 4, dtype=np.int64), lights=(Light(direction=(0.0, 0.0, -1.0)),),
-                 ambient=(0.2, 0.2, 0.2), material=Material(ka=1.0, kd=0.8, ks=0.0))
-
-
-def _build_snu(seed: int, *, n: int = 2000, width: int = 1280, height: int = 1024, area: float = 100.0,
-               name: str = "snu-100px") -> Scene:
-    """Gouraud triangles of exactly ``area`` px each, random vertex colours, random depths."""
-    rng = np.random.default_rng(seed)
-    cam, f = _screen_camera(height)
-    tri = _random_triangles(rng, n, np.full(n, area))
-    r = np.abs(tri).max(axis=(1, 2))
-    c = np.stack([rng.uniform(r, width - r), rng.uniform(r, height - r)], axis=1)
-    dist = rng.uniform(0.5 * f, 1.5 * f, n)
-    pos = _lift(tri + c[:, None, :], dist[:, None], width, height, f, cam.eye[2])
-    nrm = np.broadcast_to(np.array([0.0, 0.0, 1.0]), pos.shape).copy()
-    col = rng.random((n, 3, 3))
-    return Scene(name=name, seed=seed, camera=cam, positions=pos, normals=nrm, colours=col,
-                 nverts=np.full(n, 3, dtype=np.int64), lights=(Light(direction=(0.0, 0.0, -1.0)),),
-                 ambient=(0.2, 0.2, 0.2), material=Material(ka=1.0, kd=0.8, ks=0.0))
-
-
-def _build_experts(fr: int) -> Callable[[int], Scene]:
-    def build(seed: int, *, width: int = 512, height: int = 512, dc: float = 3.0) -> Scene:
-        """``fr`` screen-parallel triangles, all on screen, total area ``dc * width * height``."""
-        rng = np.random.default_rng(seed)
-        cam, f = _screen_camera(height)
-        area = rng.uniform(0.5, 1.5, fr)
-        area *= dc * width * height / area.sum()
-        tri = _random_triangles(rng, fr, area)
-        r = np.abs(tri).max(axis=(1, 2))
-        c = np.stack([rng.uniform(r, width - r), rng.uniform(r, height - r)], axis=1)
-        dist = rng.uniform(0.5 * f, 1.5 * f, fr)  # one depth per face: faces never interpenetrate
-        pos = _lift(tri + c[:, None, :], dist[:, None], width, height, f, cam.eye[2])
-        # Smooth-shading normals: tilted up to ~30 degrees from the face normal, per vertex.
-        tilt = rng.uniform(-0.55, 0.55, (fr, 3, 2))
-        nrm = _unit(np.concatenate([tilt, np.ones((fr, 3, 1))], axis=-1))
-        col = np.repeat(0.2 + 0.8 * rng.random((fr, 1, 3)), 3, axis=1)
-        return Scene(name=f"experts-{fr}", seed=seed, camera=cam, positions=pos, normals=nrm, colours=col,
-                     nverts=np.full(fr, 3, dtype=np.int64), lights=(Light(direction=(-0.3, -0.4, -1.0)),),
-                     ambient=(0.2, 0.2, 0.2), material=Material(ka=1.0, kd=0.8, ks=0.0))
-
-    return build
-
-
-def _experts_builder(fn: str, *args) -> Callable[[int], Scene]:
-    """An EXPERTS builder from golden_model/experts/scenes.py, imported when first used."""
-    def build(seed: int) -> Scene:
-        from rasterhw.golden_model.experts import scenes as ex
-        f = getattr(ex, fn)
-        return (f(*args) if args else f)(seed)
-    return build
-
-
-def _info(name, desc, size, builder, seed, polygons) -> SceneInfo:
-    return SceneInfo(name, desc, size[0], size[1], builder, seed, polygons)
-
-
 _CUBE_SEED = 1987
-SCENES: dict[str, SceneInfo] = {
+_SHARED: dict[str, SceneInfo] = {
     **{
-        f"c{n}": _info(f"c{n}", f"{n} random cubes on a ground plate (vector Z-buffer paper, table 1)",
-                       (512, 512), _build_cubes(n), _CUBE_SEED, 6 * n + 1)
+        f"c{n}": SceneInfo(f"c{n}", f"{n} random cubes on a ground plate (vector Z-buffer paper, table 1)",
+                           512, 512, _build_cubes(n), _CUBE_SEED, 6 * n + 1)
         for n in (50, 100, 150, 200, 250, 300)
     },
-    "sp27": _info("sp27", "3x3x3 stacked spheres of 10x10 polygons on a ground plate (vector Z-buffer paper)",
-                  (512, 512), _build_spheres("sp27", _grid(3, 3, 3), 10, 10, ground_half=5.0, ground_pieces=1,
-                                             azimuth=30.0, elevation=25.0, distance=15.0), 27, 2701),
-    "sp5": _info("sp5", "5 spheres of 20x20 polygons spread down the screen on a ground plate (vector Z-buffer paper)",
-                 (512, 512), _build_spheres("sp5", _SP5_CENTRES, 20, 20, ground_half=8.5, ground_pieces=1,
-                                            azimuth=45.0, elevation=75.0, distance=35.0), 5, 2001),
-    "sp8": _info("sp8", "a column of 8 spheres of 13x13 polygons, small on screen (vector Z-buffer paper)",
-                 (512, 512), _build_spheres("sp8", _grid(1, 8, 1), 13, 13, ground_half=2.0, ground_pieces=2,
-                                            azimuth=30.0, elevation=15.0, distance=28.0), 8, 1354),
-    "zbm-5x5": _info("zbm-5x5", "1000 screen-facing diamonds, each two 5x5-pixel edge pairs (ZB/M table 1)",
-                     (512, 512), _build_zbm, 3, 1000),
-    "snu-100px": _info("snu-100px", "2000 Gouraud triangles of 100 px, random vertex colours (SNU target)",
-                       (1280, 1024), _build_snu, 4, 2000),
-    "snu-100k": _info("snu-100k", "100,000 Gouraud triangles of 100 px, random vertex colours: the SNU headline "
-                      "frame (one second's work)", (1280, 1024),
-                      lambda seed: _build_snu(seed, n=100_000, name="snu-100k"), 100, 100_000),
-    "experts-1000": _info("experts-1000", "Fr = 1000 front-facing triangles at depth complexity 3 (EXPERTS fig. 4.1)",
-                          (512, 512), _build_experts(1000), 1000, 1000),
-    "experts-2000": _info("experts-2000", "Fr = 2000 front-facing triangles at depth complexity 3 (EXPERTS fig. 4.1)",
-                          (512, 512), _build_experts(2000), 2000, 2000),
-    # EXPERTS: tilted, interpenetrating faces (same Fr, Dc), table 2.1's solids, an uneven load
-    # (builders in golden_model/experts/scenes.py, imported when a scene is built)
-    **{
-        f"experts-tilt-{fr}": _info(f"experts-tilt-{fr}", f"Fr = {fr} tilted, interpenetrating triangles at Dc = 3 "
-                                    "(EXPERTS fig. 4.1)", (512, 512), _experts_builder("build_tilt", fr), fr, fr)
-        for fr in (1000, 2000)
-    },
-    **{
-        f"experts-solid-{k}": _info(f"experts-solid-{k}", f"EXPERTS table 2.1 solid with {k} visible edges",
-                                    (512, 512), _experts_builder("build_solid", str(k)), 21, n)
-        for k, n in ((5, 4), (9, 6), (15, 9), (20, 12))
-    },
-    "experts-solids": _info("experts-solids", "the four solids of EXPERTS table 2.1 in one frame",
-                            (512, 512), _experts_builder("build_solids"), 21, 31),
-    "experts-uneven": _info("experts-uneven", "850 small triangles crowded top-left over 150 large ones "
-                            "(EXPERTS load balancing)", (512, 512), _experts_builder("build_uneven"), 8, 1000),
+    "sp27": SceneInfo("sp27", "3x3x3 stacked spheres of 10x10 polygons on a ground plate (vector Z-buffer paper)",
+                      512, 512, _build_spheres("sp27", _grid(3, 3, 3), 10, 10, ground_half=5.0, ground_pieces=1,
+                                               azimuth=30.0, elevation=25.0, distance=15.0), 27, 2701),
+    "sp5": SceneInfo("sp5", "5 spheres of 20x20 polygons spread down the screen on a ground plate "
+                     "(vector Z-buffer paper)", 512, 512,
+                     _build_spheres("sp5", _SP5_CENTRES, 20, 20, ground_half=8.5, ground_pieces=1,
+                                    azimuth=45.0, elevation=75.0, distance=35.0), 5, 2001),
+    "sp8": SceneInfo("sp8", "a column of 8 spheres of 13x13 polygons, small on screen (vector Z-buffer paper)",
+                     512, 512, _build_spheres("sp8", _grid(1, 8, 1), 13, 13, ground_half=2.0, ground_pieces=2,
+                                              azimuth=30.0, elevation=15.0, distance=28.0), 8, 1354),
 }
+
+
+class _Scenes(Mapping[str, SceneInfo]):
+    """Every built-in scene by name: the shared ones above, then each machine's
+    ``golden_model/NAME/scenes.py`` ``SCENES`` (found by looking, in folder order, on first use:
+    no machine is named here)."""
+
+    def __init__(self) -> None:
+        self._all: dict[str, SceneInfo] | None = None
+
+    def _load(self) -> dict[str, SceneInfo]:
+        if self._all is None:
+            found = dict(_SHARED)
+            root = Path(__file__).parent
+            for pkg in sorted(p.parent.name for p in root.glob("*/scenes.py")):
+                table = importlib.import_module(f"{__package__}.{pkg}.scenes").SCENES
+                for name in table:
+                    if name in found:
+                        raise RuntimeError(f"scene {name!r} is defined twice (golden_model/{pkg}/scenes.py)")
+                found.update(table)
+            self._all = found
+        return self._all
+
+    def __getitem__(self, name: str) -> SceneInfo:
+        return self._load()[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._load())
+
+    def __len__(self) -> int:
+        return len(self._load())
+
+
+SCENES: Mapping[str, SceneInfo] = _Scenes()
 
 
 def build_scene(name: str, *, seed: int | None = None) -> Scene:
@@ -395,21 +299,6 @@ def list_scenes() -> list[dict]:
 
 
 # --------------------------------------------------------------------------- statistics
-
-
-def _project(scene: Scene, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
-    """Corners -> (P, K, 2) screen pixels (y down) and (P, K) eye depth along the view axis."""
-    cam = scene.camera
-    eye = np.asarray(cam.eye, dtype=float)
-    fwd = _unit(np.asarray(cam.target, dtype=float) - eye)
-    side = _unit(np.cross(fwd, np.asarray(cam.up, dtype=float)))
-    up = np.cross(side, fwd)
-    rel = scene.positions - eye
-    xc, yc, zc = rel @ side, rel @ up, rel @ fwd
-    f = _focal_px(height, cam.fovy_deg)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        sxy = np.stack([width / 2 + f * xc / zc, height / 2 - f * yc / zc], axis=-1)
-    return sxy, zc
 
 
 def _clip_area(poly: np.ndarray, width: int, height: int) -> float:
@@ -446,7 +335,7 @@ def screen_stats(scene: Scene, width: int, height: int) -> dict:
     (``area_px / (width * height)``), ``empty_rows`` and ``empty_row_fraction`` (scan lines whose
     centre no drawn polygon spans).
     """
-    sxy, zc = _project(scene, width, height)
+    sxy, zc = project(scene, width, height)
     k = scene.max_corners
     used = np.arange(k)[None, :] < scene.nverts[:, None]
     near_bad = np.any(used & (zc <= scene.camera.near), axis=1)

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.meshio import load_mesh, load_scene
-from rasterhw.golden_model.scenes import SCENES, _project, build_scene, list_scenes, screen_stats
+from rasterhw.golden_model.scenekit import project as _project
+from rasterhw.golden_model.scenes import SCENES, build_scene, list_scenes, screen_stats
 
 EXPECTED = {
     "c50": 301, "c100": 601, "c150": 901, "c200": 1201, "c250": 1501, "c300": 1801,

@@ -1,4 +1,7 @@
-"""EXPERTS scene builders (registered in ``golden_model/scenes.py``; recipes in docs/scenes.md).
+"""EXPERTS scenes (found by ``golden_model/scenes.py``; recipes in docs/scenes.md).
+
+* ``experts-1000`` / ``-2000``: Fr screen-parallel triangles, all on screen, total screen area
+  Dc * 512 * 512 with Dc = 3, one depth per face (faces never interpenetrate).
 
 * ``experts-tilt-1000`` / ``-2000``: the ``experts-{Fr}`` recipe (Fr triangles, all on screen,
   total screen area exactly Dc * 512 * 512 with Dc = 3) with every *vertex* at its own eye
@@ -18,32 +21,34 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from rasterhw.golden_model.scene import Camera, Light, Material, Scene
+from rasterhw.golden_model.scenekit import lift, project, random_outlines, screen_camera, unit
+from rasterhw.golden_model.scenes import SceneInfo
 
-__all__ = ["build_tilt", "build_solid", "build_solids", "build_pyramid", "build_uneven", "SOLIDS",
+__all__ = ["SCENES", "build_tilt", "build_solid", "build_solids", "build_pyramid", "build_uneven", "SOLIDS",
            "PYRAMID_FAMILY", "visible_edges"]
 
 
 def _screen(height: int = 512):
-    from rasterhw.golden_model.scenes import _screen_camera
-    return _screen_camera(height)
+    return screen_camera(height)
 
 
 def _tilted(name: str, seed: int, fr: int, *, width=512, height=512, dc=3.0, tilt=0.08) -> Scene:
-    from rasterhw.golden_model.scenes import _lift, _random_triangles, _unit
     rng = np.random.default_rng(seed)
     cam, f = _screen(height)
     area = rng.uniform(0.5, 1.5, fr)
     area *= dc * width * height / area.sum()
-    tri = _random_triangles(rng, fr, area)
+    tri = random_outlines(rng, fr, area)
     r = np.abs(tri).max(axis=(1, 2))
     c = np.stack([rng.uniform(r, width - r), rng.uniform(r, height - r)], axis=1)
     dist = rng.uniform(0.85 * f, 1.15 * f, fr)[:, None] * (1 + rng.uniform(-tilt, tilt, (fr, 3)))
-    pos = _lift(tri + c[:, None, :], dist, width, height, f, cam.eye[2])
+    pos = lift(tri + c[:, None, :], dist, width, height, f, cam.eye[2])
     # smooth-shading normals: the face's own normal, tilted per vertex by up to ~0.4 rad
-    fn = _unit(np.cross(pos[:, 1] - pos[:, 0], pos[:, 2] - pos[:, 0]))
-    nrm = _unit(fn[:, None, :] + rng.uniform(-0.4, 0.4, (fr, 3, 3)))
+    fn = unit(np.cross(pos[:, 1] - pos[:, 0], pos[:, 2] - pos[:, 0]))
+    nrm = unit(fn[:, None, :] + rng.uniform(-0.4, 0.4, (fr, 3, 3)))
     col = np.repeat(0.2 + 0.8 * rng.random((fr, 1, 3)), 3, axis=1)
     return Scene(name=name, seed=seed, camera=cam, positions=pos, normals=nrm, colours=col,
                  nverts=np.full(fr, 3, dtype=np.int64), lights=(Light(direction=(-0.3, -0.4, -1.0)),),
@@ -164,8 +169,7 @@ def _solid_polys(key: str, rng: np.random.Generator, centre, scale: float):
 def visible_edges(scene: Scene) -> int:
     """Edges of front-facing polygons (orthographic test along the camera axis is not used:
     the winding on screen decides, as in the pipeline)."""
-    from rasterhw.golden_model.scenes import _project
-    sxy, _ = _project(scene, 512, 512)
+    sxy, _ = project(scene, 512, 512)
     edges = set()
     for p in range(scene.n_polygons):
         k = int(scene.nverts[p])
@@ -224,22 +228,21 @@ def build_solids(seed: int) -> Scene:
 
 
 def build_uneven(seed: int, *, width: int = 512, height: int = 512) -> Scene:
-    from rasterhw.golden_model.scenes import _lift, _random_triangles
     rng = np.random.default_rng(seed)
     cam, f = _screen(height)
     ns, nb = 850, 150
-    small = _random_triangles(rng, ns, rng.uniform(20.0, 60.0, ns))
+    small = random_outlines(rng, ns, rng.uniform(20.0, 60.0, ns))
     rs = np.abs(small).max(axis=(1, 2))
     cs = np.stack([rng.uniform(rs, 176 - rs), rng.uniform(rs, 200 - rs)], axis=1)
     big_area = rng.uniform(0.5, 1.5, nb)
     big_area *= 1.0 * width * height / big_area.sum()
-    big = _random_triangles(rng, nb, big_area)
+    big = random_outlines(rng, nb, big_area)
     rb = np.abs(big).max(axis=(1, 2))
     cb = np.stack([rng.uniform(rb, width - rb), rng.uniform(rb, height - rb)], axis=1)
     sxy = np.concatenate([small + cs[:, None], big + cb[:, None]])
     n = ns + nb
     dist = rng.uniform(0.85 * f, 1.15 * f, n)[:, None] * (1 + rng.uniform(-0.08, 0.08, (n, 3)))
-    pos = _lift(sxy, dist, width, height, f, cam.eye[2])
+    pos = lift(sxy, dist, width, height, f, cam.eye[2])
     fn = np.cross(pos[:, 1] - pos[:, 0], pos[:, 2] - pos[:, 0])
     fn /= np.linalg.norm(fn, axis=1, keepdims=True)
     nrm = np.broadcast_to(fn[:, None, :], pos.shape).copy()
@@ -248,3 +251,52 @@ def build_uneven(seed: int, *, width: int = 512, height: int = 512) -> Scene:
                  nverts=np.full(n, 3, dtype=np.int64), lights=(Light(direction=(-0.3, -0.4, -1.0)),),
                  ambient=(0.2, 0.2, 0.2), material=Material(ka=1.0, kd=0.8, ks=0.0))
 
+
+# --------------------------------------------------------------------------- flat faces (fig. 4.1)
+
+
+def _build_experts(fr: int) -> Callable[[int], Scene]:
+    def build(seed: int, *, width: int = 512, height: int = 512, dc: float = 3.0) -> Scene:
+        """``fr`` screen-parallel triangles, all on screen, total area ``dc * width * height``."""
+        rng = np.random.default_rng(seed)
+        cam, f = screen_camera(height)
+        area = rng.uniform(0.5, 1.5, fr)
+        area *= dc * width * height / area.sum()
+        tri = random_outlines(rng, fr, area)
+        r = np.abs(tri).max(axis=(1, 2))
+        c = np.stack([rng.uniform(r, width - r), rng.uniform(r, height - r)], axis=1)
+        dist = rng.uniform(0.5 * f, 1.5 * f, fr)  # one depth per face: faces never interpenetrate
+        pos = lift(tri + c[:, None, :], dist[:, None], width, height, f, cam.eye[2])
+        # Smooth-shading normals: tilted up to ~30 degrees from the face normal, per vertex.
+        tilt = rng.uniform(-0.55, 0.55, (fr, 3, 2))
+        nrm = unit(np.concatenate([tilt, np.ones((fr, 3, 1))], axis=-1))
+        col = np.repeat(0.2 + 0.8 * rng.random((fr, 1, 3)), 3, axis=1)
+        return Scene(name=f"experts-{fr}", seed=seed, camera=cam, positions=pos, normals=nrm, colours=col,
+                     nverts=np.full(fr, 3, dtype=np.int64), lights=(Light(direction=(-0.3, -0.4, -1.0)),),
+                     ambient=(0.2, 0.2, 0.2), material=Material(ka=1.0, kd=0.8, ks=0.0))
+
+    return build
+
+
+SCENES: dict[str, SceneInfo] = {
+    **{
+        f"experts-{fr}": SceneInfo(f"experts-{fr}", f"Fr = {fr} front-facing triangles at depth complexity 3 "
+                                   "(EXPERTS fig. 4.1)", 512, 512, _build_experts(fr), fr, fr)
+        for fr in (1000, 2000)
+    },
+    # tilted, interpenetrating faces (same Fr, Dc), table 2.1's solids, an uneven load
+    **{
+        f"experts-tilt-{fr}": SceneInfo(f"experts-tilt-{fr}", f"Fr = {fr} tilted, interpenetrating triangles at "
+                                        "Dc = 3 (EXPERTS fig. 4.1)", 512, 512, build_tilt(fr), fr, fr)
+        for fr in (1000, 2000)
+    },
+    **{
+        f"experts-solid-{k}": SceneInfo(f"experts-solid-{k}", f"EXPERTS table 2.1 solid with {k} visible edges",
+                                        512, 512, build_solid(str(k)), 21, n)
+        for k, n in ((5, 4), (9, 6), (15, 9), (20, 12))
+    },
+    "experts-solids": SceneInfo("experts-solids", "the four solids of EXPERTS table 2.1 in one frame",
+                                512, 512, build_solids, 21, 31),
+    "experts-uneven": SceneInfo("experts-uneven", "850 small triangles crowded top-left over 150 large ones "
+                                "(EXPERTS load balancing)", 512, 512, build_uneven, 8, 1000),
+}
