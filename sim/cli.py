@@ -15,6 +15,7 @@ from pathlib import Path
 import click
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
+from rasterhw.sim.flow_cli import add_commands
 from rasterhw.sim.report import systems as _report_systems
 
 #: the float reference rasteriser is shared by every machine; the rest come from the registry
@@ -70,45 +71,6 @@ def _take_options(given: dict, declared: tuple[registry.Option, ...], who: str) 
 
 _RENDER_OPTIONS = _union_options(a for _, a in registry.archs().values())
 _SIM_OPTIONS = _union_options(b for _, b in registry.sim_blocks().values())
-
-
-def parse_params(params: tuple[str, ...], factory) -> dict:
-    """``-p NAME=VALUE`` pairs -> keyword arguments typed by ``factory``'s signature: a parameter
-    whose default is a bool takes true/false/1/0, an int default takes an integer, and so on;
-    an unknown name is an error."""
-    import inspect
-
-    sig = inspect.signature(factory)
-    out: dict = {}
-    for p in params:
-        if "=" not in p:
-            raise RasterhwError(f"--param must be NAME=VALUE, not {p!r}")
-        k, v = p.split("=", 1)
-        if k not in sig.parameters:
-            raise RasterhwError(f"no parameter {k!r}; parameters: {', '.join(sig.parameters)}")
-        if k in out:
-            raise RasterhwError(f"parameter {k!r} given twice")
-        default = sig.parameters[k].default
-        if isinstance(default, bool):
-            low = v.lower()
-            if low not in ("true", "false", "1", "0", "yes", "no"):
-                raise RasterhwError(f"parameter {k!r} is true or false, not {v!r}")
-            out[k] = low in ("true", "1", "yes")
-        elif isinstance(default, int) or default is inspect.Parameter.empty:
-            try:
-                out[k] = int(v, 0)
-            except ValueError:
-                if isinstance(default, int):
-                    raise RasterhwError(f"parameter {k!r} is an integer, not {v!r}") from None
-                out[k] = v
-        elif isinstance(default, float):
-            try:
-                out[k] = float(v)
-            except ValueError:
-                raise RasterhwError(f"parameter {k!r} is a number, not {v!r}") from None
-        else:
-            out[k] = v
-    return out
 
 
 def parse_size(text: str | None) -> tuple[int, int] | None:
@@ -364,7 +326,8 @@ def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool) ->
 def verilog(block: str | None, list_blocks: bool, output: str | None, params: tuple[str, ...],
             interleave: int | None) -> None:
     """Generate Verilog for BLOCK (see `rasterhw verilog --list`)."""
-    from rasterhw.sim.verilog import block_names, write_verilog
+    from rasterhw.sim.verilog import block_names, parse_params
+    from rasterhw.sim.verilog_cache import write_verilog
 
     if list_blocks:
         click.echo("\n".join(block_names()))
@@ -494,10 +457,7 @@ def demo(out_dir: str, scene: str, engine: str) -> None:
     run_demo(Path(out_dir), scene=scene, engine=engine)
 
 
-# synth, fpga, prove: the hardware flow (sim/flow_cli.py)
-from rasterhw.sim.flow_cli import add_commands  # noqa: E402
-
-add_commands(cli)
+add_commands(cli)   # synth, fpga, prove: the hardware flow (sim/flow_cli.py)
 
 
 def _terminate(signum, _frame):

@@ -15,8 +15,7 @@ from rasterhw.sim import registry
 
 
 def _params(block: str, params: tuple[str, ...]) -> dict:
-    from rasterhw.sim.cli import parse_params
-    from rasterhw.sim.verilog import block_names
+    from rasterhw.sim.verilog import block_names, parse_params
 
     if block not in block_names():
         raise RasterhwError(f"unknown block {block!r}; blocks: {', '.join(block_names())}")

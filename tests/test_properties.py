@@ -115,7 +115,7 @@ def test_param_parser_result_or_one_line_error(block, data):
     import inspect
 
     from rasterhw.sim import registry
-    from rasterhw.sim.cli import parse_params
+    from rasterhw.sim.verilog import parse_params
 
     factory = registry.load(registry.blocks()[block])
     names = list(inspect.signature(factory).parameters) + ["nonsense", ""]

@@ -42,7 +42,7 @@ def one_line_error(r: subprocess.CompletedProcess, *, contains: str = "") -> str
 # ------------------------------------------------------------------ row 2
 def test_p_false_is_false_not_a_truthy_string():
     from rasterhw.hdl.zbm.unit import ZbmUnit
-    from rasterhw.sim.cli import parse_params
+    from rasterhw.sim.verilog import parse_params
 
     assert parse_params(("head=false",), ZbmUnit) == {"head": False}
     assert parse_params(("head=1", "interleave=0x2"), ZbmUnit) == {"head": True, "interleave": 2}

@@ -8,7 +8,8 @@ import shutil
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.runner import SimulatorUnavailable, build_dir_for, get_sim, lint_verilog
-from rasterhw.sim.verilog import block_names, generate_verilog, write_verilog
+from rasterhw.sim.verilog import block_names, generate_verilog
+from rasterhw.sim.verilog_cache import write_verilog
 
 
 def test_registry_has_every_machines_blocks():

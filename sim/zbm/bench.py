@@ -8,8 +8,9 @@ def bench(*, repeat: int = 11, hdl: bool = True, progress: bool = False) -> list
     if not hdl:
         return []
     from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.sim.zbm.driver import chip_speed, simulate_zbm
+    from rasterhw.sim.zbm.driver import chip_speed
     from rasterhw.sim.zbm.fast import chip_speed_fast
+    from rasterhw.sim.zbm.scene_run import simulate_zbm
 
     res = simulate_zbm(build_scene("c300"), 512, 512, interleave=8, engine="verilator")
     chip = chip_speed(interleave=8, repeat=8)

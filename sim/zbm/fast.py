@@ -38,6 +38,7 @@ from rasterhw.sim.zbm.driver import (
     chain_verilog,
     chip_stimulus,
     read_hex_words,
+    run_unit_bench,
     stimulus_depth,
     unit_watchdog,
     write_unit_stimulus,
@@ -166,8 +167,6 @@ def run_units_equal_clocks(per_unit: list, *, width: int, height: int, interleav
     if engine == "verilator":
         return run_unit_fast(per_unit, width=width, height=height, interleave=interleave, schedule=schedule,
                              line_log=line_log, opt="-O0")
-    from rasterhw.sim.zbm.driver import run_unit_bench
-
     return run_unit_bench(per_unit, width=width, height=height, interleave=interleave, sim=engine, phase=0,
                           speed_run=True, schedule=schedule, line_log=line_log, opt="-O0")
 

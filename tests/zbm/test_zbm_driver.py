@@ -1,4 +1,4 @@
-"""simulate_zbm (sim/zbm/driver.py) on a tiny scene in Amaranth pysim, and its input checks."""
+"""simulate_zbm (sim/zbm/scene_run.py) on a tiny scene in Amaranth pysim, and its input checks."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ from rasterhw.golden_model.scenes import SCENES, build_scene
 from rasterhw.golden_model.zbm import words as W
 from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.sim.zbm import driver as Z
+from rasterhw.sim.zbm.scene_run import simulate_zbm
 
 
 def _scene():
@@ -21,7 +22,7 @@ def _scene():
 
 def test_simulate_zbm_pysim_tiny_frame():
     # 32 x 8 (not 16): pysim runs ~1,000 clocks per line of c300 here; Verilator runs the bigger frames
-    r = Z.simulate_zbm(_scene(), 32, 8, interleave=2, engine="pysim")
+    r = simulate_zbm(_scene(), 32, 8, interleave=2, engine="pysim")
     assert r["block"] == "zbm" and r["engine"] == "pysim" and r["units"] == 1
     assert r["pixels_compared"] == 32 * 8 and r["mismatches"] == 0
     assert r["edge_pairs"] > 0 and r["cycles"] > 0 and r["frame_rgb"].shape == (8, 32, 3)
@@ -32,13 +33,13 @@ def test_simulate_zbm_pysim_tiny_frame():
 def test_bad_arguments():
     sc = _scene()
     with pytest.raises(RasterhwError, match="engine"):
-        Z.simulate_zbm(sc, 32, 16, engine="modelsim")
+        simulate_zbm(sc, 32, 16, engine="modelsim")
     with pytest.raises(RasterhwError, match="interleave"):
-        Z.simulate_zbm(sc, 32, 16, interleave=3, engine="pysim")
+        simulate_zbm(sc, 32, 16, interleave=3, engine="pysim")
     with pytest.raises(RasterhwError, match="units"):
-        Z.simulate_zbm(sc, 32, 16, units=0, engine="pysim")
+        simulate_zbm(sc, 32, 16, units=0, engine="pysim")
     with pytest.raises(RasterhwError, match="width"):
-        Z.simulate_zbm(sc, 1024, 16, engine="pysim")
+        simulate_zbm(sc, 1024, 16, engine="pysim")
 
 
 def _eps():
@@ -73,7 +74,7 @@ def test_words_round_trip():
 def test_float_tolerance_when_last_triangles_cover_no_pixel():
     """Issue 14 row 1: the highest-numbered triangles of c50 at 16x16 cover no pixel; the
     float-tolerance check must still size its per-triangle table by every edge-pair tag."""
-    res = Z.simulate_zbm(build_scene("c50"), 16, 16, interleave=1, engine="pysim")
+    res = simulate_zbm(build_scene("c50"), 16, 16, interleave=1, engine="pysim")
     assert res["mismatches"] == 0 and res["pixels_compared"] == 256
 
 
