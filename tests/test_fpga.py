@@ -6,9 +6,8 @@ from __future__ import annotations
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.fpga import (
-    CHIP_SWEEP,
-    FPGA_BLOCKS,
-    FPGA_CONFIGS,
+    fpga_configs,
+    fpga_sweeps,
     paper_clock,
     place_and_route,
     rows,
@@ -51,7 +50,7 @@ def test_merger_places_on_ecp5_with_both_clocks(tmp_path, monkeypatch):
 
 
 def test_paper_clocks_and_blocks():
-    assert set(FPGA_BLOCKS) <= set(block_names())
+    assert {b for b, _, _ in fpga_configs()} <= set(block_names())
     assert paper_clock("pixelbus-bank")[0][2] == 12.5e6       # 80 ns pixel slot
     assert [d for d, _, _ in paper_clock("zbm-chip")] == ["sync", "merge"]
     assert paper_clock("zbm-pixel")[0][2] == 25e6
@@ -60,11 +59,13 @@ def test_paper_clocks_and_blocks():
 
 
 def test_every_block_has_a_full_configuration_and_rows():
-    full = {b for b, _, kind in FPGA_CONFIGS if kind == "full"}
+    configs = fpga_configs()
+    full = {b for b, _, kind in configs if kind == "full"}
     assert full == set(block_names())                         # every `rasterhw verilog --list` block
-    assert {kind for _, _, kind in FPGA_CONFIGS} == {"full", "reduced"}
-    assert len({(b, tuple(sorted(p.items()))) for b, p, _ in FPGA_CONFIGS}) == len(FPGA_CONFIGS)
-    assert CHIP_SWEEP == (1, 2, 4, 8, 16)
+    assert {kind for _, _, kind in configs} == {"full", "reduced"}
+    assert len({(b, tuple(sorted(p.items()))) for b, p, _ in configs}) == len(configs)
+    (chip,) = [sw for sw in fpga_sweeps() if sw.block == "zbm-chip"]
+    assert chip.param == "interleave" and chip.values == (1, 2, 4, 8, 16)   # the paper's interleaves
     out, _ = rows(out_dir=None, fast=True)
     figs = {r["figure"] for r in out}
     for b in block_names():
@@ -72,7 +73,7 @@ def test_every_block_has_a_full_configuration_and_rows():
     assert all(r["measured"] is None and r["reason"] for r in out)   # fast: kept, unmeasured
     sweep = [r for r in out if "against interleave" in r["figure"]]
     assert [r["quantity"] for r in sweep if "segment" in r["quantity"]] == \
-        [f"Fmax, segment clock, interleave {i}" for i in CHIP_SWEEP]
+        [f"Fmax, segment clock, interleave {i}" for i in chip.values]
 
 
 def test_utilisation_parser():

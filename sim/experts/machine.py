@@ -1,6 +1,8 @@
 """Registry entry of EXPERTS (seed 000): its arch, PXP block and sim, report and bench."""
 
-from rasterhw.sim.registry import Arch, Machine, Option, SimBlock
+from rasterhw.sim.registry import Arch, Clock, Flow, Machine, Option, SimBlock
+
+_NO_CLOCK = Clock("sync", "EXPERTS: the paper names no clock (times in operation times)", None, "clock")
 
 MACHINE = Machine(
     name="experts",
@@ -30,6 +32,10 @@ MACHINE = Machine(
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",
     soak={"pxp": "rasterhw.sim.experts.soak:pxp_round"},
+    flows={"experts-dmm": Flow(small={"depth": 16}, clocks=(_NO_CLOCK,)),
+           "experts-pxp": Flow(small={"width": 64}, clocks=(_NO_CLOCK,)),
+           "experts-pxp-unit": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,))},
+    fpga_note="EXPERTS names no clock (docs/experts.md: times in operation times).",
     status="scan-line golden model split as SLP/PXP (float and 16-bit), Sn x Pn parallel model with "
            "load balancing at both levels, fig. 4.1 cost model (golden); PXP datapath (HDL, bit- and cycle-exact)",
 )

@@ -1,6 +1,15 @@
 """Registry entry of the SNU graphics system (seed 004): its arch, blocks, sim, report, bench."""
 
-from rasterhw.sim.registry import Arch, Machine, SimBlock
+from rasterhw.sim.registry import Arch, Clock, Flow, Machine, SimBlock
+
+#: the pixel bus's clock: one 80 ns slot, the bank's 400 ns memory cycle being 5 slots (sec. 3)
+_SLOT = Clock("sync", "SNU pixel-bus slot 80 ns (bank memory cycle 400 ns = 5 slots)", 12.5e6, "pixel-bus clock")
+
+
+def ram_bits(params: dict[str, int]) -> int:
+    """Bits of one ``rasterhw_pixelbus_ram`` instance (the frame memory chips) from its parameters."""
+    return params["WIDTH"] * params["DEPTH"]
+
 
 MACHINE = Machine(
     name="snu",
@@ -16,6 +25,17 @@ MACHINE = Machine(
     bench="rasterhw.sim.snu.bench:bench",
     soak={"pixelbus": "rasterhw.sim.snu.soak:pixelbus_round"},
     proofs={"pixelbus-bank": "rasterhw.sim.snu.proof:PROOF"},
+    flows={"pixelbus-bank": Flow(synth={"ram": "verilog", "depth": 1280 * 1024 // 5},  # one of 5 banks of the frame
+                                 small={"depth": 64}, fpga={"ram": "memory", "depth": 4096},
+                                 fpga_runs=(({}, "full"), ({"ram": "memory", "depth": 4096}, "reduced")),
+                                 clocks=(_SLOT,), demand_from_synth=True),
+           "pixelbus": Flow(synth={"ram": "verilog"}, small={"width": 40, "height": 16},
+                            fpga={"ram": "memory", "width": 160, "height": 128},
+                            fpga_runs=(({}, "full"), ({"ram": "memory", "width": 160, "height": 128}, "reduced")),
+                            clocks=(_SLOT,), demand_from_synth=True)},
+    # the frame memory outside the controller: a black box in synthesis (sim/synth.py)
+    ram_modules={"rasterhw_pixelbus_ram": "rasterhw.sim.snu.machine:ram_bits"},
+    fpga_note="SNU: 80 ns pixel-bus slot, the bank's 400 ns memory cycle being 5 slots.",
     status="pixel-bus controller with Z comparator over a 5-bank frame buffer (HDL, bit- and cycle-exact); "
            "i860 timing model, the paper's geometry recipe, Gouraud scan converter, PHIGS traversal (golden); "
            "snu-100k frame end to end (pixel bus on Verilator with clear and swap)",

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
-from rasterhw.sim.registry import Arch, Machine, Option, SimBlock
+from rasterhw.sim.registry import Arch, Clock, Flow, Machine, Option, SimBlock
 
 _MATRIX = Option(name="matrix", help="matrix of video processors PxQ (powers of two; the raster must be "
                                      "p*2^n x q*2^n)", default="4x4")
+
+_NO_CLOCK = Clock("sync", "sparse video processor: the paper names no clock", None, "clock")
 
 MACHINE = Machine(
     name="sparse",
@@ -26,6 +28,9 @@ MACHINE = Machine(
     report="rasterhw.sim.sparse.report:rows",
     bench="rasterhw.sim.sparse.bench:bench",
     soak={"sparse": "rasterhw.sim.sparse.soak:sparse_round"},
+    flows={"sparse-vp": Flow(small={"n": 4, "p": 2, "q": 2}, clocks=(_NO_CLOCK,)),
+           "sparse-matrix": Flow(small={"n": 3}, clocks=(_NO_CLOCK,))},
+    fpga_note="The sparse video processor's paper names no clock (docs/sparse.md).",
     status="golden model (image = reference), formulas (1)-(12), Monte-Carlo window counts, figs. 3-6; "
            "video processor in Amaranth, bit-exact in pysim and Verilator",
 )

@@ -1,11 +1,16 @@
 """Registry entry of the ZB/M scan-line Z-buffer merger (seed 003)."""
 
-from rasterhw.sim.registry import Arch, Machine, Option, SimBlock
+from rasterhw.sim.registry import Arch, Clock, Flow, FpgaSweep, Machine, Option, SimBlock
 
 _INTERLEAVE = Option("interleave", "ZB/M chips per scan line (1, 2, 4, 8 or 16)", default=8, type=int)
 _UNITS = Option("units", "ZB/M units chained by merge ports", default=1, type=int)
 _SCHEDULE = Option("schedule", "ZB/M timing: overlap (ours) or paper (sec. 6.1's schedule)", default="overlap",
                    choices=("overlap", "paper"))
+
+#: the clocks of sec. 6.1: the segment clock (cond. 3) and the merger's own clock
+_SEG = Clock("sync", "ZB/M segment clock 25 MHz (sec. 6.1 cond. 3)", 25e6, "segment clock")
+_MERGE = Clock("merge", "ZB/M merge clock: independent of the segment clock, frequency not given", None,
+               "merge clock")
 
 MACHINE = Machine(
     name="zbm",
@@ -26,6 +31,27 @@ MACHINE = Machine(
     bench="rasterhw.sim.zbm.bench:bench",
     soak={"zbm": "rasterhw.sim.zbm.soak:zbm_round"},
     proofs={"zbm-merger": "rasterhw.sim.zbm.proof:PROOF"},
+    flows={"zbm-chip": Flow(small={"interleave": 8, "width": 128}, fpga={"interleave": 8, "width": 512},
+                            fpga_runs=(({"interleave": 8, "width": 512}, "full"),), clocks=(_SEG, _MERGE)),
+           "zbm-loop": Flow(small={"interleave": 8, "width": 128}, fpga={"interleave": 8, "width": 512},
+                            fpga_runs=(({"interleave": 8, "width": 512}, "full"),), clocks=(_SEG,)),
+           "zbm-merger": Flow(small={"fifo_depth": 4}, fpga={"fifo_depth": 16},
+                              fpga_runs=(({"fifo_depth": 16}, "full"),), clocks=(_SEG, _MERGE)),
+           "zbm-pixel": Flow(small={"interleave": 8, "width": 128}, fpga={"interleave": 8, "width": 512},
+                             fpga_runs=(({"interleave": 8, "width": 512}, "full"),), clocks=(_SEG,)),
+           "zbm-seggen": Flow(small={"width": 64, "height": 64, "capacity": 16},
+                              fpga_runs=(({}, "full"), ({"capacity": 16}, "reduced")), clocks=(_SEG,)),
+           "zbm-unit": Flow(small={"interleave": 2, "width": 64, "height": 64, "capacity": 16},
+                            fpga_runs=(({}, "full"), ({"interleave": 2, "width": 64, "height": 64, "capacity": 16},
+                                                      "reduced")), clocks=(_SEG, _MERGE))},
+    # the chip's Fmax against interleave (paper, sec. 5.3), at a 512-pixel line
+    fpga_sweeps=(FpgaSweep("zbm-chip", "interleave", (1, 2, 4, 8, 16), {"width": 512},
+                           "ZB/M chip on ECP5-85F, 512-pixel line, out of context", "interleave (chips per unit)",
+                           "what the interleave changes in the chip is the initial processor's slot arithmetic and "
+                           "the pixel memories, ceil(512 / interleave) double-Z words per line; the loop's 8 pixel "
+                           "processors are the same at every interleave."),),
+    fpga_note=("ZB/M segment clock 25 MHz (\"ZB/M の入力クロックは 25MHz\", sec. 6.1 cond. 3); the merge clock is "
+               "independent (\"マージャはそれとは独立のマージクロックで動作\") and its frequency is not given."),
     status="segment generator, ZB/M chip (8 pixel processors on a segment loop, double Z, merger on its own "
            "clock), unit, chained units (HDL, bit- and cycle-exact)",
 )
