@@ -36,23 +36,36 @@ def _screen(height: int = 512):
     return screen_camera(height)
 
 
-def _tilted(name: str, seed: int, fr: int, *, width=512, height=512, dc=3.0, tilt=0.08) -> Scene:
-    rng = np.random.default_rng(seed)
-    cam, f = _screen(height)
+def _placed(rng: np.random.Generator, fr: int, width: int, height: int, dc: float) -> np.ndarray:
+    """``fr`` triangle outlines (fr, 3, 2) in screen pixels, all on screen, total area
+    ``dc * width * height`` (areas uniform in 0.5..1.5 of the mean, centres uniform)."""
     area = rng.uniform(0.5, 1.5, fr)
     area *= dc * width * height / area.sum()
     tri = random_outlines(rng, fr, area)
     r = np.abs(tri).max(axis=(1, 2))
     c = np.stack([rng.uniform(r, width - r), rng.uniform(r, height - r)], axis=1)
-    dist = rng.uniform(0.85 * f, 1.15 * f, fr)[:, None] * (1 + rng.uniform(-tilt, tilt, (fr, 3)))
-    pos = lift(tri + c[:, None, :], dist, width, height, f, cam.eye[2])
-    # smooth-shading normals: the face's own normal, tilted per vertex by up to ~0.4 rad
-    fn = unit(np.cross(pos[:, 1] - pos[:, 0], pos[:, 2] - pos[:, 0]))
-    nrm = unit(fn[:, None, :] + rng.uniform(-0.4, 0.4, (fr, 3, 3)))
+    return tri + c[:, None, :]
+
+
+def _faces(name: str, seed: int, cam: Camera, pos: np.ndarray, nrm: np.ndarray, rng: np.random.Generator) -> Scene:
+    """The scene of triangles ``pos`` / ``nrm``: one random colour per face, the EXPERTS light."""
+    fr = len(pos)
     col = np.repeat(0.2 + 0.8 * rng.random((fr, 1, 3)), 3, axis=1)
     return Scene(name=name, seed=seed, camera=cam, positions=pos, normals=nrm, colours=col,
                  nverts=np.full(fr, 3, dtype=np.int64), lights=(Light(direction=(-0.3, -0.4, -1.0)),),
                  ambient=(0.2, 0.2, 0.2), material=Material(ka=1.0, kd=0.8, ks=0.0))
+
+
+def _tilted(name: str, seed: int, fr: int, *, width=512, height=512, dc=3.0, tilt=0.08) -> Scene:
+    rng = np.random.default_rng(seed)
+    cam, f = _screen(height)
+    sxy = _placed(rng, fr, width, height, dc)
+    dist = rng.uniform(0.85 * f, 1.15 * f, fr)[:, None] * (1 + rng.uniform(-tilt, tilt, (fr, 3)))
+    pos = lift(sxy, dist, width, height, f, cam.eye[2])
+    # smooth-shading normals: the face's own normal, tilted per vertex by up to ~0.4 rad
+    fn = unit(np.cross(pos[:, 1] - pos[:, 0], pos[:, 2] - pos[:, 0]))
+    nrm = unit(fn[:, None, :] + rng.uniform(-0.4, 0.4, (fr, 3, 3)))
+    return _faces(name, seed, cam, pos, nrm, rng)
 
 
 def build_tilt(fr: int):
@@ -259,21 +272,14 @@ def _build_experts(fr: int) -> Callable[[int], Scene]:
     def build(seed: int, *, width: int = 512, height: int = 512, dc: float = 3.0) -> Scene:
         """``fr`` screen-parallel triangles, all on screen, total area ``dc * width * height``."""
         rng = np.random.default_rng(seed)
-        cam, f = screen_camera(height)
-        area = rng.uniform(0.5, 1.5, fr)
-        area *= dc * width * height / area.sum()
-        tri = random_outlines(rng, fr, area)
-        r = np.abs(tri).max(axis=(1, 2))
-        c = np.stack([rng.uniform(r, width - r), rng.uniform(r, height - r)], axis=1)
+        cam, f = _screen(height)
+        sxy = _placed(rng, fr, width, height, dc)
         dist = rng.uniform(0.5 * f, 1.5 * f, fr)  # one depth per face: faces never interpenetrate
-        pos = lift(tri + c[:, None, :], dist[:, None], width, height, f, cam.eye[2])
+        pos = lift(sxy, dist[:, None], width, height, f, cam.eye[2])
         # Smooth-shading normals: tilted up to ~30 degrees from the face normal, per vertex.
         tilt = rng.uniform(-0.55, 0.55, (fr, 3, 2))
         nrm = unit(np.concatenate([tilt, np.ones((fr, 3, 1))], axis=-1))
-        col = np.repeat(0.2 + 0.8 * rng.random((fr, 1, 3)), 3, axis=1)
-        return Scene(name=f"experts-{fr}", seed=seed, camera=cam, positions=pos, normals=nrm, colours=col,
-                     nverts=np.full(fr, 3, dtype=np.int64), lights=(Light(direction=(-0.3, -0.4, -1.0)),),
-                     ambient=(0.2, 0.2, 0.2), material=Material(ka=1.0, kd=0.8, ks=0.0))
+        return _faces(f"experts-{fr}", seed, cam, pos, nrm, rng)
 
     return build
 
