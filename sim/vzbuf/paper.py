@@ -91,6 +91,16 @@ T7 = {
 }
 T7["VP200"]["total"]["c200"] = 546
 
+#: "ベクトル処理時間" (time the vector unit was used, 3.3 ③), ms; tables 4/5 give c300..sp5
+VTIME = {
+    "table 2": {"VP100": _row(210, 180, 150, 120, 90, 60, 320, 160, 100), "VP200": _row(170, 140, 120, 100, 80, 50, 260, 120, 80)},
+    "table 3": {"VP100": _row(270, 240, 210, 180, 150, 120, N, 240, 200), "VP200": _row(180, 170, 150, 130, 110, 90, N, 170, 140)},
+    "table 4": {"VP100": _row(1320, 1120, 890, 710, 500, 260, 620, 300, N),
+                "VP200": _row(1200, 1020, 810, 650, 450, 230, 570, 280, N)},
+    "table 5": {"VP100": _row(2620, 2260, 1820, 1460, 1020, 560, 1250, 490, N),
+                "VP200": _row(1710, 1480, 1200, 960, 670, 380, 840, 370, N)},
+}
+
 TABLES = {"table 2": T2, "table 3": T3, "table 4": T4, "table 5": T5, "table 6": T6, "table 7": T7}
 RATES = {"table 2": T2_RATE, "table 3": T3_RATE, "table 4": T4_RATE, "table 5": T5_RATE}
 #: which algorithm / shadow method each timing table ran

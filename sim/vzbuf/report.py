@@ -24,7 +24,7 @@ from rasterhw.golden_model.vzbuf.shadows import ray_shadow
 from rasterhw.golden_model.vzbuf.stats import table1
 from rasterhw.golden_model.vzbuf.trace import Trace
 from rasterhw.sim.report import make_row
-from rasterhw.sim.vzbuf.paper import COLS, CORRECTED, RATES, RUNS, T1, TABLES
+from rasterhw.sim.vzbuf.paper import COLS, CORRECTED, RATES, RUNS, T1, TABLES, VTIME
 
 SYS = "vzbuf"
 W = H = 512
@@ -137,6 +137,10 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
                                         paper=p1 / p2 if p1 and p2 else None, formula=None,
                                         measured=ms["vp100"][stage] / ms["vp200"][stage], unit="ratio",
                                         source="model:facom"))
+            for m in ("vp100", "vp200"):
+                out.append(make_row(SYS, table, f"{n}: vector time (vector unit in use), {PAPER_M[m]}",
+                                    paper=VTIME[table][PAPER_M[m]][n] if table in VTIME else None, formula=None,
+                                    measured=ms[m]["vector"], unit="ms", source=f"model:{m}"))
             if table in RATES:
                 for m in ("vp100", "vp200"):
                     out.append(make_row(SYS, table, f"{n}: vectorisation rate (4), {PAPER_M[m]}",
@@ -286,6 +290,7 @@ def model_ms(tr: Trace, alg: int, sh: str, params: dict | None = None) -> dict:
         out[m] = d
         if m != "scalar":
             d["rate"] = 100.0 * 1e3 * sum(r["vectorised_scalar"].values()) / out["scalar"]["total"]
+            d["vector"] = 1e3 * sum(r["vector"].values())
     return out
 
 
@@ -429,7 +434,7 @@ def _sections(t1, times, scenes) -> list[str]:
                 if (table, n) not in times:
                     continue
                 ms = times[(table, n)][0]
-                for st in ms["scalar"]:
+                for st in ms["scalar"]:            # the stages and the total
                     cells = []
                     for m in MODELS:
                         pm = PAPER_M[m]
