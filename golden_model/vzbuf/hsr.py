@@ -80,8 +80,9 @@ def _state(seg: SegmentBlock):
 
 def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: str = "real",
                sign: np.ndarray | None = None, full_frame: bool = False, zline_of: np.ndarray | None = None,
-               counters: Counters | None = None) -> Counters:
-    """Algorithm 1 over ``seg`` into ``buf`` (see the module docstring)."""
+               counters: Counters | None = None, trace=None) -> Counters:
+    """Algorithm 1 over ``seg`` into ``buf`` (see the module docstring); ``trace`` (a
+    :class:`~.trace.Trace`) records the paper's loops as they run."""
     c = counters or Counters()
     if seg.n == 0:
         return c
@@ -97,6 +98,9 @@ def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
     clk = time.process_time
     for y in range(height):
         ta = clk()
+        if trace is not None:
+            trace.scalar("line loop and bypass test", 3)
+            trace.loop("a1 drop exited", active.size)
         if active.size:
             active = active[yend[active] >= y]
         s = head[y]
@@ -106,6 +110,8 @@ def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
                 new.append(s)
                 s = nxt[s]
             active = np.concatenate([active, np.asarray(new, np.int64)])
+            if trace is not None:
+                trace.scalar("y-list walk, append to x-list", 5 * len(new))
         tb = clk()
         c.t_update2 += tb - ta
         if active.size == 0:
@@ -116,6 +122,14 @@ def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
         xl, zl, il, xr, ir = ex[L], ez[L], ei[L], ex[R], ei[R]
         with np.errstate(divide="ignore", invalid="ignore"):
             didx = np.where(xr > xl, (ir - il) / (xr - xl), 0.0)
+        if trace is not None:
+            trace.scalar("line set-up", 6)
+            if mode == "real" and not full_frame:
+                trace.loop("clear", width)
+            trace.loop("a1 span set-up", active.size)
+            trace.scalar("span loop set-up", 8 * active.size)
+            trace.loops_of(f"a1 z-test {mode}", hi - lo + 1)
+            trace.loop("edge update", 2 * active.size)
         if mode == "real":
             zrow = depth[y] if full_frame else zline
             if not full_frame:
@@ -161,8 +175,9 @@ def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
 
 
 def algorithm2(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: str = "real",
-               sign: np.ndarray | None = None, counters: Counters | None = None) -> Counters:
-    """Algorithm 2 over ``seg`` into ``buf`` (see the module docstring)."""
+               sign: np.ndarray | None = None, counters: Counters | None = None, trace=None) -> Counters:
+    """Algorithm 2 over ``seg`` into ``buf`` (see the module docstring); ``trace`` records the
+    paper's loops (vector length = scan lines or occupied slots, masked Z-test steps)."""
     c = counters or Counters()
     if seg.n == 0:
         return c
@@ -180,6 +195,11 @@ def algorithm2(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
     clk = time.process_time
     while True:
         ta = clk()
+        if trace is not None:
+            trace.scalar("pass control", 10)
+            trace.loop("a2 drop exited", height)
+            trace.loop("a2 take y-list head", height)
+            trace.loop("a2 collect slots", height)
         # (1) drop exited segments
         ys = np.flatnonzero(slist >= 0)
         if ys.size:
@@ -220,6 +240,12 @@ def algorithm2(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
         elif mode == "shadow":
             sg_o = sign[segs][o]
         mx = int(ln_o[0]) if ln_o.size else 0
+        if trace is not None:
+            trace.loop("a2 span set-up", ys.size)
+            trace.loop(f"a2 z-test {mode}", ys.size, times=mx)   # every slot, masked, mx times
+            trace.scalar("z-test step control", 3 * mx)
+            trace.loop("edge update", 2 * ys.size)
+            trace.loop("a2 shift s-list", height)
         live = ln_o.size - np.searchsorted(ln_o[::-1], np.arange(mx), side="right")
         for k in range(mx):
             m = int(live[k])

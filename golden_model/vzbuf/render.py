@@ -35,7 +35,7 @@ from rasterhw.golden_model.vzbuf.shadows import (
     shadow_polygons,
 )
 
-__all__ = ["Frame", "render_frame", "DEFAULT_EPS"]
+__all__ = ["Frame", "render_frame", "table_stages", "DEFAULT_EPS"]
 
 #: shadow-map epsilon in light depth units (the light frame maps the scene's depth to [0, 1])
 DEFAULT_EPS = 5e-3
@@ -59,9 +59,57 @@ def _clock():
     return time.process_time()
 
 
+def table_stages(alg: int, shadows: str) -> dict[str, tuple[str, ...]]:
+    """Each table stage (labelled as :attr:`Frame.stages`) -> the trace phases it holds; the same
+    grouping as the CPU-time stages of :func:`render_frame`."""
+    if shadows == "none":
+        return {"1 set-up": ("setup",), "2 hidden-surface removal": ("init", "hsr"),
+                "3 segment build": ("segments", "split", "quantise")}
+    if shadows == "polygons" and alg == 1:
+        return {"1 set-up": ("setup", "shadow setup"), "2 hidden-surface removal + shadow": ("init", "hsr", "shadow"),
+                "3 segment build": ("segments", "split", "quantise")}
+    if shadows == "polygons":
+        return {"1 set-up": ("setup", "shadow setup"), "2 hidden-surface removal": ("init", "hsr"),
+                "3 shadow polygons": ("shadow",), "4 segment build": ("segments", "split", "quantise")}
+    return {"1 eye hidden-surface removal": ("setup", "segments", "split", "hsr"),
+            "2 light hidden-surface removal": ("light",), "3 eye->light transform": ("transform",),
+            "4 buffer init": ("init", "quantise")}
+
+
+def _trace_setup(tr, scene: Scene, sp) -> None:
+    """Set-up loops (2.2): every vertex transformed and lit, every polygon back-face tested and
+    collected; clipping (Sutherland's re-entrant clipper, polygon by polygon) stays scalar."""
+    nvert = int(np.asarray(scene.nverts).sum())
+    tr.loop("vertex transform", nvert)
+    tr.loop("vertex lighting", nvert)
+    tr.loop("back-face test", scene.n_polygons)
+    tr.loop("collect polygons", scene.n_polygons)
+    tr.scalar("clipping: 6 planes x vertices x 8", 48 * int(sp.nv.sum()))
+
+
+def _trace_segments(tr, sp, seg) -> None:
+    """Segment building (fig. 1): vertex lines per polygon scalar, edge blocks and dz/dx vector,
+    y-list linking scalar."""
+    tr.scalar("vertex lines per polygon: 10 per vertex", 10 * int(sp.nv.sum()))
+    tr.loop("edge block", 2 * seg.n)
+    tr.loop("segment dzdx", seg.n)
+    tr.scalar("link into the y-list: 6 per segment", 6 * seg.n)
+
+
+def _trace_split(tr, before: int, after: int) -> None:
+    tr.loop("segment lengths", before)
+    tr.loop("select long segments", before)
+    tr.loop("split piece", after)
+    tr.scalar("re-link the pieces: 6 per piece", 6 * after)
+
+
 def render_frame(scene: Scene, width: int = 512, height: int = 512, *, alg: int = 2,
-                 shadows: str = "none", eps: float = DEFAULT_EPS, background=(0.0, 0.0, 0.0)) -> Frame:
-    """Render ``scene`` with algorithm ``alg`` (1 or 2) and ``shadows`` none|polygons|map."""
+                 shadows: str = "none", eps: float = DEFAULT_EPS, background=(0.0, 0.0, 0.0),
+                 trace=None) -> Frame:
+    """Render ``scene`` with algorithm ``alg`` (1 or 2) and ``shadows`` none|polygons|map.
+
+    ``trace`` (a :class:`~.trace.Trace`) records the paper's loops phase by phase; recording
+    reads counts only and changes no output."""
     if alg not in (1, 2):
         raise RasterhwError(f"vzbuf: algorithm must be 1 or 2, not {alg!r}")
     if shadows not in ("none", "polygons", "map"):
@@ -83,9 +131,14 @@ def render_frame(scene: Scene, width: int = 512, height: int = 512, *, alg: int 
     seg = build_segments(sp, H)
     stats["segments"] = seg.n
     split = None
+    if trace is not None:
+        _trace_setup(trace.at("setup"), scene, sp)
+        _trace_segments(trace.at("segments"), sp, seg)
     if alg == 2:
         seg, split = split_segments(seg, W)
         stats["split"] = split
+        if trace is not None:
+            _trace_split(trace.at("split"), split["segments_before"], split["segments_after"])
     sseg = None
     if sh is not None:
         parts, signs = [], []
@@ -97,28 +150,56 @@ def render_frame(scene: Scene, width: int = 512, height: int = 512, *, alg: int 
         sseg = concat_segments(parts)
         sign = np.concatenate(signs) if signs else np.zeros(0, np.int64)
         stats["shadow_segments"] = sseg.n
+        if trace is not None:
+            trace.at("shadow setup")
+            trace.loop("silhouette test", sh["edges"])
+            trace.loop("shadow quad", sh["initial"])
+            trace.loop("vertex transform", 4 * sh["initial"])
+            trace.loop("back-face test", sh["initial"])
+            trace.loop("collect polygons", sh["initial"])
+            for name in ("front", "back"):
+                if sh[name] is not None:
+                    trace.scalar("clipping: 6 planes x vertices x 8", 48 * int(sh[name].nv.sum()))
+            trace.at("segments")
+            for name, s_ in zip([n for n in ("front", "back") if sh[n] is not None and sh[n].nv.size], parts,
+                                strict=True):
+                _trace_segments(trace, sh[name], s_)
         if alg == 2 and sseg.n:
             sseg, ssplit = split_segments(sseg, W)
             stats["shadow_split"] = ssplit
             sign = sign[ssplit["source"]]
+            if trace is not None:
+                _trace_split(trace.at("split"), ssplit["segments_before"], ssplit["segments_after"])
     t2 = _clock()
     buf = new_buffers(W, H)
     t_init = _clock() - t2
+    if trace is not None:
+        # the image memory always; a full-frame Z-buffer (algorithm 2, ray casting); the shadow
+        # count buffer (shadow polygons); the light-space shadow buffer (ray casting)
+        n_buf = 1 + (alg == 2 or shadows == "map") + (shadows == "polygons") + (shadows == "map")
+        trace.at("init").loop("clear", W * H, times=n_buf)
     c_real, c_sh = Counters(), Counters()
     t3 = _clock()
+    if trace is not None:
+        trace.at("hsr")
     if shadows == "map":
-        (algorithm1 if alg == 1 else algorithm2)(seg, W, H, buf, counters=c_real,
+        (algorithm1 if alg == 1 else algorithm2)(seg, W, H, buf, counters=c_real, trace=trace,
                                                   **({"full_frame": True} if alg == 1 else {}))
     elif alg == 1:
-        algorithm1(seg, W, H, buf, counters=c_real)
+        algorithm1(seg, W, H, buf, counters=c_real, trace=trace)
     else:
-        algorithm2(seg, W, H, buf, counters=c_real)
+        algorithm2(seg, W, H, buf, counters=c_real, trace=trace)
     t4 = _clock()
     visible = buf["qid"] >= 0
     shadowed = np.zeros((H, W), bool)
     t5 = t4
     if sseg is not None and sseg.n:
-        (algorithm1 if alg == 1 else algorithm2)(sseg, W, H, buf, mode="shadow", sign=sign, counters=c_sh)
+        if trace is not None:
+            trace.at("shadow")
+        (algorithm1 if alg == 1 else algorithm2)(sseg, W, H, buf, mode="shadow", sign=sign, counters=c_sh,
+                                                  trace=trace)
+        if trace is not None:
+            trace.loop("shadow darken", W * H)
         shadowed = visible & (buf["count"] > 0)
         buf["inten"][shadowed] = ia
         t5 = _clock()
@@ -128,14 +209,26 @@ def render_frame(scene: Scene, width: int = 512, height: int = 512, *, alg: int 
         ls = light_space(scene, W, H)
         lsp = light_polygons(scene, W, H, ls)
         lseg = build_segments(lsp, H)
+        if trace is not None:
+            trace.at("light")
+            nl = int(lsp.nv.size)
+            trace.loop("vertex transform", int(np.asarray(scene.nverts).sum()))
+            trace.loop("back-face test", scene.n_polygons)
+            trace.loop("collect polygons", scene.n_polygons)
+            trace.scalar("clipping: 6 planes x vertices x 8", 48 * int(lsp.nv.sum()) if nl else 0)
+            _trace_segments(trace, lsp, lseg)
         if alg == 2:
-            lseg, _ = split_segments(lseg, W)
+            lseg, lsplit = split_segments(lseg, W)
+            if trace is not None:
+                _trace_split(trace, lsplit["segments_before"], lsplit["segments_after"])
         lbuf = new_buffers(W, H)
         b = _clock()
         c_l = Counters()
-        (algorithm1 if alg == 1 else algorithm2)(lseg, W, H, lbuf, mode="depth", counters=c_l,
+        (algorithm1 if alg == 1 else algorithm2)(lseg, W, H, lbuf, mode="depth", counters=c_l, trace=trace,
                                                   **({"full_frame": True} if alg == 1 else {}))
         c = _clock()
+        if trace is not None:
+            trace.at("transform").loop("to light space", W * H)
         shadowed = shadow_map_test(scene, W, H, buf["depth"], visible, lbuf["depth"], ls, eps)
         buf["inten"][shadowed] = ia
         d = _clock()
@@ -145,6 +238,8 @@ def render_frame(scene: Scene, width: int = 512, height: int = 512, *, alg: int 
     poly = np.where(visible, sp.poly[np.maximum(buf["qid"], 0)], -1)
     face = blocks.polygon.colour[np.maximum(poly, 0)]
     bg = np.asarray(background, float)
+    # (no trace here: the paper writes each pixel's RGBI word in the Z test, "画像記憶に色情報を
+    # 書き込む"; our float intensity buffer and this final packing pass are NumPy bookkeeping)
     rgb3, i7, rgb8 = quantise_rgbi(face, buf["inten"])
     rgb8[~visible] = np.clip(np.floor(bg * 255 + 0.5), 0, 255).astype(np.uint8)
     t7 = _clock()

@@ -24,6 +24,6 @@ MACHINE = Machine(
     ),
     report="rasterhw.sim.vzbuf.report:rows",
     bench="rasterhw.sim.vzbuf.bench:bench",
-    status="golden model (NumPy as the vector unit): algorithms 1 and 2, Gouraud, shadow polygons, "
-           "shadow map; tables 1-7 side by side",
+    status="golden model: algorithms 1 and 2, Gouraud, shadow polygons, shadow map (NumPy), with the "
+           "vector-operation trace priced on the scalar unit, VP100 and VP200; tables 1-7 side by side",
 )

@@ -1,0 +1,159 @@
+"""The vector-operation trace and the FACOM timing model (golden_model/vzbuf/trace.py, facom.py)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from rasterhw.golden_model.scenes import build_scene
+from rasterhw.golden_model.vzbuf.facom import PARAMS, SCALAR_COST, price
+from rasterhw.golden_model.vzbuf.render import render_frame, table_stages
+from rasterhw.golden_model.vzbuf.trace import BODIES, Trace
+from rasterhw.sim.vzbuf.paper import TABLES
+from rasterhw.sim.vzbuf.report import _getter_paper, conclusions
+
+W = H = 512
+
+
+@pytest.mark.parametrize("alg,shadows", [(1, "none"), (2, "none"), (1, "polygons"), (2, "map")])
+def test_recording_changes_no_image(alg, shadows):
+    sc = build_scene("c50")
+    a = render_frame(sc, W, H, alg=alg, shadows=shadows)
+    tr = Trace()
+    b = render_frame(sc, W, H, alg=alg, shadows=shadows, trace=tr)
+    for k in ("rgb8", "depth", "qid", "inten", "shadowed"):
+        assert np.array_equal(getattr(a, k), getattr(b, k)), k
+    # and it recorded the loops of every table stage
+    phases = set(tr.phases())
+    for stage, ph in table_stages(alg, shadows).items():
+        assert phases & set(ph), stage
+    assert tr.elements("compare", "hsr") > 0 and sum(tr.scalars.values()) > 0
+
+
+def test_trace_follows_the_paper_loops():
+    sc = build_scene("c50")
+    tr1, tr2 = Trace(), Trace()
+    f1 = render_frame(sc, W, H, alg=1, trace=tr1)
+    f2 = render_frame(sc, W, H, alg=2, trace=tr2)
+    # algorithm 1: one Z-test loop per span, its length the span: the counters agree
+    c = f1.stats["counters"]
+    assert tr1.mean_length("a1 z-test real") == pytest.approx(c["mean_vector_length"])
+    assert sum(t for (_p, b, _n), t in tr1.loops.items() if b == "a1 z-test real") == c["ztests"]
+    # algorithm 2: every pass's Z-test runs over all occupied slots (masked), so its loops are at
+    # least as long as the live prefix the NumPy code slices; one s-list shift per pass
+    c2 = f2.stats["counters"]
+    assert tr2.mean_length("a2 z-test real") >= c2["mean_vector_length"]
+    assert sum(t for (_p, b, _n), t in tr2.loops.items() if b == "a2 shift s-list") == c2["passes"]
+    assert max(n for (_p, b, n) in tr2.loops if b == "a2 z-test real") <= H
+
+
+def _one(body, n):
+    t = Trace()
+    t.at("hsr").loop(body, n)
+    return t
+
+
+def test_price_of_one_loop_by_hand():
+    P = {k: p.value for k, p in PARAMS.items()}
+    vl = int(P["vr_bytes"] // (8 * P["vregs"]))
+    n = vl + 1                                # two strips
+    tr = _one("a1 z-test real", n)
+    ts = P["scalar_ns"] * 1e-9
+    body = BODIES["a1 z-test real"]
+    per_iter = P["loop_overhead"] + sum(c * SCALAR_COST[k] for k, _w, c in body)
+    assert price(tr, "scalar")["phases"]["hsr"] == pytest.approx(n * per_iter * ts)
+    t_unit = P["fp_pipes"] / (P["peak_vp100"] * 1e6)
+    want = 2 * P["strip_scalar"] * ts
+    for _k, _w, c in body:
+        want += c * (2 * P["startup_ns"] * 1e-9 + n * t_unit)
+    assert price(tr, "vp100")["phases"]["hsr"] == pytest.approx(want)
+
+
+def test_vp200_doubles_pipes_but_not_the_mask_pipe_and_l10_collects_on_the_scalar_unit():
+    n = 400
+    arith = _one("clear", n)                            # one contiguous store
+    t100, t200 = (price(arith, m)["phases"]["hsr"] for m in ("vp100", "vp200"))
+    assert t200 < t100
+    mask = Trace()
+    mask.at("hsr").loop("a2 collect slots", n)          # load, compare, compress
+    v100, v200 = (price(mask, m) for m in ("vp100", "vp200"))
+    # V10L10: the compress runs scalar (not in the vector time); V10L20 vectorises it
+    assert v100["phases"]["hsr"] > v200["phases"]["hsr"]
+    assert v100["vectorised_scalar"]["hsr"] < v200["vectorised_scalar"]["hsr"]
+    # the one mask pipeline: a loop of compares only is no faster on the VP200
+    only = {"a": (("compare", 8, 1),)}
+    BODIES.update(only)
+    try:
+        cmp_ = _one("a", n)
+        assert price(cmp_, "vp100")["phases"]["hsr"] == pytest.approx(price(cmp_, "vp200")["phases"]["hsr"])
+    finally:
+        del BODIES["a"]
+
+
+def test_sensitivity_override_moves_the_price():
+    tr = _one("a1 z-test real", 12)
+    base = price(tr, "vp200")["phases"]["hsr"]
+    slow = price(tr, "vp200", params={"vp200_startup_factor": 2.0})["phases"]["hsr"]
+    assert slow > base
+    assert price(tr, "vp100", params={"vp200_startup_factor": 2.0})["phases"] == price(tr, "vp100")["phases"]
+
+
+def test_bad_input_is_refused():
+    tr = _one("clear", 3)
+    with pytest.raises(KeyError, match="machine"):
+        price(tr, "vp400")
+    with pytest.raises(KeyError, match="parameter"):
+        price(tr, "vp100", params={"clock_ns": 7.5})
+    with pytest.raises(ValueError, match="by"):
+        price(tr, "vp100", by="stage")
+    with pytest.raises(KeyError, match="loop body"):
+        tr.loop("no such loop", 3)
+
+
+def test_every_chosen_parameter_is_labelled_and_every_parameter_has_a_source():
+    chosen = [k for k, p in PARAMS.items() if p.chosen]
+    assert chosen and all("chosen" in PARAMS[k].source for k in chosen)
+    assert all(len(p.source) > 20 for p in PARAMS.values())
+
+
+def test_model_imports_without_the_paper_tables():
+    """The model and the trace must not read the paper's tables: import them with the paper
+    module blocked (and check that the block works)."""
+    code = (
+        "import sys, importlib.abc\n"
+        "class B(importlib.abc.MetaPathFinder):\n"
+        "    def find_spec(self, name, path, target=None):\n"
+        "        if name == 'rasterhw.sim.vzbuf.paper': raise ImportError('blocked: ' + name)\n"
+        "sys.meta_path.insert(0, B())\n"
+        "import rasterhw.golden_model.vzbuf.facom, rasterhw.golden_model.vzbuf.trace\n"
+        "import rasterhw.golden_model.vzbuf.render, rasterhw.golden_model.vzbuf.hsr\n"
+        "assert 'rasterhw.sim.vzbuf.paper' not in sys.modules\n"
+        "try:\n"
+        "    import rasterhw.sim.vzbuf.paper\n"
+        "except ImportError:\n"
+        "    print('blocked')\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "blocked"
+
+
+def test_conclusions_check_holds_on_the_paper_and_fails_when_a_claim_is_broken():
+    scenes = tuple(TABLES["table 2"]["scalar"]["total"])
+    paper = conclusions(_getter_paper(), scenes)
+    assert {k: v[0] for k, v in paper.items()} == {k: 1.0 for k in "abcde"}
+    get = _getter_paper()
+
+    def broken(table, n, m, stage="total"):      # algorithm 2 ten times slower on the VP200
+        v = get(table, n, m, stage)
+        return 10 * v if v and table == "table 3" and m == "vp200" else v
+
+    r = conclusions(broken, scenes)
+    assert r["a"][0] < 1.0 and r["d"][0] < 1.0
+
+
+def test_damaged_table2_cell_is_the_column_sum():
+    T = TABLES["table 2"]["scalar"]
+    assert T["1"]["c250"] == T["total"]["c250"] - T["2"]["c250"] - T["3"]["c250"] == 169
