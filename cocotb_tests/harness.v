@@ -147,3 +147,110 @@ module rasterhw_stream_check #(
     end
   end
 endmodule
+
+// ---------------------------------------------------------------------------------------------
+// The generic bench (sim/engines/verilator.py): one stream source per input port of a block and
+// one stream sink per output port, in a bench top generated from Amaranth around the block.
+
+// Plays +NAME_n= words {gap[GW-1:0], payload[PW-1:0]} from the $readmemh file +NAME=: each word is
+// offered `gap` clocks after the clock of the previous transfer (the first `gap` clocks after
+// start) and held until accepted (the stream rules). `done` once every word was taken.
+module rasterhw_stream_source #(
+  parameter PW = 8,
+  parameter GW = 8,
+  parameter DEPTH = 16,              // > words played
+  parameter FILE_ARG = "i=%s",
+  parameter COUNT_ARG = "i_n=%d"
+) (
+  input wire clk,
+  output wire valid,
+  input wire ready,
+  output wire [PW-1:0] payload,
+  output wire done
+);
+  reg [GW+PW-1:0] mem [0:DEPTH-1];
+  reg [8*512-1:0] fname;
+  reg [31:0] n, ptr;
+  reg [GW-1:0] wt;
+  initial begin
+    if (!$value$plusargs(COUNT_ARG, n)) n = 0;
+    if (n != 0) begin
+      if (!$value$plusargs(FILE_ARG, fname)) $fatal(1, "rasterhw_stream_source: +%s missing", FILE_ARG);
+      $readmemh(fname, mem);
+    end
+    ptr = 0;
+    wt = (n != 0) ? mem[0][GW+PW-1:PW] : {GW{1'b0}};
+  end
+  wire [GW+PW-1:0] cur = mem[ptr];
+  wire [GW+PW-1:0] nxt = mem[ptr + 32'd1];
+  assign done = (ptr >= n);
+  assign valid = !done && (wt == {GW{1'b0}});
+  assign payload = cur[PW-1:0];
+  always @(posedge clk) begin
+    if (valid && ready) begin
+      ptr <= ptr + 32'd1;
+      wt <= (ptr + 32'd1 < n) ? nxt[GW+PW-1:PW] : {GW{1'b0}};
+    end else if (wt != {GW{1'b0}}) begin
+      wt <= wt - 1'b1;
+    end
+  end
+endmodule
+
+// Takes words from a stream: `ready` is low on a clock when the low byte of a seeded xorshift
+// (+NAME_seed=, advanced every clock) is below +NAME_stall= (0 = always ready). Every transfer's
+// payload and the `cycle` it happened in are stored and dumped at the end ($writememh to +NAME=
+// and +NAME_cyc=); `done` once +NAME_n= words were taken.
+module rasterhw_stream_sink #(
+  parameter PW = 8,
+  parameter DEPTH = 16,
+  parameter FILE_ARG = "o=%s",
+  parameter CYC_ARG = "o_cyc=%s",
+  parameter COUNT_ARG = "o_n=%d",
+  parameter STALL_ARG = "o_stall=%d",
+  parameter SEED_ARG = "o_seed=%d"
+) (
+  input wire clk,
+  input wire [31:0] cycle,
+  input wire valid,
+  output wire ready,
+  input wire [PW-1:0] payload,
+  output wire done
+);
+  reg [PW-1:0] words [0:DEPTH-1];
+  reg [31:0] stamps [0:DEPTH-1];
+  reg [8*512-1:0] fwords, fcyc;
+  reg [31:0] n, q, stall, seed, lf;
+  initial begin
+    if (!$value$plusargs(COUNT_ARG, n)) n = 0;
+    if (!$value$plusargs(STALL_ARG, stall)) stall = 0;
+    if (!$value$plusargs(SEED_ARG, seed)) seed = 1;
+    if (!$value$plusargs(FILE_ARG, fwords)) fwords = 0;
+    if (!$value$plusargs(CYC_ARG, fcyc)) fcyc = 0;
+    q = 0;
+    lf = seed;
+  end
+  final begin
+    if (fwords != 0) $writememh(fwords, words, 0, (q == 0) ? 0 : q - 1);
+    if (fcyc != 0) $writememh(fcyc, stamps, 0, (q == 0) ? 0 : q - 1);
+  end
+  // the 32-bit xorshift (x ^= x << 13; x ^= x >> 17; x ^= x << 5); sim/engines/pattern.py draws
+  // the same sequence for the pysim engine
+  function [31:0] xorshift32(input [31:0] x);
+    reg [31:0] t;
+    begin
+      t = x ^ (x << 13);
+      t = t ^ (t >> 17);
+      xorshift32 = t ^ (t << 5);
+    end
+  endfunction
+  assign ready = ({24'd0, lf[7:0]} >= stall);
+  assign done = (q >= n);
+  always @(posedge clk) begin
+    lf <= xorshift32(lf);
+    if (valid && ready && q < DEPTH) begin
+      words[q] <= payload;
+      stamps[q] <= cycle;
+      q <= q + 32'd1;
+    end
+  end
+endmodule

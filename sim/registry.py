@@ -133,6 +133,7 @@ class Machine:
     soak: dict[str, str] = field(default_factory=dict)     # soak block -> "module:round" (sim/soak.py)
     proofs: dict[str, str] = field(default_factory=dict)   # verilog block -> "module:PROOF" (sim/prove.py)
     flows: dict[str, Flow] = field(default_factory=dict)   # verilog block -> its hardware-flow settings
+    testbenches: dict[str, str] = field(default_factory=dict)  # verilog block -> "module:Testbench" (sim/testbench.py)
     ram_modules: dict[str, str] = field(default_factory=dict)  # black-box RAM module -> "module:bits(params)"
     fpga_sweeps: tuple[FpgaSweep, ...] = ()
     fpga_note: str = ""                           # the paper's clocks in words, for the fpga report

@@ -1,0 +1,62 @@
+"""The engines that run any registered :class:`~rasterhw.sim.testbench.Testbench`: Amaranth pysim
+(``pysim.py``) and plain Verilator with the one C++ main (``verilator.py``), both with the same
+stream sources (idle gaps from the stimulus) and sinks (seeded back-pressure, ``pattern.py``), so a
+run gives the same words and the same cycle stamps on either. They know no machine.
+
+Usage::
+
+    tb = find_testbench("zbm-seggen")
+    p = tb.params(width=48, height=24)
+    stim = tb.stimulus(p, seed=3)
+    got = run(tb, p, stim, engine="verilator", stall=64, seed=5)
+    compare(tb.expect(p, stim), got)
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim.engines import pysim, verilator
+from rasterhw.sim.testbench import Run, Stimulus, Testbench
+
+__all__ = ["ENGINES", "run", "with_gaps"]
+
+ENGINES = {"pysim": pysim.run, "verilator": verilator.run}
+
+
+def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", idle: float = 0.0, stall: int = 0,
+        seed: int = 1, expect_words: dict[str, int] | None = None, max_cycles: int = 10_000_000) -> Run:
+    """Run ``stim`` through block ``tb.block`` with ``params`` on ``engine``.
+
+    ``idle`` (0 <= idle < 1): every input word without a gap of its own in ``stim`` waits a random
+    number of idle clocks (geometric: each clock idle with probability ``idle``, at most 255),
+    drawn from ``seed`` and the port, the same on every engine.
+    ``stall`` (0..255): every output's ``ready`` is low on a clock when the low byte of a seeded
+    xorshift is below it (0: always ready); ``seed`` seeds it (port k uses ``seed + k``).
+    ``expect_words``: words to collect per output port (the run ends when all have come);
+    ``max_cycles``: a watchdog.
+    """
+    if engine not in ENGINES:
+        raise RasterhwError(f"engine must be one of {', '.join(ENGINES)}, not {engine!r}")
+    if not (isinstance(stall, int) and 0 <= stall <= 255):
+        raise RasterhwError(f"stall must be an integer in 0..255, not {stall!r}")
+    if not (isinstance(idle, (int, float)) and 0 <= idle < 1):
+        raise RasterhwError(f"idle must be a probability in [0, 1), not {idle!r}")
+    if idle:
+        stim = with_gaps(stim, idle, seed, tb.inputs)
+    if expect_words is None:
+        raise RasterhwError("say how many words to collect per output port (expect_words)")
+    return ENGINES[engine](tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
+                           max_cycles=max_cycles)
+
+
+def with_gaps(stim: Stimulus, idle: float, seed: int, ports) -> Stimulus:
+    """``stim`` with random idle gaps before every word of the ``ports`` that have none."""
+    gaps = dict(stim.gaps)
+    for k, p in enumerate(ports):
+        if p not in gaps:
+            rng = np.random.default_rng([seed, k])
+            gaps[p] = np.minimum(rng.geometric(1 - idle, len(stim.words[p])) - 1, 255).tolist()
+    return replace(stim, gaps=gaps)

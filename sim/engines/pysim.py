@@ -1,0 +1,69 @@
+"""The Amaranth pysim engine: the block itself in the simulator, every clock domain clocked
+together; one source per input port (:func:`rasterhw.sim.harness.stream_put` after each word's
+gap) and one sink per output port (back-pressure from :mod:`pattern`, every transfer stamped
+with its edge)."""
+
+from __future__ import annotations
+
+import time
+
+from amaranth.sim import Simulator
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim.engines.pattern import ready_pattern
+from rasterhw.sim.harness import as_plain, stream_protocol_checker, stream_put
+from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
+
+__all__ = ["run"]
+
+
+def _source(port, words, gaps, domain):
+    async def bench(ctx):
+        for w, g in zip(words, gaps, strict=True):
+            await stream_put(ctx, port, w, gap=g, domain=domain)
+    return bench
+
+
+def _sink(port, need, words, stamps, ready, domain, max_cycles, name):
+    async def bench(ctx):
+        k = 0
+        while len(words) < need:
+            r = next(ready)
+            ctx.set(port.ready, r)
+            _, _, valid, payload = await ctx.tick(domain).sample(port.valid, port.payload)
+            if valid and r:
+                words.append(as_plain(payload))
+                stamps.append(k)
+            k += 1
+            if k > max_cycles:
+                raise RasterhwError(f"pysim: {name} gave {len(words)} of {need} words in {max_cycles} cycles")
+        ctx.set(port.ready, 0)
+    return bench
+
+
+def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, expect_words: dict[str, int],
+        max_cycles: int) -> Run:
+    t0 = time.perf_counter()
+    dut = tb.dut(params)
+    sim = Simulator(dut)
+    for d in tb.domains:
+        sim.add_clock(1e-8, domain=d)
+    dom = getattr(tb, "port_domains", {})
+    errors: list[str] = []
+    for name in tb.inputs:
+        port = port_of(dut, name)
+        sim.add_testbench(_source(port, stim.words[name], stim.gaps_of(name), dom.get(name, "sync")),
+                          background=True)
+    words: dict[str, list[int]] = {}
+    stamps: dict[str, list[int]] = {}
+    for k, name in enumerate(tb.outputs_of(params)):
+        port = port_of(dut, name)
+        words[name], stamps[name] = [], []
+        d = dom.get(name.split("[")[0], dom.get(name, "sync"))
+        sim.add_testbench(stream_protocol_checker(port, name, domain=d, errors=errors), background=True)
+        sim.add_testbench(_sink(port, expect_words[name], words[name], stamps[name],
+                                ready_pattern(seed + k, stall), d, max_cycles, name))
+    t1 = time.perf_counter()
+    sim.run()
+    if errors:
+        raise RasterhwError(f"pysim: {tb.block} broke the stream rules: {errors[0]}")
+    return Run("pysim", words, stamps, wall_s=time.perf_counter() - t0, run_s=time.perf_counter() - t1)

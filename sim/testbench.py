@@ -1,0 +1,148 @@
+# amaranth: UnusedElaboratable=no
+"""One testbench per HDL block: what makes the block different, declared once.
+
+A :class:`Testbench` (one per block, in its machine's ``sim/NAME/testbench.py``, registered in
+``Machine.testbenches``) knows how to build the block from typed parameters, which of its
+stream ports the engines drive and collect, how to turn a random seed (or a scene) into stimulus
+words through the golden model, and what the golden model expects on every output port (words
+in order, and the cycle count where the golden cycle model gives one). The engines
+(``sim/engines/``: Amaranth pysim, plain Verilator with the one C++ main) run any testbench the
+same way: they own clocks, stream sources with idle gaps, sinks with seeded back-pressure, cycle
+stamps, build caches and run folders. This module and the engines know no machine.
+
+Words are plain integers: a stream's payload as one packed word (``payload.as_value()``).
+
+Cycles: clock edges are counted from 0 at the first rising edge of the run (no reset: the
+design starts at its ``init`` values in every engine); a transfer's stamp is the index of the
+edge at which it happened, and a run's ``cycles`` is the last output stamp + 1.
+"""
+
+from __future__ import annotations
+
+import inspect
+from dataclasses import dataclass, field
+
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim import registry
+
+__all__ = ["Expected", "Run", "Stimulus", "Testbench", "compare", "find_testbench", "port_of"]
+
+
+@dataclass(frozen=True)
+class Stimulus:
+    """Words for every input port, and the idle clocks before each word (none: back to back)."""
+
+    words: dict[str, list[int]]
+    gaps: dict[str, list[int]] = field(default_factory=dict)
+    what: str = ""                               # one line for logs: scene / seed / settings
+    source: object = None                        # the golden model's input the words were made from
+
+    def gaps_of(self, port: str) -> list[int]:
+        g = self.gaps.get(port)
+        return [0] * len(self.words[port]) if g is None else list(g)
+
+
+@dataclass(frozen=True)
+class Expected:
+    """What the golden model says comes out: every word of every output port, in order, and the
+    cycle count when the golden cycle model gives it (input back to back, output always ready)."""
+
+    words: dict[str, list[int]]
+    cycles: int | None = None
+
+
+@dataclass(frozen=True)
+class Run:
+    """What an engine saw: the words and the edge of every transfer, per output port."""
+
+    engine: str
+    words: dict[str, list[int]]
+    stamps: dict[str, list[int]]
+    wall_s: float = 0.0
+    build_s: float = 0.0
+    run_s: float = 0.0
+
+    @property
+    def cycles(self) -> int:
+        return max((s[-1] + 1 for s in self.stamps.values() if s), default=0)
+
+
+class Testbench:
+    """Base of every block's testbench; a subclass sets the class attributes and the two methods.
+
+    ``block``: the registry name (``rasterhw verilog --list``); ``inputs`` / ``outputs``: stream
+    ports as attribute paths (``"i"``, ``"o_merge[3]"``; :meth:`outputs_of` may depend on the
+    parameters); ``domains``: the clock domains the block uses (every engine clocks them
+    together, one edge each per cycle).
+    """
+
+    block: str = ""
+    inputs: tuple[str, ...] = ("i",)
+    outputs: tuple[str, ...] = ("o",)
+    domains: tuple[str, ...] = ("sync",)
+
+    # ------------------------------------------------------------------ parameters and the DUT
+    def params(self, **given) -> dict:
+        """The block's parameters: its factory's defaults, overridden by ``given`` (checked by
+        the factory, which raises on a bad one)."""
+        factory = registry.load(registry.blocks()[self.block])
+        sig = inspect.signature(factory)
+        unknown = sorted(set(given) - set(sig.parameters))
+        if unknown:
+            raise RasterhwError(f"{self.block}: no parameter {', '.join(unknown)}; "
+                                f"parameters: {', '.join(sig.parameters)}")
+        out = {k: p.default for k, p in sig.parameters.items() if p.default is not inspect.Parameter.empty}
+        out.update(given)
+        return out
+
+    def dut(self, params: dict):
+        """A fresh instance of the block (engines elaborate it once per run)."""
+        return registry.load(registry.blocks()[self.block])(**params)
+
+    def outputs_of(self, params: dict) -> tuple[str, ...]:
+        return self.outputs
+
+    # ------------------------------------------------------------------ what differs per block
+    def stimulus(self, params: dict, seed: int) -> Stimulus:   # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:   # pragma: no cover - abstract
+        raise NotImplementedError
+
+
+def port_of(dut, path: str):
+    """``"o_merge[3]"`` -> ``dut.o_merge[3]``; ``"i"`` -> ``dut.i``."""
+    obj = dut
+    for part in path.replace("]", "").split("."):
+        name, *idx = part.split("[")
+        obj = getattr(obj, name)
+        for i in idx:
+            obj = obj[int(i)]
+    return obj
+
+
+def compare(exp: Expected, got: Run, *, cycle_exact: bool = True) -> dict:
+    """``{"mismatches": words that differ or are missing/extra, per port summed, "ports": {...},
+    "cycles", "cycles_golden", "cycle_mismatches"}``; a cycle mismatch is counted only where the
+    golden model gives cycles and ``cycle_exact`` (a run with idle gaps or back-pressure may take
+    longer, never fewer cycles)."""
+    ports, total = {}, 0
+    for p, want in exp.words.items():
+        have = got.words.get(p, [])
+        bad = sum(a != b for a, b in zip(want, have, strict=False)) + abs(len(want) - len(have))
+        ports[p] = {"words": len(want), "mismatches": bad}
+        total += bad
+    cyc = None
+    if exp.cycles is not None:
+        cyc = int(got.cycles != exp.cycles) if cycle_exact else int(got.cycles < exp.cycles)
+    return {"mismatches": total, "ports": ports, "cycles": got.cycles, "cycles_golden": exp.cycles,
+            "cycle_mismatches": cyc}
+
+
+def find_testbench(block: str) -> Testbench:
+    """The registered testbench of ``block`` (``Machine.testbenches``), a one-line error if none."""
+    for m in registry.machines().values():
+        if block in m.testbenches:
+            return registry.load(m.testbenches[block])()
+    known = sorted(b for m in registry.machines().values() for b in m.testbenches)
+    raise RasterhwError(f"no testbench for block {block!r}; testbenches: {', '.join(known)}")

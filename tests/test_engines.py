@@ -1,0 +1,92 @@
+"""The generic engines (sim/engines/) on registered testbenches (sim/testbench.py): Amaranth pysim
+and plain Verilator give the same words and the same cycle stamps, with idle gaps and
+back-pressure, equal to the golden model's words."""
+
+from __future__ import annotations
+
+import pytest
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim import registry
+from rasterhw.sim.engines import run
+from rasterhw.sim.engines.pattern import ready_pattern, xorshift32
+from rasterhw.sim.testbench import Expected, compare, find_testbench
+
+#: every block with a testbench, at a small size
+SMALL = {
+    "zbm-seggen": {"width": 48, "height": 24, "capacity": 64},
+}
+
+
+def _need(exp: Expected) -> dict[str, int]:
+    return {k: len(v) for k, v in exp.words.items()}
+
+
+def test_every_testbench_names_a_registered_block():
+    blocks = registry.blocks()
+    for m in registry.machines().values():
+        for block, ref in m.testbenches.items():
+            assert block in blocks and block in m.blocks, (m.name, block)
+            assert registry.load(ref)().block == block
+
+
+@pytest.mark.parametrize("block", sorted(SMALL))
+def test_pysim_matches_golden_with_idle_and_back_pressure(block):
+    tb = find_testbench(block)
+    p = tb.params(**SMALL[block])
+    stim = tb.stimulus(p, seed=11)
+    exp = tb.expect(p, stim)
+    assert sum(_need(exp).values()) > 50
+    plain = run(tb, p, stim, engine="pysim", expect_words=_need(exp))
+    slow = run(tb, p, stim, engine="pysim", idle=0.3, stall=90, seed=5, expect_words=_need(exp))
+    assert compare(exp, plain)["mismatches"] == 0 and compare(exp, slow)["mismatches"] == 0
+    assert slow.cycles > plain.cycles          # the gaps and the stalls cost clocks
+
+
+@pytest.mark.heavy
+@pytest.mark.cocotb
+@pytest.mark.parametrize("block", sorted(SMALL))
+def test_verilator_gives_the_pysim_words_and_cycle_stamps(block):
+    tb = find_testbench(block)
+    p = tb.params(**SMALL[block])
+    stim = tb.stimulus(p, seed=12)
+    exp = tb.expect(p, stim)
+    for kw in ({}, {"idle": 0.25, "stall": 120, "seed": 9}):
+        a = run(tb, p, stim, engine="pysim", expect_words=_need(exp), **kw)
+        b = run(tb, p, stim, engine="verilator", expect_words=_need(exp), **kw)
+        assert compare(exp, b)["mismatches"] == 0, kw
+        assert (a.words, a.stamps) == (b.words, b.stamps), kw
+
+
+def test_compare_counts_wrong_missing_and_extra_words_and_cycles():
+    from rasterhw.sim.testbench import Run
+
+    exp = Expected({"o": [1, 2, 3]}, cycles=10)
+    assert compare(exp, Run("x", {"o": [1, 2, 3]}, {"o": [3, 5, 9]}))["mismatches"] == 0
+    r = compare(exp, Run("x", {"o": [1, 7]}, {"o": [3, 9]}))
+    assert r["mismatches"] == 2 and r["cycle_mismatches"] == 0
+    assert compare(exp, Run("x", {"o": [1, 2, 3, 4]}, {"o": [1, 2, 3, 11]}))["cycle_mismatches"] == 1
+    # with gaps or stalls a run may be slower than the model, never faster
+    assert compare(exp, Run("x", {"o": [1, 2, 3]}, {"o": [1, 2, 20]}), cycle_exact=False)["cycle_mismatches"] == 0
+    assert compare(exp, Run("x", {"o": [1, 2, 3]}, {"o": [1, 2, 5]}), cycle_exact=False)["cycle_mismatches"] == 1
+
+
+def test_bad_runs_are_refused_in_one_line():
+    tb = find_testbench("zbm-seggen")
+    p = tb.params(**SMALL["zbm-seggen"])
+    stim = tb.stimulus(p, seed=1)
+    for kw, msg in (({"engine": "modelsim"}, "engine must be"), ({"stall": 256}, "stall must be"),
+                    ({"idle": 1.0}, "idle must be"), ({}, "how many words")):
+        with pytest.raises(RasterhwError, match=msg):
+            run(tb, p, stim, **({"expect_words": {"o": 1}} if kw else {}) | kw)
+    with pytest.raises(RasterhwError, match="no parameter"):
+        tb.params(interleave=2)
+    with pytest.raises(RasterhwError, match="no testbench for block 'nope'"):
+        find_testbench("nope")
+
+
+def test_back_pressure_pattern_is_the_benches_xorshift():
+    assert xorshift32(1) == 270369 and xorshift32(270369) == 67634689   # x ^= x<<13; x ^= x>>17; x ^= x<<5
+    pat = ready_pattern(7, 128)
+    got = [next(pat) for _ in range(1000)]
+    assert 350 < sum(got) < 650                  # about half the clocks ready at stall 128
+    assert all(next(ready_pattern(s, 0)) for s in range(5))   # stall 0: always ready
