@@ -199,8 +199,21 @@ def _warn_if_empty(tris, pixels_written: int) -> None:
 
 
 @cli.command()
-def machines() -> None:
+@click.option("--json", "as_json", is_flag=True, help="Print the machines as JSON: archs, blocks (each with its "
+              "testbench and the engines that run it), sim blocks, report, soak rounds, proofs.")
+def machines(as_json: bool) -> None:
     """List the machines with their archs, HDL blocks and sim blocks."""
+    if as_json:
+        from rasterhw.sim.engines import ENGINES
+
+        emit_json([{"name": m.name, "title": m.title, "seed": m.seed, "status": m.status,
+                    "archs": [a.name for a in m.archs],
+                    "blocks": {b: {"factory": ref, "testbench": m.testbenches.get(b),
+                                   "engines": list(ENGINES) if b in m.testbenches else []}
+                               for b, ref in m.blocks.items()},
+                    "sims": [s.name for s in m.sims], "report": m.report, "soak": m.soak, "proofs": m.proofs}
+                   for m in registry.machines().values()])
+        return
     for m in registry.machines().values():
         click.echo(f"{m.name:<9}{m.title}  (seed {m.seed})")
         if m.status:
