@@ -14,6 +14,7 @@ from rasterhw.sim.testbench import Expected, compare, find_testbench
 #: every block with a testbench, at a small size
 SMALL = {
     "zbm-seggen": {"width": 48, "height": 24, "capacity": 64},
+    "zbm-unit": {"interleave": 2, "width": 32, "height": 16, "capacity": 16},
 }
 
 

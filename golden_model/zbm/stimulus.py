@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.screen import ScreenTriangles
 from rasterhw.golden_model.zbm import formats as F
 
-__all__ = ["multi_line_segments", "random_doublez", "random_segments", "random_triangles"]
+__all__ = ["first_triangles", "multi_line_segments", "random_doublez", "random_segments", "random_triangles"]
 
 
 def random_segments(rng: np.random.Generator, n: int, width: int, mode: int = F.MODE_COLOUR,
@@ -65,3 +67,11 @@ def random_triangles(rng: np.random.Generator, n: int, width: int, height: int, 
                            zq=np.round(z * ((1 << 24) - 1)).astype(np.int64),
                            colour=rng.uniform(0, 1, (n, 3, 3)), poly_id=np.arange(n),
                            uv=rng.uniform(0, 1, (n, 3, 2)))
+
+
+def first_triangles(tris: ScreenTriangles, k: int) -> ScreenTriangles:
+    """The first ``k`` triangles of ``tris`` (submission order kept)."""
+    cut = {f: getattr(tris, f)[:k] for f in ("xy", "z", "zq", "colour", "poly_id")}
+    if tris.uv is not None:
+        cut["uv"] = tris.uv[:k]
+    return replace(tris, **cut)

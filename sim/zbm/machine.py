@@ -52,7 +52,8 @@ MACHINE = Machine(
                            "processors are the same at every interleave."),),
     fpga_note=("ZB/M segment clock 25 MHz (\"ZB/M の入力クロックは 25MHz\", sec. 6.1 cond. 3); the merge clock is "
                "independent (\"マージャはそれとは独立のマージクロックで動作\") and its frequency is not given."),
-    testbenches={"zbm-seggen": "rasterhw.sim.zbm.testbench:SeggenBench"},
+    testbenches={"zbm-seggen": "rasterhw.sim.zbm.testbench:SeggenBench",
+                 "zbm-unit": "rasterhw.sim.zbm.testbench:UnitBench"},
     status="segment generator, ZB/M chip (8 pixel processors on a segment loop, double Z, merger on its own "
            "clock), unit, chained units (HDL, bit- and cycle-exact)",
 )

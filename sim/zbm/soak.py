@@ -9,14 +9,12 @@ plain-Verilator bench; both double-Z samples of every pixel are compared.
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
-from rasterhw.golden_model.zbm.stimulus import random_triangles
+from rasterhw.golden_model.zbm.stimulus import first_triangles, random_triangles
 from rasterhw.golden_model.zbm.words import doublez_words
 from rasterhw.sim.zbm import driver as Z
 from rasterhw.sim.zbm.fast import run_unit_fast
@@ -31,14 +29,6 @@ ZBM_SDEPTH = 16384
 #: every this many rounds (from round 0) runs two clocks at a random ratio under cocotb; the
 #: others run equal clocks on plain Verilator (several times faster per round)
 ZBM_RATIO_EVERY = 4
-
-
-def _first_triangles(tris, k: int):
-    """The first ``k`` triangles of ``tris`` (submission order kept)."""
-    cut = {f: getattr(tris, f)[:k] for f in ("xy", "z", "zq", "colour", "poly_id")}
-    if tris.uv is not None:
-        cut["uv"] = tris.uv[:k]
-    return replace(tris, **cut)
 
 
 def zbm_round(rng: np.random.Generator, k: int) -> dict:
@@ -58,7 +48,7 @@ def zbm_round(rng: np.random.Generator, k: int) -> dict:
     if len(eps) > ZBM_MAX_EDGE_PAIRS:  # keep the first triangles: one bench build for every round
         keep = max(1, len(tris.xy) * ZBM_MAX_EDGE_PAIRS // len(eps) - 1)
         while len(eps) > ZBM_MAX_EDGE_PAIRS:
-            tris = _first_triangles(tris, keep)
+            tris = first_triangles(tris, keep)
             eps = G.edge_pairs(tris)
             keep = max(1, keep * 9 // 10)
         what += f" (first {len(tris.xy)} triangles)"

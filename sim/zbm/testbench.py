@@ -5,11 +5,16 @@ from __future__ import annotations
 
 import numpy as np
 from rasterhw.golden_model import zbm as G
-from rasterhw.golden_model.zbm.stimulus import random_triangles
-from rasterhw.golden_model.zbm.words import edge_pair_words, segment_words
+from rasterhw.golden_model.zbm.stimulus import first_triangles, random_triangles
+from rasterhw.golden_model.zbm.words import (
+    doublez_words,
+    edge_pair_words,
+    merge_words,
+    segment_words,
+)
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 
-__all__ = ["SeggenBench"]
+__all__ = ["SeggenBench", "UnitBench"]
 
 
 class SeggenBench(Testbench):
@@ -32,3 +37,33 @@ class SeggenBench(Testbench):
         h = params["height"]
         segs = G.segment_generator(stim.source, h, width=params["width"], capacity=params["capacity"])
         return Expected({"o": [wd for y in range(h) for wd in segment_words(segs, y)]})
+
+
+class UnitBench(Testbench):
+    """``zbm-unit`` (the head unit of a chain): edge-pair words in (``i``), every chip's merge-bus
+    words out (``o_merge[c]``, chip ``c`` owning columns ``c, c + I, ...``, line by line), the
+    double-Z samples of ``golden_model/zbm/render.py: render_zbm``. The merge clock runs with the
+    segment clock (the two-clock ratios stay with the cocotb bench). A random frame: 2..40 random
+    screen triangles (seeded), the first ones that fit the active-edge-pair memory."""
+
+    block = "zbm-unit"
+    domains = ("sync", "merge")
+    port_domains = {"o_merge": "merge"}
+
+    def outputs_of(self, params: dict) -> tuple[str, ...]:
+        return tuple(f"o_merge[{c}]" for c in range(params["interleave"]))
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        rng = np.random.default_rng(seed)
+        w, h = params["width"], params["height"]
+        n = int(rng.integers(2, 41))
+        tris = random_triangles(rng, n, w, h, size=float(rng.uniform(3, max(4, min(w, h) / 2))))
+        while len(tris.xy) > 1 and G.max_active_edge_pairs(G.edge_pairs(tris))[0] > params["capacity"]:
+            tris = first_triangles(tris, len(tris.xy) - 1)
+        return Stimulus({"i": edge_pair_words(G.edge_pairs(tris))}, what=f"{len(tris.xy)} random triangles, "
+                        f"seed {seed}", source=tris)
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        i = params["interleave"]
+        g0, g1 = doublez_words(G.render_zbm(stim.source, interleave=i).pixels)
+        return Expected({f"o_merge[{c}]": merge_words(g0[:, c::i], g1[:, c::i]) for c in range(i)})
