@@ -36,6 +36,9 @@ MACHINE = Machine(
            "experts-pxp": Flow(small={"width": 64}, clocks=(_NO_CLOCK,)),
            "experts-pxp-unit": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,))},
     fpga_note="EXPERTS names no clock (docs/experts.md: times in operation times).",
+    testbenches={"experts-pxp": "rasterhw.sim.experts.testbench:PxpBench",
+                 "experts-pxp-unit": "rasterhw.sim.experts.testbench:PxpUnitBench",
+                 "experts-dmm": "rasterhw.sim.experts.testbench:DmmBench"},
     status="scan-line golden model split as SLP/PXP (float and 16-bit), Sn x Pn parallel model with "
            "load balancing at both levels, fig. 4.1 cost model (golden); PXP datapath (HDL, bit- and cycle-exact)",
 )

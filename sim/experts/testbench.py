@@ -1,0 +1,131 @@
+# amaranth: UnusedElaboratable=no
+"""Testbenches of the EXPERTS blocks (``sim/testbench.py``): the PXP, the DMM/P and the two
+together, fed with the golden SLP's segment words of a random frame."""
+
+from __future__ import annotations
+
+import numpy as np
+from amaranth import Module, Signal
+from amaranth.lib import stream, wiring
+from amaranth.lib.wiring import In, Out
+from rasterhw.golden_model.experts.model import render_frame
+from rasterhw.golden_model.pipeline import run_geometry
+from rasterhw.golden_model.scenes import build_scene
+from rasterhw.sim import registry
+from rasterhw.sim.experts.pxp_sim import SEG_BITS, job_list
+from rasterhw.sim.testbench import Expected, Stimulus, Testbench
+
+__all__ = ["DmmBench", "PxpBench", "PxpUnitBench", "RangeFromTokens"]
+
+_RANGE_BITS = 21          # next_hi[10:0], next_lo[9:0] above the segment payload (the jobs' words)
+
+
+class RangeFromTokens(wiring.Component):
+    """Bench adapter: a PXP (or DMM/P + PXP) whose line range ``lo``/``hi`` rides on the stimulus.
+
+    ``i`` carries ``{next_hi[10:0], next_lo[9:0], segment}``; the segment goes to the block, and when
+    a ``last`` token is taken the range of the next line is put on ``lo``/``hi`` (which the block
+    samples when that line starts). The first line's range is ``[0, width)``. No register on the
+    stream: the block sees every word in the cycle the bench offers it."""
+
+    def __init__(self, block, width: int):
+        self.block, self._width = block, width
+        super().__init__({"i": In(stream.Signature(SEG_BITS + _RANGE_BITS)), "o": Out(stream.Signature(16))})
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.block = b = self.block
+        lo, hi = Signal(10, init=0), Signal(11, init=self._width)
+        seg = self.i.payload[:SEG_BITS]
+        m.d.comb += [b.i.valid.eq(self.i.valid), b.i.payload.eq(seg), self.i.ready.eq(b.i.ready),
+                     b.lo.eq(lo), b.hi.eq(hi)]
+        with m.If(self.i.valid & self.i.ready & seg[0]):
+            m.d.sync += [lo.eq(self.i.payload[SEG_BITS:SEG_BITS + 10]), hi.eq(self.i.payload[SEG_BITS + 10:])]
+        wiring.connect(m, b.o, wiring.flipped(self.o))
+        return m
+
+
+def _frame(params: dict, seed: int):
+    """A random EXPERTS frame at the block's width (square), bit-accurate model, A.J. as built."""
+    rng = np.random.default_rng(seed)
+    w = params["width"]
+    name = str(rng.choice(["experts-1000", "experts-tilt-1000", "c100"]))
+    sc = build_scene(name, seed=int(rng.integers(0, 1 << 30)))
+    return rng, name, render_frame(run_geometry(sc, w, w, z_bits=16), model="bit", aj=params.get("aj", "none"))
+
+
+def _lines(rng, width: int, n: int, *, whole: bool = False) -> list[tuple[int, int, int]]:
+    """``n`` random PXP lines ``(y, lo, hi)``, the first one (``whole``: every one) the whole line."""
+    out = [(int(rng.integers(0, width)), 0, width)]
+    for _ in range(n - 1):
+        if whole:
+            out.append((int(rng.integers(0, width)), 0, width))
+            continue
+        lo = int(rng.integers(0, width))
+        out.append((int(rng.integers(0, width)), lo, int(rng.integers(lo + 1, width + 1))))
+    return out
+
+
+class PxpBench(Testbench):
+    """``experts-pxp``: one line's segments and ``last`` token at a time in (``i``, the range of
+    the next line on the token), the line's pixel words out (``o``), as the golden PXP gives them;
+    cycles from the golden cycle model (``golden_model/experts/pxp_cycles.py: schedule``)."""
+
+    block = "experts-pxp"
+    whole_lines = False     # every line the whole width (the range never changes)
+
+    def dut(self, params: dict):
+        return RangeFromTokens(registry.load(registry.blocks()[self.block])(**params), params["width"])
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        rng, name, fr = _frame(params, seed)
+        jb = job_list(fr, _lines(rng, params["width"], int(rng.integers(2, 9)), whole=self.whole_lines))
+        return Stimulus({"i": jb["words"]}, what=f"{name} at {params['width']}, {jb['lines']} lines, seed {seed}",
+                        source=jb)
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        jb = stim.source
+        # the model's cycle 0 is line 0's first clear cycle, one edge after the run's first (which
+        # takes the first word), and the last pixel leaves on the edge after its drain cycle: the
+        # run's edges up to the last pixel are last_pixel + 2 (as tests/experts/test_experts_pxp_pysim.py)
+        return Expected({"o": jb["pixels"].tolist()}, cycles=int(jb["last_pixel"]) + 2)
+
+
+class PxpUnitBench(PxpBench):
+    """``experts-pxp-unit`` (DMM/P + PXP): the PXP's stimulus and pixels, every line the whole
+    width (the range inputs reach the PXP directly while the DMM/P holds lines back, so a range
+    riding on the tokens would arrive early); the DMM/P in front of the PXP delays every line, so
+    the golden PXP cycle model does not apply (no cycle check)."""
+
+    block = "experts-pxp-unit"
+    whole_lines = True
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        return Expected({"o": stim.source["pixels"].tolist()})
+
+
+class DmmBench(Testbench):
+    """``experts-dmm``: lines of segment words, each ended by its ``last`` token, in (``i``) and
+    the same words out (``o``), a line at a time (the DMM/P changes nothing, it only buffers).
+    A line with more segments than a bank holds keeps its first ``depth - 1``."""
+
+    block = "experts-dmm"
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        rng, name, fr = _frame({"width": 64}, seed)
+        jb = job_list(fr, _lines(rng, 64, int(rng.integers(2, 9))))
+        mask, words = (1 << SEG_BITS) - 1, []
+        for segs in jb["segments"]:
+            line = [w & mask for w in jb["words"][len(words):len(words) + len(segs) + 1]]
+            words += line
+        out, line = [], []
+        for w in words:
+            if w & 1:   # the last token ends a line
+                out += line[:params["depth"] - 1] + [w]
+                line = []
+            else:
+                line.append(w)
+        return Stimulus({"i": out}, what=f"{name} segments, {jb['lines']} lines, seed {seed}")
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        return Expected({"o": list(stim.words["i"])})
