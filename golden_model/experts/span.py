@@ -110,7 +110,7 @@ def _stays_nearest(bit: bool, zs_l, zb_l, zs_r, zb_r, s_lower):
 
 def _bounds2d(bounds, W: int, H: int) -> np.ndarray:
     b = np.asarray([0, W] if bounds is None else bounds, dtype=np.int64)
-    if b.ndim not in (1, 2) or b.shape[-1] < 2:
+    if b.ndim not in (1, 2) or b.shape[-1] < 2 or (b.ndim == 2 and b.shape[0] != H):
         raise RasterhwError("experts: range bounds must be (P + 1,) or (H, P + 1) pixel boundaries")
     b = np.broadcast_to(b, (H, b.shape[-1]))
     if np.any(b[:, 0] != 0) or np.any(b[:, -1] != W) or np.any(np.diff(b, axis=1) < 0):
@@ -141,7 +141,9 @@ def span_pxp(st: Setup, rec: Records, W: int, H: int, bounds=None) -> SpanResult
     lo, hi = B[prow, j], B[prow, j + 1]
     a = np.maximum(rec.c0[pr], lo)
     b = np.minimum(rec.c1[pr], hi - 1)
-    pu = prow * P + j                                        # piece -> unit (line, range)
+    nonempty = a <= b                                        # an empty range between: no piece
+    pr, a, b = pr[nonempty], a[nonempty], b[nonempty]
+    pu = (prow * P + j)[nonempty]                            # piece -> unit (line, range)
     # span cull: cuts at every unit's ends and every piece's ends
     ulo, uhi = B[:, :-1].ravel(), B[:, 1:].ravel()
     uid = np.arange(U)
