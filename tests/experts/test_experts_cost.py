@@ -116,3 +116,19 @@ def test_aj_routine_counts_by_path_and_computes_the_image_alpha():
         assert len(set(ops.tolist())) == paths
         from rasterhw.golden_model.experts.alpha import ALPHA
         assert np.allclose(a, ALPHA[m](x - (np.clip(np.floor(x), 10, 11) + 0.5), s), atol=1e-12)
+
+
+@pytest.mark.parametrize("model", ["float", "bit"])
+@pytest.mark.parametrize("m", ["a", "b", "c"])
+def test_counted_aj_routine_computes_the_image_alpha(model, m):
+    """The counted routine is the work behind the image: its alpha (and in the bit model with (c),
+    the machine's, its blend) is the one anti_jagging puts in the frame."""
+    from rasterhw.golden_model.experts import pxp
+    f = render_frame(run_geometry(build_scene("experts-solids"), 512, 512, z_bits=16), model=model)
+    fields = pxp.pixel_fields(f.setup, f.records, f.win, pxp.smooth_shading(f.setup, f.records, f.win, 512))
+    _, info = pxp.anti_jagging(f.setup, f.records, f.win, fields, 512, 512, m)
+    assert info["pixels"] > 1000 and info["ops"].size == info["pixels"]
+    if model == "bit" and m == "c":
+        assert np.array_equal(info["alpha"], info["alpha_counted"])
+    else:
+        assert np.abs(info["alpha"] - info["alpha_counted"]).max() <= (1e-12 if model == "float" else 1)
