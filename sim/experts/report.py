@@ -132,6 +132,10 @@ def _tables(out: list, sections: list, out_dir: Path, progress: bool) -> None:
         out.append(make_row(SYS, "table 2.1 (ours)", f"A.J. (c) extra operations per A.J. pixel, experts-solid-{k}",
                             paper=None, formula=None, measured=round((c - a) / max(fc.aj_pixels, 1), 2), unit="ops",
                             source="golden"))
+        out.append(make_row(SYS, "table 2.1 (ours)", f"A.J. (c) routine operations per blended pixel as executed "
+                            f"(aj_ops.aj_pixel_ops: alpha + eq. (5) blend), experts-solid-{k}", paper=None, formula=None,
+                            measured=round(fc.stats["aj_routine_ops"] / max(fc.aj_pixels, 1), 2), unit="ops",
+                            source="golden"))
     # ours: a family in which only the number of edges varies (n-gonal pyramids from above, one size)
     from rasterhw.golden_model.experts.scenes import PYRAMID_FAMILY, build_pyramid
     fam = []
@@ -151,7 +155,12 @@ def _tables(out: list, sections: list, out_dir: Path, progress: bool) -> None:
     base = cost.total_ops(render_frame(ls))
     rat = {}
     for m in ("b", "c"):
-        rat[m] = cost.total_ops(render_frame(ls, aj=m)) / base
+        fm = render_frame(ls, aj=m)
+        rat[m] = cost.total_ops(fm) / base
+        out.append(make_row(SYS, "table 2.2 (ours)", f"A.J. ({m}) routine operations per blended pixel as executed "
+                            "(aj_ops.aj_pixel_ops), 8 line segments", paper=None, formula=None,
+                            measured=round(fm.stats["aj_routine_ops"] / max(fm.aj_pixels, 1), 2), unit="ops",
+                            source="golden"))
         out.append(make_row(SYS, "table 2.2", f"work with A.J. ({m}), 8 line segments (no A.J. = 1)",
                             paper=PAPER_T22[m], formula=None, measured=round(rat[m], 4), unit="x", source="golden"))
     out.append(make_row(SYS, "table 2.2", "(b) / (c) work ratio, 8 line segments", paper=round(1.15 / 3.35, 4),
@@ -181,8 +190,10 @@ def _tables(out: list, sections: list, out_dir: Path, progress: bool) -> None:
                     "exact for vertical edges and worst at the 45-degree switch.\n")
     sections.append("## Table 2.1: what the A.J. overhead depends on\n\nThe paper's increase rises with the number of "
                     "line segments (4.4 % at 5 to 12.4 % at 20); ours on the four solids does not. The rows above say "
-                    "why: every A.J. pixel costs the same extra operations (the `extra operations per A.J. pixel` rows "
-                    "agree within a few per cent on all four solids), so the increase is that constant times the A.J. "
+                    "why: every A.J. pixel costs about the same extra operations (the `extra operations per A.J. pixel` rows "
+                    "agree within a few per cent on all four solids; the per-pixel part is what the A.J. routine "
+                    "executed for that pixel, counted by `golden_model/experts/aj_ops.py` `aj_pixel_ops`: 23 operations "
+                    "on a steep edge, 25 on a shallow one in the float model), so the increase is that constant times the A.J. "
                     "pixels over the frame's base work, and A.J. pixels count scan-line crossings of edges (one per "
                     "edge per line), not edges. Our dodecahedron's 20 edges are short, so it has fewer crossings than "
                     "the octagonal pyramid's 15. In a family where only the edge count varies (ours: n-gonal pyramids "
