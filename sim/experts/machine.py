@@ -29,6 +29,8 @@ MACHINE = Machine(
                                    "previous line's finish-time counters", "static", ("static", "i", "ii")))),),
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",
-    status="scan-line golden model split as SLP/PXP (float and 16-bit), Sn x Pn parallel model with "
-           "load balancing at both levels, fig. 4.1 cost model (golden); PXP datapath (HDL, bit- and cycle-exact)",
+    status="scan-line golden model split as SLP/PXP (float and 16-bit): the paper's span PXP (span cull, "
+           "depth search per span) and the SLP's sorts run and counted, Sn x Pn parallel model with "
+           "load balancing at both levels, fig. 4.1 cost model (golden); line-Z-buffer PXP datapath "
+           "(HDL, bit- and cycle-exact)",
 )

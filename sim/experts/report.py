@@ -65,6 +65,14 @@ def _fig41(out: list, sections: list, out_dir: Path, progress: bool) -> None:
         ax.set_xlabel("Pn (PXPs per SLP)")
         ax.set_title(f"Fr = {fr} ({name})")
         ax.grid(True, which="both", alpha=0.3)
+        for sn, pn in ((1, 1), (8, 8)):
+            q = cost.measured_q_run(f, sn, pn, cache)
+            out.append(make_row(SYS, "fig. 4.1", f"Q_s, Fr={fr}, Sn={sn} (busiest SLP: Y-sort, X-merge, L-sort as run)",
+                                paper=None, formula=round(cost.q_s(fr, sn)), measured=int(q["q_s"]), unit="ops",
+                                source="golden"))
+            out.append(make_row(SYS, "fig. 4.1", f"Q_p, Fr={fr}, Sn={sn}, Pn={pn} (busiest PXP: span cull + depth "
+                                "search as run)", paper=None, formula=round(cost.q_p(fr, sn, pn)),
+                                measured=int(q["q_p"]), unit="ops", source="golden"))
         # balance Pn: formula closed form; measured where the counted Q_s and Q_p meet
         out.append(make_row(SYS, "fig. 4.1 / text", f"balance Pn (Q_s = Q_p), Fr={fr}", paper="4-8",
                             formula=round(cost.balance_pn(fr), 3), measured=round(q1["q_p"] / q1["q_s"], 3),
