@@ -132,3 +132,36 @@ def test_counted_aj_routine_computes_the_image_alpha(model, m):
         assert np.array_equal(info["alpha"], info["alpha_counted"])
     else:
         assert np.abs(info["alpha"] - info["alpha_counted"]).max() <= (1e-12 if model == "float" else 1)
+
+
+def test_measured_q_run_comes_from_the_sorts_run_and_the_span_pxp():
+    from rasterhw.golden_model.experts import slp_run, span
+    from rasterhw.golden_model.experts.model import equal_bounds
+    f = render_frame(run_geometry(build_scene("experts-tilt-1000"), 512, 512))
+    cache: dict = {}
+    one = cost.measured_q_run(f, 1, 1, cache)
+    (run,) = slp_run.run_bands(f, equal_bounds(512, 1))
+    sp = span.span_pxp(f.setup, f.records, 512, 512)
+    assert one["q_s"] == run.ops["y_sort"] + run.ops["x_merge"] + run.ops["l_sort"]
+    assert one["q_p"] == sp.total(("span_cull", "depth_search"))
+    q = [cost.measured_q_run(f, sn, pn, cache) for sn, pn in ((2, 4), (8, 8), (8, 16))]
+    assert all(d["q_seq"] == one["q_seq"] and d["q_par"] == max(d["q_s"], d["q_p"]) for d in q)
+    assert one["q_p"] / 32 < q[1]["q_p"] < one["q_p"] / 8      # 64 PXPs: not a perfect split, not none
+
+
+def test_realtime_clocks_from_golden_counts():
+    """The busiest SLP's operations and the busiest span PXP's cycles, times 30 frames/s; the span
+    PXP needs more on the tilted scene than on the flat one with the same screen triangles."""
+    from rasterhw.golden_model.experts import span
+    from rasterhw.golden_model.experts.model import equal_bounds, slp_band_ops
+    tilt = render_frame(run_geometry(build_scene("experts-tilt-1000"), 512, 512, z_bits=16), model="bit", aj="c")
+    r = cost.realtime(tilt, 8, 8)
+    bands = equal_bounds(512, 8)
+    runs, counted = r["slp_detail"], slp_band_ops(tilt, bands, 8)
+    per_band = [sum(x.ops.values()) + sum(v for k, v in c.items() if k not in x.ops) for x, c in zip(runs, counted, strict=True)]
+    assert r["slp_ops"] == max(per_band) and r["slp_clock_for_30fps_hz"] == 30 * max(per_band)
+    cyc = span.span_cycles(tilt, r["span"])
+    assert r["pxp_cycles"] == max(int(cyc[bands[s]:bands[s + 1]].sum(axis=0).max()) for s in range(8))
+    assert r["pxp_clock_for_30fps_hz"] == 30 * r["pxp_cycles"]
+    flat = render_frame(run_geometry(build_scene("experts-1000"), 512, 512, z_bits=16), model="bit", aj="c")
+    assert cost.realtime(flat, 8, 8)["pxp_cycles"] < r["pxp_cycles"]
