@@ -110,7 +110,7 @@ def realtime(f: ExpertsFrame, sn: int, pn: int, fps: float = 30.0) -> dict:
     from rasterhw.golden_model.experts import slp_run, span
     bands = equal_bounds(f.height, sn)
     ranges = equal_bounds(f.width, pn)
-    runs = slp_run.run_bands(f, bands, ranges)
+    runs = slp_run.run_bands(f, bands, ranges, guard=1 if f.aj == "c" else 0)   # A.J. (c): guard pixels
     counted = slp_band_ops(f, bands, pn)
     slp_ops = [sum(r.ops.values()) + sum(v for k, v in c.items() if k not in r.ops) for r, c in zip(runs, counted, strict=True)]
     sp = span.span_pxp(f.setup, f.records, f.width, f.height, ranges)

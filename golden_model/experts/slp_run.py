@@ -21,10 +21,10 @@ move and exchange it executes (seed 000, section 4):
 * **Block lists** (fig. 3.2, our reading in docs/experts.md): walking the finished ASL once,
   the **block leading segment pointer** of each PXP range is the first segment (in ASL order)
   whose first pixel lies in the range, and the **block boundary bucket list** of a range holds
-  the segments that start left of it and reach into it. Per segment: 1 compare for an empty
-  segment (no pixel), the range walk (1 compare per range boundary passed, 1 move per pointer
-  set), and per range it reaches beyond its first: 1 compare and 1 move (link into that
-  range's bucket); 1 compare to stop.
+  the segments that start left of it and reach into it (with A.J. for the range widened by the
+  guard pixel each side). Per segment: 1 compare (has it a pixel?), 2 compares per range start it
+  passes (and 1 move when it becomes that range's leading segment), 1 to stop; per later range it
+  reaches: 1 compare and 1 move (link into that range's bucket); 1 compare to stop.
 
 The sorted lists are the ASL of :func:`slp.l_sort_x_merge` (tested), and the executed counts
 sit beside its priced ones in the report (comparison only; the report's SLP rows are these).
@@ -112,34 +112,45 @@ def bucket_sort(first: np.ndarray, last: np.ndarray, band: tuple[int, int]) -> t
     return buckets, ops
 
 
-def block_lists(asl: list[int], c0: np.ndarray, c1: np.ndarray, bounds: np.ndarray) -> tuple[list[int], list[list[int]], dict]:
+def block_lists(asl: list[int], c0: np.ndarray, c1: np.ndarray, bounds: np.ndarray, *, guard: int = 0,
+                width: int | None = None) -> tuple[list[int], list[list[int]], dict]:
     """Leading pointer (ASL position or -1) and bucket list (ASL positions) of every range.
 
-    ``asl``: record ids in ASL order (their first pixels ``c0`` rise); ``bounds``: (P + 1,)."""
-    P = len(bounds) - 1
+    ``asl``: record ids in ASL order (their first pixels ``c0`` rise); ``bounds``: (P + 1,).
+    ``guard``: the lists are for ``[max(lo - guard, 0), min(hi + guard, width))`` -- with A.J. the
+    PXP resolves one guard pixel each side, so neighbouring lists overlap. One walk of the ASL: a
+    segment is the leading one of every range whose start it is the first to reach (if it starts
+    before that range's end), and goes into the bucket of every later range that starts after it
+    and no later than its last pixel."""
+    b = np.asarray(bounds, dtype=np.int64)
+    P = len(b) - 1
+    W = int(b[-1]) if width is None else width
+    glo = np.maximum(b[:-1] - guard, 0).tolist()
+    ghi = np.minimum(b[1:] + guard, W).tolist()
+    live = [ghi[p] > glo[p] and b[p + 1] > b[p] for p in range(P)]
     lead = [-1] * P
     buckets: list[list[int]] = [[] for _ in range(P)]
     c = m = 0
-    p = 0
+    q = 0
     for pos, r in enumerate(asl):
-        a, b = int(c0[r]), int(c1[r])
+        a, e = int(c0[r]), int(c1[r])
         c += 1
-        if b < a:
+        if e < a:
             continue
-        while p < P - 1 and a >= bounds[p + 1]:
-            c += 1
-            p += 1
-        c += 1
-        if lead[p] < 0:
-            lead[p] = pos
-            m += 1
-        q = p + 1
-        while q < P and b >= bounds[q]:
-            c += 1
-            if bounds[q + 1] > bounds[q]:
-                buckets[q].append(pos)
+        while q < P and a >= glo[q]:
+            c += 2
+            if live[q] and a < ghi[q]:
+                lead[q] = pos
                 m += 1
             q += 1
+        c += 1
+        k = q
+        while k < P and glo[k] <= e:
+            c += 1
+            if live[k]:
+                buckets[k].append(pos)
+                m += 1
+            k += 1
         c += 1
     return lead, buckets, {"compares": c, "moves": m}
 
@@ -157,8 +168,9 @@ class SlpBand:
     per_line: dict = field(default_factory=dict)
 
 
-def run_band(st: Setup, rec: Records, band: tuple[int, int], bounds=None, *, W: int = 512) -> SlpBand:
-    """Run the SLP's sorts over one band; ``bounds`` (P + 1,) PXP ranges for the block lists."""
+def run_band(st: Setup, rec: Records, band: tuple[int, int], bounds=None, *, W: int = 512, guard: int = 0) -> SlpBand:
+    """Run the SLP's sorts over one band; ``bounds`` (P + 1,) PXP ranges for the block lists
+    (``guard``: pixels each side the PXPs resolve beyond their ranges, 1 with A.J. (c))."""
     y0, y1 = band
     if not 0 <= y0 < y1:
         raise RasterhwError(f"experts: band must be 0 <= start < end, not {band!r}")
@@ -204,7 +216,7 @@ def run_band(st: Setup, rec: Records, band: tuple[int, int], bounds=None, *, W: 
         pl["x_merge"][y - y0] = c1_ + c2 + m1 + m2
         recs = [rid(t, y) for t in cur]
         out.asl.append(recs)
-        lead, bk, bo = block_lists(recs, rec.c0, rec.c1, b)
+        lead, bk, bo = block_lists(recs, rec.c0, rec.c1, b, guard=guard, width=W)
         out.lead.append(lead)
         out.buckets.append(bk)
         d["block_compares"] += bo["compares"]
@@ -220,7 +232,7 @@ def run_band(st: Setup, rec: Records, band: tuple[int, int], bounds=None, *, W: 
     return out
 
 
-def run_bands(fr, bands: np.ndarray, bounds=None) -> list[SlpBand]:
+def run_bands(fr, bands: np.ndarray, bounds=None, *, guard: int = 0) -> list[SlpBand]:
     """:func:`run_band` for every band ``[bands[s], bands[s+1])`` of an :class:`model.ExpertsFrame`."""
-    return [run_band(fr.setup, fr.records, (int(bands[s]), int(bands[s + 1])), bounds, W=fr.width)
+    return [run_band(fr.setup, fr.records, (int(bands[s]), int(bands[s + 1])), bounds, W=fr.width, guard=guard)
             for s in range(len(bands) - 1)]

@@ -74,21 +74,30 @@ def test_run_slp_builds_the_asl_and_its_counts_meet_the_priced_ones(name):
         int(((f.setup.r1 >= a) & (f.setup.r0 < b)).sum()) for a, b in zip(equal_bounds(512, 4), equal_bounds(512, 4)[1:], strict=False))
 
 
-def test_block_lists_hand_each_pxp_exactly_its_segments():
+@pytest.mark.parametrize("guard", [0, 1])
+def test_block_lists_hand_each_pxp_exactly_its_segments(guard):
     """Bucket list + the segments from the leading pointer on (while they start in the range)
-    are the segments that reach the range -- what the PXP's range clip needs, nothing more."""
+    are the segments that reach the range -- what the PXP's range clip needs, nothing more; with
+    the A.J. guard pixel, exactly the segments the PXP HDL's bench hands it today."""
+    from rasterhw.golden_model.experts.pxp_cycles import line_segments
     f = _frame("experts-tilt-1000")
     rec = f.records
     rng = np.random.default_rng(3)
     cuts = np.sort(rng.integers(0, 513, 6))
     bounds = np.concatenate([[0], cuts, [512]])
-    (r,) = slp_run.run_bands(f, np.array([100, 164]), bounds)
+    (r,) = slp_run.run_bands(f, np.array([100, 164]), bounds, guard=guard)
     seen = 0
     for y in range(100, 164):
         asl = r.asl[y - 100]
         for p in range(len(bounds) - 1):
-            lo, hi = bounds[p], bounds[p + 1]
+            if bounds[p + 1] == bounds[p]:
+                assert r.lead[y - 100][p] == -1 and not r.buckets[y - 100][p]
+                continue
+            lo, hi = max(bounds[p] - guard, 0), min(bounds[p + 1] + guard, 512)
             want = {q for q in asl if rec.c1[q] >= rec.c0[q] and rec.c1[q] >= lo and rec.c0[q] <= hi - 1}
+            if guard and y % 8 == 0:
+                hdl = {s["addr"] for s in line_segments(f, y, int(bounds[p]), int(bounds[p + 1]), aj="c")}
+                assert hdl == {int(rec.tri[q]) for q in want}
             got = {asl[i] for i in r.buckets[y - 100][p]}
             assert all(rec.c0[q] < lo for q in got)
             pos = r.lead[y - 100][p]
