@@ -347,6 +347,9 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
         return
     if block not in block_names():
         what = f"unknown block {block!r}" if block else "name a block"
+        near = [b for b in block_names() if block and b.endswith(f"-{block}")]
+        if near:  # e.g. `rasterhw verilog pxp`: the sim block's name, not the Verilog block's
+            what += f" (did you mean {' or '.join(near)}?)"
         raise RasterhwError(f"{what}; blocks: {', '.join(block_names())}")
     if output is None:
         raise RasterhwError("say where to write the Verilog: -o FILE")

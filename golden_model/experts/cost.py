@@ -29,7 +29,8 @@ from rasterhw.golden_model.experts.model import (
 )
 from rasterhw.golden_model.screen import ScreenTriangles
 
-__all__ = ["q_seq", "q_s", "q_p", "q_par", "balance_pn", "measured_q", "alpha_error", "line_segments",
+__all__ = ["q_seq", "q_s", "q_p", "q_par", "balance_pn", "measured_q", "measured_q_run", "realtime", "alpha_error",
+           "line_segments",
            "total_ops"]
 
 
@@ -68,6 +69,56 @@ def measured_q(f: ExpertsFrame, sn: int, pn: int) -> dict:
     one = slp_band_ops(f, equal_bounds(f.height, 1), 1)[0]
     seq = sum(one.get(s, 0) for s in PAPER_SLP) + float(pxp_range_ops(f, equal_bounds(f.width, 1), PAPER_PXP).sum())
     return {"q_seq": seq, "q_s": float(qs), "q_p": qp, "q_par": max(float(qs), qp)}
+
+
+def measured_q_run(f: ExpertsFrame, sn: int, pn: int, cache: dict | None = None) -> dict:
+    """Q_seq, Q_s, Q_p, Q_par as :func:`measured_q`, from the machine as the paper built it:
+    Q_s from the SLP's sorts as they run (:mod:`slp_run`: Y-sort, X-merge, L-sort, executed
+    compares, moves and exchanges), Q_p from the span PXP (:mod:`span`: span cull + depth search
+    as executed). ``cache`` (a dict) keeps the runs of one frame between calls."""
+    from rasterhw.golden_model.experts import slp_run, span
+    cache = {} if cache is None else cache
+
+    def slp_ops(n):
+        if ("slp", n) not in cache:
+            cache[("slp", n)] = [sum(r.ops[s] for s in PAPER_SLP)
+                                 for r in slp_run.run_bands(f, equal_bounds(f.height, n))]
+        return cache[("slp", n)]
+
+    def pxp_ops(n):
+        if ("pxp", n) not in cache:
+            sp = span.span_pxp(f.setup, f.records, f.width, f.height, equal_bounds(f.width, n))
+            cache[("pxp", n)] = sum(sp.ops[s] for s in PAPER_PXP)
+        return cache[("pxp", n)]
+
+    bands = equal_bounds(f.height, sn)
+    qs = float(max(slp_ops(sn)))
+    pt = pxp_ops(pn)
+    qp = max(float(pt[bands[s]:bands[s + 1]].sum(axis=0).max()) for s in range(sn))
+    seq = float(sum(slp_ops(1)) + pxp_ops(1).sum())
+    return {"q_seq": seq, "q_s": qs, "q_p": qp, "q_par": max(qs, qp)}
+
+
+def realtime(f: ExpertsFrame, sn: int, pn: int, fps: float = 30.0) -> dict:
+    """The clock each of SLP and PXP needs for ``fps`` frames/s, equal static Sn x Pn split.
+
+    SLP: the busiest band's operations, one per cycle -- the sorts and block lists as they run
+    (:mod:`slp_run`) plus the other SLP stages as counted in :func:`slp.slp_line_ops` (PL read,
+    set-up, ASL update, DMM/P write). PXP: the busiest PXP's cycles over its band's lines by the
+    span PXP's cycle model (:func:`span.span_cycles`). The two overlap through DMM/P, so the
+    frame needs each processor at its own clock."""
+    from rasterhw.golden_model.experts import slp_run, span
+    bands = equal_bounds(f.height, sn)
+    ranges = equal_bounds(f.width, pn)
+    runs = slp_run.run_bands(f, bands, ranges, guard=1 if f.aj == "c" else 0)   # A.J. (c): guard pixels
+    counted = slp_band_ops(f, bands, pn)
+    slp_ops = [sum(r.ops.values()) + sum(v for k, v in c.items() if k not in r.ops) for r, c in zip(runs, counted, strict=True)]
+    sp = span.span_pxp(f.setup, f.records, f.width, f.height, ranges)
+    cyc = span.span_cycles(f, sp)
+    pxp = [cyc[bands[s]:bands[s + 1]].sum(axis=0) for s in range(sn)]
+    busy_s, busy_p = int(max(slp_ops)), int(max(int(p.max()) for p in pxp))
+    return {"slp_ops": busy_s, "pxp_cycles": busy_p, "slp_clock_for_30fps_hz": busy_s * fps,
+            "pxp_clock_for_30fps_hz": busy_p * fps, "slp_detail": runs, "span": sp}
 
 
 def total_ops(f: ExpertsFrame) -> int:

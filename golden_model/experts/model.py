@@ -94,6 +94,7 @@ def render_frame(tris: ScreenTriangles, *, model: str = "float", aj: str = "none
                         stats={"sat_dzdx": st.sat_dzdx, "sat_didx": st.sat_didx,
                                "triangles": int(tris.n_triangles), "kept": st.n,
                                "crossings": crossings(rec, win, W, H),
+                               "aj_routine_ops": int(info["ops"].sum()) if info else 0,
                                **({} if sh is None else {"shadowed_pixels": int(sh["shadowed"].sum()),
                                                          "shadow_segments": sh["segments"],
                                                          "shadow_triangles": sh.get("triangles", 0)})})

@@ -38,7 +38,7 @@ from rasterhw.golden_model.experts.alpha import ALPHA
 from rasterhw.golden_model.experts.formats import ALPHA_BITS, DZ_FRAC, SLOPE_FRAC, X_FRAC, Z_BITS
 from rasterhw.golden_model.experts.slp import Records, Setup
 
-__all__ = ["PXP_OPS", "AJ_OPS", "fragments", "depth_search", "smooth_shading", "anti_jagging",
+__all__ = ["PXP_OPS", "fragments", "depth_search", "smooth_shading", "anti_jagging",
            "pixel_costs"]
 
 #: PXP operations per item (16-bit operations)
@@ -51,12 +51,9 @@ PXP_OPS = {
     "dslb_per_pixel": 1,           # one write
     "aj_edge_test": 1,             # is this run boundary a polygon edge?
 }
-#: A.J. operations per blended pixel, by method (blend: 4 fields x (sub, mul, add) = 12)
-AJ_OPS = {
-    "a": 1 + 1 + 2 * 5 + 1 + 1 + 2 + 12,   # delta+0.5, s/2, two clamp-integral pieces, sub, * dy/dx, clamp
-    "b": 1 + 1 + 2 + 12,                   # delta, * 1/sqrt(1+s^2), clamp
-    "c": 1 + 1 + 2 + 12,                   # slope switch (tag), delta, clamp; +1 mul when shallow
-}
+# A.J. operations per blended pixel are not typed in: :func:`anti_jagging` runs the counted
+# routine of :func:`aj_ops.aj_pixel_ops` on every blended pixel and :func:`pixel_costs` adds
+# what each pixel executed.
 
 
 def fragments(st: Setup, rec: Records, W: int) -> dict:
@@ -198,13 +195,19 @@ def anti_jagging(st: Setup, rec: Records, win: np.ndarray, fields: np.ndarray, W
         fl, frr = fields[yy * W + xx - 1], fields[yy * W + xx]
         val = al[:, None] * fl + (1 - al[:, None]) * frr
     qp = yy * W + q
+    # the same work, counted: the routine each blended pixel executes (aj_ops)
+    from rasterhw.golden_model.experts.aj_ops import aj_pixel_ops
+    perp = None if method != "b" else 1.0 / np.sqrt(1.0 + (s / (1 << SLOPE_FRAC) if st.bit else s) ** 2)
+    al_counted, _, ops = aj_pixel_ops(method, st.bit, xe, xx, s, q_, perp, fl, frr, x_frac=X_FRAC,
+                                      slope_frac=SLOPE_FRAC, alpha_bits=ALPHA_BITS)
     # two boundaries may blend the same pixel (a one-pixel run): the later (right) one wins, as a
     # PXP that walks the line left to right would have it
     _, last = np.unique(qp[::-1], return_index=True)
     keep = qp.size - 1 - last
     out[qp[keep]] = val[keep]
     return out, {"pixels": int(qp.size), "shallow": shallow, "boundaries": int(np.count_nonzero(a != b)),
-                 "qpix": qp, "shallow_mask": (np.abs(s) > (1 << SLOPE_FRAC if st.bit else 1))}
+                 "qpix": qp, "shallow_mask": (np.abs(s) > (1 << SLOPE_FRAC if st.bit else 1)),
+                 "ops": ops, "alpha": al, "alpha_counted": al_counted, "blend": val}
 
 
 def to_rgb8(st: Setup, fields: np.ndarray, H: int, W: int) -> np.ndarray:
@@ -250,9 +253,7 @@ def pixel_costs(st: Setup, rec: Records, win: np.ndarray, k: np.ndarray, W: int,
     c["dslb"] = np.full(npix, PXP_OPS["dslb_per_pixel"], np.int64)
     if aj != "none" and aj_info is not None:
         a = np.zeros(npix, np.int64)
-        np.add.at(a, aj_info["qpix"], AJ_OPS[aj])
-        if aj == "c":
-            np.add.at(a, aj_info["qpix"][aj_info["shallow_mask"]], 1)
+        np.add.at(a, aj_info["qpix"], aj_info["ops"])        # executed per blended pixel (aj_ops)
         bnd = np.zeros((H, W), np.int64)
         bnd[:, 1:] = (w2[:, 1:] != w2[:, :-1])
         c["anti_jagging"] = a + PXP_OPS["aj_edge_test"] * bnd.ravel()

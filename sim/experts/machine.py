@@ -39,6 +39,8 @@ MACHINE = Machine(
     testbenches={"experts-pxp": "rasterhw.sim.experts.testbench:PxpBench",
                  "experts-pxp-unit": "rasterhw.sim.experts.testbench:PxpUnitBench",
                  "experts-dmm": "rasterhw.sim.experts.testbench:DmmBench"},
-    status="scan-line golden model split as SLP/PXP (float and 16-bit), Sn x Pn parallel model with "
-           "load balancing at both levels, fig. 4.1 cost model (golden); PXP datapath (HDL, bit- and cycle-exact)",
+    status="scan-line golden model split as SLP/PXP (float and 16-bit): the paper's span PXP (span cull, "
+           "depth search per span) and the SLP's sorts run and counted, Sn x Pn parallel model with "
+           "load balancing at both levels, fig. 4.1 cost model (golden); line-Z-buffer PXP datapath "
+           "(HDL, bit- and cycle-exact)",
 )

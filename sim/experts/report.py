@@ -36,8 +36,8 @@ def _plt():
 
 
 def _fig41(out: list, sections: list, out_dir: Path, progress: bool) -> None:
-    from rasterhw.golden_model.experts import cost
-    from rasterhw.golden_model.experts.model import stage_totals
+    from rasterhw.golden_model.experts import cost, slp_run, span
+    from rasterhw.golden_model.experts.model import equal_bounds, stage_totals
     plt = _plt()
     fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharey=True)
     terms = []
@@ -46,12 +46,13 @@ def _fig41(out: list, sections: list, out_dir: Path, progress: bool) -> None:
         if progress:
             print(f"experts: fig. 4.1 on {name}")
         f = _frame(name)
-        q1 = cost.measured_q(f, 1, 1)
+        cache: dict = {}
+        q1 = cost.measured_q_run(f, 1, 1, cache)
         for sn in SNS:
             form, meas = [], []
             for pn in PNS:
                 qf = cost.q_seq(fr) / cost.q_par(fr, sn, pn)
-                qm = q1["q_seq"] / cost.measured_q(f, sn, pn)["q_par"]
+                qm = q1["q_seq"] / cost.measured_q_run(f, sn, pn, cache)["q_par"]
                 form.append(qf)
                 meas.append(qm)
                 out.append(make_row(SYS, "fig. 4.1", f"Q_seq/Q_par, Fr={fr}, Sn={sn}, Pn={pn} ({name})",
@@ -64,20 +65,36 @@ def _fig41(out: list, sections: list, out_dir: Path, progress: bool) -> None:
         ax.set_xlabel("Pn (PXPs per SLP)")
         ax.set_title(f"Fr = {fr} ({name})")
         ax.grid(True, which="both", alpha=0.3)
+        for sn, pn in ((1, 1), (8, 8)):
+            q = cost.measured_q_run(f, sn, pn, cache)
+            out.append(make_row(SYS, "fig. 4.1", f"Q_s, Fr={fr}, Sn={sn} (busiest SLP: Y-sort, X-merge, L-sort as run)",
+                                paper=None, formula=round(cost.q_s(fr, sn)), measured=int(q["q_s"]), unit="ops",
+                                source="golden"))
+            out.append(make_row(SYS, "fig. 4.1", f"Q_p, Fr={fr}, Sn={sn}, Pn={pn} (busiest PXP: span cull + depth "
+                                "search as run)", paper=None, formula=round(cost.q_p(fr, sn, pn)),
+                                measured=int(q["q_p"]), unit="ops", source="golden"))
         # balance Pn: formula closed form; measured where the counted Q_s and Q_p meet
         out.append(make_row(SYS, "fig. 4.1 / text", f"balance Pn (Q_s = Q_p), Fr={fr}", paper="4-8",
                             formula=round(cost.balance_pn(fr), 3), measured=round(q1["q_p"] / q1["q_s"], 3),
                             unit="PXPs per SLP", source="model"))
         st = stage_totals(f)
+        (run,) = slp_run.run_bands(f, equal_bounds(f.height, 1))
+        sp = span.span_pxp(f.setup, f.records, f.width, f.height)
         r = math.sqrt(fr)
         m = float(f.lines["m"].mean())
         terms += [
-            make_row(SYS, "4 i)", f"Y-sort, Fr={fr}", paper=None, formula=4 * fr, measured=st["y_sort"],
+            make_row(SYS, "4 i)", f"Y-sort, Fr={fr}", paper=None, formula=4 * fr, measured=run.ops["y_sort"],
                      unit="ops", source="golden"),
             make_row(SYS, "4 ii)+iii)", f"X-merge + L-sort, Fr={fr}", paper=None,
-                     formula=round(3.46 * fr * r + 893 * r), measured=st["x_merge"] + st["l_sort"],
+                     formula=round(3.46 * fr * r + 893 * r), measured=run.ops["x_merge"] + run.ops["l_sort"],
                      unit="ops", source="golden"),
+            make_row(SYS, "4 ii)+iii) (comparison)", f"X-merge + L-sort priced from the sorts' inputs "
+                     f"(slp.l_sort_x_merge, not the sorts run), Fr={fr}", paper=None, formula=None,
+                     measured=st["x_merge"] + st["l_sort"], unit="ops", source="golden"),
             make_row(SYS, "4 iv)+v)", f"span cull + depth search, Fr={fr}", paper=None, formula=round(31607 * r),
+                     measured=sp.total(("span_cull", "depth_search")), unit="ops", source="golden"),
+            make_row(SYS, "4 iv)+v) (ours: line Z-buffer)", f"per-pixel depth search of our line Z-buffer PXP "
+                     f"(span entry/exit + 2k - 1 per pixel covered k times), Fr={fr}", paper=None, formula=None,
                      measured=st["span_cull"] + st["depth_search"], unit="ops", source="golden"),
             make_row(SYS, "4", f"segments per scan line, Fr={fr}", paper=None, formula=round(math.sqrt(3 * fr), 2),
                      measured=round(m, 2), unit="segments", source="golden"),
@@ -94,10 +111,11 @@ def _fig41(out: list, sections: list, out_dir: Path, progress: bool) -> None:
     plt.close(fig)
     out += terms
     sections.append("## Fig. 4.1\n\n![fig. 4.1](experts_fig41.png)\n\nLines: the paper's Q_seq/Q_par. Markers: "
-                    "the same ratio from the operations our golden model counted in the paper's stages "
-                    "(Y-sort, X-merge, L-sort on the SLP; span cull, depth search on the PXP), equal static "
-                    "bands and ranges, on `experts-tilt-1000/2000` (Fr, Dc = 3). The term rows above say why "
-                    "they differ (docs/experts.md, cost model).\n")
+                    "the same ratio from the operations our golden model executed in the paper's stages -- "
+                    "Y-sort, X-merge, L-sort as the SLP runs them (`slp_run`: bucket, merge and bubble sorts, "
+                    "compares, moves and exchanges counted), span cull and depth search as the span PXP runs "
+                    "them (`span`) -- equal static bands and ranges, on `experts-tilt-1000/2000` (Fr, Dc = 3). "
+                    "The term rows above say why they differ (docs/experts.md, cost model).\n")
 
 
 def _tables(out: list, sections: list, out_dir: Path, progress: bool) -> None:
@@ -122,6 +140,10 @@ def _tables(out: list, sections: list, out_dir: Path, progress: bool) -> None:
         out.append(make_row(SYS, "table 2.1 (ours)", f"A.J. (c) extra operations per A.J. pixel, experts-solid-{k}",
                             paper=None, formula=None, measured=round((c - a) / max(fc.aj_pixels, 1), 2), unit="ops",
                             source="golden"))
+        out.append(make_row(SYS, "table 2.1 (ours)", f"A.J. (c) routine operations per blended pixel as executed "
+                            f"(aj_ops.aj_pixel_ops: alpha + eq. (5) blend), experts-solid-{k}", paper=None, formula=None,
+                            measured=round(fc.stats["aj_routine_ops"] / max(fc.aj_pixels, 1), 2), unit="ops",
+                            source="golden"))
     # ours: a family in which only the number of edges varies (n-gonal pyramids from above, one size)
     from rasterhw.golden_model.experts.scenes import PYRAMID_FAMILY, build_pyramid
     fam = []
@@ -141,11 +163,16 @@ def _tables(out: list, sections: list, out_dir: Path, progress: bool) -> None:
     base = cost.total_ops(render_frame(ls))
     rat = {}
     for m in ("b", "c"):
-        rat[m] = cost.total_ops(render_frame(ls, aj=m)) / base
+        fm = render_frame(ls, aj=m)
+        rat[m] = cost.total_ops(fm) / base
+        out.append(make_row(SYS, "table 2.2 (ours)", f"A.J. ({m}) routine operations per blended pixel as executed "
+                            "(aj_ops.aj_pixel_ops), 8 line segments", paper=None, formula=None,
+                            measured=round(fm.stats["aj_routine_ops"] / max(fm.aj_pixels, 1), 2), unit="ops",
+                            source="golden"))
         out.append(make_row(SYS, "table 2.2", f"work with A.J. ({m}), 8 line segments (no A.J. = 1)",
                             paper=PAPER_T22[m], formula=None, measured=round(rat[m], 4), unit="x", source="golden"))
     out.append(make_row(SYS, "table 2.2", "(b) / (c) work ratio, 8 line segments", paper=round(1.15 / 3.35, 4),
-                        formula=None, measured=round(rat["b"] / rat["c"], 4), unit="x", source="formula"))
+                        formula=None, measured=round(rat["b"] / rat["c"], 4), unit="x", source="golden"))
     e = cost.alpha_error()
     for m in ("b", "c"):
         out.append(make_row(SYS, "fig. 2.7 (ours)", f"alpha ({m}) max |error| against the area (a), all slopes",
@@ -171,8 +198,10 @@ def _tables(out: list, sections: list, out_dir: Path, progress: bool) -> None:
                     "exact for vertical edges and worst at the 45-degree switch.\n")
     sections.append("## Table 2.1: what the A.J. overhead depends on\n\nThe paper's increase rises with the number of "
                     "line segments (4.4 % at 5 to 12.4 % at 20); ours on the four solids does not. The rows above say "
-                    "why: every A.J. pixel costs the same extra operations (the `extra operations per A.J. pixel` rows "
-                    "agree within a few per cent on all four solids), so the increase is that constant times the A.J. "
+                    "why: every A.J. pixel costs about the same extra operations (the `extra operations per A.J. pixel` rows "
+                    "agree within a few per cent on all four solids; the per-pixel part is what the A.J. routine "
+                    "executed for that pixel, counted by `golden_model/experts/aj_ops.py` `aj_pixel_ops`: 23 operations "
+                    "on a steep edge, 25 on a shallow one in the float model), so the increase is that constant times the A.J. "
                     "pixels over the frame's base work, and A.J. pixels count scan-line crossings of edges (one per "
                     "edge per line), not edges. Our dodecahedron's 20 edges are short, so it has fewer crossings than "
                     "the octagonal pyramid's 15. In a family where only the edge count varies (ours: n-gonal pyramids "
@@ -242,6 +271,77 @@ def _balance(out: list, sections: list, out_dir: Path, progress: bool) -> None:
                     "over the mean (1 = perfect), with static equal ranges and with ranges set from the previous "
                     "line's finish times by method i and method ii (the rows give the mean over the first 16 lines, "
                     "where the ranges start equal, and over the rest).\n")
+
+
+def _bit_frame(name: str, aj: str = "none"):
+    from rasterhw.golden_model.experts.model import render_frame
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    return render_frame(run_geometry(build_scene(name), 512, 512, z_bits=16), model="bit", aj=aj)
+
+
+def _span(out: list, sections: list, progress: bool) -> None:
+    """The paper's PXP (span cull + depth search per span) against our line Z-buffer PXP: how
+    each one's work grows from Fr 1000 to Fr 2000 at Dc = 3 (the paper: as sqrt(Fr))."""
+    from rasterhw.golden_model.experts import span
+    from rasterhw.golden_model.experts.model import stage_totals
+    res = {}
+    for name in ("experts-tilt-1000", "experts-tilt-2000", "experts-1000", "experts-2000"):
+        if progress:
+            print(f"experts: span PXP on {name}")
+        f = _bit_frame(name)
+        sp = span.span_pxp(f.setup, f.records, f.width, f.height)
+        if not np.array_equal(sp.win, f.win):
+            raise RuntimeError(f"span PXP and per-pixel search disagree on {name}")
+        st = stage_totals(f)
+        res[name] = {"span": sp.total(("span_cull", "depth_search")), "spans": sp.counts["spans"],
+                     "halvings": sp.counts["halvings"], "pairs": sp.counts["span_pairs"],
+                     "segments": sp.counts["segments"], "zb_cmp": f.fragments,
+                     "zb_ops": st["span_cull"] + st["depth_search"]}
+        out.append(make_row(SYS, "4 iv)+v) (span PXP)", f"span cull + depth search operations, {name} (1 SLP x 1 PXP, "
+                            f"bit model; {sp.counts['spans']} spans, {sp.counts['halvings']} halvings where faces cross)",
+                            paper=None, formula=None, measured=res[name]["span"], unit="ops", source="golden"))
+        out.append(make_row(SYS, "4 iv)+v) (span PXP)", f"pixels whose visible segment differs between the span PXP "
+                            f"and the per-pixel search, {name}", paper=None, formula=None,
+                            measured=int(np.count_nonzero(sp.win != f.win)), unit="pixels", source="golden"))
+    for a, b, what in (("experts-tilt-1000", "experts-tilt-2000", "experts-tilt-2000 / experts-tilt-1000"),
+                       ("experts-1000", "experts-2000", "flat experts-2000 / experts-1000")):
+        ra, rb = res[a], res[b]
+        out.append(make_row(SYS, "4 iv)+v)", f"span cull + depth search operations, Fr 2000 / Fr 1000 ({what}, span PXP)",
+                            paper=None, formula=round(math.sqrt(2), 4), measured=round(rb["span"] / ra["span"], 4),
+                            unit="x", source="golden"))
+        out.append(make_row(SYS, "4 iv)+v) (ours: line Z-buffer)", f"line Z-buffer compare operations, Fr 2000 / Fr 1000 "
+                            f"({what}, one compare per covered pixel per segment)", paper=None, formula=None,
+                            measured=round(rb["zb_cmp"] / ra["zb_cmp"], 4), unit="x", source="golden"))
+        keys = [("segments", "segments"), ("spans", "spans"), ("pairs", "segments in spans (sum of k)")]
+        if a.startswith("experts-tilt"):      # the flat scenes' faces never cross: no halving
+            keys.append(("halvings", "halvings"))
+        for key, label in keys:
+            out.append(make_row(SYS, "4 iv)+v) (span PXP)", f"{label}, Fr 2000 / Fr 1000 ({what})", paper=None,
+                                formula=None, measured=round(rb[key] / ra[key], 4), unit="x", source="golden"))
+    sections.append("## Span PXP: work against Fr\n\nThe paper's PXP splits each line into spans at the segments' "
+                    "ends (span cull) and finds each span's visible segment from the depths at its two end pixels, "
+                    "halving a span where the order flips (depth search; `golden_model/experts/span.py`, rule in "
+                    "docs/experts.md). Its image equals the per-pixel search's on every scene (rows above: 0 pixels). "
+                    "The `Fr 2000 / Fr 1000` rows compare its work with the paper's sqrt(2) and with our line Z-buffer "
+                    "PXP's (compares per covered pixel: fixed by Dc x 512 x 512, so near 1).\n")
+
+
+def _realtime(out: list, progress: bool) -> None:
+    """The real-time verdict from golden counts: the clock each of SLP and PXP needs for 30 frames/s."""
+    from rasterhw.golden_model.experts import cost
+    for name in ("experts-tilt-1000", "experts-1000", "experts-tilt-2000"):
+        if progress:
+            print(f"experts: real-time verdict on {name}")
+        r = cost.realtime(_bit_frame(name, "c"), 8, 8)
+        out.append(make_row(SYS, "5", f"SLP clock for 30 frames/s, {name}, 8x8, A.J. (c) (busiest SLP's operations "
+                            "per frame, sorts run, one operation per cycle)", paper=None, formula=None,
+                            measured=round(r["slp_clock_for_30fps_hz"] / 1e6, 3), unit="MHz", source="golden"))
+        out.append(make_row(SYS, "5", f"PXP clock for 30 frames/s, {name}, 8x8, A.J. (c) (busiest span PXP's cycles "
+                            "per frame, span PXP cycle model)", paper=None, formula=None,
+                            measured=round(r["pxp_clock_for_30fps_hz"] / 1e6, 3), unit="MHz", source="golden"))
+        out.append(make_row(SYS, "5", f"SLP / PXP clock needed, {name}, 8x8", paper=None, formula=None,
+                            measured=round(r["slp_ops"] / r["pxp_cycles"], 3), unit="x", source="golden"))
 
 
 def _tolerance(out: list, progress: bool) -> None:
@@ -336,6 +436,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, **know
     _fig41(out, sections, out_dir, progress)
     _tables(out, sections, out_dir, progress)
     _balance(out, sections, out_dir, progress)
+    _span(out, sections, progress)
+    _realtime(out, progress)
     _tolerance(out, progress)
     _shadows(out, progress)
     _hdl(out, engine, progress)

@@ -43,3 +43,16 @@ def test_report_rows(tmp_path):
     assert (tmp_path / "experts_fig41.png").exists() and (tmp_path / "experts_balance.png").exists()
     bal = {r["quantity"]: r["measured"] for r in rows if r["figure"] == "fig. 4.1 / text"}
     assert 4 <= bal["balance Pn (Q_s = Q_p), Fr=1000"] <= 10
+
+
+@pytest.mark.parametrize("name", ["pxp", "dmm"])
+def test_verilog_with_the_sim_block_name_names_the_verilog_block(name, tmp_path, capsys):
+    """`rasterhw verilog pxp` (the `rasterhw sim` name) fails in one line naming experts-pxp."""
+    from rasterhw.sim.cli import main
+    with pytest.raises(SystemExit) as e:
+        main(["verilog", name, "-o", str(tmp_path / "x.v")])
+    assert e.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: ") and "\n" not in err
+    assert f"did you mean experts-{name}?" in err
+    assert not (tmp_path / "x.v").exists()
