@@ -10,7 +10,8 @@ A row is a dict with the keys of :data:`ROW_KEYS`:
 ``measured``  the value our model produced when this report ran — never typed in
 ``unit``      unit of the three values
 ``source``    what produced ``measured`` in this run: ``golden`` (a golden model ran), ``model`` (a cost
-              or timing model ran, e.g. on counted operations), ``formula`` (arithmetic on other
+              or timing model ran, e.g. on counted operations; ``model:NAME`` names it, e.g.
+              ``model:i860``), ``formula`` (arithmetic on other
               values), ``hdl:pysim``, ``hdl:verilator``, ``hdl:icarus`` (the HDL was simulated),
               ``hdl:yosys`` / ``hdl:nextpnr`` (the generated Verilog was synthesised / placed)
 
@@ -59,8 +60,8 @@ def make_row(system: str, figure: str, quantity: str, *, paper, formula, measure
     ``measured=None`` needs a ``reason`` (why this run could not measure it): a row is never
     dropped for lack of a tool or of time, it is kept unmeasured.
     """
-    if source not in SOURCES:
-        raise ValueError(f"source must be one of {SOURCES}, not {source!r}")
+    if source not in SOURCES and not re.fullmatch(r"model:[a-z0-9_.-]+", str(source)):
+        raise ValueError(f"source must be one of {SOURCES} or model:NAME, not {source!r}")
     if measured is None and not reason:
         raise ValueError(f"row {quantity!r}: measured is None, so say why (reason=...)")
     row = {"system": system, "figure": figure, "quantity": quantity, "paper": paper,
