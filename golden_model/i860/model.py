@@ -421,6 +421,8 @@ def _list(ins: list, succ: list[list[int]], cpu: I860) -> dict:  # noqa: C901 - 
     spill_work = 0
     end = 0
     waiting = [i for i in range(n) if nsrc_open[i] == 0]
+    # registers a value holds: an fld.q brings up to four (kept until its last reader issues)
+    weight = [len(ins[i][5]) if ins[i][1] == "fld" else 1 for i in range(n)]
 
     def src_ok(i, unit, eA, eM, paired):
         path = []
@@ -454,7 +456,7 @@ def _list(ins: list, succ: list[list[int]], cpu: I860) -> dict:  # noqa: C901 - 
                     fp_path[u].append(i)
         # register pressure: when the file is (nearly) full, issue first what frees registers
         # (an operation that is the last reader of its sources), as a programmer would
-        busy = len(consts) + sum(1 for v in live if left[v] > 0) + sum(
+        busy = len(consts) + sum(weight[v] for v in live if left[v] > 0) + sum(
             1 for q in pipes.values() for x in q if x is not None)
         if busy >= cpu.value_registers - 1:
             def frees(i):
@@ -504,8 +506,6 @@ def _list(ins: list, succ: list[list[int]], cpu: I860) -> dict:  # noqa: C901 - 
         else:
             # a load only while its values fit the register file (values live, in flight in the
             # pipes, and the named constants): hand-written code loads no earlier than that
-            busy = len(consts) + sum(1 for v in live if left[v] > 0) + sum(
-                1 for q in pipes.values() for x in q if x is not None)
             for c in core_ready:
                 if ins[c][1] == "fld" and busy + len(ins[c][5]) > cpu.value_registers:
                     continue
@@ -581,15 +581,19 @@ def _list(ins: list, succ: list[list[int]], cpu: I860) -> dict:  # noqa: C901 - 
             core_n += 1
         elif not issued_fp and done < n:
             pass  # a stall: every ready instruction waits for a result
-        nlive = len(consts) + sum(1 for v in live if left[v] > 0)
+        nlive = len(consts) + sum(weight[v] for v in live if left[v] > 0)
         if nlive > cpu.value_registers:
             over = nlive - cpu.value_registers
             spills += over
             spill_work += 2 * over  # a store now and a load before the use, on the core
             # the spilled values leave the register file (their reload is assumed in time)
-            for v in sorted((v for v in live if left[v] > 0), key=lambda v: -min(
-                    (prio[j] for j in succ[v] if issue[j] < 0), default=0))[:over]:
+            freed = 0
+            for v in sorted((v for v in live if left[v] > 0), key=lambda v: min(
+                    (prio[j] for j in succ[v] if issue[j] < 0), default=0)):
+                if freed >= over:
+                    break
                 live.discard(v)
+                freed += weight[v]
         peak = max(peak, min(nlive, cpu.value_registers))
         live = {v for v in live if left[v] > 0}
         t += 1
