@@ -70,12 +70,12 @@ def stage_program(stage: str, *, newton_steps: int = NEWTON_STEPS) -> Program:
     Named constants (matrix entries, light terms) are strings; ``None`` is a register that
     reads as zero (f0) or a value kept in a register."""
     p = Program(newton_steps=newton_steps)
-    if stage == "vertex_transform":  # 4 rows: m0 x + m1 y + m2 z + t, summed as a tree
+    if stage == "vertex_transform":  # 4 rows: m0 x + m1 y + m2 z + t
         x = p.load(3)
         out = []
         for r in range(4):
-            a, b, c = (p.mul(x[k], f"m{r}{k}") for k in range(3))
-            out.append(p.add(p.add(a, b), p.add(c, f"t{r}")))
+            # the golden code's order (opcount.affine): ((m0 x + m1 y) + m2 z) + t
+            out.append(p.add(p.dot3(x, tuple(f"m{r}{k}" for k in range(3))), f"t{r}"))
         p.store(*out)
     elif stage == "normal_transform":
         n = p.load(3)
@@ -148,7 +148,8 @@ def stage_clocks(stage: str, cpu: I860 | None = None, *, mode: str = "assembler"
     """Clocks of one triangle (three vertices) of ``stage`` on ``cpu``, scheduled as ``mode``.
 
     ``clocks``: one triangle alone, pipes empty before and drained after; ``stream``: clocks per
-    triangle over ``stream_triangles`` triangles scheduled together (``None`` if 0);
+    triangle over ``stream_triangles`` triangles scheduled together, or ``clocks`` if running them
+    one after another is faster (``None`` if ``stream_triangles`` is 0);
     ``counted``: the paper-style operation counts per triangle; ``units``: instructions per
     unit; plus the schedule's ``pushes``, ``dual_ops``, ``spills``, ``peak_registers``,
     ``fp_instructions`` and ``core_instructions`` for the one triangle.
@@ -160,7 +161,10 @@ def stage_clocks(stage: str, cpu: I860 | None = None, *, mode: str = "assembler"
     c = counts(one)
     stream = None
     if stream_triangles:
-        stream = schedule(_triangles(stage, stream_triangles, cpu.newton_steps), cpu, mode)["clocks"] / stream_triangles
+        # the better of two legal programs: the triangles scheduled together, or one after
+        # another (the list scheduler can lose when 30 registers limit the overlap)
+        together = schedule(_triangles(stage, stream_triangles, cpu.newton_steps), cpu, mode)["clocks"]
+        stream = min(together / stream_triangles, float(r["clocks"]))
     return {"stage": stage, "mode": mode, "clocks": r["clocks"], "stream": stream, "counted": c["counted"],
             "units": c["units"], **{k: r[k] for k in ("pushes", "dual_ops", "spills", "peak_registers",
                                                        "fp_instructions", "core_instructions")}}

@@ -54,8 +54,8 @@ def stage_program(stage: str, *, mode: str = "colour", newton_steps: int = 2) ->
         x = p.load(3)
         out = []
         for r in range(4):
-            a, b, c = (p.mul(x[k], f"m{r}{k}") for k in range(3))
-            out.append(p.add(p.add(a, b), p.add(c, f"t{r}")))
+            # the golden code's order (opcount.affine): ((m0 x + m1 y) + m2 z) + t
+            out.append(p.add(p.dot3(x, tuple(f"m{r}{k}" for k in range(3))), f"t{r}"))
         p.store(*out)
     elif stage == "perspective":
         x, y, z, w = p.load(4)
