@@ -139,12 +139,24 @@ def frame_rows(frame: dict) -> list[dict]:
     for k, v in f["share_of_frame"].items():
         out.append(make_row("snu", "abstract", f"snu-100k share of the frame: {k}", paper=None, formula=None,
                             measured=100 * v, unit="%", source=_share_source(k, src)))
+    busy = f["busy_s"]
+    geo = busy["geometry (i860 model, slowest of 3 processors, busiest pipeline)"]
+    trav = busy["traversal output (108 B/triangle over a 16-bit dual-port memory)"]
+    scan = busy["scan conversion (i860 model, busiest pipeline)"]
+    out.append(make_row("snu", "abstract", "snu-100k geometry time / traversal time (i860 model, assembler schedule; "
+                        "> 1: the three geometry processors, not the traversal, bound the front end)", paper=None,
+                        formula=None, measured=geo / trav, unit="x", source="model:i860"))
+    out.append(make_row("snu", "abstract", "snu-100k slower front-end stage (geometry or traversal) / scan conversion "
+                        "time (i860 model; > 1: the front end bounds the producers)", paper=None, formula=None,
+                        measured=max(geo, trav) / scan, unit="x", source="model:i860"))
     return out
 
 
 def _share_source(name: str, src: str) -> str:
     if "golden" in name:
         return "golden"
+    if "i860 model" in name:
+        return "model:i860"
     return src if "pixel bus" in name else "model"
 
 

@@ -114,8 +114,25 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
     out += area
     sections = [f"HDL rows in this run: Table 1, paper schedule on `{hdl_engine}`, ours on `pysim`; "
                 "the other `hdl:*` rows name their own simulator.", ""]
-    sections += _plot(measured, out_dir, hdl_engine) + area_note
+    sections += _plot(measured, out_dir, hdl_engine) + area_note + _i860_note()
     return out, sections
+
+
+def _i860_note() -> list[str]:
+    """Where the table 2 rows come from, and every parameter of the i860 model with its source."""
+    from rasterhw.golden_model.i860 import PARAMETERS
+
+    md = ["", "## The i860 model (table 2, i860s per unit)", "",
+          "Rows `model:i860`: the first-level work our golden code does (transform, perspective, clipping, "
+          "edge-pair set-up: `golden_model/zbm/i860.py`) scheduled on the shared i860 model "
+          "(`golden_model/i860/`) at the paper's 33.3 MHz; C column = every stage as compiler code, assembler "
+          "column = transform and perspective as hand-scheduled code (as the paper rewrote them). Nothing is "
+          "taken from table 2; `docs/zbm.md#first-level-processors-on-the-i860-table-2` discusses every gap. "
+          "The i860s-per-unit rows divide the unit's rate (HDL cycles of this run at interleave 4, or the exact "
+          "cycle model at interleave 8, named in each label) by the model's per-processor rate.", "",
+          "| parameter | value | source |", "|---|---|---|"]
+    md += [f"| `{k}` | {v} | {src} |" for k, (v, src) in PARAMETERS.items()]
+    return md + [""]
 
 
 #: Table 2 (sec. 6.2): processors N -> (C seconds, assembler seconds, K polygons/s per processor)
