@@ -38,7 +38,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
 
         frame = frame_run(build_scene(HEADLINE), 1280, 1024, progress=progress, bus_only_bound=True)
     out = golden_rows(HEADLINE, frame=frame) + pixelbus_rows(engine=engine, progress=progress) + frame_rows(frame)
-    return out, _plot_table1(out, out_dir) + _model_section()
+    return out, _plot_table1(out, out_dir) + _model_section() + _i860_note()
 
 
 def golden_rows(scene_name: str = HEADLINE, *, frame: dict | None = None) -> list[dict]:
@@ -53,16 +53,18 @@ def golden_rows(scene_name: str = HEADLINE, *, frame: dict | None = None) -> lis
     from rasterhw.golden_model.snu.traversal import measure_traversal
 
     model = i860.table1_model()
-    out = table1_rows(recipe.ops_per_triangle(), ops_per_triangle(), model)
-    to_int = i860.stage_clocks("to_integer")["clocks"]
+    compiler = i860.table1_model(mode="compiler", stream_triangles=0)
+    out = table1_rows(recipe.ops_per_triangle(), ops_per_triangle(), model, compiler=compiler)
+    to_int = i860.stage_clocks("to_integer", stream_triangles=0)["clocks"]
     out.append(make_row("snu", "table 1", "screen_map + float -> integer (outside the paper's count): i860 clocks "
-                        "(model)", paper=PAPER_TABLE1["screen_map"]["clocks"], formula=None,
-                        measured=model["screen_map"]["clocks"] + to_int, unit="clocks", source="model"))
+                        "(model, assembler schedule)", paper=PAPER_TABLE1["screen_map"]["clocks"], formula=None,
+                        measured=model["screen_map"]["clocks"] + to_int, unit="clocks", source="model:i860"))
     for label, cpu in (("without dual-operation instructions", i860.I860(dual_operation=False)),
                        ("with one Newton step (14-bit reciprocals)", i860.I860(newton_steps=1))):
-        m = i860.table1_model(cpu)
-        out.append(make_row("snu", "table 1", f"total i860 clocks per triangle (model {label})", paper=309,
-                            formula=None, measured=m["total"]["clocks"], unit="clocks", source="model"))
+        m = i860.table1_model(cpu, stream_triangles=0)
+        out.append(make_row("snu", "table 1", f"total i860 clocks per triangle (model {label}; assembler schedule)",
+                            paper=309, formula=None, measured=m["total"]["clocks"], unit="clocks",
+                            source="model:i860"))
     sc = build_scene(scene_name)
     w, h = SCENES[scene_name].size
     tv = measure_traversal(sc)
@@ -86,7 +88,7 @@ def golden_rows(scene_name: str = HEADLINE, *, frame: dict | None = None) -> lis
     px = {k: loop["pixels"] for k in ("add_addr", "add_r", "add_g", "add_b", "add_z", "add_count", "store", "branch")}
     out.append(make_row("snu", "text 4.3", "Gouraud inner loop, i860 clocks per pixel (dual-instruction mode)",
                         paper=4, formula=None, measured=i860.inner_loop_clocks({"pixels": loop["pixels"], **px}),
-                        unit="clocks", source="model"))
+                        unit="clocks", source="model:i860"))
     return out
 
 
@@ -137,20 +139,33 @@ def frame_rows(frame: dict) -> list[dict]:
     for k, v in f["share_of_frame"].items():
         out.append(make_row("snu", "abstract", f"snu-100k share of the frame: {k}", paper=None, formula=None,
                             measured=100 * v, unit="%", source=_share_source(k, src)))
+    busy = f["busy_s"]
+    geo = busy["geometry (i860 model, slowest of 3 processors, busiest pipeline)"]
+    trav = busy["traversal output (108 B/triangle over a 16-bit dual-port memory)"]
+    scan = busy["scan conversion (i860 model, busiest pipeline)"]
+    out.append(make_row("snu", "abstract", "snu-100k geometry time / traversal time (i860 model, assembler schedule; "
+                        "> 1: the three geometry processors, not the traversal, bound the front end)", paper=None,
+                        formula=None, measured=geo / trav, unit="x", source="model:i860"))
+    out.append(make_row("snu", "abstract", "snu-100k slower front-end stage (geometry or traversal) / scan conversion "
+                        "time (i860 model; > 1: the front end bounds the producers)", paper=None, formula=None,
+                        measured=max(geo, trav) / scan, unit="x", source="model:i860"))
     return out
 
 
 def _share_source(name: str, src: str) -> str:
     if "golden" in name:
         return "golden"
+    if "i860 model" in name:
+        return "model:i860"
     return src if "pixel bus" in name else "model"
 
 
 def _model_section() -> list[str]:
     return ["## Where the numbers come from", "",
             "Operations: counted by running the paper's recipe (`golden_model/snu/recipe.py`) and our full "
-            "pipeline (`golden_model/pipeline.py`). i860 clocks: `golden_model/snu/i860.py`, a list scheduler "
-            "over each stage's instructions with the documented pipelines (no parameter taken from table 1). "
+            "pipeline (`golden_model/pipeline.py`). i860 clocks: the shared i860 model `golden_model/i860/` "
+            "scheduling the stage programs of `golden_model/snu/i860.py` two ways (compiler, assembler); no "
+            "parameter is taken from table 1. "
             "The snu-100k frame: `sim/snu/frame.py` (pixel bus in HDL on plain Verilator, producers' timing "
             "from the i860 model). See `docs/snu_geometry.md` and `docs/snu.md` for every gap.", ""]
 
@@ -161,12 +176,13 @@ def _plot_table1(rows: list[dict], out_dir: Path) -> list[str]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    clk = [r for r in rows if r["figure"] == "table 1" and r["quantity"].endswith("(i860 model, one triangle)")]
+    clk = [r for r in rows if r["figure"] == "table 1"
+           and r["quantity"].endswith("(i860 model, assembler schedule, one triangle)")]
     names = [r["quantity"].split(":")[0] for r in clk]
     x = range(len(names))
     fig, ax = plt.subplots(figsize=(8, 3.6))
     ax.bar([i - 0.2 for i in x], [r["paper"] for r in clk], width=0.4, label="paper (table 1)")
-    ax.bar([i + 0.2 for i in x], [r["measured"] for r in clk], width=0.4, label="i860 model")
+    ax.bar([i + 0.2 for i in x], [r["measured"] for r in clk], width=0.4, label="i860 model (assembler)")
     ax.set_xticks(list(x), [n.replace("_", "\n") for n in names], fontsize=8)
     ax.set_ylabel("i860 clocks per triangle")
     ax.set_title("SNU table 1: clocks per triangle by stage")
@@ -178,3 +194,25 @@ def _plot_table1(rows: list[dict], out_dir: Path) -> list[str]:
     return ["## Plots", "", f"![table 1 clocks]({path.name})", "",
             "Clocks: the i860 timing model scheduling each stage's instructions (paper's recipe); where it "
             "differs from table 1, `docs/snu_geometry.md` says why, stage by stage.", ""]
+
+
+def _i860_note() -> list[str]:
+    """Stage by stage: the model's clocks beside table 1 and the manual fact that decides the
+    difference; then every parameter of the i860 model with its source (no cache: scheduled now)."""
+    from rasterhw.golden_model.i860 import PARAMETERS
+    from rasterhw.golden_model.snu import i860
+    from rasterhw.golden_model.snu.balance import PAPER_TABLE1
+
+    asm = i860.table1_model(stream_triangles=0)
+    cc = i860.table1_model(mode="compiler", stream_triangles=0)
+    md = ["## The i860 model against table 1, stage by stage", "",
+          "| stage | paper | assembler | compiler | pushes | dual ops | peak registers (of 30) | what decides the difference |",
+          "|---|---|---|---|---|---|---|---|"]
+    for s in i860.STAGES:
+        a = asm[s]
+        md.append(f"| {s} | {PAPER_TABLE1[s]['clocks']} | {a['clocks']} | {cc[s]['clocks']} | {a['pushes']} | "
+                  f"{a['dual_ops']} | {a['peak_registers']} | {i860.STAGE_NOTES[s]} |")
+    md += ["", "Every parameter of the i860 model (`golden_model/i860/model.py: PARAMETERS`):", "",
+           "| parameter | value | source |", "|---|---|---|"]
+    md += [f"| `{k}` | {v} | {src} |" for k, (v, src) in PARAMETERS.items()]
+    return md + [""]

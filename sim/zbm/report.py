@@ -16,6 +16,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+import numpy as np
 from rasterhw.sim.report import make_row
 from tqdm import tqdm
 
@@ -104,6 +105,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
                         reason=f"{UNITS_SECOND_LEVEL} units are not simulated here: chains of 1-8 units of "
                                "interleave 1 are (rows 'chain'); an interleave-16 unit alone takes ~21 min "
                                "to verilate on this machine"))
+    out += i860_rows(measured, progress=progress)
+    out += mapping_mode_rows()
     out += extra_rows(progress, "verilator" if hdl_engine == "pysim" else hdl_engine, fast=fast)
     out += scene_rows(progress)
     out += mapping_rows(fast=fast, progress=progress)
@@ -111,8 +114,162 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
     out += area
     sections = [f"HDL rows in this run: Table 1, paper schedule on `{hdl_engine}`, ours on `pysim`; "
                 "the other `hdl:*` rows name their own simulator.", ""]
-    sections += _plot(measured, out_dir, hdl_engine) + area_note
+    sections += _plot(measured, out_dir, hdl_engine) + area_note + _i860_note()
     return out, sections
+
+
+def _i860_note() -> list[str]:
+    """Where the table 2 rows come from, and every parameter of the i860 model with its source."""
+    from rasterhw.golden_model.i860 import PARAMETERS
+
+    md = ["", "## The i860 model (table 2, i860s per unit)", "",
+          "Rows `model:i860`: the first-level work our golden code does (transform, perspective, clipping, "
+          "edge-pair set-up: `golden_model/zbm/i860.py`) scheduled on the shared i860 model "
+          "(`golden_model/i860/`) at the paper's 33.3 MHz; C column = every stage as compiler code, assembler "
+          "column = transform and perspective as hand-scheduled code (as the paper rewrote them). Nothing is "
+          "taken from table 2; `docs/zbm.md#first-level-processors-on-the-i860-table-2` discusses every gap. "
+          "The i860s-per-unit rows divide the unit's rate (HDL cycles of this run at interleave 4, or the exact "
+          "cycle model at interleave 8, named in each label) by the model's per-processor rate.", "",
+          "| parameter | value | source |", "|---|---|---|"]
+    md += [f"| `{k}` | {v} | {src} |" for k, (v, src) in PARAMETERS.items()]
+    return md + [""]
+
+
+#: Table 2 (sec. 6.2): processors N -> (C seconds, assembler seconds, K polygons/s per processor)
+#: for 5,760 / N polygons on one i860XR at 33.3 MHz
+PAPER_TABLE2 = {4: (0.107, 0.090, 16.0), 8: (0.054, 0.050, 14.4), 12: (0.037, 0.033, 14.5),
+                16: (0.029, 0.025, 14.4)}
+PAPER_TEST_POLYGONS = 5760
+PAPER_I860S_PER_UNIT = 8  # sec. 6.2: "i860 プロセッサ 8 個でバランスする"
+#: the polygon the rows price when no scene is named: the paper's own table 1 polygon (a
+#: triangle: 3 vertices, 2 edge pairs); table 2's mix is not given
+PAPER_POLYGON = {"vertices": 3.0, "triangles": 1.0, "edge_pairs": 2.0}
+
+
+def _unit_cycles_model(interleave: int, schedule: str, mode: int) -> float:
+    """Steady-state cycles per edge pair of one unit from the exact cycle model (golden; the
+    table 1 rows hold the HDL equal to it): ``hdl_cycles(n + 1) - hdl_cycles(n)`` on the
+    paper's workload, in colour (``mode`` 0) or mapping mode (1: 6 channels, 7 segment words)."""
+    import dataclasses
+
+    import numpy as np
+    from rasterhw.golden_model.zbm import cycles as C
+    from rasterhw.golden_model.zbm.formats import CHANNELS
+    from rasterhw.sim.zbm.cycles_hdl import table1_width
+
+    w = table1_width(interleave)
+    n = N_PAIRS
+
+    def work(k):
+        eps = C.paper_workload(k, width=w)
+        if mode:
+            z = np.zeros((k, len(CHANNELS[mode])), np.int64)
+            eps = dataclasses.replace(eps, val=z, ddy=z.copy(), ddx=z.copy(), mode=mode)
+        return C.hdl_cycles(eps, 5 * k, width=w, interleave=interleave, schedule=schedule)["cycles"]
+
+    return float(work(n + 1) - work(n))
+
+
+def _scene_mix(name: str) -> dict:
+    """Vertices, triangles and edge pairs per polygon of a scene (golden: the scene's polygons and
+    ``scene_cycles``' edge pairs at polygon level)."""
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.zbm.scene_cycles import scene_table
+
+    sc = build_scene(name)
+    nv = np.asarray(sc.nverts, float)
+    (r,) = scene_table((name,), (8,), hdl=False)
+    return {"vertices": float(nv.mean()), "triangles": float((nv - 2).mean()),
+            "edge_pairs": float(r["edge_pairs_per_polygon"])}
+
+
+def i860_rows(measured: dict[str, dict[int, float]], *, progress: bool = False) -> list[dict]:
+    """Table 2 from the i860 model (``golden_model/zbm/i860.py`` on ``golden_model/i860``), the
+    polygon rate across our scenes, the i860s that balance one unit, and the bus load that implies.
+
+    Source ``model:i860``: the per-processor rate is the i860 model's (nothing taken from table 2);
+    the unit's rate in the balance rows is named in each label: HDL cycles measured in this run
+    (interleave 4, both schedules: every run measures it) or the exact cycle model (interleave 8,
+    golden; equal to the HDL, the table 1 rows check it in a full run)."""
+    from rasterhw.golden_model.zbm import i860 as z
+    from rasterhw.golden_model.zbm.formats import EP_CHANNEL, EP_WORDS
+
+    src = "model:i860"
+    out = []
+    pol = z.polygon_clocks(**PAPER_POLYGON)
+    mix = "triangle: 3 vertices, 2 edge pairs (the paper's table 1 polygon; table 2's mix is not given)"
+    for n, (pc, pa, pk) in PAPER_TABLE2.items():
+        polys = PAPER_TEST_POLYGONS // n
+        out += [
+            make_row("zbm", "table 2", f"{n} processors: seconds for {polys} polygons on one i860XR at 33.3 MHz, "
+                     f"C (all stages compiled; {mix})", paper=pc, formula=None,
+                     measured=polys * pol["C"] / z.CLOCK_HZ, unit="s", source=src),
+            make_row("zbm", "table 2", f"{n} processors: seconds for {polys} polygons, assembler (transform and "
+                     "perspective hand-scheduled, clipping and set-up compiled)", paper=pa, formula=None,
+                     measured=polys * pol["assembler"] / z.CLOCK_HZ, unit="s", source=src),
+            make_row("zbm", "table 2", f"{n} processors: polygons/s per processor (assembler column)",
+                     paper=pk * 1e3, formula=None, measured=pol["assembler_polygons_per_s"], unit="polygons/s",
+                     source=src)]
+    out.append(make_row("zbm", "table 2 / 6.2", "C / assembler time ratio (paper: table 1.08-1.19 from its "
+                        "seconds, text 'about 1.25'; paper column = the text)", paper=1.25, formula=None,
+                        measured=pol["C"] / pol["assembler"], unit="x", source=src))
+    for s, v in pol["per_stage"].items():
+        out.append(make_row("zbm", "table 2 (stages)", f"{s}: i860 clocks per polygon, compiler schedule "
+                            f"({mix})", paper=None, formula=None,
+                            measured=v["compiler"], unit="clocks", source=src))
+        out.append(make_row("zbm", "table 2 (stages)", f"{s}: i860 clocks per polygon, assembler schedule",
+                            paper=None, formula=None, measured=v["assembler"], unit="clocks", source=src))
+    for name in tqdm(REAL_SCENES, desc="ZB/M i860 polygon mix", disable=not progress, leave=False):
+        m = _scene_mix(name)
+        r = z.polygon_clocks(**m)
+        out.append(make_row("zbm", "table 2 (real scene)", f"{name}: polygons/s per processor, assembler column "
+                            f"({m['vertices']:.2f} vertices, {m['triangles']:.2f} triangles, "
+                            f"{m['edge_pairs']:.2f} edge pairs per polygon)", paper=14.4e3, formula=None,
+                            measured=r["assembler_polygons_per_s"], unit="polygons/s", source=src))
+    per_proc = {"colour": pol["assembler_polygons_per_s"],
+                "mapping": z.polygon_clocks(**PAPER_POLYGON, channels="mapping")["assembler_polygons_per_s"]}
+    bytes_per_pair = EP_WORDS * EP_CHANNEL.width / 8
+    for sched in ("paper", "overlap"):
+        for mode_name, mode in (("Gouraud (colour)", 0), ("mapping", 1)):
+            cases = [(8, _unit_cycles_model(8, sched, mode), "exact cycle model (golden)")]
+            if mode == 0 and 4 in measured[sched]:
+                cases.append((4, measured[sched][4], "HDL cycles measured in this run"))
+            for il, cyc, how in cases:
+                unit_rate = polygons_per_s(cyc)
+                k = "colour" if mode == 0 else "mapping"
+                n_bal = unit_rate / per_proc[k]
+                out.append(make_row(
+                    "zbm", "6.2", f"i860s to balance one unit, {mode_name} mode, {sched} schedule, interleave {il} "
+                    f"(unit: {how}; i860: model, assembler column)", paper=PAPER_I860S_PER_UNIT, formula=None,
+                    measured=n_bal, unit="i860s", source=src))
+                if il == 8:
+                    out.append(make_row(
+                        "zbm", "6.2", f"inter-processor bus load at that balance, {mode_name} mode, {sched} schedule "
+                        f"(edge pairs of {EP_WORDS} x {EP_CHANNEL.width}-bit words; paper: the bus saturates "
+                        "with fewer processors)", paper=None, formula=None,
+                        measured=unit_rate * EDGE_PAIRS_PER_POLYGON * bytes_per_pair, unit="bytes/s", source=src))
+    return out
+
+
+def mapping_mode_rows() -> list[dict]:
+    """Mapping mode (6 channels, 7 segment words): cycles per edge pair and polygons/s per unit
+    from the exact cycle model (golden), beside the paper's table 1 (its figures are colour mode;
+    the paper's 7.4 M polygons/s is for textured polygons)."""
+    out = []
+    for sched in ("paper", "overlap"):
+        for i in (1, 2, 4, 8, 16):
+            cyc = _unit_cycles_model(i, sched, 1)
+            out.append(make_row("zbm", "table 1 (mapping mode)", f"cycles per edge pair, mapping mode, interleave {i}, "
+                                f"{sched} schedule (exact cycle model)", paper=PAPER_CYCLES[i], formula=None,
+                                measured=cyc, unit="cycles", source="golden"))
+            out.append(make_row("zbm", "table 1 (mapping mode)", f"polygons/s per unit, mapping mode, interleave {i}, "
+                                f"{sched} schedule (x1/2 skew)", paper=PAPER_KPOLYS[i] * 1e3, formula=None,
+                                measured=polygons_per_s(cyc), unit="polygons/s", source="golden"))
+    best = max(polygons_per_s(_unit_cycles_model(i, "paper", 1)) for i in (8, 16))
+    out.append(make_row("zbm", "6.1 (mapping mode)", f"{UNITS_SECOND_LEVEL} units, mapping mode, paper schedule, best "
+                        "interleave (64 x the exact cycle model's unit rate; not simulated)", paper=PAPER_64_UNITS,
+                        formula=None, measured=UNITS_SECOND_LEVEL * best, unit="polygons/s", source="golden"))
+    return out
 
 
 def extra_rows(progress: bool, engine: str, *, fast: bool = False) -> list[dict]:

@@ -63,7 +63,7 @@ def test_table1_rows():
     assert by_q["light: operations per triangle, paper's recipe (formula = the text)"]["paper"] == 72
     assert by_q["backface_cull: operations per triangle, our full pipeline (not in the paper)"]["measured"] == 15
     clocks = [r for r in rows if "i860 clocks" in r["quantity"]]
-    assert clocks and all(r["source"] == "model" for r in clocks)
+    assert clocks and all(r["source"] == "model:i860" for r in clocks)
     ops = [r for r in rows if r["unit"] == "ops"]
     assert all(r["source"] == "golden" for r in ops)
     # the model's shares add up to 100 %

@@ -44,7 +44,7 @@ def test_producer_gaps_follow_the_model():
     assert np.all(g[heads] >= int(np.ceil((sc["pixel"] + sc["span"]) / ratio)) - 1)
     # each pipeline's first write carries the geometry fill (the three groups' clocks)
     assert all(fw >= sum(p["group_clocks"]) for fw in p["first_work"])
-    assert p["group_clocks"] == [76, 101, 64]
+    assert p["group_clocks"] == [74 + 43, 64 + 72, 24 + 39 + 21]  # docs/snu_geometry.md, assembler
     # sp27 at 80 x 64 has ~1-pixel triangles: the scan converter would outrun the traversal
     # processor (one triangle per pipeline per 216 clocks); 100-pixel triangles never do
     assert p["geometry_starves"]
