@@ -171,7 +171,8 @@ def _check_aperture(name: str, v) -> int:
 
 
 def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: int = 2,
-                  test: str = "exact", depth: str = "float", background=(0.0, 0.0, 0.0)) -> SparseFrame:
+                  test: str = "exact", depth: str = "float", background=(0.0, 0.0, 0.0),
+                  per_record: bool = False) -> SparseFrame:
     """Draw ``tris`` with a ``p x q`` matrix of video processors by recursive pixel search.
 
     Parameters
@@ -185,6 +186,9 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
         polygon" count) or ``"edges"`` (the three edges only). Same image either way.
     depth : ``"float"`` (reference arithmetic, bit-identical image) or ``"fixed"`` (quantised
         depth as a fixed-point plane, the bit-accurate layer).
+    per_record : also keep ``stats["windows_per_record"]``, ``(p*q, T, n + 1)`` int32: the windows
+        leaving each level for every (processor, broadcast record) pair (level 0: the root, 1;
+        level n: pixels passing the point test), what the cycle models of :mod:`.cycles` price.
     """
     p, q = parse_matrix(matrix)
     W, H = tris.width, tris.height
@@ -218,6 +222,9 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
     tpp = np.zeros((P, n + 1), dtype=np.int64)
     windows[0] = rt.size
     wpp[:, 0] = T
+    wrec = np.zeros((P, T, n + 1), dtype=np.int32) if per_record else None
+    if per_record:
+        wrec[:, :, 0] = 1
     thr_all = es.thr
     ext_all = (np.abs(es.A) * al + np.abs(es.B) * be) // 2  # aperture growth, exact (A, B even)
     ap_n = 0
@@ -264,6 +271,8 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
         u0, v0 = u4[keep], v4[keep]
         windows[i] = rt.size
         wpp[:, i] = np.bincount(proc, minlength=P)
+        if per_record:
+            wrec[:, :, i] = np.bincount(rt * P + proc, minlength=T * P).reshape(T, P).T
         if i < n:
             check_signed("window corner value", mx, EDGE_BITS)
 
@@ -349,4 +358,4 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
         windows=windows, tests=tests, windows_aperture_n=ap_n, windows_per_proc=wpp,
         tests_per_proc=tpp, fragments=int(F), pixels_written=written, triangles=int(T),
         stats={"alpha": al, "beta": be, "test": test, "depth": depth, "frag_x": x, "frag_y": y, "frag_proc": proc,
-               "frag_tri": tri})
+               "frag_tri": tri, **({"windows_per_record": wrec} if per_record else {})})
