@@ -24,6 +24,8 @@ SYSTEM = "sparse"
 M_BITS = 10  # the paper's full raster: 2**10 x 2**10
 KS = (1, 2, 3, 4)
 SEED = 2002
+#: Monte-Carlo samples of the large-S growth rows (S = 10^4, 10^5)
+GROWTH_SAMPLES = 4000
 #: areas at which the Monte-Carlo counts are measured for figs. 3, 5, 6
 S_GRID = (0.1, 0.3, 1.0, 1.8, 3.0, 6.0, 10.0, 23.3, 40.0, 100.0, 157.0, 300.0, 1000.0)
 
@@ -63,6 +65,18 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
             measured=round(s_ex[0], 4), unit="px", source="golden")
         row("text after (4)", f"S_{k}, edges-only test (MC {M}, 95 % [{s_ed[1]:.3g}, {s_ed[2]:.3g}])",
             paper=paper, formula=round(f, 4), measured=round(s_ed[0], 4), unit="px", source="golden")
+
+    # S_k at one fixed rotation: (1)'s perimeter term sqrt(a^2 + b^2) U / 2 is the exact mean
+    # count's a H + b W for a square window at 45 degrees (its largest value), so (1) and the
+    # paper's S_k are those of the rectangle at 45 degrees; uniform rotations count fewer windows
+    sk_rot = {}
+    for k in KS[1:]:
+        for name, ang in (("45°", math.pi / 4), ("0°", 0.0)):
+            s_r = mc.s_k_measured(k, m=M_BITS, M=M, seed=SEED, test="exact", rotation=ang)
+            sk_rot[(k, name)] = s_r
+            row("text after (4)", f"S_{k}, 5:1 rectangles all at {name} rotation, exact test (MC {M}, 95 % "
+                f"[{s_r[1]:.3g}, {s_r[2]:.3g}])", paper=th.PAPER_S_K[k - 1], formula=round(th.s_k(k), 4),
+                measured=round(s_r[0], 4), unit="px", source="golden")
 
     # ---------------------------------------------------------------- Monte-Carlo counts, fig. 3
     mono = {}  # S -> counts of the monoprocessor on the full raster (for Q_a)
@@ -178,6 +192,20 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     row("fig. 6a text", "p_p(1000) growth per matrix step, (p_p(k=4)/p_p(k=1))^(1/3) (paper: ∝ 4^k)", paper=4.0,
         formula=round((pp[3] / pp[0]) ** (1 / 3), 4), measured=round((ppm[3] / ppm[0]) ** (1 / 3), 4),
         unit="x per k", source="model")
+    # the growth per matrix step tends to 4 only as S grows (the limiting stage's 4 w_(n-1) term has
+    # the larger relative window alpha_(n-1), whose perimeter term falls slower than 1/pq)
+    growth = []
+    for S in (1e4, 1e5):
+        pf = [th.summary(S, M_BITS, k)["p_p"] for k in KS]
+        pm = []
+        for k in KS:
+            poly, off = mc.rectangles(S, GROWTH_SAMPLES, seed=SEED)
+            pm.append(float(th.perf_pipeline(mc.level_counts(poly, off, M_BITS - k, 1 << k).mean)))
+        gf, gm = (pf[3] / pf[0]) ** (1 / 3), (pm[3] / pm[0]) ** (1 / 3)
+        growth.append((S, gf, gm))
+        row("fig. 6a text", f"p_p(S={S:g}) growth per matrix step, (p_p(k=4)/p_p(k=1))^(1/3) (paper: ∝ 4^k; MC "
+            f"{GROWTH_SAMPLES})", paper=4.0, formula=round(gf, 4), measured=round(gm, 4), unit="x per k",
+            source="model")
     # R_p peak near S_k (fig. 6b): formula on a fine grid; measured on the Monte-Carlo grid
     for k in (2, 3, 4):
         Rp = th.load_pipeline(th.windows(Sg, M_BITS - k, 1 << k))
@@ -213,6 +241,9 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     # ---------------------------------------------------------------- HDL cycles (t_i, R_p)
     hdl_sec = _hdl_rows(row, engine, progress, hdl_scene=known.get("hdl_scene"))
 
+    # ---------------------------------------------------------------- the coupled matrix (golden)
+    coupled_sec = _coupled_rows(row, out_dir)
+
     # ---------------------------------------------------------------- plots
     plots = _plots(out_dir, spr, mono, Sg, S_GRID)
 
@@ -231,9 +262,25 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     sec.append("| k | paper | formula (1) | MC exact test (95 %) | MC edges-only test (95 %) |\n|---|---|---|---|---|\n" +
                "\n".join(f"| {k} | {th.PAPER_S_K[k - 1]:g} | {th.s_k(k):.4g} | {e[0]:.4g} [{e[1]:.4g}, {e[2]:.4g}] | "
                          f"{d[0]:.4g} [{d[1]:.4g}, {d[2]:.4g}] |" for k, (e, d) in sk_meas.items()) + "\n")
+    sec.append("## Why the measured S_k exceed the paper's, and why p_p grows by less than 4 per step\n")
+    sec.append("Formula (1)'s perimeter term, sqrt(α_i² + β_i²)·L·sqrt(πS), is the largest over rotations of the "
+               "exact mean count's a·H + b·W (W, H the polygon's extents): for a square window it is reached at "
+               "45°. Rectangles all at 45° reproduce the paper's S_k; uniform rotations (the table above) need a "
+               "larger area for one window; axis-aligned ones larger still.\n\n| k | paper | formula | MC 45° (95 %) | "
+               "MC uniform rotation | MC 0° (95 %) |\n|---|---|---|---|---|---|\n" +
+               "\n".join(f"| {k} | {th.PAPER_S_K[k - 1]:g} | {th.s_k(k):.4g} | {sk_rot[(k, '45°')][0]:.4g} "
+                         f"[{sk_rot[(k, '45°')][1]:.4g}, {sk_rot[(k, '45°')][2]:.4g}] | {sk_meas[k][0][0]:.4g} | "
+                         f"{sk_rot[(k, '0°')][0]:.4g} [{sk_rot[(k, '0°')][1]:.4g}, {sk_rot[(k, '0°')][2]:.4g}] |"
+                         for k in KS[1:]) + "\n\n"
+               "p_p's growth per step of k: " + "; ".join(f"S = {S:g}: formula ×{gf:.3f}, MC ×{gm:.3f}"
+                                                          for S, gf, gm in growth) +
+               " (×3.33 at S = 1000, above). The limiting stage is the pixel level, t_n = 4 w_(n−1) + w_n k_p/k_e; "
+               "w_n falls as 1/pq but w_(n−1) counts windows of relative size α_(n−1) = (1 + α/p)/2, whose "
+               "perimeter and corner terms fall more slowly, so the step tends to 4 only as S grows.\n")
     sec.append("## Limiting level in each regime\n")
     sec.append("\n".join(reg) + "\n\nFrom the formula on a fine grid (S = 0.1 … 1000): " + "; ".join(lim_ranges) + ".\n")
     sec.extend(hdl_sec)
+    sec.extend(coupled_sec)
     sec.append("## Figures\n")
     sec.append("\n".join(f"![{t}]({fn})" for t, fn in plots) + "\n")
     return out, sec
@@ -373,3 +420,202 @@ def _plots(out_dir: Path, spr, mono, Sg, S_GRID):  # noqa: N803
     plt.close(fig)
     files.append(("figs. 5-6", "sparse_fig5_6.png"))
     return files
+
+
+# ---------------------------------------------------------------- the coupled matrix (golden cycle model)
+#: the paper's full raster (m = 10) for the coupled-matrix rows
+COUPLED_SIZE = 1 << M_BITS
+COUPLED_MATRICES = ("2x2", "4x4", "8x8", "16x16")
+FIFO_DEPTHS = (1, 2, 4, 8, 16, 32, 64)
+#: the FIFO depth of the R_p / Q_p / stack / k_p rows (the HDL VP's inner FIFOs are 8 deep)
+REF_DEPTH = 8
+
+
+def _coupled_rows(row, out_dir: Path, scene: str = "c300") -> list[str]:
+    """Frame cycles against FIFO depth, R_p and Q_p from busy cycles, the stack processor and the
+    k_p/k_e cost: :mod:`rasterhw.golden_model.sparse.cycles` on the golden search's per-record
+    window counts of ``scene`` at 1024 x 1024."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.sparse import cycles as cy
+    from rasterhw.golden_model.sparse.search import sparse_render
+
+    W = COUPLED_SIZE
+    tris = run_geometry(build_scene(scene), W, W)
+    xy = np.asarray(tris.xy)
+    lab = f"{scene} {W}x{W}"
+    gp = f"GP issue interval {cy.GP_ISSUE_INTERVAL} cycle (ours)"
+    mono = sparse_render(tris, "1x1", depth="fixed")
+    T_mono = float(mono.tests.sum())
+    fw_mono = _formula_frame(xy, M_BITS, 1)
+    curves = {}
+    sweep_tab = ["| matrix | FIFO depth D | frame cycles | / unbounded FIFO | broadcast stall cycles | FIFO peak (max) | "
+                 "busy / frame, least and most loaded processor |", "|---|---|---|---|---|---|---|"]
+    rp_tab = ["| matrix | n | R_p golden (frame) | R_p formula (10), k_p/k_e = 0 | R_p coupled, D = 8 | Q_a golden | "
+              "Q_a formula (7) | Q_p golden | Q_p formula (12) | stack / pipeline frame | formula n R_p |",
+              "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for m in COUPLED_MATRICES:
+        p = int(m.split("x")[0])
+        P = p * p
+        f = sparse_render(tris, m, depth="fixed", per_record=True)
+        n = f.n
+        w = f.stats["windows_per_record"]
+        s_pipe = cy.service_times(w)
+        alone = int(1 + s_pipe.sum(axis=1).max())
+        fr = {}
+        for D in FIFO_DEPTHS:
+            r = cy.coupled_matrix(s_pipe, D)
+            fr[D] = r.frame_cycles
+            util = r.busy / r.frame_cycles
+            sweep_tab.append(f"| {m} | {D} | {r.frame_cycles} | {r.frame_cycles / alone:.4f} | {r.stall_cycles} | "
+                             f"{int(r.fifo_peak.max())} | {util.min():.3f} … {util.max():.3f} |")
+            row("FIFO sizing (coupled)", f"{lab}, {m}: frame cycles, FIFO depth {D} (pipeline VPs, {gp})",
+                paper=None, formula=None, measured=r.frame_cycles, unit="cycles", source="golden")
+            if D == 1:
+                row("FIFO sizing (coupled)", f"{lab}, {m}: broadcast stall cycles, FIFO depth 1", paper=None,
+                    formula=None, measured=r.stall_cycles, unit="cycles", source="golden")
+        sweep_tab.append(f"| {m} | unbounded | {alone} | 1 | 0 | — | — |")
+        curves[m] = [fr[D] / alone for D in FIFO_DEPTHS]
+        for D in (1, 8, 64):
+            row("FIFO sizing (coupled)", f"{lab}, {m}: frame with FIFO depth {D} / frame with an unbounded FIFO "
+                "(the slowest processor alone; paper's assumption: coupling small with enough FIFO)",
+                paper=None, formula=None, measured=round(fr[D] / alone, 5), unit="ratio", source="golden")
+        d1 = next((D for D in FIFO_DEPTHS if fr[D] <= 1.01 * alone), None)
+        row("FIFO sizing (coupled)", f"{lab}, {m}: smallest FIFO depth (of 1 … 64) within 1 % of the unbounded "
+            "frame", paper=None, formula=None, measured=d1 if d1 is not None else -1, unit="entries",
+            source="golden")
+        # R_p, Q_a, Q_p from busy cycles (pipeline VP as our HDL prices it: headers, k_p = 0)
+        sb = cy.stage_cycles(w).sum(axis=1)  # (P, n) busy cycles per stage
+        Bi = sb.sum(axis=0).astype(float)
+        Rp = float(Bi.sum() / (n * Bi.max()))
+        fw = _formula_frame(xy, n, p)
+        tf = th.stage_times(fw, kp_ke=0.0)
+        Rp_f = float(tf.sum() / (n * tf.max()))
+        rc = cy.coupled_matrix(s_pipe, REF_DEPTH)
+        Rp_c = float(Bi.sum() / (n * P * rc.frame_cycles))
+        Qa = T_mono / float(f.tests.sum())
+        Qa_f = float(th.total_time(fw_mono, kp_ke=0.0) / (P * th.total_time(fw, kp_ke=0.0)))
+        row("(10) / golden", f"{lab}, {m}: R_p = sum_i B_i / (n max_i B_i) from the golden pipeline's busy cycles "
+            "B_i per stage (summed over processors; header cycles included; formula: (10) on (1)'s counts for "
+            "the frame's triangles, k_p/k_e = 0)", paper=None, formula=round(Rp_f, 4), measured=round(Rp, 4),
+            unit="", source="golden")
+        row("(10) / golden", f"{lab}, {m}: R_p of the coupled frame, sum_i B_i / (n P frame cycles), FIFO depth "
+            f"{REF_DEPTH} (load including the coupling and the processors' imbalance)", paper=None,
+            formula=round(Rp_f, 4), measured=round(Rp_c, 4), unit="", source="golden")
+        row("(7) / golden", f"{lab}, {m}: Q_a = T_mono / (pq T_sparse), coverage tests of the golden search "
+            "(monoprocessor: 1x1 on the full raster, n = 10; formula (7) on (1)'s counts, k_p/k_e = 0)",
+            paper=None, formula=round(Qa_f, 4), measured=round(Qa, 4), unit="", source="golden")
+        row("(12) / golden", f"{lab}, {m}: Q_p = Q_a R_p (golden busy cycles; formula (12))", paper=None,
+            formula=round(Qa_f * Rp_f, 4), measured=round(Qa * Rp, 4), unit="", source="golden")
+        # the stack-based processor on the same frame
+        s_st = cy.service_times(w, vp="stack")
+        rs = cy.coupled_matrix(s_st, REF_DEPTH)
+        sp_st = rs.frame_cycles / rc.frame_cycles
+        tf0h = th.stage_times(fw, kp_ke=0.0)
+        row("(10) / stack", f"{lab}, {m}: frame cycles of the stack-based processors, FIFO depth {REF_DEPTH} "
+            f"(set-up {cy.SETUP_CYCLES} + every coverage test, one per cycle)", paper=None, formula=None,
+            measured=rs.frame_cycles, unit="cycles", source="golden")
+        row("(10) / stack", f"{lab}, {m}: stack frame / pipeline frame, FIFO depth {REF_DEPTH} (formula: "
+            "P_p / P_s = n R_p of (10) on (1)'s counts, k_p/k_e = 0)", paper=None,
+            formula=round(float(tf0h.sum() / tf0h.max()), 4), measured=round(sp_st, 4), unit="ratio",
+            source="golden")
+        rp_tab.append(f"| {m} | {n} | {Rp:.4f} | {Rp_f:.4f} | {Rp_c:.4f} | {Qa:.4f} | {Qa_f:.4f} | {Qa * Rp:.4f} | "
+                      f"{Qa_f * Rp_f:.4f} | {sp_st:.3f} | {tf0h.sum() / tf0h.max():.3f} |")
+        if m == "4x4":
+            # surface parameters priced as (5): depth and RGB (k_p = 4) on the k_e = 3 edge adders
+            kp_tab = []
+            for vp, s0 in (("pipeline", s_pipe), ("stack", s_st)):
+                s4 = cy.service_times(w, vp=vp, kp=4)
+                f0 = cy.coupled_matrix(s0, REF_DEPTH).frame_cycles
+                f4 = cy.coupled_matrix(s4, REF_DEPTH).frame_cycles
+                t0, t4 = th.stage_times(fw, kp_ke=0.0), th.stage_times(fw, kp_ke=4 / 3)
+                ff = float(t4.max() / t0.max()) if vp == "pipeline" else float(t4.sum() / t0.sum())
+                row("(5) k_p/k_e", f"{lab}, {m}: frame with depth and RGB priced (k_p = 4, k_e = 3: "
+                    f"ceil(w_i k_p / k_e) cycles per stage and record) / unpriced, {vp} VPs, FIFO depth "
+                    f"{REF_DEPTH} (formula: (5) on (1)'s counts, k_p/k_e = 4/3 against 0)", paper=None,
+                    formula=round(ff, 4), measured=round(f4 / f0, 4), unit="ratio", source="golden")
+                kp_tab.append(f"{vp}: {f0} → {f4} cycles (×{f4 / f0:.3f}; formula ×{ff:.3f})")
+    load_tab = _load_rows(row)
+    plot = _fifo_plot(out_dir, curves)
+    return ["## The coupled matrix: FIFO sizing (golden cycle model)\n",
+            f"`golden_model/sparse/cycles.py` on the golden search's per-record window counts of {lab} "
+            f"(records in submission order). One geometry processor offers a record every {cy.GP_ISSUE_INTERVAL} "
+            "cycle (ours: the paper gives no rate, so the broadcast is never the bottleneck and every stall is the "
+            "processors'); a record is pushed into all p·q FIFOs only when each has room; a pipeline video "
+            "processor holds a record for its busiest stage's cycles (4 w_(i−1) tests plus a header cycle where "
+            "the triangle has survivors; (9)), a stack processor for all of its tests plus a 3-cycle set-up. "
+            "'unbounded' is the slowest processor alone, plus the one-cycle push.\n",
+            "\n".join(sweep_tab) + "\n",
+            "R_p, Q_a and Q_p from the golden busy cycles beside the paper's (10), (7), (12) evaluated with "
+            "formula (1)'s counts for the same triangles (each with its own S and L), k_p/k_e = 0 as our stage "
+            f"prices it. Coupled R_p at FIFO depth {REF_DEPTH}.\n",
+            "\n".join(rp_tab) + "\n",
+            "Surface parameters priced as formula (5) (4x4, FIFO depth 8): " + "; ".join(kp_tab) + ".\n",
+            "## Where \"practically 100 %\" load holds (fig. 6b)\n",
+            "Frames of random triangles (`reference.random_triangles`, seed 2002, 1024 x 1024) of one mean area: "
+            "at the paper's S_k and at 1000 px. R_p from the golden search's per-record counts of the frame priced "
+            "as the paper prices them (formula (5) with k_p/k_e = 1, no header cycles; source `model`), beside "
+            "(10) on formula (1)'s counts for the same triangles.\n",
+            "\n".join(load_tab) + "\n",
+            f"![FIFO sizing]({plot})\n"]
+
+
+#: triangles per frame of the load rows
+LOAD_TRIANGLES = 3000
+
+
+def _load_rows(row) -> list[str]:
+    """R_p of frames of equal-area random triangles near S_k and at 1000 px (the paper's claim of a
+    load maximum "практически до 100 %" in the neighbourhood of S = S_k)."""
+    from rasterhw.golden_model.reference import random_triangles
+    from rasterhw.golden_model.sparse import cycles as cy
+    from rasterhw.golden_model.sparse.search import sparse_render
+
+    W = COUPLED_SIZE
+    tab = ["| matrix | mean area S | R_p measured (model: (5), (10) on golden counts) | R_p formula (10) | "
+           "R_p golden, our pipeline (headers, k_p = 0) |", "|---|---|---|---|---|"]
+    for k in (2, 3, 4):
+        p = 1 << k
+        n = M_BITS - k
+        for S in (th.PAPER_S_K[k - 1], 1000.0):
+            tris = random_triangles(W, W, LOAD_TRIANGLES, mean_area=S, seed=SEED)
+            xy = np.asarray(tris.xy)
+            f = sparse_render(tris, (p, p), per_record=True)
+            w = f.stats["windows_per_record"]
+            B = cy.stage_cycles(w, kp=3, headers=False).sum(axis=(0, 1)).astype(float)  # k_p/k_e = 3/3
+            Rm = float(B.sum() / (n * B.max()))
+            Bg = cy.stage_cycles(w).sum(axis=(0, 1)).astype(float)
+            Rg = float(Bg.sum() / (n * Bg.max()))
+            tf = th.stage_times(_formula_frame(xy, n, p), kp_ke=1.0)
+            Rf = float(tf.sum() / (n * tf.max()))
+            e1, e2 = xy[:, 1] - xy[:, 0], xy[:, 2] - xy[:, 0]
+            Sm = float(np.mean(0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])))
+            near = S < 999
+            row("fig. 6b text", f"R_p of a frame of {LOAD_TRIANGLES} random triangles of mean area {Sm:.3g} px "
+                f"({'S_k' if near else 'S = 1000'}), {p}x{p}, 1024x1024 (paper: load maximum "
+                "'practically up to 100 %' near S_k)", paper=1.0 if near else None, formula=round(Rf, 4),
+                measured=round(Rm, 4), unit="", source="model")
+            tab.append(f"| {p}x{p} | {Sm:.3g} ({'S_k' if near else '1000'}) | {Rm:.4f} | {Rf:.4f} | {Rg:.4f} |")
+    return tab
+
+
+def _fifo_plot(out_dir: Path, curves: dict) -> str:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for m, c in curves.items():
+        ax.semilogx(FIFO_DEPTHS, c, "o-", base=2, label=m)
+    ax.axhline(1.0, color="k", lw=0.8, ls=":")
+    ax.set_xlabel("FIFO depth D (records)")
+    ax.set_ylabel("frame cycles / unbounded FIFO")
+    ax.set_title(f"coupled matrix, c300 {COUPLED_SIZE}x{COUPLED_SIZE} (golden cycle model)", fontsize=9)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out_dir / "sparse_fifo.png", dpi=90)
+    plt.close(fig)
+    return "sparse_fifo.png"
