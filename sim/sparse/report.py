@@ -41,7 +41,8 @@ def _fmt_ci(r: mc.MCResult, i: int) -> str:
 
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path("docs/reproduction"),
          samples: int = 20000, scenes: tuple[str, ...] = ("c300", "sp27"), s_grid: tuple[float, ...] = S_GRID,
-         **known):
+         coupled_size: int = 1 << M_BITS, coupled_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8", "16x16"),
+         load_triangles: int = 3000, **known):
     """Rows and markdown sections of the sparse-raster report (see the module docstring)."""
     M = int(samples)
     S_GRID = tuple(s_grid)  # noqa: N806 (the module default, narrowed by tests)
@@ -74,7 +75,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
         for name, ang in (("45°", math.pi / 4), ("0°", 0.0)):
             s_r = mc.s_k_measured(k, m=M_BITS, M=M, seed=SEED, test="exact", rotation=ang)
             sk_rot[(k, name)] = s_r
-            row("text after (4)", f"S_{k}, 5:1 rectangles all at {name} rotation, exact test (MC {M}, 95 % "
+            row("text after (4)", f"S_{k}, 5:1 rectangles all at {name} rotation, exact window test (MC {M}, 95 % "
                 f"[{s_r[1]:.3g}, {s_r[2]:.3g}])", paper=th.PAPER_S_K[k - 1], formula=round(th.s_k(k), 4),
                 measured=round(s_r[0], 4), unit="px", source="golden")
 
@@ -199,12 +200,12 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
         pf = [th.summary(S, M_BITS, k)["p_p"] for k in KS]
         pm = []
         for k in KS:
-            poly, off = mc.rectangles(S, GROWTH_SAMPLES, seed=SEED)
+            poly, off = mc.rectangles(S, min(M, GROWTH_SAMPLES), seed=SEED)
             pm.append(float(th.perf_pipeline(mc.level_counts(poly, off, M_BITS - k, 1 << k).mean)))
         gf, gm = (pf[3] / pf[0]) ** (1 / 3), (pm[3] / pm[0]) ** (1 / 3)
         growth.append((S, gf, gm))
         row("fig. 6a text", f"p_p(S={S:g}) growth per matrix step, (p_p(k=4)/p_p(k=1))^(1/3) (paper: ∝ 4^k; MC "
-            f"{GROWTH_SAMPLES})", paper=4.0, formula=round(gf, 4), measured=round(gm, 4), unit="x per k",
+            f"{min(M, GROWTH_SAMPLES)})", paper=4.0, formula=round(gf, 4), measured=round(gm, 4), unit="x per k",
             source="model")
     # R_p peak near S_k (fig. 6b): formula on a fine grid; measured on the Monte-Carlo grid
     for k in (2, 3, 4):
@@ -242,7 +243,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     hdl_sec = _hdl_rows(row, engine, progress, hdl_scene=known.get("hdl_scene"))
 
     # ---------------------------------------------------------------- the coupled matrix (golden)
-    coupled_sec = _coupled_rows(row, out_dir)
+    coupled_sec = _coupled_rows(row, out_dir, size=coupled_size, matrices=coupled_matrices,
+                                load_triangles=load_triangles)
 
     # ---------------------------------------------------------------- plots
     plots = _plots(out_dir, spr, mono, Sg, S_GRID)
@@ -423,38 +425,38 @@ def _plots(out_dir: Path, spr, mono, Sg, S_GRID):  # noqa: N803
 
 
 # ---------------------------------------------------------------- the coupled matrix (golden cycle model)
-#: the paper's full raster (m = 10) for the coupled-matrix rows
-COUPLED_SIZE = 1 << M_BITS
-COUPLED_MATRICES = ("2x2", "4x4", "8x8", "16x16")
 FIFO_DEPTHS = (1, 2, 4, 8, 16, 32, 64)
 #: the FIFO depth of the R_p / Q_p / stack / k_p rows (the HDL VP's inner FIFOs are 8 deep)
 REF_DEPTH = 8
 
 
-def _coupled_rows(row, out_dir: Path, scene: str = "c300") -> list[str]:
+def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], load_triangles: int,
+                  scene: str = "c300") -> list[str]:
     """Frame cycles against FIFO depth, R_p and Q_p from busy cycles, the stack processor and the
     k_p/k_e cost: :mod:`rasterhw.golden_model.sparse.cycles` on the golden search's per-record
-    window counts of ``scene`` at 1024 x 1024."""
+    window counts of ``scene`` at ``size`` x ``size`` (the paper's 1024 x 1024 in the report)."""
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.golden_model.sparse import cycles as cy
     from rasterhw.golden_model.sparse.search import sparse_render
 
-    W = COUPLED_SIZE
+    W = size
+    m_bits = W.bit_length() - 1
     tris = run_geometry(build_scene(scene), W, W)
     xy = np.asarray(tris.xy)
     lab = f"{scene} {W}x{W}"
     gp = f"GP issue interval {cy.GP_ISSUE_INTERVAL} cycle (ours)"
     mono = sparse_render(tris, "1x1", depth="fixed")
     T_mono = float(mono.tests.sum())
-    fw_mono = _formula_frame(xy, M_BITS, 1)
+    fw_mono = _formula_frame(xy, m_bits, 1)
     curves = {}
     sweep_tab = ["| matrix | FIFO depth D | frame cycles | / unbounded FIFO | broadcast stall cycles | FIFO peak (max) | "
                  "busy / frame, least and most loaded processor |", "|---|---|---|---|---|---|---|"]
     rp_tab = ["| matrix | n | R_p golden (frame) | R_p formula (10), k_p/k_e = 0 | R_p coupled, D = 8 | Q_a golden | "
               "Q_a formula (7) | Q_p golden | Q_p formula (12) | stack / pipeline frame | formula n R_p |",
               "|---|---|---|---|---|---|---|---|---|---|---|"]
-    for m in COUPLED_MATRICES:
+    kp_tab: list[str] = []
+    for m in matrices:
         p = int(m.split("x")[0])
         P = p * p
         f = sparse_render(tris, m, depth="fixed", per_record=True)
@@ -523,7 +525,6 @@ def _coupled_rows(row, out_dir: Path, scene: str = "c300") -> list[str]:
                       f"{Qa_f * Rp_f:.4f} | {sp_st:.3f} | {tf0h.sum() / tf0h.max():.3f} |")
         if m == "4x4":
             # surface parameters priced as (5): depth and RGB (k_p = 4) on the k_e = 3 edge adders
-            kp_tab = []
             for vp, s0 in (("pipeline", s_pipe), ("stack", s_st)):
                 s4 = cy.service_times(w, vp=vp, kp=4)
                 f0 = cy.coupled_matrix(s0, REF_DEPTH).frame_cycles
@@ -535,8 +536,8 @@ def _coupled_rows(row, out_dir: Path, scene: str = "c300") -> list[str]:
                     f"{REF_DEPTH} (formula: (5) on (1)'s counts, k_p/k_e = 4/3 against 0)", paper=None,
                     formula=round(ff, 4), measured=round(f4 / f0, 4), unit="ratio", source="golden")
                 kp_tab.append(f"{vp}: {f0} → {f4} cycles (×{f4 / f0:.3f}; formula ×{ff:.3f})")
-    load_tab = _load_rows(row)
-    plot = _fifo_plot(out_dir, curves)
+    load_tab = _load_rows(row, W, load_triangles)
+    plot = _fifo_plot(out_dir, curves, lab)
     return ["## The coupled matrix: FIFO sizing (golden cycle model)\n",
             f"`golden_model/sparse/cycles.py` on the golden search's per-record window counts of {lab} "
             f"(records in submission order). One geometry processor offers a record every {cy.GP_ISSUE_INTERVAL} "
@@ -552,7 +553,8 @@ def _coupled_rows(row, out_dir: Path, scene: str = "c300") -> list[str]:
             "\n".join(rp_tab) + "\n",
             "Surface parameters priced as formula (5) (4x4, FIFO depth 8): " + "; ".join(kp_tab) + ".\n",
             "## Where \"practically 100 %\" load holds (fig. 6b)\n",
-            "Frames of random triangles (`reference.random_triangles`, seed 2002, 1024 x 1024) of one mean area: "
+            f"Frames of {load_triangles} random triangles (`reference.random_triangles`, seed {SEED}, {W} x {W}) "
+            "of one mean area: "
             "at the paper's S_k and at 1000 px. R_p from the golden search's per-record counts of the frame priced "
             "as the paper prices them (formula (5) with k_p/k_e = 1, no header cycles; source `model`), beside "
             "(10) on formula (1)'s counts for the same triangles.\n",
@@ -560,28 +562,25 @@ def _coupled_rows(row, out_dir: Path, scene: str = "c300") -> list[str]:
             f"![FIFO sizing]({plot})\n"]
 
 
-#: triangles per frame of the load rows
-LOAD_TRIANGLES = 3000
-
-
-def _load_rows(row) -> list[str]:
+def _load_rows(row, W: int, ntri: int) -> list[str]:
     """R_p of frames of equal-area random triangles near S_k and at 1000 px (the paper's claim of a
     load maximum "практически до 100 %" in the neighbourhood of S = S_k)."""
     from rasterhw.golden_model.reference import random_triangles
     from rasterhw.golden_model.sparse import cycles as cy
     from rasterhw.golden_model.sparse.search import sparse_render
 
-    W = COUPLED_SIZE
     tab = ["| matrix | mean area S | R_p measured (model: (5), (10) on golden counts) | R_p formula (10) | "
            "R_p golden, our pipeline (headers, k_p = 0) |", "|---|---|---|---|---|"]
     for k in (2, 3, 4):
         p = 1 << k
-        n = M_BITS - k
+        if W // p < 2:
+            continue
         for S in (th.PAPER_S_K[k - 1], 1000.0):
-            tris = random_triangles(W, W, LOAD_TRIANGLES, mean_area=S, seed=SEED)
+            tris = random_triangles(W, W, ntri, mean_area=S, seed=SEED)
             xy = np.asarray(tris.xy)
             f = sparse_render(tris, (p, p), per_record=True)
             w = f.stats["windows_per_record"]
+            n = f.n
             B = cy.stage_cycles(w, kp=3, headers=False).sum(axis=(0, 1)).astype(float)  # k_p/k_e = 3/3
             Rm = float(B.sum() / (n * B.max()))
             Bg = cy.stage_cycles(w).sum(axis=(0, 1)).astype(float)
@@ -591,15 +590,15 @@ def _load_rows(row) -> list[str]:
             e1, e2 = xy[:, 1] - xy[:, 0], xy[:, 2] - xy[:, 0]
             Sm = float(np.mean(0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])))
             near = S < 999
-            row("fig. 6b text", f"R_p of a frame of {LOAD_TRIANGLES} random triangles of mean area {Sm:.3g} px "
-                f"({'S_k' if near else 'S = 1000'}), {p}x{p}, 1024x1024 (paper: load maximum "
+            row("fig. 6b text", f"R_p of a frame of {ntri} random triangles of mean area {Sm:.3g} px "
+                f"({'S_k' if near else 'S = 1000'}), {p}x{p}, {W}x{W} (paper: load maximum "
                 "'practically up to 100 %' near S_k)", paper=1.0 if near else None, formula=round(Rf, 4),
                 measured=round(Rm, 4), unit="", source="model")
             tab.append(f"| {p}x{p} | {Sm:.3g} ({'S_k' if near else '1000'}) | {Rm:.4f} | {Rf:.4f} | {Rg:.4f} |")
     return tab
 
 
-def _fifo_plot(out_dir: Path, curves: dict) -> str:
+def _fifo_plot(out_dir: Path, curves: dict, lab: str) -> str:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -613,7 +612,7 @@ def _fifo_plot(out_dir: Path, curves: dict) -> str:
     ax.axhline(1.0, color="k", lw=0.8, ls=":")
     ax.set_xlabel("FIFO depth D (records)")
     ax.set_ylabel("frame cycles / unbounded FIFO")
-    ax.set_title(f"coupled matrix, c300 {COUPLED_SIZE}x{COUPLED_SIZE} (golden cycle model)", fontsize=9)
+    ax.set_title(f"coupled matrix, {lab} (golden cycle model)", fontsize=9)
     ax.legend()
     fig.tight_layout()
     fig.savefig(out_dir / "sparse_fifo.png", dpi=90)
