@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 
-__all__ = ["HDL_FIFO_DEPTH", "VPCycleModel", "vp_streams", "vp_standalone"]
+__all__ = ["HDL_FIFO_DEPTH", "VPCycleModel", "coupled_matrix_vp", "vp_standalone", "vp_streams"]
 
 #: ``VideoProcessor(fifo_depth=8)``, the default every driver builds
 HDL_FIFO_DEPTH = 8
@@ -228,3 +228,62 @@ def vp_standalone(oks, news, new_px, records: int, *, fifo_depth: int = HDL_FIFO
         if c > max_cycles:
             raise RasterhwError("sparse VP cycles: runaway drain")
     return {"cycles": c + 1, "accept": acc, "tests": list(vp.tests), "stalls": list(vp.stalls)}
+
+
+def coupled_matrix_vp(frame, depth: int, *, issue_interval: int = 1, fifo_depth: int = HDL_FIFO_DEPTH,
+                      max_cycles: int = 100_000_000) -> dict:
+    """The coupled matrix of :mod:`.cycles` (same broadcast, FIFO and counting rules) with every
+    processor the HDL video processor as built (:class:`VPCycleModel`) instead of a server: a
+    processor takes the record at the head of its matrix FIFO on a cycle on which its set-up is
+    idle (``i.ready``), and ``busy`` is the HDL's ``busy`` output. ``frame`` must be drawn with
+    ``trace=True``. Returns the keys of :meth:`~.cycles.CoupledResult.as_dict` plus ``accept``
+    ((P, T) cycle each processor took each record) and ``broadcast`` ((T,))."""
+    from rasterhw.golden_model.sparse.cycles import _check_int
+
+    D = _check_int("FIFO depth", depth, 1)
+    g = _check_int("issue interval", issue_interval, 1)
+    P = frame.p * frame.q
+    T = frame.triangles
+    vps = [VPCycleModel(*vp_streams(frame, k), fifo_depth=fifo_depth) for k in range(P)]
+    lev = [0] * P
+    peak = [0] * P
+    busy = [0] * P
+    acc = np.zeros((P, T), dtype=np.int64)
+    taken = [0] * P
+    bc = np.zeros(T, dtype=np.int64)
+    offer = np.zeros(T, dtype=np.int64)
+    t = 0
+    o = 0
+    c = 0
+    while True:
+        vb = [vp.busy for vp in vps]
+        if t == T and not any(lev) and not any(vb):
+            break
+        push = t < T and c >= o and max(lev) < D
+        for k in range(P):
+            if vb[k]:
+                busy[k] += 1
+            valid = lev[k] > 0
+            if not valid and not vb[k]:
+                continue  # an idle processor with nothing offered keeps its state
+            if vps[k].step(valid):
+                acc[k, taken[k]] = c
+                taken[k] += 1
+                lev[k] -= 1
+        if push:
+            offer[t], bc[t] = o, c
+            t += 1
+            o = c + g
+            for k in range(P):
+                lev[k] += 1
+                if lev[k] > peak[k]:
+                    peak[k] = lev[k]
+        c += 1
+        if c > max_cycles:
+            raise RasterhwError("sparse VP cycles: runaway coupled frame")
+    busy_a = np.array(busy, dtype=np.int64)
+    peak_a = np.array(peak, dtype=np.int64)
+    return {"frame_cycles": c, "stall_cycles": int((bc - offer).sum()), "fifo_peak": peak_a.tolist(),
+            "fifo_peak_max": int(peak_a.max(initial=0)), "busy": busy_a.tolist(), "idle": (c - busy_a).tolist(),
+            "depth": D, "issue_interval": g, "accept": acc, "broadcast": bc,
+            "tests": [vp.tests for vp in vps], "stalls": [vp.stalls for vp in vps]}

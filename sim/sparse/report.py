@@ -344,8 +344,8 @@ def _hdl_rows(row, engine: str, progress: bool, hdl_scene=None) -> list[str]:
         formula=1.0, measured=round(r["cycles"] / r["max_stage_tests_per_processor"], 4), unit="ratio", source=src)
     return ["## HDL cycles\n",
             f"`rasterhw sim sparse` run inside this report ({engine}): {label}, 4x4, every processor; "
-            f"{r['cycles']} cycles for the slowest processor, {r['sim_cycles']} cycles simulated in all at "
-            f"{r['cycles_per_s']} cycles/s; busy cycles (coverage tests) per level summed over processors: "
+            f"{r['cycles']} cycles for the slowest processor, {r['sim_cycles']} cycles simulated in all (the "
+            "simulation rate is a `rasterhw bench` figure, not a table's); busy cycles (coverage tests) per level summed over processors: "
             f"{r['tests_per_level_hdl']}. A stage makes one coverage test per busy cycle (τ = 1 cycle) and takes "
             "the next window in the cycle of its last test; the frame still takes a little more than its busiest "
             "stage's tests: a triangle's header costs one cycle at every level where it has survivors, and a "
