@@ -96,13 +96,13 @@ class VPCycleModel:
         self.stalls = [0] * n
         self.px_next = 0
         self.v1 = self.v2 = False
-        self.writes_seen = 0
+        self.held = 0
+        self.active = 0
 
     @property
     def busy(self) -> bool:
-        if self.setup or self.v1 or self.v2 or any(self.st):
-            return True
-        return any(self.wl) or any(self.wv) or any(self.hl) or any(self.hv)
+        # held: entries in all FIFOs (inner levels plus output registers); active: stages in TEST
+        return bool(self.setup or self.v1 or self.v2 or self.held or self.active)
 
     def step(self, in_valid: bool) -> bool:
         n, cap = self.n, self.cap
@@ -188,6 +188,7 @@ class VPCycleModel:
         self.v2 = self.v1
         self.v1 = take
         # ---- FIFOs (the edge)
+        held = 0
         for k in range(n + 1):
             for lv, vv, wen, ren in ((wl, wv, w_wen[k], w_ren[k]), (hl, hv, h_wen[k], h_ren[k])):
                 lev = lv[k]
@@ -197,9 +198,13 @@ class VPCycleModel:
                     vv[k] = True
                 elif ren:
                     vv[k] = False
-                lv[k] = lev + (1 if do_write else 0) - (1 if do_inner_read else 0)
+                lev += (1 if do_write else 0) - (1 if do_inner_read else 0)
+                lv[k] = lev
+                held += lev + vv[k]
+        self.held = held
         self.setup = setup_next
         self.st = st_next
+        self.active = sum(st_next)
         return accepted
 
 

@@ -42,7 +42,7 @@ def _fmt_ci(r: mc.MCResult, i: int) -> str:
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path("docs/reproduction"),
          samples: int = 20000, scenes: tuple[str, ...] = ("c300", "sp27"), s_grid: tuple[float, ...] = S_GRID,
          coupled_size: int = 1 << M_BITS, coupled_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8", "16x16"),
-         load_triangles: int = 3000, **known):
+         load_triangles: int = 3000, coupled_vp_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8"), **known):
     """Rows and markdown sections of the sparse-raster report (see the module docstring)."""
     M = int(samples)
     S_GRID = tuple(s_grid)  # noqa: N806 (the module default, narrowed by tests)
@@ -244,7 +244,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
 
     # ---------------------------------------------------------------- the coupled matrix (golden)
     coupled_sec = _coupled_rows(row, out_dir, size=coupled_size, matrices=coupled_matrices,
-                                load_triangles=load_triangles)
+                                load_triangles=load_triangles, vp_matrices=coupled_vp_matrices)
 
     # ---------------------------------------------------------------- plots
     plots = _plots(out_dir, spr, mono, Sg, S_GRID)
@@ -342,6 +342,14 @@ def _hdl_rows(row, engine: str, progress: bool, hdl_scene=None) -> list[str]:
         measured=round(Rh, 4), unit="", source=src)
     row("(9) / HDL", f"{label}, 4x4: frame cycles (slowest processor) / busiest stage's tests", paper=None,
         formula=1.0, measured=round(r["cycles"] / r["max_stage_tests_per_processor"], 4), unit="ratio", source=src)
+    from rasterhw.golden_model.sparse.search import sparse_render
+    from rasterhw.golden_model.sparse.vpcycles import vp_standalone, vp_streams
+
+    gf = sparse_render(tris, (p, p), depth="fixed", trace=True)
+    model_cycles = max(vp_standalone(*vp_streams(gf, k), gf.triangles)["cycles"] for k in range(p * p))
+    row("HDL", f"{label}, 4x4: slowest processor's cycles, HDL minus the golden cycle model of the video processor "
+        f"(golden_model/sparse/vpcycles.py: {model_cycles} cycles; 0 = cycle-exact)", paper=None, formula=0,
+        measured=int(r["cycles"]) - model_cycles, unit="cycles", source=src)
     return ["## HDL cycles\n",
             f"`rasterhw sim sparse` run inside this report ({engine}): {label}, 4x4, every processor; "
             f"{r['cycles']} cycles for the slowest processor, {r['sim_cycles']} cycles simulated in all (the "
@@ -431,7 +439,7 @@ REF_DEPTH = 8
 
 
 def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], load_triangles: int,
-                  scene: str = "c300") -> list[str]:
+                  vp_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8"), scene: str = "c300") -> list[str]:
     """Frame cycles against FIFO depth, R_p and Q_p from busy cycles, the stack processor and the
     k_p/k_e cost: :mod:`rasterhw.golden_model.sparse.cycles` on the golden search's per-record
     window counts of ``scene`` at ``size`` x ``size`` (the paper's 1024 x 1024 in the report)."""
@@ -536,6 +544,7 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
                     f"{REF_DEPTH} (formula: (5) on (1)'s counts, k_p/k_e = 4/3 against 0)", paper=None,
                     formula=round(ff, 4), measured=round(f4 / f0, 4), unit="ratio", source="golden")
                 kp_tab.append(f"{vp}: {f0} → {f4} cycles (×{f4 / f0:.3f}; formula ×{ff:.3f})")
+    vp_tab = _coupled_vp_rows(row, tris, lab, vp_matrices)
     load_tab = _load_rows(row, W, load_triangles)
     plot = _fifo_plot(out_dir, curves, lab)
     return ["## The coupled matrix: FIFO sizing (golden cycle model)\n",
@@ -552,6 +561,13 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
             f"prices it. Coupled R_p at FIFO depth {REF_DEPTH}.\n",
             "\n".join(rp_tab) + "\n",
             "Surface parameters priced as formula (5) (4x4, FIFO depth 8): " + "; ".join(kp_tab) + ".\n",
+            "## The coupled matrix with the HDL video processors (golden cycle model of the processor as built)\n",
+            "`vpcycles.coupled_matrix_vp`: the same broadcast, FIFO and counting rules, each processor the cycle "
+            "model of `hdl/sparse/vp.py` (set-up FSM, level stages, eight-entry inner FIFOs, pixel processor), "
+            "which equals the HDL cycle for cycle (pysim tests; Verilator per-processor cycles in the HDL rows). "
+            "The processor buffers records in its inner FIFOs, so its input FIFO matters far less than for a "
+            "processor that holds one record at a time.\n",
+            "\n".join(vp_tab) + "\n",
             "## Where \"practically 100 %\" load holds (fig. 6b)\n",
             f"Frames of {load_triangles} random triangles (`reference.random_triangles`, seed {SEED}, {W} x {W}) "
             "of one mean area: "
@@ -560,6 +576,34 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
             "(10) on formula (1)'s counts for the same triangles.\n",
             "\n".join(load_tab) + "\n",
             f"![FIFO sizing]({plot})\n"]
+
+
+def _coupled_vp_rows(row, tris, lab: str, matrices: tuple[str, ...]) -> list[str]:
+    """Frame cycles, stalls and FIFO peaks of the coupled matrix whose processors are the HDL video
+    processor's cycle model, at FIFO depths 1 and 64 (and 8 on 4x4)."""
+    from rasterhw.golden_model.sparse.search import sparse_render
+    from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
+
+    tab = ["| matrix | FIFO depth D | frame cycles | broadcast stall cycles | FIFO peak (max) | "
+           "processor busy / frame, least loaded |", "|---|---|---|---|---|---|"]
+    for m in matrices:
+        f = sparse_render(tris, m, depth="fixed", trace=True)
+        fr = {}
+        for D in ((1, 8, 64) if m == "4x4" else (1, 64)):
+            r = coupled_matrix_vp(f, D)
+            fr[D] = r["frame_cycles"]
+            tab.append(f"| {m} | {D} | {r['frame_cycles']} | {r['stall_cycles']} | {r['fifo_peak_max']} | "
+                       f"{min(r['busy']) / r['frame_cycles']:.3f} |")
+            row("FIFO sizing (coupled, HDL VPs)", f"{lab}, {m}: frame cycles, FIFO depth {D} (video processors: "
+                "the HDL's cycle model)", paper=None, formula=None, measured=r["frame_cycles"], unit="cycles",
+                source="golden")
+            row("FIFO sizing (coupled, HDL VPs)", f"{lab}, {m}: broadcast stall cycles, FIFO depth {D}",
+                paper=None, formula=None, measured=r["stall_cycles"], unit="cycles", source="golden")
+            row("FIFO sizing (coupled, HDL VPs)", f"{lab}, {m}: largest FIFO peak, FIFO depth {D} (never above D)",
+                paper=None, formula=None, measured=r["fifo_peak_max"], unit="entries", source="golden")
+        row("FIFO sizing (coupled, HDL VPs)", f"{lab}, {m}: frame with FIFO depth 1 / with depth 64", paper=None,
+            formula=None, measured=round(fr[1] / fr[64], 5), unit="ratio", source="golden")
+    return tab
 
 
 def _load_rows(row, W: int, ntri: int) -> list[str]:

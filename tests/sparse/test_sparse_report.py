@@ -13,7 +13,8 @@ def report(tmp_path_factory):
 
     out = tmp_path_factory.mktemp("sparse_report")
     return rows(samples=100, out_dir=out, scenes=("sp8",), s_grid=(0.1, 1.8, 10.0, 23.3, 100.0, 157.0, 1000.0),
-                engine="none", coupled_size=64, coupled_matrices=("2x2",), load_triangles=40), out
+                engine="none", coupled_size=64, coupled_matrices=("2x2",), load_triangles=40,
+                coupled_vp_matrices=("2x2",)), out
     # HDL rows: tests/sparse/test_sparse_vp_*.py; the coupled rows at a useful size: the fixture below
 
 
@@ -87,20 +88,23 @@ def coupled(tmp_path_factory):
         out.append(make_row("sparse", fig, qty, **kw))
 
     d = Path(tmp_path_factory.mktemp("sparse_coupled"))
-    sec = _coupled_rows(row, d, size=256, matrices=("2x2", "4x4", "8x8"), load_triangles=300)
+    sec = _coupled_rows(row, d, size=128, matrices=("2x2", "4x4", "8x8"), load_triangles=300,
+                        vp_matrices=("4x4",))
     return out, sec, d
 
 
 def test_coupled_rows_frame_against_fifo_depth(coupled):
     rows, sec, d = coupled
     for m in ("2x2", "4x4", "8x8"):
-        fr = [r for r in rows if r["quantity"].startswith(f"c300 256x256, {m}: frame cycles, FIFO depth")]
+        fr = [r for r in rows if r["quantity"].startswith(f"c300 128x128, {m}: frame cycles, FIFO depth")
+              and r["figure"] == "FIFO sizing (coupled)"]
         assert len(fr) == 7 and all(r["source"] == "golden" and r["formula"] is None for r in fr)
         vals = [r["measured"] for r in fr]
         assert vals == sorted(vals, reverse=True) and vals[0] > vals[-1]
-        st = [r for r in rows if r["quantity"].startswith(f"c300 256x256, {m}: broadcast stall cycles")]
+        st = [r for r in rows if r["quantity"].startswith(f"c300 128x128, {m}: broadcast stall cycles")
+              and r["figure"] == "FIFO sizing (coupled)"]
         assert st[0]["measured"] > 0
-        ratio = [r for r in rows if r["quantity"].startswith(f"c300 256x256, {m}: stack frame / pipeline frame")]
+        ratio = [r for r in rows if r["quantity"].startswith(f"c300 128x128, {m}: stack frame / pipeline frame")]
         assert ratio[0]["measured"] > 1 and ratio[0]["formula"] > 1
     assert (d / "sparse_fifo.png").stat().st_size > 10000 and any("sparse_fifo.png" in s for s in sec)
     for key in ("R_p = sum_i", "R_p of the coupled frame", "Q_a = T_mono", "Q_p = Q_a R_p"):
@@ -117,3 +121,15 @@ def test_load_is_highest_near_s_k(coupled):
     for near, far in zip(load[::2], load[1::2], strict=True):
         assert near["paper"] == 1.0 and far["paper"] is None
         assert near["measured"] > far["measured"] and near["formula"] > far["formula"]
+
+
+def test_coupled_rows_with_the_hdl_processors(coupled):
+    rows, sec, _ = coupled
+    got = {r["quantity"].split(": ", 1)[1]: r for r in rows if r["figure"] == "FIFO sizing (coupled, HDL VPs)"}
+    assert len(got) == 10  # 4x4: three depths x (frame, stalls, peak) + the ratio
+    for D in (1, 8, 64):
+        assert got[f"largest FIFO peak, FIFO depth {D} (never above D)"]["measured"] <= D
+        assert got[f"frame cycles, FIFO depth {D} (video processors: the HDL's cycle model)"]["measured"] > 0
+    assert got["broadcast stall cycles, FIFO depth 1"]["measured"] > 0
+    assert got["frame with FIFO depth 1 / with depth 64"]["measured"] >= 1.0
+    assert any("HDL video processors" in s for s in sec)
