@@ -26,5 +26,6 @@ MACHINE = Machine(
     report="rasterhw.sim.sparse.report:rows",
     bench="rasterhw.sim.sparse.bench:bench",
     status="golden model (image = reference), formulas (1)-(12), Monte-Carlo window counts, figs. 3-6; "
-           "video processor in Amaranth, bit-exact in pysim and Verilator",
+           "video processor in Amaranth, bit-exact in pysim and Verilator; golden cycle models of the coupled "
+           "matrix (FIFO sizing), of the HDL video processor (cycle-exact) and of a stack-based processor",
 )
