@@ -42,7 +42,8 @@ def _fmt_ci(r: mc.MCResult, i: int) -> str:
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path("docs/reproduction"),
          samples: int = 20000, scenes: tuple[str, ...] = ("c300", "sp27"), s_grid: tuple[float, ...] = S_GRID,
          coupled_size: int = 1 << M_BITS, coupled_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8", "16x16"),
-         load_triangles: int = 3000, coupled_vp_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8"), **known):
+         load_triangles: int = 3000, coupled_vp_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8"),
+         stack_size: int = 512, **known):
     """Rows and markdown sections of the sparse-raster report (see the module docstring)."""
     M = int(samples)
     S_GRID = tuple(s_grid)  # noqa: N806 (the module default, narrowed by tests)
@@ -244,7 +245,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
 
     # ---------------------------------------------------------------- the coupled matrix (golden)
     coupled_sec = _coupled_rows(row, out_dir, size=coupled_size, matrices=coupled_matrices,
-                                load_triangles=load_triangles, vp_matrices=coupled_vp_matrices)
+                                load_triangles=load_triangles, vp_matrices=coupled_vp_matrices,
+                                stack_size=stack_size)
 
     # ---------------------------------------------------------------- plots
     plots = _plots(out_dir, spr, mono, Sg, S_GRID)
@@ -439,7 +441,8 @@ REF_DEPTH = 8
 
 
 def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], load_triangles: int,
-                  vp_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8"), scene: str = "c300") -> list[str]:
+                  vp_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8"), stack_size: int = 512,
+                  scene: str = "c300") -> list[str]:
     """Frame cycles against FIFO depth, R_p and Q_p from busy cycles, the stack processor and the
     k_p/k_e cost: :mod:`rasterhw.golden_model.sparse.cycles` on the golden search's per-record
     window counts of ``scene`` at ``size`` x ``size`` (the paper's 1024 x 1024 in the report)."""
@@ -545,6 +548,7 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
                     formula=round(ff, 4), measured=round(f4 / f0, 4), unit="ratio", source="golden")
                 kp_tab.append(f"{vp}: {f0} → {f4} cycles (×{f4 / f0:.3f}; formula ×{ff:.3f})")
     vp_tab = _coupled_vp_rows(row, tris, lab, vp_matrices)
+    stack_txt = _stack_rows(row, scene, stack_size)
     load_tab = _load_rows(row, W, load_triangles)
     plot = _fifo_plot(out_dir, curves, lab)
     return ["## The coupled matrix: FIFO sizing (golden cycle model)\n",
@@ -568,6 +572,7 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
             "The processor buffers records in its inner FIFOs, so its input FIFO matters far less than for a "
             "processor that holds one record at a time.\n",
             "\n".join(vp_tab) + "\n",
+            "## The stack-based processor's golden model\n", stack_txt,
             "## Where \"practically 100 %\" load holds (fig. 6b)\n",
             f"Frames of {load_triangles} random triangles (`reference.random_triangles`, seed {SEED}, {W} x {W}) "
             "of one mean area: "
@@ -604,6 +609,40 @@ def _coupled_vp_rows(row, tris, lab: str, matrices: tuple[str, ...]) -> list[str
         row("FIFO sizing (coupled, HDL VPs)", f"{lab}, {m}: frame with FIFO depth 1 / with depth 64", paper=None,
             formula=None, measured=round(fr[1] / fr[64], 5), unit="ratio", source="golden")
     return tab
+
+
+def _stack_rows(row, scene: str, size: int) -> str:
+    """Every processor of a 4x4 matrix as a stack processor (depth first) on ``scene`` at ``size``:
+    image against the breadth-first golden search, its stack depth, its cycles against the stack
+    cycle model."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.sparse.cycles import service_times
+    from rasterhw.golden_model.sparse.search import sparse_render
+    from rasterhw.golden_model.sparse.stack import stack_processor
+
+    tris = run_geometry(build_scene(scene), size, size)
+    p = 4
+    f = sparse_render(tris, (p, p), depth="fixed", per_record=True)
+    gz = np.where(f.tri_id >= 0, np.rint(f.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    s = service_times(f.stats["windows_per_record"], vp="stack")
+    diff, same_cycles, deepest, n = 0, True, 0, f.n
+    for b in range(p):
+        for a in range(p):
+            r = stack_processor(tris, (p, p), a, b)
+            diff += int(np.count_nonzero((r["tri"] != f.local_tri[b, a]) | (r["zq"] != gz[b::p, a::p])))
+            same_cycles &= bool(np.array_equal(r["cycles"], s[b * p + a]))
+            deepest = max(deepest, r["max_stack"])
+    lab = f"{scene} {size}x{size}, 4x4"
+    row("(8) / stack", f"{lab}: pixels of the stack processors' local memories differing from the breadth-first "
+        f"golden search (of {f.tri_id.size})", paper=None, formula=0, measured=diff, unit="pixels", source="golden")
+    row("(8) / stack", f"{lab}: stack processors' cycles per record equal the stack cycle model (1 = yes)",
+        paper=None, formula=1, measured=int(same_cycles), unit="", source="golden")
+    row("(8) / stack", f"{lab}: deepest stack over every processor and record (formula: the bound 3 (n - 1) + 1)",
+        paper=None, formula=3 * (n - 1) + 1, measured=deepest, unit="entries", source="golden")
+    return (f"`golden_model/sparse/stack.py` ran every processor of {lab} depth first: {diff} pixels differ from the "
+            f"breadth-first search, its per-record cycles {'equal' if same_cycles else 'DIFFER from'} the stack "
+            f"cycle model's, and the deepest stack held {deepest} windows (bound {3 * (n - 1) + 1}).\n")
 
 
 def _load_rows(row, W: int, ntri: int) -> list[str]:

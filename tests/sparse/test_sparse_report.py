@@ -14,7 +14,7 @@ def report(tmp_path_factory):
     out = tmp_path_factory.mktemp("sparse_report")
     return rows(samples=100, out_dir=out, scenes=("sp8",), s_grid=(0.1, 1.8, 10.0, 23.3, 100.0, 157.0, 1000.0),
                 engine="none", coupled_size=64, coupled_matrices=("2x2",), load_triangles=40,
-                coupled_vp_matrices=("2x2",)), out
+                coupled_vp_matrices=("2x2",), stack_size=64), out
     # HDL rows: tests/sparse/test_sparse_vp_*.py; the coupled rows at a useful size: the fixture below
 
 
@@ -89,7 +89,7 @@ def coupled(tmp_path_factory):
 
     d = Path(tmp_path_factory.mktemp("sparse_coupled"))
     sec = _coupled_rows(row, d, size=128, matrices=("2x2", "4x4", "8x8"), load_triangles=300,
-                        vp_matrices=("4x4",))
+                        vp_matrices=("4x4",), stack_size=64)
     return out, sec, d
 
 
@@ -133,3 +133,12 @@ def test_coupled_rows_with_the_hdl_processors(coupled):
     assert got["broadcast stall cycles, FIFO depth 1"]["measured"] > 0
     assert got["frame with FIFO depth 1 / with depth 64"]["measured"] >= 1.0
     assert any("HDL video processors" in s for s in sec)
+
+
+def test_stack_rows(coupled):
+    rows, sec, _ = coupled
+    got = [r for r in rows if r["figure"] == "(8) / stack"]
+    assert len(got) == 3 and all(r["source"] == "golden" for r in got)
+    assert got[0]["measured"] == 0 and got[1]["measured"] == 1
+    assert 1 < got[2]["measured"] <= got[2]["formula"]
+    assert any("depth first" in s for s in sec)
