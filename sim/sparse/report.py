@@ -549,6 +549,7 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
                 kp_tab.append(f"{vp}: {f0} → {f4} cycles (×{f4 / f0:.3f}; formula ×{ff:.3f})")
     vp_tab = _coupled_vp_rows(row, tris, lab, vp_matrices)
     stack_txt = _stack_rows(row, scene, stack_size)
+    gp_tab = _gp_rate_rows(row, scene, stack_size)
     load_tab = _load_rows(row, W, load_triangles)
     plot = _fifo_plot(out_dir, curves, lab)
     return ["## The coupled matrix: FIFO sizing (golden cycle model)\n",
@@ -572,6 +573,12 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
             "The processor buffers records in its inner FIFOs, so its input FIFO matters far less than for a "
             "processor that holds one record at a time.\n",
             "\n".join(vp_tab) + "\n",
+            "## A geometry processor only as fast as the matrix\n",
+            "The GP issue interval is ours. With g = 1 the GP is never the bottleneck; here it offers a record "
+            "every g = ceil(slowest processor alone / records) cycles, the matrix's mean rate, so the FIFOs must "
+            "also absorb the processors' record-to-record variation against the GP (the paper: the queues "
+            "\"способствует ослаблению связей ... между матрицей и геометрическим процессором\").\n",
+            "\n".join(gp_tab) + "\n",
             "## The stack-based processor's golden model\n", stack_txt,
             "## Where \"practically 100 %\" load holds (fig. 6b)\n",
             f"Frames of {load_triangles} random triangles (`reference.random_triangles`, seed {SEED}, {W} x {W}) "
@@ -608,6 +615,33 @@ def _coupled_vp_rows(row, tris, lab: str, matrices: tuple[str, ...]) -> list[str
                 paper=None, formula=None, measured=r["fifo_peak_max"], unit="entries", source="golden")
         row("FIFO sizing (coupled, HDL VPs)", f"{lab}, {m}: frame with FIFO depth 1 / with depth 64", paper=None,
             formula=None, measured=round(fr[1] / fr[64], 5), unit="ratio", source="golden")
+    return tab
+
+
+def _gp_rate_rows(row, scene: str, size: int) -> list[str]:
+    """Frame cycles against FIFO depth with the GP issuing at the matrix's mean rate (4x4), for the
+    pipeline-as-server model and for the HDL video processors' cycle model."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.sparse.cycles import matrix_cycles
+    from rasterhw.golden_model.sparse.search import sparse_render
+    from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
+
+    tris = run_geometry(build_scene(scene), size, size)
+    f = sparse_render(tris, "4x4", depth="fixed", trace=True, per_record=True)
+    alone = matrix_cycles(f, f.triangles)["slowest_alone"]
+    g = -(-alone // f.triangles)
+    lab = f"{scene} {size}x{size}, 4x4, GP issue interval {g} (= ceil({alone} / {f.triangles}), ours)"
+    tab = [f"{lab}; the GP alone needs {g * f.triangles} cycles.\n", "| FIFO depth D | frame, pipeline as server | "
+           "stall cycles | frame, HDL video processors | stall cycles |", "|---|---|---|---|---|"]
+    for D in (1, 4, 16, 64):
+        sv = matrix_cycles(f, D, issue_interval=g)
+        hv = coupled_matrix_vp(f, D, issue_interval=g)
+        tab.append(f"| {D} | {sv['frame_cycles']} | {sv['stall_cycles']} | {hv['frame_cycles']} | "
+                   f"{hv['stall_cycles']} |")
+        for name, r in (("pipeline VPs as servers", sv), ("HDL video processors' cycle model", hv)):
+            row("FIFO sizing (GP at the matrix's rate)", f"{lab}: frame cycles, FIFO depth {D}, {name}", paper=None,
+                formula=None, measured=r["frame_cycles"], unit="cycles", source="golden")
     return tab
 
 

@@ -142,3 +142,11 @@ def test_stack_rows(coupled):
     assert got[0]["measured"] == 0 and got[1]["measured"] == 1
     assert 1 < got[2]["measured"] <= got[2]["formula"]
     assert any("depth first" in s for s in sec)
+
+
+def test_gp_rate_rows(coupled):
+    rows, _, _ = coupled
+    got = [r for r in rows if r["figure"] == "FIFO sizing (GP at the matrix's rate)"]
+    assert len(got) == 8 and all(r["source"] == "golden" and r["measured"] > 0 for r in got)
+    server = [r["measured"] for r in got if "as servers" in r["quantity"]]
+    assert server == sorted(server, reverse=True)  # deeper FIFOs never slow the frame
