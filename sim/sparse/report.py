@@ -43,7 +43,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
          samples: int = 20000, scenes: tuple[str, ...] = ("c300", "sp27"), s_grid: tuple[float, ...] = S_GRID,
          coupled_size: int = 1 << M_BITS, coupled_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8", "16x16"),
          load_triangles: int = 3000, coupled_vp_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8"),
-         stack_size: int = 512, **known):
+         stack_size: int = 512, coupled_scene: str = "c300", **known):
     """Rows and markdown sections of the sparse-raster report (see the module docstring)."""
     M = int(samples)
     S_GRID = tuple(s_grid)  # noqa: N806 (the module default, narrowed by tests)
@@ -246,7 +246,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     # ---------------------------------------------------------------- the coupled matrix (golden)
     coupled_sec = _coupled_rows(row, out_dir, size=coupled_size, matrices=coupled_matrices,
                                 load_triangles=load_triangles, vp_matrices=coupled_vp_matrices,
-                                stack_size=stack_size)
+                                stack_size=stack_size, scene=coupled_scene)
 
     # ---------------------------------------------------------------- plots
     plots = _plots(out_dir, spr, mono, Sg, S_GRID)

@@ -14,7 +14,7 @@ def report(tmp_path_factory):
     out = tmp_path_factory.mktemp("sparse_report")
     return rows(samples=100, out_dir=out, scenes=("sp8",), s_grid=(0.1, 1.8, 10.0, 23.3, 100.0, 157.0, 1000.0),
                 engine="none", coupled_size=64, coupled_matrices=("2x2",), load_triangles=40,
-                coupled_vp_matrices=("2x2",), stack_size=64), out
+                coupled_vp_matrices=("2x2",), stack_size=64, coupled_scene="c50"), out
     # HDL rows: tests/sparse/test_sparse_vp_*.py; the coupled rows at a useful size: the fixture below
 
 
@@ -89,22 +89,22 @@ def coupled(tmp_path_factory):
 
     d = Path(tmp_path_factory.mktemp("sparse_coupled"))
     sec = _coupled_rows(row, d, size=128, matrices=("2x2", "4x4", "8x8"), load_triangles=300,
-                        vp_matrices=("4x4",), stack_size=64)
+                        vp_matrices=("4x4",), stack_size=64, scene="c50")
     return out, sec, d
 
 
 def test_coupled_rows_frame_against_fifo_depth(coupled):
     rows, sec, d = coupled
     for m in ("2x2", "4x4", "8x8"):
-        fr = [r for r in rows if r["quantity"].startswith(f"c300 128x128, {m}: frame cycles, FIFO depth")
+        fr = [r for r in rows if r["quantity"].startswith(f"c50 128x128, {m}: frame cycles, FIFO depth")
               and r["figure"] == "FIFO sizing (coupled)"]
         assert len(fr) == 7 and all(r["source"] == "golden" and r["formula"] is None for r in fr)
         vals = [r["measured"] for r in fr]
         assert vals == sorted(vals, reverse=True) and vals[0] > vals[-1]
-        st = [r for r in rows if r["quantity"].startswith(f"c300 128x128, {m}: broadcast stall cycles")
+        st = [r for r in rows if r["quantity"].startswith(f"c50 128x128, {m}: broadcast stall cycles")
               and r["figure"] == "FIFO sizing (coupled)"]
         assert st[0]["measured"] > 0
-        ratio = [r for r in rows if r["quantity"].startswith(f"c300 128x128, {m}: stack frame / pipeline frame")]
+        ratio = [r for r in rows if r["quantity"].startswith(f"c50 128x128, {m}: stack frame / pipeline frame")]
         assert ratio[0]["measured"] > 1 and ratio[0]["formula"] > 1
     assert (d / "sparse_fifo.png").stat().st_size > 10000 and any("sparse_fifo.png" in s for s in sec)
     for key in ("R_p = sum_i", "R_p of the coupled frame", "Q_a = T_mono", "Q_p = Q_a R_p"):
