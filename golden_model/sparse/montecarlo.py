@@ -52,12 +52,18 @@ class MCResult:
         return self.mean + self.half95
 
 
-def rectangles(S, M: int, *, aspect: float = 5.0, seed: int = 0, rng=None) -> np.ndarray:
-    """``M`` rectangles of area ``S`` and sides ``aspect : 1`` at random rotation, centred at a
-    random point of the unit square (scaled by the caller), CCW: ``(M, 4, 2)``. The shape and the
-    random numbers depend on ``seed`` only, so counts are monotone in ``S`` for a fixed seed."""
+def rectangles(S, M: int, *, aspect: float = 5.0, seed: int = 0, rng=None,
+               rotation: float | None = None) -> np.ndarray:
+    """``M`` rectangles of area ``S`` and sides ``aspect : 1`` at random rotation (or at the fixed
+    angle ``rotation``, radians), centred at a random point of the unit square (scaled by the
+    caller), CCW: ``(M, 4, 2)``. The shape and the random numbers depend on ``seed`` only, so
+    counts are monotone in ``S`` for a fixed seed."""
     rng = np.random.default_rng(seed) if rng is None else rng
     theta = rng.random(M) * math.pi
+    if rotation is not None:
+        if not math.isfinite(rotation):
+            raise RasterhwError(f"sparse Monte-Carlo: rotation must be a finite angle, not {rotation!r}")
+        theta = np.full(M, float(rotation))
     off = rng.random((M, 2))
     a = math.sqrt(S * aspect) / 2.0
     b = math.sqrt(S / aspect) / 2.0
@@ -198,8 +204,9 @@ def level_counts(poly: np.ndarray, off: np.ndarray, n: int, p: int, q: int | Non
 
 
 def s_k_measured(k: int, *, m: int = 10, alpha: float = 2.0, aspect: float = 5.0, M: int = 20000,
-                 seed: int = 0, test: str = "exact") -> tuple[float, float, float]:
-    """The area where the measured pixel-level count is 1 (5:1 rectangles, ``p = q = 2**k``).
+                 seed: int = 0, test: str = "exact", rotation: float | None = None) -> tuple[float, float, float]:
+    """The area where the measured pixel-level count is 1 (5:1 rectangles, ``p = q = 2**k``;
+    ``rotation``: one fixed angle instead of uniform rotations).
 
     Bisection on the sample mean (monotone in S for fixed random numbers); the 95 % interval by
     the delta method, ``S_k -+ 1.96 sd(w_n) / (sqrt(M) dw_n/dS)``. Returns ``(S_k, lo, hi)``.
@@ -209,7 +216,7 @@ def s_k_measured(k: int, *, m: int = 10, alpha: float = 2.0, aspect: float = 5.0
     Px, Py, hx, hy = level_geometry(n, n, p, p, alpha, alpha)
 
     def stats(S):
-        poly, off = rectangles(max(S, 1e-12), M, aspect=aspect, seed=seed)
+        poly, off = rectangles(max(S, 1e-12), M, aspect=aspect, seed=seed, rotation=rotation)
         c = count_windows(poly + off[:, None, :] * np.array([Px, Py]) * 4, Px, Py, hx, hy, test=test)
         return c.mean(), c.std(ddof=1)
 

@@ -171,7 +171,8 @@ def _check_aperture(name: str, v) -> int:
 
 
 def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: int = 2,
-                  test: str = "exact", depth: str = "float", background=(0.0, 0.0, 0.0)) -> SparseFrame:
+                  test: str = "exact", depth: str = "float", background=(0.0, 0.0, 0.0),
+                  per_record: bool = False, trace: bool = False) -> SparseFrame:
     """Draw ``tris`` with a ``p x q`` matrix of video processors by recursive pixel search.
 
     Parameters
@@ -185,6 +186,13 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
         polygon" count) or ``"edges"`` (the three edges only). Same image either way.
     depth : ``"float"`` (reference arithmetic, bit-identical image) or ``"fixed"`` (quantised
         depth as a fixed-point plane, the bit-accurate layer).
+    per_record : also keep ``stats["windows_per_record"]``, ``(p*q, T, n + 1)`` int32: the windows
+        leaving each level for every (processor, broadcast record) pair (level 0: the root, 1;
+        level n: pixels passing the point test), what the cycle models of :mod:`.cycles` price.
+    trace : also keep ``stats["trace"]``: for every level ``i`` (list index ``i - 1``) the windows
+        entering it in the order a processor's stage takes them, as ``(proc (R,), rt (R,), ok (R, 4))``
+        (``ok``: which of the four sub-windows survive, in the order ``(0,0), (1,0), (0,1), (1,1)``);
+        what the video processor's cycle model (:mod:`.vpcycles`) steps through.
     """
     p, q = parse_matrix(matrix)
     W, H = tris.width, tris.height
@@ -218,6 +226,10 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
     tpp = np.zeros((P, n + 1), dtype=np.int64)
     windows[0] = rt.size
     wpp[:, 0] = T
+    wrec = np.zeros((P, T, n + 1), dtype=np.int32) if per_record else None
+    if per_record:
+        wrec[:, :, 0] = 1
+    tr: list = []
     thr_all = es.thr
     ext_all = (np.abs(es.A) * al + np.abs(es.B) * be) // 2  # aperture growth, exact (A, B even)
     ap_n = 0
@@ -258,12 +270,16 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
             ok_ap = ((E4 + ext_all[:, rt4]) >= thr).all(axis=0) & inbox
             ap_n = int(np.count_nonzero(ok_ap))
             ok = (E4 >= thr).all(axis=0)
+        if trace:
+            tr.append((proc, rt, ok.reshape(R, 4)))
         keep = np.flatnonzero(ok)
         rt, proc = rt4[keep], proc4[keep]
         E, Ap, Bp = E4[:, keep], Ap4[:, keep], Bp4[:, keep]
         u0, v0 = u4[keep], v4[keep]
         windows[i] = rt.size
         wpp[:, i] = np.bincount(proc, minlength=P)
+        if per_record:
+            wrec[:, :, i] = np.bincount(rt * P + proc, minlength=T * P).reshape(T, P).T
         if i < n:
             check_signed("window corner value", mx, EDGE_BITS)
 
@@ -349,4 +365,5 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
         windows=windows, tests=tests, windows_aperture_n=ap_n, windows_per_proc=wpp,
         tests_per_proc=tpp, fragments=int(F), pixels_written=written, triangles=int(T),
         stats={"alpha": al, "beta": be, "test": test, "depth": depth, "frag_x": x, "frag_y": y, "frag_proc": proc,
-               "frag_tri": tri})
+               "frag_tri": tri, **({"windows_per_record": wrec} if per_record else {}),
+               **({"trace": tr} if trace else {})})

@@ -32,5 +32,6 @@ MACHINE = Machine(
            "sparse-matrix": Flow(small={"n": 3}, clocks=(_NO_CLOCK,))},
     fpga_note="The sparse video processor's paper names no clock (docs/sparse.md).",
     status="golden model (image = reference), formulas (1)-(12), Monte-Carlo window counts, figs. 3-6; "
-           "video processor in Amaranth, bit-exact in pysim and Verilator",
+           "video processor in Amaranth, bit-exact in pysim and Verilator; golden cycle models of the coupled "
+           "matrix (FIFO sizing), of the HDL video processor (cycle-exact) and of a stack-based processor",
 )

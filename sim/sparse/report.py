@@ -24,6 +24,8 @@ SYSTEM = "sparse"
 M_BITS = 10  # the paper's full raster: 2**10 x 2**10
 KS = (1, 2, 3, 4)
 SEED = 2002
+#: Monte-Carlo samples of the large-S growth rows (S = 10^4, 10^5)
+GROWTH_SAMPLES = 4000
 #: areas at which the Monte-Carlo counts are measured for figs. 3, 5, 6
 S_GRID = (0.1, 0.3, 1.0, 1.8, 3.0, 6.0, 10.0, 23.3, 40.0, 100.0, 157.0, 300.0, 1000.0)
 
@@ -39,7 +41,9 @@ def _fmt_ci(r: mc.MCResult, i: int) -> str:
 
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path("docs/reproduction"),
          samples: int = 20000, scenes: tuple[str, ...] = ("c300", "sp27"), s_grid: tuple[float, ...] = S_GRID,
-         **known):
+         coupled_size: int = 1 << M_BITS, coupled_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8", "16x16"),
+         load_triangles: int = 3000, coupled_vp_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8"),
+         stack_size: int = 512, coupled_scene: str = "c300", **known):
     """Rows and markdown sections of the sparse-raster report (see the module docstring)."""
     M = int(samples)
     S_GRID = tuple(s_grid)  # noqa: N806 (the module default, narrowed by tests)
@@ -63,6 +67,18 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
             measured=round(s_ex[0], 4), unit="px", source="golden")
         row("text after (4)", f"S_{k}, edges-only test (MC {M}, 95 % [{s_ed[1]:.3g}, {s_ed[2]:.3g}])",
             paper=paper, formula=round(f, 4), measured=round(s_ed[0], 4), unit="px", source="golden")
+
+    # S_k at one fixed rotation: (1)'s perimeter term sqrt(a^2 + b^2) U / 2 is the exact mean
+    # count's a H + b W for a square window at 45 degrees (its largest value), so (1) and the
+    # paper's S_k are those of the rectangle at 45 degrees; uniform rotations count fewer windows
+    sk_rot = {}
+    for k in KS[1:]:
+        for name, ang in (("45°", math.pi / 4), ("0°", 0.0)):
+            s_r = mc.s_k_measured(k, m=M_BITS, M=M, seed=SEED, test="exact", rotation=ang)
+            sk_rot[(k, name)] = s_r
+            row("text after (4)", f"S_{k}, 5:1 rectangles all at {name} rotation, exact window test (MC {M}, 95 % "
+                f"[{s_r[1]:.3g}, {s_r[2]:.3g}])", paper=th.PAPER_S_K[k - 1], formula=round(th.s_k(k), 4),
+                measured=round(s_r[0], 4), unit="px", source="golden")
 
     # ---------------------------------------------------------------- Monte-Carlo counts, fig. 3
     mono = {}  # S -> counts of the monoprocessor on the full raster (for Q_a)
@@ -178,6 +194,20 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     row("fig. 6a text", "p_p(1000) growth per matrix step, (p_p(k=4)/p_p(k=1))^(1/3) (paper: ∝ 4^k)", paper=4.0,
         formula=round((pp[3] / pp[0]) ** (1 / 3), 4), measured=round((ppm[3] / ppm[0]) ** (1 / 3), 4),
         unit="x per k", source="model")
+    # the growth per matrix step tends to 4 only as S grows (the limiting stage's 4 w_(n-1) term has
+    # the larger relative window alpha_(n-1), whose perimeter term falls slower than 1/pq)
+    growth = []
+    for S in (1e4, 1e5):
+        pf = [th.summary(S, M_BITS, k)["p_p"] for k in KS]
+        pm = []
+        for k in KS:
+            poly, off = mc.rectangles(S, min(M, GROWTH_SAMPLES), seed=SEED)
+            pm.append(float(th.perf_pipeline(mc.level_counts(poly, off, M_BITS - k, 1 << k).mean)))
+        gf, gm = (pf[3] / pf[0]) ** (1 / 3), (pm[3] / pm[0]) ** (1 / 3)
+        growth.append((S, gf, gm))
+        row("fig. 6a text", f"p_p(S={S:g}) growth per matrix step, (p_p(k=4)/p_p(k=1))^(1/3) (paper: ∝ 4^k; MC "
+            f"{min(M, GROWTH_SAMPLES)})", paper=4.0, formula=round(gf, 4), measured=round(gm, 4), unit="x per k",
+            source="model")
     # R_p peak near S_k (fig. 6b): formula on a fine grid; measured on the Monte-Carlo grid
     for k in (2, 3, 4):
         Rp = th.load_pipeline(th.windows(Sg, M_BITS - k, 1 << k))
@@ -213,6 +243,11 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     # ---------------------------------------------------------------- HDL cycles (t_i, R_p)
     hdl_sec = _hdl_rows(row, engine, progress, hdl_scene=known.get("hdl_scene"))
 
+    # ---------------------------------------------------------------- the coupled matrix (golden)
+    coupled_sec = _coupled_rows(row, out_dir, size=coupled_size, matrices=coupled_matrices,
+                                load_triangles=load_triangles, vp_matrices=coupled_vp_matrices,
+                                stack_size=stack_size, scene=coupled_scene)
+
     # ---------------------------------------------------------------- plots
     plots = _plots(out_dir, spr, mono, Sg, S_GRID)
 
@@ -231,9 +266,25 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     sec.append("| k | paper | formula (1) | MC exact test (95 %) | MC edges-only test (95 %) |\n|---|---|---|---|---|\n" +
                "\n".join(f"| {k} | {th.PAPER_S_K[k - 1]:g} | {th.s_k(k):.4g} | {e[0]:.4g} [{e[1]:.4g}, {e[2]:.4g}] | "
                          f"{d[0]:.4g} [{d[1]:.4g}, {d[2]:.4g}] |" for k, (e, d) in sk_meas.items()) + "\n")
+    sec.append("## Why the measured S_k exceed the paper's, and why p_p grows by less than 4 per step\n")
+    sec.append("Formula (1)'s perimeter term, sqrt(α_i² + β_i²)·L·sqrt(πS), is the largest over rotations of the "
+               "exact mean count's a·H + b·W (W, H the polygon's extents): for a square window it is reached at "
+               "45°. Rectangles all at 45° reproduce the paper's S_k; uniform rotations (the table above) need a "
+               "larger area for one window; axis-aligned ones larger still.\n\n| k | paper | formula | MC 45° (95 %) | "
+               "MC uniform rotation | MC 0° (95 %) |\n|---|---|---|---|---|---|\n" +
+               "\n".join(f"| {k} | {th.PAPER_S_K[k - 1]:g} | {th.s_k(k):.4g} | {sk_rot[(k, '45°')][0]:.4g} "
+                         f"[{sk_rot[(k, '45°')][1]:.4g}, {sk_rot[(k, '45°')][2]:.4g}] | {sk_meas[k][0][0]:.4g} | "
+                         f"{sk_rot[(k, '0°')][0]:.4g} [{sk_rot[(k, '0°')][1]:.4g}, {sk_rot[(k, '0°')][2]:.4g}] |"
+                         for k in KS[1:]) + "\n\n"
+               "p_p's growth per step of k: " + "; ".join(f"S = {S:g}: formula ×{gf:.3f}, MC ×{gm:.3f}"
+                                                          for S, gf, gm in growth) +
+               " (×3.33 at S = 1000, above). The limiting stage is the pixel level, t_n = 4 w_(n−1) + w_n k_p/k_e; "
+               "w_n falls as 1/pq but w_(n−1) counts windows of relative size α_(n−1) = (1 + α/p)/2, whose "
+               "perimeter and corner terms fall more slowly, so the step tends to 4 only as S grows.\n")
     sec.append("## Limiting level in each regime\n")
     sec.append("\n".join(reg) + "\n\nFrom the formula on a fine grid (S = 0.1 … 1000): " + "; ".join(lim_ranges) + ".\n")
     sec.extend(hdl_sec)
+    sec.extend(coupled_sec)
     sec.append("## Figures\n")
     sec.append("\n".join(f"![{t}]({fn})" for t, fn in plots) + "\n")
     return out, sec
@@ -293,10 +344,18 @@ def _hdl_rows(row, engine: str, progress: bool, hdl_scene=None) -> list[str]:
         measured=round(Rh, 4), unit="", source=src)
     row("(9) / HDL", f"{label}, 4x4: frame cycles (slowest processor) / busiest stage's tests", paper=None,
         formula=1.0, measured=round(r["cycles"] / r["max_stage_tests_per_processor"], 4), unit="ratio", source=src)
+    from rasterhw.golden_model.sparse.search import sparse_render
+    from rasterhw.golden_model.sparse.vpcycles import vp_standalone, vp_streams
+
+    gf = sparse_render(tris, (p, p), depth="fixed", trace=True)
+    model_cycles = max(vp_standalone(*vp_streams(gf, k), gf.triangles)["cycles"] for k in range(p * p))
+    row("HDL", f"{label}, 4x4: slowest processor's cycles, HDL minus the golden cycle model of the video processor "
+        f"(golden_model/sparse/vpcycles.py: {model_cycles} cycles; 0 = cycle-exact)", paper=None, formula=0,
+        measured=int(r["cycles"]) - model_cycles, unit="cycles", source=src)
     return ["## HDL cycles\n",
             f"`rasterhw sim sparse` run inside this report ({engine}): {label}, 4x4, every processor; "
-            f"{r['cycles']} cycles for the slowest processor, {r['sim_cycles']} cycles simulated in all at "
-            f"{r['cycles_per_s']} cycles/s; busy cycles (coverage tests) per level summed over processors: "
+            f"{r['cycles']} cycles for the slowest processor, {r['sim_cycles']} cycles simulated in all (the "
+            "simulation rate is a `rasterhw bench` figure, not a table's); busy cycles (coverage tests) per level summed over processors: "
             f"{r['tests_per_level_hdl']}. A stage makes one coverage test per busy cycle (τ = 1 cycle) and takes "
             "the next window in the cycle of its last test; the frame still takes a little more than its busiest "
             "stage's tests: a triangle's header costs one cycle at every level where it has survivors, and a "
@@ -373,3 +432,306 @@ def _plots(out_dir: Path, spr, mono, Sg, S_GRID):  # noqa: N803
     plt.close(fig)
     files.append(("figs. 5-6", "sparse_fig5_6.png"))
     return files
+
+
+# ---------------------------------------------------------------- the coupled matrix (golden cycle model)
+FIFO_DEPTHS = (1, 2, 4, 8, 16, 32, 64)
+#: the FIFO depth of the R_p / Q_p / stack / k_p rows (the HDL VP's inner FIFOs are 8 deep)
+REF_DEPTH = 8
+
+
+def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], load_triangles: int,
+                  vp_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8"), stack_size: int = 512,
+                  scene: str = "c300") -> list[str]:
+    """Frame cycles against FIFO depth, R_p and Q_p from busy cycles, the stack processor and the
+    k_p/k_e cost: :mod:`rasterhw.golden_model.sparse.cycles` on the golden search's per-record
+    window counts of ``scene`` at ``size`` x ``size`` (the paper's 1024 x 1024 in the report)."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.sparse import cycles as cy
+    from rasterhw.golden_model.sparse.search import sparse_render
+
+    W = size
+    m_bits = W.bit_length() - 1
+    tris = run_geometry(build_scene(scene), W, W)
+    xy = np.asarray(tris.xy)
+    lab = f"{scene} {W}x{W}"
+    gp = f"GP issue interval {cy.GP_ISSUE_INTERVAL} cycle (ours)"
+    mono = sparse_render(tris, "1x1", depth="fixed")
+    T_mono = float(mono.tests.sum())
+    fw_mono = _formula_frame(xy, m_bits, 1)
+    curves = {}
+    sweep_tab = ["| matrix | FIFO depth D | frame cycles | / unbounded FIFO | broadcast stall cycles | FIFO peak (max) | "
+                 "busy / frame, least and most loaded processor |", "|---|---|---|---|---|---|---|"]
+    rp_tab = ["| matrix | n | R_p golden (frame) | R_p formula (10), k_p/k_e = 0 | R_p coupled, D = 8 | Q_a golden | "
+              "Q_a formula (7) | Q_p golden | Q_p formula (12) | stack / pipeline frame | formula n R_p |",
+              "|---|---|---|---|---|---|---|---|---|---|---|"]
+    kp_tab: list[str] = []
+    for m in matrices:
+        p = int(m.split("x")[0])
+        P = p * p
+        f = sparse_render(tris, m, depth="fixed", per_record=True)
+        n = f.n
+        w = f.stats["windows_per_record"]
+        s_pipe = cy.service_times(w)
+        alone = int(1 + s_pipe.sum(axis=1).max())
+        fr = {}
+        for D in FIFO_DEPTHS:
+            r = cy.coupled_matrix(s_pipe, D)
+            fr[D] = r.frame_cycles
+            util = r.busy / r.frame_cycles
+            sweep_tab.append(f"| {m} | {D} | {r.frame_cycles} | {r.frame_cycles / alone:.4f} | {r.stall_cycles} | "
+                             f"{int(r.fifo_peak.max())} | {util.min():.3f} … {util.max():.3f} |")
+            row("FIFO sizing (coupled)", f"{lab}, {m}: frame cycles, FIFO depth {D} (pipeline VPs, {gp})",
+                paper=None, formula=None, measured=r.frame_cycles, unit="cycles", source="golden")
+            if D == 1:
+                row("FIFO sizing (coupled)", f"{lab}, {m}: broadcast stall cycles, FIFO depth 1", paper=None,
+                    formula=None, measured=r.stall_cycles, unit="cycles", source="golden")
+        sweep_tab.append(f"| {m} | unbounded | {alone} | 1 | 0 | — | — |")
+        curves[m] = [fr[D] / alone for D in FIFO_DEPTHS]
+        for D in (1, 8, 64):
+            row("FIFO sizing (coupled)", f"{lab}, {m}: frame with FIFO depth {D} / frame with an unbounded FIFO "
+                "(the slowest processor alone; paper's assumption: coupling small with enough FIFO)",
+                paper=None, formula=None, measured=round(fr[D] / alone, 5), unit="ratio", source="golden")
+        d1 = next((D for D in FIFO_DEPTHS if fr[D] <= 1.01 * alone), None)
+        row("FIFO sizing (coupled)", f"{lab}, {m}: smallest FIFO depth (of 1 … 64) within 1 % of the unbounded "
+            "frame", paper=None, formula=None, measured=d1 if d1 is not None else -1, unit="entries",
+            source="golden")
+        # R_p, Q_a, Q_p from busy cycles (pipeline VP as our HDL prices it: headers, k_p = 0)
+        sb = cy.stage_cycles(w).sum(axis=1)  # (P, n) busy cycles per stage
+        Bi = sb.sum(axis=0).astype(float)
+        Rp = float(Bi.sum() / (n * Bi.max()))
+        fw = _formula_frame(xy, n, p)
+        tf = th.stage_times(fw, kp_ke=0.0)
+        Rp_f = float(tf.sum() / (n * tf.max()))
+        rc = cy.coupled_matrix(s_pipe, REF_DEPTH)
+        Rp_c = float(Bi.sum() / (n * P * rc.frame_cycles))
+        Qa = T_mono / float(f.tests.sum())
+        Qa_f = float(th.total_time(fw_mono, kp_ke=0.0) / (P * th.total_time(fw, kp_ke=0.0)))
+        row("(10) / golden", f"{lab}, {m}: R_p = sum_i B_i / (n max_i B_i) from the golden pipeline's busy cycles "
+            "B_i per stage (summed over processors; header cycles included; formula: (10) on (1)'s counts for "
+            "the frame's triangles, k_p/k_e = 0)", paper=None, formula=round(Rp_f, 4), measured=round(Rp, 4),
+            unit="", source="golden")
+        row("(10) / golden", f"{lab}, {m}: R_p of the coupled frame, sum_i B_i / (n P frame cycles), FIFO depth "
+            f"{REF_DEPTH} (load including the coupling and the processors' imbalance)", paper=None,
+            formula=round(Rp_f, 4), measured=round(Rp_c, 4), unit="", source="golden")
+        row("(7) / golden", f"{lab}, {m}: Q_a = T_mono / (pq T_sparse), coverage tests of the golden search "
+            "(monoprocessor: 1x1 on the full raster, n = 10; formula (7) on (1)'s counts, k_p/k_e = 0)",
+            paper=None, formula=round(Qa_f, 4), measured=round(Qa, 4), unit="", source="golden")
+        row("(12) / golden", f"{lab}, {m}: Q_p = Q_a R_p (golden busy cycles; formula (12))", paper=None,
+            formula=round(Qa_f * Rp_f, 4), measured=round(Qa * Rp, 4), unit="", source="golden")
+        # the stack-based processor on the same frame
+        s_st = cy.service_times(w, vp="stack")
+        rs = cy.coupled_matrix(s_st, REF_DEPTH)
+        sp_st = rs.frame_cycles / rc.frame_cycles
+        tf0h = th.stage_times(fw, kp_ke=0.0)
+        row("(10) / stack", f"{lab}, {m}: frame cycles of the stack-based processors, FIFO depth {REF_DEPTH} "
+            f"(set-up {cy.SETUP_CYCLES} + every coverage test, one per cycle)", paper=None, formula=None,
+            measured=rs.frame_cycles, unit="cycles", source="golden")
+        row("(10) / stack", f"{lab}, {m}: stack frame / pipeline frame, FIFO depth {REF_DEPTH} (formula: "
+            "P_p / P_s = n R_p of (10) on (1)'s counts, k_p/k_e = 0)", paper=None,
+            formula=round(float(tf0h.sum() / tf0h.max()), 4), measured=round(sp_st, 4), unit="ratio",
+            source="golden")
+        rp_tab.append(f"| {m} | {n} | {Rp:.4f} | {Rp_f:.4f} | {Rp_c:.4f} | {Qa:.4f} | {Qa_f:.4f} | {Qa * Rp:.4f} | "
+                      f"{Qa_f * Rp_f:.4f} | {sp_st:.3f} | {tf0h.sum() / tf0h.max():.3f} |")
+        if m == "4x4":
+            # surface parameters priced as (5): depth and RGB (k_p = 4) on the k_e = 3 edge adders
+            for vp, s0 in (("pipeline", s_pipe), ("stack", s_st)):
+                s4 = cy.service_times(w, vp=vp, kp=4)
+                f0 = cy.coupled_matrix(s0, REF_DEPTH).frame_cycles
+                f4 = cy.coupled_matrix(s4, REF_DEPTH).frame_cycles
+                t0, t4 = th.stage_times(fw, kp_ke=0.0), th.stage_times(fw, kp_ke=4 / 3)
+                ff = float(t4.max() / t0.max()) if vp == "pipeline" else float(t4.sum() / t0.sum())
+                row("(5) k_p/k_e", f"{lab}, {m}: frame with depth and RGB priced (k_p = 4, k_e = 3: "
+                    f"ceil(w_i k_p / k_e) cycles per stage and record) / unpriced, {vp} VPs, FIFO depth "
+                    f"{REF_DEPTH} (formula: (5) on (1)'s counts, k_p/k_e = 4/3 against 0)", paper=None,
+                    formula=round(ff, 4), measured=round(f4 / f0, 4), unit="ratio", source="golden")
+                kp_tab.append(f"{vp}: {f0} → {f4} cycles (×{f4 / f0:.3f}; formula ×{ff:.3f})")
+    vp_tab = _coupled_vp_rows(row, tris, lab, vp_matrices)
+    stack_txt = _stack_rows(row, scene, stack_size)
+    gp_tab = _gp_rate_rows(row, scene, stack_size)
+    load_tab = _load_rows(row, W, load_triangles)
+    plot = _fifo_plot(out_dir, curves, lab)
+    return ["## The coupled matrix: FIFO sizing (golden cycle model)\n",
+            f"`golden_model/sparse/cycles.py` on the golden search's per-record window counts of {lab} "
+            f"(records in submission order). One geometry processor offers a record every {cy.GP_ISSUE_INTERVAL} "
+            "cycle (ours: the paper gives no rate, so the broadcast is never the bottleneck and every stall is the "
+            "processors'); a record is pushed into all p·q FIFOs only when each has room; a pipeline video "
+            "processor holds a record for its busiest stage's cycles (4 w_(i−1) tests plus a header cycle where "
+            "the triangle has survivors; (9)), a stack processor for all of its tests plus a 3-cycle set-up. "
+            "'unbounded' is the slowest processor alone, plus the one-cycle push.\n",
+            "\n".join(sweep_tab) + "\n",
+            "R_p, Q_a and Q_p from the golden busy cycles beside the paper's (10), (7), (12) evaluated with "
+            "formula (1)'s counts for the same triangles (each with its own S and L), k_p/k_e = 0 as our stage "
+            f"prices it. Coupled R_p at FIFO depth {REF_DEPTH}.\n",
+            "\n".join(rp_tab) + "\n",
+            "Surface parameters priced as formula (5) (4x4, FIFO depth 8): " + "; ".join(kp_tab) + ".\n",
+            "## The coupled matrix with the HDL video processors (golden cycle model of the processor as built)\n",
+            "`vpcycles.coupled_matrix_vp`: the same broadcast, FIFO and counting rules, each processor the cycle "
+            "model of `hdl/sparse/vp.py` (set-up FSM, level stages, eight-entry inner FIFOs, pixel processor), "
+            "which equals the HDL cycle for cycle (pysim tests; Verilator per-processor cycles in the HDL rows). "
+            "The processor buffers records in its inner FIFOs, so its input FIFO matters far less than for a "
+            "processor that holds one record at a time.\n",
+            "\n".join(vp_tab) + "\n",
+            "## A geometry processor only as fast as the matrix\n",
+            "The GP issue interval is ours. With g = 1 the GP is never the bottleneck; here it offers a record "
+            "every g = ceil(slowest processor alone / records) cycles, the matrix's mean rate, so the FIFOs must "
+            "also absorb the processors' record-to-record variation against the GP (the paper: the queues "
+            "\"способствует ослаблению связей ... между матрицей и геометрическим процессором\").\n",
+            "\n".join(gp_tab) + "\n",
+            "## The stack-based processor's golden model\n", stack_txt,
+            "## Where \"practically 100 %\" load holds (fig. 6b)\n",
+            f"Frames of {load_triangles} random triangles (`reference.random_triangles`, seed {SEED}, {W} x {W}) "
+            "of one mean area: "
+            "at the paper's S_k and at 1000 px. R_p from the golden search's per-record counts of the frame priced "
+            "as the paper prices them (formula (5) with k_p/k_e = 1, no header cycles; source `model`), beside "
+            "(10) on formula (1)'s counts for the same triangles.\n",
+            "\n".join(load_tab) + "\n",
+            f"![FIFO sizing]({plot})\n"]
+
+
+def _coupled_vp_rows(row, tris, lab: str, matrices: tuple[str, ...]) -> list[str]:
+    """Frame cycles, stalls and FIFO peaks of the coupled matrix whose processors are the HDL video
+    processor's cycle model, at FIFO depths 1 and 64 (and 8 on 4x4)."""
+    from rasterhw.golden_model.sparse.search import sparse_render
+    from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
+
+    tab = ["| matrix | FIFO depth D | frame cycles | broadcast stall cycles | FIFO peak (max) | "
+           "processor busy / frame, least loaded |", "|---|---|---|---|---|---|"]
+    for m in matrices:
+        f = sparse_render(tris, m, depth="fixed", trace=True)
+        fr = {}
+        for D in ((1, 8, 64) if m == "4x4" else (1, 64)):
+            r = coupled_matrix_vp(f, D)
+            fr[D] = r["frame_cycles"]
+            tab.append(f"| {m} | {D} | {r['frame_cycles']} | {r['stall_cycles']} | {r['fifo_peak_max']} | "
+                       f"{min(r['busy']) / r['frame_cycles']:.3f} |")
+            row("FIFO sizing (coupled, HDL VPs)", f"{lab}, {m}: frame cycles, FIFO depth {D} (video processors: "
+                "the HDL's cycle model)", paper=None, formula=None, measured=r["frame_cycles"], unit="cycles",
+                source="golden")
+            row("FIFO sizing (coupled, HDL VPs)", f"{lab}, {m}: broadcast stall cycles, FIFO depth {D}",
+                paper=None, formula=None, measured=r["stall_cycles"], unit="cycles", source="golden")
+            row("FIFO sizing (coupled, HDL VPs)", f"{lab}, {m}: largest FIFO peak, FIFO depth {D} (never above D)",
+                paper=None, formula=None, measured=r["fifo_peak_max"], unit="entries", source="golden")
+        row("FIFO sizing (coupled, HDL VPs)", f"{lab}, {m}: frame with FIFO depth 1 / with depth 64", paper=None,
+            formula=None, measured=round(fr[1] / fr[64], 5), unit="ratio", source="golden")
+    return tab
+
+
+def _gp_rate_rows(row, scene: str, size: int) -> list[str]:
+    """Frame cycles against FIFO depth with the GP issuing at the matrix's mean rate (4x4), for the
+    pipeline-as-server model and for the HDL video processors' cycle model."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.sparse.cycles import matrix_cycles
+    from rasterhw.golden_model.sparse.search import sparse_render
+    from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
+
+    tris = run_geometry(build_scene(scene), size, size)
+    f = sparse_render(tris, "4x4", depth="fixed", trace=True, per_record=True)
+    alone = matrix_cycles(f, f.triangles)["slowest_alone"]
+    g = -(-alone // f.triangles)
+    lab = f"{scene} {size}x{size}, 4x4, GP issue interval {g} (= ceil({alone} / {f.triangles}), ours)"
+    tab = [f"{lab}; the GP alone needs {g * f.triangles} cycles.\n", "| FIFO depth D | frame, pipeline as server | "
+           "stall cycles | frame, HDL video processors | stall cycles |", "|---|---|---|---|---|"]
+    for D in (1, 4, 16, 64):
+        sv = matrix_cycles(f, D, issue_interval=g)
+        hv = coupled_matrix_vp(f, D, issue_interval=g)
+        tab.append(f"| {D} | {sv['frame_cycles']} | {sv['stall_cycles']} | {hv['frame_cycles']} | "
+                   f"{hv['stall_cycles']} |")
+        for name, r in (("pipeline VPs as servers", sv), ("HDL video processors' cycle model", hv)):
+            row("FIFO sizing (GP at the matrix's rate)", f"{lab}: frame cycles, FIFO depth {D}, {name}", paper=None,
+                formula=None, measured=r["frame_cycles"], unit="cycles", source="golden")
+    return tab
+
+
+def _stack_rows(row, scene: str, size: int) -> str:
+    """Every processor of a 4x4 matrix as a stack processor (depth first) on ``scene`` at ``size``:
+    image against the breadth-first golden search, its stack depth, its cycles against the stack
+    cycle model."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.sparse.cycles import service_times
+    from rasterhw.golden_model.sparse.search import sparse_render
+    from rasterhw.golden_model.sparse.stack import stack_processor
+
+    tris = run_geometry(build_scene(scene), size, size)
+    p = 4
+    f = sparse_render(tris, (p, p), depth="fixed", per_record=True)
+    gz = np.where(f.tri_id >= 0, np.rint(f.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    s = service_times(f.stats["windows_per_record"], vp="stack")
+    diff, same_cycles, deepest, n = 0, True, 0, f.n
+    for b in range(p):
+        for a in range(p):
+            r = stack_processor(tris, (p, p), a, b)
+            diff += int(np.count_nonzero((r["tri"] != f.local_tri[b, a]) | (r["zq"] != gz[b::p, a::p])))
+            same_cycles &= bool(np.array_equal(r["cycles"], s[b * p + a]))
+            deepest = max(deepest, r["max_stack"])
+    lab = f"{scene} {size}x{size}, 4x4"
+    row("(8) / stack", f"{lab}: pixels of the stack processors' local memories differing from the breadth-first "
+        f"golden search (of {f.tri_id.size})", paper=None, formula=0, measured=diff, unit="pixels", source="golden")
+    row("(8) / stack", f"{lab}: stack processors' cycles per record equal the stack cycle model (1 = yes)",
+        paper=None, formula=1, measured=int(same_cycles), unit="", source="golden")
+    row("(8) / stack", f"{lab}: deepest stack over every processor and record (formula: the bound 3 (n - 1) + 1)",
+        paper=None, formula=3 * (n - 1) + 1, measured=deepest, unit="entries", source="golden")
+    return (f"`golden_model/sparse/stack.py` ran every processor of {lab} depth first: {diff} pixels differ from the "
+            f"breadth-first search, its per-record cycles {'equal' if same_cycles else 'DIFFER from'} the stack "
+            f"cycle model's, and the deepest stack held {deepest} windows (bound {3 * (n - 1) + 1}).\n")
+
+
+def _load_rows(row, W: int, ntri: int) -> list[str]:
+    """R_p of frames of equal-area random triangles near S_k and at 1000 px (the paper's claim of a
+    load maximum "практически до 100 %" in the neighbourhood of S = S_k)."""
+    from rasterhw.golden_model.reference import random_triangles
+    from rasterhw.golden_model.sparse import cycles as cy
+    from rasterhw.golden_model.sparse.search import sparse_render
+
+    tab = ["| matrix | mean area S | R_p measured (model: (5), (10) on golden counts) | R_p formula (10) | "
+           "R_p golden, our pipeline (headers, k_p = 0) |", "|---|---|---|---|---|"]
+    for k in (2, 3, 4):
+        p = 1 << k
+        if W // p < 2:
+            continue
+        for S in (th.PAPER_S_K[k - 1], 1000.0):
+            tris = random_triangles(W, W, ntri, mean_area=S, seed=SEED)
+            xy = np.asarray(tris.xy)
+            f = sparse_render(tris, (p, p), per_record=True)
+            w = f.stats["windows_per_record"]
+            n = f.n
+            B = cy.stage_cycles(w, kp=3, headers=False).sum(axis=(0, 1)).astype(float)  # k_p/k_e = 3/3
+            Rm = float(B.sum() / (n * B.max()))
+            Bg = cy.stage_cycles(w).sum(axis=(0, 1)).astype(float)
+            Rg = float(Bg.sum() / (n * Bg.max()))
+            tf = th.stage_times(_formula_frame(xy, n, p), kp_ke=1.0)
+            Rf = float(tf.sum() / (n * tf.max()))
+            e1, e2 = xy[:, 1] - xy[:, 0], xy[:, 2] - xy[:, 0]
+            Sm = float(np.mean(0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])))
+            near = S < 999
+            row("fig. 6b text", f"R_p of a frame of {ntri} random triangles of mean area {Sm:.3g} px "
+                f"({'S_k' if near else 'S = 1000'}), {p}x{p}, {W}x{W} (paper: load maximum "
+                "'practically up to 100 %' near S_k)", paper=1.0 if near else None, formula=round(Rf, 4),
+                measured=round(Rm, 4), unit="", source="model")
+            tab.append(f"| {p}x{p} | {Sm:.3g} ({'S_k' if near else '1000'}) | {Rm:.4f} | {Rf:.4f} | {Rg:.4f} |")
+    return tab
+
+
+def _fifo_plot(out_dir: Path, curves: dict, lab: str) -> str:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for m, c in curves.items():
+        ax.semilogx(FIFO_DEPTHS, c, "o-", base=2, label=m)
+    ax.axhline(1.0, color="k", lw=0.8, ls=":")
+    ax.set_xlabel("FIFO depth D (records)")
+    ax.set_ylabel("frame cycles / unbounded FIFO")
+    ax.set_title(f"coupled matrix, {lab} (golden cycle model)", fontsize=9)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out_dir / "sparse_fifo.png", dpi=90)
+    plt.close(fig)
+    return "sparse_fifo.png"

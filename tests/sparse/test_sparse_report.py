@@ -13,7 +13,9 @@ def report(tmp_path_factory):
 
     out = tmp_path_factory.mktemp("sparse_report")
     return rows(samples=100, out_dir=out, scenes=("sp8",), s_grid=(0.1, 1.8, 10.0, 23.3, 100.0, 157.0, 1000.0),
-                engine="none"), out  # HDL rows: tests/sparse/test_sparse_vp_*.py
+                engine="none", coupled_size=64, coupled_matrices=("2x2",), load_triangles=40,
+                coupled_vp_matrices=("2x2",), stack_size=64, coupled_scene="c50"), out
+    # HDL rows: tests/sparse/test_sparse_vp_*.py; the coupled rows at a useful size: the fixture below
 
 
 def test_rows_well_formed(report):
@@ -30,6 +32,11 @@ def test_s_k_formula_rows(report):
     (rows, _), _ = report
     sk = [r for r in rows if r["quantity"].startswith("S_") and "exact test" in r["quantity"]]
     assert len(sk) == 4
+    # at 45 degrees (1)'s perimeter term is exact: the measured S_k is the paper's (k = 2, 3, 4)
+    rot = [r for r in rows if "at 45° rotation" in r["quantity"]]
+    assert len(rot) == 3
+    for r in rot:
+        assert r["measured"] == pytest.approx(r["paper"], rel=0.15)
     for r in sk:
         if r["paper"] == 0:
             assert abs(r["formula"]) <= 0.05
@@ -66,3 +73,80 @@ def test_arch_render_matches_reference():
     assert r.pixels_written == ref.pixels_written
     with pytest.raises(RasterhwError):
         render("sp8", 500, 500, arch="sparse", matrix="4x4")
+
+
+@pytest.fixture(scope="module")
+def coupled(tmp_path_factory):
+    from pathlib import Path
+
+    from rasterhw.sim.report import make_row
+    from rasterhw.sim.sparse.report import _coupled_rows
+
+    out: list[dict] = []
+
+    def row(fig, qty, **kw):
+        out.append(make_row("sparse", fig, qty, **kw))
+
+    d = Path(tmp_path_factory.mktemp("sparse_coupled"))
+    sec = _coupled_rows(row, d, size=128, matrices=("2x2", "4x4", "8x8"), load_triangles=300,
+                        vp_matrices=("4x4",), stack_size=64, scene="c50")
+    return out, sec, d
+
+
+def test_coupled_rows_frame_against_fifo_depth(coupled):
+    rows, sec, d = coupled
+    for m in ("2x2", "4x4", "8x8"):
+        fr = [r for r in rows if r["quantity"].startswith(f"c50 128x128, {m}: frame cycles, FIFO depth")
+              and r["figure"] == "FIFO sizing (coupled)"]
+        assert len(fr) == 7 and all(r["source"] == "golden" and r["formula"] is None for r in fr)
+        vals = [r["measured"] for r in fr]
+        assert vals == sorted(vals, reverse=True) and vals[0] > vals[-1]
+        st = [r for r in rows if r["quantity"].startswith(f"c50 128x128, {m}: broadcast stall cycles")
+              and r["figure"] == "FIFO sizing (coupled)"]
+        assert st[0]["measured"] > 0
+        ratio = [r for r in rows if r["quantity"].startswith(f"c50 128x128, {m}: stack frame / pipeline frame")]
+        assert ratio[0]["measured"] > 1 and ratio[0]["formula"] > 1
+    assert (d / "sparse_fifo.png").stat().st_size > 10000 and any("sparse_fifo.png" in s for s in sec)
+    for key in ("R_p = sum_i", "R_p of the coupled frame", "Q_a = T_mono", "Q_p = Q_a R_p"):
+        got = [r for r in rows if key in r["quantity"]]
+        assert len(got) == 3 and all(0 < r["measured"] <= 1 and 0 < r["formula"] <= 1 for r in got), key
+    kp = [r for r in rows if r["figure"] == "(5) k_p/k_e"]
+    assert len(kp) == 2 and all(r["measured"] > 1 for r in kp)
+
+
+def test_load_is_highest_near_s_k(coupled):
+    rows, _, _ = coupled
+    load = [r for r in rows if r["quantity"].startswith("R_p of a frame of 300 random triangles")]
+    assert len(load) == 6  # 4x4, 8x8, 16x16 at S_k and at 1000
+    for near, far in zip(load[::2], load[1::2], strict=True):
+        assert near["paper"] == 1.0 and far["paper"] is None
+        assert near["measured"] > far["measured"] and near["formula"] > far["formula"]
+
+
+def test_coupled_rows_with_the_hdl_processors(coupled):
+    rows, sec, _ = coupled
+    got = {r["quantity"].split(": ", 1)[1]: r for r in rows if r["figure"] == "FIFO sizing (coupled, HDL VPs)"}
+    assert len(got) == 10  # 4x4: three depths x (frame, stalls, peak) + the ratio
+    for D in (1, 8, 64):
+        assert got[f"largest FIFO peak, FIFO depth {D} (never above D)"]["measured"] <= D
+        assert got[f"frame cycles, FIFO depth {D} (video processors: the HDL's cycle model)"]["measured"] > 0
+    assert got["broadcast stall cycles, FIFO depth 1"]["measured"] > 0
+    assert got["frame with FIFO depth 1 / with depth 64"]["measured"] >= 1.0
+    assert any("HDL video processors" in s for s in sec)
+
+
+def test_stack_rows(coupled):
+    rows, sec, _ = coupled
+    got = [r for r in rows if r["figure"] == "(8) / stack"]
+    assert len(got) == 3 and all(r["source"] == "golden" for r in got)
+    assert got[0]["measured"] == 0 and got[1]["measured"] == 1
+    assert 1 < got[2]["measured"] <= got[2]["formula"]
+    assert any("depth first" in s for s in sec)
+
+
+def test_gp_rate_rows(coupled):
+    rows, _, _ = coupled
+    got = [r for r in rows if r["figure"] == "FIFO sizing (GP at the matrix's rate)"]
+    assert len(got) == 8 and all(r["source"] == "golden" and r["measured"] > 0 for r in got)
+    server = [r["measured"] for r in got if "as servers" in r["quantity"]]
+    assert server == sorted(server, reverse=True)  # deeper FIFOs never slow the frame

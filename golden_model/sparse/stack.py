@@ -1,0 +1,108 @@
+"""The stack-based raster processor: one video processor searching depth first with a stack.
+
+Seed 002 compares two raster processors inside a video processor: a pipeline of one stage per
+level (``hdl/sparse/``) and a "процессор со стеком" (eq. (8): ``Q(S) = P_s(S) / [pq P_so(S)]``),
+which keeps the windows still to be split on a stack and runs one coverage-test unit over all
+levels. This is its golden model, in plain Python integers as the hardware would hold them:
+
+* set-up: the broadcast record rewritten for processor ``(a, b)`` (``A' = pA``, ``B' = qB``,
+  ``C' = C + aA + bB``, depth plane likewise), the root window pushed;
+* loop: pop a window of level ``i - 1``; test its four sub-windows in the order
+  ``(0,0), (1,0), (0,1), (1,1)``, one per cycle (τ = one cycle), with the same tests as the
+  pipeline (window rectangle against the edges and the bounding box below level ``n``, the
+  top-left point test at level ``n``); push the survivors so that the first is popped first;
+  a pixel goes to the pixel processor (Z test into the local memory) in the cycle of its test;
+* a record costs ``SETUP_CYCLES`` plus one cycle per test (``cycles.service_times(vp="stack")``).
+
+The window counts do not depend on the order of the search, so the stack processor's image and
+counts equal the breadth-first golden search's (:func:`.search.sparse_render`, tested); what it
+adds is the order, the stack's depth (at most ``3 (n - 1) + 1`` entries: three siblings waiting
+per level plus the root) and its cycle count per record.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles
+from rasterhw.golden_model.sparse.cycles import SETUP_CYCLES
+from rasterhw.golden_model.sparse.formats import Z_FRAC_BITS, parse_matrix, sparse_geometry
+
+__all__ = ["stack_processor"]
+
+_SUB = 1 << SUBPIXEL_BITS
+_HALF = _SUB // 2
+
+
+def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int = 2, beta: int = 2) -> dict:
+    """Run processor ``(a, b)`` of a ``p x q`` matrix as a stack processor over every broadcast
+    record. Returns its local memories ``tri`` and ``zq`` (``2**n x 2**n``, -1 where empty),
+    ``cycles`` (per record: set-up plus tests), ``tests`` per level (``(n,)``), ``max_stack``
+    (the deepest the stack grew) and ``writes`` (pixels that passed the Z test)."""
+    from rasterhw.golden_model.sparse.fixed import depth_plane
+    from rasterhw.golden_model.sparse.search import edge_setup
+
+    p, q = parse_matrix(matrix)
+    n = sparse_geometry(tris.width, tris.height, p, q)
+    for name, v in (("a", a), ("b", b)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
+            raise RasterhwError(f"sparse stack: {name} must be an integer, not {v!r}")
+    if not (0 <= a < p and 0 <= b < q):
+        raise RasterhwError(f"sparse stack: processor ({a}, {b}) is outside a {p}x{q} matrix")
+    xy, _, _ = tris.validate(who="sparse stack", max_coord=float(1 << 13))
+    es = edge_setup(xy)
+    Z0, Zu, Zv = depth_plane(tris, es, p, q)
+    zmax = (1 << tris.z_bits) - 1
+    Ns = 1 << n
+    ztab = [zmax + 1] * (Ns * Ns)
+    ttab = [-1] * (Ns * Ns)
+    T = es.tri.size
+    cycles = np.zeros(T, dtype=np.int64)
+    tests = [0] * (n + 1)
+    max_stack = 0
+    writes = 0
+    order = ((0, 0), (1, 0), (0, 1), (1, 1))
+    for t in range(T):
+        A = [int(v) * p for v in es.A[:, t]]  # A' per sparse pixel
+        B = [int(v) * q for v in es.B[:, t]]
+        thr = [int(v) for v in es.thr[:, t]]
+        ext = [(abs(int(es.A[k, t])) * alpha + abs(int(es.B[k, t])) * beta) // 2 for k in range(3)]
+        pos = [max(A[k], 0) + max(B[k], 0) for k in range(3)]
+        bx0, bx1, by0, by1 = (int(v) for v in es.bbox[:, t])
+        E0 = [int(es.C[k, t]) + a * int(es.A[k, t]) + b * int(es.B[k, t]) for k in range(3)]
+        z0, zu, zv = int(Z0[t, b, a]), int(Zu[t]), int(Zv[t])
+        tri = int(es.tri[t])
+        stack = [(0, 0, 0, E0)]  # (level of the window, u, v, edge values at its first pixel)
+        ntest = 0
+        while stack:
+            max_stack = max(max_stack, len(stack))
+            lvl, u, v, E = stack.pop()
+            i = lvl + 1
+            N = 1 << (n - i)
+            keep = []
+            for du, dv in order:
+                ntest += 1
+                tests[i] += 1
+                uc, vc = u + du * N, v + dv * N
+                Ec = [E[k] + A[k] * du * N + B[k] * dv * N for k in range(3)]
+                if i < n:
+                    x0 = (p * uc + a) * _SUB + _HALF - alpha * _HALF
+                    x1 = (p * (uc + N - 1) + a) * _SUB + _HALF + alpha * _HALF
+                    y0 = (q * vc + b) * _SUB + _HALF - beta * _HALF
+                    y1 = (q * (vc + N - 1) + b) * _SUB + _HALF + beta * _HALF
+                    ok = (x1 >= bx0 and x0 <= bx1 and y1 >= by0 and y0 <= by1
+                          and all(Ec[k] + pos[k] * (N - 1) + ext[k] >= thr[k] for k in range(3)))
+                    if ok:
+                        keep.append((i, uc, vc, Ec))
+                elif all(Ec[k] >= thr[k] for k in range(3)):
+                    zq = min(max((z0 + zu * uc + zv * vc) >> Z_FRAC_BITS, 0), zmax)
+                    adr = vc * Ns + uc
+                    if zq < ztab[adr]:
+                        ztab[adr], ttab[adr] = zq, tri
+                        writes += 1
+            stack.extend(reversed(keep))  # the first survivor on top
+        cycles[t] = SETUP_CYCLES + ntest
+    tri_m = np.array(ttab, dtype=np.int64).reshape(Ns, Ns)
+    zq_m = np.where(tri_m >= 0, np.array(ztab, dtype=np.int64).reshape(Ns, Ns), -1)
+    return {"tri": tri_m, "zq": zq_m, "cycles": cycles, "tests": np.array(tests[1:], dtype=np.int64),
+            "max_stack": max_stack, "writes": writes, "n": n}

@@ -1,0 +1,294 @@
+"""Cycle model of the HDL video processor as built (``hdl/sparse/vp.py``), cycle by cycle.
+
+The pipeline abstraction of :mod:`.cycles` prices a record at its busiest stage; the HDL
+processor overlaps consecutive records across its stages through FIFOs. This module steps the
+processor's registers as the HDL does, so that its input acceptance -- the cycle on which it takes
+each broadcast record -- and its last busy cycle are the HDL's:
+
+* set-up FSM ``IDLE -> HDR -> ROOT``: ``i.ready`` in ``IDLE``; the header into header FIFO 0 (when
+  it has room), then the root window into window FIFO 0;
+* ``n`` level stages (``hdl/sparse/stage.py``), ``IDLE`` / ``TEST``: a window (with its header when
+  it is marked ``new``) is taken in ``IDLE`` or in the cycle of the last test; each of the four
+  sub-windows takes one cycle, plus one for the triangle's header before its first survivor; a
+  survivor or header waits while the next FIFO is full;
+* ``2 (n + 1)`` ``SyncFIFOBuffered`` FIFOs (Amaranth 0.5: an inner memory of ``depth - 1`` entries
+  and an output register; ``w_rdy = inner_level != depth - 1``; an entry written on cycle ``c``
+  is at the output on cycle ``c + 2``);
+* the pixel processor: takes one pixel per cycle, two register stages (``idle`` when both empty).
+
+Only the control flow is modelled: which sub-windows survive and which windows start a triangle
+come from the golden search (``sparse_render(..., trace=True)``), which the HDL is held to bit for
+bit. ``busy`` is the HDL's: anything held in the set-up, a stage, a FIFO or the pixel pipeline.
+
+:func:`vp_standalone` replays the Verilator bench (``sim/sparse/verilator/tb_sparse_vp.v``):
+records offered back to back, ``cycles`` counted from the first cycle after reset to the first
+cycle, after the feed phase ended, on which the processor is not busy (inclusive).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from rasterhw.golden_model.errors import RasterhwError
+
+__all__ = ["HDL_FIFO_DEPTH", "VPCycleModel", "coupled_matrix_vp", "vp_standalone", "vp_streams"]
+
+#: ``VideoProcessor(fifo_depth=8)``, the default every driver builds
+HDL_FIFO_DEPTH = 8
+
+
+def vp_streams(frame, k: int) -> tuple[list[np.ndarray], list[np.ndarray], np.ndarray]:
+    """Processor ``k``'s control streams from a frame drawn with ``trace=True``: per level ``i``
+    (list index ``i - 1``) the survivor bits ``ok`` ``(R_i, 4)`` and the ``new`` flags ``(R_i,)`` of
+    the windows entering it, and the ``new`` flags of the pixels reaching the pixel processor."""
+    tr = frame.stats.get("trace")
+    if tr is None:
+        raise RasterhwError("sparse VP cycles: the frame was drawn without trace=True")
+    P = frame.p * frame.q
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < P:
+        raise RasterhwError(f"sparse VP cycles: processor index must be in 0..{P - 1}, not {k!r}")
+    oks, news = [], []
+    for proc, rt, ok in tr:
+        sel = proc == k
+        oks.append(np.ascontiguousarray(ok[sel]))
+        r = rt[sel]
+        new = np.ones(r.size, dtype=bool)
+        new[1:] = r[1:] != r[:-1]
+        news.append(new)
+    # pixels: the survivors of the last level, in order
+    proc, rt, ok = tr[-1]
+    sel = proc == k
+    rt_px = np.repeat(rt[sel], 4)[ok[sel].ravel()]
+    new_px = np.ones(rt_px.size, dtype=bool)
+    new_px[1:] = rt_px[1:] != rt_px[:-1]
+    return oks, news, new_px
+
+
+class VPCycleModel:
+    """One video processor's registers, stepped one cycle at a time (see the module docstring).
+
+    ``step(in_valid) -> accepted``: one clock cycle with the broadcast input's ``valid``; returns
+    whether the processor took the record in that cycle. ``busy`` is the HDL's ``busy`` output
+    for the current cycle (before ``step``). Counters ``tests[i]`` (busy cycles of stage ``i + 1``)
+    and ``stalls[i]`` are the HDL stage's.
+    """
+
+    def __init__(self, oks: list[np.ndarray], news: list[np.ndarray], new_px: np.ndarray, *,
+                 fifo_depth: int = HDL_FIFO_DEPTH):
+        if isinstance(fifo_depth, bool) or not isinstance(fifo_depth, int) or fifo_depth < 2:
+            raise RasterhwError(f"sparse VP cycles: fifo_depth must be an integer >= 2, not {fifo_depth!r}")
+        self.n = n = len(oks)
+        self.ok = [[tuple(bool(b) for b in row) for row in o] for o in oks]
+        self.new = [list(map(bool, x)) for x in news] + [list(map(bool, new_px))]
+        self.cap = fifo_depth - 1
+        # FIFO k (0..n) feeds stage k + 1 (the pixel processor for k = n); w: windows, h: headers
+        self.wl = [0] * (n + 1)   # inner levels
+        self.wv = [False] * (n + 1)  # output registers valid
+        self.hl = [0] * (n + 1)
+        self.hv = [False] * (n + 1)
+        self.setup = 0  # 0 IDLE, 1 HDR, 2 ROOT
+        self.st = [0] * n  # 0 IDLE, 1 TEST
+        self.child = [0] * n
+        self.cur = [0] * n  # index of the window held
+        self.nxt = [0] * n  # index of the next window to take
+        self.sent = [False] * n
+        self.fresh = [False] * n
+        self.tests = [0] * n
+        self.stalls = [0] * n
+        self.px_next = 0
+        self.v1 = self.v2 = False
+        self.held = 0
+        self.active = 0
+
+    @property
+    def busy(self) -> bool:
+        # held: entries in all FIFOs (inner levels plus output registers); active: stages in TEST
+        return bool(self.setup or self.v1 or self.v2 or self.held or self.active)
+
+    def step(self, in_valid: bool) -> bool:
+        n, cap = self.n, self.cap
+        wl, wv, hl, hv = self.wl, self.wv, self.hl, self.hv
+        w_wen = [False] * (n + 1)
+        h_wen = [False] * (n + 1)
+        w_ren = [False] * (n + 1)
+        h_ren = [False] * (n + 1)
+        # ---- set-up
+        accepted = False
+        setup_next = self.setup
+        if self.setup == 0:
+            if in_valid:
+                accepted = True
+                setup_next = 1
+        elif self.setup == 1:
+            h_wen[0] = True
+            if hl[0] != cap:
+                setup_next = 2
+        else:
+            w_wen[0] = True
+            if wl[0] != cap:
+                setup_next = 0
+        # ---- level stages
+        st_next = list(self.st)
+        for s in range(n):
+            ok_s, new_in = self.ok[s], self.new[s]
+
+            def accept(s=s, new_in=new_in):
+                # take the next window (and its header if it starts a triangle)
+                j = self.nxt[s]
+                valid = wv[s]
+                need = new_in[j] if valid else False
+                w_ren[s] = (not need) or hv[s]
+                h_ren[s] = valid and need
+                if valid and ((not need) or hv[s]):
+                    self.cur[s] = j
+                    self.nxt[s] = j + 1
+                    self.child[s] = 0
+                    if need:
+                        self.sent[s] = False
+                        self.fresh[s] = False
+                    st_next[s] = 1
+                else:
+                    st_next[s] = 0
+
+            if self.st[s] == 0:
+                accept()
+                continue
+            c = self.child[s]
+            ok = ok_s[self.cur[s]][c]
+            advance = False
+            if ok and not self.sent[s]:
+                h_wen[s + 1] = True
+                if hl[s + 1] != cap:
+                    self.sent[s] = True
+                    self.fresh[s] = True
+            elif ok:
+                w_wen[s + 1] = True
+                if wl[s + 1] != cap:
+                    advance = True
+                    self.fresh[s] = False
+                else:
+                    self.stalls[s] += 1
+            else:
+                advance = True
+            if advance:
+                self.tests[s] += 1
+                self.child[s] = c + 1
+                if c == 3:
+                    accept()
+        # ---- pixel processor
+        take = False
+        if wv[n]:
+            need = self.new[n][self.px_next]
+            w_ren[n] = (not need) or hv[n]
+            h_ren[n] = need
+            take = (not need) or hv[n]
+            if take:
+                self.px_next += 1
+        else:
+            w_ren[n] = True  # i.ready = ~need | i_hdr.valid on a stale payload: no transfer
+        self.v2 = self.v1
+        self.v1 = take
+        # ---- FIFOs (the edge)
+        held = 0
+        for k in range(n + 1):
+            for lv, vv, wen, ren in ((wl, wv, w_wen[k], w_ren[k]), (hl, hv, h_wen[k], h_ren[k])):
+                lev = lv[k]
+                do_write = wen and lev != cap
+                do_inner_read = lev != 0 and ((not vv[k]) or ren)
+                if do_inner_read:
+                    vv[k] = True
+                elif ren:
+                    vv[k] = False
+                lev += (1 if do_write else 0) - (1 if do_inner_read else 0)
+                lv[k] = lev
+                held += lev + vv[k]
+        self.held = held
+        self.setup = setup_next
+        self.st = st_next
+        self.active = sum(st_next)
+        return accepted
+
+
+def vp_standalone(oks, news, new_px, records: int, *, fifo_depth: int = HDL_FIFO_DEPTH,
+                  max_cycles: int = 50_000_000) -> dict:
+    """The Verilator bench's run of one processor: ``cycles`` (as the bench counts them),
+    ``accept`` (cycle each record was taken, from the first cycle after reset), ``tests``,
+    ``stalls`` per level."""
+    vp = VPCycleModel(oks, news, new_px, fifo_depth=fifo_depth)
+    acc = []
+    c = 0
+    idx = 0
+    # feed phase: valid while records remain; it ends on the cycle after the last is taken
+    while idx < records:
+        if vp.step(True):
+            acc.append(c)
+            idx += 1
+        c += 1
+        if c > max_cycles:
+            raise RasterhwError("sparse VP cycles: runaway feed")
+    vp.step(False)  # the bench's cycle that sees idx == ntri
+    c += 1
+    while vp.busy:  # drain: the bench counts the cycle on which busy is seen low
+        vp.step(False)
+        c += 1
+        if c > max_cycles:
+            raise RasterhwError("sparse VP cycles: runaway drain")
+    return {"cycles": c + 1, "accept": acc, "tests": list(vp.tests), "stalls": list(vp.stalls)}
+
+
+def coupled_matrix_vp(frame, depth: int, *, issue_interval: int = 1, fifo_depth: int = HDL_FIFO_DEPTH,
+                      max_cycles: int = 100_000_000) -> dict:
+    """The coupled matrix of :mod:`.cycles` (same broadcast, FIFO and counting rules) with every
+    processor the HDL video processor as built (:class:`VPCycleModel`) instead of a server: a
+    processor takes the record at the head of its matrix FIFO on a cycle on which its set-up is
+    idle (``i.ready``), and ``busy`` is the HDL's ``busy`` output. ``frame`` must be drawn with
+    ``trace=True``. Returns the keys of :meth:`~.cycles.CoupledResult.as_dict` plus ``accept``
+    ((P, T) cycle each processor took each record) and ``broadcast`` ((T,))."""
+    from rasterhw.golden_model.sparse.cycles import _check_int
+
+    D = _check_int("FIFO depth", depth, 1)
+    g = _check_int("issue interval", issue_interval, 1)
+    P = frame.p * frame.q
+    T = frame.triangles
+    vps = [VPCycleModel(*vp_streams(frame, k), fifo_depth=fifo_depth) for k in range(P)]
+    lev = [0] * P
+    peak = [0] * P
+    busy = [0] * P
+    acc = np.zeros((P, T), dtype=np.int64)
+    taken = [0] * P
+    bc = np.zeros(T, dtype=np.int64)
+    offer = np.zeros(T, dtype=np.int64)
+    t = 0
+    o = 0
+    c = 0
+    while True:
+        vb = [vp.busy for vp in vps]
+        if t == T and not any(lev) and not any(vb):
+            break
+        push = t < T and c >= o and max(lev) < D
+        for k in range(P):
+            if vb[k]:
+                busy[k] += 1
+            valid = lev[k] > 0
+            if not valid and not vb[k]:
+                continue  # an idle processor with nothing offered keeps its state
+            if vps[k].step(valid):
+                acc[k, taken[k]] = c
+                taken[k] += 1
+                lev[k] -= 1
+        if push:
+            offer[t], bc[t] = o, c
+            t += 1
+            o = c + g
+            for k in range(P):
+                lev[k] += 1
+                if lev[k] > peak[k]:
+                    peak[k] = lev[k]
+        c += 1
+        if c > max_cycles:
+            raise RasterhwError("sparse VP cycles: runaway coupled frame")
+    busy_a = np.array(busy, dtype=np.int64)
+    peak_a = np.array(peak, dtype=np.int64)
+    return {"frame_cycles": c, "stall_cycles": int((bc - offer).sum()), "fifo_peak": peak_a.tolist(),
+            "fifo_peak_max": int(peak_a.max(initial=0)), "busy": busy_a.tolist(), "idle": (c - busy_a).tolist(),
+            "depth": D, "issue_interval": g, "accept": acc, "broadcast": bc,
+            "tests": [vp.tests for vp in vps], "stalls": [vp.stalls for vp in vps]}
