@@ -494,8 +494,14 @@ def _fast_draw(xy, z, vcol, pid, bg, W: int, H: int, y0: int, y1: int, *, depth=
                          colour=None if colour is None else colour[3 * lo:3 * hi],
                          tri=None if tri is None else tri[lo:hi], poly=None if poly is None else poly[lo:hi])
 
-    bands = [(y0 + a, y0 + b) for a, b in _bands(W, y1 - y0, X.shape[0])]
-    parts = [one(bands[0])] if len(bands) == 1 else list(_executor().map(one, bands))
+    n = len(_bands(W, y1 - y0, X.shape[0]))
+    if n == 1:
+        parts = [one((y0, y1))]
+    else:  # bands of equal bounding-box work; the calling thread draws the first
+        c = fast.cuts(X, Y, W, H, y0, y1, n)
+        bands = list(itertools.pairwise(c))
+        rest = [_executor().submit(one, b) for b in bands[1:]]
+        parts = [one(bands[0])] + [f.result() for f in rest]
     return tuple(int(sum(p[i] for p in parts)) for i in range(3))
 
 

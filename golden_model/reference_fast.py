@@ -10,7 +10,9 @@ compiled loop (:func:`_band`) that is a serial Z-buffer written out plainly:
   span from ``ceil`` / ``floor`` of the same quotients ``N_i / sS_i``, clamped to the box;
 * for each pixel of the span, the same barycentric weights and depth, the same expressions
   evaluated in the same order (``w1 = (S1*col + K1) / E`` ...,
-  ``z = (z0*w0 + z1*w1) + z2*w2``), then the strict Z test against the depth held there;
+  ``z = (z0*w0 + z1*w1) + z2*w2``), in a first pass over the span with no branches (so the
+  compiler vectorises its divisions), then, in a second pass, the strict Z test against the
+  depth held there;
 * a fragment that passes writes only the outputs the caller asked for: colour (float64,
   ``(w0*c0 + w1*c1) + w2*c2`` per channel) or RGB8 (``Frame.to_rgb8``'s rounding), the
   triangle index and the polygon id, each at the integer width of the caller's buffer.
@@ -40,7 +42,7 @@ import tempfile
 import numba
 import numpy as np
 
-__all__ = ["band", "compile_all"]
+__all__ = ["band", "cuts", "compile_all"]
 
 
 def _jit(fn):
@@ -55,6 +57,44 @@ def _jit(fn):
         return numba.njit(cache=True, nogil=True)(fn)
     except (RuntimeError, OSError):
         return numba.njit(cache=False, nogil=True)(fn)
+
+
+@_jit
+def _to8(v):  # pragma: no cover - compiled
+    """``Frame.to_rgb8`` of one channel: ``floor(v * 255 + 0.5)`` clamped to 0..255. Below 0
+    the result is 0, from 256 on it is 255, and in between ``floor`` is the truncation."""
+    q = v * 255.0 + 0.5
+    if q < 0.0:
+        return np.uint8(0)
+    if q >= 256.0:
+        return np.uint8(255)
+    return np.uint8(np.int32(q))
+
+
+@_jit
+def _row_work(Y, X, W, H, y0, y1):  # pragma: no cover - compiled
+    """Bounding-box pixels per row of rows ``y0 .. y1 - 1`` (an estimate of the work, to cut
+    the frame into row bands of equal work; any cut draws the same pixels)."""
+    d = np.zeros(y1 - y0 + 1, np.int64)
+    for t in range(X.shape[0]):
+        r0 = max(np.ceil((min(Y[t, 0], Y[t, 1], Y[t, 2]) - 128.0) / 256.0), float(y0))
+        r1 = min(np.floor((max(Y[t, 0], Y[t, 1], Y[t, 2]) - 128.0) / 256.0), float(y1 - 1))
+        c0 = max(np.ceil((min(X[t, 0], X[t, 1], X[t, 2]) - 128.0) / 256.0), 0.0)
+        c1 = min(np.floor((max(X[t, 0], X[t, 1], X[t, 2]) - 128.0) / 256.0), float(W - 1))
+        if r1 >= r0 and c1 >= c0:
+            w = int(c1 - c0) + 1
+            d[int(r0) - y0] += w
+            d[int(r1) - y0 + 1] -= w
+    return np.cumsum(d[:-1])
+
+
+def cuts(X, Y, W: int, H: int, y0: int, y1: int, n: int) -> list[int]:
+    """``n + 1`` row boundaries from ``y0`` to ``y1`` splitting the bounding-box work evenly."""
+    work = np.cumsum(_row_work(Y, X, int(W), int(H), int(y0), int(y1)))
+    if work.size == 0 or work[-1] == 0:
+        return [y0 + (y1 - y0) * k // n for k in range(n + 1)]
+    inner = np.searchsorted(work, work[-1] * np.arange(1, n) / n, side="right") + y0
+    return [y0] + [int(c) for c in np.clip(inner, y0, y1)] + [y1]
 
 
 @_jit
@@ -81,6 +121,10 @@ def _band(X, Y, z, col, pid, W, H, y0, y1, bg, bg8, want_rgb8, rgb8, want_colour
             colour[3 * p] = bg[0]
             colour[3 * p + 1] = bg[1]
             colour[3 * p + 2] = bg[2]
+    bw0 = np.empty(W)  # one scan line's weights and depths
+    bw1 = np.empty(W)
+    bw2 = np.empty(W)
+    bz = np.empty(W)
     fragments = 0
     written = 0
     covered = 0
@@ -132,6 +176,10 @@ def _band(X, Y, z, col, pid, W, H, y0, y1, bg, bg8, want_rgb8, rgb8, want_colour
         nb2 = thr2 - s * k2
         za, zb, zc = z[t, 0], z[t, 1], z[t, 2]
         pt = pid[t]
+        # the vertex colours, held in registers (the outputs may alias anything for the compiler)
+        ca0, ca1, ca2 = col[t, 0, 0], col[t, 0, 1], col[t, 0, 2]
+        cb0, cb1, cb2 = col[t, 1, 0], col[t, 1, 1], col[t, 1, 2]
+        cc0, cc1, cc2 = col[t, 2, 0], col[t, 2, 1], col[t, 2, 2]
         for row in range(ra, rb + 1):
             Yc = float(row * 256 + 128)
             # The span: sS > 0 bounds it below (ceil), sS < 0 above (floor); a horizontal edge
@@ -166,14 +214,22 @@ def _band(X, Y, z, col, pid, W, H, y0, y1, bg, bg8, want_rgb8, rgb8, want_colour
             fragments += chi - clo + 1
             K1 = dx1 * Yc + k1  # E_1, E_2 at column 0 of the row
             K2 = dx2 * Yc + k2
-            base = (row - y0) * W
-            for cc in range(clo, chi + 1):
-                colf = float(cc)
-                w1 = (S1 * colf + K1) / area
-                w2 = (S2 * colf + K2) / area
-                w0 = (1.0 - w1) - w2
-                zz = (za * w0 + zb * w1) + zc * w2
-                p = base + cc
+            base = (row - y0) * W + clo
+            n = chi - clo + 1
+            # Pass 1, no branches (the compiler vectorises it): weights and depth of the span.
+            for i in range(n):
+                colf = float(clo + i)
+                a1 = (S1 * colf + K1) / area
+                a2 = (S2 * colf + K2) / area
+                a0 = (1.0 - a1) - a2
+                bw0[i] = a0
+                bw1[i] = a1
+                bw2[i] = a2
+                bz[i] = (za * a0 + zb * a1) + zc * a2
+            # Pass 2: the serial Z test, and the outputs of the fragments that pass.
+            for i in range(n):
+                zz = bz[i]
+                p = base + i
                 held = depth[p]
                 if zz < held:
                     if held == np.inf:
@@ -185,17 +241,20 @@ def _band(X, Y, z, col, pid, W, H, y0, y1, bg, bg8, want_rgb8, rgb8, want_colour
                     if want_poly:
                         poly[p] = pt
                     if want_colour or want_rgb8:
-                        for ch in range(3):
-                            v = (w0 * col[t, 0, ch] + w1 * col[t, 1, ch]) + w2 * col[t, 2, ch]
-                            if want_colour:
-                                colour[3 * p + ch] = v
-                            if want_rgb8:
-                                q = np.floor(v * 255.0 + 0.5)
-                                if q < 0.0:
-                                    q = 0.0
-                                elif q > 255.0:
-                                    q = 255.0
-                                rgb8[3 * p + ch] = np.uint8(q)
+                        w0 = bw0[i]
+                        w1 = bw1[i]
+                        w2 = bw2[i]
+                        v0 = (w0 * ca0 + w1 * cb0) + w2 * cc0
+                        v1 = (w0 * ca1 + w1 * cb1) + w2 * cc1
+                        v2 = (w0 * ca2 + w1 * cb2) + w2 * cc2
+                        if want_colour:
+                            colour[3 * p] = v0
+                            colour[3 * p + 1] = v1
+                            colour[3 * p + 2] = v2
+                        if want_rgb8:
+                            rgb8[3 * p] = _to8(v0)
+                            rgb8[3 * p + 1] = _to8(v1)
+                            rgb8[3 * p + 2] = _to8(v2)
     return fragments, written, covered
 
 
