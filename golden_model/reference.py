@@ -484,11 +484,12 @@ def _fast_draw(xy, z, vcol, pid, bg, W: int, H: int, y0: int, y1: int, *, depth=
     vcol = np.ascontiguousarray(vcol, dtype=np.float64)
     pid = np.ascontiguousarray(pid, dtype=np.int64)
     bg = np.ascontiguousarray(bg, dtype=np.float64)
+    bg8 = fast.rgb8_of(bg)
 
     def one(rows):
         a, b = rows
         lo, hi = (a - y0) * W, (b - y0) * W
-        return fast.band(X, Y, z, vcol, pid, W, H, a, b, bg,
+        return fast.band(X, Y, z, vcol, pid, W, H, a, b, bg, bg8=bg8,
                          depth=depth[lo:hi] if depth is not None else _zbuf(hi - lo),
                          rgb8=None if rgb8 is None else rgb8[3 * lo:3 * hi],
                          colour=None if colour is None else colour[3 * lo:3 * hi],
@@ -558,10 +559,10 @@ def render(tris: ScreenTriangles, target: Target, *, background=(0.0, 0.0, 0.0),
     W, H = int(tris.width), int(tris.height)
     if not isinstance(target, Target) or (target.width, target.height) != (W, H):
         raise RasterhwError(f"render: the target must be a Target of {W}x{H}, not {target!r}")
-    for name, arr, top in (("tri_id", target.tri_id, xy.shape[0] - 1),
-                           ("poly_id", target.poly_id, int(pid.max()) if pid.size else 0)):
-        if arr is not None:
+    for name, arr in (("tri_id", target.tri_id), ("poly_id", target.poly_id)):
+        if arr is not None and arr.dtype != np.int64:
             info = np.iinfo(arr.dtype)
+            top = xy.shape[0] - 1 if name == "tri_id" else (int(pid.max()) if pid.size else 0)
             low = int(pid.min()) if name == "poly_id" and pid.size else 0
             if top > info.max or low < info.min:
                 raise RasterhwError(f"render: {name} values up to {top} (from {low}) do not fit the "

@@ -268,11 +268,12 @@ _EMPTY = {np.dtype(np.uint8): np.empty(0, np.uint8), np.dtype(np.float64): np.em
 
 
 def band(X, Y, z, col, pid, W: int, H: int, y0: int, y1: int, bg: np.ndarray, *, depth: np.ndarray,
-         rgb8=None, colour=None, tri=None, poly=None) -> tuple[int, int, int]:
+         rgb8=None, colour=None, tri=None, poly=None, bg8=None) -> tuple[int, int, int]:
     """Draw rows ``y0 .. y1 - 1`` into flat arrays that hold exactly those rows (see
     :func:`_band`); ``None`` = not wanted. ``X``, ``Y``: snapped vertex coordinates (T, 3);
-    ``z`` (T, 3), ``col`` (T, 3, 3) float64, ``pid`` (T,) int64, all C-contiguous."""
-    return _band(X, Y, z, col, pid, int(W), int(H), int(y0), int(y1), bg, rgb8_of(bg),
+    ``z`` (T, 3), ``col`` (T, 3, 3) float64, ``pid`` (T,) int64, all C-contiguous; ``bg8``:
+    :func:`rgb8_of` ``(bg)``, if already known."""
+    return _band(X, Y, z, col, pid, int(W), int(H), int(y0), int(y1), bg, rgb8_of(bg) if bg8 is None else bg8,
                  rgb8 is not None, _EMPTY[np.dtype(np.uint8)] if rgb8 is None else rgb8,
                  colour is not None, _EMPTY[np.dtype(np.float64)] if colour is None else colour,
                  depth,
