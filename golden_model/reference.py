@@ -37,6 +37,13 @@ CPU, at most 2) in threads at once, each into its rows of the outputs: NumPy's l
 GIL, and a band gives exactly the pixels and counts of the whole frame's rows (each pixel's
 serial Z-buffer sees the same triangles in the same order), which a test holds bit for bit.
 
+Engines: this module's NumPy code is the specification. :mod:`rasterhw.golden_model.reference_fast`
+draws the same pixels, bit for bit, with one compiled numba loop, and is used by default where
+numba loads (``RASTERHW_REFERENCE=numpy``, or ``engine="numpy"``, forces the NumPy code; without
+numba it runs, with one line on stderr saying so). :func:`render` is the output contract: it
+writes only the outputs a caller asks for (RGB8, float colour, depth, triangle index, polygon id)
+into the caller's reusable :class:`Target`, ids at the integer width asked for.
+
 Triangles are processed in chunks of at most about ``CHUNK_CANDIDATES`` bounding-box pixels,
 carrying the depth buffer from chunk to chunk, so memory stays bounded for large frames.
 Fresh memory is expensive here (a page fault per 4 kB page), so the fragment arrays live in a
@@ -49,6 +56,7 @@ from __future__ import annotations
 import itertools
 import os
 import statistics
+import sys
 import threading
 import time
 import tracemalloc
@@ -59,7 +67,8 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles, snap
 
-__all__ = ["SUBPIXEL", "MAX_COORD", "Frame", "rasterise", "rasterise_rgb8", "rasterise_rgb8_memory", "benchmark", "random_triangles", "snap"]
+__all__ = ["SUBPIXEL", "MAX_COORD", "ENGINE_ENV", "Frame", "Target", "choose_engine", "rasterise", "render",
+           "rasterise_rgb8", "rasterise_rgb8_memory", "benchmark", "random_triangles", "snap"]
 
 #: Sub-pixel grid: vertex coordinates are snapped to multiples of ``1 / SUBPIXEL`` px.
 SUBPIXEL = 1 << SUBPIXEL_BITS
@@ -362,7 +371,7 @@ def _resolve(pix: np.ndarray, zz: np.ndarray, F: int, depth: np.ndarray, cnt: np
     return won, nw
 
 
-def rasterise(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0)) -> Frame:
+def rasterise(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0), engine: str | None = None) -> Frame:
     """Render screen triangles with a full-frame float Z-buffer and Gouraud colour.
 
     Parameters
@@ -371,13 +380,22 @@ def rasterise(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0)) -> Frame:
         Either winding is accepted; zero-area triangles (after snapping) cover nothing.
         Any finite ``z`` is accepted (the Z test is a plain float comparison).
     background : RGB in [0, 1] for empty pixels.
+    engine : ``"numpy"`` (this module's code, the specification), ``"numba"`` (the compiled
+        fast path, bit-identical), or ``None``/``"auto"``: :data:`ENGINE_ENV` if set, else numba
+        where it loads (see :func:`choose_engine`).
 
     Returns
     -------
-    Frame
+    Frame (new arrays on every call)
     """
     xy, z, vcol, pid, bg = _check(tris, background)
     W, H = int(tris.width), int(tris.height)
+    if choose_engine(engine) == "numba":
+        depth, tri_id, poly, colour = _outputs(W * H)
+        fr, wr, cov = _fast_draw(xy, z, vcol, pid, bg, W, H, 0, H, depth=depth, colour=colour.reshape(-1),
+                                 tri=tri_id, poly=poly)
+        return Frame(colour=colour.reshape(H, W, 3), depth=depth.reshape(H, W), tri_id=tri_id.reshape(H, W),
+                     poly_id=poly.reshape(H, W), fragments=fr, pixels_written=wr, pixels_covered=cov)
     bands = _bands(W, H, xy.shape[0])
     if len(bands) == 1:
         return _guarded(_rasterise, tris, xy, z, vcol, pid, bg)
@@ -400,6 +418,171 @@ def rasterise(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0)) -> Frame:
         pixels_written=sum(f.pixels_written for f in parts),
         pixels_covered=sum(f.pixels_covered for f in parts),
     )
+
+
+#: Environment variable choosing the engine when a call does not: ``numpy`` (the specification),
+#: ``numba`` (the compiled fast path; an error where numba cannot load), or ``auto`` / unset
+#: (numba where it loads, else NumPy with one line on stderr).
+ENGINE_ENV = "RASTERHW_REFERENCE"
+_ENGINES = ("auto", "numba", "numpy")
+_fast_lock = threading.Lock()
+_fast_mod = None  # the reference_fast module once loaded, False once it failed to
+
+
+def _fast_module():
+    """:mod:`reference_fast` (imported on first use: importing numba takes ~0.4 s), or None
+    where it cannot be loaded; the first failure prints one line on stderr."""
+    global _fast_mod
+    with _fast_lock:
+        if _fast_mod is None:
+            try:
+                from rasterhw.golden_model import reference_fast
+                _fast_mod = reference_fast
+            except Exception as e:  # ImportError, or numba / llvmlite failing to load
+                _fast_mod = False
+                why = (str(e).splitlines() or [type(e).__name__])[0]
+                print(f"rasterhw: numba cannot be loaded ({why}); the reference rasteriser runs its "
+                      f"NumPy specification (same pixels, slower)", file=sys.stderr)
+        return _fast_mod or None
+
+
+def choose_engine(engine: str | None = None) -> str:
+    """``"numba"`` or ``"numpy"``: the engine that draws for ``engine`` (``None`` = the
+    environment variable :data:`ENGINE_ENV`, default ``auto``)."""
+    want = engine if engine is not None else (os.environ.get(ENGINE_ENV) or "auto")
+    if want not in _ENGINES:
+        src = "engine" if engine is not None else ENGINE_ENV
+        raise RasterhwError(f"{src} must be one of {', '.join(_ENGINES)}, not {want!r}")
+    if want == "numpy":
+        return "numpy"
+    if _fast_module() is None:
+        if want == "numba":
+            raise RasterhwError("the numba engine was asked for, but numba cannot be loaded "
+                                f"(unset {ENGINE_ENV} or set it to numpy)")
+        return "numpy"
+    return "numba"
+
+
+def _zbuf(n: int) -> np.ndarray:
+    """A per-thread float64 Z-buffer of ``n`` pixels (contents undefined), kept between calls."""
+    buf = getattr(_local, "zbuf", None)
+    if buf is None or buf.size < n:
+        buf = _local.zbuf = np.empty(n, dtype=np.float64)
+    return buf[:n]
+
+
+def _fast_draw(xy, z, vcol, pid, bg, W: int, H: int, y0: int, y1: int, *, depth=None, rgb8=None,
+               colour=None, tri=None, poly=None) -> tuple[int, int, int]:
+    """Rows ``y0 .. y1 - 1`` of the frame by the compiled fast path, into flat arrays holding
+    exactly those rows (``None`` = not wanted; without ``depth`` a per-thread Z-buffer is used),
+    as :func:`_bands` row bands in threads (the kernel releases the GIL). Returns
+    ``(fragments, pixels_written, pixels_covered)``."""
+    fast = _fast_module()
+    X = np.ascontiguousarray(snap(xy[:, :, 0]))
+    Y = np.ascontiguousarray(snap(xy[:, :, 1]))
+    z = np.ascontiguousarray(z, dtype=np.float64)
+    vcol = np.ascontiguousarray(vcol, dtype=np.float64)
+    pid = np.ascontiguousarray(pid, dtype=np.int64)
+    bg = np.ascontiguousarray(bg, dtype=np.float64)
+    bg8 = fast.rgb8_of(bg)
+
+    def one(rows):
+        a, b = rows
+        lo, hi = (a - y0) * W, (b - y0) * W
+        return fast.band(X, Y, z, vcol, pid, W, H, a, b, bg, bg8=bg8,
+                         depth=depth[lo:hi] if depth is not None else _zbuf(hi - lo),
+                         rgb8=None if rgb8 is None else rgb8[3 * lo:3 * hi],
+                         colour=None if colour is None else colour[3 * lo:3 * hi],
+                         tri=None if tri is None else tri[lo:hi], poly=None if poly is None else poly[lo:hi])
+
+    n = len(_bands(W, y1 - y0, X.shape[0]))
+    if n == 1:
+        parts = [one((y0, y1))]
+    else:  # bands of equal bounding-box work; the calling thread draws the first
+        c = fast.cuts(X, Y, W, H, y0, y1, n)
+        bands = list(itertools.pairwise(c))
+        rest = [_executor().submit(one, b) for b in bands[1:]]
+        parts = [one(bands[0])] + [f.result() for f in rest]
+    return tuple(int(sum(p[i] for p in parts)) for i in range(3))
+
+
+_ID_DTYPES = (np.dtype(np.int32), np.dtype(np.int64))
+
+
+class Target:
+    """Reusable output buffers for :func:`render`: only the outputs a caller asks for, each at
+    the width it needs.
+
+    ``rgb8``: (H, W, 3) uint8, :meth:`Frame.to_rgb8` of the colour; ``colour``: (H, W, 3)
+    float64; ``depth``: (H, W) float64 (``+inf`` where empty); ``tri_id``, ``poly_id``: (H, W)
+    signed integers, -1 where empty, ``True`` for int32 or a dtype (int32 or int64). An output
+    not asked for is ``None``. After :func:`render`, ``fragments``, ``pixels_written`` and
+    ``pixels_covered`` hold its counts. Every render overwrites the buffers (copy what must
+    outlive the next one)."""
+
+    def __init__(self, width: int, height: int, *, rgb8: bool = False, colour: bool = False,
+                 depth: bool = False, tri_id=False, poly_id=False):
+        if not all(isinstance(v, (int, np.integer)) and not isinstance(v, bool) and v >= 1
+                   for v in (width, height)):
+            raise RasterhwError(f"Target: width and height must be positive integers, not {width!r}x{height!r}")
+        self.width, self.height = int(width), int(height)
+        h, w = self.height, self.width
+        self.rgb8 = np.empty((h, w, 3), np.uint8) if rgb8 else None
+        self.colour = np.empty((h, w, 3), np.float64) if colour else None
+        self.depth = np.empty((h, w), np.float64) if depth else None
+        self.tri_id = self._ids("tri_id", tri_id)
+        self.poly_id = self._ids("poly_id", poly_id)
+        self.fragments = self.pixels_written = self.pixels_covered = 0
+
+    def _ids(self, name: str, want) -> np.ndarray | None:
+        if want is False or want is None:
+            return None
+        dt = np.dtype(np.int32) if want is True else np.dtype(want)
+        if dt not in _ID_DTYPES:
+            raise RasterhwError(f"Target: {name} must be True (int32), int32 or int64, not {want!r}")
+        return np.empty((self.height, self.width), dt)
+
+    @property
+    def counts(self) -> dict:
+        return {"fragments": self.fragments, "pixels_written": self.pixels_written,
+                "pixels_covered": self.pixels_covered}
+
+
+def render(tris: ScreenTriangles, target: Target, *, background=(0.0, 0.0, 0.0),
+           engine: str | None = None) -> Target:
+    """:func:`rasterise` into ``target``'s buffers: the same pixels, only the outputs it holds.
+
+    The NumPy engine renders a :class:`Frame` and converts it (this is the specification of
+    every output); the numba engine writes each asked-for output directly, in one pass, and
+    allocates nothing per call. Returns ``target`` (its counts set)."""
+    xy, z, vcol, pid, bg = _check(tris, background)
+    W, H = int(tris.width), int(tris.height)
+    if not isinstance(target, Target) or (target.width, target.height) != (W, H):
+        raise RasterhwError(f"render: the target must be a Target of {W}x{H}, not {target!r}")
+    for name, arr in (("tri_id", target.tri_id), ("poly_id", target.poly_id)):
+        if arr is not None and arr.dtype != np.int64:
+            info = np.iinfo(arr.dtype)
+            top = xy.shape[0] - 1 if name == "tri_id" else (int(pid.max()) if pid.size else 0)
+            low = int(pid.min()) if name == "poly_id" and pid.size else 0
+            if top > info.max or low < info.min:
+                raise RasterhwError(f"render: {name} values up to {top} (from {low}) do not fit the "
+                                    f"target's {arr.dtype}; ask for int64")
+    if choose_engine(engine) == "numba":
+        flat = (None if a is None else a.reshape(-1) for a in
+                (target.depth, target.rgb8, target.colour, target.tri_id, target.poly_id))
+        d, r8, c, t, p = flat
+        counts = _fast_draw(xy, z, vcol, pid, bg, W, H, 0, H, depth=d, rgb8=r8, colour=c, tri=t, poly=p)
+    else:
+        f = rasterise(tris, background=background, engine="numpy")
+        if target.rgb8 is not None:
+            target.rgb8[...] = f.to_rgb8()
+        for name in ("colour", "depth", "tri_id", "poly_id"):
+            arr = getattr(target, name)
+            if arr is not None:
+                arr[...] = getattr(f, name)
+        counts = (f.fragments, f.pixels_written, f.pixels_covered)
+    target.fragments, target.pixels_written, target.pixels_covered = (int(v) for v in counts)
+    return target
 
 
 #: Frames of at least this many pixels, with at least this many triangles, are rendered as
@@ -563,8 +746,8 @@ def rasterise_rgb8_memory(width: int, height: int, n_triangles: int = 0) -> int:
             + 40 * CHUNK_CANDIDATES * 8 + 600 * n_triangles)
 
 
-def rasterise_rgb8(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0), progress=None
-                   ) -> tuple[np.ndarray, dict]:
+def rasterise_rgb8(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0), progress=None,
+                   engine: str | None = None) -> tuple[np.ndarray, dict]:
     """:func:`rasterise` for frames too big to hold as a :class:`Frame`: the same pixels,
     rendered in tiles of whole rows (about :data:`TILE_PIXELS` each), keeping only the
     8-bit image.
@@ -574,16 +757,28 @@ def rasterise_rgb8(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0), progres
 
     Returns ``(rgb8 (H, W, 3) uint8, {"fragments", "pixels_written", "pixels_covered"})``.
     ``progress``, if given, is called with the number of rows just finished (tiles are then at
-    most 1/32 of the frame, so a bar moves even on a frame of one tile).
+    most 1/32 of the frame, so a bar moves even on a frame of one tile). ``engine``: as for
+    :func:`rasterise` (the numba engine writes each tile's RGB8 directly, with a tile-sized
+    Z-buffer).
     """
     xy, z, vcol, pid, bg = _check(tris, background)
     W, H = int(tris.width), int(tris.height)
     rgb8 = np.empty((H, W, 3), dtype=np.uint8)
     counts = {"fragments": 0, "pixels_written": 0, "pixels_covered": 0}
-    st = _setup(xy, W, H) if xy.shape[0] else None
     step = max(1, TILE_PIXELS // W)
     if progress is not None:  # at least ~32 updates for a person watching (same pixels: see above)
         step = max(1, min(step, -(-H // 32)))
+    if choose_engine(engine) == "numba":
+        flat = rgb8.reshape(-1)
+        for y0 in range(0, H, step):
+            y1 = min(H, y0 + step)
+            part = _fast_draw(xy, z, vcol, pid, bg, W, H, y0, y1, rgb8=flat[3 * y0 * W:3 * y1 * W])
+            for k, v in zip(counts, part, strict=True):
+                counts[k] += v
+            if progress is not None:
+                progress(y1 - y0)
+        return rgb8, counts
+    st = _setup(xy, W, H) if xy.shape[0] else None
     try:
         for y0 in range(0, H, step):
             y1 = min(H, y0 + step)

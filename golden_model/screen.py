@@ -101,10 +101,12 @@ class ScreenTriangles:
             if arr.shape != shape:
                 raise RasterhwError(f"{who}: {name} must be of shape {shape}, got shape {arr.shape}")
         for name, arr in (("xy", xy), ("z", z), ("colour", col)):
+            if np.isfinite(arr.sum()):  # one cheap pass: a NaN or an infinity makes the sum non-finite
+                continue
             ok = np.isfinite(arr).reshape(t, arr.size // t if t else 0).all(axis=1)
             if not ok.all():
                 raise RasterhwError(f"{who}: triangle {int(np.flatnonzero(~ok)[0])} has a NaN or infinite {name}")
-        if t:
+        if t and max(float(xy.max()), -float(xy.min())) > max_coord:
             mag = np.abs(xy).reshape(t, -1).max(axis=1)
             if mag.max() > max_coord:
                 bad = int(np.argmax(mag > max_coord))

@@ -130,7 +130,8 @@ class Llvmpipe:
 
 def compare(tris: ScreenTriangles, repeat: int, ours) -> dict:
     """Time llvmpipe and ``ours`` (a callable rendering ``tris``, returning a reference
-    :class:`~rasterhw.golden_model.reference.Frame`) side by side: ``repeat`` rounds, each
+    :class:`~rasterhw.golden_model.reference.Frame` or a
+    :class:`~rasterhw.golden_model.reference.Target` holding ``tri_id``) side by side: ``repeat`` rounds, each
     one run of ours then one draw of llvmpipe, so both see the same machine load; medians.
 
     Returns ``{"ours_s", "llvmpipe_s", "ratio", "repeat", "ours_min_s", "llvmpipe_min_s",

@@ -15,6 +15,22 @@ from rasterhw.golden_model.screen import ScreenTriangles
 W, H = 32, 24
 
 
+@pytest.fixture(params=["numpy", "numba"])
+def engine(request, monkeypatch):
+    """Run the test on the NumPy specification and on the numba fast path (RASTERHW_REFERENCE)."""
+    if request.param == "numba":
+        pytest.importorskip("numba")
+    monkeypatch.setenv(reference.ENGINE_ENV, request.param)
+    assert reference.choose_engine() == request.param
+    return request.param
+
+
+@pytest.fixture
+def numpy_engine(monkeypatch):
+    """The NumPy code's own internals (chunks, the pool) are under test: force that engine."""
+    monkeypatch.setenv(reference.ENGINE_ENV, "numpy")
+
+
 def make_tris(xy, z=None, colour=None, *, width=W, height=H) -> ScreenTriangles:
     xy = np.asarray(xy, dtype=np.float64).reshape(-1, 3, 2)
     t = xy.shape[0]
@@ -71,7 +87,7 @@ def cover_each(tris: ScreenTriangles) -> np.ndarray:
 
 
 @pytest.mark.parametrize("seed", range(6))
-def test_matches_brute_force(seed):
+def test_matches_brute_force(seed, engine):
     tris = random_scene(seed)
     frame = rasterise(tris)
     cov = brute_coverage(tris)
@@ -88,7 +104,7 @@ def test_matches_brute_force(seed):
 
 
 @pytest.mark.parametrize("threads", [2, 3])
-def test_row_bands_in_threads_equal_one_band(threads, monkeypatch):
+def test_row_bands_in_threads_equal_one_band(threads, monkeypatch, engine):
     """Frames rendered as row bands in threads: bit for bit the one-band frame and counts, and
     the brute-force answer (bands forced on small frames here; by default from 256 x 256)."""
     tris = random_triangles(256, 256, 900, mean_area=90, seed=7)
@@ -115,7 +131,7 @@ def test_row_bands_in_threads_equal_one_band(threads, monkeypatch):
     monkeypatch.setattr(reference, "_exec", None)
 
 
-def test_horizontal_edges_match_brute_force():
+def test_horizontal_edges_match_brute_force(engine):
     """Horizontal top and bottom edges, on pixel centres and off them, in both windings: a
     horizontal edge admits a whole row or none of it, whatever the sign of its zero slope."""
     rng = np.random.default_rng(5)
@@ -147,7 +163,7 @@ def test_random_scenes_hit_the_ties():
     assert on_centre.sum() >= 10
 
 
-def test_chunked_equals_unchunked(monkeypatch):
+def test_chunked_equals_unchunked(monkeypatch, numpy_engine):
     tris = random_triangles(96, 64, 300, mean_area=60, seed=3)
     whole = rasterise(tris)
     monkeypatch.setattr(reference, "CHUNK_CANDIDATES", 200)
@@ -157,7 +173,7 @@ def test_chunked_equals_unchunked(monkeypatch):
     assert (whole.fragments, whole.pixels_written) == (parts.fragments, parts.pixels_written)
 
 
-def test_later_calls_do_not_touch_earlier_frames(monkeypatch):
+def test_later_calls_do_not_touch_earlier_frames(monkeypatch, engine):
     """Scratch memory is reused between calls; returned frames must not be part of it."""
     a_tris = random_triangles(96, 64, 300, mean_area=60, seed=3)
     a = rasterise(a_tris)
@@ -171,7 +187,7 @@ def test_later_calls_do_not_touch_earlier_frames(monkeypatch):
         np.testing.assert_array_equal(getattr(small, name), arr)
 
 
-def test_quad_split_covers_each_pixel_once():
+def test_quad_split_covers_each_pixel_once(engine):
     # Corners on pixel centres: the top and left sides are in, the bottom and right out.
     x0, y0, x1, y1 = 2.5, 3.5, 10.5, 9.5
     for diag in (0, 1):
@@ -185,7 +201,7 @@ def test_quad_split_covers_each_pixel_once():
         np.testing.assert_array_equal(cov, expect)
 
 
-def test_jittered_mesh_covers_whole_frame_exactly_once():
+def test_jittered_mesh_covers_whole_frame_exactly_once(engine):
     rng = np.random.default_rng(7)
     nx, ny = 9, 7
     gx, gy = np.meshgrid(np.linspace(-2, W + 2, nx), np.linspace(-2, H + 2, ny))
@@ -210,7 +226,7 @@ def test_jittered_mesh_covers_whole_frame_exactly_once():
     assert frame.fragments == frame.pixels_covered == W * H
 
 
-def test_fan_has_no_gaps_or_double_cover():
+def test_fan_has_no_gaps_or_double_cover(engine):
     cx, cy = 15.5, 11.5  # fan centre on a pixel centre
     ang = np.linspace(0, 2 * np.pi, 13)[:-1] + 0.1
     rim = np.stack([cx + 9 * np.cos(ang), cy + 9 * np.sin(ang)], axis=1)
@@ -228,7 +244,7 @@ def test_fan_has_no_gaps_or_double_cover():
     assert np.all(cov[inside] == 1)
 
 
-def test_winding_does_not_matter_and_ties_go_to_the_first():
+def test_winding_does_not_matter_and_ties_go_to_the_first(engine):
     xy = np.array([[[4.5, 2.5], [20.0, 6.3], [7.1, 19.5]]])
     fwd = rasterise(make_tris(xy))
     rev = rasterise(make_tris(xy[:, ::-1]))
@@ -241,7 +257,7 @@ def test_winding_does_not_matter_and_ties_go_to_the_first():
     assert both.fragments == 2 * both.pixels_covered
 
 
-def test_nearer_triangle_wins_whatever_the_order():
+def test_nearer_triangle_wins_whatever_the_order(engine):
     big = [[0, 0], [40, 0], [0, 40]]
     for order in ((0.2, 0.8), (0.8, 0.2)):
         f = rasterise(make_tris([big, big], z=[[order[0]] * 3, [order[1]] * 3]))
@@ -250,7 +266,7 @@ def test_nearer_triangle_wins_whatever_the_order():
         assert f.pixels_written == (f.pixels_covered if winner == 0 else 2 * f.pixels_covered)
 
 
-def test_gouraud_colour_at_vertices_and_inside():
+def test_gouraud_colour_at_vertices_and_inside(engine):
     xy = [[5.5, 5.5], [25.5, 5.5], [5.5, 20.5]]  # v0 is on a top and a left edge: covered
     col = [[0.1, 0.7, 0.3], [0.9, 0.2, 0.4], [0.25, 0.5, 1.0]]
     z = [0.3, 0.6, 0.9]
@@ -272,7 +288,7 @@ def test_gouraud_colour_at_vertices_and_inside():
     assert g.depth[0, 0] == np.inf and g.tri_id[0, 0] == -1 and g.poly_id[0, 0] == -1
 
 
-def test_deterministic_bytes():
+def test_deterministic_bytes(engine):
     a = rasterise(random_triangles(64, 48, 120, mean_area=40, seed=11))
     b = rasterise(random_triangles(64, 48, 120, mean_area=40, seed=11))
     for name in ("colour", "depth", "tri_id", "poly_id"):
@@ -282,7 +298,7 @@ def test_deterministic_bytes():
     assert a.to_rgb8().tobytes() != c.to_rgb8().tobytes()
 
 
-def test_random_triangles_counts():
+def test_random_triangles_counts(engine):
     tris = random_triangles(128, 96, 200, mean_area=50, seed=2)
     f = rasterise(tris)
     assert f.pixels_covered <= f.pixels_written <= f.fragments
@@ -291,7 +307,7 @@ def test_random_triangles_counts():
     assert f.tri_id.dtype == np.int64 and f.poly_id.dtype == np.int64
 
 
-def test_offscreen_and_empty():
+def test_offscreen_and_empty(engine):
     f = rasterise(make_tris([[-30, -30], [-10, -30], [-30, -10]]))
     assert f.fragments == 0 and f.pixels_covered == 0
     e = rasterise(make_tris(np.zeros((0, 3, 2))))

@@ -63,10 +63,15 @@ def brute_colour(tris: ScreenTriangles, tri_id: np.ndarray) -> np.ndarray:
     return out
 
 
-@pytest.mark.parametrize("chunk", [1 << 18, 64, 7])
+@pytest.mark.parametrize("engine, chunk", [("numpy", 1 << 18), ("numpy", 64), ("numpy", 7), ("numba", None)])
 @pytest.mark.parametrize("seed", range(4))
-def test_equals_serial_zbuffer_with_ties(seed, chunk, monkeypatch):
-    monkeypatch.setattr(ref, "CHUNK_CANDIDATES", chunk)
+def test_equals_serial_zbuffer_with_ties(seed, engine, chunk, monkeypatch):
+    """The NumPy code with chunk boundaries anywhere, and the numba fast path (no chunks)."""
+    if engine == "numba":
+        pytest.importorskip("numba")
+    monkeypatch.setenv(ref.ENGINE_ENV, engine)
+    if chunk is not None:
+        monkeypatch.setattr(ref, "CHUNK_CANDIDATES", chunk)
     tris = stacked_scene(seed)
     frame = ref.rasterise(tris)
     tri_id, depth, written = brute.brute_visible(tris)
@@ -83,8 +88,10 @@ def test_equals_serial_zbuffer_with_ties(seed, chunk, monkeypatch):
     np.testing.assert_array_equal(frame.colour, brute_colour(tris, tri_id))
 
 
-def test_tiles_equal_whole_frame():
+@pytest.mark.parametrize("engine", ["numpy", "numba"])
+def test_tiles_equal_whole_frame(engine, monkeypatch):
     """rasterise_rgb8 renders in tiles of rows: same image and counts as rasterise."""
+    monkeypatch.setenv(ref.ENGINE_ENV, engine)
     tris = stacked_scene(11)
     frame = ref.rasterise(tris)
     old = ref.TILE_PIXELS

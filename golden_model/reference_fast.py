@@ -1,0 +1,296 @@
+"""The compiled fast path of the float reference rasteriser (numba).
+
+:mod:`rasterhw.golden_model.reference` is the specification: whole-array NumPy code whose
+every step is written to be read. This module draws the same pixels, bit for bit, with one
+compiled loop (:func:`_band`) that is a serial Z-buffer written out plainly:
+
+* for each triangle in submission order, the same set-up as ``reference._setup`` (the same
+  float64 operations, in the same order, on the same snapped integers), computed on the spot;
+* for each scan line of its bounding box (clipped to the band being drawn), the same exact
+  span from ``ceil`` / ``floor`` of the same quotients ``N_i / sS_i``, clamped to the box;
+* for each pixel of the span, the same barycentric weights and depth, the same expressions
+  evaluated in the same order (``w1 = (S1*col + K1) / E`` ...,
+  ``z = (z0*w0 + z1*w1) + z2*w2``), in a first pass over the span with no branches (so the
+  compiler vectorises its divisions), then, in a second pass, the strict Z test against the
+  depth held there;
+* a fragment that passes writes only the outputs the caller asked for: colour (float64,
+  ``(w0*c0 + w1*c1) + w2*c2`` per channel) or RGB8 (``Frame.to_rgb8``'s rounding), the
+  triangle index and the polygon id, each at the integer width of the caller's buffer.
+
+A serial Z-buffer in submission order is what the NumPy code's chunked, sorted resolve
+computes (``reference._resolve``), and IEEE-754 double arithmetic gives the same bits for the
+same operations in the same order; numba compiles without fast-math, so nothing is
+reassociated or fused into a multiply-add. ``tests/test_reference_fast.py`` holds the two
+bit-identical on c300, sp27, c300 at 1280x1024 and on hypothesis-generated scenes, and the
+brute-force tests of ``tests/test_reference*.py`` run on both.
+
+The kernel is compiled on first use and cached on disk (``cache=True``): by default in
+``__pycache__`` beside this file (numba's own choice, which falls back to the user's cache
+directory, ``~/.cache/numba``, when the installed package is read-only; ``NUMBA_CACHE_DIR``
+overrides both). Where neither place is writable, :func:`_jit` points numba at
+``$TMPDIR/rasterhw-numba-UID`` and, failing that, compiles without a cache.
+
+This module imports numba at the top: :mod:`reference` imports it lazily and falls back to the
+NumPy code, with one line on stderr, when that fails.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+
+import numba
+import numpy as np
+
+__all__ = ["band", "cuts", "compile_all"]
+
+
+def _jit(fn):
+    """``numba.njit(cache=True, nogil=True)``, with a cache directory of our own where numba
+    finds no writable one (no ``__pycache__`` beside the module, no user cache directory)."""
+    try:
+        return numba.njit(cache=True, nogil=True)(fn)
+    except RuntimeError:  # "cannot cache function ...: no locator available"
+        pass
+    try:
+        numba.config.CACHE_DIR = os.path.join(tempfile.gettempdir(), f"rasterhw-numba-{os.getuid()}")
+        return numba.njit(cache=True, nogil=True)(fn)
+    except (RuntimeError, OSError):
+        return numba.njit(cache=False, nogil=True)(fn)
+
+
+@_jit
+def _to8(v):  # pragma: no cover - compiled
+    """``Frame.to_rgb8`` of one channel: ``floor(v * 255 + 0.5)`` clamped to 0..255. Below 0
+    the result is 0, from 256 on it is 255, and in between ``floor`` is the truncation."""
+    q = v * 255.0 + 0.5
+    if q < 0.0:
+        return np.uint8(0)
+    if q >= 256.0:
+        return np.uint8(255)
+    return np.uint8(np.int32(q))
+
+
+@_jit
+def _row_work(Y, X, W, H, y0, y1):  # pragma: no cover - compiled
+    """Bounding-box pixels per row of rows ``y0 .. y1 - 1`` (an estimate of the work, to cut
+    the frame into row bands of equal work; any cut draws the same pixels)."""
+    d = np.zeros(y1 - y0 + 1, np.int64)
+    for t in range(X.shape[0]):
+        r0 = max(np.ceil((min(Y[t, 0], Y[t, 1], Y[t, 2]) - 128.0) / 256.0), float(y0))
+        r1 = min(np.floor((max(Y[t, 0], Y[t, 1], Y[t, 2]) - 128.0) / 256.0), float(y1 - 1))
+        c0 = max(np.ceil((min(X[t, 0], X[t, 1], X[t, 2]) - 128.0) / 256.0), 0.0)
+        c1 = min(np.floor((max(X[t, 0], X[t, 1], X[t, 2]) - 128.0) / 256.0), float(W - 1))
+        if r1 >= r0 and c1 >= c0:
+            w = int(c1 - c0) + 1
+            d[int(r0) - y0] += w
+            d[int(r1) - y0 + 1] -= w
+    return np.cumsum(d[:-1])
+
+
+def cuts(X, Y, W: int, H: int, y0: int, y1: int, n: int) -> list[int]:
+    """``n + 1`` row boundaries from ``y0`` to ``y1`` splitting the bounding-box work evenly."""
+    work = np.cumsum(_row_work(Y, X, int(W), int(H), int(y0), int(y1)))
+    if work.size == 0 or work[-1] == 0:
+        return [y0 + (y1 - y0) * k // n for k in range(n + 1)]
+    inner = np.searchsorted(work, work[-1] * np.arange(1, n) / n, side="right") + y0
+    return [y0] + [int(c) for c in np.clip(inner, y0, y1)] + [y1]
+
+
+@_jit
+def _band(X, Y, z, col, pid, W, H, y0, y1, bg, bg8, want_rgb8, rgb8, want_colour, colour, depth,
+          want_tri, tri, want_poly, poly):  # pragma: no cover - compiled; tested through band()
+    """Rows ``y0 .. y1 - 1`` of a ``W x H`` frame. Every output array holds exactly those rows
+    (pixel ``(row, col)`` at ``(row - y0) * W + col``, flat, colour channels interleaved); the
+    unwanted ones may be empty. ``depth`` is the Z-buffer (float64), always used.
+
+    Returns ``(fragments, pixels_written, pixels_covered)`` of the band."""
+    npix = (y1 - y0) * W
+    depth[:npix] = np.inf
+    if want_tri:
+        tri[:npix] = -1
+    if want_poly:
+        poly[:npix] = -1
+    if want_rgb8:
+        for p in range(npix):
+            rgb8[3 * p] = bg8[0]
+            rgb8[3 * p + 1] = bg8[1]
+            rgb8[3 * p + 2] = bg8[2]
+    if want_colour:
+        for p in range(npix):
+            colour[3 * p] = bg[0]
+            colour[3 * p + 1] = bg[1]
+            colour[3 * p + 2] = bg[2]
+    bw0 = np.empty(W)  # one scan line's weights and depths
+    bw1 = np.empty(W)
+    bw2 = np.empty(W)
+    bz = np.empty(W)
+    fragments = 0
+    written = 0
+    covered = 0
+    half = 128.0  # SUBPIXEL // 2
+    sub = 256.0  # SUBPIXEL
+    for t in range(X.shape[0]):
+        Xv0, Xv1, Xv2 = X[t, 0], X[t, 1], X[t, 2]
+        Yv0, Yv1, Yv2 = Y[t, 0], Y[t, 1], Y[t, 2]
+        # Edge i runs from vertex a[i] to b[i] (a = 1, 2, 0; b = 2, 0, 1): reference._setup.
+        dx0 = Xv2 - Xv1
+        dy0 = Yv2 - Yv1
+        dx1 = Xv0 - Xv2
+        dy1 = Yv0 - Yv2
+        dx2 = Xv1 - Xv0
+        dy2 = Yv1 - Yv0
+        area = dx0 * (Yv0 - Yv1) - dy0 * (Xv0 - Xv1)
+        if area == 0:
+            continue
+        r0 = max(np.ceil((min(Yv0, Yv1, Yv2) - half) / sub), 0.0)
+        r1 = min(np.floor((max(Yv0, Yv1, Yv2) - half) / sub), float(H - 1))
+        c0 = max(np.ceil((min(Xv0, Xv1, Xv2) - half) / sub), 0.0)
+        c1 = min(np.floor((max(Xv0, Xv1, Xv2) - half) / sub), float(W - 1))
+        if r1 < r0 or c1 < c0:
+            continue
+        ra = max(int(r0), y0)
+        rb = min(int(r1), y1 - 1)
+        if rb < ra:
+            continue
+        s = 1.0 if area > 0 else -1.0
+        # Per edge: k = -dx*Ya - dy*(half - Xa), S = -SUBPIXEL*dy, the fill rule's
+        # sS*col >= N = na*Yc + nb, na = -s*dx, nb = thr - s*k (thr 0 on top/left edges).
+        k0 = -dx0 * Yv1 - dy0 * (half - Xv1)
+        k1 = -dx1 * Yv2 - dy1 * (half - Xv2)
+        k2 = -dx2 * Yv0 - dy2 * (half - Xv0)
+        S0 = -sub * dy0
+        S1 = -sub * dy1
+        S2 = -sub * dy2
+        sS0 = s * S0
+        sS1 = s * S1
+        sS2 = s * S2
+        thr0 = 0.0 if (s * dy0 < 0 or (s * dy0 == 0 and s * dx0 > 0)) else 1.0
+        thr1 = 0.0 if (s * dy1 < 0 or (s * dy1 == 0 and s * dx1 > 0)) else 1.0
+        thr2 = 0.0 if (s * dy2 < 0 or (s * dy2 == 0 and s * dx2 > 0)) else 1.0
+        na0 = -s * dx0
+        na1 = -s * dx1
+        na2 = -s * dx2
+        nb0 = thr0 - s * k0
+        nb1 = thr1 - s * k1
+        nb2 = thr2 - s * k2
+        za, zb, zc = z[t, 0], z[t, 1], z[t, 2]
+        pt = pid[t]
+        # the vertex colours, held in registers (the outputs may alias anything for the compiler)
+        ca0, ca1, ca2 = col[t, 0, 0], col[t, 0, 1], col[t, 0, 2]
+        cb0, cb1, cb2 = col[t, 1, 0], col[t, 1, 1], col[t, 1, 2]
+        cc0, cc1, cc2 = col[t, 2, 0], col[t, 2, 1], col[t, 2, 2]
+        for row in range(ra, rb + 1):
+            Yc = float(row * 256 + 128)
+            # The span: sS > 0 bounds it below (ceil), sS < 0 above (floor); a horizontal edge
+            # (sS == 0) passes the whole row (N <= 0) or none of it (N > 0).
+            lo = c0
+            hi = c1
+            N = na0 * Yc + nb0
+            if sS0 > 0:
+                lo = max(lo, np.ceil(N / sS0))
+            elif sS0 < 0:
+                hi = min(hi, np.floor(N / sS0))
+            elif N > 0:
+                continue
+            N = na1 * Yc + nb1
+            if sS1 > 0:
+                lo = max(lo, np.ceil(N / sS1))
+            elif sS1 < 0:
+                hi = min(hi, np.floor(N / sS1))
+            elif N > 0:
+                continue
+            N = na2 * Yc + nb2
+            if sS2 > 0:
+                lo = max(lo, np.ceil(N / sS2))
+            elif sS2 < 0:
+                hi = min(hi, np.floor(N / sS2))
+            elif N > 0:
+                continue
+            if hi < lo:
+                continue
+            clo = int(lo)
+            chi = int(hi)
+            fragments += chi - clo + 1
+            K1 = dx1 * Yc + k1  # E_1, E_2 at column 0 of the row
+            K2 = dx2 * Yc + k2
+            base = (row - y0) * W + clo
+            n = chi - clo + 1
+            # Pass 1, no branches (the compiler vectorises it): weights and depth of the span.
+            for i in range(n):
+                colf = float(clo + i)
+                a1 = (S1 * colf + K1) / area
+                a2 = (S2 * colf + K2) / area
+                a0 = (1.0 - a1) - a2
+                bw0[i] = a0
+                bw1[i] = a1
+                bw2[i] = a2
+                bz[i] = (za * a0 + zb * a1) + zc * a2
+            # Pass 2: the serial Z test, and the outputs of the fragments that pass.
+            for i in range(n):
+                zz = bz[i]
+                p = base + i
+                held = depth[p]
+                if zz < held:
+                    if held == np.inf:
+                        covered += 1
+                    depth[p] = zz
+                    written += 1
+                    if want_tri:
+                        tri[p] = t
+                    if want_poly:
+                        poly[p] = pt
+                    if want_colour or want_rgb8:
+                        w0 = bw0[i]
+                        w1 = bw1[i]
+                        w2 = bw2[i]
+                        v0 = (w0 * ca0 + w1 * cb0) + w2 * cc0
+                        v1 = (w0 * ca1 + w1 * cb1) + w2 * cc1
+                        v2 = (w0 * ca2 + w1 * cb2) + w2 * cc2
+                        if want_colour:
+                            colour[3 * p] = v0
+                            colour[3 * p + 1] = v1
+                            colour[3 * p + 2] = v2
+                        if want_rgb8:
+                            rgb8[3 * p] = _to8(v0)
+                            rgb8[3 * p + 1] = _to8(v1)
+                            rgb8[3 * p + 2] = _to8(v2)
+    return fragments, written, covered
+
+
+def rgb8_of(bg: np.ndarray) -> np.ndarray:
+    """The background in 8 bits, by ``Frame.to_rgb8``'s rule."""
+    return np.clip(np.floor(bg * 255.0 + 0.5), 0, 255).astype(np.uint8)
+
+
+_EMPTY = {np.dtype(np.uint8): np.empty(0, np.uint8), np.dtype(np.float64): np.empty(0, np.float64),
+          np.dtype(np.int64): np.empty(0, np.int64)}
+
+
+def band(X, Y, z, col, pid, W: int, H: int, y0: int, y1: int, bg: np.ndarray, *, depth: np.ndarray,
+         rgb8=None, colour=None, tri=None, poly=None, bg8=None) -> tuple[int, int, int]:
+    """Draw rows ``y0 .. y1 - 1`` into flat arrays that hold exactly those rows (see
+    :func:`_band`); ``None`` = not wanted. ``X``, ``Y``: snapped vertex coordinates (T, 3);
+    ``z`` (T, 3), ``col`` (T, 3, 3) float64, ``pid`` (T,) int64, all C-contiguous; ``bg8``:
+    :func:`rgb8_of` ``(bg)``, if already known."""
+    return _band(X, Y, z, col, pid, int(W), int(H), int(y0), int(y1), bg, rgb8_of(bg) if bg8 is None else bg8,
+                 rgb8 is not None, _EMPTY[np.dtype(np.uint8)] if rgb8 is None else rgb8,
+                 colour is not None, _EMPTY[np.dtype(np.float64)] if colour is None else colour,
+                 depth,
+                 tri is not None, _EMPTY[np.dtype(np.int64)] if tri is None else tri,
+                 poly is not None, _EMPTY[np.dtype(np.int64)] if poly is None else poly)
+
+
+def compile_all() -> None:
+    """Compile (or load from numba's cache) the variants the package uses: the Frame's outputs
+    and the output contract's RGB8 with 32- or 64-bit ids."""
+    X = np.array([[128.0, 1280.0, 128.0]])
+    Y = np.array([[128.0, 128.0, 1280.0]])
+    z = np.zeros((1, 3))
+    col = np.zeros((1, 3, 3))
+    pid = np.zeros(1, np.int64)
+    bg = np.zeros(3)
+    n = 8 * 8
+    for ids in (np.int32, np.int64):
+        band(X, Y, z, col, pid, 8, 8, 0, 8, bg, depth=np.empty(n), rgb8=np.empty(3 * n, np.uint8),
+             colour=np.empty(3 * n), tri=np.empty(n, ids), poly=np.empty(n, ids))
