@@ -30,3 +30,71 @@ def test_every_machine_has_a_folder_in_every_tree():
                     *([m.report] if m.report else []), *([m.bench] if m.bench else [])]:
             assert callable(registry.load(ref)), ref
         assert (ROOT.parent / "shared" / "seeds" / m.seed).exists() or not (ROOT.parent / "shared").exists()
+
+
+def _import_graph() -> tuple[dict[str, set[str]], dict[str, list[str]]]:
+    """Module -> the package modules it imports (inside functions too), and module -> the
+    ``"rasterhw...:attr"`` strings it holds."""
+    import ast
+
+    trees = {"hdl": "rasterhw.hdl", "golden_model": "rasterhw.golden_model", "sim": "rasterhw.sim"}
+    mods = {}
+    for top, pkg in trees.items():
+        for p in (ROOT / top).rglob("*.py"):
+            if "__pycache__" in p.parts:
+                continue
+            parts = [pkg, *p.relative_to(ROOT / top).with_suffix("").parts]
+            if parts[-1] == "__init__":
+                parts.pop()
+            mods[".".join(parts)] = p
+    graph, strings = {}, {}
+    for m, p in mods.items():
+        tree = ast.parse(p.read_text(encoding="utf-8"))
+        names = set()
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Import):
+                names |= {a.name for a in node.names}
+            elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+                names |= {node.module} | {f"{node.module}.{a.name}" for a in node.names}
+        deps = set()
+        for n in names:
+            parts = n.split(".")
+            while parts and ".".join(parts) not in mods:
+                parts.pop()
+            d = ".".join(parts)
+            if parts and d != m and not m.startswith(d + "."):
+                deps.add(d)
+        graph[m] = deps
+        strings[m] = [n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)
+                      and n.value.startswith("rasterhw.")]
+    return graph, strings
+
+
+def test_no_import_cycles_and_shared_code_knows_no_machine():
+    graph, strings = _import_graph()
+    machines = set(registry.machines())
+
+    def machine_of(mod: str) -> bool:
+        return any(part in machines for part in mod.split(".")[1:])
+
+    leaks = [(m, d) for m, deps in graph.items() if not machine_of(m) and m != "rasterhw.sim.registry"
+             for d in deps if machine_of(d)]
+    leaks += [(m, s) for m, ss in strings.items() if not machine_of(m) and m != "rasterhw.sim.registry"
+              for s in ss if machine_of(s.split(":")[0])]
+    assert not leaks, f"shared modules that name a machine package: {leaks}"
+    # a cycle: a module that reaches itself again (depth-first, imports inside functions counted)
+    state, cycles = {}, []
+
+    def visit(m, path):
+        state[m] = 1
+        for d in graph.get(m, ()):
+            if state.get(d) == 1:
+                cycles.append(path[path.index(d):] + [d])
+            elif d not in state:
+                visit(d, path + [d])
+        state[m] = 2
+
+    for m in graph:
+        if m not in state:
+            visit(m, [m])
+    assert not cycles, f"import cycles: {cycles[:3]}"

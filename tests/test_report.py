@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from rasterhw.golden_model.opcount import ops_per_triangle
+from rasterhw.golden_model.triangle_ops import ops_per_triangle
 from rasterhw.sim.report import ROW_KEYS, format_table, make_row, ratio, run_report
 from rasterhw.sim.snu.report import golden_rows
 from rasterhw.sim.zbm.report import PAPER_CYCLES, PAPER_KPOLYS, polygons_per_s

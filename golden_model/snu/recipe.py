@@ -224,7 +224,8 @@ def ops_per_triangle(scene: Scene | None = None, *, width: int = 1280, height: i
     Returns stage -> {category: n, "total": n} for table 1's stages, ``to_integer`` (outside
     the table) and a ``"total"`` row over table 1's stages.
     """
-    from rasterhw.golden_model.opcount import CATEGORIES, _default_triangle_scene
+    from rasterhw.golden_model.opcount import CATEGORIES
+    from rasterhw.golden_model.triangle_ops import default_triangle_scene as _default_triangle_scene
 
     scene = _default_triangle_scene() if scene is None else scene
     if scene.n_polygons != 1 or int(scene.nverts[0]) != 3:

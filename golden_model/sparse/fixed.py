@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles, snap
+from rasterhw.golden_model.sparse.edges import edge_setup
 from rasterhw.golden_model.sparse.formats import Z_ACC_BITS, Z_FRAC_BITS, check_signed
 
 __all__ = ["COLOUR_BITS", "broadcast_records", "colour_planes", "colour_rgb8", "depth_plane", "plane_full"]
@@ -74,7 +75,6 @@ def broadcast_records(tris: ScreenTriangles) -> list[dict]:
     full-raster pixel indices), ``bbox`` (Xmin, Xmax, Ymin, Ymax in sub-pixel units),
     ``z00, zx, zy`` (the depth plane, ``Z_FRAC_BITS`` fraction bits) and ``tri`` (input index).
     The HDL video processor takes exactly these fields (``hdl/sparse/layouts.py``)."""
-    from rasterhw.golden_model.sparse.search import edge_setup
 
     xy, _, _ = tris.validate(who="sparse broadcast", max_coord=float(1 << 13))
     es = edge_setup(xy)
@@ -106,7 +106,6 @@ def colour_rgb8(tris: ScreenTriangles, tri_id: np.ndarray, p: int, q: int) -> np
     ``(a, b) = (x mod p, y mod q)``'s sparse pixel ``(u, v)``; the processor evaluates
     ``C0 + Cu u + Cv v`` with ``C0 = C00 + a Cx + b Cy``, ``Cu = p Cx``, ``Cv = q Cy`` and rounds
     half up to 8 bits, clamped to 0..255 (the reference's ``to_rgb8`` rounding)."""
-    from rasterhw.golden_model.sparse.search import edge_setup
 
     xy, _, _ = tris.validate(who="sparse colour", max_coord=float(1 << 13))
     tri_id = np.asarray(tri_id)

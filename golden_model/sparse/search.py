@@ -46,9 +46,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles, snap
+from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles
+from rasterhw.golden_model.sparse.edges import edge_setup
+from rasterhw.golden_model.sparse.fixed import depth_plane
 from rasterhw.golden_model.sparse.formats import (
-    EDGE_AB_BITS,
     EDGE_BITS,
     Z_FRAC_BITS,
     check_signed,
@@ -56,60 +57,10 @@ from rasterhw.golden_model.sparse.formats import (
     sparse_geometry,
 )
 
-__all__ = ["EdgeSetup", "SparseFrame", "edge_setup", "sparse_render", "interleave"]
+__all__ = ["SparseFrame", "sparse_render", "interleave"]
 
 _SUB = 1 << SUBPIXEL_BITS
 _HALF = _SUB // 2
-
-
-@dataclass
-class EdgeSetup:
-    """What the geometry processor broadcasts per triangle (kept triangles only).
-
-    Attributes
-    ----------
-    tri : (T,) int64 — index of the triangle in the input.
-    A, B, C : (3, T) int64 — oriented edge coefficients per full-raster pixel index
-        (interior ``A*x + B*y + C >= thr``).
-    thr : (3, T) int64 — 0 on a top or left edge, 1 otherwise.
-    sign : (T,) int64 — sign of the snapped area (orientation); ``E_unsigned = sign * E``.
-    area : (T,) int64 — twice the signed area on the sub-pixel grid (reference's ``E``).
-    bbox : (4, T) int64 — ``Xmin, Xmax, Ymin, Ymax`` of the snapped vertices (sub-pixel units).
-    """
-
-    tri: np.ndarray
-    A: np.ndarray
-    B: np.ndarray
-    C: np.ndarray
-    thr: np.ndarray
-    sign: np.ndarray
-    area: np.ndarray
-    bbox: np.ndarray
-
-
-def edge_setup(xy: np.ndarray) -> EdgeSetup:
-    """Edge equations of every non-degenerate triangle, exactly as the reference rasteriser."""
-    X = snap(xy[:, :, 0]).T.astype(np.int64)  # (3, T)
-    Y = snap(xy[:, :, 1]).T.astype(np.int64)
-    a = [1, 2, 0]
-    b = [2, 0, 1]
-    dx = X[b] - X[a]
-    dy = Y[b] - Y[a]
-    area = dx[0] * (Y[0] - Y[1]) - dy[0] * (X[0] - X[1])
-    keep = np.flatnonzero(area != 0)
-    s = np.sign(area[keep])
-    dx, dy, Xa, Ya = dx[:, keep], dy[:, keep], X[a][:, keep], Y[a][:, keep]
-    sdx, sdy = s * dx, s * dy
-    topleft = (sdy < 0) | ((sdy == 0) & (sdx > 0))
-    A = -_SUB * sdy
-    B = _SUB * sdx
-    C = sdx * (_HALF - Ya) - sdy * (_HALF - Xa)
-    check_signed("edge coefficient A/B", np.concatenate([A.ravel(), B.ravel()]), EDGE_AB_BITS)
-    check_signed("edge constant C", C, EDGE_BITS)
-    return EdgeSetup(tri=keep.astype(np.int64), A=A, B=B, C=C, thr=np.where(topleft, 0, 1).astype(np.int64),
-                     sign=s.astype(np.int64), area=area[keep],
-                     bbox=np.stack([X[:, keep].min(0), X[:, keep].max(0), Y[:, keep].min(0), Y[:, keep].max(0)]))
-
 
 @dataclass
 class SparseFrame:
@@ -302,7 +253,6 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
         zz += zt[2] * w2
         key = zz
     else:
-        from rasterhw.golden_model.sparse.fixed import depth_plane
 
         Z0, Zu, Zv = depth_plane(tris, es, p, q)  # (T, q, p), (T,), (T,)
         acc = Z0[rt, pb, pa] + Zu[rt] * u0 + Zv[rt] * v0

@@ -26,6 +26,7 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles
 from rasterhw.golden_model.sparse.cycles import SETUP_CYCLES
+from rasterhw.golden_model.sparse.edges import edge_setup
 from rasterhw.golden_model.sparse.formats import Z_FRAC_BITS, parse_matrix, sparse_geometry
 
 __all__ = ["stack_processor"]
@@ -40,7 +41,6 @@ def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int
     ``cycles`` (per record: set-up plus tests), ``tests`` per level (``(n,)``), ``max_stack``
     (the deepest the stack grew) and ``writes`` (pixels that passed the Z test)."""
     from rasterhw.golden_model.sparse.fixed import depth_plane
-    from rasterhw.golden_model.sparse.search import edge_setup
 
     p, q = parse_matrix(matrix)
     n = sparse_geometry(tris.width, tris.height, p, q)

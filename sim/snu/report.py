@@ -44,13 +44,13 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
 def golden_rows(scene_name: str = HEADLINE, *, frame: dict | None = None) -> list[dict]:
     """Table 1 (counted by the golden geometry, clocked by the i860 model), the traversal of
     ``scene_name``'s structure store, the Gouraud inner loop counted as the scan converter ran it."""
-    from rasterhw.golden_model.opcount import ops_per_triangle
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.scenes import SCENES, build_scene
     from rasterhw.golden_model.snu import i860, recipe
     from rasterhw.golden_model.snu.balance import PAPER_TABLE1, table1_rows
     from rasterhw.golden_model.snu.gouraud import inner_loop_ops, scan_convert
     from rasterhw.golden_model.snu.traversal import measure_traversal
+    from rasterhw.golden_model.triangle_ops import ops_per_triangle
 
     model = i860.table1_model()
     compiler = i860.table1_model(mode="compiler", stream_triangles=0)

@@ -51,8 +51,8 @@ def test_mflops_on_paper_ops():
 
 
 def test_table1_rows():
-    from rasterhw.golden_model.opcount import ops_per_triangle as full_ops
     from rasterhw.golden_model.snu import i860, recipe
+    from rasterhw.golden_model.triangle_ops import ops_per_triangle as full_ops
 
     rows = b.table1_rows(recipe.ops_per_triangle(), full_ops(), i860.table1_model())
     keys = ("system", "figure", "quantity", "paper", "formula", "measured", "unit", "source")

@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.golden_model.opcount import _default_triangle_scene
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scene import Light
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.golden_model.snu import balance, recipe
 from rasterhw.golden_model.snu.gouraud import scan_convert
+from rasterhw.golden_model.triangle_ops import default_triangle_scene as _default_triangle_scene
 
 
 def test_counts_are_the_texts():

@@ -9,8 +9,9 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.reference import random_triangles, rasterise
 from rasterhw.golden_model.scenes import build_scene
+from rasterhw.golden_model.sparse.edges import edge_setup
 from rasterhw.golden_model.sparse.fixed import colour_planes, colour_rgb8
-from rasterhw.golden_model.sparse.search import edge_setup, sparse_render
+from rasterhw.golden_model.sparse.search import sparse_render
 
 
 @pytest.mark.parametrize(("scene", "matrix"), [("c300", "4x4"), ("sp27", "2x2"), ("sp8", "8x4")])
