@@ -96,3 +96,20 @@ def test_back_pressure_pattern_is_the_benches_xorshift():
     got = [next(pat) for _ in range(1000)]
     assert 350 < sum(got) < 650                  # about half the clocks ready at stall 128
     assert all(next(ready_pattern(s, 0)) for s in range(5))   # stall 0: always ready
+
+
+def test_machines_json_names_every_block_with_its_testbench():
+    import json
+
+    from click.testing import CliRunner
+    from rasterhw.sim.cli import cli
+
+    out = CliRunner().invoke(cli, ["machines", "--json"])
+    assert out.exit_code == 0, out.output
+    ms = {m["name"]: m for m in json.loads(out.output)}
+    assert set(ms) == set(registry.machines())
+    blocks = {b: info for m in ms.values() for b, info in m["blocks"].items()}
+    assert set(blocks) == set(registry.blocks())
+    for block in SMALL:   # the testbenches tests run, with both engines
+        assert blocks[block]["testbench"] and {"pysim", "verilator"} <= set(blocks[block]["engines"]), block
+    assert all(info["engines"] == [] for info in blocks.values() if info["testbench"] is None)
