@@ -31,6 +31,8 @@ def test_every_testbench_names_a_registered_block():
         for block, ref in m.testbenches.items():
             assert block in blocks and block in m.blocks, (m.name, block)
             assert registry.load(ref)().block == block
+    # every registered testbench runs in the tests below
+    assert set(SMALL) == {b for m in registry.machines().values() for b in m.testbenches}
 
 
 @pytest.mark.parametrize("block", sorted(SMALL))
