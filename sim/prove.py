@@ -106,13 +106,7 @@ class Proof:
 
 def proofs() -> dict[str, Proof]:
     """Every block with a proof -> its :class:`Proof` (``Machine.proofs`` of each machine)."""
-    out: dict[str, Proof] = {}
-    for m in registry.machines().values():
-        for name, ref in m.proofs.items():
-            if name in out:
-                raise RuntimeError(f"proof of {name!r} registered twice")
-            out[name] = registry.load(ref)
-    return out
+    return {name: registry.load(ref) for name, ref in registry.entries("proofs").items()}
 
 
 def _sby_text(p: Proof, depth: int) -> str:

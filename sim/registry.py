@@ -34,7 +34,7 @@ from functools import cache
 from rasterhw.golden_model.errors import RasterhwError
 
 __all__ = ["SIM_KEYS", "Arch", "Clock", "Flow", "FpgaSweep", "Machine", "Option", "SimBlock", "block_machine",
-           "flow", "load", "machines"]
+           "entries", "flow", "load", "machines"]
 
 #: keys every ``rasterhw sim`` JSON result carries
 SIM_KEYS = ("engine", "cycles", "clock_hz", "pixels_compared", "mismatches", "wall_s", "cycles_per_s")
@@ -179,15 +179,21 @@ def archs() -> dict[str, tuple[Machine, Arch]]:
     return out
 
 
-def blocks() -> dict[str, str]:
-    """Every Verilog block name -> its factory reference."""
+def entries(kind: str) -> dict[str, str]:
+    """Every machine's ``Machine.<kind>`` table (``blocks``, ``soak``, ``proofs``, ``testbenches``)
+    merged into one: name -> reference; a name two machines register is an error."""
     out: dict[str, str] = {}
     for m in machines().values():
-        for name, ref in m.blocks.items():
+        for name, ref in getattr(m, kind).items():
             if name in out:
-                raise RuntimeError(f"block {name!r} registered twice")
+                raise RuntimeError(f"{kind}: {name!r} registered twice")
             out[name] = ref
     return out
+
+
+def blocks() -> dict[str, str]:
+    """Every Verilog block name -> its factory reference."""
+    return entries("blocks")
 
 
 def sim_blocks() -> dict[str, tuple[Machine, SimBlock]]:

@@ -30,13 +30,7 @@ def _rng(seed: int, block: str, k: int) -> np.random.Generator:
 
 def soak_blocks() -> dict[str, str]:
     """Every block with a soak round -> its ``"module:round"``, in block-name order."""
-    out: dict[str, str] = {}
-    for m in registry.machines().values():
-        for name, ref in m.soak.items():
-            if name in out:
-                raise RuntimeError(f"soak block {name!r} registered twice")
-            out[name] = ref
-    return dict(sorted(out.items()))
+    return dict(sorted(registry.entries("soak").items()))
 
 
 def run_soak(*, pixels: int, seed: int, blocks: list[str] | None = None, progress: bool = True,

@@ -141,8 +141,7 @@ def compare(exp: Expected, got: Run, *, cycle_exact: bool = True) -> dict:
 
 def find_testbench(block: str) -> Testbench:
     """The registered testbench of ``block`` (``Machine.testbenches``), a one-line error if none."""
-    for m in registry.machines().values():
-        if block in m.testbenches:
-            return registry.load(m.testbenches[block])()
-    known = sorted(b for m in registry.machines().values() for b in m.testbenches)
-    raise RasterhwError(f"no testbench for block {block!r}; testbenches: {', '.join(known)}")
+    known = registry.entries("testbenches")
+    if block not in known:
+        raise RasterhwError(f"no testbench for block {block!r}; testbenches: {', '.join(sorted(known))}")
+    return registry.load(known[block])()
