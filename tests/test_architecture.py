@@ -114,3 +114,32 @@ def test_every_registered_module_is_in_the_naming_table():
             if f"`{path}`" not in table:
                 missing.append((m.name, path))
     assert not missing, f"registered but not in the naming table: {sorted(set(missing))}"
+
+
+def test_docs_name_only_modules_and_names_that_exist():
+    """Every ``from rasterhw... import a, b``, ``import rasterhw...`` and ``-m rasterhw...`` in
+    docs/*.md resolves (the snippets' imports; running them is not checked here)."""
+    import importlib
+
+    bad = []
+    for doc in sorted((ROOT / "docs").glob("*.md")):
+        for k, line in enumerate(doc.read_text().splitlines(), 1):
+            for m in re.finditer(r"(?:from|import|-m) (rasterhw(?:\.\w+)+)(?: import ([\w, ]+))?", line):
+                try:
+                    mod = importlib.import_module(m.group(1))
+                except ImportError:
+                    parent, _, attr = m.group(1).rpartition(".")
+                    try:   # `import rasterhw.pkg.mod as x` where mod is an attribute
+                        if hasattr(importlib.import_module(parent), attr):
+                            continue
+                    except ImportError:
+                        pass
+                    bad.append(f"{doc.name}:{k} {m.group(1)}")
+                    continue
+                for name in (n.strip().split(" ")[0] for n in (m.group(2) or "").split(",")):
+                    if name and not hasattr(mod, name):
+                        try:
+                            importlib.import_module(f"{m.group(1)}.{name}")
+                        except ImportError:
+                            bad.append(f"{doc.name}:{k} {m.group(1)}.{name}")
+    assert not bad, f"docs name what does not exist: {bad}"
