@@ -27,7 +27,7 @@ ENGINES = {"pysim": pysim.run, "verilator": verilator.run}
 
 
 def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", idle: float = 0.0, stall: int = 0,
-        seed: int = 1, expect_words: dict[str, int] | None = None, max_cycles: int = 10_000_000) -> Run:
+        seed: int = 1, expect_words: dict[str, int] | None = None, max_cycles: int | None = None) -> Run:
     """Run ``stim`` through block ``tb.block`` with ``params`` on ``engine``.
 
     ``idle`` (0 <= idle < 1): every input word without a gap of its own in ``stim`` waits a random
@@ -36,7 +36,8 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
     ``stall`` (0..255): every output's ``ready`` is low on a clock when the low byte of a seeded
     xorshift is below it (0: always ready); ``seed`` seeds it (port k uses ``seed + k``).
     ``expect_words``: words to collect per output port (the run ends when all have come);
-    ``max_cycles``: a watchdog.
+    ``max_cycles``: a watchdog (default: 10,000 + 64 clocks per word in and out, scaled up by the
+    idle gaps and the stalls; a block that stops gives a one-line error, not a hang).
     """
     if engine not in ENGINES:
         raise RasterhwError(f"engine must be one of {', '.join(ENGINES)}, not {engine!r}")
@@ -48,6 +49,10 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
         stim = with_gaps(stim, idle, seed, tb.inputs)
     if expect_words is None:
         raise RasterhwError("say how many words to collect per output port (expect_words)")
+    if max_cycles is None:
+        words = sum(len(w) for w in stim.words.values()) + sum(expect_words.values())
+        gaps = sum(sum(g) for g in stim.gaps.values())
+        max_cycles = (10_000 + 64 * words + gaps) * (1 + stall // 32)
     return ENGINES[engine](tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
                            max_cycles=max_cycles)
 
