@@ -53,7 +53,8 @@ MACHINE = Machine(
     fpga_note=("ZB/M segment clock 25 MHz (\"ZB/M の入力クロックは 25MHz\", sec. 6.1 cond. 3); the merge clock is "
                "independent (\"マージャはそれとは独立のマージクロックで動作\") and its frequency is not given."),
     testbenches={"zbm-seggen": "rasterhw.sim.zbm.testbench:SeggenBench",
-                 "zbm-unit": "rasterhw.sim.zbm.testbench:UnitBench"},
+                 "zbm-unit": "rasterhw.sim.zbm.testbench:UnitBench",
+                 "zbm-merger": "rasterhw.sim.zbm.testbench:MergerBench"},
     status="segment generator, ZB/M chip (8 pixel processors on a segment loop, double Z, merger on its own "
            "clock), unit, chained units (HDL, bit- and cycle-exact)",
 )

@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 from rasterhw.golden_model import zbm as G
-from rasterhw.golden_model.zbm.stimulus import first_triangles, random_triangles
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.zbm import formats as F
+from rasterhw.golden_model.zbm.stimulus import first_triangles, random_doublez, random_triangles
 from rasterhw.golden_model.zbm.words import (
     doublez_words,
     edge_pair_words,
@@ -14,7 +16,7 @@ from rasterhw.golden_model.zbm.words import (
 )
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 
-__all__ = ["SeggenBench", "UnitBench"]
+__all__ = ["MergerBench", "SeggenBench", "UnitBench"]
 
 
 class SeggenBench(Testbench):
@@ -67,3 +69,36 @@ class UnitBench(Testbench):
         i = params["interleave"]
         g0, g1 = doublez_words(G.render_zbm(stim.source, interleave=i).pixels)
         return Expected({f"o_merge[{c}]": merge_words(g0[:, c::i], g1[:, c::i]) for c in range(i)})
+
+
+class MergerBench(Testbench):
+    """``zbm-merger`` (the chip's merger, its PIXEL2 word): own double-Z words in on the segment
+    side (``i_own``), the upstream chip's on the merge side (``i_merge``), the nearest two of the
+    four samples of each pair out (``o_merge``), as ``golden_model/zbm/merger.py: merge`` (upstream
+    first on equal Z). Random pixels with Z ties and empty samples (``random_doublez``). Both
+    clocks run together here; the free-running unrelated clocks are the proof's
+    (``sim/zbm/proof.py``) and the cocotb bench's."""
+
+    block = "zbm-merger"
+    inputs = ("i_own", "i_merge")
+    outputs = ("o_merge",)
+    domains = ("sync", "merge")
+    port_domains = {"i_merge": "merge", "o_merge": "merge"}
+
+    def params(self, **given) -> dict:
+        p = super().params(**given)
+        if (p["z_bits"], p["colour_bits"]) != (F.Z_BITS, F.COLOUR_BITS):
+            raise RasterhwError("zbm-merger testbench: the golden words are the full PIXEL2 "
+                                f"(z_bits {F.Z_BITS}, colour_bits {F.COLOUR_BITS})")
+        return p
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        rng = np.random.default_rng(seed)
+        n = int(rng.integers(60, 200))
+        own, up = random_doublez(rng, n), random_doublez(rng, n)
+        return Stimulus({"i_own": merge_words(*doublez_words(own)), "i_merge": merge_words(*doublez_words(up))},
+                        what=f"{n} random pixel pairs, seed {seed}", source=(own, up))
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        own, up = stim.source
+        return Expected({"o_merge": merge_words(*doublez_words(G.merge(up, own)))})
