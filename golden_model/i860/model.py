@@ -238,9 +238,15 @@ class Program:
         m = [self.mul(a[i], b[i]) for i in range(3)]
         return self.add(self.add(m[0], m[1]), m[2])
 
+    def affine(self, x, rows: int = 4, m: str = "m", t: str = "t") -> list[int]:
+        """``rows`` rows of a 3-column matrix times ``x`` plus a translation, in the golden code's
+        order (``opcount.affine``): ``((m_r0 x + m_r1 y) + m_r2 z) + t_r``, constants named
+        ``m{r}{k}`` / ``t{r}``."""
+        return [self.add(self.dot3(x, tuple(f"{m}{r}{k}" for k in range(3))), f"{t}{r}") for r in range(rows)]
+
     def concat(self, other: Program) -> list[int]:
         base = len(self.ops)
-        gbase = 1 + max((g for g in self.groups if g is not None), default=-1)
+        gbase = self._new_group()
         for (unit, kind, counted, srcs, nreg, const), g in zip(other.ops, other.groups, strict=True):
             self.ops.append((unit, kind, counted, tuple(s + base for s in srcs), nreg, const))
             self.groups.append(None if g is None else g + gbase)

@@ -71,12 +71,7 @@ def stage_program(stage: str, *, newton_steps: int = NEWTON_STEPS) -> Program:
     reads as zero (f0) or a value kept in a register."""
     p = Program(newton_steps=newton_steps)
     if stage == "vertex_transform":  # 4 rows: m0 x + m1 y + m2 z + t
-        x = p.load(3)
-        out = []
-        for r in range(4):
-            # the golden code's order (opcount.affine): ((m0 x + m1 y) + m2 z) + t
-            out.append(p.add(p.dot3(x, tuple(f"m{r}{k}" for k in range(3))), f"t{r}"))
-        p.store(*out)
+        p.store(*p.affine(p.load(3)))
     elif stage == "normal_transform":
         n = p.load(3)
         p.store(*(p.dot3(n, tuple(f"n{r}{k}" for k in range(3))) for r in range(3)))

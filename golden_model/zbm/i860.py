@@ -51,12 +51,7 @@ def stage_program(stage: str, *, mode: str = "colour", newton_steps: int = 2) ->
     nch = CHANNELS[mode]
     p = Program(newton_steps=newton_steps)
     if stage == "transform":
-        x = p.load(3)
-        out = []
-        for r in range(4):
-            # the golden code's order (opcount.affine): ((m0 x + m1 y) + m2 z) + t
-            out.append(p.add(p.dot3(x, tuple(f"m{r}{k}" for k in range(3))), f"t{r}"))
-        p.store(*out)
+        p.store(*p.affine(p.load(3)))
     elif stage == "perspective":
         x, y, z, w = p.load(4)
         r = p.recip(w)
