@@ -73,13 +73,14 @@ class Testbench:
     ``block``: the registry name (``rasterhw verilog --list``); ``inputs`` / ``outputs``: stream
     ports as attribute paths (``"i"``, ``"o_merge[3]"``; :meth:`outputs_of` may depend on the
     parameters); ``domains``: the clock domains the block uses (every engine clocks them
-    together, one edge each per cycle).
+    together, one edge each per cycle); ``port_domains``: the ports not in ``sync``.
     """
 
     block: str = ""
     inputs: tuple[str, ...] = ("i",)
     outputs: tuple[str, ...] = ("o",)
     domains: tuple[str, ...] = ("sync",)
+    port_domains: dict[str, str] = {}   # port (or port array, e.g. "o_merge") -> its domain; default sync
 
     # ------------------------------------------------------------------ parameters and the DUT
     def params(self, **given) -> dict:
@@ -101,6 +102,10 @@ class Testbench:
 
     def outputs_of(self, params: dict) -> tuple[str, ...]:
         return self.outputs
+
+    def domain_of(self, port: str) -> str:
+        """The clock domain of stream port ``port`` (``o_merge[3]`` looks up ``o_merge`` too)."""
+        return self.port_domains.get(port, self.port_domains.get(port.split("[")[0], "sync"))
 
     # ------------------------------------------------------------------ what differs per block
     def stimulus(self, params: dict, seed: int) -> Stimulus:   # pragma: no cover - abstract

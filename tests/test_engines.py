@@ -26,6 +26,14 @@ def _need(exp: Expected) -> dict[str, int]:
     return {k: len(v) for k, v in exp.words.items()}
 
 
+def _case(block: str, seed: int):
+    """``block``'s testbench at its small size, a random stimulus and what the golden model expects."""
+    tb = find_testbench(block)
+    p = tb.params(**SMALL[block])
+    stim = tb.stimulus(p, seed=seed)
+    return tb, p, stim, tb.expect(p, stim)
+
+
 def test_every_testbench_names_a_registered_block():
     blocks = registry.blocks()
     for m in registry.machines().values():
@@ -38,10 +46,7 @@ def test_every_testbench_names_a_registered_block():
 
 @pytest.mark.parametrize("block", sorted(SMALL))
 def test_pysim_matches_golden_with_idle_and_back_pressure(block):
-    tb = find_testbench(block)
-    p = tb.params(**SMALL[block])
-    stim = tb.stimulus(p, seed=11)
-    exp = tb.expect(p, stim)
+    tb, p, stim, exp = _case(block, 11)
     assert sum(_need(exp).values()) > 50
     plain = run(tb, p, stim, engine="pysim", expect_words=_need(exp))
     slow = run(tb, p, stim, engine="pysim", idle=0.3, stall=90, seed=5, expect_words=_need(exp))
@@ -55,10 +60,7 @@ def test_pysim_matches_golden_with_idle_and_back_pressure(block):
 @pytest.mark.cocotb
 @pytest.mark.parametrize("block", sorted(SMALL))
 def test_verilator_gives_the_pysim_words_and_cycle_stamps(block):
-    tb = find_testbench(block)
-    p = tb.params(**SMALL[block])
-    stim = tb.stimulus(p, seed=12)
-    exp = tb.expect(p, stim)
+    tb, p, stim, exp = _case(block, 12)
     for kw in ({}, {"idle": 0.25, "stall": 120, "seed": 9}):
         a = run(tb, p, stim, engine="pysim", expect_words=_need(exp), **kw)
         b = run(tb, p, stim, engine="verilator", expect_words=_need(exp), **kw)

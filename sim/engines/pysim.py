@@ -47,18 +47,17 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
     sim = Simulator(dut)
     for d in tb.domains:
         sim.add_clock(1e-8, domain=d)
-    dom = getattr(tb, "port_domains", {})
     errors: list[str] = []
     for name in tb.inputs:
         port = port_of(dut, name)
-        sim.add_testbench(_source(port, stim.words[name], stim.gaps_of(name), dom.get(name, "sync")),
+        sim.add_testbench(_source(port, stim.words[name], stim.gaps_of(name), tb.domain_of(name)),
                           background=True)
     words: dict[str, list[int]] = {}
     stamps: dict[str, list[int]] = {}
     for k, name in enumerate(tb.outputs_of(params)):
         port = port_of(dut, name)
         words[name], stamps[name] = [], []
-        d = dom.get(name.split("[")[0], dom.get(name, "sync"))
+        d = tb.domain_of(name)
         sim.add_testbench(stream_protocol_checker(port, name, domain=d, errors=errors), background=True)
         sim.add_testbench(_sink(port, expect_words[name], words[name], stamps[name],
                                 ready_pattern(seed + k, stall), d, max_cycles, name))

@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 from amaranth.back import verilog
-from amaranth.hdl import ClockDomain, ClockSignal, Elaboratable, Instance, Module, Signal
+from amaranth.hdl import Cat, ClockDomain, ClockSignal, Elaboratable, Instance, Module, Signal
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.memh import read_memh
 from rasterhw.sim.runner import HARNESS_V, build_plain_verilator, run_plain_verilator
@@ -87,15 +87,8 @@ class BenchTop(Elaboratable):
                 i_clk=ClockSignal("sync"), i_cycle=self.cycles, i_valid=port.valid, o_ready=port.ready,
                 i_payload=_payload(port), o_done=ok)
             dones.append(ok)
-        m.d.comb += self.done.eq(Signal.like(self.done, init=1) if not dones else _all(dones))
+        m.d.comb += self.done.eq(Cat(*dones).all())
         return m
-
-
-def _all(bits):
-    out = bits[0]
-    for b in bits[1:]:
-        out = out & b
-    return out
 
 
 def _build(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[str, int]) -> tuple[Path, float]:
