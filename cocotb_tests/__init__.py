@@ -1,1 +1,1 @@
-"""cocotb benches on the generated Verilog (run through rasterhw.sim.runner)."""
+"""cocotb benches on the generated Verilog (run through rasterhw.sim.engines.runner)."""

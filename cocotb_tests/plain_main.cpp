@@ -1,12 +1,12 @@
 // The plain Verilator driver every timing-free bench shares (no cocotb, no --timing): the bench
-// top `RASTERHW_TOP` (a -D from sim/runner.py build_plain_verilator) has an input `clk` and an
+// top `RASTERHW_TOP` (a -D from sim/engines/runner.py build_plain_verilator) has an input `clk` and an
 // output `done`; this main toggles `clk` until `done` (or +maxcyc= rising edges), then
 // RASTERHW_TAIL more edges (for state the bench stores after `done`), times the loop with
 // std::chrono and prints one JSON line:
 //   {"sim_cycles": rising edges before done, "done", "run_s"[, "cycles"][, "lines"]}
 // where "cycles" / "lines" are the top's outputs of those names when the build defines
 // RASTERHW_CYCLES / RASTERHW_LINES. `final` blocks (the benches' dumps) run at the end.
-// A build with --trace-fst or --trace (waves on request: sim/waves.py) writes the run's trace to
+// A build with --trace-fst or --trace (waves on request: sim/engines/waves.py) writes the run's trace to
 // the file named by +waves=PATH, two time steps per clock (rising edges at odd steps).
 #include <chrono>
 #include <cstdint>

@@ -20,7 +20,7 @@ Contracts of the named callables:
 * report: ``rows(*, engine, progress, out_dir, **known) -> (rows, markdown sections)``;
 * bench: ``bench(*, repeat, hdl, progress) -> list of {"name", "value", "unit", "note"}``;
 * soak round: ``round(rng, k) -> {"pixels", "mismatches", "run_s", "settings"}`` for round ``k``
-  (:mod:`rasterhw.sim.soak`).
+  (:mod:`rasterhw.sim.flow.soak`).
 """
 
 from __future__ import annotations
@@ -91,7 +91,7 @@ class Clock:
 
 @dataclass(frozen=True)
 class Flow:
-    """How the hardware flow (``sim/synth.py``, ``sim/fpga.py``) takes one Verilog block.
+    """How the hardware flow (``sim/flow/synth.py``, ``sim/flow/fpga.py``) takes one Verilog block.
 
     Every field is optional: a block with no entry is synthesised and placed at its defaults."""
 
@@ -130,8 +130,8 @@ class Machine:
     sims: tuple[SimBlock, ...] = ()
     report: str | None = None          # "module:rows"
     bench: str | None = None           # "module:bench"
-    soak: dict[str, str] = field(default_factory=dict)     # soak block -> "module:round" (sim/soak.py)
-    proofs: dict[str, str] = field(default_factory=dict)   # verilog block -> "module:PROOF" (sim/prove.py)
+    soak: dict[str, str] = field(default_factory=dict)     # soak block -> "module:round" (sim/flow/soak.py)
+    proofs: dict[str, str] = field(default_factory=dict)   # verilog block -> "module:PROOF" (sim/flow/prove.py)
     flows: dict[str, Flow] = field(default_factory=dict)   # verilog block -> its hardware-flow settings
     testbenches: dict[str, str] = field(default_factory=dict)  # verilog block -> "module:Testbench" (sim/testbench.py)
     ram_modules: dict[str, str] = field(default_factory=dict)  # black-box RAM module -> "module:bits(params)"

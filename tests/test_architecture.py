@@ -143,3 +143,27 @@ def test_docs_name_only_modules_and_names_that_exist():
                         except ImportError:
                             bad.append(f"{doc.name}:{k} {m.group(1)}.{name}")
     assert not bad, f"docs name what does not exist: {bad}"
+
+
+SIM_LAYERS = ["top", "engines", "flow", "report", "cli"]   # each may import only those before it
+
+
+def _sim_layer(mod: str) -> int | None:
+    parts = mod.split(".")
+    if parts[:2] != ["rasterhw", "sim"] or len(parts) < 3:
+        return None
+    if parts[2] in SIM_LAYERS:
+        return SIM_LAYERS.index(parts[2])
+    if len(parts) == 3 and parts[2] not in registry.machines():
+        return 0
+    return None   # a machine folder: may use any layer but cli
+
+
+def test_sim_layers_import_only_downwards():
+    graph, _ = _import_graph()
+    upward = [(m, d) for m, deps in graph.items() for d in deps
+              if _sim_layer(m) is not None and _sim_layer(d) is not None and _sim_layer(d) > _sim_layer(m)]
+    machines = set(registry.machines())
+    upward += [(m, d) for m, deps in graph.items() for d in deps
+               if any(p in machines for p in m.split(".")[2:3]) and _sim_layer(d) == SIM_LAYERS.index("cli")]
+    assert not upward, f"sim/ modules that import a layer above their own: {sorted(upward)}"

@@ -9,7 +9,7 @@ import pytest
 from amaranth import unsigned
 from amaranth.sim import Simulator
 from rasterhw.hdl.broadcast import StreamBroadcast
-from rasterhw.sim.harness import stream_protocol_checker, stream_put, stream_sink
+from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put, stream_sink
 
 
 @pytest.mark.parametrize("n,seed", [(1, 0), (3, 1), (8, 2)])

@@ -12,7 +12,7 @@ PY = sys.executable
 
 
 def run(*args: str, cwd=None) -> subprocess.CompletedProcess:
-    return subprocess.run([PY, "-m", "rasterhw.sim.cli", *args], capture_output=True, text=True,
+    return subprocess.run([PY, "-m", "rasterhw.sim.cli.main", *args], capture_output=True, text=True,
                           cwd=cwd, timeout=300)
 
 
@@ -145,7 +145,7 @@ def test_sim_image_name_carries_the_options_given():
     """Two configurations of one scene (e.g. --schedule paper / overlap) get two default images."""
     from pathlib import Path
 
-    from rasterhw.sim.cli import sim_image_name
+    from rasterhw.sim.cli.main import sim_image_name
 
     a = sim_image_name("c300", "zbm", "verilator", {"interleave": 8, "schedule": "paper", "units": None})
     b = sim_image_name("c300", "zbm", "verilator", {"interleave": 8, "schedule": "overlap", "units": None})

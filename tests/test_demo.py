@@ -1,8 +1,8 @@
-"""The demo's pages (sim/demo.py) show every machine's image and numbers and fail on a mismatch."""
+"""The demo's pages (sim/report/demo.py) show every machine's image and numbers and fail on a mismatch."""
 
 from __future__ import annotations
 
-from rasterhw.sim import demo
+from rasterhw.sim.report import demo
 
 
 def _summary(mismatches: int) -> dict:

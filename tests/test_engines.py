@@ -107,7 +107,7 @@ def test_machines_json_names_every_block_with_its_testbench():
     import json
 
     from click.testing import CliRunner
-    from rasterhw.sim.cli import cli
+    from rasterhw.sim.cli.main import cli
 
     out = CliRunner().invoke(cli, ["machines", "--json"])
     assert out.exit_code == 0, out.output

@@ -5,15 +5,15 @@ from __future__ import annotations
 
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.fpga import (
+from rasterhw.sim.flow.fpga import (
     fpga_configs,
     fpga_sweeps,
     paper_clock,
     place_and_route,
-    rows,
     utilisation,
 )
-from rasterhw.sim.verilog import block_names
+from rasterhw.sim.report.fpga import rows
+from rasterhw.sim.engines.verilog import block_names
 
 
 @pytest.mark.heavy
@@ -24,7 +24,7 @@ def test_merger_places_on_ecp5_with_both_clocks(tmp_path, monkeypatch):
     workers place the same design in one folder."""
     import json
 
-    from rasterhw.sim import fpga
+    from rasterhw.sim.flow import fpga
 
     kw = dict(family="ecp5", device="25k", fifo_depth=4, z_bits=8, colour_bits=2)
     r = place_and_route("zbm-merger", **kw)
@@ -106,7 +106,7 @@ def test_router2_out_of_time_falls_back_to_router1_and_both_are_recorded(tmp_pat
     goes to router1 with the same netlist; the result says so, and the record keeps both runs."""
     import json
 
-    from rasterhw.sim import fpga
+    from rasterhw.sim.flow import fpga
 
     calls = []
 
@@ -124,22 +124,24 @@ def test_router2_out_of_time_falls_back_to_router1_and_both_are_recorded(tmp_pat
     outcome = "router1"
     r = place_and_route("zbm-seggen", timeout=60)
     assert calls == ["router2", "router1"] and r["router"] == "router1" and r["luts"] == 6000
-    assert r["first_try"]["router"] == "router2" and fpga._reason(r) is None
+    assert r["first_try"]["router"] == "router2" and fpga.not_measured_reason(r) is None
     rec = json.loads(fpga.write_run_record([r], tmp_path / "runs.json").read_text())["runs"]
     assert sorted(x["result"]["router"] for x in rec) == ["router1", "router2"]
     assert all("first_try" not in x["result"] for x in rec)
     outcome = "neither"
     r = place_and_route("zbm-seggen", timeout=60)
-    why = fpga._reason(r)
+    why = fpga.not_measured_reason(r)
     assert r["finished"] is False and "with router1, nor with router2 before it" in why
     assert "router1 at iteration 20 with 7,356 wires overused" in why and "TRELLIS_COMB 6,235" in why
     # a report made from records only, where router1 has not run: router2's reason, and that
     monkeypatch.setattr(fpga, "_place_and_route", lambda block, *, router, **kw: None if router == "router1"
                         else fake(block, router=router, **kw))
-    r = fpga._measure("zbm-seggen", {}, fast=False, progress=False, timeout=60, cached_only=True)
-    assert fpga._reason(r).endswith("router1 not run in the session that made this table (time): "
+    from rasterhw.sim.report import fpga as fpga_report
+
+    r = fpga_report._measure("zbm-seggen", {}, fast=False, progress=False, timeout=60, cached_only=True)
+    assert fpga.not_measured_reason(r).endswith("router1 not run in the session that made this table (time): "
                                     "`rasterhw fpga zbm-seggen`")
-    assert "router2 at iteration 20" in fpga._reason(r)
+    assert "router2 at iteration 20" in fpga.not_measured_reason(r)
     rec = json.loads(fpga.write_run_record([r], tmp_path / "runs.json").read_text())["runs"]
     assert rec[0]["result"]["reason"] == "nextpnr did not finish in 1 min"   # the record keeps the run's own
     calls.clear()
@@ -149,7 +151,7 @@ def test_router2_out_of_time_falls_back_to_router1_and_both_are_recorded(tmp_pat
 
 
 def test_router_progress_parser():
-    from rasterhw.sim.fpga import _progress
+    from rasterhw.sim.flow.fpga import _progress
 
     r2 = "Info:     iter=1 wires=135739 overused=12907 overuse=16088 archfail=NA\n" \
          "Info:     iter=2 wires=141278 overused=9321 overuse=10412 archfail=NA\n"
@@ -161,7 +163,7 @@ def test_router_progress_parser():
 
 
 def test_summary_of_a_run_that_did_not_finish_names_why():
-    from rasterhw.sim.fpga import fpga_summary
+    from rasterhw.sim.flow.fpga import fpga_summary
 
     r = {"block": "zbm-seggen", "params": {}, "family": "ecp5", "device": "85k", "finished": False,
          "stage": "place and route", "reason": "nextpnr did not finish in 60 min", "synth_s": None,

@@ -1,5 +1,5 @@
 # amaranth: UnusedElaboratable=no
-"""The pysim stream harness (sim/harness.py) catches broken sources and moves data in order."""
+"""The pysim stream harness (sim/engines/harness.py) catches broken sources and moves data in order."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from amaranth import Module, Signal, unsigned
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In
 from amaranth.sim import Simulator
-from rasterhw.sim.harness import stream_get, stream_protocol_checker, stream_put, stream_sink
+from rasterhw.sim.engines.harness import stream_get, stream_protocol_checker, stream_put, stream_sink
 
 
 class _Port(wiring.Component):

@@ -1,4 +1,4 @@
-"""sim/llvmpipe.py: Mesa llvmpipe draws the reference's screen triangles (coverage and
+"""sim/report/llvmpipe.py: Mesa llvmpipe draws the reference's screen triangles (coverage and
 visible triangle compared with ours), and the bench keeps its llvmpipe rows, with no value
 and the reason, where moderngl or EGL is missing."""
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from rasterhw.golden_model.reference import rasterise
 from rasterhw.golden_model.screen import ScreenTriangles
-from rasterhw.sim import bench, llvmpipe
+from rasterhw.sim.report import bench, llvmpipe
 
 
 def _gl(width: int, height: int) -> llvmpipe.Llvmpipe:

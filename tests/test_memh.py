@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.memh import memh_uint64, read_memh
+from rasterhw.sim.engines.memh import memh_uint64, read_memh
 
 
 def _words(b: np.ndarray) -> list[int]:

@@ -88,7 +88,7 @@ def test_ply_headers_load_or_one_line_error(tmp_path_factory, raw):
 @given(text=st.one_of(st.text(max_size=24), st.builds(lambda a, b, s: f"{a}{s}{b}", st.integers(-10, 20000),
                                                        st.integers(-10, 20000), st.sampled_from(["x", "X", "*", " x ", "_"]))))
 def test_size_parser_result_or_one_line_error(text):
-    from rasterhw.sim.cli import parse_size
+    from rasterhw.sim.cli.main import parse_size
 
     try:
         w, h = parse_size(text)
@@ -115,7 +115,7 @@ def test_param_parser_result_or_one_line_error(block, data):
     import inspect
 
     from rasterhw.sim import registry
-    from rasterhw.sim.verilog import parse_params
+    from rasterhw.sim.engines.verilog import parse_params
 
     factory = registry.load(registry.blocks()[block])
     names = list(inspect.signature(factory).parameters) + ["nonsense", ""]

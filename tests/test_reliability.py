@@ -26,7 +26,7 @@ TRI = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
 
 def run(*args: str, cwd=None, env=None, timeout=300) -> subprocess.CompletedProcess:
     e = dict(os.environ, **(env or {}))
-    return subprocess.run([PY, "-m", "rasterhw.sim.cli", *args], capture_output=True, text=True, cwd=cwd,
+    return subprocess.run([PY, "-m", "rasterhw.sim.cli.main", *args], capture_output=True, text=True, cwd=cwd,
                           env=e, timeout=timeout)
 
 
@@ -42,7 +42,7 @@ def one_line_error(r: subprocess.CompletedProcess, *, contains: str = "") -> str
 # ------------------------------------------------------------------ row 2
 def test_p_false_is_false_not_a_truthy_string():
     from rasterhw.hdl.zbm.unit import ZbmUnit
-    from rasterhw.sim.verilog import parse_params
+    from rasterhw.sim.engines.verilog import parse_params
 
     assert parse_params(("head=false",), ZbmUnit) == {"head": False}
     assert parse_params(("head=1", "interleave=0x2"), ZbmUnit) == {"head": True, "interleave": 2}
@@ -262,7 +262,8 @@ def test_simulator_child_dies_with_an_interrupted_parent(tmp_path):
     """SIGTERM to a CLI process mid-run: its run folder is removed and its child is gone."""
     script = textwrap.dedent(f"""
         import signal, sys
-        from rasterhw.sim import cli, workdirs
+        from rasterhw.sim import workdirs
+        from rasterhw.sim.cli import main as cli
         signal.signal(signal.SIGTERM, cli._terminate)
         d = workdirs.temp_run_folder({str(tmp_path)!r})
         print(d, flush=True)
@@ -317,7 +318,7 @@ def test_concurrent_builds_of_one_folder_take_turns(tmp_path):
 
 
 def test_failed_verilator_build_is_one_line_naming_the_log(tmp_path):
-    from rasterhw.sim.runner import build_plain_verilator
+    from rasterhw.sim.engines.runner import build_plain_verilator
 
     bad = tmp_path / "bad.v"
     bad.write_text("module tb_bad(; endmodule\n")
@@ -362,7 +363,7 @@ def test_size_is_checked_before_the_mesh_loads(tmp_path):
 
 @pytest.mark.parametrize("text", ["5_0x5_0", "+5x5", "-5x5", "5x5x5", "0x10", "16385x1", " x ", "5.0x5"])
 def test_size_parser_takes_plain_digits_only(text):
-    from rasterhw.sim.cli import parse_size
+    from rasterhw.sim.cli.main import parse_size
 
     with pytest.raises(RasterhwError):
         parse_size(text)

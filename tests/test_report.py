@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 from rasterhw.golden_model.triangle_ops import ops_per_triangle
-from rasterhw.sim.report import ROW_KEYS, format_table, make_row, ratio, run_report
+from rasterhw.sim.report.rows import ROW_KEYS, format_table, make_row, ratio, run_report
 from rasterhw.sim.snu.report import golden_rows
 from rasterhw.sim.zbm.report import PAPER_CYCLES, PAPER_KPOLYS, polygons_per_s
 
@@ -53,7 +53,7 @@ def test_zbm_polygons_per_s_is_the_papers_arithmetic():
 
 
 def test_run_report_writes_markdown(tmp_path, monkeypatch):
-    from rasterhw.sim import report
+    from rasterhw.sim.report import rows as report
 
     def fake(*, engine, progress, out_dir):
         return [make_row("fake", "t1", "q", paper=2, formula=2, measured=2, unit="u", source="golden")], ["extra"]

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.report import (
+from rasterhw.sim.report.rows import (
     _fmt,
     make_row,
     missing_rows,
@@ -65,7 +65,7 @@ def test_every_report_has_a_committed_table():
 
 
 def test_a_report_that_would_drop_a_row_fails_and_keeps_the_file(tmp_path, monkeypatch):
-    from rasterhw.sim import report
+    from rasterhw.sim.report import rows as report
 
     two = [make_row("fake", "t1", "a", paper=1, formula=None, measured=1, unit="u", source="golden"),
            make_row("fake", "t1", "b (mean 2.5 px)", paper=1, formula=None, measured=1, unit="u", source="golden")]
@@ -82,7 +82,7 @@ def test_a_report_that_would_drop_a_row_fails_and_keeps_the_file(tmp_path, monke
 
 
 def test_an_unmeasured_row_stays_with_its_reason(tmp_path, monkeypatch):
-    from rasterhw.sim import report
+    from rasterhw.sim.report import rows as report
 
     rows = [make_row("fake", "t1", "a", paper=1, formula=None, measured=None, unit="u",
                      source="hdl:yosys", reason="no time")]

@@ -1,5 +1,5 @@
 # amaranth: UnusedElaboratable=no
-"""Verilog generation registry, lint and simulator selection (rasterhw.sim.verilog/runner)."""
+"""Verilog generation registry, lint and simulator selection (rasterhw.sim.engines.verilog/runner)."""
 
 from __future__ import annotations
 
@@ -7,9 +7,9 @@ import shutil
 
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.runner import SimulatorUnavailable, build_dir_for, get_sim, lint_verilog
-from rasterhw.sim.verilog import block_names, generate_verilog
-from rasterhw.sim.verilog_cache import write_verilog
+from rasterhw.sim.engines.runner import SimulatorUnavailable, build_dir_for, get_sim, lint_verilog
+from rasterhw.sim.engines.verilog import block_names, generate_verilog
+from rasterhw.sim.engines.verilog_cache import write_verilog
 
 
 def test_registry_has_every_machines_blocks():

@@ -1,5 +1,5 @@
 """Random differential runs of every HDL block against its golden model, on Verilator
-(sim/soak.py): at least 10**6 output pixels per block in every CI run, a fresh seed each
+(sim/flow/soak.py): at least 10**6 output pixels per block in every CI run, a fresh seed each
 time (printed; ``RASTERHW_SEED=n`` reruns it). ``make soak`` runs 10**8 per block."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import os
 import secrets
 
 import pytest
-from rasterhw.sim.soak import run_soak, soak_blocks
+from rasterhw.sim.flow.soak import run_soak, soak_blocks
 
 pytestmark = pytest.mark.cocotb
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim import synth
-from rasterhw.sim.synth import YosysUnavailable, gate_equivalent, synthesise
+from rasterhw.sim.flow import synth
+from rasterhw.sim.flow.synth import YosysUnavailable, gate_equivalent, synthesise
 
 
 def test_bank_counts_are_parsed_and_sane():
@@ -63,7 +63,7 @@ def test_bad_input():
 
 
 def test_missing_yosys_says_how_to_install(monkeypatch, tmp_path):
-    from rasterhw.sim import tools
+    from rasterhw.sim.flow import tools
 
     monkeypatch.setattr(tools.sys, "executable", str(tmp_path / "python"))
     monkeypatch.setattr(tools.shutil, "which", lambda name: None)
@@ -78,7 +78,7 @@ def test_blocks_synthesise_with_one_command():
     """`rasterhw synth --all --small` runs every block (minutes: the big ones are for
     `make bench`); here the quick ones through the same function."""
     from rasterhw.sim import registry
-    from rasterhw.sim.verilog import block_names
+    from rasterhw.sim.engines.verilog import block_names
 
     assert set(QUICK) <= set(block_names())
     for m in registry.machines().values():   # every block declares its flow settings (small sizes ...)

@@ -1,9 +1,9 @@
-"""sim/verilog_cache.py: a block's generated Verilog is keyed on exactly the sources it imports."""
+"""sim/engines/verilog_cache.py: a block's generated Verilog is keyed on exactly the sources it imports."""
 
 from __future__ import annotations
 
 import pytest
-from rasterhw.sim.verilog_cache import PKG_ROOT, design_sources, source_digest
+from rasterhw.sim.engines.verilog_cache import PKG_ROOT, design_sources, source_digest
 
 
 def _rel(block):
@@ -13,7 +13,7 @@ def _rel(block):
 def test_a_block_depends_on_its_hdl_and_formats_only():
     unit = _rel("zbm-unit")
     assert {"hdl/zbm/unit.py", "hdl/zbm/chip.py", "hdl/zbm/seggen.py", "golden_model/zbm/formats.py",
-            "sim/verilog.py", "hdl/zbm/__init__.py"} <= unit
+            "sim/engines/verilog.py", "hdl/zbm/__init__.py"} <= unit
     # golden algorithms, other machines' HDL and tests do not regenerate the unit
     assert not {"golden_model/zbm/render.py", "golden_model/zbm/unit.py", "golden_model/zbm/cycles.py",
                 "hdl/sparse/vp.py", "hdl/snu/pixelbus.py"} & unit
@@ -41,10 +41,10 @@ def test_generated_verilog_does_not_depend_on_the_hash_seed(tmp_path):
     import subprocess
     import sys
 
-    from rasterhw.sim.verilog import canonical_port_lists
+    from rasterhw.sim.engines.verilog import canonical_port_lists
 
     # each process prints the raw text (canonicalisation off) and then generate_verilog's
-    code = ("import sys, rasterhw.sim.verilog as V; canon = V.canonical_port_lists; "
+    code = ("import sys, rasterhw.sim.engines.verilog as V; canon = V.canonical_port_lists; "
             "V.canonical_port_lists = lambda t: t; "
             "raw = V.generate_verilog('zbm-chip', interleave=2, chip=0, width=32); "
             "V.canonical_port_lists = canon; "
@@ -69,7 +69,7 @@ def test_generated_verilog_does_not_depend_on_the_hash_seed(tmp_path):
 
 
 def test_canonical_port_lists_sorts_plain_and_escaped_headers():
-    from rasterhw.sim.verilog import canonical_port_lists
+    from rasterhw.sim.engines.verilog import canonical_port_lists
 
     text = "module top(b, a,\n  c);\n  input a;\nendmodule\nmodule \\top.sub (y, \\x$1 );\nendmodule\n"
     # an escaped name ends at white space: the one after \x$1 stays before the closing parenthesis

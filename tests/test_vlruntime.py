@@ -1,4 +1,4 @@
-"""sim/vlruntime.py: the Verilator runtime is compiled once and reused by the next model build."""
+"""sim/engines/vlruntime.py: the Verilator runtime is compiled once and reused by the next model build."""
 
 from __future__ import annotations
 
@@ -6,8 +6,8 @@ import json
 import subprocess
 
 import pytest
-from rasterhw.sim import vlruntime
-from rasterhw.sim.runner import build_plain_verilator, build_records
+from rasterhw.sim.engines import vlruntime
+from rasterhw.sim.engines.runner import build_plain_verilator, build_records
 
 COUNTER = """module tb_count_{k} #(parameter N = 10) (input clk, output reg done, output reg [31:0] cycles);
   initial begin done = 0; cycles = 0; end
@@ -89,7 +89,7 @@ def test_cocotb_make_step_reuses_the_runtime(tmp_path, monkeypatch):
     build with the same compiler-visible flags go in, and after a good make they are kept."""
     from types import SimpleNamespace
 
-    from rasterhw.sim.runner import _execute_cmds_as_children
+    from rasterhw.sim.engines.runner import _execute_cmds_as_children
 
     monkeypatch.setenv("RASTERHW_VL_RUNTIME_DIR", str(tmp_path / "rt"))
     make = tmp_path / "bin" / "make"

@@ -6,7 +6,7 @@ import json
 from pathlib import Path
 
 import pytest
-from rasterhw.sim.cli import main
+from rasterhw.sim.cli.main import main
 
 ARGS = ["sim", "pixelbus", "--scene", "experts-solid-5", "--size", "40x16", "--engine", "pysim", "--json"]
 
@@ -51,8 +51,8 @@ endmodule
 def test_plain_verilator_run_writes_a_trace_on_request_only(tmp_path):
     """A plain-Verilator model (the scene runs' path) built and run inside ``recording`` writes a
     VCD through the shared C++ main, numbered per run; outside it, the untraced model runs."""
-    from rasterhw.sim.runner import build_plain_verilator, run_plain_verilator
-    from rasterhw.sim.waves import recording
+    from rasterhw.sim.engines.runner import build_plain_verilator, run_plain_verilator
+    from rasterhw.sim.engines.waves import recording
 
     src = tmp_path / "tb_wave_count.v"
     src.write_text(COUNTER + f"// {tmp_path}\n")   # a fresh build folder per test run
@@ -87,7 +87,7 @@ def test_sim_on_plain_verilator_writes_one_trace_per_processor(tmp_path, capsys)
 
 
 def test_fst_without_the_writer_headers_is_one_clear_error(tmp_path, capsys, monkeypatch):
-    from rasterhw.sim import waves
+    from rasterhw.sim.engines import waves
 
     monkeypatch.setattr(waves, "fst_writer_available", lambda: False)
     args = ["sim", "sparse", "--scene", "c50", "--size", "32x32", "--matrix", "2x2", "--engine", "verilator",

@@ -170,7 +170,7 @@ def mflops(ops: dict, polys_per_s: float = 100_000) -> dict:
 
 def table1_rows(recipe_counts: dict, full_counts: dict | None = None, model: dict | None = None, *,
                 clock_hz: float = CLOCK_HZ, compiler: dict | None = None) -> list[dict]:
-    """Report rows for table 1 and the three-stage balance (keys of ``sim/report.py``).
+    """Report rows for table 1 and the three-stage balance (keys of ``sim/report/rows.py``).
 
     ``recipe_counts``: per-triangle counts of the paper's recipe (``recipe.ops_per_triangle()``),
     rows ``source="golden"``: ``paper`` = table 1, ``formula`` = the text's per-vertex mix x 3,

@@ -1,5 +1,5 @@
 """The Amaranth pysim engine: the block itself in the simulator, every clock domain clocked
-together; one source per input port (:func:`rasterhw.sim.harness.stream_put` after each word's
+together; one source per input port (:func:`rasterhw.sim.engines.harness.stream_put` after each word's
 gap) and one sink per output port (back-pressure from :mod:`pattern`, every transfer stamped
 with its edge)."""
 
@@ -10,7 +10,7 @@ import time
 from amaranth.sim import Simulator
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.engines.pattern import ready_pattern
-from rasterhw.sim.harness import as_plain, stream_protocol_checker, stream_put
+from rasterhw.sim.engines.harness import as_plain, stream_protocol_checker, stream_put
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
 
 __all__ = ["run"]

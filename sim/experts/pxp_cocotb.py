@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 from rasterhw.sim.outfile import write_if_changed
-from rasterhw.sim.runner import build_dir_for, get_sim, run_cocotb
+from rasterhw.sim.engines.runner import build_dir_for, get_sim, run_cocotb
 from rasterhw.sim.workdirs import release, temp_run_folder
 
 __all__ = ["run_cocotb_bench"]
@@ -22,7 +22,7 @@ def run_cocotb_bench(jb: dict, *, width: int = 512, sim: str | None = None, idle
 
     Raises :class:`~rasterhw.golden_model.errors.RasterhwError` if the bench's checks fail
     (a pixel, a line's cycles, the stream rules, the order of transfers)."""
-    from rasterhw.sim.verilog_cache import generate_cached
+    from rasterhw.sim.engines.verilog_cache import generate_cached
 
     sim = get_sim(sim)
     text = generate_cached("experts-pxp", width=width, aj=jb["aj"])

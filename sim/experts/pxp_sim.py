@@ -20,7 +20,7 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.experts.model import ExpertsFrame, equal_bounds, render_frame
 from rasterhw.golden_model.experts.pxp import pixel_words
 from rasterhw.golden_model.experts.pxp_cycles import line_segments, schedule
-from rasterhw.sim.runner import run_plain_verilator
+from rasterhw.sim.engines.runner import run_plain_verilator
 from rasterhw.sim.workdirs import release, temp_run_folder
 
 __all__ = ["jobs", "run_pysim", "run_verilator", "simulate_scene", "ENGINES"]
@@ -86,7 +86,7 @@ def run_pysim(jb: dict, *, width: int) -> dict:
     """Play the jobs through the Amaranth PXP in pysim."""
     from amaranth.sim import Simulator
     from rasterhw.hdl.experts.pxp import ExpertsPxp
-    from rasterhw.sim.harness import stream_sink
+    from rasterhw.sim.engines.harness import stream_sink
     dut = ExpertsPxp(width=width, aj=jb["aj"])
     sim = Simulator(dut)
     sim.add_clock(1e-8)
@@ -137,8 +137,8 @@ NSEG_MAX, NOUT_MAX, NLINE_MAX = 1 << 19, 1 << 18, 1 << 14
 
 def _build(width: int, aj: str) -> tuple[Path, float]:
     from rasterhw.hdl.experts.pxp import ExpertsPxp
-    from rasterhw.sim.runner import build_plain_verilator
-    from rasterhw.sim.verilog_cache import convert_cached
+    from rasterhw.sim.engines.runner import build_plain_verilator
+    from rasterhw.sim.engines.verilog_cache import convert_cached
     src = convert_cached("experts-pxp", lambda: ExpertsPxp(width=width, aj=aj), params={"width": width, "aj": aj},
                          module="experts_pxp")
     params = {"NSEG": NSEG_MAX, "NOUT": NOUT_MAX, "NLINE": NLINE_MAX}

@@ -11,7 +11,7 @@ import math
 from pathlib import Path
 
 import numpy as np
-from rasterhw.sim.report import make_row
+from rasterhw.sim.report.rows import make_row
 
 SYS = "experts"
 PNS = (1, 2, 4, 8, 16)

@@ -38,8 +38,8 @@ from rasterhw.golden_model.snu import i860
 from rasterhw.golden_model.snu import pixelbus as golden
 from rasterhw.golden_model.snu.formats import CLOCK_HZ, MEM_CYCLE, N_BANKS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
-from rasterhw.sim.memh import memh_uint64, read_memh
-from rasterhw.sim.runner import HARNESS_V, REPO_ROOT, build_plain_verilator, run_plain_verilator
+from rasterhw.sim.engines.memh import memh_uint64, read_memh
+from rasterhw.sim.engines.runner import HARNESS_V, REPO_ROOT, build_plain_verilator, run_plain_verilator
 
 __all__ = ["BENCH", "clear_cycles", "frame_run", "golden_schedule", "producer_gaps", "run_frame_hdl"]
 
@@ -186,7 +186,7 @@ def run_frame_hdl(stream: PixelStream, gaps: np.ndarray, first_bench_gap: list[i
     """Build (once) and run tb_pixelbus_fast.v on ``stream``; returns the schedule numbers, the
     displayed frame (rgb, z) and timings."""
     from amaranth.utils import ceil_log2
-    from rasterhw.sim.verilog_cache import generate_cached
+    from rasterhw.sim.engines.verilog_cache import generate_cached
 
     w, h = stream.width, stream.height
     npix = w * h

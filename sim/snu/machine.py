@@ -33,7 +33,7 @@ MACHINE = Machine(
                             fpga={"ram": "memory", "width": 160, "height": 128},
                             fpga_runs=(({}, "full"), ({"ram": "memory", "width": 160, "height": 128}, "reduced")),
                             clocks=(_SLOT,), demand_from_synth=True)},
-    # the frame memory outside the controller: a black box in synthesis (sim/synth.py)
+    # the frame memory outside the controller: a black box in synthesis (sim/flow/synth.py)
     ram_modules={"rasterhw_pixelbus_ram": "rasterhw.sim.snu.machine:ram_bits"},
     fpga_note="SNU: 80 ns pixel-bus slot, the bank's 400 ns memory cycle being 5 slots.",
     status="pixel-bus controller with Z comparator over a 5-bank frame buffer (HDL, bit- and cycle-exact); "

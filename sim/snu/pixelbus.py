@@ -2,7 +2,7 @@
 
 ``engine="pysim"`` runs ``hdl.pixelbus.PixelBus`` in the Amaranth simulator, the
 streams fed by two testbenches; ``engine="verilator"|"icarus"`` runs the generated
-Verilog under cocotb through :mod:`rasterhw.sim.runner`: the stimulus goes to hex files
+Verilog under cocotb through :mod:`rasterhw.sim.engines.runner`: the stimulus goes to hex files
 that the bench wrapper (``cocotb_tests/snu/pixelbus/tb_pixelbus.v``) loads into its own
 memories with ``$readmemh`` and plays out at full speed on a Verilog-side clock; the
 wrapper then reads the whole draw buffer and Z back through the read port into a file.
@@ -23,9 +23,9 @@ from rasterhw.golden_model.snu import pixelbus as golden
 from rasterhw.golden_model.snu.formats import RGB_BITS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.golden_model.snu.words import payload_words
-from rasterhw.sim.harness import stream_protocol_checker, stream_put
+from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put
 from rasterhw.sim.outfile import write_if_changed
-from rasterhw.sim.runner import HARNESS_V, REPO_ROOT, build_dir_for, get_sim, run_cocotb
+from rasterhw.sim.engines.runner import HARNESS_V, REPO_ROOT, build_dir_for, get_sim, run_cocotb
 from rasterhw.sim.workdirs import keep as keep_run_folder
 from rasterhw.sim.workdirs import temp_run_folder
 
@@ -160,7 +160,7 @@ def run_cocotb_bench(
 ) -> dict:
     """Run ``stream`` on the generated Verilog under cocotb; return cycles, frame, timings."""
     from amaranth.utils import ceil_log2
-    from rasterhw.sim.verilog_cache import generate_cached
+    from rasterhw.sim.engines.verilog_cache import generate_cached
 
     sim = get_sim(sim)
     w, h = stream.width, stream.height

@@ -1,5 +1,5 @@
 # amaranth: UnusedElaboratable=no
-"""Formal proof of the SNU pixel-bus bank (``rasterhw prove pixelbus-bank``; sim/prove.py runs it).
+"""Formal proof of the SNU pixel-bus bank (``rasterhw prove pixelbus-bank``; sim/flow/prove.py runs it).
 
 ``pixelbus-bank``: pick a symbolic address ``A``; a shadow register holds what the bank must hold
 at ``A`` after every accepted write in order (written if its Z is nearer, the Z test of the
@@ -13,7 +13,7 @@ from __future__ import annotations
 from amaranth import Signal
 from amaranth.hdl import Assert, Assume
 from amaranth.hdl._ast import AnyConst
-from rasterhw.sim.prove import Harness, Proof, drive_source
+from rasterhw.sim.flow.prove import Harness, Proof, drive_source
 
 __all__ = ["PROOF", "BankHarness"]
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rasterhw.sim.report import make_row
+from rasterhw.sim.report.rows import make_row
 
 PAPER_BUS_RATE = 12e6  # 3.2: "화소 버스의 통신속은 12 Mpixel/sec" (as printed)
 FORMULA_BUS_RATE = 5 / 400e-9  # 400 ns memory cycle / 5 banks = 80 ns per pixel = 12.5 Mpixel/s

@@ -1,4 +1,4 @@
-"""Soak round of the SNU pixel bus (``rasterhw soak --block pixelbus``; sim/soak.py runs it).
+"""Soak round of the SNU pixel bus (``rasterhw soak --block pixelbus``; sim/flow/soak.py runs it).
 
 A round (1280 x 1024, Verilog RAM) randomises the address pattern (uniform, scan-line runs,
 columns, one bank), one or two pipelines, Z from the full 24 bits or a narrow range (ties

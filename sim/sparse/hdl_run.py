@@ -26,7 +26,7 @@ def run_processor(recs: list[dict], *, n: int, p: int, q: int, a: int, b: int, z
     -1 where empty), ``tests`` per level, ``stalls``, ``writes``, ``cycles`` (until idle)."""
     from amaranth.sim import Simulator
     from rasterhw.hdl.sparse.vp import VideoProcessor
-    from rasterhw.sim.harness import stream_put
+    from rasterhw.sim.engines.harness import stream_put
 
     if not (0 <= a < p and 0 <= b < q):
         raise RasterhwError(f"sparse HDL: processor ({a}, {b}) is outside a {p}x{q} matrix")

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 from rasterhw.golden_model.sparse import montecarlo as mc
 from rasterhw.golden_model.sparse import theory as th
-from rasterhw.sim.report import make_row
+from rasterhw.sim.report.rows import make_row
 
 SYSTEM = "sparse"
 M_BITS = 10  # the paper's full raster: 2**10 x 2**10

@@ -1,5 +1,5 @@
 """Soak round of the sparse-raster video processors (``rasterhw soak --block sparse``;
-sim/soak.py runs it).
+sim/flow/soak.py runs it).
 
 A round (4 x 4 matrix, 256 x 256) draws random screen triangles (count, size; random idle clocks
 on every processor's input in most of these rounds) or a random cube scene; every processor's

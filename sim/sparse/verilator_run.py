@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.sparse.formats import TRI_BITS
-from rasterhw.sim.memh import memh_uint64, read_memh
-from rasterhw.sim.runner import build_plain_verilator, run_plain_verilator
+from rasterhw.sim.engines.memh import memh_uint64, read_memh
+from rasterhw.sim.engines.runner import build_plain_verilator, run_plain_verilator
 from rasterhw.sim.workdirs import release, temp_run_folder
 
 __all__ = ["build", "pack_records", "run_processor_verilator"]
@@ -42,7 +42,7 @@ def build(*, n: int, p: int, q: int, z_bits: int = 24) -> tuple[Path, float]:
 def _build(*, n: int, p: int, q: int, z_bits: int) -> tuple[Path, float]:
     from rasterhw.hdl.sparse.layouts import BROADCAST
     from rasterhw.hdl.sparse.vp import make_vp
-    from rasterhw.sim.verilog_cache import convert_cached
+    from rasterhw.sim.engines.verilog_cache import convert_cached
 
     src = convert_cached("sparse-vp", lambda: make_vp(n=n, p=p, q=q, z_bits=z_bits),
                          params={"n": n, "p": p, "q": q, "z_bits": z_bits}, module="sparse_vp")

@@ -13,7 +13,7 @@ from rasterhw.golden_model.sparse.fixed import broadcast_records
 from rasterhw.golden_model.sparse.formats import TRI_BITS, parse_matrix, sparse_geometry
 from rasterhw.golden_model.sparse.search import sparse_render
 from rasterhw.sim.outfile import write_if_changed
-from rasterhw.sim.runner import build_dir_for, get_sim, run_cocotb
+from rasterhw.sim.engines.runner import build_dir_for, get_sim, run_cocotb
 from rasterhw.sim.workdirs import release, temp_run_folder
 
 __all__ = ["run_cocotb_bench"]
@@ -27,7 +27,7 @@ def run_cocotb_bench(tris, matrix="4x4", *, a: int = 0, b: int = 0, sim: str | N
     from rasterhw.hdl.pack import pack
     from rasterhw.hdl.sparse.layouts import BROADCAST
     from rasterhw.hdl.sparse.vp import make_vp
-    from rasterhw.sim.verilog_cache import convert_cached
+    from rasterhw.sim.engines.verilog_cache import convert_cached
 
     sim = get_sim(sim)
     p, q = parse_matrix(matrix)

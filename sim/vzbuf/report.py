@@ -23,7 +23,7 @@ from rasterhw.golden_model.vzbuf.render import render_frame, table_stages
 from rasterhw.golden_model.vzbuf.shadows import ray_shadow
 from rasterhw.golden_model.vzbuf.stats import table1
 from rasterhw.golden_model.vzbuf.trace import Trace
-from rasterhw.sim.report import make_row
+from rasterhw.sim.report.rows import make_row
 from rasterhw.sim.vzbuf.paper import COLS, CORRECTED, RATES, RUNS, T1, TABLES, VTIME
 
 SYS = "vzbuf"
@@ -450,6 +450,6 @@ def _sections(t1, times, scenes) -> list[str]:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    from rasterhw.sim.report import run_report
+    from rasterhw.sim.report.rows import run_report
 
     run_report("vzbuf", out_dir=Path("docs/reproduction"), progress=True)

@@ -14,7 +14,7 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import EdgePairs
 from rasterhw.golden_model.zbm import cycles as C
 from rasterhw.golden_model.zbm.formats import AEP_CAPACITY, INTERLEAVES
-from rasterhw.sim.harness import stream_put
+from rasterhw.sim.engines.harness import stream_put
 
 __all__ = ["run_unit_cycles", "measure_cycles_per_edge_pair", "table1_width", "measure_table1",
            "unit_golden_words"]

@@ -10,7 +10,7 @@ inside ``cocotb_tests/zbm/fast/tb_zbm_unit_fast.v`` on plain Verilator with a C+
 :func:`rasterhw.sim.zbm.fast.run_unit_fast`) and ``icarus``: the generated Verilog inside
 ``cocotb_tests/zbm/tb_zbm_unit.v`` (Verilog-side clocks, edge pairs preloaded from a hex file
 and played out at full speed, merge words collected into a frame memory and dumped), run under
-cocotb through :mod:`rasterhw.sim.runner` (``run_unit_bench``, also on Verilator).  The same benches
+cocotb through :mod:`rasterhw.sim.engines.runner` (``run_unit_bench``, also on Verilator).  The same benches
 (with random idle gaps, back-pressure, clock ratios and the Python stream checkers) are the
 cocotb tests, ``tests/zbm/test_zbm_cocotb.py``.
 
@@ -39,9 +39,9 @@ from rasterhw.golden_model.zbm.words import (
     segment_words,
     split_merge_words,
 )
-from rasterhw.sim.harness import stream_protocol_checker, stream_put
-from rasterhw.sim.memh import memh_uint64, read_memh
-from rasterhw.sim.runner import (
+from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put
+from rasterhw.sim.engines.memh import memh_uint64, read_memh
+from rasterhw.sim.engines.runner import (
     HARNESS_V,
     REPO_ROOT,
     build_dir_for,
@@ -128,7 +128,7 @@ def check_edge_pairs(eps: G.EdgePairs, width: int, height: int, *, units: int = 
 
 # ====================================================================== Verilog
 def _digest(**params) -> str:
-    from rasterhw.sim.verilog_cache import source_digest
+    from rasterhw.sim.engines.verilog_cache import source_digest
 
     # every source the block's generated Verilog can depend on (its HDL, the formats, the
     # generator); the tail unit and the chain adapter go with the unit
@@ -200,7 +200,7 @@ def chain_verilog(*, interleave: int, width: int, height: int, units: int = 1,
     The head unit is the generated ``zbm_unit``; the others (``head=False``, with merge
     inputs) are renamed ``zbm_unit_tail`` so both can live in one simulation.
     """
-    from rasterhw.sim.verilog import generate_verilog
+    from rasterhw.sim.engines.verilog import generate_verilog
 
     p = {"interleave": interleave, "width": width, "height": height, "capacity": capacity, "schedule": schedule}
     head, _ = _cached("zbm-unit", lambda: generate_verilog("zbm-unit", head=True, **p), head=True, **p)
@@ -383,7 +383,7 @@ def run_chip_bench(seg_words: list[int], up_words: list[int], *, lines: int, chi
     ``repeat`` plays the stimulus that many times (speed runs).  Returns ``{"s0", "s1":
     (lines, npx) uint64 of the last repetition, "cycles", "lines", "proto_errors", "run_s", ...}``."""
     exp_env = _expect_env(expect, speed_run)   # before any work
-    from rasterhw.sim.verilog import generate_verilog
+    from rasterhw.sim.engines.verilog import generate_verilog
 
     sim = get_sim(sim)
     t0 = time.perf_counter()

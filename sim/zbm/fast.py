@@ -27,7 +27,7 @@ import numpy as np
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.sim.runner import HARNESS_V, REPO_ROOT, build_plain_verilator, run_plain_verilator
+from rasterhw.sim.engines.runner import HARNESS_V, REPO_ROOT, build_plain_verilator, run_plain_verilator
 from rasterhw.sim.workdirs import keep as keep_run_folder
 from rasterhw.sim.workdirs import release, temp_run_folder
 from rasterhw.sim.zbm.driver import (
@@ -55,7 +55,7 @@ def build_fast(*, interleave: int, width: int, lines: int, chip: int, nseg: int,
     """Build (once per parameter set) the timing-free chip bench; returns (binary, build seconds,
     0 if reused). ``opt``: g++ optimisation of the model (-O2 for speed runs; the small test uses
     -O0, which compiles several times faster)."""
-    from rasterhw.sim.verilog import generate_verilog
+    from rasterhw.sim.engines.verilog import generate_verilog
 
     p = {"interleave": interleave, "chip": chip, "width": width}
     src, _ = _cached("zbm-chip", lambda: generate_verilog("zbm-chip", **p), **p)

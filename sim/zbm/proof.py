@@ -1,5 +1,5 @@
 # amaranth: UnusedElaboratable=no
-"""Formal proof of the ZB/M merger (``rasterhw prove zbm-merger``; sim/prove.py runs it).
+"""Formal proof of the ZB/M merger (``rasterhw prove zbm-merger``; sim/flow/prove.py runs it).
 
 ``zbm-merger`` (two clocks: segment ``sync`` and ``merge``, free-running and unrelated; SBY
 ``multiclock on``): pick a symbolic transfer number ``k`` (``AnyConst``); record the ``k``-th
@@ -18,7 +18,7 @@ from amaranth import Signal
 from amaranth.hdl import Assert
 from amaranth.hdl._ast import AnyConst
 from rasterhw.hdl.zbm.merger import merge_words
-from rasterhw.sim.prove import Harness, Proof, drive_source, sink_rules
+from rasterhw.sim.flow.prove import Harness, Proof, drive_source, sink_rules
 
 __all__ = ["PROOF", "MergerHarness"]
 

@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from rasterhw.sim.report import make_row
+from rasterhw.sim.report.rows import make_row
 from tqdm import tqdm
 
 CLOCK_HZ = 25e6  # paper condition 3
@@ -309,7 +309,7 @@ def mapping_rows(*, fast: bool = False, progress: bool = False) -> list[dict]:
     words through ``ZbmMapper`` -> ``ZbmCompositor`` in pysim (``sim/zbm/mapping_hdl.py``), its
     lookup counters, its mapped words and composited pixels checked against the golden model.
     ``fast``: the HDL rows stay, unmeasured (~2-4 min of pysim per 512 x 512 frame)."""
-    from rasterhw.sim.report import FAST_SKIP
+    from rasterhw.sim.report.rows import FAST_SKIP
     from rasterhw.sim.zbm.mapping_hdl import mapping_accesses, mapping_golden
 
     out = []
@@ -367,7 +367,7 @@ def register_flipflops(build_dir, names=PACKET_REGISTERS) -> tuple[int, float]:
     import json
     import re
 
-    from rasterhw.sim.synth import gate_equivalent
+    from rasterhw.sim.flow.synth import gate_equivalent
 
     d = json.loads((Path(build_dir) / "netlist.json").read_text())
     mod = max(d["modules"].values(), key=lambda m: len(m.get("cells", {})))
@@ -391,8 +391,8 @@ def area_rows(*, fast: bool = False, progress: bool = False) -> tuple[list[dict]
     ``fast``: the rows stay, unmeasured (synthesis of the unit takes minutes). Yosys missing is
     a one-line error (``ToolUnavailable``), never a shorter table.
     """
-    from rasterhw.sim.report import FAST_SKIP
-    from rasterhw.sim.synth import synthesise
+    from rasterhw.sim.report.rows import FAST_SKIP
+    from rasterhw.sim.flow.synth import synthesise
 
     out = []
     for block, what, params, sched in AREA_BLOCKS:
@@ -436,7 +436,7 @@ def area_rows(*, fast: bool = False, progress: bool = False) -> tuple[list[dict]
             ]
     note = ["", "Area: all rows at 512-pixel lines, interleave 8 (the paper gives no line length; "
             "`docs/zbm.md#area` states this once). Gates are two-input-gate equivalents with the weights "
-            "of `sim/synth.py` (2-input gate 1, NOT 0.5, MUX 3, D flip-flop 6, +3 clock enable, +1 set/reset; "
+            "of `sim/flow/synth.py` (2-input gate 1, NOT 0.5, MUX 3, D flip-flop 6, +3 clock enable, +1 set/reset; "
             "memories 0); the paper's \"49 Kbit\" is read as 49,152 bits (48 x 1024, \"49 K\" in decimal) "
             "everywhere. The paper-schedule chip still has both packet registers (the schedule is a "
             "timing parameter; the registers are our design's), so its logic is given with and without "

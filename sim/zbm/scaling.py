@@ -149,7 +149,7 @@ PIXEL_RATE_WIDTH = 128
 
 
 def report_rows(*, progress: bool = False, engine: str = "verilator", fast: bool = False) -> list[dict]:
-    from rasterhw.sim.report import make_row
+    from rasterhw.sim.report.rows import make_row
     from tqdm import tqdm
 
     out = []

@@ -1,4 +1,4 @@
-"""Soak round of the ZB/M unit (``rasterhw soak --block zbm``; sim/soak.py runs it).
+"""Soak round of the ZB/M unit (``rasterhw soak --block zbm``; sim/flow/soak.py runs it).
 
 A round (interleave 2, 256 x 256) draws random screen triangles or a random built-in scene
 (seeded), random idle gaps on the edge-pair input, seeded random back-pressure on the output

@@ -7,7 +7,7 @@ import random
 import pytest
 from amaranth.sim import Simulator
 from rasterhw.hdl.experts.dmm import ExpertsDmm
-from rasterhw.sim.harness import stream_protocol_checker, stream_put, stream_sink
+from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put, stream_sink
 
 
 def _seg(rng, last=0):

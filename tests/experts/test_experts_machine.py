@@ -8,7 +8,7 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.experts.render import render
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.sim.registry import load, machines
-from rasterhw.sim.report import ROW_KEYS, SOURCES
+from rasterhw.sim.report.rows import ROW_KEYS, SOURCES
 
 
 def test_registered():
@@ -48,7 +48,7 @@ def test_report_rows(tmp_path):
 @pytest.mark.parametrize("name", ["pxp", "dmm"])
 def test_verilog_with_the_sim_block_name_names_the_verilog_block(name, tmp_path, capsys):
     """`rasterhw verilog pxp` (the `rasterhw sim` name) fails in one line naming experts-pxp."""
-    from rasterhw.sim.cli import main
+    from rasterhw.sim.cli.main import main
     with pytest.raises(SystemExit) as e:
         main(["verilog", name, "-o", str(tmp_path / "x.v")])
     assert e.value.code == 2

@@ -14,7 +14,7 @@ from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.hdl.experts.pxp import ExpertsPxp
 from rasterhw.hdl.experts.unit import ExpertsPxpUnit
-from rasterhw.sim.harness import stream_protocol_checker, stream_put, stream_sink
+from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put, stream_sink
 
 
 @cache

@@ -12,7 +12,7 @@ from rasterhw.golden_model.snu import pixelbus as g
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.hdl.snu.pixelbus import PixelBus
 from rasterhw.hdl.snu.pixelbus_bank import Command, PixelBusBank
-from rasterhw.sim.harness import stream_protocol_checker, stream_put
+from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put
 from rasterhw.sim.snu.pixelbus import run_pysim, simulate_pixelbus
 
 # --- bank ------------------------------------------------------------------------------

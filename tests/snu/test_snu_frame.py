@@ -91,7 +91,7 @@ def test_frame_on_verilator_equals_golden():
 def test_headline_frame_cli(tmp_path):
     """`rasterhw sim pixelbus --scene snu-100k --engine verilator --json`: the whole frame
     (10 M writes; a Verilator build plus ~1-2 minutes, so only with SNU_HEADLINE=1)."""
-    r = subprocess.run([sys.executable, "-m", "rasterhw.sim.cli", "sim", "pixelbus", "--scene", "snu-100k",
+    r = subprocess.run([sys.executable, "-m", "rasterhw.sim.cli.main", "sim", "pixelbus", "--scene", "snu-100k",
                         "--engine", "verilator", "--json", "-o", str(tmp_path / "f.png")],
                        capture_output=True, text=True, timeout=1800)
     assert r.returncode == 0, r.stderr[-2000:]

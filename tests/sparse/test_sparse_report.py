@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 from rasterhw.sim.registry import machines
-from rasterhw.sim.report import ROW_KEYS, SOURCES
+from rasterhw.sim.report.rows import ROW_KEYS, SOURCES
 
 
 @pytest.fixture(scope="module")
@@ -79,7 +79,7 @@ def test_arch_render_matches_reference():
 def coupled(tmp_path_factory):
     from pathlib import Path
 
-    from rasterhw.sim.report import make_row
+    from rasterhw.sim.report.rows import make_row
     from rasterhw.sim.sparse.report import _coupled_rows
 
     out: list[dict] = []

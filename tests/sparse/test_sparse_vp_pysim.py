@@ -54,7 +54,7 @@ def test_matrix_component_broadcast_and_interleaved_readout():
     from amaranth.sim import Simulator
     from rasterhw.golden_model.sparse.fixed import broadcast_records
     from rasterhw.hdl.sparse.matrix import Matrix
-    from rasterhw.sim.harness import stream_put
+    from rasterhw.sim.engines.harness import stream_put
 
     tris = random_triangles(16, 16, 10, mean_area=16.0, seed=13)
     g, zq = _golden(tris, "2x2")

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from rasterhw.sim.report import ROW_KEYS, SOURCES
+from rasterhw.sim.report.rows import ROW_KEYS, SOURCES
 from rasterhw.sim.vzbuf.paper import COLS, T1, TABLES
 
 

@@ -92,7 +92,7 @@ def test_register_flipflops_counts_named_registers(tmp_path):
 
 
 def synth_chip(width: int, interleave: int = 8) -> dict:
-    from rasterhw.sim.synth import synthesise
+    from rasterhw.sim.flow.synth import synthesise
 
     return synthesise("zbm-chip", interleave=interleave, width=width)
 

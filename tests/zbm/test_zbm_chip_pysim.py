@@ -10,7 +10,7 @@ from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.stimulus import multi_line_segments, random_doublez
 from rasterhw.golden_model.zbm.words import pixel2_words, segment_words
 from rasterhw.hdl.zbm.chip import ZbmChip
-from rasterhw.sim.harness import random_gap, stream_protocol_checker, stream_put
+from rasterhw.sim.engines.harness import random_gap, stream_protocol_checker, stream_put
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 

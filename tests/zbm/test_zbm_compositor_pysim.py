@@ -11,7 +11,7 @@ from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.composite import composite
 from rasterhw.golden_model.zbm.words import pixel2_words
 from rasterhw.hdl.zbm.compositor import ZbmCompositor
-from rasterhw.sim.harness import stream_protocol_checker, stream_put, stream_sink
+from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put, stream_sink
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 

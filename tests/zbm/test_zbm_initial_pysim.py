@@ -13,7 +13,7 @@ from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.stimulus import random_segments
 from rasterhw.golden_model.zbm.words import packets, segment_words
 from rasterhw.hdl.zbm.initial import ZbmInitialProcessor
-from rasterhw.sim.harness import stream_protocol_checker, stream_put, stream_sink
+from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put, stream_sink
 
 
 def _run(interleave: int, chip: int, seed: int, ready) -> tuple[list, list, int]:

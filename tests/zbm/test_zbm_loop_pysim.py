@@ -11,7 +11,7 @@ from rasterhw.golden_model.zbm.stimulus import random_segments
 from rasterhw.golden_model.zbm.words import packets, pixel2_words
 from rasterhw.hdl.zbm.loop import LOOP_GAP, ZbmLoop
 from rasterhw.hdl.zbm.pixel import ZbmPixelProcessor
-from rasterhw.sim.harness import random_gap, stream_protocol_checker, stream_put
+from rasterhw.sim.engines.harness import random_gap, stream_protocol_checker, stream_put
 
 
 def run_loop(interleave, chip, width, segs_list, *, idle_p=0.0, seed=0):

@@ -10,7 +10,7 @@ from rasterhw.golden_model.zbm.mapping import default_maps, map_samples
 from rasterhw.golden_model.zbm.stimulus import random_doublez
 from rasterhw.golden_model.zbm.words import pixel2_words
 from rasterhw.hdl.zbm.mapper import ZbmMapper
-from rasterhw.sim.harness import stream_protocol_checker, stream_put, stream_sink
+from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put, stream_sink
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 

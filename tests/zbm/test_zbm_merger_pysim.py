@@ -8,7 +8,7 @@ import pytest
 from amaranth.lib import data
 from amaranth.sim import Simulator
 from rasterhw.hdl.zbm.merger import ZbmMerger
-from rasterhw.sim.harness import random_gap, stream_protocol_checker, stream_put
+from rasterhw.sim.engines.harness import random_gap, stream_protocol_checker, stream_put
 
 # Background sources are closed mid-`until` when the sink finishes; that is expected.
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")

@@ -11,7 +11,7 @@ from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.golden_model.zbm.words import edge_pair_words, segment_words
 from rasterhw.hdl.zbm.seggen import ZbmSegmentGenerator
-from rasterhw.sim.harness import random_gap, stream_protocol_checker, stream_put
+from rasterhw.sim.engines.harness import random_gap, stream_protocol_checker, stream_put
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 

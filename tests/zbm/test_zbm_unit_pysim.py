@@ -15,7 +15,7 @@ from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.golden_model.zbm.words import edge_pair_words, pixel2_words
 from rasterhw.hdl.zbm.chain import ZbmChain
 from rasterhw.hdl.zbm.unit import ZbmUnit
-from rasterhw.sim.harness import stream_protocol_checker, stream_put
+from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put
 from rasterhw.sim.zbm.cycles_hdl import measure_cycles_per_edge_pair, run_unit_cycles
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")

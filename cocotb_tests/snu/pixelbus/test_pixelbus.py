@@ -1,7 +1,7 @@
 """cocotb bench: the pixel-bus Verilog inside tb_pixelbus.v, stimulus from files.
 
 Driven by ``rasterhw.sim.snu.pixelbus`` (which writes the stimulus and the expected result)
-through ``rasterhw.sim.runner``; run it with ``pytest tests/snu/test_pixelbus_cocotb.py``.
+through ``rasterhw.sim.engines.runner``; run it with ``pytest tests/snu/test_pixelbus_cocotb.py``.
 Environment: PIXELBUS_OUT (frame dump written by the wrapper), PIXELBUS_EXPECT (.npz with
 the golden ``rgb``, ``z``, ``cycles``, ``n0``, ``n1``), PIXELBUS_TIMEOUT_NS,
 PIXELBUS_CHECK_PROTOCOL=1 to check both pixel streams every clock (slow; small runs).

@@ -15,8 +15,8 @@ from pathlib import Path
 import click
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
-from rasterhw.sim.flow_cli import add_commands
-from rasterhw.sim.report import systems as _report_systems
+from rasterhw.sim.cli.flow import add_commands
+from rasterhw.sim.report.rows import systems as _report_systems
 
 #: the float reference rasteriser is shared by every machine; the rest come from the registry
 REFERENCE = "reference"
@@ -314,7 +314,7 @@ def compare(a: str, b: str, output: str | None, tolerance: int, as_json: bool) -
 @click.option("--fast", is_flag=True, help="Keep slow rows (synthesis, place and route) unmeasured.")
 def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool) -> None:
     """Reproduce a paper's figures: paper value, formula value, measured value, ratio."""
-    from rasterhw.sim.report import run_report, systems
+    from rasterhw.sim.report.rows import run_report, systems
 
     names = systems() if system == "all" else [system]
     rows = []
@@ -323,7 +323,7 @@ def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool) ->
     if as_json:
         emit_json(rows)
     else:
-        from rasterhw.sim.report import format_table
+        from rasterhw.sim.report.rows import format_table
 
         click.echo(format_table(rows))
         info(f"wrote {', '.join(str(Path(out_dir) / (n + '.md')) for n in names)}")
@@ -339,8 +339,8 @@ def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool) ->
 def verilog(block: str | None, list_blocks: bool, output: str | None, params: tuple[str, ...],
             interleave: int | None) -> None:
     """Generate Verilog for BLOCK (see `rasterhw verilog --list`)."""
-    from rasterhw.sim.verilog import block_names, parse_params
-    from rasterhw.sim.verilog_cache import write_verilog
+    from rasterhw.sim.engines.verilog import block_names, parse_params
+    from rasterhw.sim.engines.verilog_cache import write_verilog
 
     if list_blocks:
         click.echo("\n".join(block_names()))
@@ -391,7 +391,7 @@ def sim_image_name(scene: str, block: str, engine: str, options: dict) -> Path:
 def sim_cmd(block, scene, size, engine, output, waves, as_json, **block_options) -> None:
     """Run a scene through a block's HDL, compare with the golden model, write the frame."""
     from rasterhw.sim.outfile import check_image_output, write_image
-    from rasterhw.sim.waves import recording
+    from rasterhw.sim.engines.waves import recording
 
     _machine, b = registry.sim_blocks()[block]
     opts = _take_options(block_options, b.options, f"sim {block}")
@@ -421,7 +421,7 @@ def sim_cmd(block, scene, size, engine, output, waves, as_json, **block_options)
 @click.option("--hdl/--no-hdl", default=True, show_default=True, help="Also time HDL simulations (Verilator).")
 def bench(as_json: bool, repeat: int, hdl: bool) -> None:
     """Print speed and memory figures (a benchmark, not a test)."""
-    from rasterhw.sim.bench import run_bench
+    from rasterhw.sim.report.bench import run_bench
 
     rows = run_bench(repeat=repeat, hdl=hdl, progress=not as_json)
     if as_json:
@@ -444,7 +444,7 @@ def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], as_json: bool) 
     on any mismatch. The seed is printed; --seed reruns the same rounds."""
     import secrets
 
-    from rasterhw.sim.soak import run_soak
+    from rasterhw.sim.flow.soak import run_soak
 
     seed = secrets.randbelow(1 << 31) if seed is None else seed
     info(f"soak: seed {seed} (rerun: rasterhw soak --seed {seed} --pixels {pixels})")
@@ -468,12 +468,12 @@ def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], as_json: bool) 
               show_default=True, help="HDL simulator for the hardware runs.")
 def demo(out_dir: str, scene: str, engine: str) -> None:
     """Render a default scene through the golden model and the hardware; write images and a report."""
-    from rasterhw.sim.demo import run_demo
+    from rasterhw.sim.report.demo import run_demo
 
     run_demo(Path(out_dir), scene=scene, engine=engine)
 
 
-add_commands(cli)   # synth, fpga, prove: the hardware flow (sim/flow_cli.py)
+add_commands(cli)   # synth, fpga, prove: the hardware flow (sim/cli/flow.py)
 
 
 def _terminate(signum, _frame):

@@ -3,7 +3,7 @@
 Targets from the issues are printed beside each figure so a reader sees the gap at once.
 Where moderngl and an EGL library are installed (``pip install 'rasterhw[bench]'``), Mesa's
 llvmpipe draws the same screen triangles in the same run, timed round by round alternately
-with the reference (see :mod:`rasterhw.sim.llvmpipe`), and the ratio is printed; where they
+with the reference (see :mod:`rasterhw.sim.report.llvmpipe`), and the ratio is printed; where they
 are not, the llvmpipe rows are printed with no value and the reason.
 """
 
@@ -60,7 +60,7 @@ def _raster_rows(label: str, tris, repeat: int, target: str = "", mode: str = "c
     """The reference on ``tris`` and llvmpipe on the same triangles, side by side. ``mode``:
     what of the reference is timed (:data:`_MODES`)."""
     from rasterhw.golden_model.reference import Target, choose_engine, rasterise, render
-    from rasterhw.sim.llvmpipe import Unavailable, compare
+    from rasterhw.sim.report.llvmpipe import Unavailable, compare
 
     what, prefix, ratio_prefix = _MODES[mode]
     if mode == "contract":
@@ -204,7 +204,7 @@ def build_rows() -> list[dict]:
     """The cold build of every plain-Verilator model under ``build/`` (newest per model), as
     recorded when it was built (``runner.build_records``): seconds, and the memory peaks of the
     Verilator and compiler steps."""
-    from rasterhw.sim.runner import build_records
+    from rasterhw.sim.engines.runner import build_records
 
     rows, seen = [], set()
     for r in build_records():

@@ -1,7 +1,7 @@
 """``rasterhw synth``, ``rasterhw fpga`` and ``rasterhw prove``: the hardware flow's commands.
 
-Kept apart from ``sim/cli.py`` (which adds them with :func:`add_commands`); every tool comes
-from PyPI (``sim/tools.py``). Errors are ``RasterhwError``: one line ``error: ...``, exit 2.
+Kept apart from ``sim/cli/main.py`` (which adds them with :func:`add_commands`); every tool comes
+from PyPI (``sim/flow/tools.py``). Errors are ``RasterhwError``: one line ``error: ...``, exit 2.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from rasterhw.sim import registry
 
 
 def _params(block: str, params: tuple[str, ...]) -> dict:
-    from rasterhw.sim.verilog import block_names, parse_params
+    from rasterhw.sim.engines.verilog import block_names, parse_params
 
     if block not in block_names():
         raise RasterhwError(f"unknown block {block!r}; blocks: {', '.join(block_names())}")
@@ -38,7 +38,7 @@ def _emit(obj) -> None:
 def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: bool, small: bool,
           as_json: bool) -> None:
     """Synthesise BLOCK (or --all) with Yosys: gate equivalents, flip-flops, RAM bits."""
-    from rasterhw.sim.synth import summary_row, synth_all, synth_report, synthesise
+    from rasterhw.sim.flow.synth import summary_row, synth_all, synth_report, synthesise
 
     if all_blocks:
         if block or params:
@@ -73,7 +73,7 @@ def fpga(block: str, params: tuple[str, ...], family: str, device: str | None, a
 
     Routes with router2, and again with router1 on the same netlist when router2 does not finish
     in the time limit; results are cached in build/pnr-* and docs/reproduction/fpga_runs.json."""
-    from rasterhw.sim.fpga import fpga_summary, place_and_route
+    from rasterhw.sim.flow.fpga import fpga_summary, place_and_route
 
     r = place_and_route(block, family=family, device=device, **_params(block, params))
     if as_json:
@@ -92,7 +92,7 @@ def prove(block: str, depth: int | None, fresh: bool, as_json: bool) -> None:
 
     A proof whose harness, script and tool versions are unchanged is read back from build/ (said
     in the output); --fresh runs SymbiYosys again."""
-    from rasterhw.sim.prove import prove as run
+    from rasterhw.sim.flow.prove import prove as run
 
     r = run(block, depth=depth, fresh=fresh)
     if as_json:

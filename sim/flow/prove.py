@@ -42,8 +42,8 @@ from amaranth.hdl._ast import AnySeq
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
 from rasterhw.sim.outfile import atomic_path
-from rasterhw.sim.runner import REPO_ROOT
-from rasterhw.sim.tools import tool
+from rasterhw.sim.engines.runner import REPO_ROOT
+from rasterhw.sim.flow.tools import tool
 from rasterhw.sim.workdirs import build_lock
 
 __all__ = ["Harness", "Proof", "drive_source", "prove", "proofs", "sink_rules"]
@@ -150,7 +150,7 @@ def prove(block: str, *, dut_factory: Callable | None = None, depth: int | None 
     known = proofs()
     if block not in known:
         raise RasterhwError(f"no proof for block {block!r}; proofs: {', '.join(known)}")
-    from rasterhw.sim.verilog import make_block
+    from rasterhw.sim.engines.verilog import make_block
 
     p = known[block]
     depth = depth or p.depth

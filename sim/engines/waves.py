@@ -56,7 +56,7 @@ def fst_writer_available() -> bool:
 
 def plain_trace_format() -> str | None:
     """``"fst"`` or ``"vcd"`` while waves are being recorded for a compiled run, else ``None``:
-    what :func:`rasterhw.sim.runner.build_plain_verilator` builds the model with."""
+    what :func:`rasterhw.sim.engines.runner.build_plain_verilator` builds the model with."""
     with _lock:
         return None if _plain is None else _plain["path"].suffix[1:]
 

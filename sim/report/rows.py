@@ -22,7 +22,7 @@ whatever plots the system drew.
 
 Reports never shrink silently. A row that cannot be measured in this run stays, with
 ``measured`` ``None`` and a ``reason`` (listed under the table); a tool that is missing fails
-the report with one line naming it (:class:`~rasterhw.sim.tools.ToolUnavailable`). And
+the report with one line naming it (:class:`~rasterhw.sim.flow.tools.ToolUnavailable`). And
 :func:`run_report` refuses to overwrite a committed table with one that lacks any of its rows
 (:func:`row_key`: figure and quantity, numbers in the label ignored). A rows function that
 takes ``fast`` returns its slow rows (synthesis, place and route) unmeasured when
@@ -46,7 +46,7 @@ SOURCES = ("golden", "model", "formula", "hdl:pysim", "hdl:verilator", "hdl:icar
            "hdl:nextpnr")
 
 #: reports not tied to one machine: name -> "module:rows"
-EXTRA_REPORTS: dict[str, str] = {"fpga": "rasterhw.sim.fpga:rows"}
+EXTRA_REPORTS: dict[str, str] = {"fpga": "rasterhw.sim.report.fpga:rows"}
 
 #: ``reason`` of a row a fast run leaves unmeasured
 FAST_SKIP = "slow row: not measured in a fast run (rasterhw report without --fast measures it)"

@@ -22,11 +22,11 @@ from amaranth.back import verilog
 from rasterhw.sim.outfile import write_text
 from rasterhw.sim.paths import REPO_ROOT
 from rasterhw.sim.registry import blocks
-from rasterhw.sim.verilog import canonical_port_lists, generate_verilog
+from rasterhw.sim.engines.verilog import canonical_port_lists, generate_verilog
 
 __all__ = ["convert_cached", "design_sources", "generate_cached", "source_digest", "write_verilog"]
 
-PKG_ROOT = Path(__file__).resolve().parent.parent
+PKG_ROOT = REPO_ROOT
 
 
 def _module_file(mod: str) -> Path | None:
@@ -63,7 +63,7 @@ def _imported_files(f: Path) -> set[Path]:
 
 def design_sources(block: str | None = None) -> list[Path]:
     """Every Python file the generated Verilog of ``block`` (a ``rasterhw verilog --list`` name)
-    can depend on: the module of its factory, the Verilog generator (``sim/verilog.py``) and,
+    can depend on: the module of its factory, the Verilog generator (``sim/engines/verilog.py``) and,
     transitively, every module of ours they import (its HDL submodules, the formats modules in
     ``golden_model/`` the HDL takes its widths from), and nothing else, so an edit to another
     block or to a golden algorithm does not regenerate (or rebuild) it. ``block=None`` (or a name
@@ -71,7 +71,7 @@ def design_sources(block: str | None = None) -> list[Path]:
     ref = blocks().get(block) if block else None
     root = _module_file(ref.split(":")[0]) if ref else None
     todo = [root] if root is not None else sorted((PKG_ROOT / "hdl").rglob("*.py"))
-    todo.append(PKG_ROOT / "sim" / "verilog.py")
+    todo.append(PKG_ROOT / "sim" / "engines" / "verilog.py")
     seen: set[Path] = set()
     while todo:
         f = todo.pop()
@@ -118,13 +118,13 @@ def convert_cached(name: str, factory: Callable[[], object], *, params: Mapping[
 
 
 def generate_cached(block: str, **params) -> str:
-    """``rasterhw.sim.verilog.generate_verilog(block, **params)``, cached like :func:`convert_cached`."""
+    """``rasterhw.sim.engines.verilog.generate_verilog(block, **params)``, cached like :func:`convert_cached`."""
     return convert_cached(block, lambda: None, params=params, module=block,
                           convert=lambda _design, _module: generate_verilog(block, **params))
 
 
 def write_verilog(name: str, path: str | Path, **params) -> Path:
     """Write :func:`generate_verilog` output to ``path`` (from the cache of generated Verilog,
-    ``sim/verilog_cache.py``, when this design and these parameters were converted before);
+    ``sim/engines/verilog_cache.py``, when this design and these parameters were converted before);
     return the path."""
     return write_text(path, generate_cached(name, **params))  # whole or not at all

@@ -1,0 +1,1 @@
+"""The ``rasterhw`` command line."""

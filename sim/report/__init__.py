@@ -1,0 +1,1 @@
+"""Reports: the row framework, bench, demo page, llvmpipe comparison."""

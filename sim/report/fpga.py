@@ -1,0 +1,247 @@
+"""``rasterhw report fpga``: the table ``docs/reproduction/fpga.md`` from place and route
+(:mod:`rasterhw.sim.flow.fpga`) of every block at its paper's size, labelled reduced sizes and
+each machine's parameter sweeps. A report not tied to one machine (``EXTRA_REPORTS`` in
+:mod:`rasterhw.sim.report.rows`); the runs are the flow's, the rows and plots are this module's.
+"""
+
+from __future__ import annotations
+
+from rasterhw.sim import registry
+from rasterhw.sim.flow.fpga import (DEVICE_NAMES, FALLBACK_ROUTER, ROUTER, RUN_RECORD, not_measured_reason,
+                                   fpga_configs, fpga_sweeps, paper_clock, place_and_route, synth_demand,
+                                   write_run_record)
+from rasterhw.sim.registry import FpgaSweep
+from rasterhw.sim.report.rows import FAST_SKIP, make_row
+
+__all__ = ["ICE40_CONFIGS", "REPORT_TIMEOUT_S", "rows", "sweep_plot"]
+
+
+#: what the report also places on an iCE40 HX8K: nothing. nextpnr-ice40 has no out-of-context
+#: mode, so every port bit of a block takes an I/O pin, and the blocks have more port bits than the
+#: HX8K's largest package has pins (the EXPERTS DMM alone: 397 SB_IO against 206 on the CT256);
+#: a pin-light wrapper (ports through shift registers) would measure the wrapper, not the block.
+#: ``rasterhw fpga BLOCK --family ice40`` still runs one block that way.
+ICE40_CONFIGS: tuple[tuple[str, dict, str], ...] = ()
+
+
+#: nextpnr time limit per run of the report (a run that takes longer stays unmeasured, with why)
+REPORT_TIMEOUT_S = 2400.0
+
+
+#: parameters left out of a row's label (not sizes)
+_UNLABELLED = {"ram", "schedule", "head", "index", "chip", "aj", "alpha", "beta", "mem_cycle",
+               "intensity_bits", "z_bits", "colour_bits"}
+
+
+def _cfg(block: str, params: dict, kind: str) -> str:
+    """Row label: ``full``/``reduced`` and the block's size parameters (defaults filled in)."""
+    import inspect
+
+    from rasterhw.sim.engines.verilog import blocks, load
+
+    sig = inspect.signature(load(blocks()[block]))
+    eff = {k: v.default for k, v in sig.parameters.items() if v.default is not inspect.Parameter.empty}
+    eff.update(params)
+    shown = ", ".join(f"{k} {v}" for k, v in eff.items() if k not in _UNLABELLED)
+    return f"{kind}: {shown}"
+
+
+_NOT_RUN = "not run in the session that made this table (time): `rasterhw fpga {block}{args}`"
+
+
+def _measure(block, params, *, fast, progress, timeout, family="ecp5", cached_only=False):
+    """One configuration: a place_and_route / synth_demand result, or None in a fast run."""
+    import sys
+
+    if fast:
+        return None
+    if progress:
+        print(f"fpga: {block} ({params or 'defaults'}) on {family} ...", file=sys.stderr, flush=True)
+    if registry.flow(block).demand_from_synth and not params and family == "ecp5":
+        d = synth_demand(block)
+        if not d["fits"]:
+            return {**d, "finished": True, "luts": None, "ffs": None, "brams": None, "fmax_mhz": {}}
+    r = place_and_route(block, family=family, timeout=timeout, cached_only=cached_only, **params)
+    args = "".join(f" -p {k}={v}" for k, v in params.items()) + ("" if family == "ecp5" else f" --family {family}")
+    if r is None:  # cached_only and never run
+        return {"block": block, "params": params, "finished": False, "reason": _NOT_RUN.format(block=block, args=args),
+                "luts": None, "ffs": None, "brams": None, "fmax_mhz": {}}
+    if r.pop("fallback_pending", False):
+        # shown in the table; the record keeps the run's own reason
+        r["display_reason"] = f"{_reason(r)}; {FALLBACK_ROUTER} " + _NOT_RUN.format(block=block, args=args)
+    return r
+
+
+def _reason(r) -> str | None:
+    """Why a configuration has no measurement: a fast run's skip, or the flow's reason."""
+    return FAST_SKIP if r is None else not_measured_reason(r)
+
+
+def sweep_plot(sw: FpgaSweep, points: list[tuple[object, dict]], path, missing: dict | None = None) -> None:
+    """Fmax of every clock of ``sw.block`` against ``sw.param``, with the clocks the paper names;
+    ``missing``: value -> why it has no point (written at the bottom of the plot)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    clocks = registry.flow(sw.block).clocks
+    fig, ax = plt.subplots(figsize=(6, 3.6))
+    for c, mark in zip(clocks, ("o-", "s--", "^-.", "v:"), strict=False):
+        got = [(v, r["fmax_mhz"][c.domain]) for v, r in points if r.get("fmax_mhz", {}).get(c.domain) is not None]
+        if got:
+            ax.plot([v for v, _ in got], [f for _, f in got], mark, label=f"{c.name} (nextpnr)")
+    for c in clocks:
+        if c.hz is not None:
+            ax.axhline(c.hz / 1e6, color="grey", lw=1, ls=":", label=f"paper: {c.name} {c.hz / 1e6:g} MHz")
+    if all(isinstance(v, int) and v > 0 and v & (v - 1) == 0 for v in sw.values):
+        ax.set_xscale("log", base=2)
+        ax.set_xlim(min(sw.values) * 0.8, max(sw.values) * 1.25)
+    ax.set_xticks(list(sw.values), [str(v) for v in sw.values])
+    ax.set_xlabel(sw.xlabel)
+    ax.set_ylabel("Fmax (MHz)")
+    ax.set_ylim(bottom=0)
+    for v, why in (missing or {}).items():
+        ax.annotate(why, (v, 0), xytext=(0, 4), textcoords="offset points", rotation=90, fontsize=7,
+                    ha="center", va="bottom", color="firebrick")
+    ax.set_title(sw.title, fontsize=9)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, metadata={"Software": None})
+    plt.close(fig)
+
+
+def _sweep_label(sw: FpgaSweep) -> str:
+    """``width 512``: the fixed parameters of a sweep, for its row group."""
+    return ", ".join(f"{k} {v}" for k, v in sw.base.items())
+
+
+def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool = False,
+         timeout: float = REPORT_TIMEOUT_S, cached_only: bool = False):
+    """Report rows: per configuration of :func:`fpga_configs`, ECP5 LUTs, flip-flops, block RAMs
+    and Fmax per clock beside the paper's clock (``source`` ``hdl:nextpnr``; a full frame memory
+    measured by synthesis: ``hdl:yosys``), and each sweep of :func:`fpga_sweeps` (the ZB/M chip's
+    Fmax at each interleave) with a plot. ``fast``: the rows stay, unmeasured (place and route takes
+    minutes to an hour per block). ``cached_only``: use the results cached in ``build/pnr-*`` and
+    run nothing (a configuration never run stays unmeasured, saying so)."""
+    from pathlib import Path
+
+
+
+    out = []
+    dev = DEVICE_NAMES["ecp5"]["85k"]
+    walls = []
+    for block, params, kind in fpga_configs():
+        r = _measure(block, params, fast=fast, progress=progress, timeout=timeout, cached_only=cached_only)
+        why = _reason(r)
+        ok = why is None
+        system = registry.block_machine(block).name
+        fig = f"{block} on {dev} ({_cfg(block, params, kind)})"
+        src = "hdl:yosys" if (r is not None and "ram_bits" in r and "utilization" not in r) else "hdl:nextpnr"
+
+        def row(q, measured, unit, paper=None, fig=fig, system=system, why=why, src=src):
+            return make_row(system, fig, q, paper=paper, formula=None, measured=measured, unit=unit,
+                            source=src, reason=why)
+
+        out += [row("LUT4s", r["luts"] if ok else None, "LUT4"),
+                row("flip-flops", r["ffs"] if ok else None, "flip-flops"),
+                row("block RAMs (DP16KD, 18 Kbit)", r["brams"] if ok else None, "DP16KD")]
+        for dom, what, hz in paper_clock(block):
+            f = r["fmax_mhz"].get(dom) if ok else None
+            if ok and f is None:
+                continue  # the block has no such clock (e.g. the loop has no merge clock)
+            out.append(row(f"Fmax, {dom} clock (paper: {what})", f, "MHz",
+                           paper=None if hz is None else hz / 1e6))
+        if r is not None:
+            walls.append((block, params, kind, r))
+
+    ice = DEVICE_NAMES["ice40"]["hx8k"]
+    for block, params, kind in ICE40_CONFIGS:
+        r = _measure(block, params, fast=fast, progress=progress, timeout=timeout, family="ice40",
+                     cached_only=cached_only)
+        why = _reason(r)
+        ok = why is None
+        system = registry.block_machine(block).name
+        fig = f"{block} on {ice} ({_cfg(block, params, kind)})"
+
+        def row(q, measured, unit, paper=None, fig=fig, system=system, why=why):
+            return make_row(system, fig, q, paper=paper, formula=None, measured=measured, unit=unit,
+                            source="hdl:nextpnr", reason=why)
+
+        out += [row("logic cells (ICESTORM_LC)", r["luts"] if ok else None, "LC"),
+                row("flip-flops", r["ffs"] if ok else None, "flip-flops"),
+                row("block RAMs (4 Kbit)", r["brams"] if ok else None, "ICESTORM_RAM")]
+        for dom, what, hz in paper_clock(block):
+            f = r["fmax_mhz"].get(dom) if ok else None
+            if ok and f is None:
+                continue
+            out.append(row(f"Fmax, {dom} clock (paper: {what})", f, "MHz",
+                           paper=None if hz is None else hz / 1e6))
+        if r is not None:
+            walls.append((block, params, kind + ", iCE40 HX8K", r))
+
+    sweep, plots = [], []
+    for sw in fpga_sweeps():
+        clocks = registry.flow(sw.block).clocks
+        figure = f"{sw.block} Fmax against {sw.param} on {dev} ({_sweep_label(sw)})"
+        points, missing = [], {}
+        for v in sw.values:
+            params = {sw.param: v, **sw.base}
+            r = _measure(sw.block, params, fast=fast, progress=progress, timeout=timeout, cached_only=cached_only)
+            why = _reason(r)
+            if r is not None:
+                sweep.append(r)
+            if why is None:
+                points.append((v, r))
+            elif r is not None:
+                missing[v] = ("did not finish" if r.get("finished") is False and r.get("stage") else
+                              "not run" if r.get("finished") is False else "does not fit")
+                if r.get("stage"):
+                    missing[v] += f" in {r['timeout_s'] / 60:.0f} min"
+            for c in clocks:
+                f = r["fmax_mhz"].get(c.domain) if why is None else None
+                out.append(make_row(registry.block_machine(sw.block).name, figure, f"Fmax, {c.name}, {sw.param} {v}",
+                                    paper=None if c.hz is None else c.hz / 1e6, formula=None, measured=f,
+                                    unit="MHz", source="hdl:nextpnr", reason=why))
+        plots.append((sw, figure, points, missing))
+    sections = ["", "## Place and route", "",
+                "Made by `rasterhw report fpga` (slow: one nextpnr run per row group, minutes to an hour each; "
+                "results are cached in `build/pnr-*`, so a second run takes seconds); one block: "
+                "`rasterhw fpga BLOCK -p NAME=VALUE`. Flow: Yosys `synth_ecp5` + `nextpnr-ecp5 --85k` "
+                "(router2, seed 1; router1 on the same netlist where router2 does not finish in the time limit, "
+                "named in the per-run table), from PyPI, **out of context**: no I/O buffers and no global clock network, "
+                "so Fmax is nextpnr's estimate on general routing, a lower bound. `full` rows are the block at "
+                "its paper's size, `reduced` rows a smaller configuration named in the row (never the full "
+                "block). A block that does not fit keeps `measured` empty with its demand: nextpnr's packed "
+                "cells against the device's (`nextpnr --pack-only`), or, for a frame memory that lies outside "
+                "the block (`Flow.demand_from_synth`), the RAM bits from synthesis. `paper` is the clock the paper "
+                "names: " + " ".join(m.fpga_note for m in registry.machines().values() if m.fpga_note)]
+    if cached_only:
+        sections += ["", "This table was made from the cached runs (`build/pnr-*`, `fpga_runs.json`) of a "
+                     "place-and-route queue, one run at a time under `nice -n 10`, each with a time limit: "
+                     "`python -c \"from rasterhw.sim.report.rows import run_report; run_report('fpga', cached_only=True)\"`; "
+                     "`rasterhw report fpga` runs the missing ones."]
+    if not fast:
+        for sw, figure, points, missing in plots:
+            plot = f"fpga_{sw.block.replace('-', '_')}_fmax.png"
+            sweep_plot(sw, points, Path(out_dir) / plot, missing)
+            what = f"{sw.block} Fmax against {sw.param}"
+            sections += ["", f"![{what}]({plot})", "", f"{what} (rows `{figure}`): {sw.note}"]
+        sections += ["", "Per run (cached and recorded runs show the date and times of the run that made them; "
+                     "the results are kept in `fpga_runs.json` beside this table, keyed by a digest of the "
+                     "block's Verilog, the scripts and the tools' versions, so a later report on any machine "
+                     "re-runs only what changed):", "",
+                     "| block | configuration | ran | synthesis s | nextpnr s | result |", "|---|---|---|---|---|---|"]
+        for block, params, kind, r in walls:
+            res = r.get("reason") or "placed and routed"
+            if r.get("display_reason"):
+                res += f"; {FALLBACK_ROUTER} not run yet"
+            if r.get("first_try") and r.get("finished"):
+                res += (f" by {r.get('router')} ({ROUTER} did not finish in "
+                        f"{r['first_try'].get('timeout_s', 0) / 60:.0f} min: {_reason(r['first_try'])})")
+            ss = "—" if r.get("synth_s") is None else f"{r['synth_s']:.0f}"
+            ps = "—" if r.get("pnr_s") is None else f"{r['pnr_s']:.0f}"
+            sections.append(f"| {block} | {_cfg(block, params, kind)} | {r.get('ran') or '—'} | {ss} | {ps} | {res} |")
+        write_run_record([r for *_, r in walls] + sweep,
+                         Path(out_dir) / RUN_RECORD.name)
+    return out, sections
