@@ -64,6 +64,7 @@ class Arch:
     render: str                        # "module:function"
     options: tuple[Option, ...] = ()
     bytes_per_pixel: int = 400         # peak memory per frame pixel (checked before a render starts)
+    colour_note: str = ""              # why its RGB differs from the float reference by design (demo page)
 
 
 @dataclass(frozen=True)
@@ -138,6 +139,13 @@ class Machine:
     fpga_sweeps: tuple[FpgaSweep, ...] = ()
     fpga_note: str = ""                           # the paper's clocks in words, for the fpga report
     status: str = ""                   # one line for the README / index page
+    #: the demo page's headline rows: ``"figure: quantity"`` of rows of its committed report
+    #: (``docs/reproduction/NAME.md``), in order; empty: the first measured rows with a paper value
+    headline: tuple[str, ...] = ()
+    no_hdl: str = ""                   # why the machine has no HDL block (said on the demo page)
+    #: ``"module:function"`` ``(scene, width, height) -> dict`` for the demo's cross-machine table when
+    #: no sim block gives the frame's cost (keys: ``cycles`` or ``time_s``, ``clock_hz``, ``source``, ``note``)
+    frame_cost: str | None = None
 
 
 def load(ref: str) -> Callable:

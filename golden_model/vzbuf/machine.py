@@ -21,5 +21,5 @@ def render(scene: Scene, width: int, height: int, *, arch: str, shadows: str = "
     stats = {"stages_s": f.stages, "segments": f.stats["segments"], "passes": c["passes"],
              "ztests": c["ztests"], "mean_vector_length": c["mean_vector_length"],
              "pixels_real": f.stats["pixels_real"], "pixels_shadow": f.stats["pixels_shadow"],
-             "shadowed_pixels": int(f.shadowed.sum())}
+             "shadowed_pixels": int(f.shadowed.sum()), "pixels_covered": int((f.poly >= 0).sum())}
     return Rendered(rgb8=f.rgb8, tris=f.sp.tris, pixels_written=int(c["written"]), stats=stats)

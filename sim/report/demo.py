@@ -2,57 +2,89 @@
 
 1. renders a scene (default ``c300``, 512x512) through the golden geometry pipeline and the
    float reference rasteriser;
-2. renders the same scene through every machine's golden archs (``rasterhw machines``) and
-   counts the pixels where each differs from the reference;
+2. renders the same scene through every machine's golden archs (``rasterhw machines``), counts
+   the pixels where each differs from the reference and, where it differs, writes a diff image
+   (with the machine's reason: its own colour format);
 3. runs every machine's HDL sim blocks on their default scenes (the SNU pixel bus on
    ``snu-100px`` at 1280x1024, the ZB/M unit on ``c300``) on ``engine``, each compared bit for
    bit with its golden model, with cycles and throughput;
-4. writes the PNGs, ``summary.json``, ``report.md`` and ``index.html`` (open it in a browser:
-   every image side by side with its numbers) under ``out/``.
+4. runs the same scene through every machine's HDL (or, for a machine without HDL, its
+   registered ``frame_cost`` model): the cross-machine table — cycles per frame, time at the
+   paper's clock, covered pixels per clock, polygons per second;
+5. puts each machine's headline paper figures beside ours (rows of its committed report,
+   ``docs/reproduction/NAME.md``, with the command that made them), its place-and-route record
+   (``docs/reproduction/fpga_runs.json``: LUT4s, flip-flops, Fmax beside the paper's clock) and
+   its plots, and renders those reports as HTML pages beside the index;
+6. writes the PNGs, ``summary.json``, ``report.md`` and ``index.html`` (Jinja2 template
+   ``templates/index.html.j2``) under ``out/``.
 
-A machine that registers an arch or a sim block appears here with no edit to this file.
+A machine that registers an arch, a sim block, a report or a frame cost appears here with no
+edit to this file.
 """
 
 from __future__ import annotations
 
-import html
 import json
 import multiprocessing
+import re
+import shutil
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
+from jinja2 import Environment, PackageLoader, select_autoescape
+from markdown_it import MarkdownIt
 from PIL import Image
-from rasterhw.golden_model.compare import compare_images
+from rasterhw.golden_model.compare import compare_images, diff_image
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.reference import rasterise
 from rasterhw.golden_model.scenes import SCENES, build_scene
 from rasterhw.sim import registry
+from rasterhw.sim.paths import REPO_ROOT
+from rasterhw.sim.report.rows import parse_table
 from tqdm import tqdm
 
 __all__ = ["run_demo"]
 
 SIZE = (512, 512)
-_COLOUR_NOTE = ("Colour is compared as 8-bit RGB: machines with colour formats of their own (EXPERTS' 3/3/3 hue and intensity, the vector Z-buffer's RGBI 3/3/3/7) differ from the float reference in colour by design; coverage and the visible polygon of each machine are checked against the reference by its tests.")
+REPRO = REPO_ROOT / "docs" / "reproduction"
+_COLOUR_NOTE = ("Colour is compared as 8-bit RGB: a machine with a colour format of its own differs from the "
+                "float reference in colour by design (its reason is under its diff image); coverage and the "
+                "visible polygon of each machine are checked against the reference by its tests.")
+HEADLINE_MAX = 12
 
 
-def _run_sim(machine: str, block: str, engine: str) -> dict:
-    """One HDL sim block on its default scene and options (run in a worker process)."""
+def _run_sim(machine: str, block: str, engine: str, scene: str | None, size: tuple[int, int] | None) -> dict:
+    """One HDL sim block on a scene (default: its own) with its default options (a worker process)."""
     b = next(s for s in registry.machines()[machine].sims if s.name == block)
-    w, h = SCENES[b.default_scene].size
+    scene = scene or b.default_scene
+    w, h = size or SCENES[b.default_scene].size
     defaults = {o.name: o.default for o in b.options}
-    return registry.load(b.simulate)(build_scene(b.default_scene), w, h, engine=engine, progress=False, **defaults)
+    return registry.load(b.simulate)(build_scene(scene), w, h, engine=engine, progress=False, **defaults)
 
 
 def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator", workers: int = 2) -> dict:
     """Run the demo into ``out``; raises SystemExit if any HDL run differs from its golden model.
     ``workers``: HDL runs at once (each in its own process)."""
     out.mkdir(parents=True, exist_ok=True)
-    archs = [(m, a) for m in registry.machines().values() for a in m.archs]
-    sims = [(m, b) for m in registry.machines().values() for b in m.sims]
-    bar = tqdm(total=1 + len(archs) + len(sims), desc="demo", unit="step")
-    summary: dict = {"scene": scene, "engine": engine, "archs": [], "sims": []}
+    ms = list(registry.machines().values())
+    archs = [(m, a) for m in ms for a in m.archs]
+    sims = [(m, b) for m in ms for b in m.sims]
+    # HDL runs: each block on its own default scene, then on the demo's scene at SIZE for the
+    # cross-machine table (the first run reused when it is that already)
+    runs = [(m, b, None, None) for m, b in sims]
+    cross = []
+    for k, (m, b) in enumerate(sims):
+        if b.default_scene == scene and SCENES[scene].size == SIZE:
+            cross.append(k)
+        else:
+            cross.append(len(runs))
+            runs.append((m, b, scene, SIZE))
+    costs = [m for m in ms if m.frame_cost and not m.sims]
+    bar = tqdm(total=1 + len(archs) + len(runs) + len(costs), desc="demo", unit="step")
+    summary: dict = {"scene": scene, "engine": engine, "size": list(SIZE), "archs": [], "sims": [],
+                     "machines": [], "cross_machine": []}
 
     bar.set_postfix_str(f"{scene}: reference render")
     sc = build_scene(scene)
@@ -65,7 +97,8 @@ def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator", worke
     Image.fromarray(ref_rgb).save(ref_png)
     summary["reference"] = {"scene": scene, "width": SIZE[0], "height": SIZE[1], **tris.stats,
                             "fragments": int(frame.fragments), "pixels_written": int(frame.pixels_written),
-                            "wall_s": round(wall, 4), "image": ref_png.name}
+                            "pixels_covered": int(frame.pixels_covered), "wall_s": round(wall, 4),
+                            "image": ref_png.name}
     bar.update(1)
 
     for m, a in archs:
@@ -77,9 +110,15 @@ def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator", worke
         png = out / f"{scene}-{a.name}.png"
         Image.fromarray(res.rgb8).save(png)
         cmp = compare_images(ref_rgb, res.rgb8)
+        diff = None
+        if cmp["differing_pixels"]:
+            diff = out / f"{scene}-{a.name}-diff.png"
+            Image.fromarray(diff_image(res.rgb8, ref_rgb)).save(diff)
         summary["archs"].append({"machine": m.name, "arch": a.name, "help": a.help, "options": defaults,
                                  "pixels_written": int(res.pixels_written),
                                  "differing_from_reference": int(cmp["differing_pixels"]),
+                                 "diff_image": diff.name if diff else None,
+                                 "colour_note": a.colour_note or None,
                                  "wall_s": round(wall, 4), "image": png.name,
                                  "stats": _plain(res.stats)})
         bar.update(1)
@@ -87,40 +126,139 @@ def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator", worke
     # The HDL runs, two at a time, each in its own process (a first run verilates and compiles its
     # model: minutes of compiler work that two cores share; Amaranth elaborates in each process
     # alone). Results are kept in registry order.
-    n_workers = max(1, min(workers, len(sims)))
-    bar.set_postfix_str(f"HDL on {engine}, {n_workers} at a time (a first run builds the models)")
-    results: dict[int, dict] = {}
-    if sims:
-        ctx = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx) as pool:
-            jobs = {pool.submit(_run_sim, m.name, b.name, engine): k for k, (m, b) in enumerate(sims)}
-            for fut in as_completed(jobs):
-                k = jobs[fut]
-                results[k] = fut.result()
-                m, b = sims[k]
-                bar.set_postfix_str(f"{b.default_scene}: {m.name} {b.name} HDL on {engine} done")
-                bar.update(1)
-    for k, (m, b) in enumerate(sims):
-        s_name = b.default_scene
-        res = results[k]
+    results = _run_all(runs, engine, workers, bar)
+    for k, (m, b, s_name, size) in enumerate(runs):
+        s_name = s_name or b.default_scene
+        res = dict(results[k])
         defaults = {o.name: o.default for o in b.options}
-        png = out / f"{s_name}-{b.name}-{engine}.png"
+        suffix = "" if size is None else f"-{size[0]}x{size[1]}"
+        png = out / f"{s_name}{suffix}-{b.name}-{engine}.png"
         frame_rgb = res.pop("frame_rgb", None)
         if frame_rgb is not None:
             Image.fromarray(frame_rgb).save(png)
-        summary["sims"].append({"machine": m.name, "block": b.name, "scene": s_name, "help": b.help,
-                                **defaults, **_plain(res), "image": png.name if frame_rgb is not None else None})
+        results[k] = {"machine": m.name, "block": b.name, "scene": s_name, "help": b.help, **defaults,
+                      **_plain(res), "image": png.name if frame_rgb is not None else None}
+    summary["sims"] = results[:len(sims)]
+    for k, (m, b) in zip(cross, sims, strict=True):
+        summary["cross_machine"].append(_cross_row(results[k], summary["reference"], f"hdl:{engine}"))
+    for m in costs:
+        bar.set_postfix_str(f"{scene}: {m.name} frame cost")
+        c = registry.load(m.frame_cost)(sc, *SIZE)
+        summary["cross_machine"].append(_cross_row({"machine": m.name, "scene": scene, **c},
+                                                   summary["reference"], c["source"]))
+        bar.update(1)
     bar.close()
+
+    fpga = _fpga_records()
+    plots_out = out / "reproduction"
+    for m in ms:
+        entry = {"name": m.name, "title": m.title, "status": m.status, "no_hdl": m.no_hdl or None,
+                 "golden": [a for a in summary["archs"] if a["machine"] == m.name],
+                 "hdl_runs": [s for s in results if s["machine"] == m.name],
+                 "paper_rows": [], "report": None, "report_command": None, "plots": [],
+                 "fpga": [r for r in fpga if registry.block_machine(r["block"]).name == m.name]}
+        if m.report and (REPRO / f"{m.name}.md").exists():
+            text = (REPRO / f"{m.name}.md").read_text()
+            entry["paper_rows"] = headline_rows(parse_table(text), m.headline)
+            entry["report"] = f"reproduction/{m.name}.html"
+            entry["report_command"] = f"rasterhw report {m.name}"
+            entry["plots"] = [f"reproduction/{p}" for p in _plots(text)]
+            _render_report(text, plots_out / f"{m.name}.html", f"Reproduction: {m.title}")
+            for p in _plots(text):
+                shutil.copyfile(REPRO / p, plots_out / p)
+        summary["machines"].append(entry)
 
     (out / "summary.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
     (out / "report.md").write_text(_markdown(summary))
     (out / "index.html").write_text(_html(summary))
     print(_markdown(summary))
     print(f"wrote {out}/index.html (open it in a browser), {out}/report.md, {out}/summary.json and images")
-    bad = [f"{s['machine']} {s['block']}: {s['mismatches']} mismatches" for s in summary["sims"] if s["mismatches"]]
+    bad = [f"{s['machine']} {s['block']} on {s['scene']}: {s['mismatches']} mismatches"
+           for s in results if s["mismatches"]]
     if bad:
         raise SystemExit("HDL differs from the golden model: " + "; ".join(bad))
     return summary
+
+
+def _run_all(runs, engine: str, workers: int, bar) -> list[dict]:
+    n_workers = max(1, min(workers, len(runs)))
+    bar.set_postfix_str(f"HDL on {engine}, {n_workers} at a time (a first run builds the models)")
+    results: dict[int, dict] = {}
+    if runs:
+        ctx = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx) as pool:
+            jobs = {pool.submit(_run_sim, m.name, b.name, engine, s, size): k for k, (m, b, s, size) in enumerate(runs)}
+            for fut in as_completed(jobs):
+                k = jobs[fut]
+                results[k] = fut.result()
+                m, b, s, _ = runs[k]
+                bar.set_postfix_str(f"{s or b.default_scene}: {m.name} {b.name} HDL on {engine} done")
+                bar.update(1)
+    return [results[k] for k in range(len(runs))]
+
+
+def _cross_row(r: dict, ref: dict, source: str) -> dict:
+    """One machine's cost of the demo's frame: ``frame_cycles`` (the clocks of the frame on the
+    machine as built, parallel units counted once) where the run gives it, else ``cycles``."""
+    cycles = r.get("frame_cycles", r.get("cycles"))
+    clock = r.get("clock_hz")
+    t = r.get("time_s") or (cycles / clock if cycles and clock else None)
+    return {"machine": r["machine"], "block": r.get("block"), "scene": r["scene"],
+            "size": f"{ref['width']}x{ref['height']}", "cycles": cycles, "clock_hz": clock,
+            "frame_ms": None if t is None else 1e3 * t,
+            "polygons_per_s": None if not t else ref.get("polygons_drawn", 0) / t,
+            "covered_pixels_per_clock": None if not cycles else ref["pixels_covered"] / cycles,
+            "mismatches": r.get("mismatches"), "source": source, "note": r.get("note")}
+
+
+def headline_rows(rows: list[dict], wanted: tuple[str, ...]) -> list[dict]:
+    """The rows to show beside the paper: those whose ``figure: quantity`` starts with one of
+    ``wanted`` (in that order), else the first rows with both a paper and a measured value."""
+    def key(r):
+        return f"{r['figure']}: {r['quantity']}"
+
+    def has(v):
+        return v not in ("", "—", None)
+
+    if wanted:
+        picked = [r for w in wanted for r in rows if key(r).startswith(w)]
+    else:
+        picked = [r for r in rows if has(r["paper"]) and has(r["measured"])]
+    return [{k: r[k] for k in ("figure", "quantity", "paper", "measured", "ratio", "unit", "source")}
+            for r in picked[:HEADLINE_MAX]]
+
+
+def _plots(md: str) -> list[str]:
+    return [p for p in re.findall(r"!\[[^\]]*\]\(([^)\s]+\.png)\)", md) if (REPRO / p).exists()]
+
+
+def _fpga_records() -> list[dict]:
+    """Every recorded ECP5 place-and-route run (``docs/reproduction/fpga_runs.json``, written by
+    ``rasterhw report fpga``): the block, its parameters, LUT4s, flip-flops, block RAMs, Fmax per
+    clock domain beside the clock the paper names, or why it was not measured."""
+    path = REPRO / "fpga_runs.json"
+    if not path.exists():
+        return []
+    known = set(registry.blocks())
+    out = []
+    for run in json.loads(path.read_text())["runs"]:
+        r = run["result"]
+        if run["block"] not in known or r.get("family", "ecp5") != "ecp5":
+            continue
+        clocks = {c["domain"]: c for c in r.get("paper_clocks", [])}
+        out.append({"block": run["block"], "params": ", ".join(f"{k} {v}" for k, v in run["params"].items()),
+                    "finished": bool(r.get("finished")) and r.get("fits", True),
+                    "luts": r.get("luts"), "ffs": r.get("ffs"), "brams": r.get("brams"),
+                    "fmax": [{"domain": d, "mhz": f, "paper_mhz": clocks.get(d, {}).get("mhz"),
+                              "paper_what": clocks.get(d, {}).get("what")} for d, f in sorted(r.get("fmax_mhz", {}).items())],
+                    "reason": r.get("reason"), "ran": r.get("ran"), "source": "hdl:nextpnr-ecp5"})
+    return out
+
+
+def _render_report(md: str, path: Path, title: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    body = MarkdownIt("commonmark").enable("table").render(md)
+    path.write_text(_env().get_template("report.html.j2").render(title=title, body=body))
 
 
 def _plain(d: dict) -> dict:
@@ -142,6 +280,10 @@ def _sim_line(s: dict) -> str:
             + f"; simulated at {s['cycles_per_s']:.3g} cycles/s, {s['wall_s']:.1f} s wall")
 
 
+def _num(v, fmt: str = ",.0f") -> str:
+    return "—" if v is None else format(v, fmt)
+
+
 def _markdown(summary: dict) -> str:
     ref = summary["reference"]
     md = ["# rasterhw demo", "",
@@ -154,41 +296,38 @@ def _markdown(summary: dict) -> str:
     for a in summary["archs"]:
         md.append(f"| {a['machine']} | {a['arch']} | {a['pixels_written']:,} | {a['differing_from_reference']:,} "
                   f"| {a['wall_s'] * 1e3:.1f} | [{a['image']}]({a['image']}) |")
-    md += ["", _COLOUR_NOTE, "", f"## HDL runs on {summary['engine']}", ""]
+    md += ["", _COLOUR_NOTE, ""]
+    if summary.get("cross_machine"):
+        md += [f"## One scene through every machine: {summary['scene']}", "",
+               "| machine | block | cycles | clock | frame ms | polygons/s | covered px/clock | source |",
+               "|---|---|---|---|---|---|---|---|"]
+        for c in summary["cross_machine"]:
+            clock = "paper names none" if not c["clock_hz"] else f"{c['clock_hz'] / 1e6:g} MHz"
+            md.append(f"| {c['machine']} | {c['block']} | {_num(c['cycles'])} | {clock} | {_num(c['frame_ms'], '.2f')} "
+                      f"| {_num(c['polygons_per_s'])} | {_num(c['covered_pixels_per_clock'], '.3f')} | {c['source']} |")
+        md.append("")
+    md += [f"## HDL runs on {summary['engine']}", ""]
     for s in summary["sims"]:
         md += [f"### {s['machine']} {s['block']} on {s['scene']}", "", f"- {_sim_line(s)}", ""]
         if s["image"]:
             md += [f"![{s['block']}]({s['image']})", ""]
-    md += ["Paper figures beside measured ones: `rasterhw report all` -> docs/reproduction/.", ""]
+    for m in summary.get("machines", []):
+        if m["paper_rows"]:
+            md += [f"## {m['title']}: the paper beside us (from `{m['report_command']}`)", "",
+                   "| figure | quantity | paper | measured | ratio | unit | source |", "|---|---|---|---|---|---|---|"]
+            md += [f"| {r['figure']} | {r['quantity']} | {r['paper']} | {r['measured']} | {r['ratio']} | {r['unit']} "
+                   f"| {r['source']} |" for r in m["paper_rows"]]
+            md.append("")
     return "\n".join(md)
 
 
+def _env() -> Environment:
+    env = Environment(loader=PackageLoader("rasterhw.sim.report", "templates"),
+                      autoescape=select_autoescape(["html", "j2"]))
+    env.filters["num"] = _num
+    env.filters["sim_line"] = _sim_line
+    return env
+
+
 def _html(summary: dict) -> str:
-    e = html.escape
-    ref = summary["reference"]
-    cards = [f"<figure><img src='{e(ref['image'])}'><figcaption><b>reference</b> (float)<br>"
-             f"{ref['pixels_written']:,} pixel writes, {ref['wall_s'] * 1e3:.1f} ms</figcaption></figure>"]
-    for a in summary["archs"]:
-        cards.append(f"<figure><img src='{e(a['image'])}'><figcaption><b>{e(a['machine'])} / {e(a['arch'])}</b>"
-                     f"<br>{e(a['help'])}<br>{a['pixels_written']:,} pixel writes; "
-                     f"{a['differing_from_reference']:,} px differ in RGB from the reference; {a['wall_s'] * 1e3:.1f} ms"
-                     f"</figcaption></figure>")
-    sims = []
-    for s in summary["sims"]:
-        img = f"<img src='{e(s['image'])}'>" if s["image"] else ""
-        ok = "ok" if s["mismatches"] == 0 else "MISMATCH"
-        sims.append(f"<figure>{img}<figcaption><b>{e(s['machine'])} / {e(s['block'])}</b> on {e(s['scene'])} "
-                    f"[{ok}]<br>{e(s['help'])}<br>{e(_sim_line(s))}</figcaption></figure>")
-    return f"""<!doctype html>
-<html><head><meta charset="utf-8"><title>rasterhw demo</title>
-<style>body{{font-family:sans-serif;margin:2em}} figure{{display:inline-block;width:300px;vertical-align:top;margin:0 1em 1em 0}}
-img{{width:300px;image-rendering:pixelated;border:1px solid #ccc}} figcaption{{font-size:85%}}</style></head>
-<body><h1>rasterhw demo</h1>
-<h2>{e(ref['scene'])} at {ref['width']}x{ref['height']}: the float reference and every machine's golden model</h2>
-{''.join(cards)}
-<p>{e(_COLOUR_NOTE)}</p>
-<h2>HDL runs on {e(summary['engine'])}, each compared bit for bit with its golden model</h2>
-{''.join(sims)}
-<p>Paper figures beside measured ones: <code>rasterhw report all</code> writes docs/reproduction/.</p>
-</body></html>
-"""
+    return _env().get_template("index.html.j2").render(s=summary, colour_note=_COLOUR_NOTE)
