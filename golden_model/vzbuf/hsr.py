@@ -68,6 +68,12 @@ class Counters:
                 "mean_vector_length": self.mean_vector_length}
 
 
+
+def _step(values: tuple, steps: tuple, edges: np.ndarray) -> None:
+    """One line down for ``edges``: every per-edge value (x, z, intensity, normal) += its step."""
+    for v, d in zip(values, steps, strict=True):
+        v[edges] += d[edges]
+
 def new_buffers(width: int, height: int) -> dict:
     return {"depth": np.full((height, width), np.inf), "qid": np.full((height, width), -1, np.int64),
             "inten": np.zeros((height, width)), "count": np.zeros((height, width), np.int64)}
@@ -164,10 +170,7 @@ def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
         c.t_ztest += tc - tb
         # step the edges of every x-list segment at once
         both = np.concatenate([L, R])
-        ex[both] += dxdy[both]
-        ez[both] += dzdy[both]
-        ei[both] += didy[both]
-        en[both] += dn[both]
+        _step((ex, ez, ei, en), (dxdy, dzdy, didy, dn), both)
         c.edge_updates += 4
         c.edge_elements += 4 * both.size
         c.t_update1 += clk() - tc
@@ -270,10 +273,7 @@ def algorithm2(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
         c.t_ztest += tc - tb
         # (4) step the edges, shift the s-list one line down
         both = np.concatenate([L, R])
-        ex[both] += dxdy[both]
-        ez[both] += dzdy[both]
-        ei[both] += didy[both]
-        en[both] += dn[both]
+        _step((ex, ez, ei, en), (dxdy, dzdy, didy, dn), both)
         crow[segs] += 1
         c.edge_updates += 5
         c.edge_elements += 4 * both.size + segs.size

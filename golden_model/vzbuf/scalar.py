@@ -212,17 +212,21 @@ def _line_work(g, L, R, width):
     return lo, hi, xl, L[2], il, didx
 
 
+def _buffers(segs: list, width: int, height: int):
+    """Cleared frame buffers (depth, polygon id, intensity, shadow count) and the y-list: the
+    segments that start on each line, in order."""
+    n = width * height
+    ylist = [[] for _ in range(height)]
+    for si, g in enumerate(segs):
+        ylist[g["y0"]].append(si)
+    return [math.inf] * n, [-1] * n, [0.0] * n, [0] * n, ylist
+
+
 def scalar_alg1(segs: list, width: int, height: int, *, mode: str = "real", zframe=None, sign=None,
                 full_frame: bool = False):
     """Algorithm 1, one pixel at a time. Returns (depth, qid, inten, count) as flat lists."""
     inf = math.inf
-    depth = [inf] * (width * height)
-    qid = [-1] * (width * height)
-    inten = [0.0] * (width * height)
-    count = [0] * (width * height)
-    ylist = [[] for _ in range(height)]
-    for si, g in enumerate(segs):
-        ylist[g["y0"]].append(si)
+    depth, qid, inten, count, ylist = _buffers(segs, width, height)
     edges = {}
     xlist = []
     zline = [inf] * width
@@ -275,13 +279,7 @@ def scalar_alg1(segs: list, width: int, height: int, *, mode: str = "real", zfra
 def scalar_alg2(segs: list, width: int, height: int, *, mode: str = "real", zframe=None, sign=None):
     """Algorithm 2, one slot and one pixel at a time. Returns flat lists as :func:`scalar_alg1`."""
     inf = math.inf
-    depth = [inf] * (width * height)
-    qid = [-1] * (width * height)
-    inten = [0.0] * (width * height)
-    count = [0] * (width * height)
-    ylist = [[] for _ in range(height)]
-    for si, g in enumerate(segs):
-        ylist[g["y0"]].append(si)
+    depth, qid, inten, count, ylist = _buffers(segs, width, height)
     head = [0] * height
     slist = [-1] * height
     edges = {}

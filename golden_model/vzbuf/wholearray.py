@@ -27,9 +27,9 @@ __all__ = ["fragments", "render_whole"]
 CHUNK = 1 << 18
 
 
-def fragments(seg: SegmentBlock, width: int, lo_s: int = 0, hi_s: int | None = None):
-    """Fragments of segments ``lo_s .. hi_s - 1``: (pixel, z, intensity, segment) arrays."""
-    hi_s = seg.n if hi_s is None else hi_s
+def _spans(seg: SegmentBlock, width: int, lo_s: int, hi_s: int):
+    """Every non-empty (segment, line) span of segments ``lo_s .. hi_s - 1``: segment, line,
+    first pixel, pixel count."""
     ids = np.arange(lo_s, hi_s)
     nl = seg.yend[ids] - seg.y0[ids] + 1
     rec = np.repeat(ids, nl)
@@ -37,7 +37,13 @@ def fragments(seg: SegmentBlock, width: int, lo_s: int = 0, hi_s: int | None = N
     lo, hi = spans_at(seg, rec, rows, width)
     n = np.maximum(hi - lo + 1, 0)
     keep = n > 0
-    rec, rows, lo, n = rec[keep], rows[keep], lo[keep], n[keep]
+    return rec[keep], rows[keep], lo[keep], n[keep]
+
+
+def fragments(seg: SegmentBlock, width: int, lo_s: int = 0, hi_s: int | None = None):
+    """Fragments of segments ``lo_s .. hi_s - 1``: (pixel, z, intensity, segment) arrays."""
+    hi_s = seg.n if hi_s is None else hi_s
+    rec, rows, lo, n = _spans(seg, width, lo_s, hi_s)
     e = seg.edges
     dl = rows - seg.y0[rec]
     L, R = seg.left[rec], seg.right[rec]
@@ -60,14 +66,7 @@ def fragments(seg: SegmentBlock, width: int, lo_s: int = 0, hi_s: int | None = N
 def shadow_fragments(seg: SegmentBlock, width: int, sign: np.ndarray, lo_s: int, hi_s: int):
     """(pixel, z, sign) of the fragments of shadow segments ``lo_s .. hi_s - 1``, lean: per-line
     values are spread with ``np.repeat`` and only what the count buffer needs is formed."""
-    ids = np.arange(lo_s, hi_s)
-    nl = seg.yend[ids] - seg.y0[ids] + 1
-    rec = np.repeat(ids, nl)
-    rows = seg.y0[rec] + (np.arange(rec.size) - np.repeat(np.cumsum(nl) - nl, nl))
-    lo, hi = spans_at(seg, rec, rows, width)
-    n = np.maximum(hi - lo + 1, 0)
-    keep = n > 0
-    rec, rows, lo, n = rec[keep], rows[keep], lo[keep], n[keep]
+    rec, rows, lo, n = _spans(seg, width, lo_s, hi_s)
     e = seg.edges
     dl = rows - seg.y0[rec]
     L = seg.left[rec]
