@@ -596,6 +596,18 @@ def _check_int(name: str, v, lo: int, hi: int) -> int:
     return i
 
 
+
+def check_geometry_args(who: str, scene, width, height, z_bits) -> tuple[int, int, int]:
+    """A geometry run's arguments checked (one-line ``RasterhwError`` naming ``who``) and the
+    scene validated: ``(width, height, z_bits)`` as ints."""
+    width = _check_int("width", width, 1, MAX_SIZE)
+    height = _check_int("height", height, 1, MAX_SIZE)
+    z_bits = _check_int("z_bits", z_bits, 1, 32)
+    if not isinstance(scene, Scene):
+        raise RasterhwError(f"{who} needs a Scene, got {type(scene).__name__}")
+    scene.validate()
+    return width, height, z_bits
+
 def run_geometry(
     scene: Scene, width: int, height: int, *, z_bits: int = 24, z_far_is_zero: bool = False
 ) -> ScreenTriangles:
@@ -606,12 +618,7 @@ def run_geometry(
     table 1 order with the cull moved right after the vertex transform, where the clip
     coordinates it needs first exist, so back faces are not lit.
     """
-    width = _check_int("width", width, 1, MAX_SIZE)
-    height = _check_int("height", height, 1, MAX_SIZE)
-    z_bits = _check_int("z_bits", z_bits, 1, 32)
-    if not isinstance(scene, Scene):
-        raise RasterhwError(f"run_geometry needs a Scene, got {type(scene).__name__}")
-    scene.validate()
+    width, height, z_bits = check_geometry_args("run_geometry", scene, width, height, z_bits)
     n_p, k = scene.n_polygons, scene.max_corners
     # A scene of k-gons (every corner slot used, e.g. all triangles) takes reshapes where a
     # mixed one takes boolean gathers of the used slots; same values, same order.

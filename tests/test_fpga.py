@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim.engines.verilog import block_names
 from rasterhw.sim.flow.fpga import (
     fpga_configs,
     fpga_sweeps,
@@ -13,7 +14,6 @@ from rasterhw.sim.flow.fpga import (
     utilisation,
 )
 from rasterhw.sim.report.fpga import rows
-from rasterhw.sim.engines.verilog import block_names
 
 
 @pytest.mark.heavy

@@ -8,7 +8,12 @@ from amaranth import Module, Signal, unsigned
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In
 from amaranth.sim import Simulator
-from rasterhw.sim.engines.harness import stream_get, stream_protocol_checker, stream_put, stream_sink
+from rasterhw.sim.engines.harness import (
+    stream_get,
+    stream_protocol_checker,
+    stream_put,
+    stream_sink,
+)
 
 
 class _Port(wiring.Component):

@@ -49,8 +49,7 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.opcount import OpCounter
 from rasterhw.golden_model.pipeline import (
-    MAX_SIZE,
-    _check_int,
+    check_geometry_args,
     clip,
     fan_triangulate,
     frame_setup,
@@ -128,12 +127,7 @@ def _npc_inside(o: OpCounter, v: np.ndarray) -> np.ndarray:
 def run_geometry_paper(scene: Scene, width: int, height: int, *, z_bits: int = 24) -> ScreenTriangles:
     """The paper's recipe on ``scene``: screen triangles with far = 0 (``z_far_is_zero``) and
     per-stage counts in ``.ops`` (table 1's seven stages plus ``clip_cut`` and ``to_integer``)."""
-    width = _check_int("width", width, 1, MAX_SIZE)
-    height = _check_int("height", height, 1, MAX_SIZE)
-    z_bits = _check_int("z_bits", z_bits, 1, 32)
-    if not isinstance(scene, Scene):
-        raise RasterhwError(f"run_geometry_paper needs a Scene, got {type(scene).__name__}")
-    scene.validate()
+    width, height, z_bits = check_geometry_args("run_geometry_paper", scene, width, height, z_bits)
     if scene.uv is not None:
         raise RasterhwError("the paper's recipe carries no texture coordinates")
     setup = frame_setup(scene, width, height)

@@ -278,7 +278,6 @@ def scalar_alg1(segs: list, width: int, height: int, *, mode: str = "real", zfra
 
 def scalar_alg2(segs: list, width: int, height: int, *, mode: str = "real", zframe=None, sign=None):
     """Algorithm 2, one slot and one pixel at a time. Returns flat lists as :func:`scalar_alg1`."""
-    inf = math.inf
     depth, qid, inten, count, ylist = _buffers(segs, width, height)
     head = [0] * height
     slist = [-1] * height

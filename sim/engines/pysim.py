@@ -9,8 +9,8 @@ import time
 
 from amaranth.sim import Simulator
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.engines.pattern import ready_pattern
 from rasterhw.sim.engines.harness import as_plain, stream_protocol_checker, stream_put
+from rasterhw.sim.engines.pattern import ready_pattern
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
 
 __all__ = ["run"]

@@ -7,9 +7,19 @@ each machine's parameter sweeps. A report not tied to one machine (``EXTRA_REPOR
 from __future__ import annotations
 
 from rasterhw.sim import registry
-from rasterhw.sim.flow.fpga import (DEVICE_NAMES, FALLBACK_ROUTER, ROUTER, RUN_RECORD, not_measured_reason,
-                                   fpga_configs, fpga_sweeps, paper_clock, place_and_route, synth_demand,
-                                   write_run_record)
+from rasterhw.sim.flow.fpga import (
+    DEVICE_NAMES,
+    FALLBACK_ROUTER,
+    ROUTER,
+    RUN_RECORD,
+    fpga_configs,
+    fpga_sweeps,
+    not_measured_reason,
+    paper_clock,
+    place_and_route,
+    synth_demand,
+    write_run_record,
+)
 from rasterhw.sim.registry import FpgaSweep
 from rasterhw.sim.report.rows import FAST_SKIP, make_row
 
