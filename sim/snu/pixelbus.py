@@ -16,10 +16,14 @@ import time
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.snu import pixelbus as golden
+from rasterhw.golden_model.snu.formats import Z_BITS
+from rasterhw.golden_model.snu.gouraud import scan_convert
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.sim import engines
 from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put
+from rasterhw.sim.snu.frame import frame_run
 from rasterhw.sim.snu.testbench import frame_of
 from rasterhw.sim.testbench import compare, find_testbench
 
@@ -199,9 +203,6 @@ def main(argv: list[str] | None = None) -> int:
     return 0 if all(r["mismatches"] == 0 for r in rows) else 1
 
 
-if __name__ == "__main__":
-    raise SystemExit(main())
-
 
 def simulate_scene(scene, width: int, height: int, *, engine: str = "verilator", progress: bool = False) -> dict:
     """``rasterhw sim pixelbus``: the scene's frame through the pixel-bus HDL.
@@ -213,12 +214,10 @@ def simulate_scene(scene, width: int, height: int, *, engine: str = "verilator",
     :func:`simulate_pixelbus`.
     """
     if engine == "verilator":
-        from rasterhw.sim.snu.frame import frame_run
-
         return frame_run(scene, width, height, progress=progress)
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.snu.formats import Z_BITS
-    from rasterhw.golden_model.snu.gouraud import scan_convert
-
     tris = run_geometry(scene, width, height, z_bits=Z_BITS, z_far_is_zero=True)
     return simulate_pixelbus(scan_convert(tris), engine=engine, progress=progress)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
