@@ -12,13 +12,22 @@ import time
 from pathlib import Path
 
 from amaranth.back import verilog
-from amaranth.hdl import Cat, ClockDomain, ClockSignal, Const, Elaboratable, Instance, Module, Signal
+from amaranth.hdl import (
+    Cat,
+    ClockDomain,
+    ClockSignal,
+    Const,
+    Elaboratable,
+    Instance,
+    Module,
+    Signal,
+)
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.engines.memh import read_memh
 from rasterhw.sim.engines.runner import HARNESS_V, build_plain_verilator, run_plain_verilator
-from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
 from rasterhw.sim.engines.verilog import canonical_port_lists
 from rasterhw.sim.engines.verilog_cache import convert_cached
+from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
 from rasterhw.sim.workdirs import release, temp_run_folder
 
 __all__ = ["GAP_BITS", "BenchTop", "run"]

@@ -39,7 +39,12 @@ from rasterhw.golden_model.snu import pixelbus as golden
 from rasterhw.golden_model.snu.formats import CLOCK_HZ, MEM_CYCLE, N_BANKS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.sim.engines.memh import memh_uint64, read_memh
-from rasterhw.sim.engines.runner import HARNESS_V, REPO_ROOT, build_plain_verilator, run_plain_verilator
+from rasterhw.sim.engines.runner import (
+    HARNESS_V,
+    REPO_ROOT,
+    build_plain_verilator,
+    run_plain_verilator,
+)
 
 __all__ = ["BENCH", "clear_cycles", "frame_run", "golden_schedule", "producer_gaps", "run_frame_hdl"]
 
