@@ -4,9 +4,15 @@
 //   rasterhw_two_clocks    the segment and merge clocks, half periods and phase from plusargs
 //   rasterhw_reset         holds a reset for CYCLES rising edges of its own clock, then releases
 //                          it DELAY ns after the next edge (away from every clock edge)
-//   rasterhw_stream_player plays words preloaded from a hex file (name from a plusarg) into a
-//                          stream, each after its idle gap, REPEATS times, stream rules kept
+//   rasterhw_stream_source plays words preloaded from a file (name from a plusarg; $readmemh, or
+//                          $fread of big-endian binary words) into a stream, each after its idle
+//                          gap, `repeats` times, stream rules kept; the generic bench's source
+//                          and every hand-written bench's player
+//   rasterhw_stream_player the same with the older port list (no count plusarg, hex only): a
+//                          name kept for the benches that still use it
 //   rasterhw_stream_check  counts stream-rule violations and transfers on one port
+//   rasterhw_stream_sink   takes words with seeded back-pressure (the xorshift of xorshift.vh),
+//                          stamps and dumps them (the generic bench)
 //
 // Stimulus word: {gap[GW-1:0], payload[PW-1:0]}: the payload is offered `gap` clocks after the
 // clock following the previous transfer (the first `gap` clocks after reset) and held until
@@ -68,6 +74,8 @@ module rasterhw_reset #(
   end
 endmodule
 
+// The older port list of rasterhw_stream_source (hex file, `count` from the port): kept so the
+// benches that instantiate it by this name keep working.
 module rasterhw_stream_player #(
   parameter PW = 8,                // payload bits
   parameter GW = 8,                // gap bits
@@ -84,34 +92,9 @@ module rasterhw_stream_player #(
   output wire [PW-1:0] payload,
   output wire done                 // every repetition played
 );
-  reg [GW+PW-1:0] mem [0:DEPTH-1];
-  reg [8*512-1:0] fname;
-  initial begin
-    if (!$value$plusargs(FILE_ARG, fname)) $fatal(1, "rasterhw_stream_player: +%s missing", FILE_ARG);
-    $readmemh(fname, mem);
-  end
-
-  reg [31:0] ptr, rep;
-  reg [GW-1:0] wt;
-  wire last = (ptr + 32'd1 == count);
-  wire [GW+PW-1:0] cur = mem[base + ptr];
-  wire [GW+PW-1:0] nxt = mem[base + (last ? 32'd0 : ptr + 32'd1)];
-  assign done = (rep >= repeats) || (count == 32'd0);
-  assign valid = !rst && !done && (wt == {GW{1'b0}});
-  assign payload = cur[PW-1:0];
-  always @(posedge clk) begin
-    if (rst) begin
-      ptr <= 32'd0;
-      rep <= 32'd0;
-      wt <= mem[base][GW+PW-1:PW];
-    end else if (valid && ready) begin
-      ptr <= last ? 32'd0 : ptr + 32'd1;
-      if (last) rep <= rep + 32'd1;
-      wt <= nxt[GW+PW-1:PW];
-    end else if (wt != {GW{1'b0}}) begin
-      wt <= wt - 1'b1;
-    end
-  end
+  rasterhw_stream_source #(.PW(PW), .GW(GW), .DEPTH(DEPTH), .FILE_ARG(FILE_ARG), .COUNT_FROM_ARG(0)) source (
+    .clk(clk), .rst(rst), .base(base), .count(count), .repeats(repeats),
+    .valid(valid), .ready(ready), .payload(payload), .done(done));
 endmodule
 
 // Once a clock has `valid` high and `ready` low, the next clock must keep `valid` high and the
@@ -152,17 +135,29 @@ endmodule
 // The generic bench (sim/engines/verilator.py): one stream source per input port of a block and
 // one stream sink per output port, in a bench top generated from Amaranth around the block.
 
-// Plays +NAME_n= words {gap[GW-1:0], payload[PW-1:0]} from the $readmemh file +NAME=: each word is
-// offered `gap` clocks after the clock of the previous transfer (the first `gap` clocks after
-// start) and held until accepted (the stream rules). `done` once every word was taken.
+// Plays words {gap[GW-1:0], payload[PW-1:0]} from the file named by the plusarg FILE_ARG: each word
+// is offered `gap` clocks after the clock of the previous transfer (the first `gap` clocks after
+// start or reset) and held until accepted (the stream rules); the words base .. base + count - 1,
+// `repeats` times; `done` once every repetition was taken. The file is $readmemh text, or with
+// BINARY = 1 big-endian binary words of (GW + PW) / 8 bytes read with $fread (no text to parse:
+// a $readmemh of 10 million words takes longer than simulating them). The word count comes from
+// the plusarg COUNT_ARG (COUNT_FROM_ARG = 1, the generic bench: a count of 0 needs no file) or
+// from the `count` port (COUNT_FROM_ARG = 0). Without `rst` (tied low) the source starts from its
+// initial values at time 0 (the generic bench); a bench with a reset restarts it there.
 module rasterhw_stream_source #(
   parameter PW = 8,
   parameter GW = 8,
   parameter DEPTH = 16,              // > words played
   parameter FILE_ARG = "i=%s",
-  parameter COUNT_ARG = "i_n=%d"
+  parameter COUNT_ARG = "i_n=%d",
+  parameter COUNT_FROM_ARG = 1,
+  parameter BINARY = 0
 ) (
   input wire clk,
+  input wire rst,
+  input wire [31:0] base,            // first word played
+  input wire [31:0] count,           // words per repetition (COUNT_FROM_ARG = 0)
+  input wire [31:0] repeats,         // repetitions (1 = play once)
   output wire valid,
   input wire ready,
   output wire [PW-1:0] payload,
@@ -170,26 +165,42 @@ module rasterhw_stream_source #(
 );
   reg [GW+PW-1:0] mem [0:DEPTH-1];
   reg [8*512-1:0] fname;
-  reg [31:0] n, ptr;
+  reg [31:0] n_arg, ptr, rep;
   reg [GW-1:0] wt;
+  integer fd, got;
   initial begin
-    if (!$value$plusargs(COUNT_ARG, n)) n = 0;
-    if (n != 0) begin
+    if (COUNT_FROM_ARG == 0 || !$value$plusargs(COUNT_ARG, n_arg)) n_arg = 0;
+    if (COUNT_FROM_ARG == 0 || n_arg != 0) begin
       if (!$value$plusargs(FILE_ARG, fname)) $fatal(1, "rasterhw_stream_source: +%s missing", FILE_ARG);
-      $readmemh(fname, mem);
+      if (BINARY != 0) begin
+        fd = $fopen(fname, "rb");
+        if (fd == 0) $fatal(1, "rasterhw_stream_source: cannot open %0s", fname);
+        got = $fread(mem, fd);
+        $fclose(fd);
+      end else begin
+        $readmemh(fname, mem);
+      end
     end
     ptr = 0;
-    wt = (n != 0) ? mem[0][GW+PW-1:PW] : {GW{1'b0}};
+    rep = 0;
+    wt = (COUNT_FROM_ARG == 0 || n_arg != 0) ? mem[0][GW+PW-1:PW] : {GW{1'b0}};
   end
-  wire [GW+PW-1:0] cur = mem[ptr];
-  wire [GW+PW-1:0] nxt = mem[ptr + 32'd1];
-  assign done = (ptr >= n);
-  assign valid = !done && (wt == {GW{1'b0}});
+  wire [31:0] n = (COUNT_FROM_ARG != 0) ? n_arg : count;
+  wire last = (ptr + 32'd1 == n);
+  wire [GW+PW-1:0] cur = mem[base + ptr];
+  wire [GW+PW-1:0] nxt = mem[base + (last ? 32'd0 : ptr + 32'd1)];
+  assign done = (rep >= repeats) || (n == 32'd0);
+  assign valid = !rst && !done && (wt == {GW{1'b0}});
   assign payload = cur[PW-1:0];
   always @(posedge clk) begin
-    if (valid && ready) begin
-      ptr <= ptr + 32'd1;
-      wt <= (ptr + 32'd1 < n) ? nxt[GW+PW-1:PW] : {GW{1'b0}};
+    if (rst) begin
+      ptr <= 32'd0;
+      rep <= 32'd0;
+      wt <= mem[base][GW+PW-1:PW];
+    end else if (valid && ready) begin
+      ptr <= last ? 32'd0 : ptr + 32'd1;
+      if (last) rep <= rep + 32'd1;
+      wt <= nxt[GW+PW-1:PW];
     end else if (wt != {GW{1'b0}}) begin
       wt <= wt - 1'b1;
     end
@@ -233,16 +244,8 @@ module rasterhw_stream_sink #(
     if (fwords != 0) $writememh(fwords, words, 0, (q == 0) ? 0 : q - 1);
     if (fcyc != 0) $writememh(fcyc, stamps, 0, (q == 0) ? 0 : q - 1);
   end
-  // the 32-bit xorshift (x ^= x << 13; x ^= x >> 17; x ^= x << 5); sim/engines/pattern.py draws
-  // the same sequence for the pysim engine
-  function [31:0] xorshift32(input [31:0] x);
-    reg [31:0] t;
-    begin
-      t = x ^ (x << 13);
-      t = t ^ (t >> 17);
-      xorshift32 = t ^ (t << 5);
-    end
-  endfunction
+  // the 32-bit xorshift; sim/engines/pattern.py draws the same sequence for the pysim engine
+`include "xorshift.vh"
   assign ready = ({24'd0, lf[7:0]} >= stall);
   assign done = (q >= n);
   always @(posedge clk) begin

@@ -16,6 +16,8 @@ SMALL = {
     "experts-dmm": {"depth": 16},
     "experts-pxp": {"width": 64, "aj": "c"},
     "experts-pxp-unit": {"width": 64, "depth": 64},
+    "pixelbus": {"width": 20, "height": 8},
+    "pixelbus-bank": {"depth": 64},
     "zbm-merger": {"fifo_depth": 4},
     "zbm-seggen": {"width": 48, "height": 24, "capacity": 64},
     "zbm-unit": {"interleave": 2, "width": 32, "height": 16, "capacity": 16},

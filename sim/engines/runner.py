@@ -45,6 +45,10 @@ __all__ = [
 
 #: the Verilog side of the harness every bench wrapper uses (reset release, stream player, checker)
 HARNESS_V = REPO_ROOT / "cocotb_tests" / "harness.v"
+#: files the harness `includes (the xorshift): their folder is on every build's include path and
+#: their bytes are part of every build's key
+HARNESS_INCLUDES = (REPO_ROOT / "cocotb_tests" / "xorshift.vh",)
+INCLUDE_ARG = f"-I{HARNESS_V.parent}"
 #: the C++ main every timing-free (plain Verilator) bench shares
 PLAIN_MAIN = REPO_ROOT / "cocotb_tests" / "plain_main.cpp"
 #: Verilator flags of the timing-free benches: C++ model with our main, built in one step
@@ -149,7 +153,7 @@ def build_dir_for(block: str, sim: str, *, sources: Sequence[Path] = (), **param
     the Verilog ``sources`` (generated code, bench wrapper, harness): a changed file gets a
     fresh build, never a stale one, with no hand-kept list of what the build depends on."""
     h = hashlib.sha1(json.dumps(params, sort_keys=True, default=str).encode())
-    for s in sources:
+    for s in (*sources, *HARNESS_INCLUDES):
         h.update(Path(s).read_bytes())
     digest = h.hexdigest()[:10]
     return REPO_ROOT / "build" / f"{block}-{sim}-{digest}"
@@ -178,7 +182,7 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
         name = f"{name}-trace-{trace}"
     h = hashlib.sha1(json.dumps({"top": top, "args": args, "make": make, "defines": defines,
                                  "params": params}, sort_keys=True, default=str).encode())
-    for f in (*sources, PLAIN_MAIN):
+    for f in (*sources, PLAIN_MAIN, *HARNESS_INCLUDES):
         h.update(Path(f).read_bytes())
     for k in sorted(generated):
         h.update(k.encode() + generated[k].encode())
@@ -195,7 +199,7 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
         env = sim_env()
         env["MAKEFLAGS"] = f"{env['MAKEFLAGS']} {make}" if env.get("MAKEFLAGS") else make
         cflags = " ".join(f"-D{k}={v}" for k, v in defines.items())
-        cmd = [str(verilator_bin_dir() / "verilator"), *args, "--top-module", top, f"-I{bdir}",
+        cmd = [str(verilator_bin_dir() / "verilator"), *args, "--top-module", top, f"-I{bdir}", INCLUDE_ARG,
                "-CFLAGS", cflags, *[f"-G{k}={v}" for k, v in params.items()], "--Mdir", str(bdir / "obj_dir"),
                *[str(bdir / k) for k in generated if k.endswith(".v")], *[str(f) for f in sources], str(PLAIN_MAIN)]
         t0 = time.perf_counter()
@@ -311,7 +315,7 @@ def run_cocotb(
 
     Raises :class:`RasterhwError` if any cocotb test failed.  ``timings``, if given, gets
     ``build_s`` and ``test_s`` (wall seconds of the two steps).  ``test_module`` is imported
-    from the repository root (e.g. ``cocotb_tests.snu.pixelbus.test_pixelbus``).
+    from the repository root (e.g. ``cocotb_tests.zbm.test_zbm``).
     ``verilator_args`` are appended to :data:`VERILATOR_BUILD_ARGS` (Verilator builds only),
     e.g. ``--no-public-flat-rw`` and a ``.vlt`` file naming the few signals the bench reads:
     cocotb's runner always passes ``--public-flat-rw``, which makes every signal of the
@@ -329,7 +333,7 @@ def run_cocotb(
         # interrupted or killed: run its commands as children that die with us
         runner._execute_cmds = _execute_cmds_as_children.__get__(runner)
         build_args: list[str] = ([*VERILATOR_BUILD_ARGS, *map(str, verilator_args)] if sim == "verilator"
-                                 else ["-g2005"])
+                                 else ["-g2005"]) + [INCLUDE_ARG]
         build_dir = Path(build_dir)
         build_dir.mkdir(parents=True, exist_ok=True)
         t0 = time.perf_counter()
@@ -414,7 +418,7 @@ def lint_verilog(sources: Iterable[Path], top: str, *, waivers: Sequence[str] = 
 
     Raises :class:`RasterhwError` (with Verilator's messages) if any warning or error is left.
     """
-    cmd = [str(verilator_bin_dir() / "verilator"), "--lint-only", "-Wall", *waivers, "--top-module", top]
+    cmd = [str(verilator_bin_dir() / "verilator"), "--lint-only", "-Wall", *waivers, INCLUDE_ARG, "--top-module", top]
     cmd += [str(s) for s in sources]
     p = subprocess.run(cmd, capture_output=True, text=True, env=sim_env())
     out = p.stdout + p.stderr

@@ -12,7 +12,16 @@ import time
 from pathlib import Path
 
 from amaranth.back import verilog
-from amaranth.hdl import Cat, ClockDomain, ClockSignal, Elaboratable, Instance, Module, Signal
+from amaranth.hdl import (
+    Cat,
+    ClockDomain,
+    ClockSignal,
+    Const,
+    Elaboratable,
+    Instance,
+    Module,
+    Signal,
+)
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.engines.memh import read_memh
 from rasterhw.sim.engines.runner import HARNESS_V, build_plain_verilator, run_plain_verilator
@@ -74,8 +83,9 @@ class BenchTop(Elaboratable):
             m.submodules[f"src_{t}"] = Instance(
                 "rasterhw_stream_source", p_PW=len(_payload(port)), p_GW=GAP_BITS, p_DEPTH=depth,
                 p_FILE_ARG=f"{t}=%s", p_COUNT_ARG=f"{t}_n=%d",
-                i_clk=ClockSignal("sync"), o_valid=port.valid, i_ready=port.ready, o_payload=_payload(port),
-                o_done=ok)
+                i_clk=ClockSignal("sync"), i_rst=Const(0, 1), i_base=Const(0, 32), i_count=Const(0, 32),
+                i_repeats=Const(1, 32),
+                o_valid=port.valid, i_ready=port.ready, o_payload=_payload(port), o_done=ok)
             dones.append(ok)
         for name, depth in self._outputs.items():
             port, t = port_of(self.dut, name), _tag(name)
@@ -95,7 +105,7 @@ def _build(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[st
     key = {**params, "inputs": inputs, "outputs": outputs, "bench": _SELF}
     text = convert_cached(
         tb.block, lambda: BenchTop(tb.dut(params), inputs, outputs, tb.domains), params=key, module="rasterhw_bench",
-        convert=lambda top, mod: canonical_port_lists(verilog.convert(top, name=mod, ports=top.ports)))
+        convert=lambda top, mod: canonical_port_lists(verilog.convert(top, name=mod, ports=top.ports)) + _extra(top.dut))
     return build_plain_verilator(f"tb-{tb.block}", "rasterhw_bench", [HARNESS_V], params={}, opt="-O1",
                                  defines={"RASTERHW_CYCLES": 1}, generated={"rasterhw_bench.v": text})
 
@@ -133,6 +143,11 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
     finally:
         release(run_dir)
     return Run("verilator", words, stamps, wall_s=time.perf_counter() - t0, build_s=build_s, run_s=meta["run_s"])
+
+
+def _extra(dut) -> str:
+    """Hand-written Verilog the block instantiates (its ``extra_verilog()``, e.g. a RAM model), if any."""
+    return dut.extra_verilog() if hasattr(dut, "extra_verilog") else ""
 
 
 def _ints(b) -> list[int]:

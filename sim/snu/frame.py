@@ -13,7 +13,7 @@ Flow (``frame_run``):
    from the model (``i860.scan_clocks``: set-up per triangle, per scan line, per pixel), turned
    into idle bus clocks before each write (``gap``): the processor stalls on a store while the
    bus is not ready ("as if writing internal memory", 3.2.1) and resumes after the transfer.
-3. **Pixel bus (HDL)**: ``cocotb_tests/snu/pixelbus/tb_pixelbus_fast.v``: CLEAR, the two
+3. **Pixel bus (HDL)**: ``cocotb_tests/snu/tb_pixelbus_fast.v``: CLEAR, the two
    streams with their gaps, SWAP, read-back of the displayed frame; cycles from the DUT's own
    counter.
 4. **Golden**: the same schedule in ``golden_model.snu.pixelbus`` (clear length, release of
@@ -39,11 +39,16 @@ from rasterhw.golden_model.snu import pixelbus as golden
 from rasterhw.golden_model.snu.formats import CLOCK_HZ, MEM_CYCLE, N_BANKS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.sim.engines.memh import memh_uint64, read_memh
-from rasterhw.sim.engines.runner import HARNESS_V, REPO_ROOT, build_plain_verilator, run_plain_verilator
+from rasterhw.sim.engines.runner import (
+    HARNESS_V,
+    REPO_ROOT,
+    build_plain_verilator,
+    run_plain_verilator,
+)
 
 __all__ = ["BENCH", "clear_cycles", "frame_run", "golden_schedule", "producer_gaps", "run_frame_hdl"]
 
-BENCH = REPO_ROOT / "cocotb_tests" / "snu" / "pixelbus" / "tb_pixelbus_fast.v"
+BENCH = REPO_ROOT / "cocotb_tests" / "snu" / "tb_pixelbus_fast.v"
 TOP = "tb_pixelbus_fast"
 GAP_BITS = 16
 #: clocks from the end of the clear (``clear_cycles`` after its accept) to the first clock the

@@ -25,6 +25,8 @@ MACHINE = Machine(
     bench="rasterhw.sim.snu.bench:bench",
     soak={"pixelbus": "rasterhw.sim.snu.soak:pixelbus_round"},
     proofs={"pixelbus-bank": "rasterhw.sim.snu.proof:PROOF"},
+    testbenches={"pixelbus-bank": "rasterhw.sim.snu.testbench:BankBench",
+                 "pixelbus": "rasterhw.sim.snu.testbench:BusBench"},
     flows={"pixelbus-bank": Flow(synth={"ram": "verilog", "depth": 1280 * 1024 // 5},  # one of 5 banks of the frame
                                  small={"depth": 64}, fpga={"ram": "memory", "depth": 4096},
                                  fpga_runs=(({}, "full"), ({"ram": "memory", "depth": 4096}, "reduced")),

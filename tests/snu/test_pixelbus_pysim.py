@@ -265,3 +265,45 @@ def test_simulate_pixelbus_bad_input():
     ok = PixelStream(10, 2, np.array([3]), np.array([0]), np.array([1]), np.array([1]))
     with pytest.raises(RasterhwError, match="engine"):
         simulate_pixelbus(ok, engine="modelsim")
+
+
+# --- the testbenches (sim/snu/testbench.py) and their read-out adapter ---------------------------
+
+
+def test_bank_testbench_reads_out_after_the_last_memory_cycle():
+    from rasterhw.sim.engines import run
+    from rasterhw.sim.testbench import compare, find_testbench
+
+    tb = find_testbench("pixelbus-bank")
+    p = tb.params(depth=32)
+    stim = tb.stimulus(p, seed=4)
+    exp = tb.expect(p, stim)
+    n = len(stim.words["i"]) - 1          # the writes, then the end token
+    r = run(tb, p, stim, engine="pysim", expect_words={"o": 32})
+    assert compare(exp, r)["mismatches"] == 0
+    # back to back the bank takes one write per memory cycle: the last one's ends at n * 5, the
+    # read-out starts there and gives one word a clock
+    assert r.stamps["o"] == list(range(5 * n + 1, 5 * n + 1 + 32))
+
+
+@pytest.mark.parametrize("pipe", [0, 1])
+def test_bus_testbench_with_one_pipeline_empty(pipe):
+    from rasterhw.sim.engines import run
+    from rasterhw.sim.snu.testbench import frame_of
+    from rasterhw.sim.testbench import compare, find_testbench
+
+    rng = np.random.default_rng(pipe)
+    n = 50
+    s = PixelStream(20, 8, rng.integers(0, 160, n), rng.integers(0, 1 << 24, n), rng.integers(0, 8, n),
+                    np.full(n, pipe))
+    tb = find_testbench("pixelbus")
+    p = tb.params(width=20, height=8)
+    stim = tb.stimulus_of(p, s)
+    assert stim.words[f"i_pipe{1 - pipe}"] == [1 << (24 + 24 + 8)]     # only the end token
+    exp = tb.expect(p, stim)
+    r = run(tb, p, stim, engine="pysim", stall=100, seed=3, expect_words={"o": 160})
+    c = compare(exp, r, cycle_exact=False)
+    assert c["mismatches"] == 0 and c["cycle_mismatches"] == 0
+    rgb, z = g.pixelbus_frame(s)
+    assert np.array_equal(frame_of(r, 24, (8, 20))[0], rgb) and np.array_equal(frame_of(r, 24, (8, 20))[1], z)
+    assert r.stamps["o"][0] - 1 >= g.pixelbus_cycles(s)     # read out only once every write has landed

@@ -1,1 +1,0 @@
-"""cocotb bench for the SNU pixel-bus controller."""

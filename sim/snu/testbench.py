@@ -1,0 +1,130 @@
+# amaranth: UnusedElaboratable=no
+"""Testbenches of the SNU blocks (``sim/testbench.py``): pixel writes in, the frame memory out.
+
+Both blocks keep what they make in their frame memory; the bench adapter :class:`ReadOut`
+(``sim/snu/readout.py``) ends every write stream with a token and then streams the memory out
+(``o``: ``{rgb, z}`` per word, address order, draw buffer), so the generic engines compare it with
+the golden frame (``golden_model/snu/pixelbus.py: pixelbus_frame``) word for word.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from rasterhw.golden_model.snu import pixelbus as golden
+from rasterhw.golden_model.snu.formats import RGB_BITS
+from rasterhw.golden_model.snu.pixelstream import PixelStream
+from rasterhw.golden_model.snu.words import payload_words
+from rasterhw.sim.snu.readout import ReadOut
+from rasterhw.sim.testbench import Expected, Run, Stimulus, Testbench
+
+__all__ = ["BankBench", "BusBench", "frame_of"]
+
+
+def _addr_bits(n: int) -> int:
+    return max(1, (n - 1).bit_length())     # the blocks' max(1, ceil_log2(n))
+
+
+def _port_words(stream: PixelStream, idx: np.ndarray, aw: int, gaps) -> tuple[list[int], list[int] | None]:
+    """The writes ``idx`` as port words, then the end token (the payload's top bit + 1)."""
+    end = 1 << (stream.z_bits + RGB_BITS + aw)
+    words = [*payload_words(stream, idx, aw), end]
+    return words, (None if gaps is None else [*np.asarray(gaps, dtype=np.int64)[idx].tolist(), 0])
+
+
+def _stream(rng: np.random.Generator, width: int, height: int, n: int, pipes: int, z_bits: int,
+            n_banks: int) -> tuple[PixelStream, str]:
+    """A random stream: uniform, scan-line runs, column runs or one bank; full or narrow Z (ties)."""
+    npix = width * height
+    kind = str(rng.choice(["uniform", "scanline", "vertical", "one-bank"]))
+    if kind == "uniform":
+        addr = rng.integers(0, npix, n)
+    elif kind in ("scanline", "vertical"):
+        run = int(rng.integers(3, 20))
+        step = 1 if kind == "scanline" else width
+        addr = (rng.integers(0, npix, -(-n // run))[:, None] + step * np.arange(run)).ravel()[:n] % npix
+    else:
+        bank = int(rng.integers(0, n_banks))
+        addr = np.minimum(rng.integers(0, -(-npix // n_banks), n) * n_banks + bank, npix - 1)
+    narrow = bool(rng.random() < 0.5)
+    z = rng.integers(0, 16, n) if narrow else rng.integers(0, 1 << z_bits, n)
+    pipe = rng.integers(0, pipes, n)
+    s = PixelStream(width, height, addr, rng.integers(0, 1 << RGB_BITS, n), z, pipe, z_bits=z_bits)
+    return s, f"{n} {kind} writes, {'narrow' if narrow else 'full'} Z, {pipes} pipeline(s)"
+
+
+def frame_of(run: Run, z_bits: int, shape: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """The read-out words of ``run`` as ``(rgb, z)`` arrays of ``shape`` (int64)."""
+    w = np.array(run.words["o"], dtype=np.int64)
+    return (w >> z_bits).reshape(shape), (w & ((1 << z_bits) - 1)).reshape(shape)
+
+
+def _frame_words(rgb: np.ndarray, z: np.ndarray, z_bits: int) -> list[int]:
+    return ((rgb.ravel() << z_bits) | z.ravel()).tolist()
+
+
+class BankBench(Testbench):
+    """``pixelbus-bank``: pixel writes (bank-local address, RGB, Z) in on ``i`` back to back, the
+    bank's draw buffer and Z out (``o``, ``depth`` words). Golden: the writes applied in order with
+    the strict Z test (``pixelbus_frame``). The golden cycle model is the bus's (two pipelines'
+    slots), not one bank's: no cycle count here (the bank's memory-cycle timing is held by
+    ``tests/snu/test_pixelbus_pysim.py``)."""
+
+    block = "pixelbus-bank"
+
+    def dut(self, params: dict):
+        return ReadOut(super().dut(params), self.inputs, params["depth"])
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        rng = np.random.default_rng(seed)
+        s, what = _stream(rng, params["depth"], 1, int(rng.integers(40, 200)), 1, params["z_bits"], 1)
+        return self.stimulus_of(params, s, what=f"{what}, seed {seed}")
+
+    def stimulus_of(self, params: dict, stream: PixelStream, gaps=None, what: str = "") -> Stimulus:
+        """``stream`` (one pipeline, ``addr`` bank-local, a ``depth`` x 1 frame) as the bank's words."""
+        words, g = _port_words(stream, np.arange(len(stream)), _addr_bits(params["depth"]), gaps)
+        return Stimulus({"i": words}, {} if g is None else {"i": g}, what=what, source=stream)
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        s = stim.source
+        rgb, z = golden.pixelbus_frame(s, accept=np.arange(len(s)))
+        return Expected({"o": _frame_words(rgb, z, params["z_bits"])})
+
+
+class BusBench(Testbench):
+    """``pixelbus``: the two pipelines' pixel writes (linear address, RGB, Z) in on ``i_pipe0`` and
+    ``i_pipe1``, the draw buffer and Z of the whole frame out (``o``, ``width * height`` words).
+    Golden: ``pixelbus_accept_cycles`` (every write's slot) and ``pixelbus_frame``; cycles: the
+    bus is idle at ``max(accept) + mem_cycle`` (the golden cycle count), the read-out starts there
+    and takes one clock per word, plus one (``ReadOut``)."""
+
+    block = "pixelbus"
+    inputs = ("i_pipe0", "i_pipe1")
+
+    def dut(self, params: dict):
+        return ReadOut(super().dut(params), self.inputs, params["width"] * params["height"])
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        rng = np.random.default_rng(seed)
+        w, h = params["width"], params["height"]
+        n = int(rng.integers(max(20, w * h // 2), 2 * w * h + 1))
+        s, what = _stream(rng, w, h, n, int(rng.choice([1, 2, 2, 2])), params["z_bits"], params["n_banks"])
+        return self.stimulus_of(params, s, what=f"{what}, seed {seed}")
+
+    def stimulus_of(self, params: dict, stream: PixelStream, gaps=None, what: str = "") -> Stimulus:
+        """``stream``'s writes as each pipeline's words (``gaps``: idle clocks before each write)."""
+        aw = _addr_bits(params["width"] * params["height"])
+        words, gs = {}, {}
+        for p, port in enumerate(self.inputs):
+            words[port], g = _port_words(stream, np.flatnonzero(stream.pipe == p), aw, gaps)
+            if g is not None:
+                gs[port] = g
+        return Stimulus(words, gs, what=what, source=(stream, gaps))
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        s, gaps = stim.source
+        kw = {"mem_cycle": params["mem_cycle"], "n_banks": params["n_banks"]}
+        acc = golden.pixelbus_accept_cycles(s, gaps=gaps, **kw)
+        rgb, z = golden.pixelbus_frame(s, accept=acc, **kw)
+        cycles = int(acc.max()) + params["mem_cycle"] + s.width * s.height + 1 if len(s) else None
+        return Expected({"o": _frame_words(rgb, z, params["z_bits"])}, cycles=cycles)
+
