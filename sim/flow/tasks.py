@@ -56,6 +56,9 @@ __all__ = ["VARYING", "Handle", "Runner", "Task", "code_digest", "default_store"
 #: result keys that may differ between two runs of one task (timings, who ran it)
 VARYING = ("wall_s", "build_s", "cycles_per_s", "worker", "pid", "scheduler")
 
+#: how long to wait for a Dask scheduler named by address before saying it cannot be reached
+CONNECT_TIMEOUT = "20s"
+
 #: the folders whose files make up the design, the golden model and the benches
 _CODE_TREES = ("golden_model", "hdl", "sim", "cocotb_tests")
 _CODE_SUFFIXES = (".py", ".v", ".sv", ".vh", ".cpp", ".h", ".mk")
@@ -328,7 +331,7 @@ class Runner:
             self.client = Client(self.cluster)
         else:
             try:
-                self.client = Client(self.arg, timeout="20s")
+                self.client = Client(self.arg, timeout=CONNECT_TIMEOUT)
             except (OSError, TimeoutError) as e:
                 raise RasterhwError(f"cannot reach the Dask scheduler at {self.arg}: {e}") from None
         return self
