@@ -69,7 +69,7 @@ def run_soak(*, pixels: int, seed: int, blocks: list[str] | None = None, progres
     of the same seed reuses them; ``fresh`` recomputes). ``rounds``: block -> ``"module:round"``
     instead of the registry's (tests)."""
     table = dict(rounds) if rounds is not None else soak_blocks()
-    names = list(table) if not blocks else blocks
+    names = list(table) if not blocks else list(dict.fromkeys(blocks))
     for b in names:
         if b not in table:
             raise RasterhwError(f"no soak for block {b!r}; blocks: {', '.join(table)}")
