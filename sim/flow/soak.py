@@ -58,7 +58,8 @@ def run_soak(*, pixels: int, seed: int, blocks: list[str] | None = None, progres
              fresh: bool = False, rounds: dict[str, str] | None = None) -> list[dict]:
     """Random rounds per block until ``pixels`` output pixels were compared or a round
     mismatches (the block stops there: its seed reproduces it); one row per block: ``block,
-    seed, rounds, pixels_compared, mismatches, wall_s, failures`` (the failing round: number and
+    seed, rounds, pixels_compared, mismatches, wall_s`` (from the soak's start until the block
+    stopped: the blocks' rounds run side by side), ``failures`` (the failing round: number and
     settings), ``scheduler``.
 
     The rounds run on ``scheduler`` (:class:`~rasterhw.sim.flow.tasks.Runner`: ``serial``,
