@@ -87,9 +87,13 @@ def run_soak(*, pixels: int, seed: int, blocks: list[str] | None = None, progres
             while active:
                 for b in active:            # keep up to `ahead` rounds of every block in flight
                     s = st[b]
-                    while len(s["queue"]) < ahead and s["next"] < max_rounds:
+                    # one round until the block's first result says how many pixels a round
+                    # gives (a pixel-bus round can hold them all); then up to `ahead`, unless the
+                    # rounds in flight will very likely finish the block. A round started in vain
+                    # is cancelled, but one already running on a worker runs to its end.
+                    while len(s["queue"]) < (ahead if s["k"] else 1) and s["next"] < max_rounds:
                         if s["k"] and s["done"] + len(s["queue"]) * s["done"] / s["k"] >= pixels:
-                            break           # the rounds in flight will very likely finish the block
+                            break
                         s["queue"].append(run.submit(_round_task(b, seed, s["next"], refs[b])))
                         s["next"] += 1
                 for b in list(active):
