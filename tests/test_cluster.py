@@ -115,8 +115,8 @@ def test_hand_started_cluster_sweep_equals_serial(cluster, tmp_path):
 
 
 @pytest.mark.parametrize("where", ["serial", "cluster"])
-def test_interrupted_sweep_recomputes_nothing_it_had_finished(cluster, tmp_path, where):
-    scheduler = "serial" if where == "serial" else cluster["address"]
+def test_interrupted_sweep_recomputes_nothing_it_had_finished(request, tmp_path, where):
+    scheduler = "serial" if where == "serial" else request.getfixturevalue("cluster")["address"]
     store = tmp_path / "store"
     sweep = dict(scenes=["c50"], size=(24, 24), scheduler=scheduler, store=store)
     params = ["sn=1,2,4", "pn=1,2"]
