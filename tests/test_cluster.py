@@ -226,3 +226,27 @@ def test_runner_serial_runs_in_order_and_stores(tmp_path):
     with Runner("serial", store=tmp_path, fresh=True) as run:
         run.map(tasks)
         assert (run.computed, run.reused) == (3, 0)
+
+
+def test_soak_resumes_from_the_store(tmp_path, monkeypatch):
+    """A longer soak of the same seed reruns none of the rounds a shorter one finished."""
+    log = tmp_path / "rounds.log"
+    monkeypatch.setenv("RASTERHW_TEST_ROUND_LOG", str(log))
+    (short,) = run_soak(pixels=500, seed=3, progress=False, scheduler="serial", rounds=ROUNDS, store=tmp_path / "s")
+    first = [ln.split()[1] for ln in log.read_text().splitlines() if ln.startswith("end")]
+    assert first == [str(k) for k in range(short["rounds"])]
+    log.write_text("")
+    (long,) = run_soak(pixels=1_500, seed=3, progress=False, scheduler="serial", rounds=ROUNDS, store=tmp_path / "s")
+    again = [ln.split()[1] for ln in log.read_text().splitlines() if ln.startswith("end")]
+    assert again == [str(k) for k in range(short["rounds"], long["rounds"])]
+    (ref,) = run_soak(pixels=1_500, seed=3, progress=False, scheduler="serial", rounds=ROUNDS)
+    assert {k: v for k, v in long.items() if k != "wall_s"} == {k: v for k, v in ref.items() if k != "wall_s"}
+
+
+def test_a_worker_with_other_code_refuses_the_task():
+    from rasterhw.sim.flow.tasks import code_digest, run_task
+
+    t = Task("render", "experts", {"sn": 1}, scene="c50", size=(8, 8))
+    assert run_task(t, code_digest())["pixels_written"] == 64
+    with pytest.raises(RasterhwError, match="another version of the code"):
+        run_task(t, "0" * 64)
