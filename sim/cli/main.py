@@ -432,23 +432,40 @@ def bench(as_json: bool, repeat: int, hdl: bool) -> None:
             click.echo(f"{r['name']:<52} {value:>12} {r['unit']:<10} {r.get('note', '')}")
 
 
+def _scheduler_options(f):
+    """``--scheduler``, ``--store``, ``--fresh``: where a command's tasks run and where their
+    results are kept (sim/flow/tasks.py, docs/scale.md)."""
+    f = click.option("--fresh", is_flag=True, help="Recompute every task, even those in the store.")(f)
+    f = click.option("--store", type=click.Path(file_okay=False), default=None,
+                     help="Folder keeping every finished task's result (default: build/tasks).")(f)
+    return click.option("--scheduler", default="local", show_default=True, metavar="serial|local[:N]|tcp://HOST:PORT",
+                        help="Where the tasks run: in this process, a local Dask cluster of N single-threaded "
+                             "workers (default: one per core), or an existing Dask scheduler.")(f)
+
+
 @cli.command()
 @click.option("--pixels", type=int, default=1_000_000, show_default=True,
               help="Output pixels to compare per block (the soak: 100000000).")
 @click.option("--seed", type=int, default=None, help="Seed of every round (default: a fresh one, printed).")
 @click.option("--block", "blocks", multiple=True, help="Only these blocks (repeatable; default: every block).")
+@_scheduler_options
 @click.option("--json", "as_json", is_flag=True)
-def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], as_json: bool) -> None:
+def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], scheduler: str, store: str | None, fresh: bool,
+         as_json: bool) -> None:
     """Random differential runs of every HDL block against its golden model on Verilator
-    (random scenes and stimulus, idle and back-pressure patterns, ZB/M clock ratios); exit 1
-    on any mismatch. The seed is printed; --seed reruns the same rounds."""
+    (random scenes and stimulus, idle and back-pressure patterns, ZB/M clock ratios); a block
+    stops at its first mismatching round; exit 1 on any mismatch. The seed is printed; --seed
+    reruns the same rounds (on any --scheduler: the same rounds, the same result)."""
     import secrets
 
     from rasterhw.sim.flow.soak import run_soak
+    from rasterhw.sim.flow.tasks import default_store, parse_scheduler
 
+    parse_scheduler(scheduler)   # a bad one is an error before anything starts
     seed = secrets.randbelow(1 << 31) if seed is None else seed
     info(f"soak: seed {seed} (rerun: rasterhw soak --seed {seed} --pixels {pixels})")
-    rows = run_soak(pixels=pixels, seed=seed, blocks=list(blocks) or None, progress=not as_json)
+    rows = run_soak(pixels=pixels, seed=seed, blocks=list(blocks) or None, progress=not as_json,
+                    scheduler=scheduler, store=store or default_store(), fresh=fresh)
     if as_json:
         emit_json(rows)
     else:
@@ -458,6 +475,52 @@ def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], as_json: bool) 
             for fl in r["failures"]:
                 click.echo(f"{'':10} round {fl['round']}: {fl['mismatches']} mismatches ({fl['settings']})")
     if any(r["mismatches"] for r in rows):
+        sys.exit(1)
+
+
+@cli.command()
+@click.argument("target")
+@click.option("--param", "params", multiple=True, metavar="NAME=V1,V2,...",
+              help="A parameter of TARGET and the values it takes (repeatable; the sweep is the cross product).")
+@click.option("--scene", "scenes", multiple=True, help="Scene(s) to run (repeatable; default: the target's own).")
+@click.option("--size", default=None, metavar="WxH", help="Frame size (default: the scene's own).")
+@click.option("--engine", type=click.Choice(ENGINES), default=None,
+              help="HDL simulator for a sim block (default: verilator); a golden arch takes none.")
+@_scheduler_options
+@click.option("--out", "out_dir", type=click.Path(file_okay=False), default=None,
+              help="Also write DIR/points.csv and a plot of every numeric result against each swept parameter.")
+@click.option("--json", "as_json", is_flag=True, help="Print {scheduler, points: [{params, ...result}]} on stdout.")
+def sweep(target: str, params: tuple[str, ...], scenes: tuple[str, ...], size: str | None, engine: str | None,
+          scheduler: str, store: str | None, fresh: bool, out_dir: str | None, as_json: bool) -> None:
+    """Run TARGET (a sim block, or render:ARCH for a golden arch) at every combination of the
+    --param values, on --scheduler; exit 1 if a point mismatches its golden model.
+
+    \b
+      rasterhw sweep zbm --param interleave=1,2,4 --scene c50 --size 64x64
+      rasterhw sweep render:experts --param sn=1,2,4,8 --param pn=1,2,4,8 --out out/sweep
+    """
+    from rasterhw.sim.flow.sweep import plan, run_sweep, write_outputs
+    from rasterhw.sim.flow.tasks import default_store, parse_scheduler
+
+    wh = parse_size(size)
+    parse_scheduler(scheduler)
+    if not params:
+        raise RasterhwError("say what to sweep: --param NAME=V1,V2,...")
+    plan(target, list(params), scenes=list(scenes), size=wh, engine=engine)   # every check before a cluster starts
+    res = run_sweep(target, list(params), scenes=list(scenes) or None, size=wh, engine=engine, scheduler=scheduler,
+                    store=store or default_store(), fresh=fresh, progress=not as_json)
+    if out_dir is not None:
+        for p in write_outputs(res, out_dir):
+            info(f"wrote {p}")
+    if as_json:
+        emit_json(res)
+    else:
+        for pt in res["points"]:
+            given = " ".join(f"{k}={v}" for k, v in pt["params"].items())
+            extra = "".join(f" {k}={pt[k]}" for k in ("cycles", "mismatches", "pixels_written") if k in pt)
+            click.echo(f"{given} {pt.get('scene', '')}{extra} {pt['wall_s']:.2f} s [{pt['worker']}]")
+        info(f"{len(res['points'])} points on {res['scheduler']}: {res['computed']} run, {res['reused']} from the store")
+    if any(pt.get("mismatches") for pt in res["points"]):
         sys.exit(1)
 
 
