@@ -64,7 +64,7 @@ def test_doc_block_runs(doc, line, lang, flags, body, tmp_path):
     if lang == "python":
         cmd, cwd = [sys.executable, "-c", body], tmp_path
     else:
-        script = body.replace("../.venv/bin/", f"{BIN}/").replace(".venv/bin/", f"{BIN}/")
+        script = re.sub(r"(?:\.\./)*\.venv/bin/", f"{BIN}/", body)
         cmd, cwd = ["bash", "-euo", "pipefail", "-c", script], ROOT if "root" in flags else tmp_path
     r = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, env=_env(), timeout=1800)
     assert r.returncode == 0, f"{where} failed (exit {r.returncode}):\n{r.stderr[-2000:]}"
