@@ -42,7 +42,7 @@ from amaranth.hdl._ast import AnySeq
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
 from rasterhw.sim.outfile import atomic_path
-from rasterhw.sim.engines.runner import REPO_ROOT
+from rasterhw.sim.paths import BUILD_ROOT
 from rasterhw.sim.flow.tools import tool
 from rasterhw.sim.workdirs import build_lock
 
@@ -158,7 +158,7 @@ def prove(block: str, *, dut_factory: Callable | None = None, depth: int | None 
     top = p.harness(factory)
     text = rtlil.convert(top, name="top", ports=top.ports)
     key = hashlib.sha1((text + _sby_text(p, depth) + _tool_versions()).encode()).hexdigest()[:10]
-    bdir = REPO_ROOT / "build" / f"prove-{block}{'-' + tag if tag else ''}-{key}"
+    bdir = BUILD_ROOT / f"prove-{block}{'-' + tag if tag else ''}-{key}"
     with build_lock(bdir, what=f"proof of {block}"):   # a second process waits, then reads it back
         return _run_proof(p, block, bdir, text, depth, timeout, fresh)
 
