@@ -136,3 +136,34 @@ def test_every_cache_goes_under_the_build_root():
     d = runner.build_dir_for("pixelbus", "verilator", width=4)
     assert d.parent == BUILD_ROOT
     assert BUILD_ROOT in cache_dir("plain", []).parents or "RASTERHW_VL_RUNTIME_DIR" in os.environ
+
+
+def test_interrupted_cocotb_build_restarts_without_its_outputs(tmp_path, monkeypatch):
+    """cocotb builds go into a folder that also holds the generated source and run folders: an
+    interrupted build's outputs (objects, precompiled headers) are removed before the next
+    build, the source and run folders are kept."""
+    import cocotb_tools.runner as ct
+    from rasterhw.golden_model.errors import RasterhwError
+
+    bdir = tmp_path / "b"
+    bdir.mkdir()
+    src = bdir / "top.v"
+    src.write_text("module top; endmodule\n")
+    (bdir / "run-x").mkdir()
+    seen = []
+
+    class Fake:
+        def build(self, build_dir, **kw):
+            seen.append(sorted(p.name for p in Path(build_dir).iterdir()))
+            if len(seen) == 1:
+                (Path(build_dir) / "Vtop__pch.h.fast.gch").write_bytes(b"half")
+                raise KeyboardInterrupt
+            raise RuntimeError("Command failed with return code: 2")
+
+    monkeypatch.setattr(ct, "get_runner", lambda sim: Fake())
+    with pytest.raises(KeyboardInterrupt):
+        runner.run_cocotb(sources=[src], toplevel="top", test_module="x", build_dir=bdir, sim="verilator")
+    with pytest.raises(RasterhwError, match="build failed"):
+        runner.run_cocotb(sources=[src], toplevel="top", test_module="x", build_dir=bdir, sim="verilator")
+    assert "Vtop__pch.h.fast.gch" not in seen[1]
+    assert {"top.v", "run-x"} <= set(seen[1])

@@ -381,6 +381,17 @@ def run_cocotb(
         flags = verilator_make_flags("-O2", coroutines=True) if sim == "verilator" and not own \
             else contextlib.nullcontext()
         with build_lock(build_dir, what=toplevel), flags:
+            # all or nothing, like the plain builds: a build that was interrupted (its mark is
+            # still there) starts again without its outputs (every file of the folder but the
+            # sources; run folders are left alone), never continues on half-written objects
+            # and precompiled headers
+            building = build_dir / ".rasterhw-building"
+            if building.exists():
+                keep_files = {Path(s).resolve() for s in sources}
+                for f in build_dir.iterdir():
+                    if f.is_file() and f.resolve() not in keep_files and not f.name.endswith(".lock"):
+                        f.unlink(missing_ok=True)
+            building.touch()
             try:
                 runner.build(
                     sources=[str(s) for s in sources],
@@ -396,6 +407,7 @@ def run_cocotb(
                 log = build_dir / "build.log"
                 first = _first_error(log.read_text(errors="replace")) if log.exists() else str(e)
                 raise RasterhwError(f"{toplevel}: {sim} build failed ({first}); see {log}") from None
+            building.unlink()
         t1 = time.perf_counter()
         # the runner hands the simulator's Python this process's sys.path: add the
         # repository root so `cocotb_tests.<block>` imports there
