@@ -288,7 +288,7 @@ def compare(a: str, b: str, output: str | None, tolerance: int, as_json: bool) -
     from rasterhw.sim.imageio import read_rgb8_pair
     from rasterhw.sim.outfile import check_image_output, write_image
 
-    out = check_image_output(output)
+    out = check_image_output(output, inputs=(a, b))   # never the diff over an input
     if tolerance < 0:
         raise RasterhwError(f"--tolerance must be 0 or more, not {tolerance}")
     ia, ib = read_rgb8_pair(a, b, extra_bytes_per_pixel=3 if out else 0)
@@ -341,6 +341,7 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
     """Generate Verilog for BLOCK (see `rasterhw verilog --list`)."""
     from rasterhw.sim.engines.verilog import block_names, parse_params
     from rasterhw.sim.engines.verilog_cache import write_verilog
+    from rasterhw.sim.outfile import check_output
 
     if list_blocks:
         click.echo("\n".join(block_names()))
@@ -353,6 +354,7 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
         raise RasterhwError(f"{what}; blocks: {', '.join(block_names())}")
     if output is None:
         raise RasterhwError("say where to write the Verilog: -o FILE")
+    check_output(output)   # a folder name is refused before the (slow) generation
     kw = parse_params(params, registry.load(registry.blocks()[block]))
     if interleave is not None:
         if "interleave" in kw and kw["interleave"] != interleave:
@@ -366,7 +368,7 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
         raise
     except (TypeError, ValueError) as e:
         raise RasterhwError(f"{block}: {e}") from None
-    info(f"wrote {output}")
+    info(f"wrote {'standard output' if output == '-' else output}")
 
 
 def sim_image_name(scene: str, block: str, engine: str, options: dict) -> Path:
