@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import logging
 import math
+import re
 import warnings
 from pathlib import Path
 
@@ -20,7 +21,7 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.scene import Camera, Light, Material, Scene
 
-__all__ = ["MESH_EXTENSIONS", "decode_text", "load_mesh", "load_scene"]
+__all__ = ["MESH_EXTENSIONS", "decode_text", "load_mesh", "load_scene", "triangulate_polygon"]
 
 MESH_EXTENSIONS = (".obj", ".ply")
 _COORD_LIMIT = 1e15  # the Scene validator's limit
@@ -88,14 +89,97 @@ def _read_bytes(path: Path) -> bytes:
         raise RasterhwError(f"cannot read {path}: {_one_line(exc)}") from None
 
 
-def _check_obj_faces(path: Path, text: str) -> None:
+def triangulate_polygon(points: np.ndarray) -> list[tuple[int, int, int]]:
+    """Triangles ``(i, j, k)`` (indices into ``points``, an (n, 3) array of one polygon's
+    corners in order) covering the polygon, each wound like the polygon.
+
+    A convex polygon is fanned from its first corner (what OBJ and PLY readers commonly do, so
+    convex files triangulate as before); a concave (simple) one is ear-clipped: the polygon is
+    projected on the plane across its largest Newell-normal component and, corner by corner from
+    the first, a corner is cut off as a triangle when it is convex and no other corner lies in
+    that triangle. Fanning a concave polygon from a corner covers area outside it and misses area
+    inside (an L-shaped hexagon drew as a pentagon: issue 33). A polygon with no ear left
+    (self-intersecting, or all corners on a line) has its rest fanned."""
+    n = len(points)
+    if n == 3:
+        return [(0, 1, 2)]
+    p = np.asarray(points, dtype=np.float64)
+    nrm = np.zeros(3)
+    for i in range(n):   # Newell's normal: robust for non-planar and concave polygons
+        a, b = p[i], p[(i + 1) % n]
+        nrm += ((a[1] - b[1]) * (a[2] + b[2]), (a[2] - b[2]) * (a[0] + b[0]), (a[0] - b[0]) * (a[1] + b[1]))
+    drop = int(np.argmax(np.abs(nrm)))
+    if nrm[drop] == 0:
+        return [(0, i, i + 1) for i in range(1, n - 1)]
+    u, v = [(1, 2), (2, 0), (0, 1)][drop]
+    xy = p[:, [u, v]] * (1.0 if nrm[drop] > 0 else -1.0, 1.0)   # counter-clockwise in the projection
+    scale = float(np.abs(xy).max()) or 1.0
+    eps = 1e-12 * scale * scale
+
+    def cross(o, a, b):
+        return (xy[a, 0] - xy[o, 0]) * (xy[b, 1] - xy[o, 1]) - (xy[a, 1] - xy[o, 1]) * (xy[b, 0] - xy[o, 0])
+
+    if all(cross(i, (i + 1) % n, (i + 2) % n) >= -eps for i in range(n)):
+        return [(0, i, i + 1) for i in range(1, n - 1)]   # convex: the fan
+    idx = list(range(n))
+    out = []
+    while len(idx) > 3:
+        m = len(idx)
+        for k in range(m):
+            a, b, c = idx[k - 1], idx[k], idx[(k + 1) % m]
+            if cross(a, b, c) <= eps:
+                continue   # reflex or flat corner: not an ear
+            inside = False
+            for q in idx:
+                if q in (a, b, c):
+                    continue
+                if cross(a, b, q) >= -eps and cross(b, c, q) >= -eps and cross(c, a, q) >= -eps:
+                    inside = True
+                    break
+            if not inside:
+                out.append((a, b, c))
+                del idx[k]
+                break
+        else:   # no ear: not a simple polygon; fan what is left
+            out += [(idx[0], idx[i], idx[i + 1]) for i in range(1, len(idx) - 1)]
+            return out
+    out.append((idx[0], idx[1], idx[2]))
+    return out
+
+
+_SHORT_VERTEX = re.compile(r"^v(?:[ \t]+\S+){0,2}[ \t]*$", re.M)
+
+
+def _obj_is_plain(text: str) -> bool:
+    """True if ``text`` has none of what only :func:`_normalise_obj` reads right (CR line ends,
+    indentation, continued lines, inline comments, vertices of fewer than 3 coordinates); faces
+    are looked at by :func:`_check_obj_faces`. Substring tests and one regular expression: a
+    million-face file is not walked line by line in Python twice."""
+    if "\r" in text or "\\" in text or text[:1] in (" ", "\t") or "\n " in text or "\n\t" in text:
+        return False
+    at = text.find("#")
+    while at >= 0:
+        line_start = text.rfind("\n", 0, at) + 1
+        if text[line_start:at].strip():
+            return False   # something before the # on its line: an inline comment
+        nl = text.find("\n", at)
+        at = -1 if nl < 0 else text.find("#", nl)
+    return _SHORT_VERTEX.search(text) is None
+
+
+def _check_obj_faces(path: Path, text: str) -> bool:
     """What trimesh gets wrong silently in an OBJ's faces, found in the raw text: a face with
     fewer than 3 vertices (dropped) and vertex index 0 (OBJ counts from 1; NumPy would read
-    0 - 1 as the last vertex). An index that is not an integer is an error too."""
+    0 - 1 as the last vertex). An index that is not an integer is an error too. Returns True if a
+    face is a polygon of more than 3 corners or has a relative index (:func:`_normalise_obj`
+    rewrites those), False if every face is a plain triangle."""
+    rewrite = False
     for lineno, line in enumerate(text.splitlines(), 1):
         if not (line.startswith("f") and line[1:2].isspace()):
             continue
         corners = line.split("#", 1)[0].split()[1:]
+        if len(corners) > 3 or "-" in line:
+            rewrite = True
         if len(corners) < 3:
             raise RasterhwError(f"{path}: line {lineno}: face has {len(corners)} vertices (a face needs at least 3)")
         for c in corners:
@@ -107,6 +191,98 @@ def _check_obj_faces(path: Path, text: str) -> None:
             if iv == 0:
                 raise RasterhwError(f"{path}: line {lineno}: face vertex index 0 (OBJ indices start at 1, "
                                     "or count back from -1)")
+    return rewrite
+
+
+def _normalise_obj(path: Path, text: str) -> str:
+    """The OBJ ``text`` rewritten so that trimesh reads exactly what the file says: line ends
+    (``\\r\\n``, ``\\r`` alone, ``\\n``) and backslash-continued lines joined, comments
+    (whole-line and inline ``#``) and indentation removed, relative (negative) indices turned into
+    absolute ones counted from the vertices read *so far* (the OBJ rule; trimesh counted from the
+    end of the file), and polygons of more than 3 corners cut into triangles by
+    :func:`triangulate_polygon`. Errors name the line: a vertex with fewer than 3 coordinates or
+    a coordinate that is not a number, a face of fewer than 3 corners, index 0, an index that is
+    not an integer or refers to a vertex the file does not have."""
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    out: list[str] = []
+    faces: list[tuple[int, int, list[list[int | None]]]] = []   # (line number, out slot, corners)
+    verts: list[tuple[float, float, float]] = []
+    counts = {"v": 0, "vt": 0, "vn": 0}
+    pending, start = "", 0
+    for lineno, raw in enumerate(lines, 1):
+        line = raw.split("#", 1)[0]
+        if line.rstrip().endswith("\\") and "#" not in raw:
+            pending, start = pending + line.rstrip()[:-1] + " ", start or lineno
+            continue
+        line, at = (pending + line).strip(), start or lineno
+        pending, start = "", 0
+        if not line:
+            continue
+        words = line.split()
+        key = words[0]
+        if key == "v":
+            if len(words) < 4:
+                raise RasterhwError(f"{path}: line {at}: vertex has {len(words) - 1} coordinates "
+                                    "(a vertex needs x y z)")
+            try:
+                verts.append((float(words[1]), float(words[2]), float(words[3])))
+            except ValueError:
+                bad = next(w for w in words[1:4] if not _is_float(w))
+                raise RasterhwError(f"{path}: line {at}: vertex coordinate {bad[:40]!r} is not a number") from None
+            counts["v"] += 1
+        elif key in ("vt", "vn"):
+            counts[key] += 1
+        elif key == "f":
+            corners = words[1:]
+            if len(corners) < 3:
+                raise RasterhwError(f"{path}: line {at}: face has {len(corners)} vertices (a face needs at least 3)")
+            res = []
+            for c in corners:
+                parts = c.split("/")
+                if len(parts) > 3:
+                    raise RasterhwError(f"{path}: line {at}: face vertex {c[:40]!r} is not v, v/vt, v//vn or v/vt/vn")
+                idx: list[int | None] = []
+                for kind, part in zip(("v", "vt", "vn"), parts, strict=False):
+                    if part == "" and kind != "v":
+                        idx.append(None)
+                        continue
+                    try:
+                        i = int(part)
+                    except ValueError:
+                        raise RasterhwError(f"{path}: line {at}: face vertex {c[:40]!r} is not an integer index") from None
+                    if i == 0:
+                        raise RasterhwError(f"{path}: line {at}: face vertex index 0 (OBJ indices start at 1, "
+                                            "or count back from -1)")
+                    if i < 0:
+                        i = counts[kind] + i + 1   # relative: -1 is the last one read so far
+                        if i < 1:
+                            raise RasterhwError(f"{path}: line {at}: relative index {part} goes back past the first "
+                                                f"{'vertex' if kind == 'v' else kind}")
+                    idx.append(i)
+                res.append(idx)
+            faces.append((at, len(out), res))
+            out.append("")
+            continue
+        out.append(" ".join(words))
+    for at, slot, res in faces:
+        vi = [c[0] for c in res]
+        if max(vi) > len(verts):
+            raise RasterhwError(f"{path}: line {at}: face refers to vertex {max(vi)}; the file has {len(verts)}")
+        tris = triangulate_polygon(np.array([verts[i - 1] for i in vi])) if len(res) > 3 else [(0, 1, 2)]
+        out[slot] = "\n".join("f " + " ".join(_corner(res[k]) for k in t) for t in tris)
+    return "\n".join(out) + "\n"
+
+
+def _corner(idx: list[int | None]) -> str:
+    return "/".join("" if i is None else str(i) for i in idx)
+
+
+def _is_float(w: str) -> bool:
+    try:
+        float(w)
+    except ValueError:
+        return False
+    return True
 
 
 def _check_ply_faces(path: Path, mesh) -> None:
@@ -189,7 +365,8 @@ def load_mesh(path: str | Path, *, name: str | None = None, smooth: bool = True)
         # UTF-16, Latin-1) and hand trimesh clean UTF-8, so it never guesses (its guesser
         # needs an optional package) and a BOM never hides the first line.
         text, _enc = decode_text(raw)
-        _check_obj_faces(path, text)
+        if not _obj_is_plain(text) or _check_obj_faces(path, text):
+            text = _normalise_obj(path, text)
         raw = text.encode("utf-8")
     elif ext == ".ply":
         raw = _ascii_ply_header(raw)

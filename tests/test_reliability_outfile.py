@@ -13,7 +13,13 @@ import threading
 import numpy as np
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.outfile import atomic_path, check_image_output, check_output, write_image, write_text
+from rasterhw.sim.outfile import (
+    atomic_path,
+    check_image_output,
+    check_output,
+    write_image,
+    write_text,
+)
 
 PY = sys.executable
 
