@@ -91,7 +91,32 @@ def check_image_output(path: str | Path | None, *, flag: str = "-o",
         common = ".png, .bmp, .tif, .ppm, .jpg"
         raise RasterhwError(f"{flag} {str(p)!r}: {'no' if not ext else 'unknown'} image extension"
                             f"{'' if not ext else ' ' + repr(ext)}; use one of {common}")
+    if not _holds_rgb(image_formats()[ext]):   # e.g. .xbm (1 bit): refused now, not after the run
+        raise RasterhwError(f"{flag} {str(p)!r}: {image_formats()[ext]} cannot hold an RGB image; "
+                            "use one of .png, .bmp, .tif, .ppm, .jpg")
     return check_output(path, flag=flag, inputs=inputs)
+
+
+#: the largest image each format holds (Pillow shrinks a bigger .ico to 256 x 256 silently)
+_MAX_SIDE = {"ICO": 256}
+
+
+def _holds_rgb(fmt: str) -> bool:
+    """Can Pillow write a small RGB image in ``fmt``? (tried in memory, once per format)"""
+    if fmt not in _RGB_OK:
+        import io
+
+        from PIL import Image
+
+        try:
+            Image.new("RGB", (2, 2)).save(io.BytesIO(), format=fmt)
+            _RGB_OK[fmt] = True
+        except Exception:  # noqa: BLE001 - any refusal of Pillow's means no
+            _RGB_OK[fmt] = False
+    return _RGB_OK[fmt]
+
+
+_RGB_OK: dict[str, bool] = {}
 
 
 @contextmanager
@@ -152,6 +177,10 @@ def write_image(path: str | Path, rgb8: np.ndarray) -> Path:
 
     check_image_output(path)
     fmt = "PNG" if str(path) == STDOUT else image_formats()[Path(path).suffix.lower()]
+    side = _MAX_SIDE.get(fmt)
+    if side is not None and max(rgb8.shape[:2]) > side:
+        raise RasterhwError(f"cannot write {path}: {fmt} holds at most {side}x{side} pixels, the frame is "
+                            f"{rgb8.shape[1]}x{rgb8.shape[0]}; use .png")
     with atomic_path(path) as tmp:
         try:
             Image.fromarray(np.ascontiguousarray(rgb8)).save(tmp, format=fmt)

@@ -10,6 +10,7 @@ import subprocess
 import sys
 import time
 
+import numpy as np
 import pytest
 
 PY = sys.executable
@@ -73,3 +74,65 @@ def test_sigterm_during_prove_leaves_no_solver_running(tmp_path):
     p.communicate(timeout=60)
     time.sleep(0.5)
     assert not [k for k in kids if _alive(k)]
+
+
+@pytest.mark.parametrize("args,contains", [
+    (("soak", "--seed", "-1", "--pixels", "10"), "--seed must be"),
+    (("soak", "--pixels", "0"), "--pixels must be"),
+    (("bench", "--repeat", "0", "--no-hdl"), "--repeat must be"),
+    (("verilog", "pixelbus", "-p", "width=99999999999999999999999", "-o", "w.v"), "too large"),
+    (("sim", "pixelbus", "--size", "1x1", "--engine", "pysim", "-o", "a.png"), "smaller than"),
+    (("render", "c50", "--z-bits", "1", "--size", "16x16", "-o", "z.png"), "--z-bits changes no image"),
+    (("render", "c50", "--arch", "vz1", "--z-bits", "24", "--size", "16x16", "-o", "z.png"), "--z-bits"),
+    (("synth", "--small", "zbm-merger"), "--small applies only with --all"),
+    (("render", "c50", "-o", "x.xbm", "--size", "16x16"), "cannot hold an RGB image"),
+    (("render", "c50", "-o", "x.ico", "--size", "300x300"), "at most 256x256"),
+])
+def test_bad_values_are_one_line_errors(tmp_path, args, contains):
+    r = run(*args, cwd=tmp_path)
+    assert r.returncode == 2, (r.stdout, r.stderr)
+    assert "Traceback" not in r.stderr and "Warning" not in r.stderr
+    assert r.stderr.strip().splitlines()[-1].startswith("error: ") and contains in r.stderr
+    assert not [p for p in tmp_path.iterdir() if p.suffix in (".png", ".v", ".xbm", ".ico")]
+
+
+BACK = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 3 2\n"   # clockwise as the framing camera sees it
+
+
+@pytest.mark.parametrize("args", [
+    ("render", "--arch", "vz1"), ("render", "--arch", "vz2"), ("render", "--arch", "experts"),
+    ("sim", "pxp", "--engine", "pysim", "--scene"),
+])
+def test_scene_with_nothing_facing_the_camera_gives_a_blank_frame_everywhere(tmp_path, args):
+    from PIL import Image
+
+    (tmp_path / "back.obj").write_text(BACK)
+    cmd = [args[0], "back.obj", *args[1:]] if args[0] == "render" else [*args, "back.obj"]
+    r = run(*cmd, "--size", "24x24", "-o", "b.png", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "Traceback" not in r.stderr and "warning: nothing drawn" in r.stderr
+    assert not np.asarray(Image.open(tmp_path / "b.png")).any()
+
+
+def test_sim_output_of_a_block_without_a_frame_is_refused_not_silently_skipped(monkeypatch, tmp_path):
+    from click.testing import CliRunner
+    from rasterhw.sim import registry
+    from rasterhw.sim.cli import main as cli
+
+    real = registry.load
+
+    def fake_load(ref):
+        if ref == registry.sim_blocks()["pxp"][1].simulate:
+            return lambda *a, **k: {"mismatches": 0}     # a run that gives no frame_rgb
+        return real(ref)
+
+    monkeypatch.setattr(registry, "load", fake_load)
+    monkeypatch.chdir(tmp_path)
+    r = CliRunner().invoke(cli.cli, ["sim", "pxp", "--engine", "pysim", "--size", "24x24", "-o", "x.png"])
+    assert isinstance(r.exception, cli.RasterhwError) and "gives no frame image" in str(r.exception)
+
+
+def test_failed_demo_leaves_no_empty_folder(tmp_path):
+    r = run("demo", "--out", "newout", "--scene", "no-such-scene", cwd=tmp_path)
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert not (tmp_path / "newout").exists()

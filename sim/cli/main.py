@@ -189,6 +189,34 @@ def _progress_bar(total: int, desc: str, unit: str):
     return tqdm(total=total, desc=desc, unit=unit, disable=None, file=sys.stderr, leave=False)
 
 
+_GEOMETRY: dict = {}
+
+
+def _geometry(sc, w: int, h: int):
+    """The reference geometry of ``sc`` at ``w`` x ``h`` (kept for the one scene of this command)."""
+    from rasterhw.golden_model.pipeline import run_geometry
+
+    key = (id(sc), w, h)
+    if key not in _GEOMETRY:
+        _GEOMETRY.clear()
+        _GEOMETRY[key] = run_geometry(sc, w, h)
+    return _GEOMETRY[key]
+
+
+def _nothing_to_draw(sc, w: int, h: int):
+    """The reference's background frame if no polygon of ``sc`` survives culling and clipping
+    (all back-facing, or all outside the view), else None. A machine's renderer or simulation is
+    not run on an empty triangle list (some ended in an IndexError): the command warns, as the
+    reference does, and writes the blank frame."""
+    from rasterhw.golden_model.reference import rasterise_rgb8
+
+    tris = _geometry(sc, w, h)
+    if tris.n_triangles:
+        return None
+    rgb8, _counts = rasterise_rgb8(tris)
+    return rgb8
+
+
 def _warn_if_empty(tris, pixels_written: int) -> None:
     """A frame with nothing drawn is almost always a surprise: say why."""
     st = tris.stats
@@ -231,28 +259,39 @@ def machines(as_json: bool) -> None:
 @click.option("--size", default=None, metavar="WxH", help="Frame size (default: the scene's own, e.g. 512x512).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
               help="PNG file to write (default: out/SCENE-ARCH.png).")
-@click.option("--z-bits", type=int, default=24, show_default=True, help="Width of the quantised Z (reference).")
+@click.option("--z-bits", type=int, default=None, hidden=True,
+              help="Refused: no renderer's image depends on it (the reference's depth test uses float Z).")
 @_click_options(_RENDER_OPTIONS)
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout.")
-def render(scene: str, arch: str, size: str | None, output: str | None, z_bits: int, as_json: bool,
+def render(scene: str, arch: str, size: str | None, output: str | None, z_bits: int | None, as_json: bool,
            **arch_options) -> None:
     """Render SCENE (a built-in name or an .obj/.ply file) and write a PNG."""
     from rasterhw.sim.outfile import check_image_output, write_image
 
+    if z_bits is not None:
+        # it only ever set the width of the screen triangles' quantised Z, which no renderer behind
+        # `render` reads (the reference compares float Z; each machine has its own Z width): an
+        # option that changes nothing is refused rather than silently ignored (issue 33)
+        raise RasterhwError("--z-bits changes no image of `render` (the reference's depth test uses float Z; "
+                            "each machine's Z width is its own); leave it out")
     out = check_image_output(output) or Path("out") / f"{Path(scene).stem}-{arch}.png"
     t0 = time.perf_counter()
     if arch == REFERENCE:
         _take_options(arch_options, (), "--arch reference")
-        sc, tris, (rgb8, counts), _, _ = render_reference(scene, size, z_bits, progress=not as_json)
+        sc, tris, (rgb8, counts), _, _ = render_reference(scene, size, progress=not as_json)
         pixels_written = counts["pixels_written"]
         extra = {"fragments": counts["fragments"], "pixels_covered": counts["pixels_covered"]}
     else:
         _machine, a = registry.archs()[arch]
         opts = _take_options(arch_options, a.options, f"--arch {arch}")
         sc, (w, h) = load_scene_and_size(scene, size, bytes_per_pixel=a.bytes_per_pixel, what=f"render --arch {arch}")
-        res = registry.load(a.render)(sc, w, h, arch=arch, **opts)
-        rgb8, tris, pixels_written = res.rgb8, res.tris, int(res.pixels_written)
-        extra = {**opts, **res.stats}
+        empty = _nothing_to_draw(sc, w, h)
+        if empty is not None:   # every arch gives the reference's blank frame, none a traceback
+            rgb8, tris, pixels_written, extra = empty, _geometry(sc, w, h), 0, {**opts, "ran": False}
+        else:
+            res = registry.load(a.render)(sc, w, h, arch=arch, **opts)
+            rgb8, tris, pixels_written = res.rgb8, res.tris, int(res.pixels_written)
+            extra = {**opts, **res.stats}
     wall = time.perf_counter() - t0
     write_image(out, rgb8)
     _warn_if_empty(tris, pixels_written)
@@ -355,7 +394,10 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
     if output is None:
         raise RasterhwError("say where to write the Verilog: -o FILE")
     check_output(output)   # a folder name is refused before the (slow) generation
-    kw = parse_params(params, registry.load(registry.blocks()[block]))
+    try:
+        kw = parse_params(params, registry.load(registry.blocks()[block]))
+    except (OverflowError, ValueError) as e:
+        raise RasterhwError(f"{block}: {e}") from None
     if interleave is not None:
         if "interleave" in kw and kw["interleave"] != interleave:
             raise RasterhwError(f"--interleave {interleave} contradicts -p interleave={kw['interleave']}")
@@ -366,8 +408,10 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
         write_verilog(block, output, **kw)
     except RasterhwError:
         raise
-    except (TypeError, ValueError) as e:
-        raise RasterhwError(f"{block}: {e}") from None
+    except (TypeError, ValueError, OverflowError) as e:
+        raise RasterhwError(f"{block}: {str(e).splitlines()[0] if str(e) else type(e).__name__}") from None
+    except MemoryError:
+        raise RasterhwError(f"{block}: these parameters need more memory than there is") from None
     info(f"wrote {'standard output' if output == '-' else output}")
 
 
@@ -392,22 +436,35 @@ def sim_image_name(scene: str, block: str, engine: str, options: dict) -> Path:
 @click.option("--json", "as_json", is_flag=True)
 def sim_cmd(block, scene, size, engine, output, waves, as_json, **block_options) -> None:
     """Run a scene through a block's HDL, compare with the golden model, write the frame."""
-    from rasterhw.sim.outfile import check_image_output, write_image
     from rasterhw.sim.engines.waves import recording
+    from rasterhw.sim.outfile import check_image_output, write_image
 
     _machine, b = registry.sim_blocks()[block]
     opts = _take_options(block_options, b.options, f"sim {block}")
     scene = scene or b.default_scene
     out = check_image_output(output) or sim_image_name(scene, block, engine, block_options)
     sc, (w, h) = load_scene_and_size(scene, size, bytes_per_pixel=b.bytes_per_pixel, what=f"sim {block}")
-    with recording(waves, engine) as traces:
-        res = registry.load(b.simulate)(sc, w, h, engine=engine, progress=not as_json, **opts)
+    empty = _nothing_to_draw(sc, w, h)
+    if empty is not None:
+        _warn_if_empty(_geometry(sc, w, h), 0)
+        write_image(out, empty)
+        res = {"block": block, "scene": sc.name, "engine": engine, "simulated": False, "pixels_compared": 0,
+               "mismatches": 0, "image": str(out)}
+        emit_json(res) if as_json else info(" ".join(f"{k}={v}" for k, v in res.items()))
+        return
+    try:
+        with recording(waves, engine) as traces:
+            res = registry.load(b.simulate)(sc, w, h, engine=engine, progress=not as_json, **opts)
+    except (ValueError, OverflowError) as e:   # a block's own parameter check (e.g. a frame smaller than its banks)
+        raise RasterhwError(f"sim {block}: {str(e).splitlines()[0] if str(e) else type(e).__name__}") from None
     if traces:
         res["waves"] = [str(t) for t in traces]
     frame = res.pop("frame_rgb", None)
     if frame is not None:
         write_image(out, frame)
         res["image"] = str(out)
+    elif output is not None:
+        raise RasterhwError(f"sim {block} gives no frame image; -o {output} cannot be written (leave -o out)")
     res = {"block": block, "scene": sc.name, **res}
     if as_json:
         emit_json(res)
@@ -425,6 +482,8 @@ def bench(as_json: bool, repeat: int, hdl: bool) -> None:
     """Print speed and memory figures (a benchmark, not a test)."""
     from rasterhw.sim.report.bench import run_bench
 
+    if repeat < 1:
+        raise RasterhwError(f"--repeat must be 1 or more, not {repeat}")
     rows = run_bench(repeat=repeat, hdl=hdl, progress=not as_json)
     if as_json:
         emit_json(rows)
@@ -448,6 +507,10 @@ def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], as_json: bool) 
 
     from rasterhw.sim.flow.soak import run_soak
 
+    if seed is not None and not 0 <= seed < 1 << 32:
+        raise RasterhwError(f"--seed must be between 0 and {(1 << 32) - 1}, not {seed}")
+    if pixels < 1:
+        raise RasterhwError(f"--pixels must be 1 or more, not {pixels}")
     seed = secrets.randbelow(1 << 31) if seed is None else seed
     info(f"soak: seed {seed} (rerun: rasterhw soak --seed {seed} --pixels {pixels})")
     rows = run_soak(pixels=pixels, seed=seed, blocks=list(blocks) or None, progress=not as_json)
@@ -472,7 +535,14 @@ def demo(out_dir: str, scene: str, engine: str) -> None:
     """Render a default scene through the golden model and the hardware; write images and a report."""
     from rasterhw.sim.report.demo import run_demo
 
-    run_demo(Path(out_dir), scene=scene, engine=engine)
+    out = Path(out_dir)
+    existed = out.exists()
+    try:
+        run_demo(out, scene=scene, engine=engine)
+    except BaseException:
+        if not existed and out.is_dir() and not any(out.iterdir()):
+            out.rmdir()   # a failed demo leaves no empty folder it made
+        raise
 
 
 add_commands(cli)   # synth, fpga, prove: the hardware flow (sim/cli/flow.py)
@@ -500,9 +570,42 @@ def main(argv: list[str] | None = None) -> None:
         workdirs.cleanup()
 
 
+def _close_progress_bars() -> None:
+    """End every progress bar still shown, so an error line starts on a line of its own."""
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        return
+    for bar in list(getattr(tqdm, "_instances", ())):
+        bar.close()
+
+
 def _main(argv: list[str] | None) -> None:
     try:
         rc = cli.main(args=argv, prog_name="rasterhw", standalone_mode=False)
+    except BaseException:
+        _close_progress_bars()
+        _quiet_amaranth()
+        _dispatch_error()
+    if isinstance(rc, int) and rc:
+        sys.exit(rc)
+
+
+def _quiet_amaranth() -> None:
+    """After an error, the half-built Amaranth objects it left are collected at exit: no
+    UnusedElaboratable warning lines after the one error line."""
+    if "amaranth" in sys.modules:
+        import warnings
+
+        from amaranth.hdl import UnusedElaboratable
+
+        warnings.simplefilter("ignore", UnusedElaboratable)
+
+
+def _dispatch_error() -> None:
+    """The exception being handled as the CLI reports it (one line, exit status)."""
+    try:
+        raise
     except RasterhwError as e:
         click.echo(f"error: {e}", err=True)
         sys.exit(2)
@@ -516,8 +619,6 @@ def _main(argv: list[str] | None) -> None:
         # a file that cannot be read or written: say which, no traceback
         click.echo(f"error: {e.strerror or e}: {e.filename or ''}".rstrip(": "), err=True)
         sys.exit(2)
-    if isinstance(rc, int) and rc:
-        sys.exit(rc)
 
 
 if __name__ == "__main__":
