@@ -309,6 +309,64 @@ def _check_ply_faces(path: Path, mesh) -> None:
         )
 
 
+def _check_ascii_ply(path: Path, raw: bytes) -> None:
+    """An ASCII PLY's face lines say how many corners follow; trimesh reads ``5 0 1 2`` as a
+    triangle. With the face element's one property a list (the common layout), every face line
+    must hold exactly that many indices."""
+    end = raw.find(b"end_header")
+    if end < 0 or b"format ascii" not in raw[:end]:
+        return
+    elements: list[list] = []   # [name, count, [property kinds]]
+    for line in raw[:end].decode("ascii", errors="replace").splitlines():
+        w = line.split()
+        if len(w) >= 3 and w[0] == "element":
+            try:
+                elements.append([w[1], int(w[2]), []])
+            except ValueError:
+                return
+        elif w[:1] == ["property"] and elements:
+            elements[-1][2].append(w[1])
+    body = raw[end:].split(b"\n", 1)[1] if b"\n" in raw[end:] else b""
+    lines = [ln for ln in body.decode("ascii", errors="replace").splitlines() if ln.strip()]
+    row = 0
+    for name, count, props in elements:
+        if name == "face" and props == ["list"]:
+            for k, ln in enumerate(lines[row:row + count]):
+                w = ln.split()
+                try:
+                    n = int(float(w[0]))
+                except ValueError:
+                    raise RasterhwError(f"{path}: face {k}: corner count {w[0][:20]!r} is not a number") from None
+                if len(w) - 1 != n:
+                    raise RasterhwError(f"{path}: face {k} says {n} corners but lists {len(w) - 1}")
+            return
+        row += count
+
+
+def _retriangulate_ply(mesh, verts: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """PLY polygons of more than 3 corners cut by :func:`triangulate_polygon` (trimesh fans
+    them from the first corner, wrong for a concave one); ``faces`` unchanged if there are none
+    or the raw polygons are not where this trimesh keeps them."""
+    try:
+        face = mesh.metadata.get("_ply_raw", {}).get("face")
+        col = face["data"][next(iter(face["properties"]))]
+        if isinstance(col, np.ndarray) and col.dtype.names:   # binary: (count, list) records
+            polys = [list(r[col.dtype.names[1]][: r[col.dtype.names[0]]]) for r in col]
+        else:
+            polys = [list(np.asarray(f).ravel()) for f in col]
+    except Exception:  # noqa: BLE001 - private trimesh layout changed: keep its triangles
+        return faces
+    if all(len(q) <= 3 for q in polys) or sum(len(q) - 2 for q in polys) != len(faces):
+        return faces
+    out = []
+    for q in polys:
+        q = np.asarray(q, dtype=np.int64)
+        if q.min() < 0 or q.max() >= len(verts):
+            return faces
+        out += [(q[a], q[b], q[c]) for a, b, c in triangulate_polygon(verts[q])]
+    return np.asarray(out, dtype=np.int64)   # n - 2 per polygon, in order: face colours still line up
+
+
 def _frame_camera(lo: np.ndarray, hi: np.ndarray, fovy_deg: float = 45.0) -> Camera:
     """Look at the box centre from the front-right-above so the bounding sphere fits the view."""
     centre = (lo + hi) / 2
@@ -322,20 +380,20 @@ def _frame_camera(lo: np.ndarray, hi: np.ndarray, fovy_deg: float = 45.0) -> Cam
                   near=max(dist - 1.1 * radius, 1e-3 * dist), far=dist + 1.1 * radius)
 
 
-def _colours(mesh, nfaces: int) -> np.ndarray:
+def _colours(mesh, faces: np.ndarray) -> np.ndarray:
     """(F, 3, 3) corner colours in [0, 1]: the file's vertex or face colours, else grey."""
     visual = getattr(mesh, "visual", None)
     kind = getattr(visual, "kind", None)
     try:
         if kind == "vertex":
             vc = np.asarray(visual.vertex_colors, dtype=np.float64)[:, :3] / 255.0
-            return vc[np.asarray(mesh.faces)]
+            return vc[faces]
         if kind == "face":
             fc = np.asarray(visual.face_colors, dtype=np.float64)[:, :3] / 255.0
             return np.repeat(fc[:, None, :], 3, axis=1)
     except Exception:
         pass
-    return np.broadcast_to(np.array(_GREY), (nfaces, 3, 3)).copy()
+    return np.broadcast_to(np.array(_GREY), (len(faces), 3, 3)).copy()
 
 
 def load_mesh(path: str | Path, *, name: str | None = None, smooth: bool = True) -> Scene:
@@ -369,6 +427,7 @@ def load_mesh(path: str | Path, *, name: str | None = None, smooth: bool = True)
             text = _normalise_obj(path, text)
         raw = text.encode("utf-8")
     elif ext == ".ply":
+        _check_ascii_ply(path, raw)
         raw = _ascii_ply_header(raw)
 
     import io
@@ -398,6 +457,7 @@ def load_mesh(path: str | Path, *, name: str | None = None, smooth: bool = True)
 
     if ext == ".ply":
         _check_ply_faces(path, mesh)
+        faces = _retriangulate_ply(mesh, verts, faces)
     if faces.ndim != 2 or faces.shape[0] == 0:
         raise RasterhwError(f"{path}: no faces (not a polygon mesh, or nothing trimesh could parse)")
     if faces.shape[1] != 3:
@@ -430,7 +490,7 @@ def load_mesh(path: str | Path, *, name: str | None = None, smooth: bool = True)
     length = np.linalg.norm(nrm, axis=-1, keepdims=True)
     # Degenerate triangles (and vertices only they touch) have no normal: use +z, stay finite.
     nrm = np.where(length > 0, nrm / np.where(length > 0, length, 1.0), np.array([0.0, 0.0, 1.0]))
-    col = _colours(mesh, len(faces))
+    col = _colours(mesh, faces)
 
     return Scene(
         name=name if name is not None else path.stem,

@@ -221,3 +221,52 @@ def test_loader_agrees_with_an_independent_reader(tmp_path, data):
         return
     assert want is not None, "accepted a file the reference refuses"
     np.testing.assert_array_equal(got, want)
+
+
+# --------------------------------------------------------------- PLY
+def _ply(verts, faces, *, counts=None, colours=None) -> str:
+    vprops = "property float x\nproperty float y\nproperty float z\n"
+    if colours is not None:
+        vprops += "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+    head = (f"ply\nformat ascii 1.0\nelement vertex {len(verts)}\n{vprops}element face {len(faces)}\n"
+            "property list uchar int vertex_indices\nend_header\n")
+    vl = [" ".join(map(str, v)) + ("" if colours is None else " " + " ".join(map(str, colours[i])))
+          for i, v in enumerate(verts)]
+    fl = [f"{(counts or {}).get(k, len(f))} " + " ".join(map(str, f)) for k, f in enumerate(faces)]
+    return head + "\n".join(vl + fl) + "\n"
+
+
+L_VERTS = [(2, 1, 0), (1, 1, 0), (1, 2, 0), (0, 2, 0), (0, 0, 0), (2, 0, 0)]
+
+
+def test_concave_ply_polygon_is_cut_right_and_keeps_vertex_colours(tmp_path):
+    cols = [(255, 0, 0), (0, 255, 0), (0, 0, 255), (255, 255, 0), (0, 255, 255), (255, 0, 255)]
+    sc = _load(tmp_path, _ply(L_VERTS, [list(range(6))], colours=cols), "l.ply")
+    p = sc.positions
+    area = 0.5 * np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])[:, 2]
+    assert np.all(area > 0) and area.sum() == pytest.approx(3.0)
+    lookup = {tuple(map(float, v)): np.array(c) / 255 for v, c in zip(L_VERTS, cols, strict=True)}
+    for t in range(len(p)):   # each corner keeps its own vertex's colour
+        for k in range(3):
+            np.testing.assert_allclose(sc.colours[t, k], lookup[tuple(p[t, k])])
+
+
+def test_ply_face_whose_count_disagrees_with_its_indices_is_refused(tmp_path):
+    with pytest.raises(RasterhwError, match="face 0 says 5 corners but lists 3"):
+        _load(tmp_path, _ply([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [[0, 1, 2]], counts={0: 5}), "bad.ply")
+
+
+def test_convex_ply_polygon_is_fanned_from_its_first_corner_like_obj(tmp_path):
+    sq = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]
+    sc = _load(tmp_path, _ply(sq, [[0, 1, 2, 3]]), "sq.ply")
+    np.testing.assert_array_equal(sc.positions, np.array(sq, float)[[[0, 1, 2], [0, 2, 3]]])
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(simple_polygons())
+def test_ply_and_obj_of_one_polygon_load_the_same(tmp_path, pts):
+    pts = np.round(pts * 100)   # integers: exact in the PLY's float32
+    verts = [tuple(v) for v in pts]
+    obj = "".join(f"v {x} {y} {z}\n" for x, y, z in verts) + "f " + " ".join(str(i + 1) for i in range(len(verts))) + "\n"
+    np.testing.assert_array_equal(_load(tmp_path, _ply(verts, [list(range(len(verts)))]), "a.ply").positions,
+                                  _load(tmp_path, obj, "a.obj").positions)
