@@ -367,6 +367,30 @@ def _retriangulate_ply(mesh, verts: np.ndarray, faces: np.ndarray) -> np.ndarray
     return np.asarray(out, dtype=np.int64)   # n - 2 per polygon, in order: face colours still line up
 
 
+#: peak bytes per face while a mesh loads (trimesh's parse, our scene's positions, normals and
+#: colours), measured: 630 B/face loading a 977,202-face OBJ; and per byte of the file (its text,
+#: decoded and re-encoded)
+_LOAD_BYTES_PER_FACE = 700
+_LOAD_BYTES_PER_FILE_BYTE = 3
+
+
+def _check_mesh_memory(path: Path, raw: bytes, ext: str) -> None:
+    """One line before a mesh too big for this machine is parsed (a 10^7-triangle file ended in
+    a MemoryError traceback): faces counted from the text (OBJ ``f`` lines) or the PLY header."""
+    from rasterhw.golden_model.memcheck import HEADROOM, available_bytes, format_bytes
+
+    if ext == ".ply":
+        m = re.search(rb"^element\s+face\s+(\d+)", raw[: max(raw.find(b"end_header"), 0)], re.M)
+        faces = int(m.group(1)) if m else 0
+    else:
+        faces = raw.count(b"\nf ") + raw.count(b"\rf ") + raw.startswith(b"f ")
+    need = _LOAD_BYTES_PER_FACE * faces + _LOAD_BYTES_PER_FILE_BYTE * len(raw)
+    avail = available_bytes()
+    if need > HEADROOM * avail:
+        raise RasterhwError(f"{path}: loading its {faces:,} faces needs about {format_bytes(need)} of memory, "
+                            f"{format_bytes(avail)} is available; simplify the mesh")
+
+
 def _frame_camera(lo: np.ndarray, hi: np.ndarray, fovy_deg: float = 45.0) -> Camera:
     """Look at the box centre from the front-right-above so the bounding sphere fits the view."""
     centre = (lo + hi) / 2
@@ -418,6 +442,7 @@ def load_mesh(path: str | Path, *, name: str | None = None, smooth: bool = True)
     if path.stat().st_size == 0:
         raise RasterhwError(f"{path}: file is empty")
     raw = _read_bytes(path)
+    _check_mesh_memory(path, raw, ext)
     if ext == ".obj":
         # OBJ is text in no declared encoding: decode it here (UTF-8 with or without a BOM,
         # UTF-16, Latin-1) and hand trimesh clean UTF-8, so it never guesses (its guesser

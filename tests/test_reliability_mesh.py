@@ -270,3 +270,15 @@ def test_ply_and_obj_of_one_polygon_load_the_same(tmp_path, pts):
     obj = "".join(f"v {x} {y} {z}\n" for x, y, z in verts) + "f " + " ".join(str(i + 1) for i in range(len(verts))) + "\n"
     np.testing.assert_array_equal(_load(tmp_path, _ply(verts, [list(range(len(verts)))]), "a.ply").positions,
                                   _load(tmp_path, obj, "a.obj").positions)
+
+
+def test_mesh_too_big_for_memory_is_one_line_before_parsing(tmp_path, monkeypatch):
+    monkeypatch.setenv("RASTERHW_MEMORY_LIMIT", "2M")
+    faces = "".join(f"f {i % 3 + 1} {(i + 1) % 3 + 1} {(i + 2) % 3 + 1}\n" for i in range(5000))
+    with pytest.raises(RasterhwError, match=r"loading its 5,000 faces needs about .* simplify the mesh"):
+        _load(tmp_path, "v 0 0 0\nv 1 0 0\nv 0 1 0\n" + faces)
+    ply = _ply([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [[0, 1, 2]] * 5000)
+    with pytest.raises(RasterhwError, match="loading its 5,000 faces"):
+        _load(tmp_path, ply, "m.ply")
+    monkeypatch.setenv("RASTERHW_MEMORY_LIMIT", "1G")
+    assert len(_load(tmp_path, "v 0 0 0\nv 1 0 0\nv 0 1 0\n" + faces).positions) == 5000
