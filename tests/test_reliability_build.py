@@ -167,3 +167,38 @@ def test_interrupted_cocotb_build_restarts_without_its_outputs(tmp_path, monkeyp
         runner.run_cocotb(sources=[src], toplevel="top", test_module="x", build_dir=bdir, sim="verilator")
     assert "Vtop__pch.h.fast.gch" not in seen[1]
     assert {"top.v", "run-x"} <= set(seen[1])
+
+
+@pytest.mark.cocotb
+@pytest.mark.heavy(2)
+def test_interrupted_cold_sim_then_the_same_command_passes(tmp_path):
+    """The probe's case: ``rasterhw sim zbm ... --engine verilator`` interrupted (SIGINT, then
+    SIGTERM) during its cold build, then run again: it builds, passes (0 mismatches), and the
+    build folder holds only finished builds. Generated Verilog and the Verilator runtime come
+    from the shared caches (the interruption is in the model's own compile)."""
+    build = tmp_path / "build"
+    env = dict(os.environ, RASTERHW_BUILD=str(build),
+               RASTERHW_VL_RUNTIME_DIR=str(cache_dir("plain", []).parent))
+    cmd = [PY, "-m", "rasterhw.sim.cli.main", "sim", "zbm", "--scene", "c50", "--size", "48x40",
+           "--interleave", "2", "--engine", "verilator", "-o", str(tmp_path / "z.png"), "--json"]
+    rng = random.Random(1033)
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        t0 = time.time()
+        while not list(build.glob(".*.tmp-*/obj_dir/*.mk")) and time.time() - t0 < 300 and p.poll() is None:
+            time.sleep(0.05)
+        time.sleep(rng.uniform(0.2, 3.0))
+        kids = _descendants(p.pid)
+        p.send_signal(sig)
+        _out, err = p.communicate(timeout=120)
+        assert p.returncode != 0 and "Traceback" not in err, err
+        time.sleep(0.3)
+        assert not [k for k in kids if os.path.exists(f"/proc/{k}")
+                    and open(f"/proc/{k}/stat").read().split()[2] != "Z"]
+        assert not list(build.glob(".*.tmp-*")) and not (tmp_path / "z.png").exists()
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=900)
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout.strip().splitlines()[-1])
+    assert res["mismatches"] == 0 and res["pixels_compared"] == 48 * 40
+    models = [d.parent for d in build.glob("*/obj_dir")]
+    assert models and all((d / "build.json").exists() for d in models)
