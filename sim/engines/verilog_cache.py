@@ -19,10 +19,10 @@ from functools import cache
 from pathlib import Path
 
 from amaranth.back import verilog
+from rasterhw.sim.engines.verilog import canonical_port_lists, generate_verilog
 from rasterhw.sim.outfile import write_text
 from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT
 from rasterhw.sim.registry import blocks
-from rasterhw.sim.engines.verilog import canonical_port_lists, generate_verilog
 
 __all__ = ["convert_cached", "design_sources", "generate_cached", "source_digest", "write_verilog"]
 

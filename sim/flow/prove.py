@@ -41,9 +41,9 @@ from amaranth.hdl import Assert, Assume, ClockDomain
 from amaranth.hdl._ast import AnySeq
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
+from rasterhw.sim.flow.tools import tool
 from rasterhw.sim.outfile import atomic_path
 from rasterhw.sim.paths import BUILD_ROOT
-from rasterhw.sim.flow.tools import tool
 from rasterhw.sim.workdirs import build_lock, run_child
 
 __all__ = ["Harness", "Proof", "drive_source", "prove", "proofs", "sink_rules"]

@@ -50,10 +50,10 @@ from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
-from rasterhw.sim.paths import BUILD_ROOT
-from rasterhw.sim.flow.tools import ToolUnavailable, tool, tool_version
 from rasterhw.sim.engines.verilog import block_names, make_block
 from rasterhw.sim.engines.verilog_cache import generate_cached
+from rasterhw.sim.flow.tools import ToolUnavailable, tool, tool_version
+from rasterhw.sim.paths import BUILD_ROOT
 
 __all__ = [
     "GATE_WEIGHTS",
