@@ -136,3 +136,18 @@ def test_failed_demo_leaves_no_empty_folder(tmp_path):
     r = run("demo", "--out", "newout", "--scene", "no-such-scene", cwd=tmp_path)
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert not (tmp_path / "newout").exists()
+
+
+def test_ctrl_c_during_a_pysim_run_prints_one_line(tmp_path):
+    """Ctrl-C mid-simulation: "aborted" and nothing after it (the simulation's coroutines,
+    closed at exit, printed "Exception ignored ... RuntimeError" tracebacks)."""
+    p = subprocess.Popen([PY, "-m", "rasterhw.sim.cli.main", "sim", "pxp", "--size", "32x32", "--engine", "pysim",
+                          "-o", "q.png"], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    first = p.stderr.readline()            # the run has started simulating
+    assert "PXP lines" in first, first
+    time.sleep(2.0)
+    p.send_signal(signal.SIGINT)
+    _out, err = p.communicate(timeout=120)
+    assert p.returncode == 130, (p.returncode, err)
+    assert [ln for ln in err.splitlines() if ln.strip()] == ["aborted"], err
+    assert not (tmp_path / "q.png").exists()

@@ -585,15 +585,17 @@ def _main(argv: list[str] | None) -> None:
         rc = cli.main(args=argv, prog_name="rasterhw", standalone_mode=False)
     except BaseException:
         _close_progress_bars()
-        _quiet_amaranth()
+        _quiet_exit()
         _dispatch_error()
     if isinstance(rc, int) and rc:
         sys.exit(rc)
 
 
-def _quiet_amaranth() -> None:
-    """After an error, the half-built Amaranth objects it left are collected at exit: no
-    UnusedElaboratable warning lines after the one error line."""
+def _quiet_exit() -> None:
+    """After an error or Ctrl-C, nothing more after the one line: the half-built Amaranth objects
+    it left are collected at exit without UnusedElaboratable warnings, and a simulation's
+    coroutines closed mid-step at exit print no "Exception ignored" tracebacks."""
+    sys.unraisablehook = lambda _unraisable: None
     if "amaranth" in sys.modules:
         import warnings
 
