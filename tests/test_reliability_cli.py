@@ -151,3 +151,21 @@ def test_ctrl_c_during_a_pysim_run_prints_one_line(tmp_path):
     assert p.returncode == 130, (p.returncode, err)
     assert [ln for ln in err.splitlines() if ln.strip()] == ["aborted"], err
     assert not (tmp_path / "q.png").exists()
+
+
+def test_report_fpga_runs_place_and_route_only_when_asked(monkeypatch, tmp_path):
+    from click.testing import CliRunner
+    from rasterhw.sim.cli import main as cli
+    from rasterhw.sim.report import rows
+
+    calls = []
+    monkeypatch.setattr(rows, "run_report", lambda name, **kw: calls.append((name, kw)) or [])
+    monkeypatch.setattr(rows, "format_table", lambda r: "")
+    for args in (["fpga"], ["fpga", "--rerun"], ["all"]):
+        r = CliRunner().invoke(cli.cli, ["report", *args, "--out", str(tmp_path)])
+        assert r.exit_code == 0, r.output
+    fpga = [kw for name, kw in calls if name == "fpga"]
+    assert [kw.get("cached_only") for kw in fpga] == [True, False, True]
+    assert all("cached_only" not in kw for name, kw in calls if name != "fpga")
+    r = CliRunner().invoke(cli.cli, ["report", "snu", "--rerun", "--out", str(tmp_path)])
+    assert isinstance(r.exception, cli.RasterhwError)

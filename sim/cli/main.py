@@ -351,14 +351,26 @@ def compare(a: str, b: str, output: str | None, tolerance: int, as_json: bool) -
               show_default=True, help="HDL simulator for rows measured from HDL cycles (full frames always "
               "run on a compiled simulator).")
 @click.option("--fast", is_flag=True, help="Keep slow rows (synthesis, place and route) unmeasured.")
-def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool) -> None:
+@click.option("--rerun", is_flag=True, help="fpga: run place and route again (minutes to an hour per block); "
+              "without it the fpga rows come from the recorded runs (docs/reproduction/fpga_runs.json, build/pnr-*).")
+def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, rerun: bool) -> None:
     """Reproduce a paper's figures: paper value, formula value, measured value, ratio."""
     from rasterhw.sim.report.rows import run_report, systems
 
     names = systems() if system == "all" else [system]
+    if rerun and "fpga" not in names:
+        raise RasterhwError("--rerun applies to the fpga report only")
+    if rerun and fast:
+        raise RasterhwError("--rerun and --fast contradict each other")
     rows = []
     for name in names:
-        rows += run_report(name, out_dir=Path(out_dir), engine=engine, progress=not as_json, fast=fast)
+        extra = {}
+        if name == "fpga" and not fast:
+            # place and route takes minutes to an hour per block: never started unasked
+            extra["cached_only"] = not rerun
+            if rerun:
+                info("fpga: running place and route for every configuration (minutes to an hour per block)")
+        rows += run_report(name, out_dir=Path(out_dir), engine=engine, progress=not as_json, fast=fast, **extra)
     if as_json:
         emit_json(rows)
     else:
