@@ -169,3 +169,15 @@ def test_report_fpga_runs_place_and_route_only_when_asked(monkeypatch, tmp_path)
     assert all("cached_only" not in kw for name, kw in calls if name != "fpga")
     r = CliRunner().invoke(cli.cli, ["report", "snu", "--rerun", "--out", str(tmp_path)])
     assert isinstance(r.exception, cli.RasterhwError)
+
+
+def test_verilog_too_big_for_memory_is_one_line_not_an_oom_kill(tmp_path):
+    env = dict(os.environ, RASTERHW_MEMORY_LIMIT="1200M")
+    r = subprocess.run([PY, "-m", "rasterhw.sim.cli.main", "verilog", "pixelbus", "-p", "width=100000",
+                        "-p", "height=100000", "-p", "ram=memory", "-o", "pb.v"],
+                       cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
+    one_line_error(r, contains="more memory than there is")
+    assert not (tmp_path / "pb.v").exists()
+    r = subprocess.run([PY, "-m", "rasterhw.sim.cli.main", "verilog", "zbm-merger", "-o", "m.v"],
+                       cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0 and "module" in (tmp_path / "m.v").read_text()

@@ -414,6 +414,7 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
         if "interleave" in kw and kw["interleave"] != interleave:
             raise RasterhwError(f"--interleave {interleave} contradicts -p interleave={kw['interleave']}")
         kw["interleave"] = interleave
+    _limit_memory()   # explicit parameters can ask for any size: a MemoryError (one line), not an OOM kill
     if sys.stderr.isatty():  # progress for a person waiting; logs and pipes get only the result
         info(f"generating Verilog for {block} ...")
     try:
@@ -425,6 +426,27 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
     except MemoryError:
         raise RasterhwError(f"{block}: these parameters need more memory than there is") from None
     info(f"wrote {'standard output' if output == '-' else output}")
+
+
+def _limit_memory() -> None:
+    """Cap this process's data memory at what :mod:`~rasterhw.golden_model.memcheck` says may
+    be used (85 % of the available memory, or ``RASTERHW_MEMORY_LIMIT``), so an elaboration
+    too big for the machine (``verilog pixelbus -p width=100000 -p height=100000 -p ram=memory``
+    was OOM-killed at 24 GB with no message) ends in a MemoryError, reported as one line. The
+    WebAssembly Yosys reserves address space, not data, so it is not affected."""
+    import resource
+
+    from rasterhw.golden_model.memcheck import HEADROOM, available_bytes
+
+    try:
+        soft, hard = resource.getrlimit(resource.RLIMIT_DATA)
+        cap = int(HEADROOM * available_bytes())
+        if hard != resource.RLIM_INFINITY:
+            cap = min(cap, hard)
+        if soft == resource.RLIM_INFINITY or cap < soft:
+            resource.setrlimit(resource.RLIMIT_DATA, (cap, hard))
+    except (ValueError, OSError):   # a platform without the limit: keep going as before
+        pass
 
 
 def sim_image_name(scene: str, block: str, engine: str, options: dict) -> Path:
