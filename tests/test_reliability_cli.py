@@ -181,3 +181,31 @@ def test_verilog_too_big_for_memory_is_one_line_not_an_oom_kill(tmp_path):
     r = subprocess.run([PY, "-m", "rasterhw.sim.cli.main", "verilog", "zbm-merger", "-o", "m.v"],
                        cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0 and "module" in (tmp_path / "m.v").read_text()
+
+
+def test_a_big_mesh_says_what_is_going_on_before_the_silence(tmp_path):
+    """On a terminal, loading a big mesh and rendering a big scene print a line first (the
+    thresholds are lowered here so a small file stands for a big one)."""
+    import pty
+
+    (tmp_path / "m.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    script = ("import sys\nfrom rasterhw.sim.cli import main as m\nm._BIG_MESH_BYTES = 10\n"
+              "m._BIG_SCENE_POLYGONS = 0\nsys.argv = ['rasterhw', 'render', 'm.obj', '--size', '16x16', '-o', 'm.png']\n"
+              "m.main()\n")
+    master, slave = pty.openpty()
+    p = subprocess.Popen([PY, "-c", script], cwd=tmp_path, stdout=subprocess.PIPE, stderr=slave)
+    os.close(slave)
+    p.wait(timeout=300)
+    err = b""
+    while True:
+        try:
+            chunk = os.read(master, 4096)
+        except OSError:
+            break
+        if not chunk:
+            break
+        err += chunk
+    os.close(master)
+    text = err.decode(errors="replace")
+    assert p.returncode == 0, text
+    assert "loading m.obj" in text and "1 polygons; transforming and rendering" in text

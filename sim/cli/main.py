@@ -154,8 +154,19 @@ def load_scene_and_size(scene: str, size: str | None, *, bytes_per_pixel: int = 
         from rasterhw.golden_model.memcheck import check_memory
 
         check_memory(bytes_per_pixel * wh[0] * wh[1], f"{what} {wh[0]}x{wh[1]}".strip())
+    p = Path(scene)
+    big = scene not in SCENES and p.is_file() and p.stat().st_size > _BIG_MESH_BYTES
+    if big and sys.stderr.isatty():   # a big mesh takes seconds to minutes to read: say so first
+        info(f"loading {p.name} ({p.stat().st_size / 1e6:.0f} MB) ...")
     sc = load_scene(scene)
+    if sc.n_polygons > _BIG_SCENE_POLYGONS and sys.stderr.isatty():
+        info(f"{sc.name}: {sc.n_polygons:,} polygons; transforming and rendering ...")
     return sc, wh
+
+
+#: a mesh file (bytes) or scene (polygons) big enough that a person waiting is told what is going on
+_BIG_MESH_BYTES = 5_000_000
+_BIG_SCENE_POLYGONS = 200_000
 
 
 def render_reference(scene: str, size: str | None, z_bits: int = 24, *, progress: bool = False):
