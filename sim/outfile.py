@@ -1,24 +1,71 @@
 """Output files of the command line: checked before any work, written whole or not at all.
+This is the one writer of every file a command is asked to write (``-o``, ``--out``).
 
-* :func:`check_image_output` refuses a name whose extension Pillow cannot write *before* a
-  render, compare or simulation starts (not after minutes of work);
-* :func:`write_image` / :func:`write_text` write into a temporary file beside the target and
-  rename it into place, so an error or Ctrl-C never leaves a partial file under the user's
-  name.
+* :func:`check_output` / :func:`check_image_output` refuse, *before* a render, compare or
+  simulation starts, a name that cannot be written: an image extension Pillow cannot write, a
+  folder (``-o out/``, an existing folder), an output that is one of the command's inputs;
+* :func:`atomic_path` (used by :func:`write_image`, :func:`write_text`, :func:`write_bytes`)
+  lets the caller write a temporary file, then puts it at the target by what the target is:
+
+  - ``-``: the bytes go to standard output;
+  - a symbolic link: written through to the file it points at (the link stays);
+  - a device or FIFO (``/dev/null``, ``mkfifo``): opened and written, never replaced;
+  - a regular file with other hard links: rewritten in place (replacing it would break the
+    links);
+  - any other regular file: replaced atomically (rename), keeping its permission bits;
+  - a new file: created atomically with the permissions the umask gives (0666 & ~umask), not
+    ``mkstemp``'s 0600.
+
+  An error or Ctrl-C before the end leaves the target as it was and no temporary file behind.
 """
 
 from __future__ import annotations
 
 import os
+import shutil
+import stat
+import sys
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 
-__all__ = ["atomic_path", "check_image_output", "image_formats", "write_image", "write_text"]
+__all__ = ["STDOUT", "atomic_path", "check_image_output", "check_output", "image_formats", "write_bytes",
+           "write_image", "write_text"]
+
+#: the output name that means standard output
+STDOUT = "-"
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def check_output(path: str | Path | None, *, flag: str = "-o", inputs: Iterable[str | Path] = ()) -> Path | None:
+    """``path`` as a Path if a command may write a file there: not a folder name (an existing
+    folder, or a name ending in ``/``), not one of ``inputs`` (the same file by any name: links
+    included). ``-`` (standard output) passes. ``None`` passes through."""
+    if path is None:
+        return None
+    text = str(path)
+    if text == STDOUT:
+        return Path(STDOUT)
+    if text.endswith(("/", os.sep)) or (os.path.isdir(text)):
+        raise RasterhwError(f"{flag} {text!r} is a folder, not a file name")
+    p = Path(text)
+    for inp in inputs:
+        try:
+            same = os.path.samefile(p, inp)
+        except OSError:
+            same = os.path.realpath(p) == os.path.realpath(inp)
+        if same:
+            raise RasterhwError(f"{flag} {text!r} is also an input of this command; write the result elsewhere")
+    return p
 
 
 def image_formats() -> dict[str, str]:
@@ -29,34 +76,97 @@ def image_formats() -> dict[str, str]:
     return {ext: fmt for ext, fmt in Image.registered_extensions().items() if fmt in Image.SAVE}
 
 
-def check_image_output(path: str | Path | None, *, flag: str = "-o") -> Path | None:
+def check_image_output(path: str | Path | None, *, flag: str = "-o",
+                       inputs: Iterable[str | Path] = ()) -> Path | None:
     """``path`` as a Path if Pillow can write an image there by its extension; else a
-    :class:`RasterhwError` naming the extensions that work. ``None`` passes through."""
+    :class:`RasterhwError` naming the extensions that work; then :func:`check_output`. ``-``
+    (standard output: PNG) and ``None`` pass through."""
     if path is None:
         return None
     p = Path(path)
+    if str(path) == STDOUT:
+        return p
     ext = p.suffix.lower()
     if ext not in image_formats():
         common = ".png, .bmp, .tif, .ppm, .jpg"
         raise RasterhwError(f"{flag} {str(p)!r}: {'no' if not ext else 'unknown'} image extension"
                             f"{'' if not ext else ' ' + repr(ext)}; use one of {common}")
-    if p.exists() and p.is_dir():
-        raise RasterhwError(f"{flag} {str(p)!r} is a folder, not a file name")
-    return p
+    if not _holds_rgb(image_formats()[ext]):   # e.g. .xbm (1 bit): refused now, not after the run
+        raise RasterhwError(f"{flag} {str(p)!r}: {image_formats()[ext]} cannot hold an RGB image; "
+                            "use one of .png, .bmp, .tif, .ppm, .jpg")
+    return check_output(path, flag=flag, inputs=inputs)
+
+
+#: the largest image each format holds (Pillow shrinks a bigger .ico to 256 x 256 silently)
+_MAX_SIDE = {"ICO": 256}
+
+
+def _holds_rgb(fmt: str) -> bool:
+    """Can Pillow write a small RGB image in ``fmt``? (tried in memory, once per format)"""
+    if fmt not in _RGB_OK:
+        import io
+
+        from PIL import Image
+
+        try:
+            Image.new("RGB", (2, 2)).save(io.BytesIO(), format=fmt)
+            _RGB_OK[fmt] = True
+        except Exception:  # noqa: BLE001 - any refusal of Pillow's means no
+            _RGB_OK[fmt] = False
+    return _RGB_OK[fmt]
+
+
+_RGB_OK: dict[str, bool] = {}
 
 
 @contextmanager
 def atomic_path(path: str | Path) -> Iterator[Path]:
-    """``with atomic_path(p) as tmp:`` write ``tmp``; on success it replaces ``p``, on any
-    error (or Ctrl-C) it is removed and ``p`` is untouched."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
+    """``with atomic_path(p) as tmp:`` write ``tmp``; on success it is put at ``p`` by the rules
+    of this module (stdout, through a link, a device or FIFO, a hard-linked file in place, any
+    other file replaced atomically keeping its mode); on any error (or Ctrl-C) ``p`` is untouched
+    and ``tmp`` removed."""
+    text = str(path)
+    if text == STDOUT:
+        target, kind = None, "stdout"
+    else:
+        if text.endswith(("/", os.sep)):
+            raise RasterhwError(f"{text!r} is a folder, not a file name")
+        target = Path(os.path.realpath(text))    # through symbolic links (a dangling one: its target)
+        try:
+            st = os.stat(target)
+        except FileNotFoundError:
+            st = None
+        if st is None:
+            kind = "new"
+        elif stat.S_ISDIR(st.st_mode):
+            raise RasterhwError(f"{text!r} is a folder, not a file name")
+        elif not stat.S_ISREG(st.st_mode):
+            kind = "stream"          # device, FIFO, socket: write into it
+        elif st.st_nlink > 1:
+            kind = "inplace"
+        else:
+            kind = "replace"
+    if kind in ("new", "replace"):
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=target.suffix, dir=target.parent)
+    else:
+        fd, tmp = tempfile.mkstemp(prefix=".rasterhw-out.", suffix=Path(text).suffix)
     os.close(fd)
     tmp_path = Path(tmp)
     try:
         yield tmp_path
-        os.replace(tmp_path, path)
+        if kind == "stdout":
+            sys.stdout.flush()
+            with open(tmp_path, "rb") as src:
+                shutil.copyfileobj(src, sys.stdout.buffer)
+            sys.stdout.buffer.flush()
+        elif kind in ("stream", "inplace"):
+            with open(tmp_path, "rb") as src, open(target, "wb") as dst:
+                shutil.copyfileobj(src, dst)
+        else:
+            mode = stat.S_IMODE(st.st_mode) if st is not None else 0o666 & ~_umask()
+            os.chmod(tmp_path, mode)
+            os.replace(tmp_path, target)
     finally:
         tmp_path.unlink(missing_ok=True)
 
@@ -65,22 +175,30 @@ def write_image(path: str | Path, rgb8: np.ndarray) -> Path:
     """Write an (H, W, 3) uint8 image to ``path`` (format from the extension), whole or not at all."""
     from PIL import Image
 
-    path = check_image_output(path)
-    fmt = image_formats()[path.suffix.lower()]
+    check_image_output(path)
+    fmt = "PNG" if str(path) == STDOUT else image_formats()[Path(path).suffix.lower()]
+    side = _MAX_SIDE.get(fmt)
+    if side is not None and max(rgb8.shape[:2]) > side:
+        raise RasterhwError(f"cannot write {path}: {fmt} holds at most {side}x{side} pixels, the frame is "
+                            f"{rgb8.shape[1]}x{rgb8.shape[0]}; use .png")
     with atomic_path(path) as tmp:
         try:
             Image.fromarray(np.ascontiguousarray(rgb8)).save(tmp, format=fmt)
         except (ValueError, OSError, KeyError, TypeError) as e:  # a format that cannot hold RGB or this size
             raise RasterhwError(f"cannot write {path} as {fmt}: {str(e).splitlines()[0] if str(e) else type(e).__name__}") from None
-    return path
+    return Path(path)
 
 
 def write_text(path: str | Path, text: str) -> Path:
-    """Write ``text`` to ``path``, whole or not at all."""
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        tmp.write_text(text)
-    return path
+    """Write ``text`` to ``path`` (``-``: standard output), whole or not at all."""
+    return write_bytes(path, text.encode())
+
+
+def write_bytes(path: str | Path, data: bytes) -> Path:
+    """Write ``data`` to ``path`` (``-``: standard output), whole or not at all."""
+    with atomic_path(path) as tmp:   # the name as given: "out/" must stay a folder name
+        tmp.write_bytes(data)
+    return Path(path)
 
 
 def write_if_changed(path: str | Path, text: str) -> Path:

@@ -39,6 +39,7 @@ def test_merger_places_on_ecp5_with_both_clocks(tmp_path, monkeypatch):
     assert len(json.loads(rec.read_text())["runs"]) == 1
     monkeypatch.setattr(fpga, "RUN_RECORD", rec)
     monkeypatch.setattr(fpga, "REPO_ROOT", tmp_path)                   # a machine with an empty build/
+    monkeypatch.setattr(fpga, "BUILD_ROOT", tmp_path / "build")
     back = place_and_route("zbm-merger", cached_only=True, **kw)
     assert back is not None and back["cached"] and back["build_dir"] is None
     assert (back["luts"], back["ffs"], back["fmax_mhz"]) == (r["luts"], r["ffs"], r["fmax_mhz"])

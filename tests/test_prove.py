@@ -8,8 +8,8 @@ import pytest
 from amaranth import Module, Signal
 from amaranth.lib import wiring
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.flow.prove import proofs, prove
 from rasterhw.sim.engines.verilog import make_block
+from rasterhw.sim.flow.prove import proofs, prove
 
 
 class LossyMerger(wiring.Component):

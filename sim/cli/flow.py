@@ -53,6 +53,8 @@ def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: b
             click.echo(f"{r['block']:<18} {r['gate_equivalent']:>10.0f} {r['flipflops']:>10} "
                        f"{r['ram_bits']:>10} {r['wall_s']:>7.1f}  {shown}")
         return
+    if small:
+        raise RasterhwError("--small applies only with --all (a named block takes its sizes from -p)")
     if block is None:
         raise RasterhwError("name a block (rasterhw verilog --list) or give --all")
     kw = _params(block, params)

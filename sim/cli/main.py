@@ -154,8 +154,19 @@ def load_scene_and_size(scene: str, size: str | None, *, bytes_per_pixel: int = 
         from rasterhw.golden_model.memcheck import check_memory
 
         check_memory(bytes_per_pixel * wh[0] * wh[1], f"{what} {wh[0]}x{wh[1]}".strip())
+    p = Path(scene)
+    big = scene not in SCENES and p.is_file() and p.stat().st_size > _BIG_MESH_BYTES
+    if big and sys.stderr.isatty():   # a big mesh takes seconds to minutes to read: say so first
+        info(f"loading {p.name} ({p.stat().st_size / 1e6:.0f} MB) ...")
     sc = load_scene(scene)
+    if sc.n_polygons > _BIG_SCENE_POLYGONS and sys.stderr.isatty():
+        info(f"{sc.name}: {sc.n_polygons:,} polygons; transforming and rendering ...")
     return sc, wh
+
+
+#: a mesh file (bytes) or scene (polygons) big enough that a person waiting is told what is going on
+_BIG_MESH_BYTES = 5_000_000
+_BIG_SCENE_POLYGONS = 200_000
 
 
 def render_reference(scene: str, size: str | None, z_bits: int = 24, *, progress: bool = False):
@@ -187,6 +198,34 @@ def _progress_bar(total: int, desc: str, unit: str):
     from tqdm import tqdm
 
     return tqdm(total=total, desc=desc, unit=unit, disable=None, file=sys.stderr, leave=False)
+
+
+_GEOMETRY: dict = {}
+
+
+def _geometry(sc, w: int, h: int):
+    """The reference geometry of ``sc`` at ``w`` x ``h`` (kept for the one scene of this command)."""
+    from rasterhw.golden_model.pipeline import run_geometry
+
+    key = (id(sc), w, h)
+    if key not in _GEOMETRY:
+        _GEOMETRY.clear()
+        _GEOMETRY[key] = run_geometry(sc, w, h)
+    return _GEOMETRY[key]
+
+
+def _nothing_to_draw(sc, w: int, h: int):
+    """The reference's background frame if no polygon of ``sc`` survives culling and clipping
+    (all back-facing, or all outside the view), else None. A machine's renderer or simulation is
+    not run on an empty triangle list (some ended in an IndexError): the command warns, as the
+    reference does, and writes the blank frame."""
+    from rasterhw.golden_model.reference import rasterise_rgb8
+
+    tris = _geometry(sc, w, h)
+    if tris.n_triangles:
+        return None
+    rgb8, _counts = rasterise_rgb8(tris)
+    return rgb8
 
 
 def _warn_if_empty(tris, pixels_written: int) -> None:
@@ -231,28 +270,39 @@ def machines(as_json: bool) -> None:
 @click.option("--size", default=None, metavar="WxH", help="Frame size (default: the scene's own, e.g. 512x512).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
               help="PNG file to write (default: out/SCENE-ARCH.png).")
-@click.option("--z-bits", type=int, default=24, show_default=True, help="Width of the quantised Z (reference).")
+@click.option("--z-bits", type=int, default=None, hidden=True,
+              help="Refused: no renderer's image depends on it (the reference's depth test uses float Z).")
 @_click_options(_RENDER_OPTIONS)
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout.")
-def render(scene: str, arch: str, size: str | None, output: str | None, z_bits: int, as_json: bool,
+def render(scene: str, arch: str, size: str | None, output: str | None, z_bits: int | None, as_json: bool,
            **arch_options) -> None:
     """Render SCENE (a built-in name or an .obj/.ply file) and write a PNG."""
     from rasterhw.sim.outfile import check_image_output, write_image
 
+    if z_bits is not None:
+        # it only ever set the width of the screen triangles' quantised Z, which no renderer behind
+        # `render` reads (the reference compares float Z; each machine has its own Z width): an
+        # option that changes nothing is refused rather than silently ignored (issue 33)
+        raise RasterhwError("--z-bits changes no image of `render` (the reference's depth test uses float Z; "
+                            "each machine's Z width is its own); leave it out")
     out = check_image_output(output) or Path("out") / f"{Path(scene).stem}-{arch}.png"
     t0 = time.perf_counter()
     if arch == REFERENCE:
         _take_options(arch_options, (), "--arch reference")
-        sc, tris, (rgb8, counts), _, _ = render_reference(scene, size, z_bits, progress=not as_json)
+        sc, tris, (rgb8, counts), _, _ = render_reference(scene, size, progress=not as_json)
         pixels_written = counts["pixels_written"]
         extra = {"fragments": counts["fragments"], "pixels_covered": counts["pixels_covered"]}
     else:
         _machine, a = registry.archs()[arch]
         opts = _take_options(arch_options, a.options, f"--arch {arch}")
         sc, (w, h) = load_scene_and_size(scene, size, bytes_per_pixel=a.bytes_per_pixel, what=f"render --arch {arch}")
-        res = registry.load(a.render)(sc, w, h, arch=arch, **opts)
-        rgb8, tris, pixels_written = res.rgb8, res.tris, int(res.pixels_written)
-        extra = {**opts, **res.stats}
+        empty = _nothing_to_draw(sc, w, h)
+        if empty is not None:   # every arch gives the reference's blank frame, none a traceback
+            rgb8, tris, pixels_written, extra = empty, _geometry(sc, w, h), 0, {**opts, "ran": False}
+        else:
+            res = registry.load(a.render)(sc, w, h, arch=arch, **opts)
+            rgb8, tris, pixels_written = res.rgb8, res.tris, int(res.pixels_written)
+            extra = {**opts, **res.stats}
     wall = time.perf_counter() - t0
     write_image(out, rgb8)
     _warn_if_empty(tris, pixels_written)
@@ -288,7 +338,7 @@ def compare(a: str, b: str, output: str | None, tolerance: int, as_json: bool) -
     from rasterhw.sim.imageio import read_rgb8_pair
     from rasterhw.sim.outfile import check_image_output, write_image
 
-    out = check_image_output(output)
+    out = check_image_output(output, inputs=(a, b))   # never the diff over an input
     if tolerance < 0:
         raise RasterhwError(f"--tolerance must be 0 or more, not {tolerance}")
     ia, ib = read_rgb8_pair(a, b, extra_bytes_per_pixel=3 if out else 0)
@@ -312,14 +362,26 @@ def compare(a: str, b: str, output: str | None, tolerance: int, as_json: bool) -
               show_default=True, help="HDL simulator for rows measured from HDL cycles (full frames always "
               "run on a compiled simulator).")
 @click.option("--fast", is_flag=True, help="Keep slow rows (synthesis, place and route) unmeasured.")
-def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool) -> None:
+@click.option("--rerun", is_flag=True, help="fpga: run place and route again (minutes to an hour per block); "
+              "without it the fpga rows come from the recorded runs (docs/reproduction/fpga_runs.json, build/pnr-*).")
+def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, rerun: bool) -> None:
     """Reproduce a paper's figures: paper value, formula value, measured value, ratio."""
     from rasterhw.sim.report.rows import run_report, systems
 
     names = systems() if system == "all" else [system]
+    if rerun and "fpga" not in names:
+        raise RasterhwError("--rerun applies to the fpga report only")
+    if rerun and fast:
+        raise RasterhwError("--rerun and --fast contradict each other")
     rows = []
     for name in names:
-        rows += run_report(name, out_dir=Path(out_dir), engine=engine, progress=not as_json, fast=fast)
+        extra = {}
+        if name == "fpga" and not fast:
+            # place and route takes minutes to an hour per block: never started unasked
+            extra["cached_only"] = not rerun
+            if rerun:
+                info("fpga: running place and route for every configuration (minutes to an hour per block)")
+        rows += run_report(name, out_dir=Path(out_dir), engine=engine, progress=not as_json, fast=fast, **extra)
     if as_json:
         emit_json(rows)
     else:
@@ -341,6 +403,7 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
     """Generate Verilog for BLOCK (see `rasterhw verilog --list`)."""
     from rasterhw.sim.engines.verilog import block_names, parse_params
     from rasterhw.sim.engines.verilog_cache import write_verilog
+    from rasterhw.sim.outfile import check_output
 
     if list_blocks:
         click.echo("\n".join(block_names()))
@@ -353,20 +416,48 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
         raise RasterhwError(f"{what}; blocks: {', '.join(block_names())}")
     if output is None:
         raise RasterhwError("say where to write the Verilog: -o FILE")
-    kw = parse_params(params, registry.load(registry.blocks()[block]))
+    check_output(output)   # a folder name is refused before the (slow) generation
+    try:
+        kw = parse_params(params, registry.load(registry.blocks()[block]))
+    except (OverflowError, ValueError) as e:
+        raise RasterhwError(f"{block}: {e}") from None
     if interleave is not None:
         if "interleave" in kw and kw["interleave"] != interleave:
             raise RasterhwError(f"--interleave {interleave} contradicts -p interleave={kw['interleave']}")
         kw["interleave"] = interleave
+    _limit_memory()   # explicit parameters can ask for any size: a MemoryError (one line), not an OOM kill
     if sys.stderr.isatty():  # progress for a person waiting; logs and pipes get only the result
         info(f"generating Verilog for {block} ...")
     try:
         write_verilog(block, output, **kw)
     except RasterhwError:
         raise
-    except (TypeError, ValueError) as e:
-        raise RasterhwError(f"{block}: {e}") from None
-    info(f"wrote {output}")
+    except (TypeError, ValueError, OverflowError) as e:
+        raise RasterhwError(f"{block}: {str(e).splitlines()[0] if str(e) else type(e).__name__}") from None
+    except MemoryError:
+        raise RasterhwError(f"{block}: these parameters need more memory than there is") from None
+    info(f"wrote {'standard output' if output == '-' else output}")
+
+
+def _limit_memory() -> None:
+    """Cap this process's data memory at what :mod:`~rasterhw.golden_model.memcheck` says may
+    be used (85 % of the available memory, or ``RASTERHW_MEMORY_LIMIT``), so an elaboration
+    too big for the machine (``verilog pixelbus -p width=100000 -p height=100000 -p ram=memory``
+    was OOM-killed at 24 GB with no message) ends in a MemoryError, reported as one line. The
+    WebAssembly Yosys reserves address space, not data, so it is not affected."""
+    import resource
+
+    from rasterhw.golden_model.memcheck import HEADROOM, available_bytes
+
+    try:
+        soft, hard = resource.getrlimit(resource.RLIMIT_DATA)
+        cap = int(HEADROOM * available_bytes())
+        if hard != resource.RLIM_INFINITY:
+            cap = min(cap, hard)
+        if soft == resource.RLIM_INFINITY or cap < soft:
+            resource.setrlimit(resource.RLIMIT_DATA, (cap, hard))
+    except (ValueError, OSError):   # a platform without the limit: keep going as before
+        pass
 
 
 def sim_image_name(scene: str, block: str, engine: str, options: dict) -> Path:
@@ -390,22 +481,35 @@ def sim_image_name(scene: str, block: str, engine: str, options: dict) -> Path:
 @click.option("--json", "as_json", is_flag=True)
 def sim_cmd(block, scene, size, engine, output, waves, as_json, **block_options) -> None:
     """Run a scene through a block's HDL, compare with the golden model, write the frame."""
-    from rasterhw.sim.outfile import check_image_output, write_image
     from rasterhw.sim.engines.waves import recording
+    from rasterhw.sim.outfile import check_image_output, write_image
 
     _machine, b = registry.sim_blocks()[block]
     opts = _take_options(block_options, b.options, f"sim {block}")
     scene = scene or b.default_scene
     out = check_image_output(output) or sim_image_name(scene, block, engine, block_options)
     sc, (w, h) = load_scene_and_size(scene, size, bytes_per_pixel=b.bytes_per_pixel, what=f"sim {block}")
-    with recording(waves, engine) as traces:
-        res = registry.load(b.simulate)(sc, w, h, engine=engine, progress=not as_json, **opts)
+    empty = _nothing_to_draw(sc, w, h)
+    if empty is not None:
+        _warn_if_empty(_geometry(sc, w, h), 0)
+        write_image(out, empty)
+        res = {"block": block, "scene": sc.name, "engine": engine, "simulated": False, "pixels_compared": 0,
+               "mismatches": 0, "image": str(out)}
+        emit_json(res) if as_json else info(" ".join(f"{k}={v}" for k, v in res.items()))
+        return
+    try:
+        with recording(waves, engine) as traces:
+            res = registry.load(b.simulate)(sc, w, h, engine=engine, progress=not as_json, **opts)
+    except (ValueError, OverflowError) as e:   # a block's own parameter check (e.g. a frame smaller than its banks)
+        raise RasterhwError(f"sim {block}: {str(e).splitlines()[0] if str(e) else type(e).__name__}") from None
     if traces:
         res["waves"] = [str(t) for t in traces]
     frame = res.pop("frame_rgb", None)
     if frame is not None:
         write_image(out, frame)
         res["image"] = str(out)
+    elif output is not None:
+        raise RasterhwError(f"sim {block} gives no frame image; -o {output} cannot be written (leave -o out)")
     res = {"block": block, "scene": sc.name, **res}
     if as_json:
         emit_json(res)
@@ -423,6 +527,8 @@ def bench(as_json: bool, repeat: int, hdl: bool) -> None:
     """Print speed and memory figures (a benchmark, not a test)."""
     from rasterhw.sim.report.bench import run_bench
 
+    if repeat < 1:
+        raise RasterhwError(f"--repeat must be 1 or more, not {repeat}")
     rows = run_bench(repeat=repeat, hdl=hdl, progress=not as_json)
     if as_json:
         emit_json(rows)
@@ -461,6 +567,10 @@ def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], scheduler: str,
     from rasterhw.sim.flow.soak import run_soak
     from rasterhw.sim.flow.tasks import default_store, parse_scheduler
 
+    if seed is not None and not 0 <= seed < 1 << 32:
+        raise RasterhwError(f"--seed must be between 0 and {(1 << 32) - 1}, not {seed}")
+    if pixels < 1:
+        raise RasterhwError(f"--pixels must be 1 or more, not {pixels}")
     parse_scheduler(scheduler)   # a bad one is an error before anything starts
     seed = secrets.randbelow(1 << 31) if seed is None else seed
     info(f"soak: seed {seed} (rerun: rasterhw soak --seed {seed} --pixels {pixels})")
@@ -533,7 +643,14 @@ def demo(out_dir: str, scene: str, engine: str) -> None:
     """Render a default scene through the golden model and the hardware; write images and a report."""
     from rasterhw.sim.report.demo import run_demo
 
-    run_demo(Path(out_dir), scene=scene, engine=engine)
+    out = Path(out_dir)
+    existed = out.exists()
+    try:
+        run_demo(out, scene=scene, engine=engine)
+    except BaseException:
+        if not existed and out.is_dir() and not any(out.iterdir()):
+            out.rmdir()   # a failed demo leaves no empty folder it made
+        raise
 
 
 add_commands(cli)   # synth, fpga, prove: the hardware flow (sim/cli/flow.py)
@@ -561,9 +678,44 @@ def main(argv: list[str] | None = None) -> None:
         workdirs.cleanup()
 
 
+def _close_progress_bars() -> None:
+    """End every progress bar still shown, so an error line starts on a line of its own."""
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        return
+    for bar in list(getattr(tqdm, "_instances", ())):
+        bar.close()
+
+
 def _main(argv: list[str] | None) -> None:
     try:
         rc = cli.main(args=argv, prog_name="rasterhw", standalone_mode=False)
+    except BaseException:
+        _close_progress_bars()
+        _quiet_exit()
+        _dispatch_error()
+    if isinstance(rc, int) and rc:
+        sys.exit(rc)
+
+
+def _quiet_exit() -> None:
+    """After an error or Ctrl-C, nothing more after the one line: the half-built Amaranth objects
+    it left are collected at exit without UnusedElaboratable warnings, and a simulation's
+    coroutines closed mid-step at exit print no "Exception ignored" tracebacks."""
+    sys.unraisablehook = lambda _unraisable: None
+    if "amaranth" in sys.modules:
+        import warnings
+
+        from amaranth.hdl import UnusedElaboratable
+
+        warnings.simplefilter("ignore", UnusedElaboratable)
+
+
+def _dispatch_error() -> None:
+    """The exception being handled as the CLI reports it (one line, exit status)."""
+    try:
+        raise
     except RasterhwError as e:
         click.echo(f"error: {e}", err=True)
         sys.exit(2)
@@ -577,8 +729,6 @@ def _main(argv: list[str] | None) -> None:
         # a file that cannot be read or written: say which, no traceback
         click.echo(f"error: {e.strerror or e}: {e.filename or ''}".rstrip(": "), err=True)
         sys.exit(2)
-    if isinstance(rc, int) and rc:
-        sys.exit(rc)
 
 
 if __name__ == "__main__":

@@ -16,13 +16,14 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.engines import vlruntime, waves
-from rasterhw.sim.paths import REPO_ROOT, SimulatorUnavailable, verilator_bin_dir
+from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT, SimulatorUnavailable, verilator_bin_dir
 from rasterhw.sim.workdirs import build_lock, run_child
 
 __all__ = [
@@ -156,7 +157,7 @@ def build_dir_for(block: str, sim: str, *, sources: Sequence[Path] = (), **param
     for s in (*sources, *HARNESS_INCLUDES):
         h.update(Path(s).read_bytes())
     digest = h.hexdigest()[:10]
-    return REPO_ROOT / "build" / f"{block}-{sim}-{digest}"
+    return BUILD_ROOT / f"{block}-{sim}-{digest}"
 
 
 def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, params: Mapping[str, object],
@@ -186,47 +187,88 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
         h.update(Path(f).read_bytes())
     for k in sorted(generated):
         h.update(k.encode() + generated[k].encode())
-    bdir = REPO_ROOT / "build" / f"{name}-{h.hexdigest()[:10]}"
+    bdir = BUILD_ROOT / f"{name}-{h.hexdigest()[:10]}"
     exe = bdir / "obj_dir" / f"V{top}"
-    if exe.exists():
+    if _built(bdir, exe):
         return exe, 0.0
     with build_lock(bdir, what=name):
-        if exe.exists():  # another process built it while we waited
+        if _built(bdir, exe):  # another process built it while we waited
             return exe, 0.0
-        bdir.mkdir(parents=True, exist_ok=True)
-        for k, text in generated.items():
-            (bdir / k).write_text(text)
-        env = sim_env()
-        env["MAKEFLAGS"] = f"{env['MAKEFLAGS']} {make}" if env.get("MAKEFLAGS") else make
-        cflags = " ".join(f"-D{k}={v}" for k, v in defines.items())
-        cmd = [str(verilator_bin_dir() / "verilator"), *args, "--top-module", top, f"-I{bdir}", INCLUDE_ARG,
-               "-CFLAGS", cflags, *[f"-G{k}={v}" for k, v in params.items()], "--Mdir", str(bdir / "obj_dir"),
-               *[str(bdir / k) for k in generated if k.endswith(".v")], *[str(f) for f in sources], str(PLAIN_MAIN)]
-        t0 = time.perf_counter()
-        # generate, put the shared runtime objects in (newer than the generated makefile, so make
-        # keeps them: sim/engines/vlruntime.py), then compile; both steps' memory peaks are recorded
-        rt_flags = ["plain", make, cflags, *args]
-        peak = [bdir / "verilate.peak", bdir / "compile.peak"]
-        r = run_child([*_peak_rss(peak[0]), *cmd], cwd=bdir, env=env, capture_output=True, text=True)
-        log = " ".join(cmd) + "\n" + r.stdout + r.stderr
-        t1 = time.perf_counter()
-        if not r.returncode:
-            vlruntime.seed(bdir / "obj_dir", "plain", rt_flags)
-            mk = ["make", "-C", str(bdir / "obj_dir"), "-f", f"V{top}.mk", "-j", "2"]
-            r = run_child([*_peak_rss(peak[1]), *mk], cwd=bdir, env=env, capture_output=True, text=True)
-            log += " ".join(mk) + "\n" + r.stdout + r.stderr
-        build_s = time.perf_counter() - t0
-        (bdir / "build.log").write_text(log)
-        if r.returncode or not exe.exists():
-            raise RasterhwError(f"{name}: verilator build failed ({_first_error(log)}); "
-                                f"see {bdir / 'build.log'}")
-        vlruntime.harvest(bdir / "obj_dir", "plain", rt_flags)
-        mb = [float(p.read_text()) if p.exists() else None for p in peak]
-        (bdir / "build.json").write_text(json.dumps({
-            "model": name, "top": top, "params": params, "opt": opt, "build_s": round(build_s, 2),
-            "verilate_s": round(t1 - t0, 2), "compile_s": round(build_s - (t1 - t0), 2),
-            "verilate_peak_mb": mb[0], "compile_peak_mb": mb[1], "built": time.strftime("%Y-%m-%d %H:%M:%S")},
-            default=str) + "\n")
+        # all or nothing: the build runs in a fresh folder beside bdir and is renamed to bdir once
+        # it succeeded, so an interrupted build (Ctrl-C, kill mid-compile: half-written objects and
+        # precompiled headers) never leaves a folder the next build would trust; what an
+        # interrupted build left (or a folder without its record) is removed here first
+        _discard_unfinished(bdir)
+        work = Path(tempfile.mkdtemp(prefix=f".{bdir.name}.tmp-", dir=bdir.parent))
+        try:
+            _exe, build_s = _build_plain_in(work, name, top, sources, params=params, opt=opt, defines=defines,
+                                            generated=generated, args=args, make=make)
+            os.chmod(work, 0o777 & ~_umask())
+            os.rename(work, bdir)
+        except RasterhwError as e:
+            os.rename(work, bdir)   # a failed build keeps its log (the error names it) until the next try
+            raise RasterhwError(str(e).replace(str(work), str(bdir))) from None
+        finally:
+            shutil.rmtree(work, ignore_errors=True)   # interrupted: nothing is left
+    return bdir / "obj_dir" / f"V{top}", build_s
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def _built(bdir: Path, exe: Path) -> bool:
+    """A finished plain build: its binary and its record (written last) are there."""
+    return exe.exists() and (bdir / "build.json").exists()
+
+
+def _discard_unfinished(bdir: Path) -> None:
+    """Remove ``bdir`` (it has no finished build) and the work folders of interrupted builds of it."""
+    for d in [bdir, *bdir.parent.glob(f".{bdir.name}.tmp-*")]:
+        shutil.rmtree(d, ignore_errors=True)
+
+
+def _build_plain_in(bdir: Path, name: str, top: str, sources: Sequence[Path], *, params: Mapping[str, object],
+                    opt: str, defines: Mapping[str, object], generated: Mapping[str, str], args: list[str],
+                    make: str) -> tuple[Path, float]:
+    """The steps of :func:`build_plain_verilator` in folder ``bdir``."""
+    exe = bdir / "obj_dir" / f"V{top}"
+    bdir.mkdir(parents=True, exist_ok=True)
+    for k, text in generated.items():
+        (bdir / k).write_text(text)
+    env = sim_env()
+    env["MAKEFLAGS"] = f"{env['MAKEFLAGS']} {make}" if env.get("MAKEFLAGS") else make
+    cflags = " ".join(f"-D{k}={v}" for k, v in defines.items())
+    cmd = [str(verilator_bin_dir() / "verilator"), *args, "--top-module", top, f"-I{bdir}", INCLUDE_ARG,
+           "-CFLAGS", cflags, *[f"-G{k}={v}" for k, v in params.items()], "--Mdir", str(bdir / "obj_dir"),
+           *[str(bdir / k) for k in generated if k.endswith(".v")], *[str(f) for f in sources], str(PLAIN_MAIN)]
+    t0 = time.perf_counter()
+    # generate, put the shared runtime objects in (newer than the generated makefile, so make
+    # keeps them: sim/engines/vlruntime.py), then compile; both steps' memory peaks are recorded
+    rt_flags = ["plain", make, cflags, *args]
+    peak = [bdir / "verilate.peak", bdir / "compile.peak"]
+    r = run_child([*_peak_rss(peak[0]), *cmd], cwd=bdir, env=env, capture_output=True, text=True)
+    log = " ".join(cmd) + "\n" + r.stdout + r.stderr
+    t1 = time.perf_counter()
+    if not r.returncode:
+        vlruntime.seed(bdir / "obj_dir", "plain", rt_flags)
+        mk = ["make", "-C", str(bdir / "obj_dir"), "-f", f"V{top}.mk", "-j", "2"]
+        r = run_child([*_peak_rss(peak[1]), *mk], cwd=bdir, env=env, capture_output=True, text=True)
+        log += " ".join(mk) + "\n" + r.stdout + r.stderr
+    build_s = time.perf_counter() - t0
+    (bdir / "build.log").write_text(log)
+    if r.returncode or not exe.exists():
+        raise RasterhwError(f"{name}: verilator build failed ({_first_error(log)}); "
+                            f"see {bdir / 'build.log'}")
+    vlruntime.harvest(bdir / "obj_dir", "plain", rt_flags)
+    mb = [float(p.read_text()) if p.exists() else None for p in peak]
+    (bdir / "build.json").write_text(json.dumps({
+        "model": name, "top": top, "params": params, "opt": opt, "build_s": round(build_s, 2),
+        "verilate_s": round(t1 - t0, 2), "compile_s": round(build_s - (t1 - t0), 2),
+        "verilate_peak_mb": mb[0], "compile_peak_mb": mb[1], "built": time.strftime("%Y-%m-%d %H:%M:%S")},
+        default=str) + "\n")
     return exe, build_s
 
 
@@ -239,7 +281,7 @@ def build_records() -> list[dict]:
     """What :func:`build_plain_verilator` recorded of every build under ``build/`` (cold build
     seconds, verilate and compile steps, their memory peaks in MB), newest first."""
     out = []
-    for f in (REPO_ROOT / "build").glob("*/build.json"):
+    for f in BUILD_ROOT.glob("*/build.json"):
         try:
             out.append({**json.loads(f.read_text()), "dir": f.parent.name})
         except (OSError, ValueError):
@@ -343,6 +385,17 @@ def run_cocotb(
         flags = verilator_make_flags("-O2", coroutines=True) if sim == "verilator" and not own \
             else contextlib.nullcontext()
         with build_lock(build_dir, what=toplevel), flags:
+            # all or nothing, like the plain builds: a build that was interrupted (its mark is
+            # still there) starts again without its outputs (every file of the folder but the
+            # sources; run folders are left alone), never continues on half-written objects
+            # and precompiled headers
+            building = build_dir / ".rasterhw-building"
+            if building.exists():
+                keep_files = {Path(s).resolve() for s in sources}
+                for f in build_dir.iterdir():
+                    if f.is_file() and f.resolve() not in keep_files and not f.name.endswith(".lock"):
+                        f.unlink(missing_ok=True)
+            building.touch()
             try:
                 runner.build(
                     sources=[str(s) for s in sources],
@@ -358,6 +411,7 @@ def run_cocotb(
                 log = build_dir / "build.log"
                 first = _first_error(log.read_text(errors="replace")) if log.exists() else str(e)
                 raise RasterhwError(f"{toplevel}: {sim} build failed ({first}); see {log}") from None
+            building.unlink()
         t1 = time.perf_counter()
         # the runner hands the simulator's Python this process's sys.path: add the
         # repository root so `cocotb_tests.<block>` imports there

@@ -52,7 +52,7 @@ def _quietly(build, name: str):
             return build()
         except RasterhwError as e:
             msg = str(e)
-        except (ValueError, TypeError) as e:
+        except (ValueError, TypeError, OverflowError) as e:   # Overflow: a parameter too big for a C size
             msg = f"block {name!r}: {e}"
         gc.collect()
     raise RasterhwError(msg)

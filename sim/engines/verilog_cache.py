@@ -19,10 +19,10 @@ from functools import cache
 from pathlib import Path
 
 from amaranth.back import verilog
-from rasterhw.sim.outfile import write_text
-from rasterhw.sim.paths import REPO_ROOT
-from rasterhw.sim.registry import blocks
 from rasterhw.sim.engines.verilog import canonical_port_lists, generate_verilog
+from rasterhw.sim.outfile import write_text
+from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT
+from rasterhw.sim.registry import blocks
 
 __all__ = ["convert_cached", "design_sources", "generate_cached", "source_digest", "write_verilog"]
 
@@ -106,7 +106,7 @@ def convert_cached(name: str, factory: Callable[[], object], *, params: Mapping[
     arguments). ``convert(design, module)`` defaults to ``amaranth.back.verilog.convert``."""
     key = json.dumps({"name": name, "module": module, "params": dict(params)}, sort_keys=True, default=str)
     digest = hashlib.sha1((source_digest(name) + key).encode()).hexdigest()[:16]
-    path = REPO_ROOT / "build" / "verilog" / f"{name}-{digest}.v"
+    path = BUILD_ROOT / "verilog" / f"{name}-{digest}.v"
     if path.exists():
         return path.read_text()
     if convert is None:

@@ -25,7 +25,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from rasterhw.sim.outfile import atomic_path
-from rasterhw.sim.paths import REPO_ROOT, verilator_bin_dir
+from rasterhw.sim.paths import BUILD_ROOT, verilator_bin_dir
 
 __all__ = ["RUNTIME_OBJECTS", "cache_dir", "cocotb_flags", "harvest", "seed"]
 
@@ -51,7 +51,7 @@ def cache_dir(kind: str, flags: Iterable[str]) -> Path:
         pass
     for f in flags:
         h.update(" ".join(re.sub(r"-DRASTERHW_\w+=\S+", "", str(f)).split()).encode() + b"\0")
-    root = Path(os.environ.get("RASTERHW_VL_RUNTIME_DIR", REPO_ROOT / "build" / "verilator-runtime"))
+    root = Path(os.environ.get("RASTERHW_VL_RUNTIME_DIR", BUILD_ROOT / "verilator-runtime"))
     return root / h.hexdigest()[:12]
 
 

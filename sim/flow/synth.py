@@ -50,10 +50,10 @@ from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
-from rasterhw.sim.engines.runner import REPO_ROOT
 from rasterhw.sim.engines.verilog import block_names, make_block
 from rasterhw.sim.engines.verilog_cache import generate_cached
 from rasterhw.sim.flow.tools import ToolUnavailable, tool, tool_version
+from rasterhw.sim.paths import BUILD_ROOT
 
 __all__ = [
     "GATE_WEIGHTS",
@@ -287,7 +287,7 @@ def synthesise(
 
     key = json.dumps({"params": params, "top": top, "memory": memory, "flatten": flatten, "lut4": lut4},
                      sort_keys=True, default=str)
-    bdir = REPO_ROOT / "build" / f"synth-{block}-{hashlib.sha1(key.encode()).hexdigest()[:10]}"
+    bdir = BUILD_ROOT / f"synth-{block}-{hashlib.sha1(key.encode()).hexdigest()[:10]}"
     bdir.mkdir(parents=True, exist_ok=True)
     files = [bdir / f"{top}.v"]
     files[0].write_text(text)
