@@ -7,6 +7,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from platformdirs import user_cache_dir
 from rasterhw.golden_model.errors import RasterhwError
 
 __all__ = ["BUILD_ROOT", "REPO_ROOT", "build_root", "SimulatorUnavailable", "verilator_bin_dir"]
@@ -15,21 +16,17 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 
 
 def build_root() -> Path:
-    """Where builds and caches go: ``$RASTERHW_BUILD`` if set; else ``build/`` of the checkout
+    """Where builds and caches go: ``$RASTERHW_CACHE`` (or its older name ``$RASTERHW_BUILD``)
+    if set; else ``build/`` of the checkout
     when this is one (an editable install: ``pyproject.toml`` beside the package); else (an
     installed wheel, whose package folder sits in site-packages and may not be writable) the
     user's cache folder, ``platformdirs.user_cache_dir("rasterhw")`` (``~/.cache/rasterhw``)."""
-    env = os.environ.get("RASTERHW_BUILD")
+    env = os.environ.get("RASTERHW_CACHE") or os.environ.get("RASTERHW_BUILD")
     if env:
         return Path(env).expanduser().resolve()
     if (REPO_ROOT / "pyproject.toml").is_file():
         return REPO_ROOT / "build"
-    try:
-        from platformdirs import user_cache_dir
-        return Path(user_cache_dir("rasterhw"))
-    except ImportError:
-        base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-        return Path(base) / "rasterhw"
+    return Path(user_cache_dir("rasterhw"))
 
 
 #: :func:`build_root` when this process started

@@ -116,9 +116,13 @@ def test_build_root_is_the_checkout_or_a_user_cache(monkeypatch, tmp_path):
     from rasterhw.sim import paths
 
     monkeypatch.delenv("RASTERHW_BUILD", raising=False)
+    monkeypatch.delenv("RASTERHW_CACHE", raising=False)
     assert paths.build_root() == paths.REPO_ROOT / "build"        # this checkout (editable)
     monkeypatch.setenv("RASTERHW_BUILD", str(tmp_path / "b"))
     assert paths.build_root() == (tmp_path / "b").resolve()
+    monkeypatch.setenv("RASTERHW_CACHE", str(tmp_path / "c"))      # the name issue 30 asks for wins
+    assert paths.build_root() == (tmp_path / "c").resolve()
+    monkeypatch.delenv("RASTERHW_CACHE")
     # an installed package: no pyproject.toml beside it -> the user's cache folder, never site-packages
     monkeypatch.delenv("RASTERHW_BUILD")
     fake = tmp_path / "site-packages" / "rasterhw"

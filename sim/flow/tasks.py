@@ -48,7 +48,7 @@ from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
-from rasterhw.sim.paths import REPO_ROOT
+from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT
 
 __all__ = ["VARYING", "Handle", "Runner", "Task", "code_digest", "default_store", "parse_scheduler",
            "run_task", "tool_versions"]
@@ -279,7 +279,7 @@ def parse_scheduler(text: str) -> tuple[str, object]:
 
 def default_store() -> Path:
     """Where finished results are kept unless ``--store`` says otherwise."""
-    return REPO_ROOT / "build" / "tasks"
+    return BUILD_ROOT / "tasks"
 
 
 def _cores() -> int:
