@@ -1,0 +1,73 @@
+"""A package like any other: the wheel built from this checkout, installed without the checkout,
+runs a Verilator scene run from an empty folder with its caches in an empty cache folder."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import sysconfig
+import zipfile
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def wheel(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("wheel")
+    r = subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(out), str(ROOT)],
+                       capture_output=True, text=True, timeout=900)
+    assert r.returncode == 0, r.stderr[-2000:]
+    (whl,) = out.glob("rasterhw-*.whl")
+    return whl
+
+
+def test_the_wheel_carries_benches_and_templates_and_nothing_of_the_checkout(wheel):
+    names = zipfile.ZipFile(wheel).namelist()
+    for need in ("rasterhw/cocotb_tests/harness.v", "rasterhw/cocotb_tests/plain_main.cpp",
+                 "rasterhw/cocotb_tests/xorshift.vh", "rasterhw/sim/report/templates/index.html.j2"):
+        assert need in names, need
+    assert any(n.startswith("rasterhw/sim/") and n.endswith(".v") for n in names)   # a machine's own bench
+    assert any(n.endswith("licenses/LICENSE") for n in names)
+    for bad in (".venv/", "/build/", "/out/", "rasterhw/tests/", "__pycache__", "rasterhw/setup.py"):
+        assert not any(bad in n for n in names), bad
+
+
+@pytest.mark.heavy
+def test_the_installed_wheel_runs_a_verilator_scene_from_an_empty_folder(wheel, tmp_path):
+    venv = tmp_path / "venv"
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(venv)], check=True, timeout=300)
+    py = venv / "bin" / "python"
+    site = Path(subprocess.run([str(py), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+                               capture_output=True, text=True, check=True).stdout.strip())
+    # the dependencies come from this environment (its site folder on the path, after the wheel's
+    # own); this environment's editable install of the checkout is not seen (a .pth line adds a
+    # folder, it does not run the folder's own .pth files)
+    (site / "deps.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
+    r = subprocess.run([sys.executable, "-m", "pip", "--python", str(py), "install", "-q", "--no-deps",
+                        str(wheel)], capture_output=True, text=True, timeout=600)
+    if r.returncode and "--python" in r.stderr:   # an older pip: install with the target's own runpy
+        r = subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(site),
+                            str(wheel)], capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr[-2000:]
+    work, cache = tmp_path / "empty", tmp_path / "cache"
+    work.mkdir()
+    cache.mkdir()
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("RASTERHW_", "PYTHONPATH"))}
+    env.update(RASTERHW_CACHE=str(cache), PATH=f"{venv / 'bin'}{os.pathsep}{env.get('PATH', '')}")
+    where = subprocess.run([str(py), "-c", "import rasterhw, sys; print(rasterhw.__file__)"], cwd=work, env=env,
+                           capture_output=True, text=True, check=True).stdout.strip()
+    assert str(ROOT) not in where and str(site) in where
+    r = subprocess.run([str(py), "-m", "rasterhw.sim.cli.main", "sim", "pixelbus", "--scene", "snu-100px",
+                        "--size", "64x64", "--engine", "verilator", "--json", "-o", "frame.png"],
+                       cwd=work, env=env, capture_output=True, text=True, timeout=1800)
+    assert r.returncode == 0, r.stderr[-2000:]
+    res = json.loads(r.stdout)
+    assert res["mismatches"] == 0 and res["pixels_compared"] == 64 * 64
+    assert any(cache.iterdir())                                   # the build went to the cache folder
+    assert sorted(p.name for p in work.iterdir()) == ["frame.png"]  # nothing else in the working folder
+    assert not any(p.name == "build" for p in Path(where).parent.iterdir())   # none in site-packages
