@@ -125,6 +125,71 @@ def generate_cached(block: str, **params) -> str:
 
 def write_verilog(name: str, path: str | Path, **params) -> Path:
     """Write :func:`generate_verilog` output to ``path`` (from the cache of generated Verilog,
-    ``sim/engines/verilog_cache.py``, when this design and these parameters were converted before);
-    return the path."""
-    return write_text(path, generate_cached(name, **params))  # whole or not at all
+    ``sim/engines/verilog_cache.py``, when this design and these parameters were converted before),
+    under :func:`verilog_header`; return the path."""
+    text = generate_cached(name, **params)
+    return write_text(path, verilog_header(name, **params) + text)  # whole or not at all
+
+
+def verilog_header(name: str, **params) -> str:
+    """Comment lines that say what a generated file is: the block, every parameter (defaults
+    filled in), the design digest (:func:`source_digest`), the rasterhw and Amaranth versions, and
+    each port of the block's signature — a stream as one line with its payload's fields, in the
+    flattened names the Verilog uses (``<port>__payload`` ...)."""
+    import inspect
+    from importlib.metadata import PackageNotFoundError, version
+
+    import amaranth
+
+    from rasterhw.sim.engines.verilog import make_block
+    from rasterhw.sim.registry import load
+
+    try:
+        ours = version("rasterhw")
+    except PackageNotFoundError:   # pragma: no cover - run from a bare checkout
+        ours = "unknown"
+    sig = inspect.signature(load(blocks()[name]))
+    eff = {k: v.default for k, v in sig.parameters.items() if v.default is not inspect.Parameter.empty}
+    eff.update(params)
+    given = " ".join(f"-p {k}={v}" for k, v in params.items())
+    lines = [f"rasterhw {ours}: block {name} (rasterhw verilog {name}{' ' + given if given else ''})",
+             "parameters: " + (", ".join(f"{k}={v}" for k, v in eff.items()) or "none"),
+             f"design digest {source_digest(name)[:16]} (Amaranth {amaranth.__version__}; every source file "
+             "the block depends on)",
+             f"top module {name.replace('-', '_')}; ports (in/out as seen by the block; besides them, clk and rst "
+             "of each clock domain, e.g. merge_clk/merge_rst):"]
+    lines += [f"  {p}" for p in port_lines(make_block(name, **params))]
+    return "".join(f"// {ln}\n" for ln in lines) + "\n"
+
+
+def port_lines(component) -> list[str]:
+    """One line per port of ``component``'s signature; a stream (``valid``/``ready``/``payload``
+    members under one path) as one line naming its payload's fields and widths."""
+    from amaranth.hdl import Shape
+    from amaranth.lib import data, wiring
+
+    members = list(component.signature.members.flatten())
+    ports = {path: m for path, m in members if m.is_port}
+    streams = {path[:-1] for path in ports if path[-1] == "valid"
+               and path[:-1] + ("ready",) in ports and path[:-1] + ("payload",) in ports}
+
+    def vname(path):
+        return "__".join(str(p) for p in path)
+
+    def shape(m):
+        sh = m.shape
+        if isinstance(sh, data.Layout) or (isinstance(sh, type) and issubclass(sh, data.Struct)):
+            lay = data.Layout.cast(sh)
+            return "{" + ", ".join(f"{n}: {Shape.cast(f.shape).width}" for n, f in lay) + "}"
+        return f"{Shape.cast(sh).width} bit{'s' if Shape.cast(sh).width != 1 else ''}"
+
+    out = []
+    for s in sorted(streams):
+        flow = "in " if ports[s + ("valid",)].flow == wiring.In else "out"
+        out.append(f"{flow} {vname(s)}: stream ({vname(s)}__valid/__ready/__payload), payload "
+                   f"{shape(ports[s + ('payload',)])}")
+    for path, m in ports.items():
+        if path[:-1] in streams:
+            continue
+        out.append(f"{'in ' if m.flow == wiring.In else 'out'} {vname(path)}: {shape(m)}")
+    return out
