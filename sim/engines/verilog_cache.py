@@ -140,7 +140,6 @@ def verilog_header(name: str, **params) -> str:
     from importlib.metadata import PackageNotFoundError, version
 
     import amaranth
-
     from rasterhw.sim.engines.verilog import make_block
     from rasterhw.sim.registry import load
 
