@@ -151,3 +151,22 @@ def test_sim_image_name_carries_the_options_given():
     b = sim_image_name("c300", "zbm", "verilator", {"interleave": 8, "schedule": "overlap", "units": None})
     assert a == Path("out/c300-zbm-verilator-interleave-8-schedule-paper.png") and a != b
     assert sim_image_name("x/scene.obj", "pixelbus", "pysim", {}) == Path("out/scene-pixelbus-pysim.png")
+
+
+def test_every_json_option_and_every_option_has_help():
+    """`--help` answers: every option of every command says what it does (`--json` included)."""
+    import click
+    from rasterhw.sim.cli.main import cli
+
+    missing = []
+
+    def walk(cmd, path):
+        if isinstance(cmd, click.Group):
+            for name, sub in cmd.commands.items():
+                walk(sub, [*path, name])
+            return
+        for p in cmd.params:
+            if isinstance(p, click.Option) and not p.help and "--help" not in p.opts:
+                missing.append(f"{' '.join(path)} {p.opts[0]}")
+    walk(cli, ["rasterhw"])
+    assert not missing, missing

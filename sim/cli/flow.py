@@ -67,9 +67,11 @@ def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: b
 @click.command()
 @click.argument("block")
 @click.option("-p", "--param", "params", multiple=True, metavar="NAME=VALUE", help="Block parameter (repeatable).")
-@click.option("--family", type=click.Choice(["ecp5", "ice40"]), default="ecp5", show_default=True)
+@click.option("--family", type=click.Choice(["ecp5", "ice40"]), default="ecp5", show_default=True,
+              help="FPGA family: Lattice ECP5 (nextpnr-ecp5) or iCE40 (nextpnr-ice40).")
 @click.option("--device", default=None, help="ecp5: 85k (default) or 25k; ice40: hx8k (default) or up5k.")
-@click.option("--json", "as_json", is_flag=True)
+@click.option("--json", "as_json", is_flag=True,
+              help="Print the place-and-route result as JSON on stdout (LUT4s, flip-flops, block RAMs, Fmax per clock).")
 def fpga(block: str, params: tuple[str, ...], family: str, device: str | None, as_json: bool) -> None:
     """Place and route BLOCK with nextpnr: LUTs, flip-flops, block RAMs, Fmax beside the paper's clock.
 
@@ -88,7 +90,8 @@ def fpga(block: str, params: tuple[str, ...], family: str, device: str | None, a
 @click.argument("block")
 @click.option("--depth", type=int, default=None, help="Steps (BMC) or induction length (default: the proof's own).")
 @click.option("--fresh", is_flag=True, help="Prove again even if build/ holds this exact proof's result.")
-@click.option("--json", "as_json", is_flag=True)
+@click.option("--json", "as_json", is_flag=True,
+              help="Print the proof's result as JSON on stdout (block, kind, depth, passed, trace).")
 def prove(block: str, depth: int | None, fresh: bool, as_json: bool) -> None:
     """Prove BLOCK's stream rules and pixel order formally (SymbiYosys); exit 1 with a VCD trace if one fails.
 

@@ -331,7 +331,8 @@ def render(scene: str, arch: str, size: str | None, output: str | None, z_bits: 
 @click.argument("b", type=click.Path(exists=True, dir_okay=False))
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="Write a diff image here.")
 @click.option("--tolerance", type=int, default=0, show_default=True, help="Per-channel difference allowed.")
-@click.option("--json", "as_json", is_flag=True)
+@click.option("--json", "as_json", is_flag=True,
+              help="Print the comparison as JSON on stdout (differing pixels, largest difference).")
 def compare(a: str, b: str, output: str | None, tolerance: int, as_json: bool) -> None:
     """Compare two images pixel by pixel; exit 1 if they differ beyond --tolerance."""
     from rasterhw.golden_model.compare import compare_images, diff_image
@@ -473,12 +474,14 @@ def sim_image_name(scene: str, block: str, engine: str, options: dict) -> Path:
 @click.option("--scene", default=None, help="Built-in scene or .obj/.ply (default: the block's own, "
               + ", ".join(f"{n}: {b.default_scene}" for n, (_, b) in registry.sim_blocks().items()) + ").")
 @click.option("--size", default=None, metavar="WxH", help="Frame size (default: the scene's own).")
-@click.option("--engine", type=click.Choice(ENGINES), default="verilator", show_default=True)
+@click.option("--engine", type=click.Choice(ENGINES), default="verilator", show_default=True,
+              help="Simulator: pysim (Amaranth's, no build), verilator (compiled once per design) or icarus (cocotb benches, where installed).")
 @_click_options(_SIM_OPTIONS)
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="PNG of the HDL frame.")
 @click.option("--waves", type=click.Path(dir_okay=False), default=None,
               help="Write a trace of the run to this .vcd (.fst where Verilator can write FST); several simulators: NAME.1.vcd, ... Off by default.")
-@click.option("--json", "as_json", is_flag=True)
+@click.option("--json", "as_json", is_flag=True,
+              help="Print the run's result as JSON on stdout (cycles, mismatches, pixels compared, timings).")
 def sim_cmd(block, scene, size, engine, output, waves, as_json, **block_options) -> None:
     """Run a scene through a block's HDL, compare with the golden model, write the frame."""
     from rasterhw.sim.engines.waves import recording
@@ -520,7 +523,8 @@ def sim_cmd(block, scene, size, engine, output, waves, as_json, **block_options)
 
 
 @cli.command()
-@click.option("--json", "as_json", is_flag=True)
+@click.option("--json", "as_json", is_flag=True,
+              help="Print the timings as JSON on stdout.")
 @click.option("--repeat", type=int, default=11, show_default=True, help="Runs per measurement (median reported).")
 @click.option("--hdl/--no-hdl", default=True, show_default=True, help="Also time HDL simulations (Verilator).")
 def bench(as_json: bool, repeat: int, hdl: bool) -> None:
@@ -555,7 +559,8 @@ def _scheduler_options(f):
 @click.option("--seed", type=int, default=None, help="Seed of every round (default: a fresh one, printed).")
 @click.option("--block", "blocks", multiple=True, help="Only these blocks (repeatable; default: every block).")
 @_scheduler_options
-@click.option("--json", "as_json", is_flag=True)
+@click.option("--json", "as_json", is_flag=True,
+              help="Print one JSON row per block on stdout (rounds, pixels, mismatches, seed).")
 def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], scheduler: str, store: str | None, fresh: bool,
          as_json: bool) -> None:
     """Random differential runs of every HDL block against its golden model on Verilator
@@ -635,7 +640,8 @@ def sweep(target: str, params: tuple[str, ...], scenes: tuple[str, ...], size: s
 
 
 @cli.command()
-@click.option("--out", "out_dir", type=click.Path(file_okay=False), default="out", show_default=True)
+@click.option("--out", "out_dir", type=click.Path(file_okay=False), default="out", show_default=True,
+              help="Folder for the images, summary.json, report.md and index.html.")
 @click.option("--scene", default="c300", show_default=True, help="Scene for the reference render.")
 @click.option("--engine", type=click.Choice(ENGINES), default="verilator",
               show_default=True, help="HDL simulator for the hardware runs.")
