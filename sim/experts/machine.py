@@ -20,6 +20,7 @@ MACHINE = Machine(
                          Option("sn", "SLPs (bands of scan lines) for the timing stats", 8, type=int),
                          Option("pn", "PXPs per SLP (ranges of each line) for the timing stats", 8, type=int))),),
     blocks={"experts-pxp": "rasterhw.hdl.experts.pxp:ExpertsPxp",
+            "experts-pxp-span": "rasterhw.hdl.experts.pxp_span:ExpertsPxpSpan",
             "experts-dmm": "rasterhw.hdl.experts.dmm:ExpertsDmm",
             "experts-pxp-unit": "rasterhw.hdl.experts.unit:ExpertsPxpUnit"},
     sims=(SimBlock("pxp", "every PXP line of the frame through the PXP HDL, against the bit-accurate golden PXP "

@@ -60,23 +60,70 @@ def job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
             "lo0": todo[0][1], "hi0": todo[0][2], "lines": len(todo), "aj": aj, "segments": per_job}
 
 
-def jobs(fr: ExpertsFrame, sn: int, pn: int, *, ranges: np.ndarray | None = None) -> dict:
-    """:func:`job_list` for every (line, PXP) of an Sn x Pn split, in frame order, plus each PXP's
+SPAN_BITS = 204         # dmm_layout().size (checked in span_job_list)
+
+
+def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
+    """:func:`job_list` for the span PXP (``experts-pxp-span``): per PXP line ``(y, lo, hi)`` the
+    DMM/P words the SLP writes (the line's whole ASL, the range's bucket list, the ``last`` token
+    with the leading pointer and the next job's range), the expected pixels and the cycles of
+    ``golden_model/experts/span_cycles.py``; ``visible`` per job (ASL record ids, -1 background)."""
+    from rasterhw.golden_model.experts.span_cycles import dmm_line, line_asl, line_job
+    from rasterhw.golden_model.experts.span_cycles import schedule as span_schedule
+    from rasterhw.hdl.experts.pxp_span import dmm_layout
+    from rasterhw.hdl.pack import pack
+    lay = dmm_layout()
+    if lay.size != SPAN_BITS:
+        raise RasterhwError(f"experts: the bench expects {SPAN_BITS}-bit DMM/P words, the span PXP has {lay.size}")
+    W = fr.width
+    aj = fr.aj
+    pix = pixel_words(fr.setup, fr.fields).reshape(fr.height, W)
+    cache: dict[int, tuple] = {}
+    words, exp_pix, lines, steps, visible = [], [], [], [], []
+    for k, (y, lo, hi) in enumerate(todo):
+        if y not in cache:
+            segs, ids = line_asl(fr, y)
+            cache = {y: (segs, ids, [pack(lay, {"last": 0, "list": 0, "ptr": 0, **s}) for s in segs])}
+        segs, ids, packed = cache[y]
+        _, lead, buckets = dmm_line(fr, y, [lo, hi])
+        job = line_job(segs, buckets[0], lead[0], lo, hi, aj=aj, width=W)
+        _, nlo, nhi = todo[k + 1] if k + 1 < len(todo) else todo[k]
+        words += packed
+        words += [pack(lay, {"list": 1, "ptr": b}) for b in buckets[0]]
+        words.append((nhi << (SPAN_BITS + 10)) | (nlo << SPAN_BITS) | pack(lay, {"last": 1, "ptr": lead[0]}))
+        lines.append((job["words"], job["resolve"], job["drain"]))
+        steps.append(job["steps"])
+        visible.append(np.array([int(ids[v]) if v >= 0 else -1 for v in job["visible"]], np.int64))
+        exp_pix.append(pix[y, lo:hi])
+    sch = span_schedule(lines)
+    return {"words": words, "pixels": np.concatenate(exp_pix).astype(np.int64) if exp_pix else np.zeros(0, np.int64),
+            "cycles": np.array(sch["line_cycles"], np.int64), "last_pixel": sch["last_pixel"],
+            "lo0": todo[0][1], "hi0": todo[0][2], "lines": len(todo), "aj": aj, "steps": steps,
+            "visible": visible, "timing": lines, "seg_bits": SPAN_BITS}
+
+
+def jobs(fr: ExpertsFrame, sn: int, pn: int, *, ranges: np.ndarray | None = None, pxp: str = "zbuffer") -> dict:
+    """:func:`job_list` (``pxp="span"``: :func:`span_job_list`) for every (line, PXP) of an Sn x Pn
+    split, in frame order, plus each PXP's
     own frame time by the cycle model (its band's lines back to back, as that PXP runs them):
     ``pxp_frame_cycles`` (Sn, Pn). ``ranges`` (H, Pn + 1): per-line boundaries (balancing);
     default the equal static split."""
+    from rasterhw.golden_model.experts.span_cycles import schedule as span_schedule
     H = fr.height
     bands = equal_bounds(H, sn)
     rbs = np.broadcast_to(equal_bounds(fr.width, pn) if ranges is None else np.asarray(ranges), (H, pn + 1))
     todo = [(y, int(rbs[y, p]), int(rbs[y, p + 1])) for y in range(H) for p in range(pn)]
-    jb = job_list(fr, todo)
+    jb = (span_job_list if pxp == "span" else job_list)(fr, todo)
     jb["owner"] = [(int(np.searchsorted(bands, y, side="right") - 1), p) for y in range(H) for p in range(pn)]
     per = np.zeros((sn, pn), np.int64)
     for sidx in range(sn):
         for p in range(pn):
             # job k = y * pn + p (frame order): its segments were clipped once, in job_list
-            own = [(jb["segments"][y * pn + p], int(rbs[y, p]), int(rbs[y, p + 1]))
-                   for y in range(int(bands[sidx]), int(bands[sidx + 1]))]
+            ys = range(int(bands[sidx]), int(bands[sidx + 1]))
+            if pxp == "span":
+                per[sidx, p] = span_schedule([jb["timing"][y * pn + p] for y in ys])["last_pixel"] + 1
+                continue
+            own = [(jb["segments"][y * pn + p], int(rbs[y, p]), int(rbs[y, p + 1])) for y in ys]
             per[sidx, p] = schedule(own, aj=fr.aj, width=fr.width)["last_pixel"] + 1
     jb["pxp_frame_cycles"] = per
     return jb
@@ -86,13 +133,15 @@ def run_pysim(jb: dict, *, width: int) -> dict:
     """Play the jobs through the Amaranth PXP in pysim."""
     from amaranth.sim import Simulator
     from rasterhw.hdl.experts.pxp import ExpertsPxp
+    from rasterhw.hdl.experts.pxp_span import ExpertsPxpSpan
     from rasterhw.sim.engines.harness import stream_sink
-    dut = ExpertsPxp(width=width, aj=jb["aj"])
+    bits = jb.get("seg_bits", SEG_BITS)
+    dut = (ExpertsPxpSpan if bits == SPAN_BITS else ExpertsPxp)(width=width, aj=jb["aj"])
     sim = Simulator(dut)
     sim.add_clock(1e-8)
     got, cyc = [], []
     n_lines = jb["lines"]
-    mask = (1 << SEG_BITS) - 1
+    mask = (1 << bits) - 1
 
     async def feed(ctx):
         ctx.set(dut.lo, jb["lo0"])
@@ -103,8 +152,8 @@ def run_pysim(jb: dict, *, width: int) -> dict:
             await ctx.tick().until(dut.i.ready)
             ctx.set(dut.i.valid, 0)
             if w & 1:
-                ctx.set(dut.lo, (w >> SEG_BITS) & 0x3FF)
-                ctx.set(dut.hi, (w >> (SEG_BITS + 10)) & 0x7FF)
+                ctx.set(dut.lo, (w >> bits) & 0x3FF)
+                ctx.set(dut.hi, (w >> (bits + 10)) & 0x7FF)
 
     npix = int(jb["pixels"].size)
     last = {}
@@ -135,15 +184,18 @@ def run_pysim(jb: dict, *, width: int) -> dict:
 NSEG_MAX, NOUT_MAX, NLINE_MAX = 1 << 19, 1 << 18, 1 << 14
 
 
-def _build(width: int, aj: str) -> tuple[Path, float]:
+def _build(width: int, aj: str, bits: int = SEG_BITS) -> tuple[Path, float]:
     from rasterhw.hdl.experts.pxp import ExpertsPxp
+    from rasterhw.hdl.experts.pxp_span import ExpertsPxpSpan
     from rasterhw.sim.engines.runner import build_plain_verilator
     from rasterhw.sim.engines.verilog_cache import convert_cached
-    src = convert_cached("experts-pxp", lambda: ExpertsPxp(width=width, aj=aj), params={"width": width, "aj": aj},
+    block, cls = ("experts-pxp-span", ExpertsPxpSpan) if bits == SPAN_BITS else ("experts-pxp", ExpertsPxp)
+    # both PXPs go into the bench as module experts_pxp (same ports; the span PXP's words are wider)
+    src = convert_cached(block, lambda: cls(width=width, aj=aj), params={"width": width, "aj": aj},
                          module="experts_pxp")
-    params = {"NSEG": NSEG_MAX, "NOUT": NOUT_MAX, "NLINE": NLINE_MAX}
+    params = {"NSEG": NSEG_MAX, "NOUT": NOUT_MAX, "NLINE": NLINE_MAX, "SEGW": bits}
     # 4 edges after done so the last line's finish-time counter is stored
-    return build_plain_verilator("experts-pxp", "tb_experts_pxp", [BENCH_DIR / "tb_experts_pxp.v"], params=params,
+    return build_plain_verilator(block, "tb_experts_pxp", [BENCH_DIR / "tb_experts_pxp.v"], params=params,
                                  defines={"RASTERHW_TAIL": 4}, generated={"experts_pxp.v": src})
 
 
@@ -166,7 +218,7 @@ def run_verilator(jb: dict, *, width: int, idle: int = 0, stall: int = 0, seed: 
     if nseg > NSEG_MAX or nout > NOUT_MAX or nline > NLINE_MAX:
         raise RasterhwError(f"experts: {nseg} words / {nout} pixels / {nline} lines exceed the bench's "
                             f"{NSEG_MAX} / {NOUT_MAX} / {NLINE_MAX}")
-    exe, build_s = _build(width, jb["aj"])
+    exe, build_s = _build(width, jb["aj"], jb.get("seg_bits", SEG_BITS))
     run_dir = temp_run_folder(exe.parent.parent)
     (run_dir / "seg.hex").write_text("\n".join(f"{w:x}" for w in jb["words"]) + "\n")
     meta = run_plain_verilator(exe, [f"+seg={run_dir / 'seg.hex'}", f"+out={run_dir / 'out.hex'}",
