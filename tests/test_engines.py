@@ -15,6 +15,7 @@ from rasterhw.sim.testbench import Expected, compare, find_testbench
 SMALL = {
     "experts-dmm": {"depth": 16},
     "experts-pxp": {"width": 64, "aj": "c"},
+    "experts-pxp-span": {"width": 64, "aj": "c"},
     "experts-pxp-unit": {"width": 64, "depth": 64},
     "zbm-merger": {"fifo_depth": 4},
     "zbm-seggen": {"width": 48, "height": 24, "capacity": 64},

@@ -35,9 +35,11 @@ MACHINE = Machine(
     soak={"pxp": "rasterhw.sim.experts.soak:pxp_round"},
     flows={"experts-dmm": Flow(small={"depth": 16}, clocks=(_NO_CLOCK,)),
            "experts-pxp": Flow(small={"width": 64}, clocks=(_NO_CLOCK,)),
+           "experts-pxp-span": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,)),
            "experts-pxp-unit": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,))},
     fpga_note="EXPERTS names no clock (docs/experts.md: times in operation times).",
     testbenches={"experts-pxp": "rasterhw.sim.experts.testbench:PxpBench",
+                 "experts-pxp-span": "rasterhw.sim.experts.testbench:PxpSpanBench",
                  "experts-pxp-unit": "rasterhw.sim.experts.testbench:PxpUnitBench",
                  "experts-dmm": "rasterhw.sim.experts.testbench:DmmBench"},
     status="scan-line golden model split as SLP/PXP (float and 16-bit): the paper's span PXP (span cull, "

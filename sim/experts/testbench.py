@@ -13,10 +13,10 @@ from rasterhw.golden_model.experts.pxp_cycles import line_segments
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.sim import registry
-from rasterhw.sim.experts.pxp_sim import SEG_BITS, job_list
+from rasterhw.sim.experts.pxp_sim import SEG_BITS, SPAN_BITS, job_list, span_job_list
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 
-__all__ = ["DmmBench", "PxpBench", "PxpUnitBench", "RangeFromTokens"]
+__all__ = ["DmmBench", "PxpBench", "PxpSpanBench", "PxpUnitBench", "RangeFromTokens"]
 
 _RANGE_BITS = 21          # next_hi[10:0], next_lo[9:0] above the segment payload (the jobs' words)
 
@@ -29,14 +29,15 @@ class RangeFromTokens(wiring.Component):
     samples when that line starts). The first line's range is ``[0, width)``. No register on the
     stream: the block sees every word in the cycle the bench offers it."""
 
-    def __init__(self, block, width: int):
-        self.block, self._width = block, width
-        super().__init__({"i": In(stream.Signature(SEG_BITS + _RANGE_BITS)), "o": Out(stream.Signature(16))})
+    def __init__(self, block, width: int, seg_bits: int = SEG_BITS):
+        self.block, self._width, self._bits = block, width, seg_bits
+        super().__init__({"i": In(stream.Signature(seg_bits + _RANGE_BITS)), "o": Out(stream.Signature(16))})
 
     def elaborate(self, platform):
         m = Module()
         m.submodules.block = b = self.block
         lo, hi = Signal(10, init=0), Signal(11, init=self._width)
+        SEG_BITS = self._bits
         seg = self.i.payload[:SEG_BITS]
         m.d.comb += [b.i.valid.eq(self.i.valid), b.i.payload.eq(seg), self.i.ready.eq(b.i.ready),
                      b.lo.eq(lo), b.hi.eq(hi)]
@@ -98,6 +99,30 @@ class PxpBench(Testbench):
         # takes the first word), and the last pixel leaves on the edge after its drain cycle: the
         # run's edges up to the last pixel are last_pixel + 2 (as tests/experts/test_experts_pxp_pysim.py)
         return Expected({"o": jb["pixels"].tolist()}, cycles=int(jb["last_pixel"]) + 2)
+
+
+class PxpSpanBench(PxpBench):
+    """``experts-pxp-span`` (the paper's PXP): per line the DMM/P words the SLP writes -- the
+    line's whole ASL, this PXP's block boundary bucket list, the ``last`` token with the block
+    leading segment pointer (and the next line's range for the adapter) -- in (``i``), the range's
+    pixel words out (``o``), as the golden bit model gives them; cycles from
+    ``golden_model/experts/span_cycles.py: schedule`` (last pixel's edge + 1)."""
+
+    block = "experts-pxp-span"
+
+    def dut(self, params: dict):
+        return RangeFromTokens(registry.load(registry.blocks()[self.block])(**params), params["width"], SPAN_BITS)
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        rng, name, fr = _frame(params, seed)
+        todo = _lines(rng, params["width"], int(rng.integers(2, 9)))
+        jb = span_job_list(fr, todo)
+        return Stimulus({"i": jb["words"]}, what=f"{name} at {params['width']}, {jb['lines']} lines, seed {seed}",
+                        source=jb)
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        jb = stim.source
+        return Expected({"o": jb["pixels"].tolist()}, cycles=int(jb["last_pixel"]) + 1)
 
 
 class PxpUnitBench(PxpBench):
