@@ -29,7 +29,10 @@ MACHINE = Machine(
                             Option("pn", "PXPs per SLP (ranges)", 8, type=int),
                             Option("aj", "anti-jagging in the PXP: none or c", "c", ("none", "a", "b", "c")),
                             Option("ranges", "PXP ranges: static, or set per line by method i / ii from the "
-                                   "previous line's finish-time counters", "static", ("static", "i", "ii")))),),
+                                   "previous line's finish-time counters", "static", ("static", "i", "ii")),
+                            Option("pxp", "PXP datapath: span (the paper's: span cull + depth search, "
+                                   "experts-pxp-span) or zbuffer (ours: a one-line Z-buffer, experts-pxp)", "span",
+                                   ("span", "zbuffer")))),),
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",
     soak={"pxp": "rasterhw.sim.experts.soak:pxp_round"},

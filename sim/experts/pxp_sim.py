@@ -23,9 +23,10 @@ from rasterhw.golden_model.experts.pxp_cycles import line_segments, schedule
 from rasterhw.sim.engines.runner import run_plain_verilator
 from rasterhw.sim.workdirs import release, temp_run_folder
 
-__all__ = ["jobs", "run_pysim", "run_verilator", "simulate_scene", "ENGINES"]
+__all__ = ["jobs", "span_job_list", "span_ranges", "run_pysim", "run_verilator", "simulate_scene", "ENGINES", "PXPS"]
 
 ENGINES = ("pysim", "verilator")
+PXPS = ("span", "zbuffer")
 BENCH_DIR = Path(__file__).resolve().parent / "verilator"
 SEG_BITS = 194          # seg_layout().size (checked in jobs)
 
@@ -127,6 +128,32 @@ def jobs(fr: ExpertsFrame, sn: int, pn: int, *, ranges: np.ndarray | None = None
             per[sidx, p] = schedule(own, aj=fr.aj, width=fr.width)["last_pixel"] + 1
     jb["pxp_frame_cycles"] = per
     return jb
+
+
+def span_ranges(fr: ExpertsFrame, sn: int, pn: int, method: str) -> np.ndarray:
+    """(H, Pn + 1) ranges for the span PXP set line by line by method i / ii
+    (:func:`parallel.rebalance`) from the previous line's finish-time counters of every PXP of the
+    band, each PXP's own lines back to back (``span_cycles.schedule``)."""
+    from rasterhw.golden_model.experts.parallel import Balance, rebalance
+    from rasterhw.golden_model.experts.span_cycles import dmm_line, line_job
+    from rasterhw.golden_model.experts.span_cycles import schedule as span_schedule
+    H, W = fr.height, fr.width
+    bands = equal_bounds(H, sn)
+    out = np.zeros((H, pn + 1), np.int64)
+    for s in range(sn):
+        widths = np.diff(equal_bounds(W, pn))
+        own: list[list] = [[] for _ in range(pn)]
+        for y in range(int(bands[s]), int(bands[s + 1])):
+            b = np.concatenate([[0], np.cumsum(widths)]).astype(np.int64)
+            out[y] = b
+            segs, lead, buckets = dmm_line(fr, y, b)
+            c = np.zeros(pn)
+            for p in range(pn):
+                j = line_job(segs, buckets[p], lead[p], int(b[p]), int(b[p + 1]), aj=fr.aj, width=W)
+                own[p].append((j["words"], j["resolve"], j["drain"]))
+                c[p] = span_schedule(own[p])["line_cycles"][-1]
+            widths = rebalance(widths, c, method, Balance())
+    return out
 
 
 def run_pysim(jb: dict, *, width: int) -> dict:
@@ -234,13 +261,19 @@ def run_verilator(jb: dict, *, width: int, idle: int = 0, stall: int = 0, seed: 
 
 def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", progress: bool = False,
                    sn: int | None = 8, pn: int | None = 8, aj: str | None = "c",
-                   ranges: str | None = "static", idle: int = 0, stall: int = 0, seed: int = 1) -> dict:
+                   ranges: str | None = "static", idle: int = 0, stall: int = 0, seed: int = 1,
+                   pxp: str | None = "span") -> dict:
     """Registry sim block ``pxp``: the whole frame through the PXP HDL, compared with the golden model.
+
+    ``pxp``: ``"span"`` (default, the paper's PXP: ``experts-pxp-span``, span cull and depth search
+    per span, the line's ASL and block lists through its DMM/P) or ``"zbuffer"`` (ours:
+    ``experts-pxp``, a one-line Z-buffer; the same pixels).
 
     ``idle`` / ``stall`` (Verilator only, 0..255): random input idle clocks / output back-pressure.
     Then the pixels are compared as always, and ``cycle_mismatches`` counts the lines that
-    finished *faster* than the cycle model (a stalled line may only be slower); ``0, 0`` is the
-    cycle-exact run (every line's finish-time counter equal to the model's)."""
+    finished *faster* than the cycle model (a stalled line may only be slower; span PXP: faster
+    than its resolve work alone); ``0, 0`` is the cycle-exact run (every line's finish-time
+    counter equal to the model's)."""
     from rasterhw.golden_model.pipeline import run_geometry
     if engine not in ENGINES:
         raise RasterhwError(f"experts: sim pxp engine must be one of {', '.join(ENGINES)}, not {engine!r}")
@@ -253,14 +286,19 @@ def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", pro
     ranges = "static" if ranges is None else ranges
     if ranges not in ("static", "i", "ii"):
         raise RasterhwError(f"experts: sim pxp ranges must be static, i or ii, not {ranges!r}")
+    pxp = "span" if pxp is None else pxp
+    if pxp not in PXPS:
+        raise RasterhwError(f"experts: sim pxp --pxp must be one of {', '.join(PXPS)}, not {pxp!r}")
     fr = render_frame(run_geometry(scene, width, height, z_bits=16), model="bit", aj=aj)
     rb = None
-    if ranges != "static":
+    if ranges != "static" and pxp == "span":
+        rb = span_ranges(fr, sn, pn, ranges)
+    elif ranges != "static":
         # ranges set line by line from the previous line's finish-time counters (the PXP HDL's
         # resolve cycles, as the cycle model the HDL matches gives them)
         from rasterhw.golden_model.experts.parallel import run_parallel
         rb = run_parallel(fr, sn, pn, band_method="equal", range_method=ranges, pxp_unit="cycles").ranges
-    jb = jobs(fr, sn, pn, ranges=rb)
+    jb = jobs(fr, sn, pn, ranges=rb, pxp=pxp)
     if progress:
         print(f"experts: {jb['lines']} PXP lines, {len(jb['words'])} words, {int(jb['cycles'].sum()):,} cycles expected", file=sys.stderr)
     exact = idle == 0 and stall == 0
@@ -273,6 +311,10 @@ def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", pro
     mism = int(np.count_nonzero(got[:n] != jb["pixels"][:n])) + abs(got.size - jb["pixels"].size)
     cyc = res["cycles"][:jb["lines"]]
     model = jb["cycles"][:cyc.size]
+    if not exact and pxp == "span":
+        # input idle delays a line's start and so may shorten its wait for the drain: the floor
+        # of a stalled span line is its own resolve work (+ the hand-over cycle)
+        model = np.array([t[1] + 1 for t in jb["timing"]], np.int64)[:cyc.size]
     cyc_mism = int(np.count_nonzero(cyc != model if exact else cyc < model)) + (jb["lines"] - cyc.size)
     # the HDL ran every line of every PXP, interleaved, and matched the cycle model line for line;
     # a PXP's frame time (its own lines back to back) is then the model's
@@ -283,7 +325,10 @@ def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", pro
             "mismatches": mism, "wall_s": round(time.perf_counter() - t0, 3),
             "cycles_per_s": round(total / res["run_s"], 1) if res["run_s"] > 0 else None,
             "cycle_mismatches": cyc_mism, "frame_cycles_busiest_pxp": frame_cycles,
-            "last_pixel_mismatch": int(total != jb["last_pixel"] + 2) if exact else 0,
+            "last_pixel_mismatch": int(total != jb["last_pixel"] + (1 if pxp == "span" else 2)) if exact else 0,
             "pxp_cycles_per_line_mean": round(float(cyc.mean()), 2) if cyc.size else 0.0,
             "pxp_clock_for_30fps_hz": frame_cycles * 30, "sn": sn, "pn": pn, "aj": aj, "ranges": ranges,
+            "pxp": pxp, "pxp_is": "the paper's (span cull + depth search)" if pxp == "span" else "ours (line Z-buffer)",
+            **({"span_steps": {k: int(sum(st[k] for st in jb["steps"])) for k in jb["steps"][0]}}
+               if pxp == "span" and jb["steps"] else {}),
             "run_s": round(res["run_s"], 3), "build_s": round(res.get("build_s", 0.0), 2)}
