@@ -17,6 +17,7 @@ SMALL = {
     "experts-pxp": {"width": 64, "aj": "c"},
     "experts-pxp-span": {"width": 64, "aj": "c"},
     "experts-pxp-unit": {"width": 64, "depth": 64},
+    "experts-slp": {"width": 64, "tris": 1024, "lines": 32, "asl": 256},
     "zbm-merger": {"fifo_depth": 4},
     "zbm-seggen": {"width": 48, "height": 24, "capacity": 64},
     "zbm-unit": {"interleave": 2, "width": 32, "height": 16, "capacity": 16},

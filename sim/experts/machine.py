@@ -21,6 +21,7 @@ MACHINE = Machine(
                          Option("pn", "PXPs per SLP (ranges of each line) for the timing stats", 8, type=int))),),
     blocks={"experts-pxp": "rasterhw.hdl.experts.pxp:ExpertsPxp",
             "experts-pxp-span": "rasterhw.hdl.experts.pxp_span:ExpertsPxpSpan",
+            "experts-slp": "rasterhw.hdl.experts.slp:ExpertsSlp",
             "experts-dmm": "rasterhw.hdl.experts.dmm:ExpertsDmm",
             "experts-pxp-unit": "rasterhw.hdl.experts.unit:ExpertsPxpUnit"},
     sims=(SimBlock("pxp", "every PXP line of the frame through the PXP HDL, against the bit-accurate golden PXP "
@@ -39,10 +40,12 @@ MACHINE = Machine(
     flows={"experts-dmm": Flow(small={"depth": 16}, clocks=(_NO_CLOCK,)),
            "experts-pxp": Flow(small={"width": 64}, clocks=(_NO_CLOCK,)),
            "experts-pxp-span": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,)),
+           "experts-slp": Flow(small={"width": 64, "tris": 64, "lines": 16, "asl": 32}, clocks=(_NO_CLOCK,)),
            "experts-pxp-unit": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,))},
     fpga_note="EXPERTS names no clock (docs/experts.md: times in operation times).",
     testbenches={"experts-pxp": "rasterhw.sim.experts.testbench:PxpBench",
                  "experts-pxp-span": "rasterhw.sim.experts.testbench:PxpSpanBench",
+                 "experts-slp": "rasterhw.sim.experts.testbench:SlpBench",
                  "experts-pxp-unit": "rasterhw.sim.experts.testbench:PxpUnitBench",
                  "experts-dmm": "rasterhw.sim.experts.testbench:DmmBench"},
     status="scan-line golden model split as SLP/PXP (float and 16-bit): the paper's span PXP (span cull, "

@@ -16,7 +16,7 @@ from rasterhw.sim import registry
 from rasterhw.sim.experts.pxp_sim import SEG_BITS, SPAN_BITS, job_list, span_job_list
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 
-__all__ = ["DmmBench", "PxpBench", "PxpSpanBench", "PxpUnitBench", "RangeFromTokens"]
+__all__ = ["DmmBench", "PxpBench", "PxpSpanBench", "PxpUnitBench", "RangeFromTokens", "SlpBench", "slp_words"]
 
 _RANGE_BITS = 21          # next_hi[10:0], next_lo[9:0] above the segment payload (the jobs' words)
 
@@ -166,3 +166,46 @@ class DmmBench(Testbench):
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         return Expected({"o": list(stim.words["i"])})
+
+
+def slp_words(fr, band: tuple[int, int], bounds, *, guard: int) -> dict:
+    """``experts-slp`` stimulus and expectation for one band of a frame: the input words (band,
+    range bounds, PL triangles, go), the output words and cycles of
+    ``golden_model/experts/slp_cycles.py: band_run`` (its ``line_cycles`` and ``asl`` too)."""
+    from rasterhw.golden_model.experts.slp_cycles import band_run, tri_words
+    from rasterhw.hdl.experts.slp import IN_KIND, slp_in_layout, slp_out_layout
+    from rasterhw.hdl.pack import pack
+    li, lo = slp_in_layout(), slp_out_layout()
+    tws = tri_words(fr.setup)
+    br = band_run(tws, band, bounds, width=fr.width, guard=guard)
+    words = [pack(li, {"kind": IN_KIND["band"], "r0": band[0], "r1": band[1]})]
+    words += [pack(li, {"kind": IN_KIND["bound"], "xa": int(v)}) for v in bounds]
+    words += [pack(li, {"kind": IN_KIND["tri"], **tw}) for tw in tws] + [pack(li, {"kind": IN_KIND["go"]})]
+    out = [pack(lo, {"kind": k, "p": p, "pos": pos, "t": t, "y": y}) for k, p, pos, t, y in br["words"]]
+    return {"in": words, "out": out, **br, "tris": len(tws)}
+
+
+class SlpBench(Testbench):
+    """``experts-slp``: one band of a random frame -- band, PXP range bounds, the PL triangles with
+    their set-up, go -- in (``i``); per line the ASL words with the leading pointers and bucket
+    entries as the walk finds them, then the end-of-line word, out (``o``), as
+    ``golden_model/experts/slp_cycles.py`` gives them (from ``slp_run``'s sorts, run); cycles: the
+    last output's edge + 1 = every term of ``band_run`` summed."""
+
+    block = "experts-slp"
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        rng, name, fr = _frame({"width": params["width"], "aj": "c" if params["guard"] else "none"}, seed)
+        H = fr.height
+        n = int(rng.integers(1, min(params["lines"], H) + 1))
+        y0 = int(rng.integers(0, H - n + 1))
+        from rasterhw.golden_model.experts.model import equal_bounds
+        pn = int(rng.integers(1, 5))
+        sw = slp_words(fr, (y0, y0 + n), equal_bounds(params["width"], pn), guard=params["guard"])
+        if sw["tris"] > params["tris"]:
+            raise ValueError(f"{name}: {sw['tris']} triangles, the SLP holds {params['tris']}")
+        return Stimulus({"i": sw["in"]}, what=f"{name} at {params['width']}, band {y0}..{y0 + n}, {pn} ranges, "
+                        f"seed {seed}", source=sw)
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        return Expected({"o": stim.source["out"]}, cycles=int(stim.source["cycles"]))
