@@ -33,7 +33,14 @@ MACHINE = Machine(
                                    "previous line's finish-time counters", "static", ("static", "i", "ii")),
                             Option("pxp", "PXP datapath: span (the paper's: span cull + depth search, "
                                    "experts-pxp-span) or zbuffer (ours: a one-line Z-buffer, experts-pxp)", "span",
-                                   ("span", "zbuffer")))),),
+                                   ("span", "zbuffer")))),
+          SimBlock("experts", "the whole frame: every band through the SLP HDL (experts-slp), its ASL order and "
+                   "block lists then into every span PXP's DMM/P (experts-pxp-span); words, pixels and cycles "
+                   "against golden, SLP and PXP clocks for 30 frames/s", "rasterhw.sim.experts.frame_sim:simulate_frame",
+                   default_scene="experts-1000",
+                   options=(Option("sn", "SLPs (bands)", 8, type=int),
+                            Option("pn", "PXPs per SLP (ranges)", 8, type=int),
+                            Option("aj", "anti-jagging in the PXP: none or c", "c", ("none", "c")))),),
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",
     soak={"pxp": "rasterhw.sim.experts.soak:pxp_round"},

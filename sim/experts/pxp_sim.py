@@ -64,12 +64,15 @@ def job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
 SPAN_BITS = 204         # dmm_layout().size (checked in span_job_list)
 
 
-def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
+def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict | None = None) -> dict:
     """:func:`job_list` for the span PXP (``experts-pxp-span``): per PXP line ``(y, lo, hi)`` the
     DMM/P words the SLP writes (the line's whole ASL, the range's bucket list, the ``last`` token
     with the leading pointer and the next job's range), the expected pixels and the cycles of
-    ``golden_model/experts/span_cycles.py``; ``visible`` per job (ASL record ids, -1 background)."""
-    from rasterhw.golden_model.experts.span_cycles import dmm_line, line_asl, line_job
+    ``golden_model/experts/span_cycles.py``; ``visible`` per job (ASL record ids, -1 background).
+    ``slp``: ``{(y, lo, hi): (PL indices in ASL order, leading pointer, bucket list)}`` as an SLP
+    (the ``experts-slp`` HDL) made them, instead of the golden SLP's (the ASB fields of each
+    segment come from the golden records either way)."""
+    from rasterhw.golden_model.experts.span_cycles import NO_PTR, dmm_line, line_asl, line_job
     from rasterhw.golden_model.experts.span_cycles import schedule as span_schedule
     from rasterhw.hdl.experts.pxp_span import dmm_layout
     from rasterhw.hdl.pack import pack
@@ -84,9 +87,19 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
     for k, (y, lo, hi) in enumerate(todo):
         if y not in cache:
             segs, ids = line_asl(fr, y)
+            if slp is not None:       # the SLP's ASL order (a wrong one shows as wrong pixels)
+                by_t = {s["addr"]: (s, r) for s, r in zip(segs, ids, strict=True)}
+                order = slp[(y, lo, hi)][0]
+                if sorted(order) != sorted(by_t):
+                    raise RasterhwError(f"experts: the SLP's ASL of line {y} is not the line's segments")
+                segs, ids = [by_t[t][0] for t in order], np.array([by_t[t][1] for t in order], np.int64)
             cache = {y: (segs, ids, [pack(lay, {"last": 0, "list": 0, "ptr": 0, **s}) for s in segs])}
         segs, ids, packed = cache[y]
-        _, lead, buckets = dmm_line(fr, y, [lo, hi])
+        if slp is None:
+            _, lead, buckets = dmm_line(fr, y, [lo, hi])
+        else:
+            _, ld, bk = slp[(y, lo, hi)]
+            lead, buckets = [NO_PTR if ld < 0 else ld], [bk]
         job = line_job(segs, buckets[0], lead[0], lo, hi, aj=aj, width=W)
         _, nlo, nhi = todo[k + 1] if k + 1 < len(todo) else todo[k]
         words += packed
@@ -103,7 +116,8 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
             "visible": visible, "timing": lines, "seg_bits": SPAN_BITS}
 
 
-def jobs(fr: ExpertsFrame, sn: int, pn: int, *, ranges: np.ndarray | None = None, pxp: str = "zbuffer") -> dict:
+def jobs(fr: ExpertsFrame, sn: int, pn: int, *, ranges: np.ndarray | None = None, pxp: str = "zbuffer",
+         slp: dict | None = None) -> dict:
     """:func:`job_list` (``pxp="span"``: :func:`span_job_list`) for every (line, PXP) of an Sn x Pn
     split, in frame order, plus each PXP's
     own frame time by the cycle model (its band's lines back to back, as that PXP runs them):
@@ -114,7 +128,7 @@ def jobs(fr: ExpertsFrame, sn: int, pn: int, *, ranges: np.ndarray | None = None
     bands = equal_bounds(H, sn)
     rbs = np.broadcast_to(equal_bounds(fr.width, pn) if ranges is None else np.asarray(ranges), (H, pn + 1))
     todo = [(y, int(rbs[y, p]), int(rbs[y, p + 1])) for y in range(H) for p in range(pn)]
-    jb = (span_job_list if pxp == "span" else job_list)(fr, todo)
+    jb = span_job_list(fr, todo, slp) if pxp == "span" else job_list(fr, todo)
     jb["owner"] = [(int(np.searchsorted(bands, y, side="right") - 1), p) for y in range(H) for p in range(pn)]
     per = np.zeros((sn, pn), np.int64)
     for sidx in range(sn):
