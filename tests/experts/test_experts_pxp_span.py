@@ -1,3 +1,4 @@
+# amaranth: UnusedElaboratable=no
 """The span PXP (``experts-pxp-span``, the paper's: span cull and depth search per span) against
 its golden side (``golden_model/experts/span_cycles.py``): the same visible segment per pixel as
 the per-pixel depth search and as ``span.py``, pixels and per-line cycles equal in pysim, work that
@@ -112,3 +113,35 @@ def test_block_lists_reach_the_pxp_as_data():
 def test_bad_pxp_is_one_line_error():
     with pytest.raises(RasterhwError, match="--pxp must be one of span, zbuffer"):
         simulate_scene(build_scene("experts-tilt-1000"), 64, 16, pxp="linez")
+
+
+def test_dmm_bank_overflow_stalls_the_writer_never_drops():
+    """A line with more ASBs than a DMM/P bank holds: the word that does not fit is not taken,
+    ``overflow`` rises and stays, and no pixel comes out of a half-written line."""
+    from amaranth.sim import Simulator
+    from rasterhw.hdl.experts.pxp_span import ExpertsPxpSpan, dmm_layout
+    from rasterhw.hdl.pack import pack
+    lay = dmm_layout()
+    seg = {"xl": 0, "xr": 8 << 6, "zl": 10, "il": 0, "dzdx": 0, "didx": 0, "addr": 1}
+    words = [pack(lay, seg)] * 5 + [pack(lay, {"last": 1, "ptr": 0})]
+    dut = ExpertsPxpSpan(width=16, depth=4)
+    sim = Simulator(dut)
+    sim.add_clock(1e-8)
+    seen = {}
+
+    async def bench(ctx):
+        ctx.set(dut.hi, 16)
+        ctx.set(dut.o.ready, 1)
+        taken = outs = 0
+        for _ in range(60):
+            k = min(taken, len(words) - 1)
+            ctx.set(dut.i.payload.as_value(), words[k])
+            ctx.set(dut.i.valid, 1)
+            _, _, rdy, ov = await ctx.tick().sample(dut.i.ready, dut.o.valid)
+            taken += int(rdy)
+            outs += int(ov)
+        seen.update(taken=taken, outs=outs, overflow=ctx.get(dut.overflow), ready=ctx.get(dut.i.ready))
+
+    sim.add_testbench(bench)
+    sim.run()
+    assert seen == {"taken": 4, "outs": 0, "overflow": 1, "ready": 0}
