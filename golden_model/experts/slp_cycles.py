@@ -28,13 +28,15 @@ from __future__ import annotations
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.golden_model.experts.formats import ACC_EXTRA, ADDR_BITS, X_FRAC
+from rasterhw.golden_model.experts.formats import ACC_EXTRA, ADDR_BITS, SLOPE_FRAC, X_FRAC, sat
 from rasterhw.golden_model.experts.slp import rom_div
 from rasterhw.golden_model.experts.slp_run import block_lists, bubble_sort, bucket_sort, merge, merge_sort
 
-__all__ = ["TRI_FIELDS", "KIND", "tri_words", "band_run"]
+__all__ = ["TRI_FIELDS", "KIND", "tri_words", "asb", "band_run"]
 
-TRI_FIELDS = ("t", "r0", "r1", "ll", "xa", "ya", "xb", "yb", "inc_ac", "inc_ab", "inc_bc")
+TRI_FIELDS = ("t", "r0", "r1", "ll", "xa", "ya", "xb", "yb", "inc_ac", "inc_ab", "inc_bc",
+              "za", "zb", "zinc_ac", "zinc_ab", "zinc_bc", "ia", "ib", "iinc_ac", "iinc_ab", "iinc_bc",
+              "dzdx", "didx", "hue", "poly", "s_ac", "s_ab", "s_bc", "q_ac", "q_ab", "q_bc")
 KIND = {"asl": 0, "lead": 1, "bucket": 2, "eol": 3}
 _INC_MASK = (1 << 48) - 1
 
@@ -54,10 +56,34 @@ def tri_words(st) -> list[dict]:
         safe = np.where(d == 0, 1, d)
         return np.where(d == 0, 0, rom_div(X[j] - X[i], safe, sh))
 
+    def ainc(A, i, j):
+        d = Y[j] - Y[i]
+        safe = np.where(d == 0, 1, d)
+        return np.where(d == 0, 0, rom_div(A[j] - A[i], safe, sh))
+
     ac, ab, bc = inc(0, 2), inc(0, 1), inc(1, 2)
-    return [{"t": t, "r0": int(st.r0[t]), "r1": int(st.r1[t]), "ll": int(bool(st.long_left[t])),
-             "xa": int(X[0, t]), "ya": int(Y[0, t]), "xb": int(X[1, t]), "yb": int(Y[1, t]),
-             "inc_ac": int(ac[t]), "inc_ab": int(ab[t]), "inc_bc": int(bc[t])} for t in range(st.n)]
+    Z, Iv = st.Z.astype(np.int64), st.Iv.astype(np.int64)
+    zi = {f"{n}{i}{j}": ainc(A, i, j) for n, A in (("z", Z), ("i", Iv)) for i, j in ((0, 2), (0, 1), (1, 2))}
+    # the A.J. slopes of each edge, sQ7.8 (slp.asl_update's rule), selected per line like x
+    slopes, recips = {}, {}
+    for e, (i, j) in (("ac", (0, 2)), ("ab", (0, 1)), ("bc", (1, 2))):
+        dX, dY = X[j] - X[i], Y[j] - Y[i]
+        slopes[e] = np.where(dY == 0, 0, sat(rom_div(dX, np.where(dY == 0, 1, dY), SLOPE_FRAC), 16))
+        recips[e] = np.where(dX == 0, (1 << 15) - 1, sat(rom_div(dY, np.where(dX == 0, 1, dX), SLOPE_FRAC), 16))
+    out = []
+    for t in range(st.n):
+        h = st.hue[t]
+        out.append({"t": t, "r0": int(st.r0[t]), "r1": int(st.r1[t]), "ll": int(bool(st.long_left[t])),
+                    "xa": int(X[0, t]), "ya": int(Y[0, t]), "xb": int(X[1, t]), "yb": int(Y[1, t]),
+                    "inc_ac": int(ac[t]), "inc_ab": int(ab[t]), "inc_bc": int(bc[t]),
+                    "za": int(Z[0, t]), "zb": int(Z[1, t]), "zinc_ac": int(zi["z02"][t]),
+                    "zinc_ab": int(zi["z01"][t]), "zinc_bc": int(zi["z12"][t]),
+                    "ia": int(Iv[0, t]), "ib": int(Iv[1, t]), "iinc_ac": int(zi["i02"][t]),
+                    "iinc_ab": int(zi["i01"][t]), "iinc_bc": int(zi["i12"][t]),
+                    "dzdx": int(st.dzdx[t]), "didx": int(st.didx[t]),
+                    "hue": int((h[0] << 6) | (h[1] << 3) | h[2]), "poly": int(st.poly[t]),
+                    **{f"{k}_{e}": int(v[e][t]) for k, v in (("s", slopes), ("q", recips)) for e in ("ac", "ab", "bc")}})
+    return out
 
 
 def _x(tw: dict, y: int) -> tuple[int, int]:
@@ -72,9 +98,33 @@ def _x(tw: dict, y: int) -> tuple[int, int]:
     return (lng, sht) if tw["ll"] else (sht, lng)
 
 
+def asb(tw: dict, y: int) -> dict:
+    """The ASB of triangle word ``tw`` on line ``y`` as the SLP writes it into the DMM/P: x_L, x_R,
+    and z_L, i_L, the A.J. slopes of the left and right edges (the edge of each chosen as for x),
+    with the triangle's dz/dx, di/dx, hue, PL index and polygon number."""
+    yc = (y << X_FRAC) + (1 << (X_FRAC - 1))
+    upper = yc < tw["yb"]
+
+    def edge(a0, y0, inc):
+        return ((a0 << ACC_EXTRA) + (((yc - y0) * inc) >> X_FRAC)) >> ACC_EXTRA
+
+    def left_right(pre, a, b):
+        lng = edge(tw[a], tw["ya"], tw[f"{pre}inc_ac"])
+        sht = edge(tw[a], tw["ya"], tw[f"{pre}inc_ab"]) if upper else edge(tw[b], tw["yb"], tw[f"{pre}inc_bc"])
+        return (lng, sht) if tw["ll"] else (sht, lng)
+    xl, xr = left_right("", "xa", "xb")
+    zl, _ = left_right("z", "za", "zb")
+    il, _ = left_right("i", "ia", "ib")
+    es = "ab" if upper else "bc"
+    le, re = ("ac", es) if tw["ll"] else (es, "ac")
+    return {"xl": xl, "xr": xr, "zl": zl, "il": il, "dzdx": tw["dzdx"], "didx": tw["didx"], "hue": tw["hue"],
+            "addr": tw["t"], "poly": tw["poly"], "sl": tw[f"s_{le}"], "ql": tw[f"q_{le}"], "sr": tw[f"s_{re}"],
+            "qr": tw[f"q_{re}"]}
+
+
 def band_run(tws: list[dict], band: tuple[int, int], bounds, *, width: int, guard: int = 0) -> dict:
     """One band through the SLP: per line the ASL (PL indices in ASL order), the output words
-    ``(kind, p, pos, t, y)`` in order, and cycles (:data:`__doc__`); ``start_cycles`` before line 0."""
+    ``(kind, p, pos, t, y, ASB or None)`` in order, and cycles (:data:`__doc__`); ``start_cycles`` before line 0."""
     y0, y1 = band
     b = np.asarray(bounds, dtype=np.int64)
     P = len(b) - 1
@@ -116,25 +166,25 @@ def band_run(tws: list[dict], band: tuple[int, int], bounds, *, width: int, guar
         words = []
         q = 0
         for pos, t in enumerate(cur):
-            words.append((KIND["asl"], 0, pos, t, y))
+            words.append((KIND["asl"], 0, pos, t, y, asb(tws[t], y)))
             cyc += 1
             a, e = int(c0[pos]), int(c1[pos])
             if e < a:
                 continue
             while q < P and a >= glo[q]:
                 if live[q] and a < ghi[q]:
-                    words.append((KIND["lead"], q, pos, t, y))
+                    words.append((KIND["lead"], q, pos, t, y, None))
                 q += 1
                 cyc += 1
             cyc += 1
             k = q
             while k < P and glo[k] <= e:
                 if live[k]:
-                    words.append((KIND["bucket"], k, pos, t, y))
+                    words.append((KIND["bucket"], k, pos, t, y, None))
                 k += 1
                 cyc += 1
             cyc += 1
-        words.append((KIND["eol"], 0, 0, 0, y))
+        words.append((KIND["eol"], 0, 0, 0, y, None))
         cyc += 1
         lead, bk, _ = block_lists(list(range(len(cur))), c0, c1, b, guard=guard, width=W)
         assert lead == [next((w[2] for w in words if w[0] == 1 and w[1] == p), -1) for p in range(P)]

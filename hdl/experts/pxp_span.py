@@ -55,7 +55,7 @@ from rasterhw.golden_model.experts.formats import (
     Formats,
 )
 
-__all__ = ["ExpertsPxpSpan", "dmm_layout", "PTR_BITS", "NO_PTR"]
+__all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "PTR_BITS", "NO_PTR"]
 
 NONE = (1 << ADDR_BITS) - 1     # ASB address / polygon number of the background
 PTR_BITS = 9                    # ASL position in a DMM/P bank
@@ -84,7 +84,8 @@ def dmm_layout() -> data.StructLayout:
     })
 
 
-def _asb_layout() -> data.StructLayout:
+def asb_layout() -> data.StructLayout:
+    """The ASB fields of a DMM/P word (without ``last``, ``list``, ``ptr``)."""
     lay = dict(dmm_layout().members)
     for k in ("last", "list", "ptr"):
         lay.pop(k)
@@ -180,7 +181,7 @@ class ExpertsPxpSpan(wiring.Component):
         W = self._width
         D = self._depth
         aj = self._aj == "c"
-        asb = _asb_layout()
+        asb = asb_layout()
         pw = (D - 1).bit_length()                   # ASL position bits within a bank
         cw = D.bit_length()                         # counts 0..D
         ab = (W - 1).bit_length()                   # DSLB bank bit position

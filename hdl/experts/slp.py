@@ -1,4 +1,4 @@
-"""EXPERTS scan line processor (SLP), its list work: Y-sort, ASL update of x, L-sort, X-merge, block lists.
+"""EXPERTS scan line processor (SLP): Y-sort, ASL update, L-sort, X-merge, block lists, the ASBs for the DMM/P.
 
 Paper (seed 000, section 4): the SLP "すべての稜線を、y_min ... をキーとしてバケットソートする" (Y-sort),
 per line "1スキャン・ライン内に現われるセグメントを、その左稜線のxs座標値をキーとして、マージソートする"
@@ -19,7 +19,9 @@ One band at a time, as ``golden_model/experts/slp_run.py`` runs it (the rules ar
   bucket walked (ASL update of each entering segment), merge-sorted bottom up (one move a cycle, one
   cycle to set up a level), then merged into the survivors (one move a cycle; survivors first on
   equal keys, as ``slp_run.merge``);
-* **block lists**: one walk of the new ASL: its ASL word, then the leading pointer of every range
+* **block lists**: one walk of the new ASL: its ASL word (the whole ASB: x_L, x_R, and z_L, i_L
+  from the left edge's accumulators, the line's edge slopes, the set-up values), then the leading
+  pointer of every range
   whose start it is the first to reach and its entry in the bucket list of every later range it
   reaches (``slp_run.block_lists``; ranges widened by ``guard`` pixels each side), one cycle per
   test; then the end-of-line word.
@@ -58,16 +60,38 @@ def slp_in_layout() -> data.StructLayout:
         "inc_ac": signed(48),          # edge increments per line, Q.22 (slp.rom_div)
         "inc_ab": signed(48),
         "inc_bc": signed(48),
+        "za": unsigned(16),            # z at a and b, Q16.0, and the edges' z increments
+        "zb": unsigned(16),
+        "zinc_ac": signed(48),
+        "zinc_ab": signed(48),
+        "zinc_bc": signed(48),
+        "ia": unsigned(16),            # intensity at a and b, and the edges' increments
+        "ib": unsigned(16),
+        "iinc_ac": signed(48),
+        "iinc_ab": signed(48),
+        "iinc_bc": signed(48),
+        "dzdx": signed(16),            # eq. (3), passed into the ASB
+        "didx": signed(16),
+        "hue": unsigned(9),
+        "poly": unsigned(ADDR_BITS),
+        "s_ac": signed(16),            # A.J.: each edge's dx/dy and dy/dx, sQ7.8
+        "s_ab": signed(16),
+        "s_bc": signed(16),
+        "q_ac": signed(16),
+        "q_ab": signed(16),
+        "q_bc": signed(16),
     })
 
 
 def slp_out_layout() -> data.StructLayout:
+    from rasterhw.hdl.experts.pxp_span import asb_layout
     return data.StructLayout({
         "kind": unsigned(2),           # 0 ASL word, 1 leading pointer, 2 bucket entry, 3 end of line
         "p": unsigned(6),              # range
         "pos": unsigned(9),            # ASL position
         "t": unsigned(ADDR_BITS),
         "y": unsigned(10),
+        "asb": asb_layout(),           # ASL word: the ASB as it goes into the DMM/P
     })
 
 
@@ -132,9 +156,7 @@ class ExpertsSlp(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         W, G = self._w, self._guard
-        tl = data.StructLayout({"r1": unsigned(10), "ll": unsigned(1), "xa": signed(16), "ya": signed(16),
-                                "xb": signed(16), "yb": signed(16), "inc_ac": signed(48), "inc_ab": signed(48),
-                                "inc_bc": signed(48)})
+        tl = data.StructLayout({k: v for k, v in slp_in_layout().members.items() if k not in ("kind", "t", "r0")})
         tb = ADDR_BITS
         lb = max((self._lines - 1).bit_length(), 1)
         ab = max((self._asl - 1).bit_length(), 1)
@@ -206,6 +228,18 @@ class ExpertsSlp(wiring.Component):
         m.d.comb += sht.eq(Mux(yc < tv.yb, up, lo_))
         newx = Signal(xs)
         m.d.comb += [newx.xl.eq(Mux(tv.ll, lng, sht)), newx.xr.eq(Mux(tv.ll, sht, lng))]
+        # the rest of the ASL update, for the ASB written at the walk: z_L, i_L of the left edge
+        # (two multiplies each, the edge chosen as for x) and the A.J. slopes of both edges
+        def left(a_a, a_b, i_ac, i_ab, i_bc, name):
+            lg = edge(a_a, tv.ya, i_ac, f"{name}_long")
+            sh = Mux(yc < tv.yb, edge(a_a, tv.ya, i_ab, f"{name}_ab"), edge(a_b, tv.yb, i_bc, f"{name}_bc"))
+            v = Signal(signed(80), name=f"{name}_left")
+            m.d.comb += v.eq(Mux(tv.ll, lg, sh))
+            return v
+        zl_ = left(tv.za, tv.zb, tv.zinc_ac, tv.zinc_ab, tv.zinc_bc, "z")
+        il_ = left(tv.ia, tv.ib, tv.iinc_ac, tv.iinc_ab, tv.iinc_bc, "i")
+        s_sh, q_sh = Signal(signed(16)), Signal(signed(16))
+        m.d.comb += [s_sh.eq(Mux(yc < tv.yb, tv.s_ab, tv.s_bc)), q_sh.eq(Mux(yc < tv.yb, tv.q_ab, tv.q_bc))]
 
         def less(ka, ta, kb, tb_):
             """(x_L, PL index) of a before b."""
@@ -339,8 +373,13 @@ class ExpertsSlp(wiring.Component):
 
             # ------------------------------------------------------------ block lists
             with m.Case(_S.WSEG):
-                m.d.comb += [ar.addr.eq(pos), ky0.addr.eq(ar.data),
-                             self.o.valid.eq(1), o_.kind.eq(0), o_.pos.eq(pos), o_.t.eq(ar.data), o_.y.eq(y)]
+                m.d.comb += [ar.addr.eq(pos), ky0.addr.eq(ar.data), ttr.addr.eq(ar.data),
+                             self.o.valid.eq(1), o_.kind.eq(0), o_.pos.eq(pos), o_.t.eq(ar.data), o_.y.eq(y),
+                             o_.asb.xl.eq(ky0.data.xl), o_.asb.xr.eq(ky0.data.xr), o_.asb.zl.eq(zl_),
+                             o_.asb.il.eq(il_), o_.asb.dzdx.eq(tv.dzdx), o_.asb.didx.eq(tv.didx),
+                             o_.asb.hue.eq(tv.hue), o_.asb.addr.eq(ar.data), o_.asb.poly.eq(tv.poly),
+                             o_.asb.sl.eq(Mux(tv.ll, tv.s_ac, s_sh)), o_.asb.ql.eq(Mux(tv.ll, tv.q_ac, q_sh)),
+                             o_.asb.sr.eq(Mux(tv.ll, s_sh, tv.s_ac)), o_.asb.qr.eq(Mux(tv.ll, q_sh, tv.q_ac))]
                 c0, c1 = Signal(signed(12)), Signal(signed(12))
                 m.d.comb += [c0.eq((ky0.data.xl + 31) >> X_FRAC), c1.eq(((ky0.data.xr + 31) >> X_FRAC) - 1)]
                 with m.If(self.o.ready):

@@ -28,16 +28,22 @@ from rasterhw.sim.experts.pxp_sim import ENGINES, jobs, run_pysim, run_verilator
 __all__ = ["simulate_frame", "decode_slp"]
 
 
-def decode_slp(words: list[int]) -> list[tuple[int, int, int, int, int]]:
-    """``experts-slp`` output words -> ``(kind, p, pos, t, y)``."""
+def decode_slp(words: list[int]) -> list[tuple]:
+    """``experts-slp`` output words -> ``(kind, p, pos, t, y, ASB dict)`` (signed fields sign-extended)."""
+    from amaranth import Shape
     from rasterhw.hdl.experts.slp import slp_out_layout
     lay = slp_out_layout()
-    offs, o = {}, 0
-    for name, f in lay.members.items():
-        w = f.width if hasattr(f, "width") else f.shape().width
-        offs[name] = (o, (1 << w) - 1)
-        o += w
-    return [tuple((v >> offs[n][0]) & offs[n][1] for n in ("kind", "p", "pos", "t", "y")) for v in words]
+    top = {n: (f.offset, Shape.cast(f.shape).width) for n, f in lay}
+    sub = [(n, top["asb"][0] + f.offset, Shape.cast(f.shape)) for n, f in lay.members["asb"]]
+
+    def field(v, off, w, signed=False):
+        x = (v >> off) & ((1 << w) - 1)
+        return x - (1 << w) if signed and x >> (w - 1) else x
+    out = []
+    for v in words:
+        head = tuple(field(v, top[n][0], top[n][1]) for n in ("kind", "p", "pos", "t", "y"))
+        out.append((*head, {n: field(v, off, sh.width, sh.signed) for n, off, sh in sub}))
+    return out
 
 
 def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator", progress: bool = False,
@@ -90,9 +96,9 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
     # ---- the HDL SLP's lists -> every PXP's DMM/P words
     lists: dict = {}
     line: dict = {"asl": [], "lead": {}, "bk": {}}
-    for kind, q, pos, tt, y in dec:
+    for kind, q, pos, _t, y, a in dec:
         if kind == 0:
-            line["asl"].append(tt)
+            line["asl"].append(a)
         elif kind == 1:
             line["lead"][q] = pos
         elif kind == 2:

@@ -69,9 +69,8 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
     DMM/P words the SLP writes (the line's whole ASL, the range's bucket list, the ``last`` token
     with the leading pointer and the next job's range), the expected pixels and the cycles of
     ``golden_model/experts/span_cycles.py``; ``visible`` per job (ASL record ids, -1 background).
-    ``slp``: ``{(y, lo, hi): (PL indices in ASL order, leading pointer, bucket list)}`` as an SLP
-    (the ``experts-slp`` HDL) made them, instead of the golden SLP's (the ASB fields of each
-    segment come from the golden records either way)."""
+    ``slp``: ``{(y, lo, hi): (the ASBs in ASL order, leading pointer, bucket list)}`` as an SLP
+    (the ``experts-slp`` HDL) wrote them, instead of the golden SLP's."""
     from rasterhw.golden_model.experts.span_cycles import NO_PTR, dmm_line, line_asl, line_job
     from rasterhw.golden_model.experts.span_cycles import schedule as span_schedule
     from rasterhw.hdl.experts.pxp_span import dmm_layout
@@ -87,12 +86,12 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
     for k, (y, lo, hi) in enumerate(todo):
         if y not in cache:
             segs, ids = line_asl(fr, y)
-            if slp is not None:       # the SLP's ASL order (a wrong one shows as wrong pixels)
-                by_t = {s["addr"]: (s, r) for s, r in zip(segs, ids, strict=True)}
-                order = slp[(y, lo, hi)][0]
-                if sorted(order) != sorted(by_t):
+            if slp is not None:       # the SLP's ASBs in its ASL order (wrong ones show as wrong pixels)
+                rid = {s["addr"]: r for s, r in zip(segs, ids, strict=True)}
+                segs = slp[(y, lo, hi)][0]
+                if sorted(s["addr"] for s in segs) != sorted(rid):
                     raise RasterhwError(f"experts: the SLP's ASL of line {y} is not the line's segments")
-                segs, ids = [by_t[t][0] for t in order], np.array([by_t[t][1] for t in order], np.int64)
+                ids = np.array([rid[s["addr"]] for s in segs], np.int64)
             cache = {y: (segs, ids, [pack(lay, {"last": 0, "list": 0, "ptr": 0, **s}) for s in segs])}
         segs, ids, packed = cache[y]
         if slp is None:

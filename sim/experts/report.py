@@ -444,7 +444,7 @@ def _hdl_span_slp(out: list, engine: str, progress: bool) -> None:
         out.append(make_row(SYS, "5 / HDL", f"span PXP (the paper's): PXP clock for 30 frames/s, {name}, 8x8 ({what})",
                             paper=None, formula=None, measured=round(busy[name, "span"] * 30 / 1e6, 3), unit="MHz",
                             source="model"))
-        out.append(make_row(SYS, "5 / HDL", f"SLP list work (experts-slp: Y-sort, x update, L-sort, X-merge, block "
+        out.append(make_row(SYS, "5 / HDL", f"SLP list work (experts-slp: Y-sort, ASL update, L-sort, X-merge, block "
                             f"lists): busiest band's cycles, {name}, 8x8 ({what})", paper=None, formula=None,
                             measured=busy[name, "slp"], unit="cycles", source="model"))
         out.append(make_row(SYS, "5 / HDL", f"SLP list work: SLP clock for 30 frames/s, {name}, 8x8 ({what})",

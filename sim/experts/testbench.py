@@ -181,7 +181,8 @@ def slp_words(fr, band: tuple[int, int], bounds, *, guard: int) -> dict:
     words = [pack(li, {"kind": IN_KIND["band"], "r0": band[0], "r1": band[1]})]
     words += [pack(li, {"kind": IN_KIND["bound"], "xa": int(v)}) for v in bounds]
     words += [pack(li, {"kind": IN_KIND["tri"], **tw}) for tw in tws] + [pack(li, {"kind": IN_KIND["go"]})]
-    out = [pack(lo, {"kind": k, "p": p, "pos": pos, "t": t, "y": y}) for k, p, pos, t, y in br["words"]]
+    out = [pack(lo, {"kind": k, "p": p, "pos": pos, "t": t, "y": y, "asb": a or {}})
+           for k, p, pos, t, y, a in br["words"]]
     return {"in": words, "out": out, **br, "tris": len(tws)}
 
 

@@ -92,3 +92,20 @@ def test_slp_bad_parameters():
     for kw in ({"width": 0}, {"tris": 1}, {"asl": 600}, {"guard": 2}, {"lines": True}):
         with pytest.raises(ValueError):
             ExpertsSlp(**kw)
+
+
+@pytest.mark.parametrize("name", ["experts-tilt-1000", "c100", "experts-solids"])
+def test_asl_update_asb_is_the_golden_asb(name):
+    """Every ASB the SLP writes (x_L, x_R, z_L, i_L by its edge accumulators, the A.J. slopes of the
+    edges of that line, the triangle's set-up values) is the golden record's, field for field."""
+    from rasterhw.golden_model.experts.slp_cycles import asb
+    from rasterhw.golden_model.experts.span_cycles import line_asl
+    fr = _frame(name, 96, 48)
+    tws = tri_words(fr.setup)
+    n = 0
+    for y in range(48):
+        segs, _ = line_asl(fr, y)
+        for s in segs:
+            assert asb(tws[s["addr"]], y) == s
+            n += 1
+    assert n > 300
