@@ -18,6 +18,7 @@ SMALL = {
     "experts-pxp-span": {"width": 64, "aj": "c"},
     "experts-pxp-unit": {"width": 64, "depth": 64},
     "experts-slp": {"width": 64, "tris": 1024, "lines": 32, "asl": 256},
+    "experts-group": {"width": 64, "pn": 2, "tris": 1024, "lines": 8, "asl": 256, "depth": 256},
     "zbm-merger": {"fifo_depth": 4},
     "zbm-seggen": {"width": 48, "height": 24, "capacity": 64},
     "zbm-unit": {"interleave": 2, "width": 32, "height": 16, "capacity": 16},

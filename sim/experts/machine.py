@@ -22,6 +22,7 @@ MACHINE = Machine(
     blocks={"experts-pxp": "rasterhw.hdl.experts.pxp:ExpertsPxp",
             "experts-pxp-span": "rasterhw.hdl.experts.pxp_span:ExpertsPxpSpan",
             "experts-slp": "rasterhw.hdl.experts.slp:ExpertsSlp",
+            "experts-group": "rasterhw.hdl.experts.group:ExpertsGroup",
             "experts-dmm": "rasterhw.hdl.experts.dmm:ExpertsDmm",
             "experts-pxp-unit": "rasterhw.hdl.experts.unit:ExpertsPxpUnit"},
     sims=(SimBlock("pxp", "every PXP line of the frame through the PXP HDL, against the bit-accurate golden PXP "
@@ -48,11 +49,14 @@ MACHINE = Machine(
            "experts-pxp": Flow(small={"width": 64}, clocks=(_NO_CLOCK,)),
            "experts-pxp-span": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,)),
            "experts-slp": Flow(small={"width": 64, "tris": 64, "lines": 16, "asl": 32}, clocks=(_NO_CLOCK,)),
+           "experts-group": Flow(small={"width": 64, "pn": 2, "tris": 64, "lines": 16, "asl": 32, "depth": 32},
+                                 clocks=(_NO_CLOCK,)),
            "experts-pxp-unit": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,))},
     fpga_note="EXPERTS names no clock (docs/experts.md: times in operation times).",
     testbenches={"experts-pxp": "rasterhw.sim.experts.testbench:PxpBench",
                  "experts-pxp-span": "rasterhw.sim.experts.testbench:PxpSpanBench",
                  "experts-slp": "rasterhw.sim.experts.testbench:SlpBench",
+                 "experts-group": "rasterhw.sim.experts.testbench:GroupBench",
                  "experts-pxp-unit": "rasterhw.sim.experts.testbench:PxpUnitBench",
                  "experts-dmm": "rasterhw.sim.experts.testbench:DmmBench"},
     status="scan-line golden model split as SLP/PXP (float and 16-bit): the paper's span PXP (span cull, "

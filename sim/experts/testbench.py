@@ -16,7 +16,8 @@ from rasterhw.sim import registry
 from rasterhw.sim.experts.pxp_sim import SEG_BITS, SPAN_BITS, job_list, span_job_list
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 
-__all__ = ["DmmBench", "PxpBench", "PxpSpanBench", "PxpUnitBench", "RangeFromTokens", "SlpBench", "slp_words"]
+__all__ = ["DmmBench", "GroupBench", "PxpBench", "PxpSpanBench", "PxpUnitBench", "RangeFromTokens", "SlpBench",
+           "slp_words"]
 
 _RANGE_BITS = 21          # next_hi[10:0], next_lo[9:0] above the segment payload (the jobs' words)
 
@@ -210,3 +211,33 @@ class SlpBench(Testbench):
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         return Expected({"o": stim.source["out"]}, cycles=int(stim.source["cycles"]))
+
+
+class GroupBench(Testbench):
+    """``experts-group`` (one SLP, its DMM/P writers and Pn span PXPs clocked together): one band of a
+    random frame in (``i``, as :class:`SlpBench`), each PXP's pixels of the band out (``o[k]``), as
+    the golden bit model gives them. No cycle model (the SLP and the PXPs pace each other through
+    the DMM/P banks): the engines' stamps are compared with each other only."""
+
+    block = "experts-group"
+
+    def outputs_of(self, params: dict) -> tuple[str, ...]:
+        return tuple(f"o[{k}]" for k in range(params["pn"]))
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        from rasterhw.golden_model.experts.model import equal_bounds
+        rng, name, fr = _frame({"width": params["width"], "aj": params["aj"]}, seed)
+        H = fr.height
+        n = int(rng.integers(1, min(params["lines"], H) + 1))
+        y0 = int(rng.integers(0, H - n + 1))
+        b = equal_bounds(params["width"], params["pn"])
+        sw = slp_words(fr, (y0, y0 + n), b, guard=1 if params["aj"] == "c" else 0)
+        from rasterhw.golden_model.experts.pxp import pixel_words
+        pix = pixel_words(fr.setup, fr.fields).reshape(H, fr.width)
+        out = {f"o[{k}]": [int(v) for y in range(y0, y0 + n) for v in pix[y, int(b[k]):int(b[k + 1])]]
+               for k in range(params["pn"])}
+        return Stimulus({"i": sw["in"]}, what=f"{name} at {params['width']}, band {y0}..{y0 + n}, "
+                        f"{params['pn']} PXPs, seed {seed}", source=out)
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        return Expected(dict(stim.source))
