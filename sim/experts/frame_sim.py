@@ -47,8 +47,12 @@ def decode_slp(words: list[int]) -> list[tuple]:
 
 
 def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator", progress: bool = False,
-                   sn: int | None = 8, pn: int | None = 8, aj: str | None = "c") -> dict:
-    """Registry sim block ``experts``: the frame's SLP bands and PXP lines in HDL, against golden."""
+                   sn: int | None = 8, pn: int | None = 8, aj: str | None = "c", path: str | None = "chained") -> dict:
+    """Registry sim block ``experts``: the frame's SLP bands and PXP lines in HDL, against golden.
+
+    ``path="group"``: every band instead through ``experts-group`` (the SLP, its DMM/P writers and
+    Pn span PXPs clocked together, one run per band): pixels against golden, and the band's cycles
+    as measured (no cycle model: SLP and PXPs pace each other), ``group_cycles`` the slowest band."""
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.sim.engines import run
     from rasterhw.sim.experts.testbench import SlpBench, slp_words
@@ -62,8 +66,13 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
         raise RasterhwError(f"experts: sim experts aj must be none or c, not {aj!r}")
     if not (1 <= sn <= height and 1 <= pn <= min(width, 63)):
         raise RasterhwError(f"experts: sn must be 1..{height} and pn 1..{min(width, 63)}")
+    path = "chained" if path is None else path
+    if path not in ("chained", "group"):
+        raise RasterhwError(f"experts: sim experts path must be chained or group, not {path!r}")
     t0 = time.perf_counter()
     fr = render_frame(run_geometry(scene, width, height, z_bits=16), model="bit", aj=aj)
+    if path == "group":
+        return _group_frame(fr, engine, sn, pn, aj, t0, progress)
     guard = 1 if aj == "c" else 0
     bands = equal_bounds(height, sn)
     bounds = equal_bounds(width, pn)
@@ -131,3 +140,47 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
             "bottleneck": "SLP" if slp_frame > pxp_frame else "PXP",
             "sn": sn, "pn": pn, "aj": aj, "pxp": "span", "wall_s": round(time.perf_counter() - t0, 3),
             "slp_run_s": round(got.run_s, 3), "pxp_run_s": round(res["run_s"], 3)}
+
+
+def _group_frame(fr, engine: str, sn: int, pn: int, aj: str, t0: float, progress: bool) -> dict:
+    """Every band through ``experts-group``; pixels against golden, cycles measured per band."""
+    from rasterhw.golden_model.experts.pxp import pixel_words
+    from rasterhw.sim.engines import run
+    from rasterhw.sim.experts.testbench import GroupBench, slp_words
+    from rasterhw.sim.testbench import Stimulus, compare
+    W, H = fr.width, fr.height
+    bands = equal_bounds(H, sn)
+    b = equal_bounds(W, pn)
+    pix = pixel_words(fr.setup, fr.fields).reshape(H, W)
+    tb = GroupBench()
+    sws = [slp_words(fr, (int(bands[s]), int(bands[s + 1])), b, guard=1 if aj == "c" else 0) for s in range(sn)]
+    p = tb.params(width=W, pn=pn, aj=aj, tris=max(2, min(4095, max(sw["tris"] for sw in sws))),
+                  lines=max(1, int(np.diff(bands).max())), asl=256, depth=256)
+    mism = n = 0
+    band_cycles, run_s = [], 0.0
+    for s in range(sn):
+        y0, y1 = int(bands[s]), int(bands[s + 1])
+        want = {f"o[{k}]": [int(v) for y in range(y0, y1) for v in pix[y, int(b[k]):int(b[k + 1])]] for k in range(pn)}
+        if progress:
+            import sys
+            print(f"experts: band {s} through experts-group", file=sys.stderr)
+        got = run(tb, p, Stimulus({"i": sws[s]["in"]}), engine=engine,
+                  expect_words={k: len(v) for k, v in want.items()}, max_cycles=20 * sws[s]["cycles"] + 100000)
+        c = compare(_expected(want), got)
+        mism += c["mismatches"]
+        n += sum(len(v) for v in want.values())
+        band_cycles.append(got.cycles)
+        run_s += got.run_s
+    worst = max(band_cycles)
+    slp_model = max(sw["cycles"] for sw in sws)
+    return {"engine": engine, "path": "group", "cycles": int(sum(band_cycles)), "clock_hz": None,
+            "cycles_per_s": round(sum(band_cycles) / run_s, 1) if run_s > 0 else None,
+            "pixels_compared": n, "mismatches": mism, "group_cycles": int(worst),
+            "group_cycles_per_band": [int(c) for c in band_cycles],
+            "group_clock_for_30fps_hz": int(worst) * 30, "slp_cycles_alone": slp_model,
+            "sn": sn, "pn": pn, "aj": aj, "wall_s": round(time.perf_counter() - t0, 3)}
+
+
+def _expected(words):
+    from rasterhw.sim.testbench import Expected
+    return Expected(words)

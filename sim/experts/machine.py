@@ -41,7 +41,11 @@ MACHINE = Machine(
                    default_scene="experts-1000",
                    options=(Option("sn", "SLPs (bands)", 8, type=int),
                             Option("pn", "PXPs per SLP (ranges)", 8, type=int),
-                            Option("aj", "anti-jagging in the PXP: none or c", "c", ("none", "c")))),),
+                            Option("aj", "anti-jagging in the PXP: none or c", "c", ("none", "c")),
+                            Option("path", "chained (the SLP HDL, then the PXP HDL on its words, each against its "
+                                   "cycle model) or group (one SLP + Pn PXPs clocked together per band, "
+                                   "experts-group; pixels against golden, cycles measured)", "chained",
+                                   ("chained", "group")))),),
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",
     soak={"pxp": "rasterhw.sim.experts.soak:pxp_round"},
