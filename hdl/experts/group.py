@@ -1,3 +1,4 @@
+# amaranth: UnusedElaboratable=no
 """EXPERTS SLP group: one SLP, its DMM/Ps and its Pn span PXPs, clocked together (one band's machine).
 
 Paper (seed 000, section 3): each SLP drives Pn PXPs through one DMM/P per PXP ("DMMは、物理的には下位
@@ -22,7 +23,6 @@ from rasterhw.hdl.experts.pxp_span import NO_PTR, ExpertsPxpSpan, asb_layout, dm
 from rasterhw.hdl.experts.slp import ExpertsSlp, slp_in_layout, slp_out_layout
 
 __all__ = ["ExpertsGroup"]
-
 
 class _DmmWriter(wiring.Component):
     """SLP words -> the DMM/P words of PXP ``p`` (see the module docstring)."""
@@ -84,10 +84,13 @@ class ExpertsGroup(wiring.Component):
                  asl: int = 256, depth: int = 256):
         if isinstance(pn, bool) or not isinstance(pn, int) or not 1 <= pn <= min(63, width):
             raise ValueError(f"pn must be an integer in 1..{min(63, width)}, not {pn!r}")
-        self._slp = ExpertsSlp(width=width, tris=tris, lines=lines, asl=asl, guard=1 if aj == "c" else 0)
+        # the parts are built in elaborate (checked here, so a bad parameter fails at once)
+        self._slp_kw = {"width": width, "tris": tris, "lines": lines, "asl": asl, "guard": 1 if aj == "c" else 0}
+        self._pxp_kw = {"width": width, "aj": aj, "depth": depth}
+        for cls, kw in ((ExpertsPxpSpan, self._pxp_kw), (ExpertsSlp, self._slp_kw)):
+            cls(**kw)          # a throw-away, built only to check the parameters (not elaborated: no warning, line 1)
         b = equal_bounds(width, pn)
         self._ranges = [(int(b[k]), int(b[k + 1])) for k in range(pn)]
-        self._pxps = [ExpertsPxpSpan(width=width, aj=aj, depth=depth) for _ in range(pn)]
         self._pn = pn
         super().__init__({"i": In(stream.Signature(slp_in_layout())),
                           "o": Out(stream.Signature(unsigned(16))).array(pn),
@@ -95,12 +98,13 @@ class ExpertsGroup(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        m.submodules.slp = slp = self._slp
+        m.submodules.slp = slp = ExpertsSlp(**self._slp_kw)
         m.submodules.fan = fan = StreamBroadcast(slp_out_layout(), n=self._pn)
         wiring.connect(m, wiring.flipped(self.i), slp.i)
         wiring.connect(m, slp.o, fan.i)
         ovf = [slp.overflow]
-        for k, (pxp, (lo, hi)) in enumerate(zip(self._pxps, self._ranges, strict=True)):
+        for k, (lo, hi) in enumerate(self._ranges):
+            pxp = ExpertsPxpSpan(**self._pxp_kw)
             wr = _DmmWriter(k)
             m.submodules[f"dmm_writer{k}"] = wr
             m.submodules[f"pxp{k}"] = pxp
