@@ -65,6 +65,7 @@ MACHINE = Machine(
                  "experts-dmm": "rasterhw.sim.experts.testbench:DmmBench"},
     status="scan-line golden model split as SLP/PXP (float and 16-bit): the paper's span PXP (span cull, "
            "depth search per span) and the SLP's sorts run and counted, Sn x Pn parallel model with "
-           "load balancing at both levels, fig. 4.1 cost model (golden); line-Z-buffer PXP datapath "
-           "(HDL, bit- and cycle-exact)",
+           "load balancing at both levels, fig. 4.1 cost model (golden); in HDL, bit- and cycle-exact: the "
+           "span PXP (the paper's, default) and the line-Z-buffer PXP (ours), the SLP (Y-sort, ASL update, "
+           "L-sort, X-merge, block lists; not its set-up); one SLP + Pn PXPs clocked together (pixel-exact)",
 )
