@@ -15,9 +15,12 @@ from rasterhw.sim.testbench import Expected, compare, find_testbench
 SMALL = {
     "experts-dmm": {"depth": 16},
     "experts-pxp": {"width": 64, "aj": "c"},
+    "experts-pxp-span": {"width": 64, "aj": "c"},
     "experts-pxp-unit": {"width": 64, "depth": 64},
     "pixelbus": {"width": 20, "height": 8},
     "pixelbus-bank": {"depth": 64},
+    "experts-slp": {"width": 64, "tris": 1024, "lines": 32, "asl": 256},
+    "experts-group": {"width": 64, "pn": 2, "tris": 1024, "lines": 8, "asl": 256, "depth": 256},
     "zbm-merger": {"fifo_depth": 4},
     "zbm-seggen": {"width": 48, "height": 24, "capacity": 64},
     "zbm-unit": {"interleave": 2, "width": 32, "height": 16, "capacity": 16},

@@ -20,6 +20,9 @@ MACHINE = Machine(
                          Option("sn", "SLPs (bands of scan lines) for the timing stats", 8, type=int),
                          Option("pn", "PXPs per SLP (ranges of each line) for the timing stats", 8, type=int))),),
     blocks={"experts-pxp": "rasterhw.hdl.experts.pxp:ExpertsPxp",
+            "experts-pxp-span": "rasterhw.hdl.experts.pxp_span:ExpertsPxpSpan",
+            "experts-slp": "rasterhw.hdl.experts.slp:ExpertsSlp",
+            "experts-group": "rasterhw.hdl.experts.group:ExpertsGroup",
             "experts-dmm": "rasterhw.hdl.experts.dmm:ExpertsDmm",
             "experts-pxp-unit": "rasterhw.hdl.experts.unit:ExpertsPxpUnit"},
     sims=(SimBlock("pxp", "every PXP line of the frame through the PXP HDL, against the bit-accurate golden PXP "
@@ -28,19 +31,41 @@ MACHINE = Machine(
                             Option("pn", "PXPs per SLP (ranges)", 8, type=int),
                             Option("aj", "anti-jagging in the PXP: none or c", "c", ("none", "a", "b", "c")),
                             Option("ranges", "PXP ranges: static, or set per line by method i / ii from the "
-                                   "previous line's finish-time counters", "static", ("static", "i", "ii")))),),
+                                   "previous line's finish-time counters", "static", ("static", "i", "ii")),
+                            Option("pxp", "PXP datapath: span (the paper's: span cull + depth search, "
+                                   "experts-pxp-span) or zbuffer (ours: a one-line Z-buffer, experts-pxp)", "span",
+                                   ("span", "zbuffer")))),
+          SimBlock("experts", "the whole frame: every band through the SLP HDL (experts-slp), its ASL order and "
+                   "block lists then into every span PXP's DMM/P (experts-pxp-span); words, pixels and cycles "
+                   "against golden, SLP and PXP clocks for 30 frames/s", "rasterhw.sim.experts.frame_sim:simulate_frame",
+                   default_scene="experts-1000",
+                   options=(Option("sn", "SLPs (bands)", 8, type=int),
+                            Option("pn", "PXPs per SLP (ranges)", 8, type=int),
+                            Option("aj", "anti-jagging in the PXP: none or c", "c", ("none", "c")),
+                            Option("path", "chained (the SLP HDL, then the PXP HDL on its words, each against its "
+                                   "cycle model) or group (one SLP + Pn PXPs clocked together per band, "
+                                   "experts-group; pixels against golden, cycles measured)", "chained",
+                                   ("chained", "group")))),),
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",
     soak={"pxp": "rasterhw.sim.experts.soak:pxp_round"},
     flows={"experts-dmm": Flow(small={"depth": 16}, clocks=(_NO_CLOCK,)),
            "experts-pxp": Flow(small={"width": 64}, clocks=(_NO_CLOCK,)),
+           "experts-pxp-span": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,)),
+           "experts-slp": Flow(small={"width": 64, "tris": 64, "lines": 16, "asl": 32}, clocks=(_NO_CLOCK,)),
+           "experts-group": Flow(small={"width": 64, "pn": 2, "tris": 64, "lines": 16, "asl": 32, "depth": 32},
+                                 clocks=(_NO_CLOCK,)),
            "experts-pxp-unit": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,))},
     fpga_note="EXPERTS names no clock (docs/experts.md: times in operation times).",
     testbenches={"experts-pxp": "rasterhw.sim.experts.testbench:PxpBench",
+                 "experts-pxp-span": "rasterhw.sim.experts.testbench:PxpSpanBench",
+                 "experts-slp": "rasterhw.sim.experts.testbench:SlpBench",
+                 "experts-group": "rasterhw.sim.experts.testbench:GroupBench",
                  "experts-pxp-unit": "rasterhw.sim.experts.testbench:PxpUnitBench",
                  "experts-dmm": "rasterhw.sim.experts.testbench:DmmBench"},
     status="scan-line golden model split as SLP/PXP (float and 16-bit): the paper's span PXP (span cull, "
            "depth search per span) and the SLP's sorts run and counted, Sn x Pn parallel model with "
-           "load balancing at both levels, fig. 4.1 cost model (golden); line-Z-buffer PXP datapath "
-           "(HDL, bit- and cycle-exact)",
+           "load balancing at both levels, fig. 4.1 cost model (golden); in HDL, bit- and cycle-exact: the "
+           "span PXP (the paper's, default) and the line-Z-buffer PXP (ours), the SLP (Y-sort, ASL update, "
+           "L-sort, X-merge, block lists; not its set-up); one SLP + Pn PXPs clocked together (pixel-exact)",
 )

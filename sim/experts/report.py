@@ -358,12 +358,14 @@ def _tolerance(out: list, progress: bool) -> None:
 
 
 def _hdl(out: list, engine: str, progress: bool) -> None:
-    """PXP HDL rows: pysim on a sample of lines (always), the whole experts-1000 frame on Verilator
-    when ``engine == "verilator"``; the 30 frames/s PXP clock from the cycle model the HDL matched."""
+    """PXP HDL rows (the line Z-buffer PXP, ours, as labelled before the span PXP existed): pysim on
+    a sample of lines (always), the whole experts-1000 frame on Verilator when ``engine ==
+    "verilator"``; the 30 frames/s PXP clock from the cycle model the HDL matched."""
     from rasterhw.golden_model.experts.parallel import run_parallel
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.sim.experts.pxp_sim import jobs, simulate_scene
-    small = simulate_scene(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=2, pn=4, aj="c")
+    small = simulate_scene(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=2, pn=4, aj="c",
+                           pxp="zbuffer")
     out.append(make_row(SYS, "HDL", "PXP pixel mismatches with A.J. (c), experts-tilt-1000 at 64x16, 2x4 (pysim)", paper=None,
                         formula=None, measured=small["mismatches"], unit="pixels", source="hdl:pysim"))
     out.append(make_row(SYS, "HDL", "PXP lines whose cycles differ from the golden cycle model, experts-tilt-1000 "
@@ -375,7 +377,8 @@ def _hdl(out: list, engine: str, progress: bool) -> None:
     if engine == "verilator":
         if progress:
             print("experts: experts-1000 through the PXP HDL on Verilator")
-        r = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c")
+        r = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c",
+                           pxp="zbuffer")
         out.append(make_row(SYS, "HDL", "PXP pixel mismatches with A.J. (c), experts-1000, 8x8 (262,144 compared)",
                             paper=None, formula=None, measured=r["mismatches"], unit="pixels", source="hdl:verilator"))
         out.append(make_row(SYS, "HDL", "PXP lines whose cycles differ from the golden cycle model, experts-1000, 8x8",
@@ -387,7 +390,8 @@ def _hdl(out: list, engine: str, progress: bool) -> None:
     jb2 = jobs(fr, 8, 8, ranges=run_parallel(fr, 8, 8, range_method="ii", pxp_unit="cycles").ranges)
     busiest_ii = int(jb2["pxp_frame_cycles"].max())
     if engine == "verilator":
-        r2 = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c", ranges="ii")
+        r2 = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c", ranges="ii",
+                            pxp="zbuffer")
         out.append(make_row(SYS, "HDL", "PXP pixel + line-cycle mismatches, ranges by method ii from the HDL "
                             "counters, experts-1000, 8x8", paper=None, formula=None,
                             measured=r2["mismatches"] + r2["cycle_mismatches"], unit="pixels + lines",
@@ -405,6 +409,71 @@ def _hdl(out: list, engine: str, progress: bool) -> None:
     out.append(make_row(SYS, "5 / HDL", f"the same with ranges by method ii from the PXP counters ({what})",
                         paper=None, formula=None, measured=round(busiest_ii * 30 / 1e6, 3), unit="MHz",
                         source="model"))
+
+
+def _hdl_span_slp(out: list, engine: str, progress: bool) -> None:
+    """The span PXP (the paper's, ``experts-pxp-span``) and the SLP's list work (``experts-slp``) in
+    HDL: pysim on small frames (always), the whole experts-1000 frame on Verilator when ``engine ==
+    "verilator"``; frame cycles and 30 frames/s clocks from the cycle models both HDL blocks match
+    (``span_cycles``, ``slp_cycles``; the line-Z-buffer PXP's beside them)."""
+    from rasterhw.golden_model.experts.model import equal_bounds
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.sim.experts.frame_sim import simulate_frame
+    from rasterhw.sim.experts.pxp_sim import jobs
+    from rasterhw.sim.experts.testbench import slp_words
+    small = simulate_frame(build_scene("experts-tilt-1000"), 48, 16, engine="pysim", sn=2, pn=3, aj="c")
+    out.append(make_row(SYS, "HDL", "SLP (experts-slp) + span PXP (experts-pxp-span) word and pixel mismatches, "
+                        "experts-tilt-1000 at 48x16, 2x3 (pysim)", paper=None, formula=None,
+                        measured=small["mismatches"], unit="words + pixels", source="hdl:pysim"))
+    out.append(make_row(SYS, "HDL", "SLP end-of-line stamps + span PXP lines off the golden cycle models, "
+                        "experts-tilt-1000 at 48x16, 2x3 (pysim)", paper=None, formula=None,
+                        measured=small["cycle_mismatches"], unit="lines", source="hdl:pysim"))
+    busy = {}
+    for name in ("experts-1000", "experts-tilt-1000"):
+        fr = _frame(name, "bit", "c")
+        busy[name, "span"] = int(jobs(fr, 8, 8, pxp="span")["pxp_frame_cycles"].max())
+        busy[name, "zbuffer"] = int(jobs(fr, 8, 8, pxp="zbuffer")["pxp_frame_cycles"].max())
+        bands = equal_bounds(512, 8)
+        busy[name, "slp"] = max(slp_words(fr, (int(bands[s]), int(bands[s + 1])), equal_bounds(512, 8),
+                                          guard=1)["cycles"] for s in range(8))
+    what = "cycle model, matched by the HDL line for line"
+    for name in ("experts-1000", "experts-tilt-1000"):
+        out.append(make_row(SYS, "5 / HDL", f"span PXP (the paper's): busiest PXP's cycles per frame, A.J. (c), "
+                            f"{name}, 8x8 ({what})", paper=None, formula=None, measured=busy[name, "span"],
+                            unit="cycles", source="model"))
+        out.append(make_row(SYS, "5 / HDL", f"span PXP (the paper's): PXP clock for 30 frames/s, {name}, 8x8 ({what})",
+                            paper=None, formula=None, measured=round(busy[name, "span"] * 30 / 1e6, 3), unit="MHz",
+                            source="model"))
+        out.append(make_row(SYS, "5 / HDL", f"SLP list work (experts-slp: Y-sort, ASL update, L-sort, X-merge, block "
+                            f"lists): busiest band's cycles, {name}, 8x8 ({what})", paper=None, formula=None,
+                            measured=busy[name, "slp"], unit="cycles", source="model"))
+        out.append(make_row(SYS, "5 / HDL", f"SLP list work: SLP clock for 30 frames/s, {name}, 8x8 ({what})",
+                            paper=None, formula=None, measured=round(busy[name, "slp"] * 30 / 1e6, 3), unit="MHz",
+                            source="model"))
+    out.append(make_row(SYS, "4 / HDL", "span PXP busiest frame, experts-tilt-1000 / experts-1000 (depth order "
+                        f"matters; {what})", paper=None, formula=None,
+                        measured=round(busy["experts-tilt-1000", "span"] / busy["experts-1000", "span"], 4), unit="x",
+                        source="model"))
+    out.append(make_row(SYS, "4 / HDL", "line Z-buffer PXP (ours) busiest frame, experts-tilt-1000 / experts-1000 "
+                        f"({what})", paper=None, formula=None,
+                        measured=round(busy["experts-tilt-1000", "zbuffer"] / busy["experts-1000", "zbuffer"], 4),
+                        unit="x", source="model"))
+    if engine == "verilator":
+        if progress:
+            print("experts: experts-1000 through the SLP and span PXP HDL on Verilator")
+        r = simulate_frame(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c")
+        out.append(make_row(SYS, "HDL", "SLP + span PXP word and pixel mismatches, experts-1000, 8x8 (262,144 pixels)",
+                            paper=None, formula=None, measured=r["mismatches"], unit="words + pixels",
+                            source="hdl:verilator"))
+        out.append(make_row(SYS, "HDL", "SLP end-of-line stamps + span PXP lines off the golden cycle models, "
+                            "experts-1000, 8x8", paper=None, formula=None, measured=r["cycle_mismatches"],
+                            unit="lines", source="hdl:verilator"))
+        out.append(make_row(SYS, "5 / HDL", "SLP clock for 30 frames/s (list work), experts-1000, 8x8, from the HDL run",
+                            paper=None, formula=None, measured=round(r["slp_clock_for_30fps_hz"] / 1e6, 3),
+                            unit="MHz", source="hdl:verilator"))
+        out.append(make_row(SYS, "5 / HDL", "span PXP clock for 30 frames/s, experts-1000, 8x8, from the HDL run",
+                            paper=None, formula=None, measured=round(r["pxp_clock_for_30fps_hz"] / 1e6, 3),
+                            unit="MHz", source="hdl:verilator"))
 
 
 def _shadows(out: list, progress: bool) -> None:
@@ -441,4 +510,5 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, **know
     _tolerance(out, progress)
     _shadows(out, progress)
     _hdl(out, engine, progress)
+    _hdl_span_slp(out, engine, progress)
     return out, sections

@@ -1,4 +1,5 @@
-"""Soak round of the EXPERTS PXP (``rasterhw soak --block pxp``; sim/flow/soak.py runs it).
+"""Soak round of the EXPERTS PXP (``rasterhw soak --block pxp``; sim/flow/soak.py runs it): the
+span PXP (``rasterhw sim pxp``'s default; a timed line may not be faster than its resolve work).
 
 A round (512 x 512, anti-jagging (c)) renders a random EXPERTS / cube scene (seeded) with random
 Sn x Pn and range method (static, i, ii); every PXP pixel is compared, and every line's cycle

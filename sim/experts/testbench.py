@@ -13,10 +13,11 @@ from rasterhw.golden_model.experts.pxp_cycles import line_segments
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.sim import registry
-from rasterhw.sim.experts.pxp_sim import SEG_BITS, job_list
+from rasterhw.sim.experts.pxp_sim import SEG_BITS, SPAN_BITS, job_list, span_job_list
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 
-__all__ = ["DmmBench", "PxpBench", "PxpUnitBench", "RangeFromTokens"]
+__all__ = ["DmmBench", "GroupBench", "PxpBench", "PxpSpanBench", "PxpUnitBench", "RangeFromTokens", "SlpBench",
+           "slp_words"]
 
 _RANGE_BITS = 21          # next_hi[10:0], next_lo[9:0] above the segment payload (the jobs' words)
 
@@ -29,14 +30,15 @@ class RangeFromTokens(wiring.Component):
     samples when that line starts). The first line's range is ``[0, width)``. No register on the
     stream: the block sees every word in the cycle the bench offers it."""
 
-    def __init__(self, block, width: int):
-        self.block, self._width = block, width
-        super().__init__({"i": In(stream.Signature(SEG_BITS + _RANGE_BITS)), "o": Out(stream.Signature(16))})
+    def __init__(self, block, width: int, seg_bits: int = SEG_BITS):
+        self.block, self._width, self._bits = block, width, seg_bits
+        super().__init__({"i": In(stream.Signature(seg_bits + _RANGE_BITS)), "o": Out(stream.Signature(16))})
 
     def elaborate(self, platform):
         m = Module()
         m.submodules.block = b = self.block
         lo, hi = Signal(10, init=0), Signal(11, init=self._width)
+        SEG_BITS = self._bits
         seg = self.i.payload[:SEG_BITS]
         m.d.comb += [b.i.valid.eq(self.i.valid), b.i.payload.eq(seg), self.i.ready.eq(b.i.ready),
                      b.lo.eq(lo), b.hi.eq(hi)]
@@ -100,6 +102,30 @@ class PxpBench(Testbench):
         return Expected({"o": jb["pixels"].tolist()}, cycles=int(jb["last_pixel"]) + 2)
 
 
+class PxpSpanBench(PxpBench):
+    """``experts-pxp-span`` (the paper's PXP): per line the DMM/P words the SLP writes -- the
+    line's whole ASL, this PXP's block boundary bucket list, the ``last`` token with the block
+    leading segment pointer (and the next line's range for the adapter) -- in (``i``), the range's
+    pixel words out (``o``), as the golden bit model gives them; cycles from
+    ``golden_model/experts/span_cycles.py: schedule`` (last pixel's edge + 1)."""
+
+    block = "experts-pxp-span"
+
+    def dut(self, params: dict):
+        return RangeFromTokens(registry.load(registry.blocks()[self.block])(**params), params["width"], SPAN_BITS)
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        rng, name, fr = _frame(params, seed)
+        todo = _lines(rng, params["width"], int(rng.integers(2, 9)))
+        jb = span_job_list(fr, todo)
+        return Stimulus({"i": jb["words"]}, what=f"{name} at {params['width']}, {jb['lines']} lines, seed {seed}",
+                        source=jb)
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        jb = stim.source
+        return Expected({"o": jb["pixels"].tolist()}, cycles=int(jb["last_pixel"]) + 1)
+
+
 class PxpUnitBench(PxpBench):
     """``experts-pxp-unit`` (DMM/P + PXP): the PXP's stimulus and pixels, every line the whole
     width (the range inputs reach the PXP directly while the DMM/P holds lines back, so a range
@@ -141,3 +167,77 @@ class DmmBench(Testbench):
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         return Expected({"o": list(stim.words["i"])})
+
+
+def slp_words(fr, band: tuple[int, int], bounds, *, guard: int) -> dict:
+    """``experts-slp`` stimulus and expectation for one band of a frame: the input words (band,
+    range bounds, PL triangles, go), the output words and cycles of
+    ``golden_model/experts/slp_cycles.py: band_run`` (its ``line_cycles`` and ``asl`` too)."""
+    from rasterhw.golden_model.experts.slp_cycles import band_run, tri_words
+    from rasterhw.hdl.experts.slp import IN_KIND, slp_in_layout, slp_out_layout
+    from rasterhw.hdl.pack import pack
+    li, lo = slp_in_layout(), slp_out_layout()
+    tws = tri_words(fr.setup)
+    br = band_run(tws, band, bounds, width=fr.width, guard=guard)
+    words = [pack(li, {"kind": IN_KIND["band"], "r0": band[0], "r1": band[1]})]
+    words += [pack(li, {"kind": IN_KIND["bound"], "xa": int(v)}) for v in bounds]
+    words += [pack(li, {"kind": IN_KIND["tri"], **tw}) for tw in tws] + [pack(li, {"kind": IN_KIND["go"]})]
+    out = [pack(lo, {"kind": k, "p": p, "pos": pos, "t": t, "y": y, "asb": a or {}})
+           for k, p, pos, t, y, a in br["words"]]
+    return {"in": words, "out": out, **br, "tris": len(tws)}
+
+
+class SlpBench(Testbench):
+    """``experts-slp``: one band of a random frame -- band, PXP range bounds, the PL triangles with
+    their set-up, go -- in (``i``); per line the ASL words with the leading pointers and bucket
+    entries as the walk finds them, then the end-of-line word, out (``o``), as
+    ``golden_model/experts/slp_cycles.py`` gives them (from ``slp_run``'s sorts, run); cycles: the
+    last output's edge + 1 = every term of ``band_run`` summed."""
+
+    block = "experts-slp"
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        rng, name, fr = _frame({"width": params["width"], "aj": "c" if params["guard"] else "none"}, seed)
+        H = fr.height
+        n = int(rng.integers(1, min(params["lines"], H) + 1))
+        y0 = int(rng.integers(0, H - n + 1))
+        from rasterhw.golden_model.experts.model import equal_bounds
+        pn = int(rng.integers(1, 5))
+        sw = slp_words(fr, (y0, y0 + n), equal_bounds(params["width"], pn), guard=params["guard"])
+        if sw["tris"] > params["tris"]:
+            raise ValueError(f"{name}: {sw['tris']} triangles, the SLP holds {params['tris']}")
+        return Stimulus({"i": sw["in"]}, what=f"{name} at {params['width']}, band {y0}..{y0 + n}, {pn} ranges, "
+                        f"seed {seed}", source=sw)
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        return Expected({"o": stim.source["out"]}, cycles=int(stim.source["cycles"]))
+
+
+class GroupBench(Testbench):
+    """``experts-group`` (one SLP, its DMM/P writers and Pn span PXPs clocked together): one band of a
+    random frame in (``i``, as :class:`SlpBench`), each PXP's pixels of the band out (``o[k]``), as
+    the golden bit model gives them. No cycle model (the SLP and the PXPs pace each other through
+    the DMM/P banks): the engines' stamps are compared with each other only."""
+
+    block = "experts-group"
+
+    def outputs_of(self, params: dict) -> tuple[str, ...]:
+        return tuple(f"o[{k}]" for k in range(params["pn"]))
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        from rasterhw.golden_model.experts.model import equal_bounds
+        rng, name, fr = _frame({"width": params["width"], "aj": params["aj"]}, seed)
+        H = fr.height
+        n = int(rng.integers(1, min(params["lines"], H) + 1))
+        y0 = int(rng.integers(0, H - n + 1))
+        b = equal_bounds(params["width"], params["pn"])
+        sw = slp_words(fr, (y0, y0 + n), b, guard=1 if params["aj"] == "c" else 0)
+        from rasterhw.golden_model.experts.pxp import pixel_words
+        pix = pixel_words(fr.setup, fr.fields).reshape(H, fr.width)
+        out = {f"o[{k}]": [int(v) for y in range(y0, y0 + n) for v in pix[y, int(b[k]):int(b[k + 1])]]
+               for k in range(params["pn"])}
+        return Stimulus({"i": sw["in"]}, what=f"{name} at {params['width']}, band {y0}..{y0 + n}, "
+                        f"{params['pn']} PXPs, seed {seed}", source=out)
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        return Expected(dict(stim.source))

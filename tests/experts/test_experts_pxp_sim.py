@@ -11,7 +11,9 @@ from rasterhw.sim.registry import SIM_KEYS, sim_blocks
 
 @pytest.mark.parametrize("aj", ["none", "c"])
 def test_small_frame_pysim_pixel_and_cycle_exact(aj):
+    """The default PXP (span); the zbuffer one: tests/experts/test_experts_pxp_span.py."""
     r = simulate_scene(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=2, pn=4, aj=aj)
+    assert r["pxp"] == "span"
     assert set(SIM_KEYS) <= set(r)
     assert r["pixels_compared"] == 64 * 16 and r["mismatches"] == 0 and r["cycle_mismatches"] == 0
     assert r["last_pixel_mismatch"] == 0
@@ -19,10 +21,12 @@ def test_small_frame_pysim_pixel_and_cycle_exact(aj):
 
 
 def test_balanced_ranges_through_the_hdl():
-    """Ranges moved line by line by method ii from the finish-time counters: still exact."""
-    r = simulate_scene(build_scene("experts-uneven"), 128, 32, engine="pysim", sn=1, pn=4, aj="c", ranges="ii")
+    """Ranges moved line by line by method ii from the finish-time counters: still exact
+    (the line Z-buffer PXP; the span PXP: tests/experts/test_experts_pxp_span.py)."""
+    kw = {"engine": "pysim", "sn": 1, "pn": 4, "aj": "c", "pxp": "zbuffer"}
+    r = simulate_scene(build_scene("experts-uneven"), 128, 32, ranges="ii", **kw)
     assert r["mismatches"] == 0 and r["cycle_mismatches"] == 0 and r["last_pixel_mismatch"] == 0
-    s = simulate_scene(build_scene("experts-uneven"), 128, 32, engine="pysim", sn=1, pn=4, aj="c")
+    s = simulate_scene(build_scene("experts-uneven"), 128, 32, **kw)
     assert r["frame_cycles_busiest_pxp"] <= s["frame_cycles_busiest_pxp"]
 
 
@@ -38,11 +42,13 @@ def test_registered_and_bad_engine():
 
 
 @pytest.mark.slow
-def test_experts_1000_frame_on_verilator():
-    r = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c")
+@pytest.mark.parametrize("pxp", ["span", "zbuffer"])
+def test_experts_1000_frame_on_verilator(pxp):
+    r = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c", pxp=pxp)
     assert r["pixels_compared"] == 262144 and r["mismatches"] == 0 and r["cycle_mismatches"] == 0
     assert r["last_pixel_mismatch"] == 0
-    assert r["cycles_per_s"] > 1e6
+    # the span PXP's resolve side chains asynchronous reads (a slower Verilator model per clock)
+    assert r["cycles_per_s"] > (3e5 if pxp == "span" else 1e6)
 
 
 def test_verilator_idle_and_backpressure_same_pixels_no_line_faster():

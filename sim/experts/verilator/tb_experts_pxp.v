@@ -1,6 +1,7 @@
 // Timing-free bench for one EXPERTS PXP (`experts_pxp`), for plain Verilator runs (cocotb_tests/plain_main.cpp
 // toggles `clk`). Memories are sized for a 512 x 512 frame at up to 16 x 64 PXP lines (one build
-// serves every scene). Stimulus (+seg=, +nseg= words of {next_hi[10:0], next_lo[9:0], payload[193:0]})
+// serves every scene). Stimulus (+seg=, +nseg= words of {next_hi[10:0], next_lo[9:0], payload[SEGW-1:0]}
+// (SEGW 194: experts-pxp; 204: experts-pxp-span, the DMM/P words)
 // is played back to back; when an end-of-line token (payload bit 0) is taken, the range of the
 // next line (next_lo, next_hi) is put on lo/hi, which the PXP samples as the line ends. The first
 // line's range comes from +lo0= / +hi0=. Every pixel word is stored in order (dumped to +out=),
@@ -12,13 +13,14 @@
 module tb_experts_pxp #(
   parameter NSEG = 1 << 19,
   parameter NOUT = 1 << 18,
-  parameter NLINE = 1 << 14
+  parameter NLINE = 1 << 14,
+  parameter SEGW = 194
 ) (
   input clk,
   output reg done,
   output reg [63:0] cycles
 );
-  reg [214:0] stim [0:NSEG-1];
+  reg [SEGW+20:0] stim [0:NSEG-1];
   reg [15:0] frame [0:NOUT-1];
   reg [15:0] lcyc [0:NLINE-1];
   reg [8*512-1:0] fseg, fout, fcyc;
@@ -57,7 +59,7 @@ module tb_experts_pxp #(
     $writememh(fcyc, lcyc);
   end
 
-  wire [214:0] w = stim[p];
+  wire [SEGW+20:0] w = stim[p];
   function [31:0] xorshift(input [31:0] x);
     reg [31:0] t;
     begin
@@ -74,7 +76,7 @@ module tb_experts_pxp #(
   wire [15:0] line_cycles, lines;
   experts_pxp dut (
     .clk(clk), .rst(1'b0),
-    .i__valid(iv), .i__ready(ir), .i__payload(w[193:0]),
+    .i__valid(iv), .i__ready(ir), .i__payload(w[SEGW-1:0]),
     .o__valid(ov), .o__ready(ordy), .o__payload(opl),
     .lo(lo), .hi(hi), .line_cycles(line_cycles), .lines(lines)
   );
@@ -87,8 +89,8 @@ module tb_experts_pxp #(
     if (iv && ir) begin
       p <= p + 1;
       if (w[0]) begin
-        lo <= w[203:194];
-        hi <= w[214:204];
+        lo <= w[SEGW+9:SEGW];
+        hi <= w[SEGW+20:SEGW+10];
       end
     end
     if (ov && ordy) begin

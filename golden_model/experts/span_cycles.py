@@ -1,0 +1,194 @@
+"""The span PXP HDL's golden side: its DMM/P contents, its visible segments and its exact cycles.
+
+``hdl/experts/pxp_span.py`` is the paper's PXP (span cull and depth search per span, rules of
+:mod:`span`) behind its own DMM/P. This module states, in plain Python, what it does line by line
+and how many cycles each step takes, so the HDL can be checked pixel for pixel and cycle for cycle.
+
+**DMM/P contents** (:func:`dmm_line`), as the SLP writes them: the line's whole ASL in ASL order
+(every record of the line, sorted on (xL, PL order), :mod:`slp_run`'s order), then the range's
+block boundary bucket list, then the ``last`` token carrying the block leading segment pointer --
+both lists from :func:`slp_run.block_lists` (the golden SLP's walk of the finished ASL), for the
+range widened by the A.J. guard pixel each side.
+
+**Resolve cycles of one line** (:func:`resolve`; from the cycle the PXP finds the bank full to the
+cycle before it hands the DSLB bank over), every term:
+
+* ``init`` 1: take the bank (range, counts, leading pointer).
+* per span, ``cull`` = ``k_old``: one cycle per segment present in the span before (it stays or
+  leaves); ``enter`` = ``entered + skipped + 1``: one per candidate entering at the span's left
+  pixel (bucket list first, then the ASL from the leading pointer while its first pixel is before
+  the guarded range's end), one per candidate with no pixel in the range, one to set the span's
+  right end ``r = min(nearest end, next start, range end) - 1``.
+* per (sub)span searched (``k >= 2``): ``pass_a`` = ``k`` (z at both end pixels, nearest at the
+  left), ``pass_b`` = ``k`` if the (sub)span is wider than one pixel (the guarded tests); a failed
+  test halves it at ``(l + r + 1) >> 1`` and both halves are searched, the left first.
+* ``write`` = one cycle per pixel of the guarded range (every pixel is written exactly once: by
+  the visible segment of its (sub)span, or as background).
+
+**Line schedule** (:func:`schedule`, the input back to back and the output always ready; cycle =
+the edge index, edge 0 takes the first word): line ``k`` has ``w_k`` words (ASL, bucket list,
+token), resolve cycles ``r_k`` and drain cycles ``d_k`` (:func:`pxp_cycles.drain_cycles`). The
+writer starts ``WS_k = max(WE_{k-1} + 1, DE_{k-2} + 1)`` (the bank it writes is released when the
+drain has finished the line that used it), ends ``WE_k = WS_k + w_k - 1``; resolve starts
+``RS_k = max(WE_k + 1, RH_{k-1} + 1)``, hands over at ``RH_k = max(RS_k + r_k, DE_{k-1} + 1)``;
+the drain runs ``RH_k + 1 .. DE_k = RH_k + d_k``. The finish-time counter of line k is
+``RH_k - RS_k + 1``; the last pixel leaves at edge ``DE_{N-1}``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.experts.formats import ADDR_BITS, DZ_FRAC, X_FRAC, Z_BITS
+from rasterhw.golden_model.experts.model import ExpertsFrame
+from rasterhw.golden_model.experts.pxp_cycles import drain_cycles, guarded
+from rasterhw.golden_model.experts.slp_run import block_lists
+
+__all__ = ["DMM_DEPTH", "NO_PTR", "STEPS", "line_asl", "dmm_line", "resolve", "schedule"]
+
+DMM_DEPTH = 256       # ASBs per DMM/P bank (the block's default)
+NO_PTR = 511          # leading pointer: none
+STEPS = ("init", "cull", "enter", "pass_a", "pass_b", "write")
+_ZMAX_RUN = ((1 << Z_BITS) - 1) << DZ_FRAC
+
+
+def line_asl(fr: ExpertsFrame, y: int) -> tuple[list[dict], np.ndarray]:
+    """The ASL of line ``y`` as the SLP writes it: ASB field dicts in ASL order, and their record ids."""
+    if fr.model != "bit":
+        raise RasterhwError("experts: the span PXP HDL's golden side needs the bit model")
+    rec, st = fr.records, fr.setup
+    if st.n >= (1 << ADDR_BITS) - 1 or (st.n and int(st.poly.max()) >= (1 << ADDR_BITS) - 1):
+        raise RasterhwError(f"experts: {st.n} triangles do not fit the {ADDR_BITS}-bit ASB address")
+    sel = np.flatnonzero(rec.row == y)
+    sel = sel[np.lexsort((rec.tri[sel], rec.xl[sel]))]
+    out = []
+    for r in sel:
+        t = int(rec.tri[r])
+        h = st.hue[t]
+        out.append({"xl": int(rec.xl[r]), "xr": int(rec.xr[r]), "zl": int(rec.zl[r]), "il": int(rec.il[r]),
+                    "dzdx": int(st.dzdx[t]), "didx": int(st.didx[t]),
+                    "hue": int((h[0] << 6) | (h[1] << 3) | h[2]), "addr": t, "poly": int(st.poly[t]),
+                    "sl": int(rec.sl[r]), "ql": int(rec.ql[r]), "sr": int(rec.sr[r]), "qr": int(rec.qr[r])})
+    return out, sel
+
+
+def dmm_line(fr: ExpertsFrame, y: int, bounds) -> tuple[list[dict], list[int], list[list[int]]]:
+    """Line ``y``'s ASL, and per range of ``bounds`` (P + 1,) its leading pointer (``NO_PTR``: none)
+    and bucket list (ASL positions), with the A.J. guard when the frame has A.J."""
+    segs, ids = line_asl(fr, y)
+    if len(segs) > DMM_DEPTH:
+        raise RasterhwError(f"experts: line {y} holds {len(segs)} ASBs, a DMM/P bank {DMM_DEPTH}")
+    lead, buckets, _ = block_lists(list(range(len(ids))), fr.records.c0[ids], fr.records.c1[ids],
+                                   np.asarray(bounds), guard=1 if fr.aj == "c" else 0, width=fr.width)
+    return segs, [NO_PTR if v < 0 else v for v in lead], buckets
+
+
+def _ends(s: dict, glo: int, ghi: int) -> tuple[int, int, int]:
+    c0 = (s["xl"] + 31) >> X_FRAC
+    c1 = ((s["xr"] + 31) >> X_FRAC) - 1
+    return c0, max(c0, glo), min(c1, ghi - 1)
+
+
+def _zrun(s: dict, col: int) -> int:
+    return (s["zl"] << DZ_FRAC) + ((((col << X_FRAC) + (1 << (X_FRAC - 1)) - s["xl"]) * s["dzdx"]) >> X_FRAC)
+
+
+def _good(zs_l, zs_r, zb_l, zb_r, s_lower: bool) -> bool:
+    """:func:`span._stays_nearest`, bit model, one pair."""
+    if s_lower:
+        return zs_l <= zb_l and zs_r <= zb_r
+    g = 1 << DZ_FRAC
+    return (zs_l + g <= zb_l and zs_r + g <= zb_r and zb_l >= g and zb_r >= g
+            and zs_l < _ZMAX_RUN and zs_r < _ZMAX_RUN)
+
+
+def resolve(segs: list[dict], bucket: list[int], lead: int, glo: int, ghi: int) -> tuple[dict, list[int]]:
+    """One line of one range through the span PXP: cycles per step (:data:`STEPS`) and the visible
+    ASL position of every pixel of ``[glo, ghi)`` (-1: background)."""
+    cyc = dict.fromkeys(STEPS, 0)
+    cyc["init"] = 1
+    vis: list[int] = []
+    if ghi <= glo:
+        return cyc, vis
+    n = len(segs)
+    ends = [_ends(s, glo, ghi) for s in segs]
+    act: list[int] = []
+    bi, pp = 0, (n if lead == NO_PTR else lead)
+    x = glo
+    while x < ghi:
+        cyc["cull"] += len(act)
+        act = [p for p in act if ends[p][2] >= x]
+        minend = min([ghi] + [ends[p][2] + 1 for p in act])
+        while True:
+            cyc["enter"] += 1
+            if bi < len(bucket):
+                pos, cand = bucket[bi], True
+            else:
+                pos = pp
+                cand = pp < n and ends[pp][0] < ghi
+            if cand:
+                _, a, e = ends[pos]
+                if e < a or a == x:
+                    if a <= e:
+                        act.append(pos)
+                        minend = min(minend, e + 1)
+                    if bi < len(bucket):
+                        bi += 1
+                    else:
+                        pp += 1
+                    continue
+            nxt = ends[pos][1] if cand and ends[pos][1] < minend else minend
+            break
+        r = nxt - 1
+        if len(act) < 2:
+            cyc["write"] += r - x + 1
+            vis += [act[0] if act else -1] * (r - x + 1)
+        else:
+            k = len(act)
+            stack: list[int] = []
+            lft, rgt = x, r
+            while True:
+                cyc["pass_a"] += k
+                zl = {p: _zrun(segs[p], lft) for p in act}
+                zr = {p: _zrun(segs[p], rgt) for p in act}
+                S = min(act, key=lambda p: (min(max(zl[p] >> DZ_FRAC, 0), (1 << Z_BITS) - 1), segs[p]["addr"]))
+                ok = True
+                if lft < rgt:
+                    cyc["pass_b"] += k
+                    ok = all(p == S or _good(zl[S], zr[S], zl[p], zr[p], segs[S]["addr"] < segs[p]["addr"])
+                             for p in act)
+                if not ok:
+                    stack.append(rgt)
+                    rgt = ((lft + rgt + 1) >> 1) - 1
+                    continue
+                cyc["write"] += rgt - lft + 1
+                vis += [S] * (rgt - lft + 1)
+                if not stack:
+                    break
+                lft, rgt = rgt + 1, stack.pop()
+        x = r + 1
+    return cyc, vis
+
+
+def schedule(lines: list[tuple[int, int, int]]) -> dict:
+    """Exact timing of lines ``(words, resolve cycles, drain cycles)`` through the span PXP
+    (the module docstring's recurrences). Returns ``{"line_cycles": [...], "last_pixel": DE_{N-1}}``."""
+    we, rh = -1, -1
+    de: list[int] = []
+    out = []
+    for k, (w, r, d) in enumerate(lines):
+        ws = max(we + 1, de[k - 2] + 1 if k >= 2 else 0)
+        we = ws + w - 1
+        rs = max(we + 1, rh + 1)
+        rh = max(rs + r, de[k - 1] + 1 if k >= 1 else 0)
+        de.append(rh + d)
+        out.append(rh - rs + 1)
+    return {"line_cycles": out, "last_pixel": de[-1] if de else -1}
+
+
+def line_job(segs: list[dict], bucket: list[int], lead: int, lo: int, hi: int, *, aj: str, width: int) -> dict:
+    """One PXP line: its words, resolve and drain cycles and visible positions of ``[lo, hi)``."""
+    glo, ghi = guarded(lo, hi, width, aj)
+    cyc, vis = resolve(segs, bucket, lead, glo, ghi)
+    return {"words": len(segs) + len(bucket) + 1, "resolve": sum(cyc.values()), "steps": cyc,
+            "drain": drain_cycles(lo, hi, aj=aj, width=width), "visible": vis[lo - glo:lo - glo + (hi - lo)]}

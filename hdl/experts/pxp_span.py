@@ -1,0 +1,565 @@
+"""EXPERTS span PXP (the paper's): DMM/P bank in, span cull and depth search per span, S.S., A.J. (c), DSLB.
+
+Paper (seed 000, section 4): the PXP's stages are "iv) スキャン・ラインをスパンに分割し、そのスパン内に
+現われる範囲のセグメントを抽出する《span cull》" and "v) iv)で抽出したセグメントに応じてデプス・サーチを
+行ない、可視セグメントを決定する《depth search》"; visibility is decided per segment ("セグメントという
+「広がり」を持った単位で可視/不可視を判定する"), then shaded uniformly along it. Section 3: the SLP writes
+the ASL into the DMM/P ("DMM/PはSLPと各PXP間のASL等の授受において、上位プロセッサによる書込みと下位
+プロセッサによる読み出しと並行して同時に行なう"), with the block boundary bucket list and the block
+leading segment pointer ("PXPでの初期処理によるオーバヘッドを軽減するために ... ASL の附加的な情報").
+
+This block holds its own DMM/P (two banks; the writer fills one while the PXP reads the other):
+
+* **writer** (``i``, :func:`dmm_layout` words): per line, the line's whole ASL in ASL order (``list = 0``,
+  stored at the next ASL position), then this PXP's block boundary bucket list (``list = 1``,
+  ``ptr`` = an ASL position), then the ``last`` token whose ``ptr`` is the block leading segment
+  pointer (``NO_PTR``: none). The range ``lo``/``hi`` is sampled with the token. A bank is written
+  only when free (released when the DSLB drain has finished that line: the drain's A.J. reads the
+  visible segments' edges from it); a line longer than ``depth`` sets ``overflow`` and stalls ``i``.
+* **span cull** (per span, starting at ``x = glo``): one cycle per segment of the active list
+  (in place: those ending before ``x`` leave, the others stay and give the nearest end), then one
+  cycle per candidate entering at ``x`` (the bucket list first, then the ASL from the leading
+  pointer while the first pixel is before ``ghi``; a segment with no pixel is skipped in a cycle),
+  and one cycle that sets the span's right end ``r = min(nearest end, next start, ghi) - 1``.
+* **depth search** (``k >= 2`` segments present): pass A, one cycle per segment: z at the span's two
+  end pixels (two multiplies) and the nearest at the left pixel (16-bit key, ties to the lower ASB
+  address); pass B (spans wider than a pixel), one cycle per segment: the guarded end-depth test of
+  ``golden_model/experts/span.py`` (S stays nearest at every pixel). If a test fails the span is
+  halved at ``(l + r + 1) >> 1``, the right half's end pushed on a small stack, and the left half
+  searched; ``k = 0`` is background, ``k = 1`` needs no search.
+* **S.S. and DSLB write**: one cycle per pixel of a decided (sub)span, the intensity by the
+  multiplier at that pixel (equal to stepping), the word ``{ASB address, pixel, ASL position}``.
+* **drain** (double-banked DSLB, as :class:`hdl.experts.pxp.ExpertsPxp`): ``2 R`` cycles, with A.J.
+  (c) ``3 G`` plus one at the frame's right edge, the blend reading the visible segment's edges
+  from the DMM/P bank by its ASL position.
+
+Cycles: ``golden_model/experts/span_cycles.py`` (every term named there). Pixels: the golden bit
+model's. The resolve side reads the DMM/P bank, the active list and the stack asynchronously
+(one access per cycle each).
+"""
+
+from __future__ import annotations
+
+from amaranth import Module, Mux, Signal, signed, unsigned
+from amaranth.lib import data, enum, stream, wiring
+from amaranth.lib.memory import Memory
+from amaranth.lib.wiring import In, Out
+from rasterhw.golden_model.experts.formats import (
+    ADDR_BITS,
+    ALPHA_BITS,
+    DZ_FRAC,
+    HUE_BITS,
+    SLOPE_FRAC,
+    X_FRAC,
+    Z_BITS,
+    Formats,
+)
+
+__all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "PTR_BITS", "NO_PTR"]
+
+NONE = (1 << ADDR_BITS) - 1     # ASB address / polygon number of the background
+PTR_BITS = 9                    # ASL position in a DMM/P bank
+NO_PTR = (1 << PTR_BITS) - 1    # leading pointer: no segment starts in the range
+
+
+def dmm_layout() -> data.StructLayout:
+    """One DMM/P word as the SLP writes it: an ASB, a bucket-list entry or the end-of-line token."""
+    return data.StructLayout({
+        "last": unsigned(1),          # end of the line; ptr = block leading segment pointer
+        "list": unsigned(1),          # block boundary bucket list entry; ptr = its ASL position
+        "ptr": unsigned(PTR_BITS),
+        "xl": unsigned(16),           # Q10.6
+        "xr": unsigned(16),           # Q10.6
+        "zl": unsigned(16),           # Q16.0, 0 = near
+        "il": unsigned(16),           # Q(I).(16-I)
+        "dzdx": signed(16),           # sQ11.4
+        "didx": signed(16),           # sQ(I-1).(16-I)
+        "hue": unsigned(3 * HUE_BITS),
+        "addr": unsigned(ADDR_BITS),  # ASB address = PL order: the tie-break
+        "poly": unsigned(ADDR_BITS),  # polygon number (A.J. only between polygons)
+        "sl": signed(16),             # left edge dx/dy, sQ7.8 (A.J.)
+        "ql": signed(16),             # left edge dy/dx, sQ7.8
+        "sr": signed(16),             # right edge dx/dy
+        "qr": signed(16),             # right edge dy/dx
+    })
+
+
+def asb_layout() -> data.StructLayout:
+    """The ASB fields of a DMM/P word (without ``last``, ``list``, ``ptr``)."""
+    lay = dict(dmm_layout().members)
+    for k in ("last", "list", "ptr"):
+        lay.pop(k)
+    return data.StructLayout(lay)
+
+
+class _R(enum.Enum, shape=3):
+    IDLE = 0      # wait for a full DMM/P bank; start the line
+    CULL = 1      # span cull: one active segment per cycle
+    ENTER = 2     # span cull: one entering candidate per cycle, then the span's right end
+    PASSA = 3     # depth search: z at both ends, nearest at the left pixel
+    PASSB = 4     # depth search: guarded end-depth tests
+    WRITE = 5     # S.S. and DSLB write, one pixel per cycle
+    HAND = 6      # hand the DSLB bank to the drain
+
+
+class _D(enum.Enum, shape=3):
+    IDLE = 0
+    DRD = 1       # read the DSLB
+    DOUT = 2      # without A.J.: offer the pixel
+    DSEG = 3      # with A.J.: read the visible segment from the DMM/P bank
+    DAJ = 4       # with A.J.: blend the boundary, offer the pixel on its left
+    FLUSH = 5     # with A.J.: offer the range's last pixel
+
+
+class ExpertsPxpSpan(wiring.Component):
+    """One span PXP with its DMM/P: DMM/P words in, the range's pixel words out, line by line.
+
+    Parameters
+    ----------
+    width : int
+        Frame width (1..1024): depth of the DSLB.
+    intensity_bits : int
+        Intensity field width (1..7); the pixel word is ``3 * 3 + intensity_bits`` bits.
+    aj : str
+        ``"none"`` or ``"c"`` (anti-jagging, method (c)).
+    depth : int
+        ASBs per DMM/P bank (2..511).
+
+    Members
+    -------
+    i : In(stream.Signature(dmm_layout()))
+    o : Out(stream.Signature(unsigned(9 + intensity_bits)))
+    lo, hi : In(10), In(11)
+        The range ``[lo, hi)`` of the line being written, sampled with its ``last`` token.
+    line_cycles : Out(16)
+        Finish-time counter: cycles of the last line from its first resolve cycle to its hand-over
+        to the drain (waits for the drain included).
+    lines : Out(16)
+        Lines handed over.
+    overflow : Out(1)
+        Sticky: a line had more than ``depth`` ASBs or bucket entries; ``i`` is stalled for good.
+    """
+
+    def __init__(self, *, width: int = 512, intensity_bits: int = 7, aj: str = "none", depth: int = 256):
+        if isinstance(width, bool) or not isinstance(width, int) or not 1 <= width <= 1024:
+            raise ValueError(f"width must be an integer in 1..1024, not {width!r}")
+        if aj not in ("none", "c"):
+            raise ValueError(f"aj must be 'none' or 'c', not {aj!r}")
+        if isinstance(depth, bool) or not isinstance(depth, int) or not 2 <= depth <= NO_PTR:
+            raise ValueError(f"depth must be an integer in 2..{NO_PTR}, not {depth!r}")
+        self._fmt = Formats(intensity_bits)
+        self._width = width
+        self._aj = aj
+        self._depth = depth
+        super().__init__({
+            "i": In(stream.Signature(dmm_layout())),
+            "o": Out(stream.Signature(unsigned(self._fmt.pixel_bits))),
+            "lo": In(10),
+            "hi": In(11),
+            "line_cycles": Out(16),
+            "lines": Out(16),
+            "overflow": Out(1),
+        })
+
+    @property
+    def width(self) -> int:
+        return self._width
+
+    @property
+    def aj(self) -> str:
+        return self._aj
+
+    @property
+    def depth(self) -> int:
+        return self._depth
+
+    def elaborate(self, platform):
+        m = Module()
+        fmt = self._fmt
+        pb = fmt.pixel_bits
+        ib = fmt.intensity_bits
+        W = self._width
+        D = self._depth
+        aj = self._aj == "c"
+        asb = asb_layout()
+        pw = (D - 1).bit_length()                   # ASL position bits within a bank
+        cw = D.bit_length()                         # counts 0..D
+        ab = (W - 1).bit_length()                   # DSLB bank bit position
+
+        # ---------------------------------------------------------------- DMM/P (two banks)
+        m.submodules.dmm = dmm = Memory(shape=asb, depth=2 << pw, init=[])
+        dwr = dmm.write_port()
+        srd = dmm.read_port(domain="comb")          # resolve side
+        m.submodules.bkt = bkt = Memory(shape=unsigned(PTR_BITS), depth=2 << pw, init=[])
+        bwr = bkt.write_port()
+        brd = bkt.read_port(domain="comb")
+        wbank = Signal()
+        wn = Signal(cw)
+        wnb = Signal(cw)
+        full = Signal(2)
+        bn = [Signal(cw, name=f"n{b}") for b in range(2)]
+        bnb = [Signal(cw, name=f"nb{b}") for b in range(2)]
+        blead = [Signal(PTR_BITS, name=f"lead{b}") for b in range(2)]
+        blo = [Signal(10, name=f"lo{b}") for b in range(2)]
+        bhi = [Signal(11, name=f"hi{b}") for b in range(2)]
+        set_full = Signal(2)
+        clr_full = Signal(2)
+        wfull = Signal()
+        m.d.comb += wfull.eq(full.bit_select(wbank, 1))
+        p = self.i.payload
+        fits = Signal()
+        m.d.comb += fits.eq(p.last | Mux(p.list, wnb < D, wn < D))
+        m.d.comb += [self.i.ready.eq(~wfull & ~self.overflow & fits),
+                     dwr.en.eq(0), bwr.en.eq(0),
+                     dwr.addr.eq((wbank << pw) | wn[:pw]), bwr.addr.eq((wbank << pw) | wnb[:pw]),
+                     bwr.data.eq(p.ptr)]
+        for name in asb.members:
+            m.d.comb += getattr(dwr.data, name).eq(getattr(p, name))
+        with m.If(self.i.valid & ~wfull & ~fits):
+            m.d.sync += self.overflow.eq(1)
+        with m.If(self.i.valid & self.i.ready):
+            with m.If(p.last):
+                m.d.sync += [wn.eq(0), wnb.eq(0), wbank.eq(~wbank)]
+                for b in range(2):
+                    with m.If(wbank == b):
+                        m.d.comb += set_full.eq(1 << b)
+                        m.d.sync += [bn[b].eq(wn), bnb[b].eq(wnb), blead[b].eq(p.ptr),
+                                     blo[b].eq(self.lo), bhi[b].eq(self.hi)]
+            with m.Elif(p.list):
+                m.d.comb += bwr.en.eq(1)
+                m.d.sync += wnb.eq(wnb + 1)
+            with m.Else():
+                m.d.comb += dwr.en.eq(1)
+                m.d.sync += wn.eq(wn + 1)
+        m.d.sync += full.eq((full | set_full) & ~clr_full)
+
+        # ---------------------------------------------------------------- DSLB (two banks)
+        word = data.StructLayout({"addr": unsigned(ADDR_BITS), "pix": unsigned(pb), "slot": unsigned(pw)})
+        m.submodules.dslb = dslb = Memory(shape=word, depth=2 << ab, init=[])
+        wr = dslb.write_port()
+        drd = dslb.read_port(transparent_for=())
+        m.d.comb += [wr.en.eq(0), drd.en.eq(0), self.o.valid.eq(0)]
+
+        # ---------------------------------------------------------------- resolve side
+        state = Signal(_R)
+        rb = Signal()
+        glo = Signal(11)
+        ghi = Signal(11)
+        lo = Signal(10)
+        hi = Signal(11)
+        n = Signal(cw)
+        nb = Signal(cw)
+        x = Signal(11)            # the current span's left pixel
+        i = Signal(cw)            # scan index (active list)
+        j = Signal(cw)            # active list write index
+        k = Signal(cw)            # segments present in the span
+        bi = Signal(cw)           # next bucket list entry
+        pp = Signal(PTR_BITS + 1)  # next ASL position of the walk from the leading pointer
+        minend = Signal(12)       # nearest end + 1 of the segments present
+        one = Signal(pw)          # the first active entry (k = 1: the visible segment)
+        sl = Signal(11)           # (sub)span searched / written
+        sr = Signal(11)
+        S = Signal(pw)            # nearest segment (ASL position)
+        skey = Signal(Z_BITS)
+        saddr = Signal(ADDR_BITS)
+        szl = Signal(signed(40))
+        szr = Signal(signed(40))
+        bad = Signal()
+        wbg = Signal()            # the span written is background
+        sp = Signal(5)            # stack pointer
+        cyc = Signal(16)
+
+        m.submodules.act = act = Memory(shape=unsigned(pw), depth=D, init=[])
+        awr = act.write_port()
+        ard = act.read_port(domain="comb")
+        m.submodules.stk = stk = Memory(shape=unsigned(11), depth=16, init=[])
+        kwr = stk.write_port()
+        krd = stk.read_port(domain="comb")
+        m.d.comb += [awr.en.eq(0), kwr.en.eq(0), ard.addr.eq(i), awr.addr.eq(j), krd.addr.eq(sp - 1),
+                     kwr.addr.eq(sp)]
+
+        # the segment read this cycle (one DMM/P access): its first / last pixel in the guarded range
+        raddr = Signal(pw)
+        seg = Signal(asb)
+        m.d.comb += [srd.addr.eq((rb << pw) | raddr), seg.eq(srd.data)]
+        c0 = Signal(signed(12))
+        c1 = Signal(signed(12))
+        a = Signal(signed(12))
+        e = Signal(signed(12))
+        m.d.comb += [c0.eq((seg.xl + 31) >> X_FRAC), c1.eq(((seg.xr + 31) >> X_FRAC) - 1),
+                     a.eq(Mux(c0 > glo, c0, glo)), e.eq(Mux(c1 < ghi - 1, c1, ghi - 1))]
+
+        # the two multipliers: running z (Q16.4) at pixels sl and sr
+        def zrun_at(col):
+            d = Signal(signed(20), name="d_z")
+            z = Signal(signed(40), name="zrun")
+            m.d.comb += [d.eq((col << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl),
+                         z.eq((seg.zl << DZ_FRAC) + ((d * seg.dzdx) >> X_FRAC))]
+            return z
+        zl_ = zrun_at(sl)
+        zr_ = zrun_at(sr)
+        zk = Signal(signed(40))
+        key = Signal(Z_BITS)
+        m.d.comb += [zk.eq(zl_ >> DZ_FRAC),
+                     key.eq(Mux(zk < 0, 0, Mux(zk > (1 << Z_BITS) - 1, (1 << Z_BITS) - 1, zk)))]
+        nearer = Signal()
+        m.d.comb += nearer.eq((i == 0) | (key < skey) | ((key == skey) & (seg.addr < saddr)))
+        # the guarded test (span.py): S nearer than this segment B at every pixel of [sl, sr]
+        g = 1 << DZ_FRAC
+        zmax_run = ((1 << Z_BITS) - 1) << DZ_FRAC
+        lower = Signal()
+        higher = Signal()
+        good = Signal()
+        m.d.comb += [lower.eq((szl <= zl_) & (szr <= zr_)),
+                     higher.eq((szl + g <= zl_) & (szr + g <= zr_) & (zl_ >= g) & (zr_ >= g)
+                               & (szl < zmax_run) & (szr < zmax_run)),
+                     good.eq((raddr == S) | Mux(saddr < seg.addr, lower, higher))]
+        mid = Signal(11)
+        m.d.comb += mid.eq((sl + sr + 1) >> 1)
+
+        # S.S. at pixel sl (the write cursor): intensity by the multiplier
+        di = Signal(signed(20))
+        irun = Signal(signed(40))
+        m.d.comb += [di.eq((sl << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl),
+                     irun.eq(seg.il + ((di * seg.didx) >> X_FRAC))]
+        imax = fmt.i_max << fmt.i_frac
+        ic = Signal(16)
+        m.d.comb += ic.eq(Mux(irun < 0, 0, Mux(irun > imax, imax, irun)))
+
+        # the next entering candidate: the bucket list, then the walk from the leading pointer
+        in_bkt = Signal()
+        cand = Signal()
+        m.d.comb += [in_bkt.eq(bi < nb), brd.addr.eq((rb << pw) | bi[:pw])]
+
+        # ---------------------------------------------------------------- drain side (as ExpertsPxp)
+        dstate = Signal(_D)
+        dbusy = Signal()
+        dbank = Signal()
+        dx = Signal(11)
+        dlo = Signal(10)
+        dhi = Signal(11)
+        dghi = Signal(11)
+        dstored = Signal(word)
+        m.d.comb += [dstored.eq(drd.data), self.o.payload.eq(dstored.pix)]
+
+        def next_span(xn):
+            """Start the span cull at pixel ``xn`` (the line's end: hand over)."""
+            return [x.eq(xn), i.eq(0), j.eq(0), minend.eq(ghi),
+                    state.eq(Mux(xn >= ghi, _R.HAND, Mux(k == 0, _R.ENTER, _R.CULL)))]
+
+        m.d.sync += cyc.eq(cyc + 1)
+        m.d.comb += raddr.eq(ard.data)
+        with m.Switch(state):
+            with m.Case(_R.IDLE):
+                m.d.sync += cyc.eq(1)
+                lo_b, hi_b = Signal(10), Signal(11)
+                glo_b, ghi_b = Signal(11), Signal(11)
+                m.d.comb += [lo_b.eq(Mux(rb, blo[1], blo[0])), hi_b.eq(Mux(rb, bhi[1], bhi[0]))]
+                if aj:
+                    m.d.comb += [glo_b.eq(Mux(lo_b > 0, lo_b - 1, 0)), ghi_b.eq(Mux(hi_b < W, hi_b + 1, hi_b))]
+                else:
+                    m.d.comb += [glo_b.eq(lo_b), ghi_b.eq(hi_b)]
+                with m.If(full.bit_select(rb, 1)):
+                    lead = Mux(rb, blead[1], blead[0])
+                    n_b = Mux(rb, bn[1], bn[0])
+                    m.d.sync += [lo.eq(lo_b), hi.eq(hi_b), glo.eq(glo_b), ghi.eq(ghi_b), x.eq(glo_b),
+                                 n.eq(n_b), nb.eq(Mux(rb, bnb[1], bnb[0])),
+                                 pp.eq(Mux(lead == NO_PTR, n_b, lead)),
+                                 i.eq(0), j.eq(0), k.eq(0), bi.eq(0), minend.eq(ghi_b),
+                                 state.eq(Mux(ghi_b <= glo_b, _R.HAND, _R.ENTER))]
+            with m.Case(_R.CULL):
+                with m.If(e >= x):
+                    m.d.comb += [awr.en.eq(1), awr.data.eq(raddr)]
+                    m.d.sync += j.eq(j + 1)
+                    with m.If(j == 0):
+                        m.d.sync += one.eq(raddr)
+                    with m.If(e + 1 < minend):
+                        m.d.sync += minend.eq(e + 1)
+                m.d.sync += i.eq(i + 1)
+                with m.If(i + 1 >= k):
+                    m.d.sync += state.eq(_R.ENTER)
+            with m.Case(_R.ENTER):
+                with m.If(in_bkt):
+                    m.d.comb += raddr.eq(brd.data)
+                with m.Else():
+                    m.d.comb += raddr.eq(pp)
+                m.d.comb += cand.eq(in_bkt | ((pp < n) & (c0 < ghi)))
+                with m.If(cand & (e < a)):
+                    # no pixel in the range: skipped
+                    with m.If(in_bkt):
+                        m.d.sync += bi.eq(bi + 1)
+                    with m.Else():
+                        m.d.sync += pp.eq(pp + 1)
+                with m.Elif(cand & (a == x)):
+                    m.d.comb += [awr.en.eq(1), awr.data.eq(raddr)]
+                    m.d.sync += j.eq(j + 1)
+                    with m.If(j == 0):
+                        m.d.sync += one.eq(raddr)
+                    with m.If(e + 1 < minend):
+                        m.d.sync += minend.eq(e + 1)
+                    with m.If(in_bkt):
+                        m.d.sync += bi.eq(bi + 1)
+                    with m.Else():
+                        m.d.sync += pp.eq(pp + 1)
+                with m.Else():
+                    # the span's right end: the nearest end, the next start, the range's end
+                    nxt = Signal(12)
+                    m.d.comb += nxt.eq(Mux(cand & (a < minend), a, minend))
+                    m.d.sync += [k.eq(j), sl.eq(x), sr.eq(nxt - 1), sp.eq(0), i.eq(0)]
+                    with m.If(j >= 2):
+                        m.d.sync += state.eq(_R.PASSA)
+                    with m.Else():
+                        m.d.sync += [wbg.eq(j == 0), S.eq(one), state.eq(_R.WRITE)]
+            with m.Case(_R.PASSA):
+                with m.If(nearer):
+                    m.d.sync += [S.eq(raddr), skey.eq(key), saddr.eq(seg.addr), szl.eq(zl_), szr.eq(zr_)]
+                m.d.sync += i.eq(i + 1)
+                with m.If(i + 1 >= k):
+                    m.d.sync += i.eq(0)
+                    with m.If(sl == sr):
+                        m.d.sync += [wbg.eq(0), state.eq(_R.WRITE)]
+                    with m.Else():
+                        m.d.sync += [bad.eq(0), state.eq(_R.PASSB)]
+            with m.Case(_R.PASSB):
+                m.d.sync += [i.eq(i + 1), bad.eq(bad | ~good)]
+                with m.If(i + 1 >= k):
+                    m.d.sync += i.eq(0)
+                    with m.If(bad | ~good):
+                        # the end depths do not settle it: halve, search the left half first
+                        m.d.comb += [kwr.en.eq(1), kwr.data.eq(sr)]
+                        m.d.sync += [sp.eq(sp + 1), sr.eq(mid - 1), state.eq(_R.PASSA)]
+                    with m.Else():
+                        m.d.sync += [wbg.eq(0), state.eq(_R.WRITE)]
+            with m.Case(_R.WRITE):
+                m.d.comb += raddr.eq(S)
+                m.d.comb += [wr.addr.eq((rb << ab) | sl), wr.en.eq(1)]
+                with m.If(wbg):
+                    m.d.comb += wr.data.eq(word.const({"addr": NONE, "pix": 0, "slot": 0}))
+                with m.Else():
+                    m.d.comb += [wr.data.addr.eq(seg.addr), wr.data.pix.eq((seg.hue << ib) | (ic >> fmt.i_frac)),
+                                 wr.data.slot.eq(S)]
+                m.d.sync += sl.eq(sl + 1)
+                with m.If(sl == sr):
+                    with m.If(sp != 0):
+                        m.d.sync += [sr.eq(krd.data), sp.eq(sp - 1), i.eq(0), state.eq(_R.PASSA)]
+                    with m.Else():
+                        m.d.sync += next_span(sr + 1)
+            with m.Case(_R.HAND):
+                with m.If(~dbusy):
+                    m.d.sync += [dbusy.eq(1), dbank.eq(rb), dlo.eq(lo), dhi.eq(hi), dghi.eq(ghi), dx.eq(glo),
+                                 dstate.eq(_D.DRD), rb.eq(~rb), state.eq(_R.IDLE),
+                                 self.line_cycles.eq(cyc + 1), self.lines.eq(self.lines + 1)]
+
+        if aj:
+            trd = dmm.read_port(transparent_for=())     # drain side: the visible segment's edges
+            m.d.comb += trd.en.eq(0)
+            p_pix = Signal(pb)            # pixel dx-1 before A.J.
+            p_out = Signal(pb)            # pixel dx-1 as it will be output
+            p_addr = Signal(ADDR_BITS)
+            p_ent = Signal(asb)
+            p_ok = Signal()               # there is a pixel dx-1 in the walk
+            c_pix = Signal(pb)
+            c_addr = Signal(ADDR_BITS)
+            c_ent = Signal(asb)
+            m.d.comb += c_ent.eq(trd.data)
+            bg_c = Signal()
+            bg_p = Signal()
+            m.d.comb += [bg_c.eq(c_addr == NONE), bg_p.eq(p_addr == NONE)]
+            poly_c = Signal(ADDR_BITS)
+            poly_p = Signal(ADDR_BITS)
+            m.d.comb += [poly_c.eq(Mux(bg_c, NONE, c_ent.poly)), poly_p.eq(Mux(bg_p, NONE, p_ent.poly))]
+            cc0 = Signal(signed(12))
+            pc1 = Signal(signed(12))
+            m.d.comb += [cc0.eq((c_ent.xl + 31) >> X_FRAC), pc1.eq(((p_ent.xr + 31) >> X_FRAC) - 1)]
+            starts = Signal()
+            ends = Signal()
+            m.d.comb += [starts.eq(~bg_c & (dx == Mux(cc0 < 0, 0, cc0))),
+                         ends.eq(~bg_p & (dx - 1 == Mux(pc1 > W - 1, W - 1, pc1)))]
+            edge = Signal()
+            use_b = Signal()
+            use_a = Signal()
+            m.d.comb += [edge.eq(p_ok & (dx > 0) & (p_addr != c_addr) & (poly_p != poly_c)),
+                         use_b.eq(edge & starts), use_a.eq(edge & ~starts & ends)]
+            xe = Signal(16)
+            esl = Signal(signed(16))
+            qq = Signal(signed(16))
+            m.d.comb += [xe.eq(Mux(use_b, c_ent.xl, p_ent.xr)), esl.eq(Mux(use_b, c_ent.sl, p_ent.sr)),
+                         qq.eq(Mux(use_b, c_ent.ql, p_ent.qr))]
+            right = Signal()              # the blended pixel is dx (else dx - 1)
+            m.d.comb += right.eq((xe >> X_FRAC) >= dx)
+            q = Signal(11)
+            m.d.comb += q.eq(Mux(right, dx, dx - 1))
+            delta = Signal(signed(20))
+            m.d.comb += delta.eq(xe - ((q << X_FRAC) + (1 << (X_FRAC - 1))))
+            steep = Signal()
+            m.d.comb += steep.eq(Mux(esl < 0, -esl, esl) <= (1 << SLOPE_FRAC))
+            aq = Signal(17)
+            m.d.comb += aq.eq(Mux(qq < 0, -qq, qq))
+            araw = Signal(signed(40))
+            m.d.comb += araw.eq(Mux(steep, (1 << (ALPHA_BITS - 1)) + (delta << (ALPHA_BITS - X_FRAC)),
+                                    (1 << (ALPHA_BITS - 1)) + ((delta * aq) >> (X_FRAC + SLOPE_FRAC - ALPHA_BITS))))
+            one_a = 1 << ALPHA_BITS
+            alpha = Signal(ALPHA_BITS + 1)
+            m.d.comb += alpha.eq(Mux(araw < 0, 0, Mux(araw > one_a, one_a, araw)))
+            # eq. (5) per field (R, G, B, I), C = alpha C_L + (1 - alpha) C_R, Q0.8, rounded
+            blend = Signal(pb)
+            parts = []
+            for lsb, w in ((ib + 6, 3), (ib + 3, 3), (ib, 3), (0, ib)):
+                fl = p_pix[lsb:lsb + w]
+                fr = c_pix[lsb:lsb + w]
+                v = Signal(w, name=f"blend_{lsb}")
+                m.d.comb += v.eq((alpha * fl + (one_a - alpha) * fr + (one_a >> 1)) >> ALPHA_BITS)
+                parts.append((lsb, v))
+            m.d.comb += blend.eq(sum((v << lsb) for lsb, v in parts))
+            o_prev = Signal(pb)
+            o_cur = Signal(pb)
+            m.d.comb += [o_prev.eq(Mux((use_a | use_b) & ~right, blend, p_out)),
+                         o_cur.eq(Mux((use_a | use_b) & right, blend, c_pix))]
+            emit = Signal()
+            m.d.comb += emit.eq(p_ok & (dx >= dlo + 1) & (dx <= dhi))
+            with m.If((state == _R.HAND) & ~dbusy):
+                m.d.sync += p_ok.eq(0)
+
+        with m.If(dbusy):
+            def drain_done():
+                return [dbusy.eq(0), dstate.eq(_D.IDLE), clr_full.eq(Mux(dbank, 0b10, 0b01))]
+
+            with m.Switch(dstate):
+                with m.Case(_D.DRD):
+                    m.d.comb += [drd.addr.eq((dbank << ab) | dx), drd.en.eq(1)]
+                    m.d.sync += dstate.eq(_D.DSEG if aj else _D.DOUT)
+                with m.Case(_D.DOUT):
+                    m.d.comb += self.o.valid.eq(1)
+                    with m.If(self.o.ready):
+                        m.d.sync += dx.eq(dx + 1)
+                        with m.If(dx + 1 >= dhi):
+                            dd = drain_done()
+                            m.d.sync += dd[:2]
+                            m.d.comb += dd[2]
+                        with m.Else():
+                            m.d.sync += dstate.eq(_D.DRD)
+                if aj:
+                    with m.Case(_D.DSEG):
+                        m.d.comb += [trd.addr.eq((dbank << pw) | dstored.slot), trd.en.eq(1)]
+                        m.d.sync += [c_pix.eq(dstored.pix), c_addr.eq(dstored.addr), dstate.eq(_D.DAJ)]
+                    with m.Case(_D.DAJ):
+                        m.d.comb += [self.o.valid.eq(emit), self.o.payload.eq(o_prev)]
+                        with m.If(~emit | self.o.ready):
+                            m.d.sync += [p_pix.eq(c_pix), p_out.eq(o_cur), p_addr.eq(c_addr), p_ent.eq(c_ent),
+                                         p_ok.eq(1), dx.eq(dx + 1)]
+                            with m.If(dx + 1 >= dghi):
+                                with m.If(dghi == dhi):
+                                    m.d.sync += dstate.eq(_D.FLUSH)
+                                with m.Else():
+                                    dd = drain_done()
+                                    m.d.sync += dd[:2]
+                                    m.d.comb += dd[2]
+                            with m.Else():
+                                m.d.sync += dstate.eq(_D.DRD)
+                    with m.Case(_D.FLUSH):
+                        m.d.comb += [self.o.valid.eq(1), self.o.payload.eq(p_out)]
+                        with m.If(self.o.ready):
+                            dd = drain_done()
+                            m.d.sync += dd[:2]
+                            m.d.comb += dd[2]
+        return m

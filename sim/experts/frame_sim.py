@@ -1,0 +1,186 @@
+"""``rasterhw sim experts``: a whole frame through the SLP HDL and then the span PXP HDL.
+
+Every band's SLP work runs in ``experts-slp`` (the bands back to back through one instance: the
+SLPs are identical and independent, "ホスト計算機はすべての SLP に同一の PL を送出するだけ"): band,
+range bounds and the PL in; per line its ASL order, block leading pointers and bucket lists out,
+compared word for word and end-of-line by end-of-line (cycle stamps) with
+``golden_model/experts/slp_cycles.py``. Those words -- the HDL's, not the golden SLP's -- then make
+every PXP's DMM/P words (the line's ASL in the SLP's order, that PXP's bucket list and leading
+pointer; each ASB's fields from the golden records: the SLP's z / i update and set-up are not in
+HDL), which run through ``experts-pxp-span`` as ``rasterhw sim pxp`` runs them: pixels against the
+golden bit model, every line's finish-time counter against ``span_cycles``.
+
+Frame times: an SLP's is its band's cycles (band start + its lines), a PXP's its own lines back to
+back (``span_cycles.schedule``); the clock for 30 frames/s is the busiest one's cycles x 30, for
+SLPs and PXPs side by side. The SLP and PXP runs are chained, not clocked together: the DMM/P
+between them would overlap them in the machine.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.experts.model import equal_bounds, render_frame
+from rasterhw.sim.experts.pxp_sim import ENGINES, jobs, run_pysim, run_verilator
+
+__all__ = ["simulate_frame", "decode_slp"]
+
+
+def decode_slp(words: list[int]) -> list[tuple]:
+    """``experts-slp`` output words -> ``(kind, p, pos, t, y, ASB dict)`` (signed fields sign-extended)."""
+    from amaranth import Shape
+    from rasterhw.hdl.experts.slp import slp_out_layout
+    lay = slp_out_layout()
+    top = {n: (f.offset, Shape.cast(f.shape).width) for n, f in lay}
+    sub = [(n, top["asb"][0] + f.offset, Shape.cast(f.shape)) for n, f in lay.members["asb"]]
+
+    def field(v, off, w, signed=False):
+        x = (v >> off) & ((1 << w) - 1)
+        return x - (1 << w) if signed and x >> (w - 1) else x
+    out = []
+    for v in words:
+        head = tuple(field(v, top[n][0], top[n][1]) for n in ("kind", "p", "pos", "t", "y"))
+        out.append((*head, {n: field(v, off, sh.width, sh.signed) for n, off, sh in sub}))
+    return out
+
+
+def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator", progress: bool = False,
+                   sn: int | None = 8, pn: int | None = 8, aj: str | None = "c", path: str | None = "chained") -> dict:
+    """Registry sim block ``experts``: the frame's SLP bands and PXP lines in HDL, against golden.
+
+    ``path="group"``: every band instead through ``experts-group`` (the SLP, its DMM/P writers and
+    Pn span PXPs clocked together, one run per band): pixels against golden, and the band's cycles
+    as measured (no cycle model: SLP and PXPs pace each other), ``group_cycles`` the slowest band."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.sim.engines import run
+    from rasterhw.sim.experts.testbench import SlpBench, slp_words
+    from rasterhw.sim.testbench import Stimulus
+    if engine not in ENGINES:
+        raise RasterhwError(f"experts: sim experts engine must be one of {', '.join(ENGINES)}, not {engine!r}")
+    sn = 8 if sn is None else sn
+    pn = 8 if pn is None else pn
+    aj = "c" if aj is None else aj
+    if aj not in ("none", "c"):
+        raise RasterhwError(f"experts: sim experts aj must be none or c, not {aj!r}")
+    if not (1 <= sn <= height and 1 <= pn <= min(width, 63)):
+        raise RasterhwError(f"experts: sn must be 1..{height} and pn 1..{min(width, 63)}")
+    path = "chained" if path is None else path
+    if path not in ("chained", "group"):
+        raise RasterhwError(f"experts: sim experts path must be chained or group, not {path!r}")
+    t0 = time.perf_counter()
+    fr = render_frame(run_geometry(scene, width, height, z_bits=16), model="bit", aj=aj)
+    if path == "group":
+        return _group_frame(fr, engine, sn, pn, aj, t0, progress)
+    guard = 1 if aj == "c" else 0
+    bands = equal_bounds(height, sn)
+    bounds = equal_bounds(width, pn)
+    # ---- the SLPs: every band back to back through one experts-slp
+    sws = [slp_words(fr, (int(bands[s]), int(bands[s + 1])), bounds, guard=guard) for s in range(sn)]
+    tb = SlpBench()
+    p = tb.params(width=width, tris=max(2, min(4095, max(sw["tris"] for sw in sws))),
+                  lines=max(1, int(np.diff(bands).max())), asl=256, guard=guard)
+    words_in = [w for sw in sws for w in sw["in"]]
+    want = [w for sw in sws for w in sw["out"]]
+    total = sum(sw["cycles"] for sw in sws)
+    if progress:
+        import sys
+        print(f"experts: {sn} SLP bands, {len(words_in)} words in, {len(want)} out, {total:,} SLP cycles expected",
+              file=sys.stderr)
+    got = run(tb, p, Stimulus({"i": words_in}), engine=engine, expect_words={"o": len(want)},
+              max_cycles=2 * total + 10000)
+    have = got.words["o"]
+    slp_mism = sum(a != b for a, b in zip(want, have, strict=False)) + abs(len(want) - len(have))
+    # every end-of-line word on the golden cycle: band start, then its lines, band after band
+    eol_want, t = [], 0
+    for sw in sws:
+        t += sw["start_cycles"]
+        for c in sw["line_cycles"]:
+            t += c
+            eol_want.append(t - 1)
+    dec = decode_slp(have)
+    eol_got = [st for st, w in zip(got.stamps["o"], dec, strict=False) if w[0] == 3]
+    slp_cyc_mism = sum(a != b for a, b in zip(eol_want, eol_got, strict=False)) + abs(len(eol_want) - len(eol_got))
+    # ---- the HDL SLP's lists -> every PXP's DMM/P words
+    lists: dict = {}
+    line: dict = {"asl": [], "lead": {}, "bk": {}}
+    for kind, q, pos, _t, y, a in dec:
+        if kind == 0:
+            line["asl"].append(a)
+        elif kind == 1:
+            line["lead"][q] = pos
+        elif kind == 2:
+            line["bk"].setdefault(q, []).append(pos)
+        else:
+            for r in range(pn):
+                lists[(y, int(bounds[r]), int(bounds[r + 1]))] = (line["asl"], line["lead"].get(r, -1),
+                                                                  line["bk"].get(r, []))
+            line = {"asl": [], "lead": {}, "bk": {}}
+    if len(lists) != height * pn:
+        raise RasterhwError(f"experts: the SLP HDL gave lists for {len(lists) // max(pn, 1)} of {height} lines")
+    jb = jobs(fr, sn, pn, pxp="span", slp=lists)
+    res = run_pysim(jb, width=width) if engine == "pysim" else run_verilator(jb, width=width)
+    px = res["pixels"]
+    n = min(px.size, jb["pixels"].size)
+    mism = int(np.count_nonzero(px[:n] != jb["pixels"][:n])) + abs(px.size - jb["pixels"].size)
+    cyc = res["cycles"][:jb["lines"]]
+    pxp_cyc_mism = int(np.count_nonzero(cyc != jb["cycles"][:cyc.size])) + (jb["lines"] - cyc.size)
+    slp_frame = max(sw["cycles"] for sw in sws)
+    cycles = int(got.cycles) + int(res.get("sim_cycles") or res.get("last_pixel") or 0)
+    run_s = got.run_s + res["run_s"]
+    pxp_frame = int(jb["pxp_frame_cycles"].max())
+    return {"engine": engine, "cycles": cycles, "clock_hz": None,
+            "cycles_per_s": round(cycles / run_s, 1) if run_s > 0 else None, "pixels_compared": int(n), "mismatches": mism + slp_mism,
+            "pixel_mismatches": mism, "slp_word_mismatches": slp_mism, "slp_words": len(want),
+            "cycle_mismatches": slp_cyc_mism + pxp_cyc_mism,
+            "slp_cycle_mismatches": slp_cyc_mism, "pxp_cycle_mismatches": pxp_cyc_mism,
+            "slp_cycles": slp_frame, "pxp_cycles": pxp_frame,
+            "slp_clock_for_30fps_hz": slp_frame * 30, "pxp_clock_for_30fps_hz": pxp_frame * 30,
+            "bottleneck": "SLP" if slp_frame > pxp_frame else "PXP",
+            "sn": sn, "pn": pn, "aj": aj, "pxp": "span", "wall_s": round(time.perf_counter() - t0, 3),
+            "slp_run_s": round(got.run_s, 3), "pxp_run_s": round(res["run_s"], 3)}
+
+
+def _group_frame(fr, engine: str, sn: int, pn: int, aj: str, t0: float, progress: bool) -> dict:
+    """Every band through ``experts-group``; pixels against golden, cycles measured per band."""
+    from rasterhw.golden_model.experts.pxp import pixel_words
+    from rasterhw.sim.engines import run
+    from rasterhw.sim.experts.testbench import GroupBench, slp_words
+    from rasterhw.sim.testbench import Stimulus, compare
+    W, H = fr.width, fr.height
+    bands = equal_bounds(H, sn)
+    b = equal_bounds(W, pn)
+    pix = pixel_words(fr.setup, fr.fields).reshape(H, W)
+    tb = GroupBench()
+    sws = [slp_words(fr, (int(bands[s]), int(bands[s + 1])), b, guard=1 if aj == "c" else 0) for s in range(sn)]
+    p = tb.params(width=W, pn=pn, aj=aj, tris=max(2, min(4095, max(sw["tris"] for sw in sws))),
+                  lines=max(1, int(np.diff(bands).max())), asl=256, depth=256)
+    mism = n = 0
+    band_cycles, run_s = [], 0.0
+    for s in range(sn):
+        y0, y1 = int(bands[s]), int(bands[s + 1])
+        want = {f"o[{k}]": [int(v) for y in range(y0, y1) for v in pix[y, int(b[k]):int(b[k + 1])]] for k in range(pn)}
+        if progress:
+            import sys
+            print(f"experts: band {s} through experts-group", file=sys.stderr)
+        got = run(tb, p, Stimulus({"i": sws[s]["in"]}), engine=engine,
+                  expect_words={k: len(v) for k, v in want.items()}, max_cycles=20 * sws[s]["cycles"] + 100000)
+        c = compare(_expected(want), got)
+        mism += c["mismatches"]
+        n += sum(len(v) for v in want.values())
+        band_cycles.append(got.cycles)
+        run_s += got.run_s
+    worst = max(band_cycles)
+    slp_model = max(sw["cycles"] for sw in sws)
+    return {"engine": engine, "path": "group", "cycles": int(sum(band_cycles)), "clock_hz": None,
+            "cycles_per_s": round(sum(band_cycles) / run_s, 1) if run_s > 0 else None,
+            "pixels_compared": n, "mismatches": mism, "group_cycles": int(worst),
+            "group_cycles_per_band": [int(c) for c in band_cycles],
+            "group_clock_for_30fps_hz": int(worst) * 30, "slp_cycles_alone": slp_model,
+            "sn": sn, "pn": pn, "aj": aj, "wall_s": round(time.perf_counter() - t0, 3)}
+
+
+def _expected(words):
+    from rasterhw.sim.testbench import Expected
+    return Expected(words)

@@ -1,0 +1,51 @@
+"""``rasterhw sim experts``: a whole (small) frame, every band through the SLP HDL and its lists into
+every span PXP's DMM/P; the 512 x 512 8 x 8 run is a measurement (docs/experts.md), not a test."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.experts.model import equal_bounds, render_frame
+from rasterhw.golden_model.experts.span_cycles import dmm_line, line_job
+from rasterhw.golden_model.pipeline import run_geometry
+from rasterhw.golden_model.scenes import build_scene
+from rasterhw.sim.experts.frame_sim import simulate_frame
+from rasterhw.sim.registry import SIM_KEYS, sim_blocks
+
+
+def test_small_frame_slp_and_pxp_hdl_exact():
+    r = simulate_frame(build_scene("experts-tilt-1000"), 48, 16, engine="pysim", sn=2, pn=3, aj="c")
+    assert set(SIM_KEYS) <= set(r)
+    assert r["pixels_compared"] == 48 * 16 and r["mismatches"] == 0 and r["slp_words"] > 300
+    assert r["slp_cycle_mismatches"] == 0 and r["pxp_cycle_mismatches"] == 0 and r["cycle_mismatches"] == 0
+    assert r["slp_clock_for_30fps_hz"] == 30 * r["slp_cycles"] and r["pxp_clock_for_30fps_hz"] == 30 * r["pxp_cycles"]
+    assert r["bottleneck"] in ("SLP", "PXP") and r["slp_cycles"] > 0 and r["pxp_cycles"] > 0
+
+
+def test_the_pxp_needs_the_slps_bucket_list():
+    """The bucket list is data the PXP uses: without it a range loses the segments that start to
+    its left (so wrong SLP lists would show as wrong pixels in the run above)."""
+    fr = render_frame(run_geometry(build_scene("experts-tilt-1000"), 128, 32, z_bits=16), model="bit", aj="none")
+    wrong = 0
+    for y in range(32):
+        segs, lead, buckets = dmm_line(fr, y, equal_bounds(128, 4))
+        for p in range(1, 4):
+            lo, hi = 32 * p, 32 * p + 32
+            good = line_job(segs, buckets[p], lead[p], lo, hi, aj="none", width=128)["visible"]
+            bad = line_job(segs, [], lead[p], lo, hi, aj="none", width=128)["visible"]
+            ids = np.array([-1 if v < 0 else v for v in good])
+            assert (ids >= -1).all()
+            wrong += good != bad
+    assert wrong > 10
+
+
+def test_registered_and_bad_arguments():
+    m, b = sim_blocks()["experts"]
+    assert m.name == "experts" and b.default_scene == "experts-1000"
+    with pytest.raises(RasterhwError, match="engine"):
+        simulate_frame(build_scene("experts-tilt-1000"), 64, 16, engine="icarus")
+    with pytest.raises(RasterhwError, match="sn must be"):
+        simulate_frame(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=0)
+    with pytest.raises(RasterhwError, match="aj must be"):
+        simulate_frame(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", aj="b")

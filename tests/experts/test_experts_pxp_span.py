@@ -1,0 +1,147 @@
+# amaranth: UnusedElaboratable=no
+"""The span PXP (``experts-pxp-span``, the paper's: span cull and depth search per span) against
+its golden side (``golden_model/experts/span_cycles.py``): the same visible segment per pixel as
+the per-pixel depth search and as ``span.py``, pixels and per-line cycles equal in pysim, work that
+depends on the depth order (the line Z-buffer's does not)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.experts.model import equal_bounds, render_frame
+from rasterhw.golden_model.experts.span import span_pxp
+from rasterhw.golden_model.experts.span_cycles import STEPS, dmm_line, line_job, resolve, schedule
+from rasterhw.golden_model.pipeline import run_geometry
+from rasterhw.golden_model.scenes import build_scene
+from rasterhw.sim.experts.pxp_sim import jobs, simulate_scene
+
+
+def _frame(name, w, h, aj="c", seed=0):
+    return render_frame(run_geometry(build_scene(name, seed=seed), w, h, z_bits=16), model="bit", aj=aj)
+
+
+@pytest.mark.parametrize("name", ["experts-tilt-1000", "experts-1000", "c100"])
+@pytest.mark.parametrize("aj", ["none", "c"])
+def test_golden_span_pxp_sees_the_per_pixel_visible_segment(name, aj):
+    """Every pixel of every range: the span PXP's visible record (from the DMM/P words: whole ASL,
+    bucket list, leading pointer) is the per-pixel depth search's and span.py's."""
+    fr = _frame(name, 96, 48, aj)
+    W, H, pn = fr.width, fr.height, 4
+    b = equal_bounds(W, pn)
+    jb = jobs(fr, 1, pn, pxp="span")
+    got = np.full(H * W, -2, np.int64)
+    for y in range(H):
+        for p in range(pn):
+            got[y * W + int(b[p]):y * W + int(b[p + 1])] = jb["visible"][y * pn + p]
+    assert np.array_equal(got, fr.win)
+    assert np.array_equal(got, span_pxp(fr.setup, fr.records, W, H, b).win)
+    assert (got >= 0).sum() > W * H // 20                    # something is drawn
+
+
+def test_resolve_counts_every_step_and_halves_where_depths_cross():
+    """Two segments crossing inside one span: pass B fails, the span is halved until decided;
+    every pixel written once; the schedule's terms add up."""
+    s0 = {"xl": 0, "xr": 16 << 6, "zl": 100, "il": 0, "dzdx": 10 << 4, "didx": 0, "addr": 0}
+    s1 = {"xl": 0, "xr": 16 << 6, "zl": 200, "il": 0, "dzdx": -(10 << 4), "didx": 0, "addr": 1}
+    cyc, vis = resolve([s0, s1], [], 0, 0, 16)
+    assert set(cyc) == set(STEPS) and cyc["write"] == 16 and len(vis) == 16
+    z0 = [100 + 10 * x + 5 for x in range(16)]
+    z1 = [200 - 10 * x - 5 for x in range(16)]
+    assert vis == [0 if a <= b else 1 for a, b in zip(z0, z1)]
+    assert cyc["pass_b"] > 2 * 2 and cyc["pass_a"] > 2      # halved at least twice
+    flat = dict(s1, zl=300, dzdx=0)
+    c2, v2 = resolve([s0, flat], [], 0, 0, 16)
+    assert v2 == [0] * 16 and c2["pass_a"] == 2 and c2["pass_b"] == 2   # decided from the end depths
+    assert sum(c2.values()) < sum(cyc.values())
+    # by hand: line 0 written 0..2, resolved 3..12, hands over at 13, drains 14..33; line 1 written
+    # 3..5, resolve starts 14, done 24, waits for the drain until 34 (21 cycles), drains 35..54;
+    # line 2's bank is free after line 0's drain: written 34..36, resolved 37..46, hands over at 55
+    sch = schedule([(3, 10, 20), (3, 10, 20), (3, 10, 20)])
+    assert sch["line_cycles"] == [11, 21, 19] and sch["last_pixel"] == 75
+    assert schedule([(3, 10, 2)] * 3)["line_cycles"] == [11, 11, 11]
+
+
+def test_span_work_depends_on_depth_the_line_z_buffer_does_not():
+    """experts-1000 and experts-tilt-1000 cover the same pixels with different depths: the line
+    Z-buffer PXP's cycles are equal, the span PXP's differ (golden cycle models the HDL matches)."""
+    a, b = _frame("experts-1000", 128, 64), _frame("experts-tilt-1000", 128, 64)
+    za, zb = jobs(a, 2, 4, pxp="zbuffer"), jobs(b, 2, 4, pxp="zbuffer")
+    sa, sb = jobs(a, 2, 4, pxp="span"), jobs(b, 2, 4, pxp="span")
+    assert np.array_equal(za["cycles"], zb["cycles"])
+    assert not np.array_equal(sa["cycles"], sb["cycles"])
+    assert int(sa["pxp_frame_cycles"].max()) != int(sb["pxp_frame_cycles"].max())
+
+
+@pytest.mark.parametrize("aj", ["none", "c"])
+def test_small_frame_span_pxp_pysim_pixel_and_cycle_exact_same_pixels_as_zbuffer(aj):
+    sc = build_scene("experts-tilt-1000")
+    r = simulate_scene(sc, 64, 16, engine="pysim", sn=2, pn=4, aj=aj, pxp="span")
+    z = simulate_scene(sc, 64, 16, engine="pysim", sn=2, pn=4, aj=aj, pxp="zbuffer")
+    for q in (r, z):
+        assert q["pixels_compared"] == 64 * 16 and q["mismatches"] == 0 and q["cycle_mismatches"] == 0
+        assert q["last_pixel_mismatch"] == 0
+    assert r["pxp"] == "span" and z["pxp"] == "zbuffer" and "paper" in r["pxp_is"] and "ours" in z["pxp_is"]
+    # every guarded pixel written once: with A.J. each inner range end adds a guard pixel
+    assert r["span_steps"]["write"] == 16 * (64 + (2 * 3 if aj == "c" else 0))
+    assert r["span_steps"]["pass_a"] > 0 and r["frame_cycles_busiest_pxp"] != z["frame_cycles_busiest_pxp"]
+
+
+def test_span_balanced_ranges_through_the_hdl():
+    r = simulate_scene(build_scene("experts-uneven"), 128, 32, engine="pysim", sn=1, pn=4, aj="c", ranges="ii")
+    assert r["mismatches"] == 0 and r["cycle_mismatches"] == 0 and r["last_pixel_mismatch"] == 0
+    s = simulate_scene(build_scene("experts-uneven"), 128, 32, engine="pysim", sn=1, pn=4, aj="c")
+    assert r["frame_cycles_busiest_pxp"] < s["frame_cycles_busiest_pxp"]
+
+
+def test_block_lists_reach_the_pxp_as_data():
+    """The bucket list and leading pointer the span PXP starts from are the golden SLP's
+    (slp_run.block_lists): with them it never looks at a segment wholly left of its range."""
+    fr = _frame("experts-tilt-1000", 128, 32)
+    segs, lead, buckets = dmm_line(fr, 16, equal_bounds(128, 4))
+    for p in range(4):
+        lo, hi = 32 * p, 32 * p + 32
+        glo = max(lo - 1, 0)
+        for q in buckets[p]:
+            c0 = (segs[q]["xl"] + 31) >> 6
+            c1 = ((segs[q]["xr"] + 31) >> 6) - 1
+            assert c0 < glo <= c1
+        job = line_job(segs, buckets[p], lead[p], lo, hi, aj="c", width=128)
+        assert len(job["visible"]) == 32 and job["words"] == len(segs) + len(buckets[p]) + 1
+
+
+def test_bad_pxp_is_one_line_error():
+    with pytest.raises(RasterhwError, match="--pxp must be one of span, zbuffer"):
+        simulate_scene(build_scene("experts-tilt-1000"), 64, 16, pxp="linez")
+
+
+def test_dmm_bank_overflow_stalls_the_writer_never_drops():
+    """A line with more ASBs than a DMM/P bank holds: the word that does not fit is not taken,
+    ``overflow`` rises and stays, and no pixel comes out of a half-written line."""
+    from amaranth.sim import Simulator
+    from rasterhw.hdl.experts.pxp_span import ExpertsPxpSpan, dmm_layout
+    from rasterhw.hdl.pack import pack
+    lay = dmm_layout()
+    seg = {"xl": 0, "xr": 8 << 6, "zl": 10, "il": 0, "dzdx": 0, "didx": 0, "addr": 1}
+    words = [pack(lay, seg)] * 5 + [pack(lay, {"last": 1, "ptr": 0})]
+    dut = ExpertsPxpSpan(width=16, depth=4)
+    sim = Simulator(dut)
+    sim.add_clock(1e-8)
+    seen = {}
+
+    async def bench(ctx):
+        ctx.set(dut.hi, 16)
+        ctx.set(dut.o.ready, 1)
+        taken = outs = 0
+        for _ in range(60):
+            k = min(taken, len(words) - 1)
+            ctx.set(dut.i.payload.as_value(), words[k])
+            ctx.set(dut.i.valid, 1)
+            _, _, rdy, ov = await ctx.tick().sample(dut.i.ready, dut.o.valid)
+            taken += int(rdy)
+            outs += int(ov)
+        seen.update(taken=taken, outs=outs, overflow=ctx.get(dut.overflow), ready=ctx.get(dut.i.ready))
+
+    sim.add_testbench(bench)
+    sim.run()
+    assert seen == {"taken": 4, "outs": 0, "overflow": 1, "ready": 0}
