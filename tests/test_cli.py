@@ -170,3 +170,15 @@ def test_every_json_option_and_every_option_has_help():
                 missing.append(f"{' '.join(path)} {p.opts[0]}")
     walk(cli, ["rasterhw"])
     assert not missing, missing
+
+
+def test_render_json_has_pixels_covered_for_every_arch(tmp_path):
+    """Every arch's render says how many pixels it covered, and it is the reference's (coverage
+    is the one thing every machine must agree on)."""
+    from rasterhw.sim import registry
+
+    ref = json.loads(run("render", "c50", "--size", "64x64", "--json", "-o", str(tmp_path / "r.png")).stdout)
+    for arch in registry.archs():
+        r = run("render", "c50", "--size", "64x64", "--arch", arch, "--json", "-o", str(tmp_path / f"{arch}.png"))
+        assert r.returncode == 0, (arch, r.stderr[-500:])
+        assert json.loads(r.stdout)["pixels_covered"] == ref["pixels_covered"], arch

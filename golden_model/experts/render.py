@@ -42,4 +42,5 @@ def render(scene: Scene, width: int, height: int, *, arch: str = "experts", aj: 
                     {"model": model, "aj": aj, "sn": sn, "pn": pn, "aj_pixels": f.aj_pixels,
                      "operations": int(sum(ops.values())), "frame_op_times": round(par.frame_time, 1),
                      "pxp_imbalance": round(par.imbalance(), 4), "crossings": f.stats["crossings"],
+                     "pixels_covered": int(f.covered.sum()),
                      "shadows": shadows, **({"shadowed_pixels": f.stats["shadowed_pixels"]} if sf else {})})

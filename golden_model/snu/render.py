@@ -17,5 +17,6 @@ def render(scene: Scene, width: int, height: int, *, arch: str = "snu") -> Rende
     """One frame through the SNU golden models; ``pixels_written`` counts bus writes."""
     tris = run_geometry(scene, width, height, z_bits=Z_BITS, z_far_is_zero=True)
     stream = scan_convert(tris)
-    return Rendered(rgb_image(pixelbus_frame(stream)[0]), tris, len(stream),
-                    {"pixel_writes": len(stream)})
+    rgb, z = pixelbus_frame(stream)
+    return Rendered(rgb_image(rgb), tris, len(stream),
+                    {"pixel_writes": len(stream), "pixels_covered": int((z > 0).sum())})

@@ -30,6 +30,7 @@ def render(scene, width: int, height: int, *, arch: str = "sparse", matrix: str 
     f = sparse_render(tris, (p, q))
     return Rendered(rgb8=f.to_rgb8(), tris=tris, pixels_written=f.pixels_written,
                     stats={"matrix": f"{p}x{q}", "n": f.n, "fragments": f.fragments,
+                           "pixels_covered": int((f.tri_id >= 0).sum()),
                            "windows_per_level": [int(v) for v in f.windows],
                            "coverage_tests_per_level": [int(v) for v in f.tests],
                            "coverage_tests": int(f.tests.sum()),

@@ -156,4 +156,5 @@ def render_scene(scene, width: int, height: int, *, arch: str = "zbm", interleav
     tris = run_geometry(scene, width, height, z_bits=Z_BITS)
     res = render_zbm(tris, interleave=interleave, units=units)
     st = {k: v for k, v in res.stats.items() if k != "units"}
+    st["pixels_covered"] = int((res.pixels.tag[..., 0] >= 0).sum())   # the nearest sample of each pixel
     return Rendered(res.rgb8, tris, int(res.stats["z_writes"]), st)

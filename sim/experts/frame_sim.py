@@ -23,7 +23,7 @@ import time
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.experts.model import equal_bounds, render_frame
-from rasterhw.sim.experts.pxp_sim import ENGINES, jobs, run_pysim, run_verilator
+from rasterhw.sim.experts.pxp_sim import ENGINES, hdl_image, jobs, run_pysim, run_verilator
 
 __all__ = ["simulate_frame", "decode_slp"]
 
@@ -139,7 +139,9 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
             "slp_clock_for_30fps_hz": slp_frame * 30, "pxp_clock_for_30fps_hz": pxp_frame * 30,
             "bottleneck": "SLP" if slp_frame > pxp_frame else "PXP",
             "sn": sn, "pn": pn, "aj": aj, "pxp": "span", "wall_s": round(time.perf_counter() - t0, 3),
-            "slp_run_s": round(got.run_s, 3), "pxp_run_s": round(res["run_s"], 3)}
+            "slp_run_s": round(got.run_s, 3), "pxp_run_s": round(res["run_s"], 3),
+            # SLPs and PXPs work side by side: the machine's frame is the slower of the two
+            "frame_cycles": max(slp_frame, pxp_frame), "frame_rgb": hdl_image(fr, px)}
 
 
 def _group_frame(fr, engine: str, sn: int, pn: int, aj: str, t0: float, progress: bool) -> dict:

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.experts.model import ExpertsFrame, equal_bounds, render_frame
-from rasterhw.golden_model.experts.pxp import pixel_words
+from rasterhw.golden_model.experts.pxp import pixel_words, to_rgb8
 from rasterhw.golden_model.experts.pxp_cycles import line_segments, schedule
 from rasterhw.sim.engines.runner import run_plain_verilator
 from rasterhw.sim.workdirs import release, temp_run_folder
@@ -29,6 +29,19 @@ ENGINES = ("pysim", "verilator")
 PXPS = ("span", "zbuffer")
 BENCH_DIR = Path(__file__).resolve().parent / "verilator"
 SEG_BITS = 194          # seg_layout().size (checked in jobs)
+
+
+def hdl_image(fr: ExpertsFrame, got: np.ndarray) -> np.ndarray | None:
+    """The frame the HDL wrote, as 8-bit RGB: its pixel words (R3 G3 B3 I, frame order: every
+    line's PXP ranges left to right) decoded and shown as the VOC shows them (``to_rgb8``);
+    None when the run did not give one word per pixel."""
+    H, W = fr.height, fr.width
+    if got.size != H * W:
+        return None
+    ib = fr.setup.fmt.intensity_bits
+    w = got.astype(np.int64)
+    fields = np.stack([(w >> (6 + ib)) & 7, (w >> (3 + ib)) & 7, (w >> ib) & 7, w & ((1 << ib) - 1)], axis=1)
+    return to_rgb8(fr.setup, fields, H, W)
 
 
 def _pack(seg: dict, layout) -> int:
@@ -344,4 +357,6 @@ def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", pro
             "pxp": pxp, "pxp_is": "the paper's (span cull + depth search)" if pxp == "span" else "ours (line Z-buffer)",
             **({"span_steps": {k: int(sum(st[k] for st in jb["steps"])) for k in jb["steps"][0]}}
                if pxp == "span" and jb["steps"] else {}),
-            "run_s": round(res["run_s"], 3), "build_s": round(res.get("build_s", 0.0), 2)}
+            "run_s": round(res["run_s"], 3), "build_s": round(res.get("build_s", 0.0), 2),
+            # the machine's frame on its Sn x Pn PXPs (all at once): the busiest PXP's
+            "frame_cycles": frame_cycles, "frame_rgb": hdl_image(fr, got)}
