@@ -16,7 +16,10 @@ SMALL = {
     "experts-dmm": {"depth": 16},
     "experts-pxp": {"width": 64, "aj": "c"},
     "experts-pxp-unit": {"width": 64, "depth": 64},
+    "zbm-chip": {"interleave": 2, "chip": 1, "width": 32},
+    "zbm-loop": {"interleave": 2, "width": 32},
     "zbm-merger": {"fifo_depth": 4},
+    "zbm-pixel": {"index": 3, "interleave": 1, "width": 128},
     "zbm-seggen": {"width": 48, "height": 24, "capacity": 64},
     "zbm-unit": {"interleave": 2, "width": 32, "height": 16, "capacity": 16},
 }
