@@ -14,17 +14,16 @@ from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.cycles import check_schedule
 from rasterhw.golden_model.zbm.words import doublez_words, words_to_doublez
-from rasterhw.sim.zbm.driver import (
-    CLOCK_HZ,
-    ENGINES,
-    check_edge_pairs,
-    run_unit_bench,
-    run_units_pysim,
-)
+from rasterhw.sim.zbm.edge_check import check_edge_pairs
 from rasterhw.sim.zbm.fast import run_unit_fast
+from rasterhw.sim.zbm.unit_bench import run_unit_bench
+from rasterhw.sim.zbm.units_pysim import run_units_pysim
 from tqdm import tqdm
 
-__all__ = ["float_tolerance", "simulate_zbm"]
+__all__ = ["CLOCK_HZ", "ENGINES", "float_tolerance", "simulate_zbm"]
+
+ENGINES = ("pysim", "verilator", "icarus")
+CLOCK_HZ = 25e6          # the paper's segment clock (sec. 6.1)
 
 
 # ====================================================================== float tolerance
