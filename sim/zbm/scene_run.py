@@ -89,8 +89,7 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
     t0 = time.perf_counter()
     if engine not in ENGINES:
         raise RasterhwError(f"engine must be one of {', '.join(ENGINES)}, not {engine!r}")
-    if interleave not in F.INTERLEAVES:
-        raise RasterhwError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+    F.check_interleave(interleave)
     check_schedule(schedule)
     if not isinstance(units, (int, np.integer)) or isinstance(units, bool) or not 1 <= units <= 16:
         raise RasterhwError(f"units must be an integer in 1..16, not {units!r}")
