@@ -21,7 +21,10 @@ SMALL = {
     "pixelbus-bank": {"depth": 64},
     "experts-slp": {"width": 64, "tris": 1024, "lines": 32, "asl": 256},
     "experts-group": {"width": 64, "pn": 2, "tris": 1024, "lines": 8, "asl": 256, "depth": 256},
+    "zbm-chip": {"interleave": 2, "chip": 1, "width": 32},
+    "zbm-loop": {"interleave": 2, "width": 32},
     "zbm-merger": {"fifo_depth": 4},
+    "zbm-pixel": {"index": 3, "interleave": 1, "width": 128},
     "zbm-seggen": {"width": 48, "height": 24, "capacity": 64},
     "zbm-unit": {"interleave": 2, "width": 32, "height": 16, "capacity": 16},
 }

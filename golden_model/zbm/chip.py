@@ -15,9 +15,10 @@ from rasterhw.golden_model.zbm.formats import (
     MODE_COLOUR,
     TEX,
     Z_MAX_SAMPLE,
+    check_interleave,
     wrap,
 )
-from rasterhw.golden_model.zbm.initial import _check_interleave, initial_processor
+from rasterhw.golden_model.zbm.initial import initial_processor
 from rasterhw.golden_model.zbm.seggen import Segments
 
 __all__ = ["chip_scanline"]
@@ -60,7 +61,7 @@ def chip_scanline(segs: Segments, y: int, chip: int, interleave: int, width: int
     pixel ``k`` of the packet gets the value ``v + k * (inc * I)`` (the loop's repeated 56-bit adds) and is Z-tested into the
     double-Z memory. Returns the memory and counts (``packets``, ``pixels``, ``writes``).
     """
-    _check_interleave(interleave, chip)
+    check_interleave(interleave, chip)
     npx = -(-(width - chip) // interleave)
     buf = DoubleZ.empty((npx,)) if buf is None else buf
     sl = segs.line(y)

@@ -47,6 +47,7 @@ from rasterhw.golden_model.zbm.formats import (
     INTERLEAVES,
     PACKET_FLITS,
     SCHEDULES,
+    check_interleave,
     paper_lead,
 )
 
@@ -63,8 +64,7 @@ CLOCK_HZ = 25e6
 
 def len_chip(seg_len: int, interleave: int) -> int:
     """Pixels of a ``seg_len``-pixel segment on the busiest of ``interleave`` chips."""
-    if interleave not in INTERLEAVES:
-        raise RasterhwError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+    check_interleave(interleave)
     if seg_len < 0:
         raise RasterhwError(f"segment length must be >= 0, not {seg_len!r}")
     return math.ceil(seg_len / interleave)
@@ -100,8 +100,7 @@ def event_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: i
     Returns totals (``loop_cycles``: R1 and R2 summed; ``frame_cycles``: with R4's overlap),
     per-line arrays and per-edge-pair averages.
     """
-    if interleave not in INTERLEAVES:
-        raise RasterhwError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+    check_interleave(interleave)
     if not merge_ratio > 0:
         raise RasterhwError(f"merge_ratio must be > 0, not {merge_ratio!r}")
     segs = segment_generator(eps, height, width=width, capacity=capacity)
@@ -196,8 +195,7 @@ def hdl_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: int
     most ``paper_lead(mode) + 1`` -- the 9 load cycles then leave the ring idle for exactly 9
     cycles (``count["wait_zbm"]`` counts the generator's cycles waiting for that).
     """
-    if interleave not in INTERLEAVES:
-        raise RasterhwError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+    check_interleave(interleave)
     paper = check_schedule(schedule) == "paper"
     lead = paper_lead(int(eps.mode))
     segs = segment_generator(eps, height, width=width, capacity=capacity)   # raises if over capacity

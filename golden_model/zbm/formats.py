@@ -41,7 +41,7 @@ __all__ = [
     "SLOT_BITS", "Z_BITS", "Z_EMPTY", "Z_MAX_SAMPLE", "COLOUR_BITS", "TEX_BITS",
     "EP_WORDS", "EP_LOAD_CYCLES", "LOOP_BITS", "PACKET_FLITS", "PP_PER_CHIP", "INTERLEAVES",
     "AEP_CAPACITY", "MODE_COLOUR", "MODE_MAPPING", "CHANNELS",
-    "Field", "Layout", "EP_HEADER", "EP_CHANNEL", "SEG_HEADER", "FLIT", "PKT_HEADER",
+    "check_interleave", "Field", "Layout", "EP_HEADER", "EP_CHANNEL", "SEG_HEADER", "FLIT", "PKT_HEADER",
     "SAMPLE", "PIXEL2",
     "wrap", "to_fixed_floor", "slot_check",
     "pack_edge_pair", "unpack_edge_pair", "pack_segment", "unpack_segment",
@@ -80,6 +80,18 @@ CHANNELS = {
 
 _SLOT_MIN = -(1 << (SLOT_BITS - 1))
 _SLOT_MAX = (1 << (SLOT_BITS - 1)) - 1
+
+
+def check_interleave(interleave, chip=None) -> None:
+    """The one check of the ZB/M interleave, for the golden model, the HDL blocks' signatures
+    (``hdl/zbm/layouts.py`` re-exports it) and the drivers: ``interleave`` one of
+    :data:`INTERLEAVES` (paper, sec. 5.3) and, if given, ``0 <= chip < interleave``; else
+    :class:`RasterhwError` (one line on the command line)."""
+    if not isinstance(interleave, (int, np.integer)) or isinstance(interleave, bool) or interleave not in INTERLEAVES:
+        raise RasterhwError(f"ZB/M: interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+    if chip is not None and not (isinstance(chip, (int, np.integer)) and not isinstance(chip, bool)
+                                 and 0 <= chip < interleave):
+        raise RasterhwError(f"ZB/M: chip must be in 0..{interleave - 1}, not {chip!r}")
 
 
 def wrap(v, bits: int = SLOT_BITS, signed: bool = True):

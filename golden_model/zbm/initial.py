@@ -8,20 +8,9 @@ Golden model of the ZB/M (seed 003); integer arithmetic with the hardware's widt
 from __future__ import annotations
 
 import numpy as np
-from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.golden_model.zbm.formats import (
-    INTERLEAVES,
-    wrap,
-)
+from rasterhw.golden_model.zbm.formats import check_interleave, wrap
 
 __all__ = ["initial_processor"]
-
-
-def _check_interleave(interleave: int, chip: int | None = None) -> None:
-    if interleave not in INTERLEAVES:
-        raise RasterhwError(f"ZB/M: interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
-    if chip is not None and not (isinstance(chip, (int, np.integer)) and 0 <= chip < interleave):
-        raise RasterhwError(f"ZB/M: chip must be in 0..{interleave - 1}, not {chip!r}")
 
 
 def initial_processor(x: np.ndarray, ln: np.ndarray, val: np.ndarray, inc: np.ndarray,
@@ -35,7 +24,7 @@ def initial_processor(x: np.ndarray, ln: np.ndarray, val: np.ndarray, inc: np.nd
     ``keep`` marks segments with ``n >= 1`` (the others
     are dropped by the initial processor).
     """
-    _check_interleave(interleave, chip)
+    check_interleave(interleave, chip)
     j = (chip - x) % interleave
     px = x + j
     n = np.maximum(-(-(ln - j) // interleave), 0)

@@ -34,8 +34,8 @@ from rasterhw.golden_model.zbm.formats import (
     SUB,
     Z_BITS,
     Z_SCALE,
+    check_interleave,
 )
-from rasterhw.golden_model.zbm.initial import _check_interleave
 from rasterhw.golden_model.zbm.mapping import default_maps, map_samples
 from rasterhw.golden_model.zbm.merger import merge_chain
 from rasterhw.golden_model.zbm.seggen import segment_generator
@@ -64,7 +64,7 @@ def render_zbm(tris: ScreenTriangles, *, interleave: int = 8, units: int = 1, mo
     bit-identical whole-unit shortcut. Returns :class:`ZbmResult` (rgb8, final double-Z
     buffers, per-unit buffers, stats).
     """
-    _check_interleave(interleave)
+    check_interleave(interleave)
     if not isinstance(units, (int, np.integer)) or not 1 <= units <= 256:
         raise RasterhwError(f"ZB/M: units must be an integer in 1..256, not {units!r}")
     eps = edge_pairs(tris, mode=mode, alpha=alpha)

@@ -48,7 +48,13 @@ from rasterhw.golden_model.zbm.cycles import (
     event_cycles,
     formula_cycles_per_edge_pair,
 )
-from rasterhw.golden_model.zbm.formats import INTERLEAVES, MAX_HEIGHT, MAX_WIDTH, wrap
+from rasterhw.golden_model.zbm.formats import (
+    INTERLEAVES,
+    MAX_HEIGHT,
+    MAX_WIDTH,
+    check_interleave,
+    wrap,
+)
 
 __all__ = ["LEVELS", "SEG_LEN_BINS", "polygon_edge_pairs", "scene_edge_pairs", "scene_rows",
            "scene_table", "format_table"]
@@ -169,8 +175,7 @@ def scene_rows(scene, *, interleaves: Iterable[int] = INTERLEAVES, level: str = 
     """One row per interleave for one scene at one level (see :func:`scene_table`)."""
     interleaves = tuple(interleaves)
     for i in interleaves:
-        if i not in INTERLEAVES:
-            raise RasterhwError(f"interleave must be 1, 2, 4, 8 or 16, not {i!r}")
+        check_interleave(i)
     sc = _load(scene)
     eps, tris = scene_edge_pairs(sc, level=level, width=width, height=height)
     segs = segment_generator(eps, height, width=width)

@@ -11,7 +11,9 @@ from __future__ import annotations
 from amaranth import signed, unsigned
 from amaranth.lib import data
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.golden_model.zbm.formats import GAP_PENDING, SCHEDULES, paper_lead
+
+# the one interleave check (RasterhwError), where every ZB/M block's signature is built
+from rasterhw.golden_model.zbm.formats import GAP_PENDING, SCHEDULES, check_interleave, paper_lead
 
 __all__ = [
     "check_interleave", "struct_of", "EP_HEADER", "EP_CHANNEL", "SEG_HEADER", "FLIT", "PKT_HEADER",
@@ -55,10 +57,3 @@ def check_schedule(schedule) -> None:
         raise ValueError(f"schedule must be 'overlap' or 'paper', not {schedule!r}")
 
 
-def check_interleave(interleave, chip=None) -> None:
-    """The one parameter check of every ZB/M block: ``interleave`` one of 1, 2, 4, 8, 16 (paper,
-    sec. 5.3) and, if given, ``0 <= chip < interleave``; else ``ValueError``."""
-    if interleave not in F.INTERLEAVES:
-        raise ValueError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
-    if chip is not None and not (isinstance(chip, int) and 0 <= chip < interleave):
-        raise ValueError(f"chip must be in 0..{interleave - 1}, not {chip!r}")

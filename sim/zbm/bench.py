@@ -8,7 +8,7 @@ def bench(*, repeat: int = 11, hdl: bool = True, progress: bool = False) -> list
     if not hdl:
         return []
     from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.sim.zbm.driver import chip_speed
+    from rasterhw.sim.zbm.chip_bench import chip_speed
     from rasterhw.sim.zbm.fast import chip_speed_fast
     from rasterhw.sim.zbm.scene_run import simulate_zbm
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import EdgePairs
 from rasterhw.golden_model.zbm import cycles as C
-from rasterhw.golden_model.zbm.formats import AEP_CAPACITY, INTERLEAVES
+from rasterhw.golden_model.zbm.formats import AEP_CAPACITY, INTERLEAVES, check_interleave
 from rasterhw.sim.engines.harness import stream_put
 
 __all__ = ["run_unit_cycles", "measure_cycles_per_edge_pair", "table1_width", "measure_table1",
@@ -77,8 +77,7 @@ def measure_cycles_per_edge_pair(interleave: int, *, n_edge_pairs: int = 8,
     ``model_cycles`` (``zbm.cycles.hdl_cycles``, must equal ``cycles``), ``marginal_cycles_per_edge_pair``
     (model: cycles(n + 1) - cycles(n), the steady state) and ``paper_formula`` (74, 64, 59,
     54, 54: the paper's Table 1 estimate, not a measurement)."""
-    if interleave not in INTERLEAVES:
-        raise ValueError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+    check_interleave(interleave)
     if engine != "pysim":
         raise ValueError(f"engine must be 'pysim' (the only one wired here), not {engine!r}")
     if not (isinstance(n_edge_pairs, int) and 1 <= n_edge_pairs <= 100):
@@ -132,8 +131,7 @@ def measure_table1(interleave: int, *, schedule: str = "overlap", engine: str = 
     model's marginal ``hdl_cycles(k + 1) - hdl_cycles(k)`` and, on Verilator / Icarus, the
     number of merge words that differ from the golden model (must be 0).
     """
-    if interleave not in INTERLEAVES:
-        raise ValueError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+    check_interleave(interleave)
     C.check_schedule(schedule)
     n = n_edge_pairs
     width = table1_width(interleave)

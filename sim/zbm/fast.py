@@ -27,22 +27,25 @@ import numpy as np
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.sim.engines.runner import HARNESS_V, REPO_ROOT, build_plain_verilator, run_plain_verilator
+from rasterhw.sim.engines.runner import (
+    HARNESS_V,
+    REPO_ROOT,
+    build_plain_verilator,
+    run_plain_verilator,
+)
 from rasterhw.sim.workdirs import keep as keep_run_folder
 from rasterhw.sim.workdirs import release, temp_run_folder
-from rasterhw.sim.zbm.driver import (
+from rasterhw.sim.zbm.chip_bench import chip_stimulus
+from rasterhw.sim.zbm.stimfiles import (
     GAP_BITS,
-    _cached,
-    _depth,
-    _write_hex,
-    chain_verilog,
-    chip_stimulus,
+    memory_depth,
     read_hex_words,
-    run_unit_bench,
     stimulus_depth,
-    unit_watchdog,
+    write_hex,
     write_unit_stimulus,
 )
+from rasterhw.sim.zbm.unit_bench import run_unit_bench, unit_watchdog
+from rasterhw.sim.zbm.unit_verilog import chain_verilog, chip_verilog
 
 __all__ = ["FAST_DIR", "build_fast", "run_chip_fast", "chip_speed_fast", "build_unit_fast", "run_unit_fast"]
 
@@ -55,12 +58,9 @@ def build_fast(*, interleave: int, width: int, lines: int, chip: int, nseg: int,
     """Build (once per parameter set) the timing-free chip bench; returns (binary, build seconds,
     0 if reused). ``opt``: g++ optimisation of the model (-O2 for speed runs; the small test uses
     -O0, which compiles several times faster)."""
-    from rasterhw.sim.engines.verilog import generate_verilog
-
-    p = {"interleave": interleave, "chip": chip, "width": width}
-    src, _ = _cached("zbm-chip", lambda: generate_verilog("zbm-chip", **p), **p)
+    src = chip_verilog(interleave=interleave, chip=chip, width=width)
     params = {"I": interleave, "CHIP": chip, "W": width, "L": lines, "GW": GAP_BITS,
-              "SDEPTH": _depth(nseg), "MDEPTH": _depth(nup)}
+              "SDEPTH": memory_depth(nseg), "MDEPTH": memory_depth(nup)}
     # the chip's counter and line count come back in the main's JSON line
     return build_plain_verilator("zbm-fast", TOP, [src, HARNESS_V, FAST_DIR / "tb_zbm_fast.v"], params=params,
                                  opt=opt, defines={"RASTERHW_CYCLES": 1, "RASTERHW_LINES": 1})
@@ -77,8 +77,8 @@ def run_chip_fast(seg_words: list[int], up_words: list[int], *, lines: int, chip
     npx = -(-(width - chip) // interleave)
     run_dir = temp_run_folder(exe.parent.parent)
     zero = np.zeros(len(seg_words) + len(up_words), np.int64)
-    _write_hex(run_dir / "seg.hex", seg_words, zero[:len(seg_words)], F.LOOP_BITS)
-    _write_hex(run_dir / "up.hex", up_words, zero[len(seg_words):], F.PIXEL2.width)
+    write_hex(run_dir / "seg.hex", seg_words, zero[:len(seg_words)], F.LOOP_BITS)
+    write_hex(run_dir / "up.hex", up_words, zero[len(seg_words):], F.PIXEL2.width)
     out = run_dir / "out.hex"
     maxcyc = repeat * (40 * len(seg_words) + 40 * lines * (npx + 16)) + 1000
     meta = run_plain_verilator(exe, [f"+seg={run_dir / 'seg.hex'}", f"+up={run_dir / 'up.hex'}", f"+out={out}",

@@ -54,7 +54,10 @@ MACHINE = Machine(
                "independent (\"マージャはそれとは独立のマージクロックで動作\") and its frequency is not given."),
     testbenches={"zbm-seggen": "rasterhw.sim.zbm.testbench:SeggenBench",
                  "zbm-unit": "rasterhw.sim.zbm.testbench:UnitBench",
-                 "zbm-merger": "rasterhw.sim.zbm.testbench:MergerBench"},
+                 "zbm-merger": "rasterhw.sim.zbm.testbench:MergerBench",
+                 "zbm-chip": "rasterhw.sim.zbm.testbench:ChipBench",
+                 "zbm-loop": "rasterhw.sim.zbm.testbench:LoopBench",
+                 "zbm-pixel": "rasterhw.sim.zbm.testbench:PixelBench"},
     status="segment generator, ZB/M chip (8 pixel processors on a segment loop, double Z, merger on its own "
            "clock), unit, chained units (HDL, bit- and cycle-exact)",
 )

@@ -391,8 +391,8 @@ def area_rows(*, fast: bool = False, progress: bool = False) -> tuple[list[dict]
     ``fast``: the rows stay, unmeasured (synthesis of the unit takes minutes). Yosys missing is
     a one-line error (``ToolUnavailable``), never a shorter table.
     """
-    from rasterhw.sim.report.rows import FAST_SKIP
     from rasterhw.sim.flow.synth import synthesise
+    from rasterhw.sim.report.rows import FAST_SKIP
 
     out = []
     for block, what, params, sched in AREA_BLOCKS:

@@ -14,17 +14,16 @@ from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.cycles import check_schedule
 from rasterhw.golden_model.zbm.words import doublez_words, words_to_doublez
-from rasterhw.sim.zbm.driver import (
-    CLOCK_HZ,
-    ENGINES,
-    check_edge_pairs,
-    run_unit_bench,
-    run_units_pysim,
-)
+from rasterhw.sim.zbm.edge_check import check_edge_pairs
 from rasterhw.sim.zbm.fast import run_unit_fast
+from rasterhw.sim.zbm.unit_bench import run_unit_bench
+from rasterhw.sim.zbm.units_pysim import run_units_pysim
 from tqdm import tqdm
 
-__all__ = ["float_tolerance", "simulate_zbm"]
+__all__ = ["CLOCK_HZ", "ENGINES", "float_tolerance", "simulate_zbm"]
+
+ENGINES = ("pysim", "verilator", "icarus")
+CLOCK_HZ = 25e6          # the paper's segment clock (sec. 6.1)
 
 
 # ====================================================================== float tolerance
@@ -90,8 +89,7 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
     t0 = time.perf_counter()
     if engine not in ENGINES:
         raise RasterhwError(f"engine must be one of {', '.join(ENGINES)}, not {engine!r}")
-    if interleave not in F.INTERLEAVES:
-        raise RasterhwError(f"interleave must be 1, 2, 4, 8 or 16, not {interleave!r}")
+    F.check_interleave(interleave)
     check_schedule(schedule)
     if not isinstance(units, (int, np.integer)) or isinstance(units, bool) or not 1 <= units <= 16:
         raise RasterhwError(f"units must be an integer in 1..16, not {units!r}")

@@ -16,8 +16,9 @@ from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.golden_model.zbm.stimulus import first_triangles, random_triangles
 from rasterhw.golden_model.zbm.words import doublez_words
-from rasterhw.sim.zbm import driver as Z
+from rasterhw.sim.zbm.edge_check import check_edge_pairs
 from rasterhw.sim.zbm.fast import run_unit_fast
+from rasterhw.sim.zbm.unit_bench import run_unit_bench
 
 __all__ = ["zbm_round"]
 
@@ -53,7 +54,7 @@ def zbm_round(rng: np.random.Generator, k: int) -> dict:
             keep = max(1, keep * 9 // 10)
         what += f" (first {len(tris.xy)} triangles)"
     try:
-        Z.check_edge_pairs(eps, ZBM_W, ZBM_H)
+        check_edge_pairs(eps, ZBM_W, ZBM_H)
     except RasterhwError:  # more active pairs than the unit holds: not a frame it can draw
         return {"pixels": 0, "mismatches": 0, "run_s": 0.0, "settings": what + " (skipped: over capacity)"}
     gold = G.render_zbm(tris, interleave=ZBM_I)
@@ -63,8 +64,8 @@ def zbm_round(rng: np.random.Generator, k: int) -> dict:
     gap_seed = int(rng.integers(0, 1 << 30)) if rng.random() < 0.7 else None
     seed = int(rng.integers(0, 1 << 30))
     if k % ZBM_RATIO_EVERY == 0:   # two clocks at a random ratio: the cocotb bench (Verilator --timing)
-        r = Z.run_unit_bench([eps], width=ZBM_W, height=ZBM_H, interleave=ZBM_I, sim="verilator", ratio=ratio,
-                             stall=stall, seed=seed, gap_seed=gap_seed, expect=exp, sdepth=ZBM_SDEPTH)
+        r = run_unit_bench([eps], width=ZBM_W, height=ZBM_H, interleave=ZBM_I, sim="verilator", ratio=ratio,
+                           stall=stall, seed=seed, gap_seed=gap_seed, expect=exp, sdepth=ZBM_SDEPTH)
     else:   # equal clocks: the plain-Verilator bench (held cycle-exact with the cocotb one)
         ratio = (5, 5)
         r = run_unit_fast([eps], width=ZBM_W, height=ZBM_H, interleave=ZBM_I, stall=stall, seed=seed,

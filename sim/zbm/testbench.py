@@ -7,16 +7,25 @@ import numpy as np
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.golden_model.zbm.stimulus import first_triangles, random_doublez, random_triangles
+from rasterhw.golden_model.zbm.stimulus import (
+    first_triangles,
+    multi_line_segments,
+    random_doublez,
+    random_triangles,
+)
 from rasterhw.golden_model.zbm.words import (
     doublez_words,
     edge_pair_words,
     merge_words,
+    packets,
+    pixel2_words,
     segment_words,
 )
+from rasterhw.sim import registry
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
+from rasterhw.sim.zbm.line_bench import LineBench
 
-__all__ = ["MergerBench", "SeggenBench", "UnitBench"]
+__all__ = ["ChipBench", "LoopBench", "MergerBench", "PixelBench", "SeggenBench", "UnitBench", "pixel_visits"]
 
 
 class SeggenBench(Testbench):
@@ -102,3 +111,142 @@ class MergerBench(Testbench):
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         own, up = stim.source
         return Expected({"o_merge": merge_words(*doublez_words(G.merge(up, own)))})
+
+
+def _lines(rng, params: dict, chip_slots: int) -> tuple[G.Segments, int]:
+    """A random frame of 4..7 scan lines of 2..12 random segments (one line empty), colour or
+    mapping mode, and a chip slot ``0 <= chip < chip_slots`` (seeded)."""
+    w = params["width"]
+    mode = int(rng.choice([F.MODE_COLOUR, F.MODE_MAPPING]))
+    counts = [int(c) for c in rng.integers(2, 13, int(rng.integers(4, 8)))]
+    counts[int(rng.integers(0, len(counts)))] = 0
+    chip = int(rng.integers(0, min(chip_slots, w)))
+    return multi_line_segments(rng, counts, w, mode), chip
+
+
+def _packet_word(flits: list[int]) -> int:
+    """8 loop flits -> one ``PACKET`` word (flit ``k`` in bits ``112 k ..``)."""
+    return sum(f << (F.LOOP_BITS * k) for k, f in enumerate(flits))
+
+
+#: the end-of-line token of the loop and pixel benches: a packet whose header has ``len == 0``
+_EOL = _packet_word([F.PKT_HEADER.pack(len=0)] + [0] * (F.PACKET_FLITS - 1))
+
+
+def _line_words(buf: G.DoubleZ, n: int) -> list[int]:
+    """A chip line's PIXEL2 words padded with empty pixels to ``n`` (a chip with ``chip > 0``
+    may own one pixel fewer than the loop's memory holds)."""
+    w = pixel2_words(buf)
+    return w + pixel2_words(G.DoubleZ.empty((n - len(w),))) if n > len(w) else w
+
+
+def pixel_visits(flits: list[int], index: int, interleave: int) -> list[list[int]]:
+    """The packet ``flits`` (from ``golden_model/zbm/words.py: packets``) as it reaches pixel
+    processor ``index`` on the ring, once per pixel it owns there: after ``h`` hops the header
+    has ``x + h * dx``, ``len - h`` and every channel ``value + h * inc`` (the loop's 56-bit adds:
+    ``golden_model/zbm/chip.py: chip_scanline``); processor ``index`` owns chip pixels
+    ``q = x // interleave`` with ``q % 8 == index``."""
+    hdr = F.PKT_HEADER.unpack(flits[0])
+    chans = [F.FLIT.unpack(f) for f in flits[1:]]
+    q0 = hdr["x"] // interleave
+    out = []
+    for h in range(hdr["len"]):
+        if (q0 + h) % F.PP_PER_CHIP != index:
+            continue
+        head = F.PKT_HEADER.pack(**{**hdr, "x": hdr["x"] + h * hdr["dx"], "len": hdr["len"] - h})
+        out.append([head] + [F.FLIT.pack(value=int(F.wrap(c["value"] + h * c["inc"])), inc=c["inc"]) for c in chans])
+    return out
+
+
+class ChipBench(Testbench):
+    """``zbm-chip``: one chip's segment words in (``i_seg``, line by line with end-of-line
+    records: ``golden_model/zbm/words.py: segment_words``), the upstream chip's double-Z words
+    in (``i_merge``, random pixels with ties and empty samples), the merged line out (``o_merge``),
+    as ``merge(upstream, chip_scanline(...))`` gives it. A random frame: 4..7 lines of random
+    segments (one line empty), colour or mapping mode; the chip slot is the block's parameter
+    ``chip``. Both clocks run together here (the clock ratios stay with the cocotb bench)."""
+
+    block = "zbm-chip"
+    inputs = ("i_seg", "i_merge")
+    outputs = ("o_merge",)
+    domains = ("sync", "merge")
+    port_domains = {"i_merge": "merge", "o_merge": "merge"}
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        rng = np.random.default_rng(seed)
+        segs, _ = _lines(rng, params, 1)
+        i, c, w = params["interleave"], params["chip"], params["width"]
+        lines = len(segs.line_start) - 1
+        npx = -(-(w - c) // i)
+        ups = [random_doublez(rng, npx) for _ in range(lines)]
+        words = [wd for y in range(lines) for wd in segment_words(segs, y)]
+        return Stimulus({"i_seg": words, "i_merge": [wd for u in ups for wd in pixel2_words(u)]},
+                        what=f"{lines} lines of random segments, seed {seed}", source=(segs, ups))
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        segs, ups = stim.source
+        i, c, w = params["interleave"], params["chip"], params["width"]
+        out = []
+        for y, up in enumerate(ups):
+            own, _ = G.chip_scanline(segs, y, c, i, w)
+            out += pixel2_words(G.merge(up, own))
+        return Expected({"o_merge": out})
+
+
+class LoopBench(Testbench):
+    """``zbm-loop`` (segment processor + 8 pixel processors) in :class:`LineBench`: one chip's
+    packets in (``i``, line by line, each line ended by a ``len == 0`` token; the chip slot is
+    drawn from the seed), every finished line out (``o``, the loop's ``chip_pixels`` words), as
+    ``golden_model/zbm/chip.py: chip_scanline`` gives it."""
+
+    block = "zbm-loop"
+
+    def dut(self, params: dict):
+        block = registry.load(registry.blocks()[self.block])(**params)
+        return LineBench(block, block.chip_pixels)
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        rng = np.random.default_rng(seed)
+        segs, chip = _lines(rng, params, params["interleave"])
+        lines = len(segs.line_start) - 1
+        words = [wd for y in range(lines)
+                 for wd in [_packet_word(p) for p in packets(segs, y, chip, params["interleave"])] + [_EOL]]
+        return Stimulus({"i": words}, what=f"{lines} lines of random segments, chip {chip}, seed {seed}",
+                        source=(segs, chip, lines))
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        segs, chip, lines = stim.source
+        i, w = params["interleave"], params["width"]
+        n = -(-w // i)
+        return Expected({"o": [wd for y in range(lines) for wd in _line_words(G.chip_scanline(segs, y, chip, i, w)[0], n)]})
+
+
+class PixelBench(Testbench):
+    """``zbm-pixel`` (pixel processor ``index``) in :class:`LineBench`: the visits of one chip's
+    packets to this processor in (``i``: :func:`pixel_visits`, line by line, each line ended by
+    a ``len == 0`` token; the chip slot is drawn from the seed), its line memory out (``o``,
+    ``depth`` words: chip pixels ``index, index + 8, ...``), as ``chip_scanline`` gives them."""
+
+    block = "zbm-pixel"
+
+    def dut(self, params: dict):
+        block = registry.load(registry.blocks()[self.block])(**params)
+        return LineBench(block, block.depth)
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        rng = np.random.default_rng(seed)
+        segs, chip = _lines(rng, params, params["interleave"])
+        lines = len(segs.line_start) - 1
+        i, k = params["interleave"], params["index"]
+        words = [wd for y in range(lines)
+                 for wd in [_packet_word(v) for p in packets(segs, y, chip, i) for v in pixel_visits(p, k, i)] + [_EOL]]
+        return Stimulus({"i": words}, what=f"{lines} lines of random segments, chip {chip}, seed {seed}",
+                        source=(segs, chip, lines))
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        segs, chip, lines = stim.source
+        i, w, k = params["interleave"], params["width"], params["index"]
+        depth = max(1, -(-w // (F.PP_PER_CHIP * i)))
+        n = depth * F.PP_PER_CHIP
+        return Expected({"o": [wd for y in range(lines)
+                               for wd in _line_words(G.chip_scanline(segs, y, chip, i, w)[0], n)[k::F.PP_PER_CHIP]]})

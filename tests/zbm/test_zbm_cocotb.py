@@ -20,7 +20,8 @@ from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm.stimulus import random_doublez, random_triangles
 from rasterhw.golden_model.zbm.words import doublez_words
-from rasterhw.sim.zbm import driver as Z
+from rasterhw.sim.zbm.chip_bench import chip_stimulus, run_chip_bench
+from rasterhw.sim.zbm.unit_bench import plusargs, run_unit_bench
 
 pytestmark = pytest.mark.cocotb
 
@@ -41,7 +42,7 @@ def _unit_run(sim, interleave, units, ratio, stall, seed):
     eps = G.edge_pairs(tris)
     per = [eps.take(np.flatnonzero(eps.tag % units == k)) for k in range(units)]
     exp = doublez_words(gold.pixels)
-    r = Z.run_unit_bench(per, width=W, height=H, interleave=interleave, sim=sim, ratio=ratio, stall=stall,
+    r = run_unit_bench(per, width=W, height=H, interleave=interleave, sim=sim, ratio=ratio, stall=stall,
                          seed=seed, gap_seed=seed, expect=exp, check_protocol=True)
     # the cocotb test already compared; check the returned dump here as well
     assert np.array_equal(r["s0"], exp[0]) and np.array_equal(r["s1"], exp[1])
@@ -73,8 +74,8 @@ def _chip_run(sim, ratio, stall, seed, interleave=4, chip=1):
     up = random_doublez(np.random.default_rng(seed), H * npx)
     up = G.DoubleZ(up.z.reshape(H, npx, 2), up.a.reshape(H, npx, 2), up.c.reshape(H, npx, 2, 4),
                    up.tag.reshape(H, npx, 2))
-    seg_w, up_w, exp = Z.chip_stimulus(segs, H, up, chip=chip, interleave=interleave, width=W)
-    r = Z.run_chip_bench(seg_w, up_w, lines=H, chip=chip, interleave=interleave, width=W, sim=sim,
+    seg_w, up_w, exp = chip_stimulus(segs, H, up, chip=chip, interleave=interleave, width=W)
+    r = run_chip_bench(seg_w, up_w, lines=H, chip=chip, interleave=interleave, width=W, sim=sim,
                          ratio=ratio, stall=stall, seed=seed, gap_seed=seed, expect=exp, check_protocol=True)
     assert np.array_equal(r["s0"], exp[0]) and np.array_equal(r["s1"], exp[1])
     assert r["lines"] == H and r["proto_errors"] == 0
@@ -94,11 +95,11 @@ def test_chip_sims(sim):
 
 def test_bench_rejects_bad_settings():
     with pytest.raises(RasterhwError, match="stall"):
-        Z._plusargs((5, 5), 300, 1, 10)
+        plusargs((5, 5), 300, 1, 10)
     with pytest.raises(RasterhwError, match="clock ratio"):
-        Z._plusargs((0, 5), 0, 1, 10)
+        plusargs((0, 5), 0, 1, 10)
     with pytest.raises(RasterhwError, match="phase"):
-        Z._plusargs((5, 5), 0, 1, 10, phase=2)
+        plusargs((5, 5), 0, 1, 10, phase=2)
 
 
 @pytest.mark.heavy
@@ -107,7 +108,7 @@ def test_unit_paper_schedule_verilator_protocol():
     tris = _scene(5)
     gold = G.render_zbm(tris, interleave=2)
     exp = doublez_words(gold.pixels)
-    r = Z.run_unit_bench([G.edge_pairs(tris)], width=W, height=H, interleave=2, sim="verilator", ratio=(3, 2),
+    r = run_unit_bench([G.edge_pairs(tris)], width=W, height=H, interleave=2, sim="verilator", ratio=(3, 2),
                          stall=60, seed=5, gap_seed=5, expect=exp, check_protocol=True, schedule="paper")
     assert np.array_equal(r["s0"], exp[0]) and np.array_equal(r["s1"], exp[1]) and r["proto_errors"] == 0
 

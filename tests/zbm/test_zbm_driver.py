@@ -9,8 +9,10 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.scenes import SCENES, build_scene
 from rasterhw.golden_model.zbm import words as W
 from rasterhw.golden_model.zbm.stimulus import random_triangles
-from rasterhw.sim.zbm import driver as Z
+from rasterhw.sim.zbm.chip_bench import run_chip_bench
+from rasterhw.sim.zbm.edge_check import check_edge_pairs
 from rasterhw.sim.zbm.scene_run import simulate_zbm
+from rasterhw.sim.zbm.unit_bench import run_unit_bench
 
 
 def _scene():
@@ -48,19 +50,24 @@ def _eps():
 
 def test_edge_pair_checks():
     eps = _eps()
-    assert Z.check_edge_pairs(eps, 32, 16) >= 1
+    assert check_edge_pairs(eps, 32, 16) >= 1
     bad = eps.take(np.arange(len(eps)))
     bad.len[2] = -1
     with pytest.raises(RasterhwError, match="len -1 < 0"):
-        Z.check_edge_pairs(bad, 32, 16)
+        check_edge_pairs(bad, 32, 16)
     bad = eps.take(np.arange(len(eps)))
     bad.h[-1] = 40
     with pytest.raises(RasterhwError, match="outside 0..15"):
-        Z.check_edge_pairs(bad, 32, 16)
+        check_edge_pairs(bad, 32, 16)
     with pytest.raises(RasterhwError, match="active-edge-pair memory"):
-        Z.check_edge_pairs(eps, 32, 16, capacity=2)
+        check_edge_pairs(eps, 32, 16, capacity=2)
     # dealing to more units lowers each unit's peak
-    assert Z.check_edge_pairs(eps, 32, 16, units=3) <= Z.check_edge_pairs(eps, 32, 16)
+    assert check_edge_pairs(eps, 32, 16, units=3) <= check_edge_pairs(eps, 32, 16)
+    # the frame must fit the chips' line memories (width was once ignored)
+    for w, h, msg in ((513, 16, "width must be an integer in 1..512, not 513"), (0, 16, "width"),
+                      (32, 0, "height must be"), (32.0, 16, "width")):
+        with pytest.raises(RasterhwError, match=msg):
+            check_edge_pairs(eps, w, h)
 
 
 def test_words_round_trip():
@@ -82,7 +89,7 @@ def test_bench_without_golden_frame_must_say_speed_run():
     """A cocotb bench run with nothing to compare against is refused unless it is an explicit
     speed run whose caller compares the dump itself."""
     with pytest.raises(RasterhwError, match="speed_run"):
-        Z.run_chip_bench([0], [0], lines=1, chip=0, interleave=1, width=8, sim="verilator")
+        run_chip_bench([0], [0], lines=1, chip=0, interleave=1, width=8, sim="verilator")
     with pytest.raises(RasterhwError, match="speed_run"):
-        Z.run_unit_bench([G.edge_pairs(random_triangles(np.random.default_rng(0), 2, 8, 8))], width=8,
+        run_unit_bench([G.edge_pairs(random_triangles(np.random.default_rng(0), 2, 8, 8))], width=8,
                          height=8, interleave=1, sim="verilator")

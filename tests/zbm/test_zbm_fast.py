@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.zbm.stimulus import random_doublez, random_triangles
-from rasterhw.sim.zbm import driver as Z
 from rasterhw.sim.zbm import fast as ZF
+from rasterhw.sim.zbm.chip_bench import chip_stimulus, run_chip_bench
 
 pytestmark = pytest.mark.cocotb
 
@@ -25,7 +25,7 @@ def _stimulus(seed: int = 5):
     up = random_doublez(np.random.default_rng(seed + 1), H * npx)
     up = G.DoubleZ(up.z.reshape(H, npx, 2), up.a.reshape(H, npx, 2), up.c.reshape(H, npx, 2, 4),
                    up.tag.reshape(H, npx, 2))
-    return Z.chip_stimulus(segs, H, up, chip=CHIP, interleave=ILV, width=W)
+    return chip_stimulus(segs, H, up, chip=CHIP, interleave=ILV, width=W)
 
 
 @pytest.mark.heavy
@@ -35,7 +35,7 @@ def test_fast_chip_matches_golden_and_cocotb_cycles():
     fast = ZF.run_chip_fast(seg_w, up_w, lines=H, chip=CHIP, interleave=ILV, width=W, repeat=2, opt="-O1")
     assert int(np.count_nonzero((fast["s0"] != exp[0]) | (fast["s1"] != exp[1]))) == 0
     assert fast["lines"] == (2 * H) % (1 << 16) and fast["cycles"] > 0
-    ref = Z.run_chip_bench(seg_w, up_w, lines=H, chip=CHIP, interleave=ILV, width=W, sim="verilator",
+    ref = run_chip_bench(seg_w, up_w, lines=H, chip=CHIP, interleave=ILV, width=W, sim="verilator",
                            ratio=(5, 5), stall=0, repeat=2, phase=0, expect=exp)
     assert np.array_equal(ref["s0"], exp[0]) and np.array_equal(ref["s1"], exp[1])
     assert fast["cycles"] == ref["cycles"]

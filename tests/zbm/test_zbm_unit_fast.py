@@ -12,8 +12,9 @@ from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.golden_model.zbm.words import doublez_words
-from rasterhw.sim.zbm import driver as Z
 from rasterhw.sim.zbm import fast as ZF
+from rasterhw.sim.zbm.stimfiles import stimulus_depth
+from rasterhw.sim.zbm.unit_bench import run_unit_bench, unit_watchdog
 
 pytestmark = pytest.mark.cocotb
 
@@ -27,7 +28,7 @@ def _compare(units: int, stall: int, gap_seed, seed: int, schedule: str = "overl
     per = [eps.take(np.flatnonzero(eps.tag % units == k)) for k in range(units)]
     fast = ZF.run_unit_fast(per, width=W, height=H, interleave=2, stall=stall, seed=seed, gap_seed=gap_seed,
                             line_log=True, opt="-O1", schedule=schedule)
-    ref = Z.run_unit_bench(per, width=W, height=H, interleave=2, sim="verilator", ratio=(5, 5), phase=0,
+    ref = run_unit_bench(per, width=W, height=H, interleave=2, sim="verilator", ratio=(5, 5), phase=0,
                            stall=stall, seed=seed, gap_seed=gap_seed, speed_run=True, line_log=True,
                            schedule=schedule)
     assert np.array_equal(fast["s0"], gold[0]) and np.array_equal(fast["s1"], gold[1])
@@ -63,10 +64,10 @@ def test_unit_fast_rejects_bad_stall():
 
 
 def test_stimulus_depth_shared_by_runs_of_different_sizes():
-    assert Z.stimulus_depth(10) == 1024 and Z.stimulus_depth(5000) == 8192
-    assert Z.stimulus_depth(10, 16384) == Z.stimulus_depth(9000, 16384) == 16384
+    assert stimulus_depth(10) == 1024 and stimulus_depth(5000) == 8192
+    assert stimulus_depth(10, 16384) == stimulus_depth(9000, 16384) == 16384
     with pytest.raises(RasterhwError, match="does not hold"):
-        Z.stimulus_depth(9000, 4096)
+        stimulus_depth(9000, 4096)
 
 
 def test_watchdog_covers_heavy_backpressure_and_a_slow_merge_clock():
@@ -79,11 +80,11 @@ def test_watchdog_covers_heavy_backpressure_and_a_slow_merge_clock():
     eps = G.edge_pairs(tris)
     gold = doublez_words(G.render_zbm(tris, interleave=2).pixels)
     total = len(eps) * 9 + 1
-    r = Z.run_unit_bench([eps], width=W, height=H, interleave=2, sim="verilator", ratio=(2, 7), stall=254,
+    r = run_unit_bench([eps], width=W, height=H, interleave=2, sim="verilator", ratio=(2, 7), stall=254,
                          seed=3, speed_run=True)
     assert np.array_equal(r["s0"], gold[0]) and np.array_equal(r["s1"], gold[1])
     old = 200 * (total + 64) + 40 * H * (W + 64)          # the cocotb bench's watchdog before
-    assert old < r["cycles"] < Z.unit_watchdog(total, width=W, height=H, stall=254, ratio=(2, 7))
-    assert Z.unit_watchdog(total, width=W, height=H) == old   # unchanged for free-running runs
+    assert old < r["cycles"] < unit_watchdog(total, width=W, height=H, stall=254, ratio=(2, 7))
+    assert unit_watchdog(total, width=W, height=H) == old   # unchanged for free-running runs
     fast = ZF.run_unit_fast([eps], width=W, height=H, interleave=2, stall=255, seed=3)
     assert np.array_equal(fast["s0"], gold[0])

@@ -28,3 +28,32 @@ def test_ports_use_the_formats():
     assert chip.o_merge.payload.shape().size == F.PIXEL2.width
     sg = ZbmSegmentGenerator(width=64, height=16)
     assert len(sg.i.payload) == F.EP_WORD_BITS
+
+
+def test_interleave_is_checked_once_where_every_block_is_built():
+    """One check (``formats.check_interleave``, RasterhwError) for the golden model, every HDL
+    block's signature and the drivers; the command line prints it as one line, exit 2."""
+    import subprocess
+    import sys
+
+    import pytest
+    from rasterhw.golden_model import zbm as G
+    from rasterhw.golden_model.errors import RasterhwError
+    from rasterhw.hdl.zbm.loop import ZbmLoop
+    from rasterhw.hdl.zbm.unit import ZbmUnit
+    from rasterhw.sim.zbm.cycles_hdl import measure_cycles_per_edge_pair
+
+    assert L.check_interleave is F.check_interleave
+    for bad in (3, 0, 32, True, "8", 8.0):
+        for build in (lambda i: ZbmUnit(interleave=i, width=64, height=16), lambda i: ZbmLoop(interleave=i),
+                      lambda i: ZbmChip(interleave=i), lambda i: G.render_zbm(None, interleave=i),
+                      lambda i: measure_cycles_per_edge_pair(i)):
+            with pytest.raises(RasterhwError, match=f"interleave must be 1, 2, 4, 8 or 16, not {bad!r}"):
+                build(bad)
+    with pytest.raises(RasterhwError, match="chip must be in 0..3, not 4"):
+        ZbmChip(interleave=4, chip=4)
+    for args in (("sim", "zbm", "--interleave", "3", "--size", "32x32", "--engine", "pysim"),
+                 ("verilog", "zbm-unit", "--interleave", "3", "-o", "never.v")):
+        r = subprocess.run([sys.executable, "-m", "rasterhw.sim.cli.main", *args], capture_output=True, text=True,
+                           timeout=300)
+        assert r.returncode == 2 and r.stderr.strip() == "error: ZB/M: interleave must be 1, 2, 4, 8 or 16, not 3", r.stderr
