@@ -126,3 +126,13 @@ def test_machines_json_names_every_block_with_its_testbench():
     for block in SMALL:   # the testbenches tests run, with both engines
         assert blocks[block]["testbench"] and {"pysim", "verilator"} <= set(blocks[block]["engines"]), block
     assert all(info["engines"] == [] for info in blocks.values() if info["testbench"] is None)
+
+
+def test_a_seed_that_would_never_raise_ready_is_refused():
+    """Output k's back-pressure is the xorshift seeded seed + k; a zero seed stays zero, so the
+    sink would never take a word: refused before the run, not found by the watchdog."""
+    tb, p, stim, exp = _case("zbm-merger", 3)
+    with pytest.raises(RasterhwError, match="back-pressure seed of 0"):
+        run(tb, p, stim, engine="pysim", stall=32, seed=0, expect_words=_need(exp))
+    r = run(tb, p, stim, engine="pysim", stall=0, seed=0, expect_words=_need(exp))   # no stalls: fine
+    assert compare(exp, r)["mismatches"] == 0

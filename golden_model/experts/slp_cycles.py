@@ -30,7 +30,13 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.experts.formats import ACC_EXTRA, ADDR_BITS, SLOPE_FRAC, X_FRAC, sat
 from rasterhw.golden_model.experts.slp import rom_div
-from rasterhw.golden_model.experts.slp_run import block_lists, bubble_sort, bucket_sort, merge, merge_sort
+from rasterhw.golden_model.experts.slp_run import (
+    block_lists,
+    bubble_sort,
+    bucket_sort,
+    merge,
+    merge_sort,
+)
 
 __all__ = ["TRI_FIELDS", "KIND", "tri_words", "asb", "band_run"]
 
@@ -145,7 +151,7 @@ def band_run(tws: list[dict], band: tuple[int, int], bounds, *, width: int, guar
         for t in surv:
             xs[t] = _x(tws[t], y)
 
-        def key(t):
+        def key(t, xs=xs):
             return (xs[t][0], t)
         if len(surv) >= 2:
             surv, _, _, passes = bubble_sort(surv, key)

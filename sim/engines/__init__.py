@@ -45,6 +45,11 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
         raise RasterhwError(f"stall must be an integer in 0..255, not {stall!r}")
     if not (isinstance(idle, (int, float)) and 0 <= idle < 1):
         raise RasterhwError(f"idle must be a probability in [0, 1), not {idle!r}")
+    n_out = len(tb.outputs_of(params))
+    if stall and any((seed + k) & 0xFFFF_FFFF == 0 for k in range(n_out)):
+        # output k's back-pressure is the xorshift seeded seed + k: from 0 it stays 0 (never ready)
+        raise RasterhwError(f"seed {seed} gives an output a back-pressure seed of 0 (xorshift stays 0: "
+                            "ready never rises); use another seed")
     if idle:
         stim = with_gaps(stim, idle, seed, tb.inputs)
     if expect_words is None:

@@ -9,8 +9,8 @@ back-pressure on the pixel stream, stream checkers on both ports, and in-order s
 from __future__ import annotations
 
 import numpy as np
-from rasterhw.sim.outfile import write_if_changed
 from rasterhw.sim.engines.runner import build_dir_for, get_sim, run_cocotb
+from rasterhw.sim.outfile import write_if_changed
 from rasterhw.sim.workdirs import release, temp_run_folder
 
 __all__ = ["run_cocotb_bench"]

@@ -48,7 +48,7 @@ def test_resolve_counts_every_step_and_halves_where_depths_cross():
     assert set(cyc) == set(STEPS) and cyc["write"] == 16 and len(vis) == 16
     z0 = [100 + 10 * x + 5 for x in range(16)]
     z1 = [200 - 10 * x - 5 for x in range(16)]
-    assert vis == [0 if a <= b else 1 for a, b in zip(z0, z1)]
+    assert vis == [0 if a <= b else 1 for a, b in zip(z0, z1, strict=True)]
     assert cyc["pass_b"] > 2 * 2 and cyc["pass_a"] > 2      # halved at least twice
     flat = dict(s1, zl=300, dzdx=0)
     c2, v2 = resolve([s0, flat], [], 0, 0, 16)

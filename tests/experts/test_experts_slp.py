@@ -6,7 +6,6 @@ golden words and cycles."""
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 from amaranth.sim import Simulator
 from rasterhw.golden_model.experts.model import equal_bounds, render_frame
