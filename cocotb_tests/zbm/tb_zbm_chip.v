@@ -91,14 +91,7 @@ module tb_zbm_chip #(
   );
 
   // --- sink: random back-pressure, last repetition kept --------------------------------------
-  function [31:0] xorshift(input [31:0] x);
-    reg [31:0] a;
-    begin
-      a = x ^ (x << 13);
-      a = a ^ (a >> 17);
-      xorshift = a ^ (a << 5);
-    end
-  endfunction
+  `include "xorshift.vh"   // xorshift32, the one copy (cocotb_tests/xorshift.vh)
 
   reg [31:0] got, oaddr;
   always @(posedge mclk) begin
@@ -107,7 +100,7 @@ module tb_zbm_chip #(
       got <= 32'd0;
       oaddr <= 32'd0;
     end else begin
-      lf <= xorshift(lf);
+      lf <= xorshift32(lf);
       if (o_v && o_r && got < NOUT * REPEAT) begin
         frame[oaddr] <= o_p;
         got <= got + 32'd1;

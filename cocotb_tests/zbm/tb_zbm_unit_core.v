@@ -87,14 +87,7 @@ module tb_zbm_unit_core #(
   endgenerate
 
   // --- one sink per merge slot: random back-pressure, frame address from arrival order ---
-  function [31:0] xorshift(input [31:0] x);
-    reg [31:0] a;
-    begin
-      a = x ^ (x << 13);
-      a = a ^ (a >> 17);
-      xorshift = a ^ (a << 5);
-    end
-  endfunction
+  `include "xorshift.vh"   // xorshift32, the one copy (cocotb_tests/xorshift.vh)
 
   wire [32*I-1:0] faddr;
   wire [32*I-1:0] out_err;
@@ -117,7 +110,7 @@ module tb_zbm_unit_core #(
           q <= 32'd0;
           y <= 32'd0;
         end else begin
-          lf <= xorshift(lf);
+          lf <= xorshift32(lf);
           if (v && r && y < H) begin
             if (q == NPX - 1) begin
               q <= 32'd0;

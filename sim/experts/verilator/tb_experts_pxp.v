@@ -60,14 +60,7 @@ module tb_experts_pxp #(
   end
 
   wire [SEGW+20:0] w = stim[p];
-  function [31:0] xorshift(input [31:0] x);
-    reg [31:0] t;
-    begin
-      t = x ^ (x << 13);
-      t = t ^ (t >> 17);
-      xorshift = t ^ (t << 5);
-    end
-  endfunction
+  `include "xorshift.vh"   // xorshift32, the one copy (cocotb_tests/xorshift.vh)
 
   wire iv = (p < nseg) && offer;
   wire ordy = (lfo[7:0] >= STALL);
@@ -83,8 +76,8 @@ module tb_experts_pxp #(
   reg [15:0] seen = 16'd0;
   always @(posedge clk) begin
     cycles <= cycles + 64'd1;
-    lfi <= xorshift(lfi);
-    lfo <= xorshift(lfo);
+    lfi <= xorshift32(lfi);
+    lfo <= xorshift32(lfo);
     if (!offer || ir) offer <= (lfi[7:0] >= IDLE);
     if (iv && ir) begin
       p <= p + 1;
