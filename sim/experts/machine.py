@@ -5,6 +5,9 @@ from rasterhw.sim.registry import Arch, Clock, Flow, Machine, Option, SimBlock
 _NO_CLOCK = Clock("sync", "EXPERTS: the paper names no clock (times in operation times)", None, "clock")
 
 MACHINE = Machine(
+    headline=("fig. 4.1 / text: balance Pn", "table 2.2: work with A.J.", "5: processor op rate for 30 frames/s",
+              "5: SLP clock for 30 frames/s, experts-1000", "5: PXP clock for 30 frames/s, experts-1000",
+              "5 / HDL: span PXP (the paper's)", "5 / HDL: SLP list work"),
     name="experts",
     title="EXPERTS scan-line multiprocessor (Kyoto Univ.)",
     seed="000_5ac5e14b809e6e93.txt",

@@ -12,6 +12,9 @@ def ram_bits(params: dict[str, int]) -> int:
 
 
 MACHINE = Machine(
+    headline=("table 1: total operations per triangle", "text 3.2: pixel-bus rate",
+              "abstract: snu-100k polygons/s", "abstract: geometry-bound polygons/s",
+              "text 4.5: polygons/s per 3-processor pipeline"),
     name="snu",
     title="SNU graphics system (Seoul Nat. Univ.)",
     seed="004_259eba1ba2ec22c5.txt",

@@ -13,6 +13,9 @@ _MERGE = Clock("merge", "ZB/M merge clock: independent of the segment clock, fre
                "merge clock")
 
 MACHINE = Machine(
+    headline=("table 1 / 6.1: cycles per edge pair", "6.2: i860s to balance one unit, Gouraud (colour) mode, paper",
+              "section 7: chip logic, 2-input gate equivalents (interleave 8, width 512; paper",
+              "section 7: chip RAM bits (interleave 8, width 512; paper"),
     name="zbm",
     title="ZB/M scan-line Z-buffer merger (Matsushita)",
     seed="003_3355a922071bd992.txt",
