@@ -395,3 +395,31 @@ def test_render_reports_progress_per_tile():
     tris = R.random_triangles(64, 50, 10, seed=1)
     rgb, _ = R.rasterise_rgb8(tris, progress=rows.append)
     assert sum(rows) == 50 and len(rows) >= 25 and np.array_equal(rgb, R.rasterise(tris).to_rgb8())
+
+
+def test_pixelbus_frame_run_folder_is_removed_when_the_run_is_interrupted(monkeypatch, tmp_path):
+    """Issue 33: the SNU frame bench's run folder (115 MB at snu-100k) is a shared run folder:
+    Ctrl-C / SIGTERM (``workdirs.cleanup``) removes it, where ``tempfile.mkdtemp`` left it."""
+    import numpy as np
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.snu.gouraud import scan_convert
+    from rasterhw.sim import workdirs
+    from rasterhw.sim.snu import frame
+
+    exe = tmp_path / "model" / "obj_dir" / "Vtb"
+    exe.parent.mkdir(parents=True)
+    seen = []
+    monkeypatch.setattr(frame, "build_plain_verilator", lambda *a, **k: (exe, 0.0))
+
+    def interrupted(_exe, _args, *, run_dir, maxcyc):
+        seen.append(run_dir)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(frame, "run_plain_verilator", interrupted)
+    s = scan_convert(run_geometry(build_scene("c50"), 16, 8, z_bits=24, z_far_is_zero=True))
+    with pytest.raises(KeyboardInterrupt):
+        frame.run_frame_hdl(s, np.zeros(len(s), np.int64), [0, 0])
+    assert seen and seen[0].is_dir()
+    workdirs.cleanup()                       # what the CLI's signal handling runs
+    assert not seen[0].exists()

@@ -87,6 +87,14 @@ def test_sigterm_during_prove_leaves_no_solver_running(tmp_path):
     (("synth", "--small", "zbm-merger"), "--small applies only with --all"),
     (("render", "c50", "-o", "x.xbm", "--size", "16x16"), "cannot hold an RGB image"),
     (("render", "c50", "-o", "x.ico", "--size", "300x300"), "at most 256x256"),
+    (("render", "c50", "--arch", "experts", "--sn", "0", "--size", "32x32", "-o", "e.png"), "--sn must be"),
+    (("render", "c50", "--arch", "experts", "--sn", "-1", "--size", "32x32", "-o", "e.png"), "--sn must be"),
+    (("render", "c50", "--arch", "experts", "--sn", "33", "--size", "32x32", "-o", "e.png"), "32 lines"),
+    (("render", "c50", "--arch", "experts", "--pn", "0", "--size", "32x32", "-o", "e.png"), "--pn must be"),
+    (("sim", "pxp", "--scene", "c50", "--sn", "0", "--size", "32x16", "--engine", "pysim"), "parts must be"),
+    (("render", "c50", "--arch", "vz2", "--eps", "0.01", "--size", "16x16", "-o", "v.png"), "shadow map's"),
+    (("render", "c50", "--arch", "vz2", "--shadows", "map", "--eps", "1e300", "--size", "16x16", "-o", "v.png"),
+     "number in (0, 1)"),
 ])
 def test_bad_values_are_one_line_errors(tmp_path, args, contains):
     r = run(*args, cwd=tmp_path)

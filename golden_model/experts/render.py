@@ -24,6 +24,9 @@ def render(scene: Scene, width: int, height: int, *, arch: str = "experts", aj: 
     model = "bit" if model is None else model
     sn = 8 if sn is None else sn
     pn = 8 if pn is None else pn
+    for name, v, hi, what in (("sn", sn, height, "lines"), ("pn", pn, width, "pixels per line")):
+        if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= hi:
+            raise RasterhwError(f"experts: --{name} must be an integer from 1 to the frame's {hi} {what}, not {v!r}")
     if width > 1024 or height > 1024:
         raise RasterhwError(f"experts: frame {width}x{height} is larger than the Q10.6 coordinates allow (1024)")
     shadows = "none" if shadows is None else shadows

@@ -115,8 +115,12 @@ def render_frame(scene: Scene, width: int = 512, height: int = 512, *, alg: int 
     if shadows not in ("none", "polygons", "map"):
         raise RasterhwError(f"vzbuf: shadows must be none, polygons or map, not {shadows!r}")
     if shadows == "map" and not (isinstance(eps, (int, float)) and not isinstance(eps, bool)
-                                 and np.isfinite(eps) and eps > 0):
-        raise RasterhwError(f"vzbuf: shadow-map eps must be a finite number > 0, not {eps!r}")
+                                 and np.isfinite(eps) and 0 < eps < 1):
+        raise RasterhwError(f"vzbuf: shadow-map eps must be a number in (0, 1) (light depth runs 0..1; "
+                            f"1 or more shadows nothing), not {eps!r}")
+    if shadows != "map" and eps != DEFAULT_EPS:
+        raise RasterhwError(f"vzbuf: eps is the shadow map's (--shadows map); with --shadows {shadows} it would "
+                            "change nothing")
     st: dict[str, float] = {}
     stats: dict = {}
     W, H = width, height

@@ -27,8 +27,6 @@ Times are reported at the paper's clocks: 12.5 MHz bus (80 ns slot), i860 at
 from __future__ import annotations
 
 import os
-import shutil
-import tempfile
 import time
 from pathlib import Path
 
@@ -45,6 +43,7 @@ from rasterhw.sim.engines.runner import (
     build_plain_verilator,
     run_plain_verilator,
 )
+from rasterhw.sim.workdirs import release, temp_run_folder
 
 __all__ = ["BENCH", "clear_cycles", "frame_run", "golden_schedule", "producer_gaps", "run_frame_hdl"]
 
@@ -206,7 +205,7 @@ def run_frame_hdl(stream: PixelStream, gaps: np.ndarray, first_bench_gap: list[i
     exe, build_s = build_plain_verilator("snu-pixelbus-fast", TOP, [HARNESS_V, BENCH],
                                          params={"AW": aw, "ZW": stream.z_bits, "NPIX": npix, "SDEPTH": sdepth},
                                          generated={"pixelbus.v": text}, defines={"RASTERHW_CYCLES": 1})
-    run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=exe.parent.parent))
+    run_dir = temp_run_folder(exe.parent.parent)   # removed on Ctrl-C / SIGTERM too (workdirs.cleanup)
     g = np.asarray(gaps, dtype=np.int64).copy()
     counts = []
     for p in range(2):
@@ -224,7 +223,7 @@ def run_frame_hdl(stream: PixelStream, gaps: np.ndarray, first_bench_gap: list[i
     rgb, z = _read_frame(run_dir / "frame.hex", npix)
     sched = [int(x) for x in (run_dir / "meta.txt").read_text().split()]
     if os.environ.get("PIXELBUS_KEEP") != "1":
-        shutil.rmtree(run_dir, ignore_errors=True)
+        release(run_dir)
     return {"t_clear": sched[0], "t_start": sched[1], "t_pixels_done": sched[2], "t_swap": sched[3],
             "cycles": sched[4], "rgb": rgb.reshape(h, w), "z": z.reshape(h, w), "build_s": build_s,
             "prepare_s": t1 - t0, "run_s": t2 - t1, "sim_cycles": meta["sim_cycles"], "loop_s": meta["run_s"]}
