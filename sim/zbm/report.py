@@ -33,11 +33,11 @@ PAPER_GATES = 27_000  # section 7: "logic about 27,000 gates"
 PAPER_RAM_BITS = 49_152
 REAL_SCENES = ("c300", "sp27")
 #: a fast run (``rasterhw report zbm --fast``, the committed-report test) leaves the pysim Table 1
-#: runs of the 8- and 16-chip units unmeasured: 1-7 min each in pysim on this machine, against
-#: seconds for 1, 2 and 4 chips. Interleave 8, paper schedule, is measured on Verilator by
+#: runs of the 8- and 16-chip units unmeasured: tens of seconds each in pysim (interleave 8: 9.6 s on
+#: a quiet machine, 1-7 min under load), against a few seconds for 1, 2 and 4 chips. Interleave 8, paper schedule, is measured on Verilator by
 #: tests/zbm/test_zbm_cocotb.py in every test run; ``make slow`` runs the pysim sweep.
 FAST_SKIP_INTERLEAVES = (8, 16)
-FAST_TABLE1_SKIP = ("slow row: not measured in a fast run (pysim of the 8- and 16-chip units takes minutes; "
+FAST_TABLE1_SKIP = ("slow row: not measured in a fast run (pysim of the 8- and 16-chip units: tens of seconds each; "
                     "rasterhw report zbm without --fast measures it)")
 N_PAIRS = 4  # 2N edge pairs per run; steady state over the second N
 
