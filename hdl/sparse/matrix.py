@@ -34,7 +34,7 @@ class Matrix(wiring.Component):
     ``cells="inline"`` elaborates every cell (pysim); ``cells="instance"`` instantiates the Verilog
     module :data:`CELL_MODULE` by name, ``p*q`` times, so the generated Verilog holds one processor
     module however large the matrix (the cell's Verilog is generated once, separately:
-    ``MatrixCell(...)`` converted with that name).
+    ``MatrixCell`` of the same parameters converted with that name).
 
     Members
     -------
@@ -67,7 +67,7 @@ class Matrix(wiring.Component):
         super().__init__({"i": In(stream.Signature(BROADCAST)), "limit": In(range(in_depth + 1)),
                           "rd_x": In(n + lp), "rd_y": In(n + lq), "rd_z": Out(z_bits + 1), "rd_tri": Out(TRI_BITS),
                           "busy": Out(1), "cycles": Out(32), "stall_cycles": Out(32),
-                          "stat_cell": In(range(p * q)), "stat_sel": In(range(len(cell_stats(n)))), "stat": Out(32)})
+                          "stat_cell": In(range(max(p * q, 2))), "stat_sel": In(range(len(cell_stats(n)))), "stat": Out(32)})
 
     def elaborate(self, platform):
         m = Module()
@@ -116,10 +116,6 @@ class Matrix(wiring.Component):
                 with m.Case(k):
                     m.d.comb += self.stat.eq(c["stat"])
         return m
-
-    def cell(self) -> MatrixCell:
-        """A fresh :class:`MatrixCell` of this matrix's parameters (the module ``cells="instance"`` names)."""
-        return MatrixCell(**self._kw)
 
 
 def make_matrix(*, n: int = 4, p: int = 2, q: int = 2, alpha: int = 2, beta: int = 2, z_bits: int = 24,

@@ -10,60 +10,15 @@ import pytest
 from rasterhw.golden_model.reference import random_triangles
 from rasterhw.golden_model.sparse.search import sparse_render
 from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
-from rasterhw.hdl.sparse.cell import cell_stats
 
 
-def run_matrix_pysim(tris, *, p, q, limit, in_depth=8, fifo_depth=8, gaps=None):
-    """The matrix in pysim with a source that offers a record on every cycle from the first
-    (``gaps``: a per-cycle offer pattern instead); returns the read-out and every counter."""
-    from amaranth.sim import Simulator
+def run_matrix_pysim(tris, *, p, q, limit, gaps=None):
     from rasterhw.golden_model.sparse.fixed import broadcast_records
     from rasterhw.golden_model.sparse.formats import sparse_geometry
-    from rasterhw.hdl.sparse.matrix import Matrix
+    from rasterhw.sim.sparse.matrix_run import run_matrix_pysim as run
 
     n = sparse_geometry(tris.width, tris.height, p, q)
-    dut = Matrix(n=n, p=p, q=q, z_bits=tris.z_bits, fifo_depth=fifo_depth, in_depth=in_depth)
-    recs = broadcast_records(tris)
-    W, H = tris.width, tris.height
-    res = {"tri": np.full((H, W), -1, dtype=np.int64), "zq": np.full((H, W), -1, dtype=np.int64)}
-    names = cell_stats(n)
-
-    async def bench(ctx):
-        ctx.set(dut.limit, limit)
-        idx, c = 0, 0
-        while idx < len(recs):
-            v = True if gaps is None else bool(gaps[c])
-            ctx.set(dut.i.payload, recs[idx])
-            ctx.set(dut.i.valid, v)
-            if v and ctx.get(dut.i.ready):
-                idx += 1
-            await ctx.tick()
-            c += 1
-        ctx.set(dut.i.valid, 0)
-        while ctx.get(dut.busy):
-            await ctx.tick()
-        res["cycles"], res["stall_cycles"] = ctx.get(dut.cycles), ctx.get(dut.stall_cycles)
-        st = np.zeros((p * q, len(names)), dtype=np.int64)
-        for k in range(p * q):
-            ctx.set(dut.stat_cell, k)
-            for j in range(len(names)):
-                ctx.set(dut.stat_sel, j)
-                st[k, j] = ctx.get(dut.stat)
-        res["stats"] = {name: st[:, j] for j, name in enumerate(names)}
-        for y in range(H):
-            for x in range(W):
-                ctx.set(dut.rd_x, x)
-                ctx.set(dut.rd_y, y)
-                await ctx.tick()
-                t, z = ctx.get(dut.rd_tri), ctx.get(dut.rd_z)
-                if t != 0xFFFF:
-                    res["tri"][y, x], res["zq"][y, x] = t, z
-
-    sim = Simulator(dut)
-    sim.add_clock(1e-8)
-    sim.add_testbench(bench)
-    sim.run()
-    return res
+    return run(broadcast_records(tris), n=n, p=p, q=q, limit=limit, z_bits=tris.z_bits, gaps=gaps)
 
 
 @pytest.mark.parametrize(("size", "matrix", "limit", "ntri", "area"), [
