@@ -16,6 +16,8 @@ SMALL = {
     "experts-dmm": {"depth": 16},
     "experts-pxp": {"width": 64, "aj": "c"},
     "experts-pxp-unit": {"width": 64, "depth": 64},
+    "sparse-matrix": {"n": 3, "p": 2, "q": 2, "in_depth": 4},
+    "sparse-vp": {"n": 3, "p": 2, "q": 2},
     "zbm-merger": {"fifo_depth": 4},
     "zbm-seggen": {"width": 48, "height": 24, "capacity": 64},
     "zbm-unit": {"interleave": 2, "width": 32, "height": 16, "capacity": 16},

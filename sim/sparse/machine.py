@@ -38,6 +38,8 @@ MACHINE = Machine(
                    bytes_per_pixel=700),),
     report="rasterhw.sim.sparse.report:rows",
     bench="rasterhw.sim.sparse.bench:bench",
+    testbenches={"sparse-vp": "rasterhw.sim.sparse.testbench:VPBench",
+                 "sparse-matrix": "rasterhw.sim.sparse.testbench:MatrixBench"},
     soak={"sparse": "rasterhw.sim.sparse.soak:sparse_round"},
     flows={"sparse-vp": Flow(small={"n": 4, "p": 2, "q": 2}, clocks=(_NO_CLOCK,)),
            "sparse-matrix": Flow(small={"n": 3}, clocks=(_NO_CLOCK,))},
