@@ -85,3 +85,19 @@ def test_verilator_matrix_cycle_exact_and_depth_is_run_time():
     assert r64["build_s"] == 0.0  # the second depth reused the first one's build
     assert r1["stall_cycles"] > 0 and r1["fifo_peak_max"] == 1
     assert r64["fifo_peak_max"] <= 64 and r1["frame_cycles"] >= r64["frame_cycles"]
+
+
+def test_bad_depths_are_one_line_errors():
+    from rasterhw.golden_model.errors import RasterhwError
+    from rasterhw.sim.sparse.sim import simulate, simulate_coupled
+
+    tris = random_triangles(16, 16, 4, mean_area=10.0, seed=1)
+    for kw in ({"fifo_depth": 0}, {"fifo_depth": 65}, {"fifo_depth": 2.5}, {"vp_fifo_depth": 1}):
+        with pytest.raises(RasterhwError):
+            simulate_coupled(tris, "2x2", **kw)
+    with pytest.raises(RasterhwError, match="coupled"):
+        simulate("c50", 32, 32, matrix="2x2", coupled=False, fifo_depth=3)
+    with pytest.raises(ValueError):
+        from rasterhw.hdl.sparse.matrix import Matrix
+
+        Matrix(n=2, cells="flat")
