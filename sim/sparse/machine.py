@@ -42,7 +42,7 @@ MACHINE = Machine(
                  "sparse-matrix": "rasterhw.sim.sparse.testbench:MatrixBench"},
     soak={"sparse": "rasterhw.sim.sparse.soak:sparse_round"},
     flows={"sparse-vp": Flow(small={"n": 4, "p": 2, "q": 2}, clocks=(_NO_CLOCK,)),
-           "sparse-matrix": Flow(small={"n": 3}, clocks=(_NO_CLOCK,))},
+           "sparse-matrix": Flow(small={"n": 3, "in_depth": 4}, clocks=(_NO_CLOCK,))},
     fpga_note="The sparse video processor's paper names no clock (docs/sparse.md).",
     status="golden model (image = reference), formulas (1)-(12), Monte-Carlo window counts, figs. 3-6; "
            "video processor in Amaranth, bit-exact in pysim and Verilator; golden cycle models of the coupled "
