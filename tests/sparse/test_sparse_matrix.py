@@ -80,7 +80,8 @@ def test_verilator_matrix_cycle_exact_and_depth_is_run_time():
     r64 = simulate_coupled(tris, "2x2", fifo_depth=64)
     for r in (r1, r64):
         assert r["coupled"] and r["mismatches"] == 0 and r["pixels_compared"] == 32 * 32
-        assert r["cycle_mismatches"] == 0 and r["cycles_compared"] == 2 + 3 * 4 + 4 * 4
+        # frame, stalls; per processor its FIFO peak, busy cycles and tests of its 4 levels
+        assert r["cycle_mismatches"] == 0 and r["cycles_compared"] == 2 + 2 * 4 + 4 * 4
         assert r["tests_match_golden"]
     assert r64["build_s"] == 0.0  # the second depth reused the first one's build
     assert r1["stall_cycles"] > 0 and r1["fifo_peak_max"] == 1
