@@ -78,7 +78,7 @@ def test_plain_verilator_run_writes_a_trace_on_request_only(tmp_path):
 def test_sim_on_plain_verilator_writes_one_trace_per_processor(tmp_path, capsys):
     vcd = tmp_path / "sp.vcd"
     args = ["sim", "sparse", "--scene", "c50", "--size", "32x32", "--matrix", "2x2", "--engine", "verilator",
-            "--json", "--waves", str(vcd)]   # no -o: sim sparse gives no frame image (issue 33)
+            "--no-coupled", "--json", "--waves", str(vcd)]   # no -o: sim sparse gives no frame image (issue 33)
     assert _run(args) == 0
     res = json.loads(capsys.readouterr().out)
     assert res["mismatches"] == 0 and len(res["waves"]) == 4

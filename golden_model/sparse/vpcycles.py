@@ -73,13 +73,16 @@ class VPCycleModel:
     """
 
     def __init__(self, oks: list[np.ndarray], news: list[np.ndarray], new_px: np.ndarray, *,
-                 fifo_depth: int = HDL_FIFO_DEPTH):
-        if isinstance(fifo_depth, bool) or not isinstance(fifo_depth, int) or fifo_depth < 2:
-            raise RasterhwError(f"sparse VP cycles: fifo_depth must be an integer >= 2, not {fifo_depth!r}")
+                 fifo_depth: int = HDL_FIFO_DEPTH, setup_fifo_depth: int | None = None):
+        setup_fifo_depth = fifo_depth if setup_fifo_depth is None else setup_fifo_depth
+        for name, v in (("fifo_depth", fifo_depth), ("setup_fifo_depth", setup_fifo_depth)):
+            if isinstance(v, bool) or not isinstance(v, int) or v < 2:
+                raise RasterhwError(f"sparse VP cycles: {name} must be an integer >= 2, not {v!r}")
         self.n = n = len(oks)
         self.ok = [[tuple(bool(b) for b in row) for row in o] for o in oks]
         self.new = [list(map(bool, x)) for x in news] + [list(map(bool, new_px))]
-        self.cap = fifo_depth - 1
+        # inner capacity of FIFO k (0: the set-up's, into level 1)
+        self.caps = [setup_fifo_depth - 1] + [fifo_depth - 1] * n
         # FIFO k (0..n) feeds stage k + 1 (the pixel processor for k = n); w: windows, h: headers
         self.wl = [0] * (n + 1)   # inner levels
         self.wv = [False] * (n + 1)  # output registers valid
@@ -105,7 +108,7 @@ class VPCycleModel:
         return bool(self.setup or self.v1 or self.v2 or self.held or self.active)
 
     def step(self, in_valid: bool) -> bool:
-        n, cap = self.n, self.cap
+        n, caps = self.n, self.caps
         wl, wv, hl, hv = self.wl, self.wv, self.hl, self.hv
         w_wen = [False] * (n + 1)
         h_wen = [False] * (n + 1)
@@ -120,11 +123,11 @@ class VPCycleModel:
                 setup_next = 1
         elif self.setup == 1:
             h_wen[0] = True
-            if hl[0] != cap:
+            if hl[0] != caps[0]:
                 setup_next = 2
         else:
             w_wen[0] = True
-            if wl[0] != cap:
+            if wl[0] != caps[0]:
                 setup_next = 0
         # ---- level stages
         st_next = list(self.st)
@@ -157,12 +160,12 @@ class VPCycleModel:
             advance = False
             if ok and not self.sent[s]:
                 h_wen[s + 1] = True
-                if hl[s + 1] != cap:
+                if hl[s + 1] != caps[s + 1]:
                     self.sent[s] = True
                     self.fresh[s] = True
             elif ok:
                 w_wen[s + 1] = True
-                if wl[s + 1] != cap:
+                if wl[s + 1] != caps[s + 1]:
                     advance = True
                     self.fresh[s] = False
                 else:
@@ -192,7 +195,7 @@ class VPCycleModel:
         for k in range(n + 1):
             for lv, vv, wen, ren in ((wl, wv, w_wen[k], w_ren[k]), (hl, hv, h_wen[k], h_ren[k])):
                 lev = lv[k]
-                do_write = wen and lev != cap
+                do_write = wen and lev != caps[k]
                 do_inner_read = lev != 0 and ((not vv[k]) or ren)
                 if do_inner_read:
                     vv[k] = True
@@ -236,6 +239,7 @@ def vp_standalone(oks, news, new_px, records: int, *, fifo_depth: int = HDL_FIFO
 
 
 def coupled_matrix_vp(frame, depth: int, *, issue_interval: int = 1, fifo_depth: int = HDL_FIFO_DEPTH,
+                      setup_fifo_depth: int | None = None,
                       max_cycles: int = 100_000_000) -> dict:
     """The coupled matrix of :mod:`.cycles` (same broadcast, FIFO and counting rules) with every
     processor the HDL video processor as built (:class:`VPCycleModel`) instead of a server: a
@@ -249,7 +253,8 @@ def coupled_matrix_vp(frame, depth: int, *, issue_interval: int = 1, fifo_depth:
     g = _check_int("issue interval", issue_interval, 1)
     P = frame.p * frame.q
     T = frame.triangles
-    vps = [VPCycleModel(*vp_streams(frame, k), fifo_depth=fifo_depth) for k in range(P)]
+    vps = [VPCycleModel(*vp_streams(frame, k), fifo_depth=fifo_depth, setup_fifo_depth=setup_fifo_depth)
+           for k in range(P)]
     lev = [0] * P
     peak = [0] * P
     busy = [0] * P

@@ -1,96 +1,125 @@
-"""The p x q matrix of video processors: a broadcast input and the interleaved read-out."""
+"""The p x q matrix of video processors: the broadcast into every processor's input FIFO, held
+back by the fullest, and the interleaved read-out."""
 
 from __future__ import annotations
 
-from amaranth.hdl import Module, Mux, Signal
+from amaranth.hdl import ClockSignal, Instance, Module, ResetSignal, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import TRI_BITS
+from rasterhw.hdl.sparse.cell import MatrixCell, cell_stats
 from rasterhw.hdl.sparse.layouts import BROADCAST
-from rasterhw.hdl.sparse.vp import VideoProcessor
 
-__all__ = ["Matrix", "make_matrix"]
+__all__ = ["CELL_MODULE", "Matrix", "make_matrix"]
+
+#: the Verilog module name of :class:`MatrixCell` when the matrix instantiates it by name
+CELL_MODULE = "sparse_cell"
 
 
 class Matrix(wiring.Component):
-    """``p x q`` :class:`VideoProcessor` s behind one broadcast register.
+    """``p x q`` :class:`~rasterhw.hdl.sparse.cell.MatrixCell` s (input FIFO + video processor)
+    behind one broadcast.
 
-    The geometry processor's record is held in a register until every processor has taken it
-    ("выдает описания геометрических примитивов всем видеопроцессорам матрицы в режиме
-    Broadcast"); each processor's input FIFOs let it run ahead of or behind the others. The
-    video controller reads pixel ``(x, y)`` of the full ``p*2**n x q*2**n`` raster from processor
-    ``(x mod p, y mod q)`` at sparse address ``(y div q) * 2**n + x div p`` ("как единая память с
-    расслоением по двум координатным осям").
+    Seed 002: the geometry processor "выдает описания геометрических примитивов всем
+    видеопроцессорам матрицы в режиме Broadcast. Описания определяют очереди на входах растровых
+    процессоров". A record on ``i`` is pushed into every processor's input FIFO in the cycle in
+    which every FIFO has room (``i.ready``, from the registered levels and the run-time ``limit``);
+    the fullest FIFO -- the slowest processor -- holds the broadcast back. The geometry processor's
+    rate is the source's (ours: the paper gives none; the drivers offer a record every cycle).
+
+    The video controller reads pixel ``(x, y)`` of the full ``p*2**n x q*2**n`` raster from
+    processor ``(x mod p, y mod q)`` at sparse address ``(y div q) * 2**n + x div p`` ("как единая
+    память с расслоением по двум координатным осям").
+
+    ``cells="inline"`` elaborates every cell (pysim); ``cells="instance"`` instantiates the Verilog
+    module :data:`CELL_MODULE` by name, ``p*q`` times, so the generated Verilog holds one processor
+    module however large the matrix (the cell's Verilog is generated once, separately:
+    ``MatrixCell`` of the same parameters converted with that name).
 
     Members
     -------
     i : In(stream BROADCAST).
+    limit : In — run-time input FIFO depth (1..in_depth).
     rd_x, rd_y : In — full-raster pixel to read; rd_z, rd_tri : Out — its depth and triangle one
         cycle later (empty: ``z = 2**z_bits``, ``tri = 2**TRI_BITS - 1``).
-    busy : Out(1) — a record is still in the broadcast register or in a processor.
-    max_tests : Out(32) — the largest busy-cycle count of any stage of any processor.
+    busy : Out(1) — a record in some FIFO or processor.
+    cycles : Out(32) — cycles on which ``i.valid`` or ``busy`` was high (the frame, for a source
+        that offers from its first cycle with no gaps).
+    stall_cycles : Out(32) — cycles on which ``i.valid`` was high and some FIFO full.
+    stat_cell, stat_sel : In; stat : Out(32) — counter ``stat_sel`` (``cell_stats(n)``) of cell
+        ``stat_cell`` (``b * p + a``).
     """
 
     def __init__(self, *, n: int, p: int = 2, q: int = 2, alpha: int = 2, beta: int = 2, z_bits: int = 24,
-                 fifo_depth: int = 8):
-        self._vps = [VideoProcessor(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth)
-                     for _ in range(p * q)]
-        self._n, self._p, self._q, self._z_bits = n, p, q, z_bits
+                 fifo_depth: int = 8, in_depth: int = 64, cells: str = "inline"):
+        if cells not in ("inline", "instance"):
+            raise ValueError(f"cells must be 'inline' or 'instance', not {cells!r}")
+        self._kw = dict(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth,
+                        in_depth=in_depth)
+        # the processor's checks run here (a bad parameter set fails before any instance is made)
+        self._cells = [MatrixCell(**self._kw)] if cells == "instance" else [MatrixCell(**self._kw) for _ in range(p * q)]
+        if cells == "instance":
+            # only its parameters were checked: not an unused design
+            self._cells[0]._MustUse__silence = self._cells[0]._vp._MustUse__silence = True
+        self._mode = cells
+        self._n, self._p, self._q, self._z_bits, self._in_depth = n, p, q, z_bits, in_depth
         lp, lq = p.bit_length() - 1, q.bit_length() - 1
-        super().__init__({"i": In(stream.Signature(BROADCAST)), "rd_x": In(n + lp), "rd_y": In(n + lq),
-                          "rd_z": Out(z_bits + 1), "rd_tri": Out(TRI_BITS), "busy": Out(1), "max_tests": Out(32)})
+        super().__init__({"i": In(stream.Signature(BROADCAST)), "limit": In(range(in_depth + 1)),
+                          "rd_x": In(n + lp), "rd_y": In(n + lq), "rd_z": Out(z_bits + 1), "rd_tri": Out(TRI_BITS),
+                          "busy": Out(1), "cycles": Out(32), "stall_cycles": Out(32),
+                          "stat_cell": In(range(max(p * q, 2))), "stat_sel": In(range(len(cell_stats(n)))), "stat": Out(32)})
 
     def elaborate(self, platform):
         m = Module()
-        n, p, q = self._n, self._p, self._q
+        n, p, q, zb = self._n, self._p, self._q, self._z_bits
         lp, lq = p.bit_length() - 1, q.bit_length() - 1
         P = p * q
-        full = Signal()
-        rec = Signal(BROADCAST)
-        taken = Signal(P)
-        all_taken = Signal()
-        nxt = Signal(P)
-        for k, vp in enumerate(self._vps):
-            m.submodules[f"vp{k}"] = vp
-            m.d.comb += [vp.a.eq(k % p), vp.b.eq(k // p), vp.i.payload.eq(rec),
-                         vp.i.valid.eq(full & ~taken[k]),
-                         nxt[k].eq(taken[k] | (vp.i.valid & vp.i.ready))]
-        m.d.comb += all_taken.eq(nxt == (1 << P) - 1)
-        # the register takes a new record when empty or when the last processor takes the old one
-        m.d.comb += self.i.ready.eq(~full | all_taken)
-        with m.If(full & all_taken):
-            m.d.sync += [full.eq(0), taken.eq(0)]
-        with m.Elif(full):
-            m.d.sync += taken.eq(nxt)
-        with m.If(self.i.valid & self.i.ready):
-            m.d.sync += [rec.eq(self.i.payload), full.eq(1), taken.eq(0)]
-        # read-out: processor (x mod p, y mod q), address (y div q) * 2**n + x div p
-        sel = Signal(range(P + 1))
-        ypart = self.rd_y[:lq] * p if lq else 0
-        xpart = self.rd_x[:lp] if lp else 0
-        m.d.sync += sel.eq(ypart + xpart)
-        addr = (self.rd_y[lq:] << n) | self.rd_x[lp:]
-        busy = full
-        mx = Signal(32)
-        for k, vp in enumerate(self._vps):
-            m.d.comb += vp.rd_addr.eq(addr)
-            with m.If(sel == k):
-                m.d.comb += [self.rd_z.eq(vp.rd_z), self.rd_tri.eq(vp.rd_tri)]
-            busy = busy | vp.busy
-        m.d.comb += self.busy.eq(busy)
-        # the busiest stage anywhere (the matrix's P_p is set by it)
-        best = Signal(32)
-        vals = [getattr(vp, f"tests_{i}") for vp in self._vps for i in range(1, n + 1)]
-        acc = vals[0]
-        for j, v in enumerate(vals[1:]):
-            nxt_max = Signal(32, name=f"max{j}")  # a signal per step keeps the expression linear
-            m.d.comb += nxt_max.eq(Mux(v > acc, v, acc))
-            acc = nxt_max
-        m.d.comb += [best.eq(acc), mx.eq(best), self.max_tests.eq(mx)]
+        push = Signal()
+        addr = Signal(2 * n)
+        m.d.comb += addr.eq((self.rd_y[lq:] << n) | self.rd_x[lp:])
+        ports = []
+        for k in range(P):
+            c = {"room": Signal(name=f"room{k}"), "busy": Signal(name=f"busy{k}"),
+                 "rd_z": Signal(zb + 1, name=f"rd_z{k}"), "rd_tri": Signal(TRI_BITS, name=f"rd_tri{k}"),
+                 "stat": Signal(32, name=f"stat{k}")}
+            ins = {"a": k % p, "b": k // p, "limit": self.limit, "push": push, "rec": self.i.payload.as_value(),
+                   "rd_addr": addr, "stat_sel": self.stat_sel}
+            if self._mode == "inline":
+                cell = self._cells[k]
+                m.submodules[f"cell{k}"] = cell
+                m.d.comb += [getattr(cell, name).eq(v) for name, v in ins.items()]
+                m.d.comb += [v.eq(getattr(cell, name)) for name, v in c.items()]
+            else:
+                m.submodules[f"cell{k}"] = Instance(
+                    CELL_MODULE, i_clk=ClockSignal(), i_rst=ResetSignal(),
+                    **{f"i_{name}": v for name, v in ins.items()}, **{f"o_{name}": v for name, v in c.items()})
+            ports.append(c)
+        room = ports[0]["room"]
+        busy = ports[0]["busy"]
+        for c in ports[1:]:
+            room = room & c["room"]
+            busy = busy | c["busy"]
+        m.d.comb += [self.i.ready.eq(room), push.eq(self.i.valid & room), self.busy.eq(busy)]
+        with m.If(self.i.valid | busy):
+            m.d.sync += self.cycles.eq(self.cycles + 1)
+        with m.If(self.i.valid & ~room):
+            m.d.sync += self.stall_cycles.eq(self.stall_cycles + 1)
+        # read-out: processor (x mod p, y mod q), registered to meet the read port's latency
+        sel = Signal(range(P))
+        m.d.sync += sel.eq((self.rd_y[:lq] << lp | self.rd_x[:lp]) if P > 1 else 0)
+        with m.Switch(sel):
+            for k, c in enumerate(ports):
+                with m.Case(k):
+                    m.d.comb += [self.rd_z.eq(c["rd_z"]), self.rd_tri.eq(c["rd_tri"])]
+        with m.Switch(self.stat_cell):
+            for k, c in enumerate(ports):
+                with m.Case(k):
+                    m.d.comb += self.stat.eq(c["stat"])
         return m
 
 
 def make_matrix(*, n: int = 4, p: int = 2, q: int = 2, alpha: int = 2, beta: int = 2, z_bits: int = 24,
-                fifo_depth: int = 8) -> Matrix:
-    """Factory for ``rasterhw verilog sparse-matrix`` (default: 2x2 processors on a 32x32 raster)."""
-    return Matrix(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth)
+                fifo_depth: int = 8, in_depth: int = 64) -> Matrix:
+    """Factory for ``rasterhw verilog sparse-matrix`` (default: 2x2 processors on a 32x32 raster,
+    every cell elaborated)."""
+    return Matrix(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth)

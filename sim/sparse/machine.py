@@ -7,6 +7,16 @@ from rasterhw.sim.registry import Arch, Clock, Flow, Machine, Option, SimBlock
 _MATRIX = Option(name="matrix", help="matrix of video processors PxQ (powers of two; the raster must be "
                                      "p*2^n x q*2^n)", default="4x4")
 
+_COUPLED = Option(name="coupled", type=bool, default=True,
+                  help="the whole matrix in one simulation (broadcast, input FIFOs, back-pressure); "
+                       "--no-coupled: every processor alone on the full stream, one simulation each")
+_FIFO_DEPTH = Option(name="fifo_depth", type=int, default=64,
+                     help="coupled matrix: every processor's input FIFO depth, 1..64 (a run-time limit inside "
+                          "one 64-entry build)")
+_VP_FIFO_DEPTH = Option(name="vp_fifo_depth", type=int, default=8,
+                        help="coupled matrix: depth of the FIFOs between a processor's levels, 2..64 (a build "
+                             "parameter)")
+
 _NO_CLOCK = Clock("sync", "sparse video processor: the paper names no clock", None, "clock")
 
 MACHINE = Machine(
@@ -23,15 +33,19 @@ MACHINE = Machine(
     blocks={"sparse-vp": "rasterhw.hdl.sparse.vp:make_vp", "sparse-matrix": "rasterhw.hdl.sparse.matrix:make_matrix"},
     sims=(SimBlock(name="sparse", help="every video processor of the matrix in HDL, interleaved local memories "
                                        "against the bit-accurate golden model",
-                   simulate="rasterhw.sim.sparse.sim:simulate", default_scene="c300", options=(_MATRIX,),
+                   simulate="rasterhw.sim.sparse.sim:simulate", default_scene="c300",
+                   options=(_MATRIX, _COUPLED, _FIFO_DEPTH, _VP_FIFO_DEPTH),
                    bytes_per_pixel=700),),
     report="rasterhw.sim.sparse.report:rows",
     bench="rasterhw.sim.sparse.bench:bench",
+    testbenches={"sparse-vp": "rasterhw.sim.sparse.testbench:VPBench",
+                 "sparse-matrix": "rasterhw.sim.sparse.testbench:MatrixBench"},
     soak={"sparse": "rasterhw.sim.sparse.soak:sparse_round"},
     flows={"sparse-vp": Flow(small={"n": 4, "p": 2, "q": 2}, clocks=(_NO_CLOCK,)),
-           "sparse-matrix": Flow(small={"n": 3}, clocks=(_NO_CLOCK,))},
+           "sparse-matrix": Flow(small={"n": 3, "in_depth": 4}, clocks=(_NO_CLOCK,))},
     fpga_note="The sparse video processor's paper names no clock (docs/sparse.md).",
     status="golden model (image = reference), formulas (1)-(12), Monte-Carlo window counts, figs. 3-6; "
-           "video processor in Amaranth, bit-exact in pysim and Verilator; golden cycle models of the coupled "
+           "video processor in Amaranth, bit-exact in pysim and Verilator; the whole matrix (broadcast, input FIFOs, "
+           "back-pressure, interleaved read-out) in one simulation, bit- and cycle-exact at 1024² 4x4; golden cycle models of the coupled "
            "matrix (FIFO sizing), of the HDL video processor (cycle-exact) and of a stack-based processor",
 )

@@ -242,6 +242,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
 
     # ---------------------------------------------------------------- HDL cycles (t_i, R_p)
     hdl_sec = _hdl_rows(row, engine, progress, hdl_scene=known.get("hdl_scene"))
+    hdl_sec += _coupled_hdl_rows(row, engine, progress)
 
     # ---------------------------------------------------------------- the coupled matrix (golden)
     coupled_sec = _coupled_rows(row, out_dir, size=coupled_size, matrices=coupled_matrices,
@@ -735,3 +736,91 @@ def _fifo_plot(out_dir: Path, curves: dict, lab: str) -> str:
     fig.savefig(out_dir / "sparse_fifo.png", dpi=90)
     plt.close(fig)
     return "sparse_fifo.png"
+
+
+def _coupled_hdl_rows(row, engine: str, progress: bool) -> list[str]:
+    """The whole matrix in HDL (``hdl/sparse/matrix.py``, one simulation) at a few FIFO depths: frame
+    cycles, stalls and FIFO peaks beside the golden coupled cycle model (``coupled_matrix_vp``), and
+    R_p, Q_a, Q_p from the HDL's busy-cycle counters beside formulas (10), (7), (12)."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.reference import random_triangles
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.sparse.search import sparse_render
+    from rasterhw.sim.sparse.sim import simulate_coupled
+
+    if engine == "verilator":
+        W, m, depths = 1 << M_BITS, "4x4", (1, 8, 64)
+        tris = run_geometry(build_scene("c300"), W, W)
+        lab = f"c300 {W}x{W}"
+    elif engine == "pysim":  # pysim runs a few k cycles/s: a small frame
+        W, m, depths = 32, "2x2", (1, 8)
+        tris = random_triangles(W, W, 30, mean_area=40.0, seed=SEED)
+        lab = f"30 random triangles of 40 px, {W}x{W}"
+    else:
+        return [f"## The whole matrix in HDL\n\nNo rows: engine {engine!r} is not supported (pysim or verilator).\n"]
+    src = f"hdl:{engine}"
+    fig = "FIFO sizing (coupled, HDL)"
+    tab = ["| FIFO depth D | frame cycles, HDL | golden cycle model | stall cycles, HDL | golden | FIFO peak, HDL | "
+           "golden | counters differing | least / most loaded processor busy / frame |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    runs = {}
+    for D in depths:
+        r = simulate_coupled(tris, m, engine=engine, fifo_depth=D, progress=progress)
+        runs[D] = r
+        fr = r["frame_cycles"]
+        util = np.array(r["busy"]) / fr
+        tab.append(f"| {D} | {fr} | {r['frame_cycles_golden']} | {r['stall_cycles']} | {r['stall_cycles_golden']} | "
+                   f"{r['fifo_peak_max']} | {r['fifo_peak_max_golden']} | {r['cycle_mismatches']} of "
+                   f"{r['cycles_compared']} | {util.min():.3f} … {util.max():.3f} |")
+        row(fig, f"{lab}, {m}: frame cycles of the whole matrix in one simulation, FIFO depth {D}", paper=None,
+            formula=None, measured=fr, unit="cycles", source=src)
+        row(fig, f"{lab}, {m}: frame cycles, HDL minus the golden coupled cycle model (coupled_matrix_vp: "
+            f"{r['frame_cycles_golden']}), FIFO depth {D}", paper=None, formula=0,
+            measured=fr - r["frame_cycles_golden"], unit="cycles", source=src)
+        row(fig, f"{lab}, {m}: broadcast stall cycles, FIFO depth {D} (golden cycle model: "
+            f"{r['stall_cycles_golden']})", paper=None, formula=None, measured=r["stall_cycles"], unit="cycles",
+            source=src)
+        row(fig, f"{lab}, {m}: largest FIFO peak, FIFO depth {D} (golden cycle model: {r['fifo_peak_max_golden']})",
+            paper=None, formula=None, measured=r["fifo_peak_max"], unit="entries", source=src)
+        row(fig, f"{lab}, {m}: counters differing from the golden coupled cycle model (frame, stalls, every FIFO "
+            f"peak, busy and per-level tests; of {r['cycles_compared']}), FIFO depth {D}", paper=None, formula=0,
+            measured=r["cycle_mismatches"], unit="counters", source=src)
+        row(fig, f"{lab}, {m}: pixels differing from the bit-accurate golden model (of {r['pixels_compared']}), "
+            f"FIFO depth {D}", paper=None, formula=0, measured=r["mismatches"], unit="pixels", source=src)
+    row(fig, f"{lab}, {m}: frame with FIFO depth {depths[0]} / with depth {depths[-1]} (whole matrix in HDL)",
+        paper=None, formula=None, measured=round(runs[depths[0]]["frame_cycles"] / runs[depths[-1]]["frame_cycles"], 5),
+        unit="ratio", source=src)
+    # R_p, Q_a, Q_p from the HDL's counters at the reference depth (or the deepest run)
+    D = REF_DEPTH if REF_DEPTH in runs else depths[-1]
+    r = runs[D]
+    p = int(m.split("x")[0])
+    P, n = p * p, r["n"]
+    Bi = np.array(r["tests_per_level_hdl"], dtype=float)   # busy (test) cycles per stage, all processors
+    Rp = float(Bi.sum() / (n * Bi.max()))
+    Rp_c = float(Bi.sum() / (n * P * r["frame_cycles"]))
+    m_bits = (tris.width - 1).bit_length()
+    fw = _formula_frame(np.asarray(tris.xy), n, p)
+    tf = th.stage_times(fw, kp_ke=0.0)
+    Rp_f = float(tf.sum() / (n * tf.max()))
+    T_mono = float(sparse_render(tris, "1x1", depth="fixed").tests.sum())
+    Qa = T_mono / float(Bi.sum())
+    fw_mono = _formula_frame(np.asarray(tris.xy), m_bits, 1)
+    Qa_f = float(th.total_time(fw_mono, kp_ke=0.0) / (P * th.total_time(fw, kp_ke=0.0)))
+    row("(10) / HDL busy", f"{lab}, {m}: R_p = sum_i B_i / (n max_i B_i), B_i the HDL stages' busy (test) cycles "
+        f"summed over processors, coupled run at FIFO depth {D} (formula: (10) on (1)'s counts, k_p/k_e = 0)",
+        paper=None, formula=round(Rp_f, 4), measured=round(Rp, 4), unit="", source=src)
+    row("(10) / HDL busy", f"{lab}, {m}: R_p of the coupled frame, sum_i B_i / (n P frame cycles), HDL, FIFO depth "
+        f"{D}", paper=None, formula=round(Rp_f, 4), measured=round(Rp_c, 4), unit="", source=src)
+    row("(7) / HDL busy", f"{lab}, {m}: Q_a = T_mono / (HDL coverage tests of all processors) (T_mono: the golden "
+        "1x1 search on the full raster; formula (7) on (1)'s counts, k_p/k_e = 0)", paper=None,
+        formula=round(Qa_f, 4), measured=round(Qa, 4), unit="", source=src)
+    row("(12) / HDL busy", f"{lab}, {m}: Q_p = Q_a R_p from the HDL's busy cycles (formula (12))", paper=None,
+        formula=round(Qa_f * Rp_f, 4), measured=round(Qa * Rp, 4), unit="", source=src)
+    return ["## The whole matrix in HDL (one simulation)\n",
+            f"`rasterhw sim sparse` (coupled, {engine}) run inside this report: {lab}, {m}, the input FIFOs limited "
+            "at run time to D entries (one build), the geometry processor offering a record every cycle (ours). "
+            "Every counter of the HDL is compared with the golden coupled cycle model (`coupled_matrix_vp`, "
+            "processors as the HDL video processor's cycle model).\n",
+            "\n".join(tab) + "\n",
+            f"From the HDL's counters at D = {D}: R_p {Rp:.4f} (formula (10) {Rp_f:.4f}), coupled R_p {Rp_c:.4f}, "
+            f"Q_a {Qa:.4f} (formula (7) {Qa_f:.4f}), Q_p {Qa * Rp:.4f} (formula (12) {Qa_f * Rp_f:.4f}).\n"]

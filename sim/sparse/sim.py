@@ -15,7 +15,7 @@ from rasterhw.golden_model.sparse.fixed import broadcast_records
 from rasterhw.golden_model.sparse.formats import parse_matrix, sparse_geometry
 from rasterhw.golden_model.sparse.search import interleave, sparse_render
 
-__all__ = ["simulate", "simulate_tris"]
+__all__ = ["simulate", "simulate_coupled", "simulate_tris"]
 
 
 def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bool = False, idle: int = 0,
@@ -92,9 +92,75 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
             "run_s": round(run_s, 4)}
 
 
+def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_depth: int = 64,
+                     vp_fifo_depth: int = 8, progress: bool = False) -> dict:
+    """The whole matrix in one simulation (``hdl/sparse/matrix.py``): the image against the golden
+    model pixel by pixel, and the frame's cycles, broadcast stalls, FIFO peaks and every processor's
+    busy cycles and per-level tests against the coupled matrix's golden cycle model
+    (``golden_model/sparse/vpcycles.py``, ``coupled_matrix_vp``): ``cycle_mismatches`` counts
+    the counters that differ. ``fifo_depth``: the input FIFOs' run-time limit (built
+    :data:`~rasterhw.sim.sparse.matrix_run.IN_DEPTH` deep); ``vp_fifo_depth``: the FIFOs between
+    the processor's levels (a build parameter; 8 as every driver builds it)."""
+    from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
+    from rasterhw.sim.sparse.matrix_run import IN_DEPTH, run_matrix_pysim, run_matrix_verilator
+
+    p, q = parse_matrix(matrix)
+    n = sparse_geometry(tris.width, tris.height, p, q)
+    if engine not in ("pysim", "verilator"):
+        raise RasterhwError(f"sparse sim: engine must be 'pysim' or 'verilator', not {engine!r}")
+    if isinstance(vp_fifo_depth, bool) or not isinstance(vp_fifo_depth, int) or not 2 <= vp_fifo_depth <= 64:
+        raise RasterhwError(f"sparse sim: --vp-fifo-depth must be an integer in 2..64, not {vp_fifo_depth!r}")
+    in_depth = IN_DEPTH  # one build for every run-time depth
+    t0 = time.perf_counter()
+    recs = broadcast_records(tris)
+    run = run_matrix_verilator if engine == "verilator" else run_matrix_pysim
+    h = run(recs, n=n, p=p, q=q, limit=fifo_depth, z_bits=tris.z_bits, fifo_depth=vp_fifo_depth, in_depth=in_depth)
+    hdl_s = time.perf_counter() - t0
+    t1 = time.perf_counter()
+    g = sparse_render(tris, (p, q), depth="fixed", trace=True)
+    gz = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    gc = coupled_matrix_vp(g, fifo_depth, fifo_depth=vp_fifo_depth)
+    golden_s = time.perf_counter() - t1
+    mism = int(np.count_nonzero((h["tri"] != g.tri_id) | (h["zq"] != gz)))
+    st = h["stats"]
+    tests = np.stack([st[f"tests_{i}"] for i in range(1, n + 1)], axis=1)
+    pairs = [(h["cycles"], gc["frame_cycles"]), (h["stall_cycles"], gc["stall_cycles"])]
+    pairs += list(zip(st["fifo_peak"].tolist(), gc["fifo_peak"], strict=True))
+    pairs += list(zip(st["busy_cycles"].tolist(), gc["busy"], strict=True))
+    pairs += list(zip(tests.ravel().tolist(), np.asarray(gc["tests"]).ravel().tolist(), strict=True))
+    cyc_mism = sum(int(a != b) for a, b in pairs)
+    frame = h["cycles"]
+    busy = st["busy_cycles"]
+    if progress:
+        print(f"coupled {p}x{q}: {frame} cycles (golden {gc['frame_cycles']}), stalls {h['stall_cycles']}, "
+              f"FIFO peak {int(st['fifo_peak'].max())}", file=sys.stderr, flush=True)
+    return {"engine": engine, "coupled": True, "cycles": frame, "clock_hz": None,
+            "pixels_compared": int(h["tri"].size), "mismatches": mism, "cycle_mismatches": cyc_mism,
+            "cycles_compared": len(pairs), "matrix": f"{p}x{q}", "n": n, "triangles": len(recs),
+            "fifo_depth": fifo_depth, "fifo_depth_built": in_depth, "vp_fifo_depth": vp_fifo_depth,
+            "gp_issue_interval": 1,
+            "frame_cycles": frame, "frame_cycles_golden": gc["frame_cycles"],
+            "stall_cycles": h["stall_cycles"], "stall_cycles_golden": gc["stall_cycles"],
+            "fifo_peak": st["fifo_peak"].tolist(), "fifo_peak_golden": gc["fifo_peak"],
+            "fifo_peak_max": int(st["fifo_peak"].max()), "fifo_peak_max_golden": gc["fifo_peak_max"],
+            "busy": busy.tolist(), "busy_golden": gc["busy"],
+            "idle": (frame - busy).tolist(), "idle_golden": gc["idle"],
+            "tests_per_level_hdl": tests.sum(axis=0).tolist(),
+            "tests_match_golden": bool(np.array_equal(tests, g.tests_per_proc[:, 1:])),
+            "writes": int(st["writes"].sum()), "pixels_written_golden": int(g.pixels_written),
+            "readout_cycles": int(h["tri"].size),
+            "sim_cycles": int(h["sim_cycles"]), "run_s": round(h["run_s"], 4), "build_s": round(h["build_s"], 2),
+            "cycles_per_s": round(h["sim_cycles"] / h["run_s"], 1) if h["run_s"] > 0 else None,
+            "hdl_wall_s": round(hdl_s, 3), "golden_wall_s": round(golden_s, 3),
+            "wall_s": round(time.perf_counter() - t0, 3),
+            **{k: h[k] for k in ("verilog_bytes_cell", "verilog_bytes_matrix") if k in h}}
+
+
 def simulate(scene, width: int, height: int, *, engine: str = "verilator", progress: bool = False,
-             matrix: str = "4x4") -> dict:
-    """The registry's sim-block contract (``scene`` a Scene or a built-in name)."""
+             matrix: str = "4x4", coupled: bool = True, fifo_depth: int = 64, vp_fifo_depth: int = 8) -> dict:
+    """The registry's sim-block contract (``scene`` a Scene or a built-in name). ``coupled``: the
+    whole matrix in one simulation (:func:`simulate_coupled`); otherwise every processor alone on
+    the full stream, one simulation each (:func:`simulate_tris`, ``"coupled": false``)."""
     if isinstance(scene, str):
         from rasterhw.golden_model.scenes import build_scene
 
@@ -102,4 +168,10 @@ def simulate(scene, width: int, height: int, *, engine: str = "verilator", progr
     p, q = parse_matrix(matrix)
     sparse_geometry(width, height, p, q)
     tris = run_geometry(scene, width, height)
-    return simulate_tris(tris, (p, q), engine=engine, progress=progress)
+    if coupled:
+        return simulate_coupled(tris, (p, q), engine=engine, fifo_depth=fifo_depth, vp_fifo_depth=vp_fifo_depth,
+                                progress=progress)
+    if fifo_depth != 64 or vp_fifo_depth != 8:
+        raise RasterhwError("sparse sim: --fifo-depth and --vp-fifo-depth are options of the coupled matrix "
+                            "(drop --no-coupled)")
+    return {**simulate_tris(tris, (p, q), engine=engine, progress=progress), "coupled": False}

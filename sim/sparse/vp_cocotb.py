@@ -12,8 +12,8 @@ import numpy as np
 from rasterhw.golden_model.sparse.fixed import broadcast_records
 from rasterhw.golden_model.sparse.formats import TRI_BITS, parse_matrix, sparse_geometry
 from rasterhw.golden_model.sparse.search import sparse_render
-from rasterhw.sim.outfile import write_if_changed
 from rasterhw.sim.engines.runner import build_dir_for, get_sim, run_cocotb
+from rasterhw.sim.outfile import write_if_changed
 from rasterhw.sim.workdirs import release, temp_run_folder
 
 __all__ = ["run_cocotb_bench"]

@@ -150,3 +150,30 @@ def test_gp_rate_rows(coupled):
     assert len(got) == 8 and all(r["source"] == "golden" and r["measured"] > 0 for r in got)
     server = [r["measured"] for r in got if "as servers" in r["quantity"]]
     assert server == sorted(server, reverse=True)  # deeper FIFOs never slow the frame
+
+
+def test_coupled_hdl_rows_in_pysim():
+    """The report's whole-matrix HDL rows (pysim: a small frame, 2x2, FIFO depths 1 and 8): every
+    counter equal to the golden coupled cycle model, R_p and Q_p from the HDL's busy cycles beside
+    the formulas, sources hdl:pysim."""
+    from rasterhw.sim.sparse.report import _coupled_hdl_rows
+
+    rows = []
+
+    def row(fig, qty, *, paper, formula, measured, unit, source):
+        rows.append({"figure": fig, "quantity": qty, "formula": formula, "measured": measured, "source": source})
+
+    sec = _coupled_hdl_rows(row, "pysim", False)
+    assert sec and all(r["source"] == "hdl:pysim" for r in rows)
+    diff = [r for r in rows if "HDL minus the golden" in r["quantity"] or "counters differing" in r["quantity"]
+            or "pixels differing" in r["quantity"]]
+    assert len(diff) == 6 and all(r["measured"] == 0 for r in diff)
+    peaks = {r["quantity"].split("FIFO depth ")[1].split(" ")[0]: r["measured"] for r in rows
+             if "largest FIFO peak" in r["quantity"]}
+    assert peaks["1"] == 1 and 1 <= peaks["8"] <= 8
+    stall1 = next(r for r in rows if "stall cycles, FIFO depth 1" in r["quantity"])
+    assert stall1["measured"] > 0
+    rp = next(r for r in rows if r["quantity"].endswith("k_p/k_e = 0)") and r["figure"] == "(10) / HDL busy")
+    assert 0 < rp["measured"] <= 1 and 0 < rp["formula"] <= 1
+    qp = next(r for r in rows if r["figure"] == "(12) / HDL busy")
+    assert 0 < qp["measured"] <= 1

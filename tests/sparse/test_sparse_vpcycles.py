@@ -127,3 +127,20 @@ def test_model_equals_the_verilator_bench_per_processor():
             want.append((m["cycles"], m["tests"], m["stalls"]))
     assert got == want
     assert len({c for c, _, _ in got}) > 1  # the processors differ: the check is per processor
+
+
+def test_setup_fifo_depth_is_fifo_zero_only():
+    """``setup_fifo_depth`` sizes only FIFO 0 (set-up into level 1): equal to ``fifo_depth`` it is the
+    default processor; a shallower one can only slow the processor; below 2 it is refused."""
+    from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
+
+    tris = random_triangles(32, 32, 30, mean_area=30.0, seed=11)
+    f = sparse_render(tris, (2, 2), depth="fixed", trace=True)
+    base = coupled_matrix_vp(f, 2, fifo_depth=4)
+    same = coupled_matrix_vp(f, 2, fifo_depth=4, setup_fifo_depth=4)
+    assert base["frame_cycles"] == same["frame_cycles"] and base["busy"] == same["busy"]
+    assert np.array_equal(base["accept"], same["accept"])
+    small = coupled_matrix_vp(f, 2, fifo_depth=4, setup_fifo_depth=2)
+    assert small["frame_cycles"] >= base["frame_cycles"]
+    with pytest.raises(RasterhwError):
+        coupled_matrix_vp(f, 2, fifo_depth=4, setup_fifo_depth=1)

@@ -1,0 +1,104 @@
+"""The whole matrix (``hdl/sparse/matrix.py``: broadcast, every processor's input FIFO, the slowest
+holding the broadcast back, interleaved read-out) in Amaranth pysim against the golden model: the
+image bit for bit, and frame cycles, broadcast stalls, FIFO peaks, per-processor busy cycles and
+per-level tests against the coupled matrix's cycle model (``golden_model/sparse/vpcycles.py``)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from rasterhw.golden_model.reference import random_triangles
+from rasterhw.golden_model.sparse.search import sparse_render
+from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
+
+
+def run_matrix_pysim(tris, *, p, q, limit, gaps=None):
+    from rasterhw.golden_model.sparse.fixed import broadcast_records
+    from rasterhw.golden_model.sparse.formats import sparse_geometry
+    from rasterhw.sim.sparse.matrix_run import run_matrix_pysim as run
+
+    n = sparse_geometry(tris.width, tris.height, p, q)
+    return run(broadcast_records(tris), n=n, p=p, q=q, limit=limit, z_bits=tris.z_bits, gaps=gaps)
+
+
+@pytest.mark.parametrize(("size", "matrix", "limit", "ntri", "area"), [
+    ((16, 16), (2, 2), 1, 12, 16.0),    # shallowest input FIFO: the broadcast waits
+    ((16, 16), (2, 2), 8, 12, 16.0),
+    ((32, 16), (4, 2), 2, 16, 20.0),    # a non-square matrix
+])
+def test_matrix_cycle_exact_against_coupled_model(size, matrix, limit, ntri, area):
+    p, q = matrix
+    tris = random_triangles(*size, ntri, mean_area=area, seed=ntri + limit)
+    f = sparse_render(tris, matrix, depth="fixed", trace=True)
+    gz = np.where(f.tri_id >= 0, np.rint(f.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    h = run_matrix_pysim(tris, p=p, q=q, limit=limit)
+    assert np.array_equal(h["tri"], f.tri_id)
+    assert np.array_equal(h["zq"], gz)
+    g = coupled_matrix_vp(f, limit)
+    assert h["cycles"] == g["frame_cycles"]
+    assert h["stall_cycles"] == g["stall_cycles"]
+    assert h["stats"]["fifo_peak"].tolist() == g["fifo_peak"]
+    assert max(g["fifo_peak"]) <= limit
+    assert h["stats"]["busy_cycles"].tolist() == g["busy"]
+    assert h["stats"]["records"].tolist() == [ntri] * (p * q)
+    n = len(g["tests"][0])
+    tests = np.stack([h["stats"][f"tests_{i}"] for i in range(1, n + 1)], axis=1)
+    assert np.array_equal(tests, np.array(g["tests"]))
+    assert np.array_equal(tests, f.tests_per_proc[:, 1:])
+
+
+def test_depth_one_stalls_the_broadcast():
+    tris = random_triangles(16, 16, 12, mean_area=16.0, seed=3)
+    h1 = run_matrix_pysim(tris, p=2, q=2, limit=1)
+    assert h1["stall_cycles"] > 0
+    assert h1["stats"]["fifo_peak"].max() == 1
+
+
+def test_verilog_holds_one_processor_module_for_256_processors():
+    """16 x 16 = 256 processors: the matrix's Verilog instantiates one cell module by name 256 times
+    and defines no processor itself (the cell's Verilog is generated once, whatever p*q)."""
+    import re
+
+    from amaranth.back import verilog
+    from rasterhw.hdl.sparse.matrix import CELL_MODULE, Matrix
+
+    text = verilog.convert(Matrix(n=2, p=16, q=16, cells="instance"), name="sparse_matrix")
+    modules = re.findall(r"^module\s+(\w+)", text, flags=re.M)
+    assert modules == ["sparse_matrix"]
+    assert len(re.findall(rf"^\s*{CELL_MODULE}\s", text, flags=re.M)) == 256
+    assert len(text) < 400_000
+
+
+def test_verilator_matrix_cycle_exact_and_depth_is_run_time():
+    """The whole matrix on Verilator at 2x2 (one build, two run-time FIFO depths): image and every
+    counter equal to the golden model and its coupled cycle model; depth 1 stalls the broadcast and
+    its FIFOs never hold more than one record."""
+    from rasterhw.sim.sparse.sim import simulate_coupled
+
+    tris = random_triangles(32, 32, 40, mean_area=40.0, seed=7)
+    r1 = simulate_coupled(tris, "2x2", fifo_depth=1)
+    r64 = simulate_coupled(tris, "2x2", fifo_depth=64)
+    for r in (r1, r64):
+        assert r["coupled"] and r["mismatches"] == 0 and r["pixels_compared"] == 32 * 32
+        # frame, stalls; per processor its FIFO peak, busy cycles and tests of its 4 levels
+        assert r["cycle_mismatches"] == 0 and r["cycles_compared"] == 2 + 2 * 4 + 4 * 4
+        assert r["tests_match_golden"]
+    assert r64["build_s"] == 0.0  # the second depth reused the first one's build
+    assert r1["stall_cycles"] > 0 and r1["fifo_peak_max"] == 1
+    assert r64["fifo_peak_max"] <= 64 and r1["frame_cycles"] >= r64["frame_cycles"]
+
+
+def test_bad_depths_are_one_line_errors():
+    from rasterhw.golden_model.errors import RasterhwError
+    from rasterhw.sim.sparse.sim import simulate, simulate_coupled
+
+    tris = random_triangles(16, 16, 4, mean_area=10.0, seed=1)
+    for kw in ({"fifo_depth": 0}, {"fifo_depth": 65}, {"fifo_depth": 2.5}, {"vp_fifo_depth": 1}):
+        with pytest.raises(RasterhwError):
+            simulate_coupled(tris, "2x2", **kw)
+    with pytest.raises(RasterhwError, match="coupled"):
+        simulate("c50", 32, 32, matrix="2x2", coupled=False, fifo_depth=3)
+    with pytest.raises(ValueError):
+        from rasterhw.hdl.sparse.matrix import Matrix
+
+        Matrix(n=2, cells="flat")
