@@ -12,6 +12,9 @@ import time
 
 import numpy as np
 import pytest
+from test_reliability import (
+    one_line_error,  # the one check of a one-line error (tests/ is on the path)
+)
 
 PY = sys.executable
 
@@ -19,15 +22,6 @@ PY = sys.executable
 def run(*args, cwd=None, timeout=300):
     return subprocess.run([PY, "-m", "rasterhw.sim.cli.main", *args], capture_output=True, text=True,
                           cwd=cwd, timeout=timeout)
-
-
-def one_line_error(r, contains=""):
-    assert r.returncode == 2, (r.returncode, r.stdout, r.stderr)
-    assert "Traceback" not in r.stderr
-    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
-    assert len(lines) == 1 and lines[0].startswith("error: "), r.stderr
-    assert contains in lines[0], lines[0]
-    return lines[0]
 
 
 @pytest.mark.parametrize("depth", ["-3", "0"])

@@ -44,15 +44,18 @@ def line_segments(fr: ExpertsFrame, y: int, lo: int, hi: int, *, aj: str = "none
         raise ValueError(f"{st.n} triangles do not fit the {ADDR_BITS}-bit ASB address / polygon number")
     sel = np.flatnonzero((rec.row == y) & (rec.c1 >= lo) & (rec.c0 <= hi - 1) & (rec.c1 >= rec.c0))
     sel = sel[np.lexsort((rec.tri[sel], rec.xl[sel]))]
-    out = []
-    for r in sel:
-        t = int(rec.tri[r])
-        h = st.hue[t]
-        out.append({"xl": int(rec.xl[r]), "xr": int(rec.xr[r]), "zl": int(rec.zl[r]), "il": int(rec.il[r]),
-                    "dzdx": int(st.dzdx[t]), "didx": int(st.didx[t]),
-                    "hue": int((h[0] << 6) | (h[1] << 3) | h[2]), "addr": t, "poly": int(st.poly[t]),
-                    "sl": int(rec.sl[r]), "ql": int(rec.ql[r]), "sr": int(rec.sr[r]), "qr": int(rec.qr[r])})
-    return out
+    return [asb_record(rec, st, r) for r in sel]
+
+
+def asb_record(rec, st, r: int) -> dict:
+    """Record ``r`` of the frame as the PXP receives it (one ASB: ends, left depth and intensity,
+    slopes, 9-bit hue, ASB address, polygon, the A.J. end values)."""
+    t = int(rec.tri[r])
+    h = st.hue[t]
+    return {"xl": int(rec.xl[r]), "xr": int(rec.xr[r]), "zl": int(rec.zl[r]), "il": int(rec.il[r]),
+            "dzdx": int(st.dzdx[t]), "didx": int(st.didx[t]),
+            "hue": int((h[0] << 6) | (h[1] << 3) | h[2]), "addr": t, "poly": int(st.poly[t]),
+            "sl": int(rec.sl[r]), "ql": int(rec.ql[r]), "sr": int(rec.sr[r]), "qr": int(rec.qr[r])}
 
 
 def line_pixels(fr: ExpertsFrame, y: int, lo: int, hi: int) -> list[int]:

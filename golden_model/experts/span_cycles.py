@@ -41,7 +41,7 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.experts.formats import ADDR_BITS, DZ_FRAC, X_FRAC, Z_BITS
 from rasterhw.golden_model.experts.model import ExpertsFrame
-from rasterhw.golden_model.experts.pxp_cycles import drain_cycles, guarded
+from rasterhw.golden_model.experts.pxp_cycles import asb_record, drain_cycles, guarded
 from rasterhw.golden_model.experts.slp_run import block_lists
 
 __all__ = ["DMM_DEPTH", "NO_PTR", "STEPS", "line_asl", "dmm_line", "resolve", "schedule"]
@@ -61,15 +61,7 @@ def line_asl(fr: ExpertsFrame, y: int) -> tuple[list[dict], np.ndarray]:
         raise RasterhwError(f"experts: {st.n} triangles do not fit the {ADDR_BITS}-bit ASB address")
     sel = np.flatnonzero(rec.row == y)
     sel = sel[np.lexsort((rec.tri[sel], rec.xl[sel]))]
-    out = []
-    for r in sel:
-        t = int(rec.tri[r])
-        h = st.hue[t]
-        out.append({"xl": int(rec.xl[r]), "xr": int(rec.xr[r]), "zl": int(rec.zl[r]), "il": int(rec.il[r]),
-                    "dzdx": int(st.dzdx[t]), "didx": int(st.didx[t]),
-                    "hue": int((h[0] << 6) | (h[1] << 3) | h[2]), "addr": t, "poly": int(st.poly[t]),
-                    "sl": int(rec.sl[r]), "ql": int(rec.ql[r]), "sr": int(rec.sr[r]), "qr": int(rec.qr[r])})
-    return out, sel
+    return [asb_record(rec, st, r) for r in sel], sel
 
 
 def dmm_line(fr: ExpertsFrame, y: int, bounds) -> tuple[list[dict], list[int], list[list[int]]]:
