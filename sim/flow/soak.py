@@ -26,6 +26,7 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
 from rasterhw.sim.flow.tasks import Runner, Task
+from tqdm import tqdm
 
 __all__ = ["run_soak", "soak_blocks", "soak_round"]
 
@@ -77,7 +78,11 @@ def run_soak(*, pixels: int, seed: int, blocks: list[str] | None = None, progres
     if not isinstance(pixels, int) or pixels < 1:
         raise RasterhwError(f"--pixels must be a positive integer, not {pixels!r}")
     refs = {b: (table[b] if rounds is not None else None) for b in names}
-    with Runner(scheduler, store=store, fresh=fresh) as run:
+    # one bar over every block's pixels, with rate and ETA (the full soak is hours); the per-round
+    # lines go above it
+    bar = tqdm(total=pixels * len(names), unit="px", unit_scale=True, desc="soak", disable=not progress,
+               file=sys.stderr, dynamic_ncols=True)
+    with bar, Runner(scheduler, store=store, fresh=fresh) as run:
         ahead = max(1, run.nworkers) if run.client is not None else 1
         t0 = time.perf_counter()
         st = {b: {"next": 0, "k": 0, "done": 0, "bad": 0, "failures": [], "queue": deque(), "wall": None}
@@ -107,9 +112,11 @@ def run_soak(*, pixels: int, seed: int, blocks: list[str] | None = None, progres
                     s["done"] += r["pixels"]
                     s["bad"] += r["mismatches"]
                     s["k"] += 1
+                    bar.update(max(0, min(r["pixels"], pixels - (s["done"] - r["pixels"]))))
+                    bar.set_postfix_str(f"{b} round {k}", refresh=False)
                     if progress:
-                        print(f"soak {b} round {k}: {r['pixels']} pixels, {r['mismatches']} mismatches "
-                              f"({r['settings']}) [{r['worker']}]", file=sys.stderr, flush=True)
+                        bar.write(f"soak {b} round {k}: {r['pixels']} pixels, {r['mismatches']} mismatches "
+                                  f"({r['settings']}) [{r['worker']}]", file=sys.stderr)
                     if r["mismatches"]:
                         s["failures"].append({"round": k, "mismatches": r["mismatches"], "settings": r["settings"]})
                         print(f"soak {b}: round {k} mismatches; reproduce: rasterhw soak --seed {seed} --block {b} "
@@ -119,6 +126,7 @@ def run_soak(*, pixels: int, seed: int, blocks: list[str] | None = None, progres
                             run.cancel(rest)
                         s["queue"].clear()
                         s["wall"] = time.perf_counter() - t0
+                        bar.update(max(0, pixels - s["done"]))   # a block that stopped early: its rest counts as done
                         active.remove(b)
         finally:
             for s in st.values():
