@@ -153,7 +153,17 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
             "cycles_per_s": round(h["sim_cycles"] / h["run_s"], 1) if h["run_s"] > 0 else None,
             "hdl_wall_s": round(hdl_s, 3), "golden_wall_s": round(golden_s, 3),
             "wall_s": round(time.perf_counter() - t0, 3),
-            **{k: h[k] for k in ("verilog_bytes_cell", "verilog_bytes_matrix") if k in h}}
+            **{k: h[k] for k in ("verilog_bytes_cell", "verilog_bytes_matrix") if k in h},
+            "frame_rgb": depth_image(h["zq"], tris.z_bits),
+            "frame_note": "the HDL's video memory holds depth only: the image is its depth buffer (near = bright)"}
+
+
+def depth_image(zq: np.ndarray, z_bits: int) -> np.ndarray:
+    """(H, W, 3) uint8 grey image of a read-out depth buffer (-1 empty -> black; near -> bright)."""
+    z = zq.astype(np.float64)
+    grey = np.where(zq >= 0, 255.0 - 200.0 * z / float((1 << z_bits) - 1), 0.0)
+    g = np.clip(np.rint(grey), 0, 255).astype(np.uint8)
+    return np.repeat(g[..., None], 3, axis=2)
 
 
 def simulate(scene, width: int, height: int, *, engine: str = "verilator", progress: bool = False,
