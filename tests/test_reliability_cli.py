@@ -86,6 +86,7 @@ def test_sigterm_during_prove_leaves_no_solver_running(tmp_path):
     (("render", "c50", "--arch", "experts", "--sn", "33", "--size", "32x32", "-o", "e.png"), "32 lines"),
     (("render", "c50", "--arch", "experts", "--pn", "0", "--size", "32x32", "-o", "e.png"), "--pn must be"),
     (("sim", "pxp", "--scene", "c50", "--sn", "0", "--size", "32x16", "--engine", "pysim"), "parts must be"),
+    (("render", "c50", "--arch", "experts", "--size", "1024x1024", "-o", "e.png"), "at most 1023 px a side"),
     (("render", "c50", "--arch", "vz2", "--eps", "0.01", "--size", "16x16", "-o", "v.png"), "shadow map's"),
     (("render", "c50", "--arch", "vz2", "--shadows", "map", "--eps", "1e300", "--size", "16x16", "-o", "v.png"),
      "number in (0, 1)"),

@@ -46,6 +46,8 @@ WORD = 16
 FRAME = 512
 HUE_BITS = 3          # per channel R, G, B
 X_FRAC = 6            # x, y: Q10.6
+#: the largest frame side: a vertex on the right/bottom edge sits at x = width, and Q10.6 holds at most 1023.98
+MAX_SIDE = (1 << (WORD - X_FRAC)) - 1
 Z_BITS = 16           # z word, 0 = near
 DZ_FRAC = 4           # dz/dx sQ11.4, running z Q16.4
 SLOPE_FRAC = 8        # dx/dy, dy/dx sQ7.8

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from rasterhw.golden_model.arch import Rendered
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.golden_model.experts.formats import Z_BITS, Formats
+from rasterhw.golden_model.experts.formats import MAX_SIDE, Z_BITS, Formats
 from rasterhw.golden_model.experts.model import render_frame, stage_totals
 from rasterhw.golden_model.experts.parallel import run_parallel
 from rasterhw.golden_model.pipeline import run_geometry
@@ -27,8 +27,10 @@ def render(scene: Scene, width: int, height: int, *, arch: str = "experts", aj: 
     for name, v, hi, what in (("sn", sn, height, "lines"), ("pn", pn, width, "pixels per line")):
         if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= hi:
             raise RasterhwError(f"experts: --{name} must be an integer from 1 to the frame's {hi} {what}, not {v!r}")
-    if width > 1024 or height > 1024:
-        raise RasterhwError(f"experts: frame {width}x{height} is larger than the Q10.6 coordinates allow (1024)")
+    if width > MAX_SIDE or height > MAX_SIDE:
+        raise RasterhwError(f"experts: frame {width}x{height} is larger than the Q10.6 vertex coordinates allow: "
+                            f"at most {MAX_SIDE} px a side (a vertex on the right or bottom edge sits at x = width, "
+                            "and Q10.6 holds at most 1023.98)")
     shadows = "none" if shadows is None else shadows
     if shadows not in ("none", "polygons"):
         raise RasterhwError(f"experts: shadows must be none or polygons, not {shadows!r}")

@@ -33,6 +33,7 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.experts.formats import (
     ACC_EXTRA,
+    MAX_SIDE,
     SLOPE_FRAC,
     X_FRAC,
     Z_BITS,
@@ -114,8 +115,8 @@ def set_up(tris: ScreenTriangles, *, bit: bool, fmt: Formats | None = None) -> S
     fmt = fmt or Formats()
     xy, z, col = tris.validate(max_coord=1023.0)
     W, H = int(tris.width), int(tris.height)
-    if W > 1024 or H > 1024:
-        raise RasterhwError(f"experts: frame {W}x{H} does not fit the Q10.6 coordinates (at most 1024 px)")
+    if W > MAX_SIDE or H > MAX_SIDE:
+        raise RasterhwError(f"experts: frame {W}x{H} does not fit the Q10.6 coordinates (at most {MAX_SIDE} px a side)")
     hue, inten = _hue_intensity(col)
     if bit:
         g = 1 << X_FRAC
