@@ -479,7 +479,9 @@ def sim_image_name(scene: str, block: str, engine: str, options: dict) -> Path:
 @_click_options(_SIM_OPTIONS)
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="PNG of the HDL frame.")
 @click.option("--waves", type=click.Path(dir_okay=False), default=None,
-              help="Write a trace of the run to this .vcd (.fst where Verilator can write FST); several simulators: NAME.1.vcd, ... Off by default.")
+              help="Write a trace of the run to this .vcd (.fst where Verilator can write FST); several simulators: "
+                   "NAME.1.vcd, ... Off by default. Open it with Surfer (surfer FILE, or app.surfer-project.org) "
+                   "or GTKWave (gtkwave FILE).")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the run's result as JSON on stdout (cycles, mismatches, pixels compared, timings).")
 def sim_cmd(block, scene, size, engine, output, waves, as_json, **block_options) -> None:
