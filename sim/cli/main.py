@@ -505,6 +505,8 @@ def sim_cmd(block, scene, size, engine, output, waves, as_json, **block_options)
     try:
         with recording(waves, engine) as traces:
             res = registry.load(b.simulate)(sc, w, h, engine=engine, progress=not as_json, **opts)
+    except RasterhwError:
+        raise                                  # already one line that names what is wrong
     except (ValueError, OverflowError) as e:   # a block's own parameter check (e.g. a frame smaller than its banks)
         raise RasterhwError(f"sim {block}: {str(e).splitlines()[0] if str(e) else type(e).__name__}") from None
     if traces:
