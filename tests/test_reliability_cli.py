@@ -4,6 +4,7 @@ process."""
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -212,3 +213,16 @@ def test_a_big_mesh_says_what_is_going_on_before_the_silence(tmp_path):
     text = err.decode(errors="replace")
     assert p.returncode == 0, text
     assert "loading m.obj" in text and "1 polygons; transforming and rendering" in text
+
+
+@pytest.mark.heavy
+def test_synth_memory_map_says_when_there_is_nothing_to_map(tmp_path):
+    """Issue 33 (low): `synth --memory map` on a block with no memories used to give the keep
+    netlist without a word; it says so, and counts what it maps where there is something."""
+    r = run("synth", "pixelbus-bank", "-p", "depth=64", "-p", "ram=verilog", "--memory", "map", cwd=tmp_path,
+            timeout=900)
+    assert r.returncode == 0, r.stderr
+    assert "nothing to map: the block has no memories" in r.stdout
+    r = run("synth", "zbm-merger", "-p", "fifo_depth=4", "--memory", "map", "--json", cwd=tmp_path, timeout=900)
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["memories_mapped"] >= 1

@@ -187,7 +187,8 @@ def _script(top: str, files: list[Path], stubs: Path | None, memory: str, flatte
         f"synth -top {top}{' -flatten' if flatten else ''} -run :fine",
         # synth's `fine` steps, memory_map only when asked
         "opt -fast -full",
-        *(["memory_map"] if memory == "map" else []),
+        # with --memory map: how many memories there are to map (0: the same netlist as keep; said)
+        *(["tee -q -o memories.txt select -count t:$mem_v2 t:$mem", "memory_map"] if memory == "map" else []),
         "opt -full",
         "techmap",
         "opt -fast",
@@ -366,11 +367,18 @@ def synthesise(
         "port_bits": port_bits,
         "ram_port_bits": ram_port_bits,
         "check_problems": problems,
+        "memories_mapped": _memories_mapped(bdir) if memory == "map" else None,
         "yosys_version": version,
         "wall_s": wall,
     }
     cached.write_text(json.dumps({"digest": digest, "result": result}, indent=1))
     return {**result, "build_dir": bdir, "cached": False}
+
+
+def _memories_mapped(bdir: Path) -> int:
+    """Memories ``memory_map`` turned into flip-flops (Yosys's ``select -count`` before it)."""
+    m = re.search(r"(\d+) objects", (bdir / "memories.txt").read_text())
+    return int(m.group(1)) if m else 0
 
 
 def synth_report(block: str, **params) -> str:
@@ -386,6 +394,9 @@ def synth_report(block: str, **params) -> str:
         f"  gate equivalent  {r['gate_equivalent']:.0f}  (two-input gates, sim.synth.GATE_WEIGHTS)",
         *([f"  4-input LUTs     {r['lut4']}  (abc -lut 4)"] if r["lut4"] is not None else []),
         f"  RAM              {r['ram_cells']} cells, {r['ram_bits']} bits",
+        *([f"  memory map       {r['memories_mapped']} memories mapped to flip-flops" if r["memories_mapped"]
+           else "  memory map       nothing to map: the block has no memories (the same netlist as --memory keep)"]
+          if r.get("memory") == "map" else []),
         f"  port bits        {r['port_bits']} top-level, {r['ram_port_bits']} to black-boxed RAMs",
         f"  check problems   {r['check_problems']}",
         "  by type:",
@@ -414,5 +425,5 @@ def synth_all(*, small: bool = False, blocks: list[str] | None = None, memory: s
 def summary_row(r: dict) -> dict:
     """The JSON-friendly headline of a :func:`synthesise` result."""
     keys = ("block", "params", "memory", "gate_equivalent", "flipflops", "ram_bits", "ram_cells",
-            "logic_cells", "lut4", "check_problems", "yosys_version", "wall_s")
-    return {k: r[k] for k in keys}
+            "logic_cells", "lut4", "check_problems", "memories_mapped", "yosys_version", "wall_s")
+    return {k: r.get(k) for k in keys}
