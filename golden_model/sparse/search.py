@@ -42,6 +42,7 @@ processors at once, as the matrix runs every processor on every broadcast triang
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -56,6 +57,7 @@ from rasterhw.golden_model.sparse.formats import (
     parse_matrix,
     sparse_geometry,
 )
+from tqdm import tqdm
 
 __all__ = ["SparseFrame", "sparse_render", "interleave"]
 
@@ -121,6 +123,10 @@ def _check_aperture(name: str, v) -> int:
     return int(v)
 
 
+#: root records (triangles x processors) from which a search shows a progress bar on a terminal
+BIG_RECORDS = 1_000_000
+
+
 def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: int = 2,
                   test: str = "exact", depth: str = "float", background=(0.0, 0.0, 0.0),
                   per_record: bool = False, trace: bool = False) -> SparseFrame:
@@ -184,7 +190,11 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
     thr_all = es.thr
     ext_all = (np.abs(es.A) * al + np.abs(es.B) * be) // 2  # aperture growth, exact (A, B even)
     ap_n = 0
-    for i in range(1, n + 1):
+    # a big matrix is millions of records (64x64 on c300: 7.3 M, about a minute): a bar per level
+    # for a person at a terminal (logs and pipes get nothing)
+    big = rt.size >= BIG_RECORDS and sys.stderr.isatty()
+    for i in tqdm(range(1, n + 1), desc=f"sparse {p}x{q}: {rt.size:,} records, level", disable=not big,
+                  file=sys.stderr, leave=False):
         N = 1 << (n - i)
         # Four children per record: origins (u0 + du*N, v0 + dv*N), corner values by increments.
         du = np.array([0, 1, 0, 1], dtype=np.int64)

@@ -176,3 +176,20 @@ def test_non_square_matrix_on_matching_raster():
     f = sparse_render(tris, "4x2")
     assert f.n == 6
     assert np.array_equal(f.tri_id, rasterise(tris).tri_id)
+
+
+def test_a_big_search_shows_a_bar_on_a_terminal_and_nothing_in_a_pipe(monkeypatch, capsys):
+    """Issue 33 (low): a 64x64 matrix ran a minute in silence. Past BIG_RECORDS root records the
+    search draws a bar per level on a terminal; logs and pipes get nothing."""
+    import sys
+
+    from rasterhw.golden_model.sparse import search
+
+    tris = random_triangles(64, 64, 20, mean_area=60.0, seed=3)
+    monkeypatch.setattr(search, "BIG_RECORDS", 1)
+    search.sparse_render(tris, "2x2")
+    assert "records, level" not in capsys.readouterr().err          # not a terminal: silent
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
+    search.sparse_render(tris, "2x2")
+    err = capsys.readouterr().err
+    assert "sparse 2x2" in err and "records, level" in err
