@@ -52,7 +52,9 @@ def _frame(params: dict, seed: int):
     """A random EXPERTS frame at the block's width (square), bit-accurate model, A.J. as built."""
     rng = np.random.default_rng(seed)
     w = params["width"]
-    name = str(rng.choice(["experts-1000", "experts-tilt-1000", "c100"]))
+    # the paper's scenes; a block built for fewer triangles (a quick test) gets scenes that fit it
+    small = params.get("tris", 1000) < 1000
+    name = str(rng.choice(["c50", "experts-solids"] if small else ["experts-1000", "experts-tilt-1000", "c100"]))
     sc = build_scene(name, seed=int(rng.integers(0, 1 << 30)))
     return rng, name, render_frame(run_geometry(sc, w, w, z_bits=16), model="bit", aj=params.get("aj", "none"))
 
@@ -197,7 +199,8 @@ class SlpBench(Testbench):
     block = "experts-slp"
 
     def stimulus(self, params: dict, seed: int) -> Stimulus:
-        rng, name, fr = _frame({"width": params["width"], "aj": "c" if params["guard"] else "none"}, seed)
+        rng, name, fr = _frame({"width": params["width"], "tris": params["tris"],
+                                "aj": "c" if params["guard"] else "none"}, seed)
         H = fr.height
         n = int(rng.integers(1, min(params["lines"], H) + 1))
         y0 = int(rng.integers(0, H - n + 1))
@@ -226,7 +229,7 @@ class GroupBench(Testbench):
 
     def stimulus(self, params: dict, seed: int) -> Stimulus:
         from rasterhw.golden_model.experts.model import equal_bounds
-        rng, name, fr = _frame({"width": params["width"], "aj": params["aj"]}, seed)
+        rng, name, fr = _frame({"width": params["width"], "tris": params["tris"], "aj": params["aj"]}, seed)
         H = fr.height
         n = int(rng.integers(1, min(params["lines"], H) + 1))
         y0 = int(rng.integers(0, H - n + 1))
