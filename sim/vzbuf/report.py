@@ -17,12 +17,13 @@ from pathlib import Path
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.reference import rasterise
-from rasterhw.golden_model.scenes import build_scene
+from rasterhw.golden_model.scenes import build_scene as _shared_scene
 from rasterhw.golden_model.vzbuf.facom import PARAMS, price
 from rasterhw.golden_model.vzbuf.render import render_frame, table_stages
 from rasterhw.golden_model.vzbuf.shadows import ray_shadow
 from rasterhw.golden_model.vzbuf.stats import table1
 from rasterhw.golden_model.vzbuf.trace import Trace
+from rasterhw.golden_model.vzbuf.workload import table1_light
 from rasterhw.sim.report.rows import make_row
 from rasterhw.sim.vzbuf.paper import COLS, CORRECTED, RATES, RUNS, T1, TABLES, VTIME
 
@@ -32,6 +33,11 @@ W = H = 512
 T1_KEYS = ("initial polygons", "initial shadow polygons", "processed polygons", "processed shadow polygons",
            "segments", "shadow segments", "pixels processed", "shadow pixels processed", "area per polygon",
            "shadow area per polygon")
+
+
+def build_scene(name: str):
+    """A paper scene under vzbuf's table-1 light (``workload.py``): every report run uses it."""
+    return table1_light(_shared_scene(name))
 
 
 def _say(progress, msg):
