@@ -305,14 +305,13 @@ def model_ms(tr: Trace, alg: int, sh: str, params: dict | None = None) -> dict:
 FIG_E = "where the time goes (e)"
 
 
-def where_the_time_goes(times, t1) -> list[dict]:
+def where_the_time_goes(times, t1, n: str = "c300") -> list[dict]:
     """Conclusion (e)'s gap on c300 taken apart with no parameter changed: the unit price of the
     simplest loop (buffer initialisation, a store per element) beside the paper's, a fixed
     floating-point loop body (eye -> light transform) relative to it, the work per item of the
     stages the model prices lightest, the time outside the vector unit, and two speed-ups the
     paper's text states (docs/vzbuf.md, conclusion (e))."""
     out: list[dict] = []
-    n = "c300"
 
     def row(q, paper, measured, unit, source):
         out.append(make_row(SYS, FIG_E, f"{n}: {q}", paper=paper, formula=None, measured=measured, unit=unit,
