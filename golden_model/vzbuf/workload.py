@@ -16,7 +16,7 @@ looks, i.e. it comes from behind the eye). One setting per scene family, not per
 
 * cubes (``cN``): elevation 15 deg, azimuth 0 -- a low light from behind the viewer. Every cube
   scene is within 25 % over elevations 10-20 deg; the scenes' own light (elevation 54 deg, from
-  the front left) gives 2.1-2.3 x the paper's pixels per shadow polygon.
+  behind the eye 34 deg to its right) gives 2.0-2.3 x the paper's pixels per shadow polygon.
 * spheres (``spN``): elevation 30 deg, azimuth 45 deg. sp27 and sp8 are within 25 % for
   elevations 25-30 deg and azimuths 45-60 deg; below 25 deg a UV sphere's lit/unlit boundary
   zig-zags over more edges (sp8: 1.30 x the paper's shadow polygons). sp5 is not reached by any
