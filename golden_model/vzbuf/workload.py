@@ -8,7 +8,9 @@ item 4 asks for a light under which table 1's shadow-polygon counts and pixels p
 polygon are approached (within 25 %); this module is that choice, for vzbuf only (``--light
 table1``; the report uses it for every table). It is a *workload* setting, chosen by sweeping the
 light against table 1's two shadow rows (docs/vzbuf.md, "Shadow workload"); no timing parameter
-depends on it, and the timing tables are then compared at a matched shadow workload.
+depends on it, and the timing tables are then compared at a matched shadow workload. Tables 2
+and 3 (no shadows), from which conclusions (a)-(e) are drawn, trace the same work under either
+light (tested), so the choice cannot move a conclusion.
 
 The light is set relative to the camera: ``elevation`` above the horizon, ``azimuth`` from the
 camera's horizontal view direction toward its right (0 = the light travels the way the camera

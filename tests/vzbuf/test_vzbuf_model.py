@@ -185,3 +185,19 @@ def test_where_the_time_goes_rows():
     seg = rows[f"{n}: segment build, scalar time per segment (table 2 stage 3 / table 1 segments)"]
     assert seg["measured"] < 0.5 * seg["paper"]
     assert len(rows) == 15
+
+
+def test_conclusions_do_not_depend_on_the_table1_light():
+    """Conclusions (a)-(e) read tables 2 and 3 (no shadows), whose traced work does not depend on
+    the light: the table-1 light (a chosen workload setting) cannot move a conclusion."""
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.vzbuf.render import render_frame
+    from rasterhw.golden_model.vzbuf.trace import Trace
+    from rasterhw.golden_model.vzbuf.workload import table1_light
+
+    sc = build_scene("c50")
+    for alg in (1, 2):
+        a, b = Trace(), Trace()
+        render_frame(sc, 512, 512, alg=alg, trace=a)
+        render_frame(table1_light(sc), 512, 512, alg=alg, trace=b)
+        assert a.loops == b.loops and a.scalars == b.scalars
