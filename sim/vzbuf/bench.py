@@ -17,6 +17,7 @@ import tracemalloc
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.golden_model.vzbuf.render import render_frame
 from rasterhw.golden_model.vzbuf.wholearray import render_whole
+from rasterhw.golden_model.vzbuf.workload import table1_light
 from rasterhw.sim.vzbuf.paper import COLS, T1, T5, VP200_T5_C300_FRAGMENTS_PER_S, VP200_T5_C300_MS
 
 
@@ -43,7 +44,7 @@ def _peak(fn) -> float:
 def bench(*, repeat: int = 3, hdl: bool = False, progress: bool = False, scenes=COLS) -> list[dict]:
     res = []
     for n in scenes:
-        sc = build_scene(n)
+        sc = table1_light(build_scene(n))
         vp_ms = T5["VP200"]["total"][n]
         vp_rate = (T1["pixels processed"][n] + T1["shadow pixels processed"][n]) / (vp_ms / 1e3) if vp_ms else None
         for label, fn in (("vz2", lambda sc=sc: render_frame(sc, 512, 512, alg=2, shadows="polygons")),

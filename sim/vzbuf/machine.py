@@ -9,6 +9,8 @@ _OPTIONS = (
            default="none", choices=("none", "polygons", "map")),
     Option("eps", "Shadow-map epsilon in light depth units (scene depth mapped to 0..1); > 0.",
            default=5e-3, type=float),
+    Option("light", "Light: the scene's own, or vzbuf's table-1 light (chosen so that the paper's scenes approach "
+           "table 1's shadow workload; docs/vzbuf.md).", default="scene", choices=("scene", "table1")),
 )
 
 #: why vz1/vz2's RGB differs from the float reference (docs/vzbuf.md, "Output")

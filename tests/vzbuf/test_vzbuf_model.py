@@ -129,6 +129,7 @@ def test_model_imports_without_the_paper_tables():
         "sys.meta_path.insert(0, B())\n"
         "import rasterhw.golden_model.vzbuf.facom, rasterhw.golden_model.vzbuf.trace\n"
         "import rasterhw.golden_model.vzbuf.render, rasterhw.golden_model.vzbuf.hsr\n"
+        "import rasterhw.golden_model.vzbuf.workload\n"
         "assert 'rasterhw.sim.vzbuf.paper' not in sys.modules\n"
         "try:\n"
         "    import rasterhw.sim.vzbuf.paper\n"
@@ -157,3 +158,46 @@ def test_conclusions_check_holds_on_the_paper_and_fails_when_a_claim_is_broken()
 def test_damaged_table2_cell_is_the_column_sum():
     T = TABLES["table 2"]["scalar"]
     assert T["1"]["c250"] == T["total"]["c250"] - T["2"]["c250"] - T["3"]["c250"] == 169
+
+
+def test_where_the_time_goes_rows():
+    """Conclusion (e)'s decomposition (c50 here; the report runs c300): the unit price of the
+    simplest loop (a store per buffer element) is the paper's within 0.5-2x on the scalar unit and
+    the VP200, while the scalar work per segment is far below the paper's (the finding)."""
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.vzbuf.render import render_frame
+    from rasterhw.golden_model.vzbuf.stats import table1
+    from rasterhw.golden_model.vzbuf.trace import Trace
+    from rasterhw.sim.vzbuf.report import FIG_E, RUNS, model_ms, where_the_time_goes
+
+    n = "c50"
+    sc = build_scene(n)
+    times = {}
+    for table in ("table 2", "table 3", "table 6"):
+        tr = Trace()
+        f = render_frame(sc, 512, 512, alg=RUNS[table][0], shadows=RUNS[table][1], trace=tr)
+        times[(table, n)] = (model_ms(tr, *RUNS[table]), f, tr)
+    rows = {r["quantity"]: r for r in where_the_time_goes(times, {n: table1(sc, shadows=False)}, n)}
+    assert all(r["figure"] == FIG_E and r["source"].startswith("model:") for r in rows.values())
+    for m in ("scalar", "VP200"):
+        r = rows[f"{n}: buffer initialisation, ns per buffer element ({m}; table 6 stage 4 / 3 x 512^2)"]
+        assert 0.5 < r["measured"] / r["paper"] < 2, r
+    seg = rows[f"{n}: segment build, scalar time per segment (table 2 stage 3 / table 1 segments)"]
+    assert seg["measured"] < 0.5 * seg["paper"]
+    assert len(rows) == 15
+
+
+def test_conclusions_do_not_depend_on_the_table1_light():
+    """Conclusions (a)-(e) read tables 2 and 3 (no shadows), whose traced work does not depend on
+    the light: the table-1 light (a chosen workload setting) cannot move a conclusion."""
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.vzbuf.render import render_frame
+    from rasterhw.golden_model.vzbuf.trace import Trace
+    from rasterhw.golden_model.vzbuf.workload import table1_light
+
+    sc = build_scene("c50")
+    for alg in (1, 2):
+        a, b = Trace(), Trace()
+        render_frame(sc, 512, 512, alg=alg, trace=a)
+        render_frame(table1_light(sc), 512, 512, alg=alg, trace=b)
+        assert a.loops == b.loops and a.scalars == b.scalars
