@@ -29,7 +29,7 @@ def test_waves_written_on_request_only(tmp_path, capsys):
     assert _run([*ARGS, "-o", str(tmp_path / "b.png")]) == 0
     res = json.loads(capsys.readouterr().out)
     assert "waves" not in res
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png", "b.png", "run.vcd"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png", "b.png", "run.gtkw", "run.vcd"]
 
 
 def test_pysim_waves_must_be_vcd(tmp_path, capsys):

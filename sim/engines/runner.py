@@ -328,6 +328,9 @@ def run_plain_verilator(exe: Path, plusargs: Sequence[str], *, run_dir: Path, ma
     :class:`RasterhwError` naming the binary."""
     trace = waves.next_plain_trace() if "-trace-" in exe.parent.parent.name else None
     plus = [*plusargs, f"+maxcyc={maxcyc}", *([f"+waves={trace}"] if trace else [])]
+    if trace:   # the trace window (--trace-start / --trace-end): edges the main dumps
+        start, end = waves.plain_trace_window()
+        plus += [*([f"+trace_start={start}"] if start else []), *([f"+trace_end={end}"] if end is not None else [])]
     r = run_child([str(exe), *plus], cwd=run_dir, capture_output=True, text=True)
     try:
         meta = json.loads(r.stdout.strip().splitlines()[-1])
