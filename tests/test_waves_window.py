@@ -1,6 +1,6 @@
 """Waves people can open (issue 30 item 4): a GTKWave save file beside every VCD with the block's
 stream ports grouped, and a trace window (``--trace-start`` / ``--trace-end``) on pysim and on
-plain Verilator; the hook on Amaranth's simulator holds only for the version it was written for."""
+plain Verilator (the hook on Amaranth's simulator: tests/test_library_hooks.py)."""
 
 from __future__ import annotations
 
@@ -209,9 +209,3 @@ def test_verilator_engine_gtkw_names_the_bench_blocks_stream_ports(tmp_path):
     dut_ids = {i for s, n, w, r, i in waves.vcd_header(vcd) if s[-1:] == ("dut",)}
     assert names and all(ids[re.sub(r"\[\d+:\d+\]$", "", n)] in dut_ids for n in names)
     assert min(_times(vcd)) == 11 and max(_times(vcd)) <= 60
-
-
-def test_amaranth_is_the_version_the_pysim_hook_was_written_for():
-    """Fails when Amaranth's ``Simulator.run`` / ``write_vcd`` change: the hook must be looked at
-    again (and, if Amaranth gained a public way to trace every simulator, replaced by it)."""
-    assert waves.amaranth_hook_ok() is None

@@ -331,7 +331,7 @@ def amaranth_hook_ok() -> str | None:
     """``None`` if Amaranth's simulator is the one the pysim hook was written for (0.5, ``run`` and
     ``write_vcd`` as above), else why not. Amaranth has no public way to trace every simulator a
     run creates (the scene drivers make their own), so :func:`recording` wraps ``Simulator.run``
-    for the run's duration; ``tests/test_waves_window.py`` fails when this stops holding."""
+    for the run's duration; ``tests/test_library_hooks.py`` fails when this stops holding."""
     import amaranth
     from amaranth.sim import Simulator
 
