@@ -7,7 +7,6 @@ traceback. ``--json`` puts a machine-readable result on stdout; progress goes to
 
 from __future__ import annotations
 
-import json
 import sys
 import time
 from pathlib import Path
@@ -16,6 +15,7 @@ import click
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
 from rasterhw.sim.cli.flow import add_commands
+from rasterhw.sim.cli.jsonout import emit_json, normalise
 from rasterhw.sim.report.rows import systems as _report_systems
 
 #: the float reference rasteriser is shared by every machine; the rest come from the registry
@@ -87,22 +87,6 @@ def parse_size(text: str | None) -> tuple[int, int] | None:
     if not (1 <= w <= 16384 and 1 <= h <= 16384):
         raise RasterhwError(f"--size {w}x{h}: width and height must be between 1 and 16384")
     return w, h
-
-
-def emit_json(obj: dict) -> None:
-    click.echo(json.dumps(obj, indent=None, sort_keys=False, default=_json_default))
-
-
-def _json_default(o):
-    import numpy as np
-
-    if isinstance(o, np.integer):
-        return int(o)
-    if isinstance(o, np.floating):
-        return float(o)
-    if isinstance(o, Path):
-        return str(o)
-    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
 
 
 def info(msg: str) -> None:
@@ -524,7 +508,7 @@ def sim_cmd(block, scene, size, engine, output, waves, trace_start, trace_end, a
         res["image"] = str(out)
     elif output is not None:
         raise RasterhwError(f"sim {block} gives no frame image; -o {output} cannot be written (leave -o out)")
-    res = {"block": block, "scene": sc.name, **res}
+    res = normalise({"block": block, "scene": sc.name, **res})
     if as_json:
         emit_json(res)
     else:
