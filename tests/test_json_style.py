@@ -142,7 +142,7 @@ def test_renamed_keys():
     (["report", "vzbuf", "--fast", "--json"], list),
     (["soak", "--pixels", "256", "--block", "pixelbus", "--seed", "3", "--scheduler", "serial", "--json"], list),
     (["bench", "--json"], list),
-])
+], ids=["synth", "prove", "fpga", "report", "soak", "bench"])
 def test_slow_commands(argv, shape, tmp_path, capsys, monkeypatch):
     if argv[0] == "report":
         argv = [*argv, "--out", str(tmp_path)]
