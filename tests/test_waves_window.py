@@ -209,3 +209,23 @@ def test_verilator_engine_gtkw_names_the_bench_blocks_stream_ports(tmp_path):
     dut_ids = {i for s, n, w, r, i in waves.vcd_header(vcd) if s[-1:] == ("dut",)}
     assert names and all(ids[re.sub(r"\[\d+:\d+\]$", "", n)] in dut_ids for n in names)
     assert min(_times(vcd)) == 11 and max(_times(vcd)) <= 60
+
+
+@pytest.mark.cocotb
+def test_plain_verilator_trace_named_relative_lands_in_the_current_folder(tmp_path, monkeypatch):
+    """The binary runs in its own run folder: ``--waves run.vcd`` still means ./run.vcd (it used to
+    be written into the run folder and removed with it)."""
+    from rasterhw.sim.engines.runner import build_plain_verilator, run_plain_verilator
+    from rasterhw.sim.engines.waves import recording
+
+    src = tmp_path / "tb_wave_window.v"
+    src.write_text(COUNTER)
+    (tmp_path / "here").mkdir()
+    (tmp_path / "elsewhere").mkdir()
+    monkeypatch.chdir(tmp_path / "here")
+    with recording("run.vcd", "verilator") as traces:
+        exe, _s = build_plain_verilator("waves-window-test", "tb_wave_window", [src], params={})
+        run_plain_verilator(exe, [], run_dir=tmp_path / "elsewhere", maxcyc=1000)
+    assert traces == [Path("run.vcd")]
+    assert (tmp_path / "here" / "run.vcd").exists() and (tmp_path / "here" / "run.gtkw").exists()
+    assert not list((tmp_path / "elsewhere").iterdir())

@@ -102,7 +102,7 @@ def next_plain_trace() -> Path | None:
         path, written = _plain["path"], _plain["written"]
         out = _nth(path, len(written))
         written.append(out)
-        return out
+        return out.absolute()   # the binary runs in its run folder: a relative name would land (and vanish) there
 
 
 def _nth(path: Path, n: int) -> Path:
