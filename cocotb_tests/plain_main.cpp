@@ -7,7 +7,9 @@
 // where "cycles" / "lines" are the top's outputs of those names when the build defines
 // RASTERHW_CYCLES / RASTERHW_LINES. `final` blocks (the benches' dumps) run at the end.
 // A build with --trace-fst or --trace (waves on request: sim/engines/waves.py) writes the run's trace to
-// the file named by +waves=PATH, two time steps per clock (rising edges at odd steps).
+// the file named by +waves=PATH, two time steps per clock (rising edges at odd steps); with
+// +trace_start=N / +trace_end=M only edges N .. M-1 (counted from 0, the tail included): the trace
+// is opened at edge N (every value, then changes) and closed at edge M.
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -35,9 +37,12 @@ int main(int argc, char** argv) {
     ctx->commandArgs(argc, argv);
     uint64_t maxcyc = 4000000000ull;
     const char* waves = nullptr;
+    uint64_t tstart = 0, tend = UINT64_MAX;  // trace window: edges tstart .. tend-1
     for (int i = 1; i < argc; ++i) {
         if (!std::strncmp(argv[i], "+maxcyc=", 8)) maxcyc = std::strtoull(argv[i] + 8, nullptr, 10);
         if (!std::strncmp(argv[i], "+waves=", 7)) waves = argv[i] + 7;
+        if (!std::strncmp(argv[i], "+trace_start=", 13)) tstart = std::strtoull(argv[i] + 13, nullptr, 10);
+        if (!std::strncmp(argv[i], "+trace_end=", 11)) tend = std::strtoull(argv[i] + 11, nullptr, 10);
     }
 #if VM_TRACE
     std::unique_ptr<RasterhwTrace> tfp;
@@ -47,15 +52,24 @@ int main(int argc, char** argv) {
     top->clk = 0;
     top->eval();  // initial blocks: plusargs, $readmemh
 #if VM_TRACE
-    if (waves) {
-        tfp = std::make_unique<RasterhwTrace>();
-        top->trace(tfp.get(), 99);
-        tfp->open(waves);
-        tfp->dump(0);
-    }
+    bool traced = false;  // the window has been opened (and perhaps closed)
+    const auto window = [&](uint64_t k) {  // open the trace at edge tstart, close it at edge tend
+        if (waves && !traced && k >= tstart && k < tend) {
+            tfp = std::make_unique<RasterhwTrace>();
+            top->trace(tfp.get(), 99);
+            tfp->open(waves);
+            if (k == 0) tfp->dump(0);
+            traced = true;
+        } else if (tfp && k >= tend) {
+            tfp->close();
+            tfp.reset();
+        }
+    };
+    window(0);
 #define RASTERHW_DUMP(t) \
     if (tfp) tfp->dump(t)
 #else
+    const auto window = [](uint64_t) {};
     if (waves) {
         std::fprintf(stderr, "+waves given, but this model was built without tracing\n");
         return 3;
@@ -64,12 +78,15 @@ int main(int argc, char** argv) {
 #endif
     uint64_t n = 0, steps = 0;
     const auto edge = [&]() {
+        window(steps / 2);  // the edge about to happen
         top->clk = 1;
         top->eval();
-        RASTERHW_DUMP(++steps);
+        ++steps;
+        RASTERHW_DUMP(steps);
         top->clk = 0;
         top->eval();
-        RASTERHW_DUMP(++steps);
+        ++steps;
+        RASTERHW_DUMP(steps);
     };
     const auto t0 = std::chrono::steady_clock::now();
     while (!top->done && n < maxcyc && !ctx->gotFinish()) {

@@ -42,30 +42,32 @@ _BOMS = ((b"\x00\x00\xfe\xff", "utf-32-be"), (b"\xff\xfe\x00\x00", "utf-32-le"),
 def decode_text(raw: bytes) -> tuple[str, str]:
     """Text of a mesh file whose encoding is not declared -> ``(text, encoding)``.
 
-    A byte-order mark decides (UTF-8, UTF-16, UTF-32; the mark is dropped). Without one, a
-    file with NUL bytes in every other position is UTF-16 (LE or BE by where they fall);
-    otherwise UTF-8 if it decodes, else Latin-1, which decodes any byte string (an OBJ's
-    numbers and keywords are ASCII, so only comments and names can be affected).
+    A byte-order mark decides (UTF-8, UTF-16, UTF-32; the mark is dropped). Without one: bytes
+    with no NUL that decode as UTF-8 are UTF-8 (a shortcut: the common case, and what the
+    detector says of them too); anything else is detected by the ``charset-normalizer`` library
+    (UTF-16/32 without a mark, Cyrillic or Japanese code pages, ...), and where it finds nothing
+    (a few bytes, or bytes no encoding explains) it is Latin-1, which decodes any byte string.
+    An OBJ's numbers and keywords are ASCII, and no detected encoding uses a line end as part of
+    a character, so only comments and names can be affected by a wrong guess (a short Western
+    European comment may come back in a neighbouring code page: the detector needs more text).
     """
     for bom, enc in _BOMS:
         if raw.startswith(bom):
             try:
                 return raw[len(bom):].decode(enc), enc
             except UnicodeDecodeError:
-                break  # not really a mark: fall through to the guesses below
-    if len(raw) >= 2 and b"\x00" in raw:
-        even, odd = raw[0::2], raw[1::2]
-        enc = ("utf-16-le" if odd.count(0) > len(odd) // 2 else
-               "utf-16-be" if even.count(0) > len(even) // 2 else None)
-        if enc is not None:
-            try:
-                return raw[: len(raw) // 2 * 2].decode(enc), enc
-            except UnicodeDecodeError:
-                pass
-    try:
-        return raw.decode("utf-8"), "utf-8"
-    except UnicodeDecodeError:
-        return raw.decode("latin-1"), "latin-1"
+                break  # not really a mark: fall through to the detector below
+    if b"\x00" not in raw:
+        try:
+            return raw.decode("utf-8"), "utf-8"
+        except UnicodeDecodeError:
+            pass
+    from charset_normalizer import from_bytes
+
+    best = from_bytes(raw).best()
+    if best is not None:
+        return str(best), best.encoding.replace("_", "-")
+    return raw.decode("latin-1"), "latin-1"
 
 
 def _ascii_ply_header(raw: bytes) -> bytes:

@@ -1,8 +1,9 @@
 """Build folders, run folders and simulator children that never outlive their run.
 
-* :func:`build_lock` — one build at a time per build folder, across processes (``flock`` on
-  ``build/<name>.lock``): two cold runs of the same design wait for each other instead of
-  compiling into one folder and one ``build.log``;
+* :func:`build_lock` — one build at a time per build folder, across processes (the ``filelock``
+  library on ``build/<name>.lock``: ``flock`` on POSIX, ``msvcrt`` locking on Windows, so the
+  command line imports everywhere): two cold runs of the same design wait for each other instead
+  of compiling into one folder and one ``build.log``;
 * :func:`run_folder` — a fresh ``run-*`` folder for one run's stimulus and dumps, removed when
   the run ends however it ends (``with``), or, for code that only asks for a path, by
   :func:`cleanup` (the CLI calls it in ``finally``; ``atexit`` too). ``RASTERHW_KEEP=1`` keeps
@@ -18,7 +19,6 @@ from __future__ import annotations
 import atexit
 import contextlib
 import ctypes
-import fcntl
 import os
 import shutil
 import signal
@@ -27,6 +27,8 @@ import sys
 import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
+
+from filelock import FileLock, Timeout
 
 __all__ = ["build_lock", "cleanup", "keep", "run_child", "run_folder", "temp_run_folder"]
 
@@ -46,18 +48,18 @@ def build_lock(bdir: str | Path, *, what: str = "") -> Iterator[None]:
         yield
         return
     bdir.parent.mkdir(parents=True, exist_ok=True)
-    fh = open(bdir.parent / f"{bdir.name}.lock", "w")  # noqa: SIM115 - closed in finally
+    lock = FileLock(bdir.parent / f"{bdir.name}.lock")
     try:
-        try:
-            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            print(f"waiting for another build of {what or bdir.name} to finish", file=sys.stderr)
-            fcntl.flock(fh, fcntl.LOCK_EX)
+        lock.acquire(timeout=0)       # try first: a message only when we have to wait
+    except Timeout:
+        print(f"waiting for another build of {what or bdir.name} to finish", file=sys.stderr)
+        lock.acquire()
+    try:
         _held.add(key)
         yield
     finally:
         _held.discard(key)
-        fh.close()  # releases the lock
+        lock.release()
 
 
 

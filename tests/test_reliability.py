@@ -423,3 +423,20 @@ def test_pixelbus_frame_run_folder_is_removed_when_the_run_is_interrupted(monkey
     assert seen and seen[0].is_dir()
     workdirs.cleanup()                       # what the CLI's signal handling runs
     assert not seen[0].exists()
+
+
+def test_decode_text_detects_what_latin1_would_garble():
+    """Without a mark, the detector (charset-normalizer) reads a Cyrillic or Japanese comment and
+    BOM-less UTF-16; what it cannot place is Latin-1; the geometry loads the same either way."""
+    from rasterhw.golden_model.meshio import decode_text
+
+    obj = "\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+    for text, enc in (("# Модель экспортирована из Blender" + obj, "cp1251"),
+                      ("# ポリゴンモデル、ブレンダーから" + obj, "shift_jis")):
+        got, _how = decode_text(text.encode(enc))
+        assert got == text
+    assert decode_text(("v 1 2 3" + obj).encode("utf-16-be")) == ("v 1 2 3" + obj, "utf-16-be")
+    assert decode_text(("# caf\u00e9" + obj).encode("utf-8")) == ("# caf\u00e9" + obj, "utf-8")
+    # whatever it decides for a Western comment, the lines and numbers come through
+    got, _how = decode_text(("# caf\u00e9 mod\u00e8le" + obj).encode("latin-1"))
+    assert got.splitlines()[1:] == obj.splitlines()[1:]

@@ -29,7 +29,7 @@ def test_waves_written_on_request_only(tmp_path, capsys):
     assert _run([*ARGS, "-o", str(tmp_path / "b.png")]) == 0
     res = json.loads(capsys.readouterr().out)
     assert "waves" not in res
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png", "b.png", "run.vcd"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png", "b.png", "run.gtkw", "run.vcd"]
 
 
 def test_pysim_waves_must_be_vcd(tmp_path, capsys):
@@ -71,7 +71,7 @@ def test_plain_verilator_run_writes_a_trace_on_request_only(tmp_path):
     plain, _s = build_plain_verilator("waves-test", "tb_wave_count", [src], params={})
     assert plain != exe and "-trace-" not in plain.parent.parent.name
     assert run_plain_verilator(plain, [], run_dir=tmp_path, maxcyc=100)["sim_cycles"] == 20
-    assert sorted(p.name for p in (tmp_path / "w").iterdir()) == ["run.1.vcd", "run.vcd"]
+    assert sorted(p.name for p in (tmp_path / "w").iterdir()) == ["run.1.gtkw", "run.1.vcd", "run.gtkw", "run.vcd"]
 
 
 @pytest.mark.cocotb

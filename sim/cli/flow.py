@@ -6,12 +6,12 @@ from PyPI (``sim/flow/tools.py``). Errors are ``RasterhwError``: one line ``erro
 
 from __future__ import annotations
 
-import json
 import sys
 
 import click
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
+from rasterhw.sim.cli.jsonout import emit_json
 
 
 def _params(block: str, params: tuple[str, ...]) -> dict:
@@ -23,7 +23,7 @@ def _params(block: str, params: tuple[str, ...]) -> dict:
 
 
 def _emit(obj) -> None:
-    click.echo(json.dumps(obj, indent=1, default=str))
+    emit_json(obj)   # the one JSON style (sim/cli/jsonout.py)
 
 
 @click.command()

@@ -7,7 +7,6 @@ traceback. ``--json`` puts a machine-readable result on stdout; progress goes to
 
 from __future__ import annotations
 
-import json
 import sys
 import time
 from pathlib import Path
@@ -16,6 +15,7 @@ import click
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
 from rasterhw.sim.cli.flow import add_commands
+from rasterhw.sim.cli.jsonout import emit_json, normalise
 from rasterhw.sim.report.rows import systems as _report_systems
 
 #: the float reference rasteriser is shared by every machine; the rest come from the registry
@@ -87,22 +87,6 @@ def parse_size(text: str | None) -> tuple[int, int] | None:
     if not (1 <= w <= 16384 and 1 <= h <= 16384):
         raise RasterhwError(f"--size {w}x{h}: width and height must be between 1 and 16384")
     return w, h
-
-
-def emit_json(obj: dict) -> None:
-    click.echo(json.dumps(obj, indent=None, sort_keys=False, default=_json_default))
-
-
-def _json_default(o):
-    import numpy as np
-
-    if isinstance(o, np.integer):
-        return int(o)
-    if isinstance(o, np.floating):
-        return float(o)
-    if isinstance(o, Path):
-        return str(o)
-    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
 
 
 def info(msg: str) -> None:
@@ -481,14 +465,20 @@ def sim_image_name(scene: str, block: str, engine: str, options: dict) -> Path:
 @click.option("--waves", type=click.Path(dir_okay=False), default=None,
               help="Write a trace of the run to this .vcd (.fst where Verilator can write FST); several simulators: "
                    "NAME.1.vcd, ... Off by default. Open it with Surfer (surfer FILE, or app.surfer-project.org) "
-                   "or GTKWave (gtkwave FILE).")
+                   "or GTKWave (gtkwave FILE, or the NAME.gtkw save file written beside a .vcd: the block's "
+                   "stream ports, one group each).")
+@click.option("--trace-start", type=int, default=None, metavar="N",
+              help="With --waves: record from clock edge N (counted from 0 at the first rising edge).")
+@click.option("--trace-end", type=int, default=None, metavar="N",
+              help="With --waves: record up to edge N, not included (must be after --trace-start).")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the run's result as JSON on stdout (cycles, mismatches, pixels compared, timings).")
-def sim_cmd(block, scene, size, engine, output, waves, as_json, **block_options) -> None:
+def sim_cmd(block, scene, size, engine, output, waves, trace_start, trace_end, as_json, **block_options) -> None:
     """Run a scene through a block's HDL, compare with the golden model, write the frame."""
-    from rasterhw.sim.engines.waves import recording
+    from rasterhw.sim.engines.waves import check_window, recording
     from rasterhw.sim.outfile import check_image_output, write_image
 
+    check_window(trace_start, trace_end, waves=waves)   # before any work
     _machine, b = registry.sim_blocks()[block]
     opts = _take_options(block_options, b.options, f"sim {block}")
     scene = scene or b.default_scene
@@ -503,7 +493,7 @@ def sim_cmd(block, scene, size, engine, output, waves, as_json, **block_options)
         emit_json(res) if as_json else info(" ".join(f"{k}={v}" for k, v in res.items()))
         return
     try:
-        with recording(waves, engine) as traces:
+        with recording(waves, engine, start=trace_start, end=trace_end) as traces:
             res = registry.load(b.simulate)(sc, w, h, engine=engine, progress=not as_json, **opts)
     except RasterhwError:
         raise                                  # already one line that names what is wrong
@@ -511,13 +501,14 @@ def sim_cmd(block, scene, size, engine, output, waves, as_json, **block_options)
         raise RasterhwError(f"sim {block}: {str(e).splitlines()[0] if str(e) else type(e).__name__}") from None
     if traces:
         res["waves"] = [str(t) for t in traces]
+        res["gtkw"] = [str(t.with_suffix(".gtkw")) for t in traces if t.with_suffix(".gtkw").exists()]
     frame = res.pop("frame_rgb", None)
     if frame is not None:
         write_image(out, frame)
         res["image"] = str(out)
     elif output is not None:
         raise RasterhwError(f"sim {block} gives no frame image; -o {output} cannot be written (leave -o out)")
-    res = {"block": block, "scene": sc.name, **res}
+    res = normalise({"block": block, "scene": sc.name, **res})
     if as_json:
         emit_json(res)
     else:

@@ -11,6 +11,7 @@ from amaranth.sim import Simulator
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.engines.harness import as_plain, stream_protocol_checker, stream_put
 from rasterhw.sim.engines.pattern import ready_pattern
+from rasterhw.sim.engines.waves import declare_streams
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
 
 __all__ = ["run"]
@@ -61,6 +62,8 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
         sim.add_testbench(stream_protocol_checker(port, name, domain=d, errors=errors), background=True)
         sim.add_testbench(_sink(port, expect_words[name], words[name], stamps[name],
                                 ready_pattern(seed + k, stall), d, max_cycles, name))
+    # with --waves: the GTKWave save file shows these ports, one group each (sim/engines/waves.py)
+    declare_streams(sim, {name: port_of(dut, name) for name in (*tb.inputs, *tb.outputs_of(params))})
     t1 = time.perf_counter()
     sim.run()
     if errors:

@@ -1,44 +1,69 @@
-"""Waves on request: ``rasterhw sim BLOCK ... --waves out.vcd`` (never on by default).
+"""Waves on request: ``rasterhw sim BLOCK ... --waves out.vcd`` (never on by default), with a
+GTKWave save file ``out.gtkw`` beside it and an optional window of cycles
+(``--trace-start N --trace-end M``).
 
 :func:`recording` wraps one simulation run:
 
 * ``--engine pysim``: every Amaranth ``Simulator`` the run creates writes its trace with
   ``Simulator.write_vcd`` (VCD; pysim writes no FST). A run with several simulators (one per
-  line or per chip) writes ``out.vcd``, ``out.1.vcd``, ...;
+  line or per chip) writes ``out.vcd``, ``out.1.vcd``, ...; a simulator whose testbench declared
+  its stream ports (:func:`declare_streams`, the generic pysim engine does) gets Amaranth's own
+  GTKWave save file (``write_vcd(gtkw_file=, traces=)``), one group per stream port;
 * ``--engine verilator`` / ``icarus`` on a cocotb bench: ``WAVES=1`` for the run (cocotb's
   runner builds with tracing: VCD from Verilator's ``--trace``, the bench's own dump from
   Icarus), and the trace the run wrote is copied to the path given (its suffix must match);
 * ``--engine verilator`` on a plain-Verilator scene run (ZB/M unit, EXPERTS PXP, sparse video
   processors, the SNU pixel-bus frame): the model is built once more with ``--trace-fst`` (or
   ``--trace`` for a ``.vcd`` name; its own build folder, so the untraced model stays as it is) and
-  the shared C++ main writes the trace to the path given (``+waves=``). A run of several binaries
-  (one per processor of the sparse matrix) writes ``out.fst``, ``out.1.fst``, ... in the order the
-  runs started.
+  the shared C++ main writes the trace to the path given (``+waves=``, the window as
+  ``+trace_start=`` / ``+trace_end=``). A run of several binaries (one per processor of the sparse
+  matrix) writes ``out.fst``, ``out.1.fst``, ... in the order the runs started.
+
+The window counts clock edges from 0 at the first rising edge of the run (the testbenches'
+convention, ``sim/testbench.py``) and keeps edges ``start .. end - 1``: the Verilator main opens
+the trace at edge ``start`` (all values, then changes) and closes it at edge ``end``; pysim
+cannot start ``write_vcd`` once time has advanced, so its VCD goes through :class:`VcdWindow`,
+which keeps the header, writes every value at the window's first time step and then only the
+changes inside the window (the edges are those of the trace's ``clk``). A cocotb bench's VCD is
+cut the same way after the run.
+
+Every VCD without Amaranth's save file gets one from :func:`write_gtkw`: the trace's header is
+read, and the stream ports of the block (Amaranth names a port's members ``PORT__valid``,
+``PORT__ready``, ``PORT__payload``, in pysim and in the generated Verilog alike) in the
+shallowest scope that has any are listed, one GTKWave group per port. Shared code knows no machine:
+the names are the block's own. FST traces get no save file (reading FST needs a library we do
+not carry).
 
 Open the file with Surfer (``surfer out.vcd``, or drop it on https://app.surfer-project.org)
-or GTKWave (``gtkwave out.fst``); see ``docs/architecture.md#waves``.
+or GTKWave (``gtkwave out.gtkw``, or ``gtkwave out.fst``); see ``docs/architecture.md#waves``.
 """
 
 from __future__ import annotations
 
 import contextlib
 import functools
+import inspect
 import os
+import re
 import shutil
 import subprocess
 import threading
 import time
+import weakref
 from collections.abc import Iterator
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.paths import BUILD_ROOT
 
-__all__ = ["next_plain_trace", "plain_trace_format", "recording"]
+__all__ = ["VcdWindow", "amaranth_hook_ok", "check_window", "declare_streams", "next_plain_trace",
+           "plain_trace_format", "plain_trace_window", "recording", "vcd_header", "write_gtkw"]
 
 _lock = threading.Lock()
-#: while a ``recording`` of a compiled run is open: ``{"path": Path, "written": [Path, ...]}``
+#: while a ``recording`` of a compiled run is open: ``{"path": Path, "written": [Path, ...], "window": (s, e)}``
 _plain: dict | None = None
+#: stream ports a pysim engine declared for its simulator: ``{Simulator: {port name: interface}}``
+_streams: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 @functools.cache
@@ -61,6 +86,12 @@ def plain_trace_format() -> str | None:
         return None if _plain is None else _plain["path"].suffix[1:]
 
 
+def plain_trace_window() -> tuple[int, int | None]:
+    """``(start, end)`` edges of the trace window of the compiled runs (``end`` ``None``: to the end)."""
+    with _lock:
+        return (0, None) if _plain is None else _plain["window"]
+
+
 def next_plain_trace() -> Path | None:
     """The file the next plain-Verilator run writes its trace to (``None``: waves are off);
     ``out.fst``, then ``out.1.fst``, ``out.2.fst``, ... (thread-safe: the sparse matrix runs its
@@ -69,35 +100,300 @@ def next_plain_trace() -> Path | None:
         if _plain is None:
             return None
         path, written = _plain["path"], _plain["written"]
-        out = path if not written else path.with_suffix(f".{len(written)}{path.suffix}")
+        out = _nth(path, len(written))
         written.append(out)
-        return out
+        return out.absolute()   # the binary runs in its run folder: a relative name would land (and vanish) there
+
+
+def _nth(path: Path, n: int) -> Path:
+    return path if n == 0 else path.with_suffix(f".{n}{path.suffix}")
+
+
+def declare_streams(sim, streams: dict) -> None:
+    """Say which stream ports (``{name: interface}``) simulator ``sim`` drives and collects: with
+    ``--waves`` its GTKWave save file shows one group per port (Amaranth writes it)."""
+    _streams[sim] = dict(streams)
+
+
+def check_window(start: int | None, end: int | None, *, waves: object = True) -> tuple[int, int | None]:
+    """``(start, end)`` of a trace window given on the command line, checked (one-line errors)."""
+    if start is None and end is None:
+        return 0, None
+    if waves is None:
+        raise RasterhwError("--trace-start / --trace-end need --waves FILE")
+    for flag, v in (("--trace-start", start), ("--trace-end", end)):
+        if v is not None and (isinstance(v, bool) or not isinstance(v, int) or v < 0):
+            raise RasterhwError(f"{flag} must be a cycle number 0 or more, not {v!r}")
+    s = start or 0
+    if end is not None and end <= s:
+        raise RasterhwError(f"--trace-end {end} must be after --trace-start {s}")
+    return s, end
+
+
+# ---------------------------------------------------------------------------------------- VCD
+class VcdWindow:
+    """A text file to write a VCD into that keeps only clock edges ``start .. end - 1``.
+
+    The header goes through as it is; the clock is the header's first ``clk`` variable (the
+    shallowest), and an edge is a change of it to 1. The first time step inside the window gets
+    every variable's current value (``$dumpvars``), later ones their changes; nothing after edge
+    ``end`` is written. ``name`` and :meth:`tell` are those of the file written (Amaranth's GTKWave
+    writer reads them)."""
+
+    def __init__(self, out, start: int, end: int | None, clock: str = "clk"):
+        self.out, self.start, self.end, self.clock = out, start, end, clock
+        self.name = getattr(out, "name", "")
+        self._buf = ""
+        self._header = True
+        self._clk: str | None = None
+        self._clk_val = "0"
+        self._last: dict[str, str] = {}
+        self._t: int | None = None
+        self._block: list[tuple[str, str]] = []
+        self.edges = 0            # rising clock edges so far
+        self.opened = False       # the window's first time step is written
+        self.times: list[int] = []   # the time steps written (first and last are enough: kept short)
+        self._written = 0
+
+    # file protocol (what pyvcd's writer and print() use)
+    def write(self, s: str) -> int:
+        if "\n" not in s:
+            self._buf += s
+            return len(s)
+        *lines, rest = (self._buf + s).split("\n")
+        self._buf = rest
+        for ln in lines:
+            self._line(ln)
+        return len(s)
+
+    def tell(self) -> int:
+        return self._written
+
+    def flush(self) -> None:
+        self.out.flush()
+
+    def close(self) -> None:
+        if self._buf:
+            self._line(self._buf)
+            self._buf = ""
+        self._finish_block()
+        if self._clk is None:
+            raise RasterhwError(f"--trace-start/--trace-end: {self.name} has no {self.clock!r} clock to count")
+        self.out.close()
+
+    def _emit(self, text: str) -> None:
+        self.out.write(text)
+        self._written += len(text)
+
+    def _line(self, ln: str) -> None:
+        if self._header:
+            self._emit(ln + "\n")
+            tok = ln.split()
+            if tok[:1] == ["$var"] and len(tok) >= 5 and self._clk is None and tok[4].lstrip("\\") == self.clock:
+                self._clk = tok[3]
+            elif "$enddefinitions" in tok:
+                self._header = False
+            return
+        if not ln:
+            return
+        if ln[0] == "#":
+            self._finish_block()
+            self._t = int(ln[1:])
+            return
+        if ln[0] == "$":          # $dumpvars / $end / $comment ...: we write our own $dumpvars
+            return
+        if ln[0] in "bBrRsS":
+            ident = ln.split(None, 1)[1].strip()
+        else:
+            ident = ln[1:].strip()
+        self._block.append((ident, ln))
+
+    def _finish_block(self) -> None:
+        if self._t is None:
+            return
+        for ident, ln in self._block:
+            self._last[ident] = ln
+            if ident == self._clk:
+                v = ln[0]
+                if v == "1" and self._clk_val != "1":
+                    self.edges += 1
+                self._clk_val = v
+        c = self.edges              # rising edges at or before this time step
+        inside = c >= self.start + 1 and (self.end is None or c <= self.end)
+        if inside:
+            if not self.opened:
+                self.opened = True
+                self._emit(f"#{self._t}\n$dumpvars\n" + "".join(v + "\n" for v in self._last.values()) + "$end\n")
+            else:
+                self._emit(f"#{self._t}\n" + "".join(ln + "\n" for _, ln in self._block))
+            if not self.times:
+                self.times.append(self._t)
+            elif len(self.times) == 1:
+                self.times.append(self._t)
+            else:
+                self.times[1] = self._t
+        self._block = []
+        self._t = None
+
+
+def cut_vcd(src: Path, dst: Path, start: int, end: int | None) -> VcdWindow:
+    """Copy VCD ``src`` to ``dst`` keeping edges ``start .. end - 1`` (:class:`VcdWindow`)."""
+    w = VcdWindow(open(dst, "w"), start, end)  # noqa: SIM115 - closed by w.close()
+    w.name = str(dst)
+    with open(src) as f:
+        for ln in f:
+            w.write(ln)
+    w.close()
+    return w
+
+
+_VAR = re.compile(r"\$var\s+\S+\s+(\d+)\s+(\S+)\s+(\S+)(?:\s+(\[[^\]]*\]))?\s+\$end")
+
+
+def vcd_header(path: Path) -> list[tuple[tuple[str, ...], str, int, str, str]]:
+    """Every variable a VCD declares: ``(scope path, name, width, bit range or "", id code)``."""
+    out, scope = [], []
+    with open(path) as f:
+        text = ""
+        for ln in f:
+            text += ln
+            if "$enddefinitions" in ln:
+                break
+    for tok in re.finditer(r"\$scope\s+\S+\s+(\S+)\s+\$end|\$upscope\s+\$end|(\$var\s.*?\$end)", text, re.S):
+        if tok.group(1) is not None:
+            scope.append(tok.group(1))
+        elif tok.group(2) is None:
+            scope.pop()
+        else:
+            m = _VAR.match(" ".join(tok.group(2).split()))
+            if m:
+                out.append((tuple(scope), m.group(3), int(m.group(1)), m.group(4) or "", m.group(2)))
+    return out
+
+
+_STREAM = re.compile(r"^\\?(?P<port>[A-Za-z_][A-Za-z0-9_]*?)__(?P<member>valid|ready|payload)(?P<rest>(\.[^$]*)?)$")
+_ORDER = {"valid": 0, "ready": 1, "payload": 2}
+
+
+def stream_signals(vars_) -> tuple[tuple[str, ...], dict[str, list[str]]]:
+    """The stream ports of the block in a VCD header (from :func:`vcd_header`): the shallowest scope
+    with ``PORT__valid`` variables and, per port, its signals as GTKWave names (``scope.name`` and
+    the bit range of a vector). Where the scope's parent shares nets with some of those ports (a
+    Verilog module's ports are the nets its bench drives), only those are kept: the block's own
+    wires that happen to be named like a stream (a sub-block's port) are left out."""
+    hits = [(s, n, w, r, i, m) for s, n, w, r, i in vars_ if (m := _STREAM.match(n))]
+    scopes = [s for s, *_, m in hits if m["member"] == "valid"]
+    if not scopes:
+        return (), {}
+    top = min(scopes, key=len)
+    parent_ids = {i for s, *_, i in vars_ if s == top[:-1]}
+    ports: dict[str, list[tuple[int, str, str]]] = {}
+    wired: set[str] = set()
+    for s, n, w, r, i, m in hits:
+        if s != top:
+            continue
+        rng = r or (f"[{w - 1}:0]" if w > 1 else "")
+        ports.setdefault(m["port"], []).append((_ORDER[m["member"]], m["rest"], ".".join((*s, n)) + rng))
+        if i in parent_ids:
+            wired.add(m["port"])
+    return top, {p: [name for *_, name in sorted(sig, key=lambda t: (t[0], t[1]))]
+                 for p, sig in ports.items() if not wired or p in wired}
+
+
+def write_gtkw(vcd: Path, gtkw: Path | None = None) -> Path:
+    """A GTKWave save file beside ``vcd`` (``out.vcd`` -> ``out.gtkw``) that opens the trace with
+    the block's stream ports (:func:`stream_signals`), one group per port."""
+    from vcd.gtkw import GTKWSave
+
+    vcd, gtkw = Path(vcd), Path(gtkw) if gtkw else Path(vcd).with_suffix(".gtkw")
+    top, ports = stream_signals(vcd_header(vcd))
+    with open(gtkw, "w") as f:
+        g = GTKWSave(f)
+        g.comment(f"rasterhw: the stream ports of {'.'.join(top) or 'the trace'}")
+        g.dumpfile(str(vcd.resolve()))
+        for k in range(1, len(top) + 1):
+            g.treeopen(".".join(top[:k]))
+        for port, names in ports.items():
+            with g.group(port):
+                for n in names:
+                    g.trace(n)
+    return gtkw
+
+
+# ---------------------------------------------------------------------------------- pysim hook
+#: what the hook was written against: Amaranth 0.5's ``Simulator.run(self)`` and
+#: ``Simulator.write_vcd(self, vcd_file, gtkw_file=None, *, traces=(), fs_per_delta=0)``
+_AMARANTH_RUN = ["self"]
+_AMARANTH_WRITE_VCD = ["self", "vcd_file", "gtkw_file", "traces", "fs_per_delta"]
+
+
+def amaranth_hook_ok() -> str | None:
+    """``None`` if Amaranth's simulator is the one the pysim hook was written for (0.5, ``run`` and
+    ``write_vcd`` as above), else why not. Amaranth has no public way to trace every simulator a
+    run creates (the scene drivers make their own), so :func:`recording` wraps ``Simulator.run``
+    for the run's duration; ``tests/test_library_hooks.py`` fails when this stops holding."""
+    import amaranth
+    from amaranth.sim import Simulator
+
+    ver = getattr(amaranth, "__version__", "?")
+    if not ver.startswith("0.5."):
+        return f"Amaranth {ver} (the waves hook is written for 0.5)"
+    for fn, want in ((Simulator.run, _AMARANTH_RUN), (Simulator.write_vcd, _AMARANTH_WRITE_VCD)):
+        got = list(inspect.signature(fn).parameters)
+        if got != want:
+            return f"Amaranth {ver}: Simulator.{fn.__name__}{tuple(got)} (the waves hook expects {tuple(want)})"
+    return None
 
 
 @contextlib.contextmanager
-def _pysim(path: Path) -> Iterator[list[Path]]:
+def _pysim(path: Path, window: tuple[int, int | None]) -> Iterator[list[Path]]:
     from amaranth.sim import Simulator
 
+    why = amaranth_hook_ok()
+    if why:
+        raise RasterhwError(f"--waves on pysim: {why}")
     written: list[Path] = []
+    windows: list[VcdWindow] = []
     orig = Simulator.run
 
-    def run(self, *a, **kw):
-        n = len(written)
-        out = path if n == 0 else path.with_suffix(f".{n}{path.suffix}")
+    def run(self):
+        out = _nth(path, len(written))
         written.append(out)
-        with self.write_vcd(str(out)):
-            return orig(self, *a, **kw)
+        streams = _streams.get(self)
+        gtkw = str(out.with_suffix(".gtkw")) if streams else None
+        if window == (0, None):
+            vcd_file = str(out)
+        else:
+            vcd_file = VcdWindow(open(out, "w"), *window)   # noqa: SIM115 - closed below
+            vcd_file.name = str(out)
+            windows.append(vcd_file)
+        try:
+            with self.write_vcd(vcd_file, gtkw, traces=streams or ()):
+                return orig(self)
+        finally:
+            if not isinstance(vcd_file, str):
+                vcd_file.close()
 
     Simulator.run = run
     try:
         yield written
     finally:
         Simulator.run = orig
+    if windows and not any(w.opened for w in windows):
+        # (a run of several simulators, one per line or chip: one that ended before the window
+        # keeps a trace with its header only, as long as another reached it)
+        raise RasterhwError(f"--trace-start {window[0]}: the run ended after {max(w.edges for w in windows)} cycles")
+    for out in written:
+        if not out.with_suffix(".gtkw").exists():
+            write_gtkw(out)
 
 
 @contextlib.contextmanager
-def recording(path: str | Path | None, engine: str) -> Iterator[list[Path]]:
-    """Record the waves of the simulation run inside the ``with`` to ``path`` (``None``: off)."""
+def recording(path: str | Path | None, engine: str, *, start: int | None = None,
+              end: int | None = None) -> Iterator[list[Path]]:
+    """Record the waves of the simulation run inside the ``with`` to ``path`` (``None``: off),
+    only clock edges ``start .. end - 1`` if given, with a GTKWave save file beside every VCD."""
+    window = check_window(start, end, waves=path)
     if path is None:
         yield []
         return
@@ -111,7 +407,7 @@ def recording(path: str | Path | None, engine: str) -> Iterator[list[Path]]:
                             "(Debian: liblz4-dev zlib1g-dev); name a .vcd file")
     path.parent.mkdir(parents=True, exist_ok=True)   # only once the name is good
     if engine == "pysim":
-        with _pysim(path) as written:
+        with _pysim(path, window) as written:
             yield written
         if not written:
             raise RasterhwError("--waves: this run started no Amaranth simulation")
@@ -122,7 +418,7 @@ def recording(path: str | Path | None, engine: str) -> Iterator[list[Path]]:
     os.environ["WAVES"] = "1"
     written: list[Path] = []
     with _lock:
-        _plain = {"path": path, "written": written}
+        _plain = {"path": path, "written": written, "window": window}
     try:
         yield written
     finally:
@@ -134,8 +430,17 @@ def recording(path: str | Path | None, engine: str) -> Iterator[list[Path]]:
             os.environ["WAVES"] = old
     if written:  # plain-Verilator runs wrote their traces where they were told
         missing = [p for p in written if not p.exists()]
-        if missing:
+        if missing and window[0] and len(missing) < len(written):
+            # several binaries (one per processor): one that ended before the window wrote nothing
+            written[:] = [p for p in written if p.exists()]
+        elif missing:
+            if window[0]:
+                raise RasterhwError(f"--trace-start {window[0]}: the run ended before that cycle "
+                                    f"(no trace written to {missing[0]})")
             raise RasterhwError(f"--waves: the run wrote no trace to {missing[0]}")
+        for p in written:
+            if p.suffix == ".vcd":
+                write_gtkw(p)
         return
     # a cocotb bench (WAVES=1): the trace its runner wrote in the build folder
     traces = [p for ext in ("*.fst", "*.vcd") for p in BUILD_ROOT.rglob(ext)
@@ -146,5 +451,14 @@ def recording(path: str | Path | None, engine: str) -> Iterator[list[Path]]:
     if newest.suffix != path.suffix:
         raise RasterhwError(f"--waves {path}: this bench writes {newest.suffix[1:].upper()}; "
                             f"name a {newest.suffix} file")
-    shutil.copyfile(newest, path)
+    if window != (0, None):
+        if path.suffix != ".vcd":
+            raise RasterhwError(f"--waves {path}: a trace window on a cocotb bench needs a .vcd trace")
+        w = cut_vcd(newest, path, *window)
+        if not w.opened:
+            raise RasterhwError(f"--trace-start {window[0]}: the run ended after {w.edges} cycles")
+    else:
+        shutil.copyfile(newest, path)
+    if path.suffix == ".vcd":
+        write_gtkw(path)
     written.append(path)
