@@ -124,11 +124,8 @@ class ExpertsPxp(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        fmt = self._fmt
-        pb = fmt.pixel_bits
-        ib = fmt.intensity_bits
-        W = self._width
-        aj = self._aj == "c"
+        fmt, W, aj = self._fmt, self._width, self._aj == "c"
+        pb, ib = fmt.pixel_bits, fmt.intensity_bits
         word = data.StructLayout({"z": unsigned(Z_BITS), "addr": unsigned(ADDR_BITS), "pix": unsigned(pb),
                                   "slot": unsigned(SLOT_BITS)})
         # the DSLB: two banks (bank = top address bit), one resolved while the other drains

@@ -129,12 +129,8 @@ class ExpertsPxpSpan(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        fmt = self._fmt
-        pb = fmt.pixel_bits
-        ib = fmt.intensity_bits
-        W = self._width
-        D = self._depth
-        aj = self._aj == "c"
+        fmt, W, D, aj = self._fmt, self._width, self._depth, self._aj == "c"
+        pb, ib = fmt.pixel_bits, fmt.intensity_bits
         asb = asb_layout()
         pw = (D - 1).bit_length()                   # ASL position bits within a bank
         cw = D.bit_length()                         # counts 0..D
