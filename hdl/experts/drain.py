@@ -1,15 +1,17 @@
-"""The DSLB drain of an EXPERTS PXP, its ports and parameter checks, shared by both PXPs (``pxp.py``, the line Z-buffer;
-``pxp_span.py``, the paper's span PXP).
+"""The DSLB drain of an EXPERTS PXP, its ports and parameter checks, shared by both PXPs
+(``pxp.py``, the line Z-buffer; ``pxp_span.py``, the paper's span PXP).
 
 Paper (seed 000, 3.2): "DSLBもDMM同様、2重系の構成とし、PXPによる書き込みと、FBへの転送のための読み出し
 とを並行して同時に行なう" -- the DSLB is double-banked; one bank is written by the resolve side while
-the other is read out towards the frame buffer. The drain walks its bank left to right, one pixel
-per two cycles (read, offer); with A.J. (c) one pixel per three cycles (read the DSLB, read the
-visible segment's edges from the segment table or DMM/P bank, blend the boundary with the pixel
-on its left and offer that one: ``aj.py``), over the guarded range ``[lo-1, hi+1)``, offering
-only ``[lo, hi)``; the range's last pixel is offered by a flush cycle where the guard pixel on
-its right lies outside the frame. The resolve side hands a finished bank over with
-:meth:`Drain.hand` once :attr:`Drain.dbusy` is low.
+the other is read out towards the frame buffer. The drain walks its bank left to right: without
+A.J., over ``[lo, hi)``, one pixel per two cycles (read, offer); with A.J. (c), over the guarded
+range ``[lo-1, hi+1)`` within the frame, one pixel per three cycles (read the DSLB, read the
+visible segment's edges from the segment table or DMM/P bank, blend the boundary and offer the
+pixel on its left: ``aj.py``), offering only ``[lo, hi)``; where the range ends at the frame's
+right edge (no guard pixel), a flush cycle offers its last pixel. The resolve side hands a
+finished bank over with :meth:`Drain.hand` once :attr:`Drain.dbusy` is low. The paper does not
+give the drain's rate; these are ours, as the golden cycle models (``pxp_cycles``,
+``span_cycles``) count them.
 """
 
 from __future__ import annotations
