@@ -138,3 +138,31 @@ def test_a_seed_that_would_never_raise_ready_is_refused():
         run(tb, p, stim, engine="pysim", stall=32, seed=0, expect_words=_need(exp))
     r = run(tb, p, stim, engine="pysim", stall=0, seed=0, expect_words=_need(exp))   # no stalls: fine
     assert compare(exp, r)["mismatches"] == 0
+
+
+def test_dump_decoding_fast_path_gives_the_same_ints():
+    """``verilator._ints``: words of up to 64 bits in one NumPy pass, wider ones row by row; both
+    equal ``int.from_bytes`` of every dumped row (widths 1..9 bytes, extreme values)."""
+    import numpy as np
+    from rasterhw.sim.engines.verilator import _ints
+
+    rng = np.random.default_rng(7)
+    for nbytes in range(1, 10):
+        b = rng.integers(0, 256, (50, nbytes), dtype=np.uint8)
+        b[0], b[1] = 0, 255
+        assert _ints(b) == [int.from_bytes(r.tobytes(), "big") for r in b]
+
+
+def test_block_parameters_are_read_only():
+    """``hdl/params.py``: ``@params`` gives a read-only property per name, reading ``self._NAME``."""
+    from rasterhw.hdl.params import params
+
+    @params("width", "ram")
+    class Block:
+        def __init__(self):
+            self._width, self._ram = 40, "memory"
+
+    b = Block()
+    assert (b.width, b.ram) == (40, "memory")
+    with pytest.raises(AttributeError):
+        b.width = 3

@@ -15,12 +15,9 @@
 // `cycles`: segment-clock cycles (unit 0's counter) when the last merge word was taken.
 // The run also ends (early) on the watchdog (`timeout`) or a unit's sticky `overflow`.
 module tb_zbm_unit #(
-  parameter I = 8,             // interleave (merge slots)
-  parameter U = 1,             // units
-  parameter W = 64,
-  parameter H = 16,
-  parameter GW = 8,            // gap bits
-  parameter SDEPTH = 1024      // stimulus memory depth (> all words + 1)
+  // what the core takes (tb_zbm_unit_core.v): interleave (merge slots), units, frame width and
+  // height, gap bits, stimulus memory depth (> all words + 1)
+  parameter I = 8, U = 1, W = 64, H = 16, GW = 8, SDEPTH = 1024
 ) (
   output reg finished,
   output reg timeout,

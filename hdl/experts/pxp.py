@@ -25,9 +25,9 @@ starts. Output: the line's ``hi - lo`` pixel words, left to right, after its las
 from __future__ import annotations
 
 from amaranth import Module, Mux, Signal, signed, unsigned
-from amaranth.lib import data, enum, stream, wiring
+from amaranth.lib import data, enum, wiring
 from amaranth.lib.memory import Memory
-from amaranth.lib.wiring import In, Out
+from amaranth.lib.wiring import Out
 from rasterhw.golden_model.experts.formats import (
     ADDR_BITS,
     DZ_FRAC,
@@ -37,17 +37,17 @@ from rasterhw.golden_model.experts.formats import (
     Z_BITS,
     Formats,
 )
-from rasterhw.hdl.experts.aj import aj_boundary
+from rasterhw.hdl.experts.drain import Drain, check_pxp_params, pxp_members
+from rasterhw.hdl.params import params
 
-__all__ = ["ExpertsPxp", "seg_layout"]
+__all__ = ["ExpertsPxp", "asb_fields", "seg_layout"]
 
 NONE = (1 << ADDR_BITS) - 1     # ASB address / polygon number of the background
 
 
-def seg_layout() -> data.StructLayout:
-    """One ASB as the PXP reads it (the fields it uses)."""
-    return data.StructLayout({
-        "last": unsigned(1),          # end of the line's list
+def asb_fields() -> dict:
+    """The ASB fields a PXP reads (both PXPs: ``seg_layout`` here, ``dmm_layout`` in ``pxp_span.py``)."""
+    return {
         "xl": unsigned(16),           # Q10.6
         "xr": unsigned(16),           # Q10.6
         "zl": unsigned(16),           # Q16.0, 0 = near
@@ -61,23 +61,24 @@ def seg_layout() -> data.StructLayout:
         "ql": signed(16),             # left edge dy/dx, sQ7.8
         "sr": signed(16),             # right edge dx/dy
         "qr": signed(16),             # right edge dy/dx
-    })
+    }
 
 
-class _S(enum.Enum, shape=4):
+def seg_layout() -> data.StructLayout:
+    """One ASB as the PXP reads it (the fields it uses)."""
+    return data.StructLayout({"last": unsigned(1), **asb_fields()})   # last: end of the line's list
+
+
+class _S(enum.Enum, shape=3):
     CLEAR = 0
     SEG = 1
     START = 2
     READ = 3
     CMP = 4
-    DRD = 5       # drain: read the line memory
-    DOUT = 6      # drain without A.J.: offer the pixel
-    DSEG = 7      # drain with A.J.: read the segment table
-    DAJ = 8       # drain with A.J.: blend the boundary, offer the pixel on its left
-    FLUSH = 9     # drain with A.J.: offer the range's last pixel
-    HAND = 10     # resolve side: hand the bank to the drain (waits while the drain is busy)
+    HAND = 5      # hand the bank to the drain (waits while the drain is busy; drain.py)
 
 
+@params("width", "aj")
 class ExpertsPxp(wiring.Component):
     """One PXP: clipped ASL in, the range's pixel words out, line by line.
 
@@ -111,42 +112,20 @@ class ExpertsPxp(wiring.Component):
     """
 
     def __init__(self, *, width: int = 512, intensity_bits: int = 7, aj: str = "none"):
-        if isinstance(width, bool) or not isinstance(width, int) or not 1 <= width <= 1024:
-            raise ValueError(f"width must be an integer in 1..1024, not {width!r}")
-        if aj not in ("none", "c"):
-            raise ValueError(f"aj must be 'none' or 'c', not {aj!r}")
+        check_pxp_params(width=width, aj=aj)
         self._fmt = Formats(intensity_bits)
         self._width = width
         self._aj = aj
-        super().__init__({
-            "i": In(stream.Signature(seg_layout())),
-            "o": Out(stream.Signature(unsigned(self._fmt.pixel_bits))),
-            "lo": In(10),
-            "hi": In(11),
-            "line_cycles": Out(16),
-            "lines": Out(16),
-            "slot_overflow": Out(1),
-        })
-
-    @property
-    def width(self) -> int:
-        return self._width
+        super().__init__({**pxp_members(seg_layout(), self._fmt.pixel_bits), "slot_overflow": Out(1)})
 
     @property
     def intensity_bits(self) -> int:
         return self._fmt.intensity_bits
 
-    @property
-    def aj(self) -> str:
-        return self._aj
-
     def elaborate(self, platform):
         m = Module()
-        fmt = self._fmt
-        pb = fmt.pixel_bits
-        ib = fmt.intensity_bits
-        W = self._width
-        aj = self._aj == "c"
+        fmt, W, aj = self._fmt, self._width, self._aj == "c"
+        pb, ib = fmt.pixel_bits, fmt.intensity_bits
         word = data.StructLayout({"z": unsigned(Z_BITS), "addr": unsigned(ADDR_BITS), "pix": unsigned(pb),
                                   "slot": unsigned(SLOT_BITS)})
         # the DSLB: two banks (bank = top address bit), one resolved while the other drains
@@ -220,36 +199,14 @@ class ExpertsPxp(wiring.Component):
         m.d.comb += stored.eq(rd.data)
         wins = Signal()
         m.d.comb += wins.eq((key < stored.z) | ((key == stored.z) & (seg.addr < stored.addr)))
-        m.d.comb += [rd.en.eq(0), wr.en.eq(0), drd.en.eq(0), self.i.ready.eq(0), self.o.valid.eq(0)]
+        m.d.comb += [rd.en.eq(0), wr.en.eq(0), self.i.ready.eq(0)]
         if aj:
-            m.d.comb += [trd.en.eq(0), twr.en.eq(0)]
+            m.d.comb += twr.en.eq(0)
 
-        # ---------------------------------------------------------------- drain side
-        dstate = Signal(_S)           # IDLE (= CLEAR value unused) / DRD / DOUT / DSEG / DAJ / FLUSH
-        dbusy = Signal()
-        dbank = Signal()
-        dx = Signal(11)
-        dlo = Signal(10)
-        dhi = Signal(11)
-        dghi = Signal(11)
-        dstored = Signal(word)
-        m.d.comb += dstored.eq(drd.data)
-        m.d.comb += self.o.payload.eq(dstored.pix)
-
-        if aj:
-            p_pix = Signal(pb)            # pixel dx-1 before A.J.
-            p_out = Signal(pb)            # pixel dx-1 as it will be output
-            p_addr = Signal(ADDR_BITS)
-            p_ent = Signal(ent)
-            p_ok = Signal()               # there is a pixel dx-1 in the walk
-            c_pix = Signal(pb)
-            c_addr = Signal(ADDR_BITS)
-            c_ent = Signal(ent)
-            m.d.comb += c_ent.eq(trd.data)
-            o_prev, o_cur = aj_boundary(m, dx=dx, width=W, ib=ib, p_ok=p_ok, p_pix=p_pix, p_out=p_out, p_addr=p_addr,
-                                          p_ent=p_ent, c_pix=c_pix, c_addr=c_addr, c_ent=c_ent)
-            emit = Signal()
-            m.d.comb += emit.eq(p_ok & (dx >= dlo + 1) & (dx <= dhi))
+        # ---------------------------------------------------------------- drain side (drain.py)
+        drain = Drain(m, o=self.o, drd=drd, word=word, bank_bit=ab, width=W, ib=ib, aj=aj,
+                      trd=trd if aj else None, ent=ent if aj else None, ent_bank_bit=SLOT_BITS)
+        dbusy = drain.dbusy
 
         m.d.sync += cyc.eq(cyc + 1)
         started = Signal()
@@ -301,47 +258,9 @@ class ExpertsPxp(wiring.Component):
             with m.Case(_S.HAND):
                 # swap handshake: the resolved bank goes to the drain once the drain is free
                 with m.If(~dbusy):
-                    m.d.sync += [dbusy.eq(1), dbank.eq(rbank), dlo.eq(lo), dhi.eq(hi), dghi.eq(ghi), dx.eq(glo),
-                                 dstate.eq(_S.DRD), rbank.eq(~rbank), state.eq(_S.CLEAR),
+                    m.d.sync += [*drain.hand(bank=rbank, lo=lo, hi=hi, glo=glo, ghi=ghi),
+                                 rbank.eq(~rbank), state.eq(_S.CLEAR),
                                  self.line_cycles.eq(cyc + 1), cyc.eq(0), self.lines.eq(self.lines + 1),
                                  *sample_range()]
-                    if aj:
-                        m.d.sync += p_ok.eq(0)
 
-        with m.If(dbusy):
-            def drain_done():
-                return [dbusy.eq(0)]
-
-            with m.Switch(dstate):
-                with m.Case(_S.DRD):
-                    m.d.comb += [drd.addr.eq((dbank << ab) | dx), drd.en.eq(1)]
-                    m.d.sync += dstate.eq(_S.DSEG if aj else _S.DOUT)
-                with m.Case(_S.DOUT):
-                    m.d.comb += self.o.valid.eq(1)
-                    with m.If(self.o.ready):
-                        m.d.sync += dx.eq(dx + 1)
-                        with m.If(dx + 1 >= dhi):
-                            m.d.sync += drain_done()
-                        with m.Else():
-                            m.d.sync += dstate.eq(_S.DRD)
-                if aj:
-                    with m.Case(_S.DSEG):
-                        m.d.comb += [trd.addr.eq((dbank << SLOT_BITS) | dstored.slot), trd.en.eq(1)]
-                        m.d.sync += [c_pix.eq(dstored.pix), c_addr.eq(dstored.addr), dstate.eq(_S.DAJ)]
-                    with m.Case(_S.DAJ):
-                        m.d.comb += [self.o.valid.eq(emit), self.o.payload.eq(o_prev)]
-                        with m.If(~emit | self.o.ready):
-                            m.d.sync += [p_pix.eq(c_pix), p_out.eq(o_cur), p_addr.eq(c_addr), p_ent.eq(c_ent),
-                                         p_ok.eq(1), dx.eq(dx + 1)]
-                            with m.If(dx + 1 >= dghi):
-                                with m.If(dghi == dhi):
-                                    m.d.sync += dstate.eq(_S.FLUSH)
-                                with m.Else():
-                                    m.d.sync += drain_done()
-                            with m.Else():
-                                m.d.sync += dstate.eq(_S.DRD)
-                    with m.Case(_S.FLUSH):
-                        m.d.comb += [self.o.valid.eq(1), self.o.payload.eq(p_out)]
-                        with m.If(self.o.ready):
-                            m.d.sync += drain_done()
         return m

@@ -41,18 +41,19 @@ model's. The resolve side reads the DMM/P bank, the active list and the stack as
 from __future__ import annotations
 
 from amaranth import Module, Mux, Signal, signed, unsigned
-from amaranth.lib import data, enum, stream, wiring
+from amaranth.lib import data, enum, wiring
 from amaranth.lib.memory import Memory
-from amaranth.lib.wiring import In, Out
+from amaranth.lib.wiring import Out
 from rasterhw.golden_model.experts.formats import (
     ADDR_BITS,
     DZ_FRAC,
-    HUE_BITS,
     X_FRAC,
     Z_BITS,
     Formats,
 )
-from rasterhw.hdl.experts.aj import aj_boundary
+from rasterhw.hdl.experts.drain import Drain, check_pxp_params, pxp_members
+from rasterhw.hdl.experts.pxp import asb_fields
+from rasterhw.hdl.params import params
 
 __all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "PTR_BITS", "NO_PTR"]
 
@@ -67,28 +68,13 @@ def dmm_layout() -> data.StructLayout:
         "last": unsigned(1),          # end of the line; ptr = block leading segment pointer
         "list": unsigned(1),          # block boundary bucket list entry; ptr = its ASL position
         "ptr": unsigned(PTR_BITS),
-        "xl": unsigned(16),           # Q10.6
-        "xr": unsigned(16),           # Q10.6
-        "zl": unsigned(16),           # Q16.0, 0 = near
-        "il": unsigned(16),           # Q(I).(16-I)
-        "dzdx": signed(16),           # sQ11.4
-        "didx": signed(16),           # sQ(I-1).(16-I)
-        "hue": unsigned(3 * HUE_BITS),
-        "addr": unsigned(ADDR_BITS),  # ASB address = PL order: the tie-break
-        "poly": unsigned(ADDR_BITS),  # polygon number (A.J. only between polygons)
-        "sl": signed(16),             # left edge dx/dy, sQ7.8 (A.J.)
-        "ql": signed(16),             # left edge dy/dx, sQ7.8
-        "sr": signed(16),             # right edge dx/dy
-        "qr": signed(16),             # right edge dy/dx
+        **asb_fields(),
     })
 
 
 def asb_layout() -> data.StructLayout:
     """The ASB fields of a DMM/P word (without ``last``, ``list``, ``ptr``)."""
-    lay = dict(dmm_layout().members)
-    for k in ("last", "list", "ptr"):
-        lay.pop(k)
-    return data.StructLayout(lay)
+    return data.StructLayout(asb_fields())
 
 
 class _R(enum.Enum, shape=3):
@@ -101,15 +87,7 @@ class _R(enum.Enum, shape=3):
     HAND = 6      # hand the DSLB bank to the drain
 
 
-class _D(enum.Enum, shape=3):
-    IDLE = 0
-    DRD = 1       # read the DSLB
-    DOUT = 2      # without A.J.: offer the pixel
-    DSEG = 3      # with A.J.: read the visible segment from the DMM/P bank
-    DAJ = 4       # with A.J.: blend the boundary, offer the pixel on its left
-    FLUSH = 5     # with A.J.: offer the range's last pixel
-
-
+@params("width", "aj", "depth")
 class ExpertsPxpSpan(wiring.Component):
     """One span PXP with its DMM/P: DMM/P words in, the range's pixel words out, line by line.
 
@@ -140,46 +118,19 @@ class ExpertsPxpSpan(wiring.Component):
     """
 
     def __init__(self, *, width: int = 512, intensity_bits: int = 7, aj: str = "none", depth: int = 256):
-        if isinstance(width, bool) or not isinstance(width, int) or not 1 <= width <= 1024:
-            raise ValueError(f"width must be an integer in 1..1024, not {width!r}")
-        if aj not in ("none", "c"):
-            raise ValueError(f"aj must be 'none' or 'c', not {aj!r}")
+        check_pxp_params(width=width, aj=aj)
         if isinstance(depth, bool) or not isinstance(depth, int) or not 2 <= depth <= NO_PTR:
             raise ValueError(f"depth must be an integer in 2..{NO_PTR}, not {depth!r}")
         self._fmt = Formats(intensity_bits)
         self._width = width
         self._aj = aj
         self._depth = depth
-        super().__init__({
-            "i": In(stream.Signature(dmm_layout())),
-            "o": Out(stream.Signature(unsigned(self._fmt.pixel_bits))),
-            "lo": In(10),
-            "hi": In(11),
-            "line_cycles": Out(16),
-            "lines": Out(16),
-            "overflow": Out(1),
-        })
-
-    @property
-    def width(self) -> int:
-        return self._width
-
-    @property
-    def aj(self) -> str:
-        return self._aj
-
-    @property
-    def depth(self) -> int:
-        return self._depth
+        super().__init__({**pxp_members(dmm_layout(), self._fmt.pixel_bits), "overflow": Out(1)})
 
     def elaborate(self, platform):
         m = Module()
-        fmt = self._fmt
-        pb = fmt.pixel_bits
-        ib = fmt.intensity_bits
-        W = self._width
-        D = self._depth
-        aj = self._aj == "c"
+        fmt, W, D, aj = self._fmt, self._width, self._depth, self._aj == "c"
+        pb, ib = fmt.pixel_bits, fmt.intensity_bits
         asb = asb_layout()
         pw = (D - 1).bit_length()                   # ASL position bits within a bank
         cw = D.bit_length()                         # counts 0..D
@@ -237,7 +188,7 @@ class ExpertsPxpSpan(wiring.Component):
         m.submodules.dslb = dslb = Memory(shape=word, depth=2 << ab, init=[])
         wr = dslb.write_port()
         drd = dslb.read_port(transparent_for=())
-        m.d.comb += [wr.en.eq(0), drd.en.eq(0), self.o.valid.eq(0)]
+        m.d.comb += wr.en.eq(0)
 
         # ---------------------------------------------------------------- resolve side
         state = Signal(_R)
@@ -330,21 +281,26 @@ class ExpertsPxpSpan(wiring.Component):
         cand = Signal()
         m.d.comb += [in_bkt.eq(bi < nb), brd.addr.eq((rb << pw) | bi[:pw])]
 
-        # ---------------------------------------------------------------- drain side (as ExpertsPxp)
-        dstate = Signal(_D)
-        dbusy = Signal()
-        dbank = Signal()
-        dx = Signal(11)
-        dlo = Signal(10)
-        dhi = Signal(11)
-        dghi = Signal(11)
-        dstored = Signal(word)
-        m.d.comb += [dstored.eq(drd.data), self.o.payload.eq(dstored.pix)]
+        # ---------------------------------------------------------------- drain side (drain.py)
+        trd = dmm.read_port(transparent_for=()) if aj else None    # the visible segment's edges
+        drain = Drain(m, o=self.o, drd=drd, word=word, bank_bit=ab, width=W, ib=ib, aj=aj,
+                      trd=trd, ent=asb, ent_bank_bit=pw,
+                      done_comb=lambda d: [clr_full.eq(Mux(d.dbank, 0b10, 0b01))])
+        dbusy = drain.dbusy
 
         def next_span(xn):
             """Start the span cull at pixel ``xn`` (the line's end: hand over)."""
             return [x.eq(xn), i.eq(0), j.eq(0), minend.eq(ghi),
                     state.eq(Mux(xn >= ghi, _R.HAND, Mux(k == 0, _R.ENTER, _R.CULL)))]
+
+        def keep_active():
+            """The segment read (``raddr``) is present in the span: onto the active list."""
+            m.d.comb += [awr.en.eq(1), awr.data.eq(raddr)]
+            m.d.sync += j.eq(j + 1)
+            with m.If(j == 0):
+                m.d.sync += one.eq(raddr)
+            with m.If(e + 1 < minend):
+                m.d.sync += minend.eq(e + 1)
 
         m.d.sync += cyc.eq(cyc + 1)
         m.d.comb += raddr.eq(ard.data)
@@ -368,12 +324,7 @@ class ExpertsPxpSpan(wiring.Component):
                                  state.eq(Mux(ghi_b <= glo_b, _R.HAND, _R.ENTER))]
             with m.Case(_R.CULL):
                 with m.If(e >= x):
-                    m.d.comb += [awr.en.eq(1), awr.data.eq(raddr)]
-                    m.d.sync += j.eq(j + 1)
-                    with m.If(j == 0):
-                        m.d.sync += one.eq(raddr)
-                    with m.If(e + 1 < minend):
-                        m.d.sync += minend.eq(e + 1)
+                    keep_active()
                 m.d.sync += i.eq(i + 1)
                 with m.If(i + 1 >= k):
                     m.d.sync += state.eq(_R.ENTER)
@@ -390,12 +341,7 @@ class ExpertsPxpSpan(wiring.Component):
                     with m.Else():
                         m.d.sync += pp.eq(pp + 1)
                 with m.Elif(cand & (a == x)):
-                    m.d.comb += [awr.en.eq(1), awr.data.eq(raddr)]
-                    m.d.sync += j.eq(j + 1)
-                    with m.If(j == 0):
-                        m.d.sync += one.eq(raddr)
-                    with m.If(e + 1 < minend):
-                        m.d.sync += minend.eq(e + 1)
+                    keep_active()
                     with m.If(in_bkt):
                         m.d.sync += bi.eq(bi + 1)
                     with m.Else():
@@ -445,69 +391,7 @@ class ExpertsPxpSpan(wiring.Component):
                         m.d.sync += next_span(sr + 1)
             with m.Case(_R.HAND):
                 with m.If(~dbusy):
-                    m.d.sync += [dbusy.eq(1), dbank.eq(rb), dlo.eq(lo), dhi.eq(hi), dghi.eq(ghi), dx.eq(glo),
-                                 dstate.eq(_D.DRD), rb.eq(~rb), state.eq(_R.IDLE),
+                    m.d.sync += [*drain.hand(bank=rb, lo=lo, hi=hi, glo=glo, ghi=ghi), rb.eq(~rb), state.eq(_R.IDLE),
                                  self.line_cycles.eq(cyc + 1), self.lines.eq(self.lines + 1)]
 
-        if aj:
-            trd = dmm.read_port(transparent_for=())     # drain side: the visible segment's edges
-            m.d.comb += trd.en.eq(0)
-            p_pix = Signal(pb)            # pixel dx-1 before A.J.
-            p_out = Signal(pb)            # pixel dx-1 as it will be output
-            p_addr = Signal(ADDR_BITS)
-            p_ent = Signal(asb)
-            p_ok = Signal()               # there is a pixel dx-1 in the walk
-            c_pix = Signal(pb)
-            c_addr = Signal(ADDR_BITS)
-            c_ent = Signal(asb)
-            m.d.comb += c_ent.eq(trd.data)
-            o_prev, o_cur = aj_boundary(m, dx=dx, width=W, ib=ib, p_ok=p_ok, p_pix=p_pix, p_out=p_out, p_addr=p_addr,
-                                          p_ent=p_ent, c_pix=c_pix, c_addr=c_addr, c_ent=c_ent)
-            emit = Signal()
-            m.d.comb += emit.eq(p_ok & (dx >= dlo + 1) & (dx <= dhi))
-            with m.If((state == _R.HAND) & ~dbusy):
-                m.d.sync += p_ok.eq(0)
-
-        with m.If(dbusy):
-            def drain_done():
-                return [dbusy.eq(0), dstate.eq(_D.IDLE), clr_full.eq(Mux(dbank, 0b10, 0b01))]
-
-            with m.Switch(dstate):
-                with m.Case(_D.DRD):
-                    m.d.comb += [drd.addr.eq((dbank << ab) | dx), drd.en.eq(1)]
-                    m.d.sync += dstate.eq(_D.DSEG if aj else _D.DOUT)
-                with m.Case(_D.DOUT):
-                    m.d.comb += self.o.valid.eq(1)
-                    with m.If(self.o.ready):
-                        m.d.sync += dx.eq(dx + 1)
-                        with m.If(dx + 1 >= dhi):
-                            dd = drain_done()
-                            m.d.sync += dd[:2]
-                            m.d.comb += dd[2]
-                        with m.Else():
-                            m.d.sync += dstate.eq(_D.DRD)
-                if aj:
-                    with m.Case(_D.DSEG):
-                        m.d.comb += [trd.addr.eq((dbank << pw) | dstored.slot), trd.en.eq(1)]
-                        m.d.sync += [c_pix.eq(dstored.pix), c_addr.eq(dstored.addr), dstate.eq(_D.DAJ)]
-                    with m.Case(_D.DAJ):
-                        m.d.comb += [self.o.valid.eq(emit), self.o.payload.eq(o_prev)]
-                        with m.If(~emit | self.o.ready):
-                            m.d.sync += [p_pix.eq(c_pix), p_out.eq(o_cur), p_addr.eq(c_addr), p_ent.eq(c_ent),
-                                         p_ok.eq(1), dx.eq(dx + 1)]
-                            with m.If(dx + 1 >= dghi):
-                                with m.If(dghi == dhi):
-                                    m.d.sync += dstate.eq(_D.FLUSH)
-                                with m.Else():
-                                    dd = drain_done()
-                                    m.d.sync += dd[:2]
-                                    m.d.comb += dd[2]
-                            with m.Else():
-                                m.d.sync += dstate.eq(_D.DRD)
-                    with m.Case(_D.FLUSH):
-                        m.d.comb += [self.o.valid.eq(1), self.o.payload.eq(p_out)]
-                        with m.If(self.o.ready):
-                            dd = drain_done()
-                            m.d.sync += dd[:2]
-                            m.d.comb += dd[2]
         return m

@@ -6,16 +6,9 @@ from amaranth import Array, Module, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2
-from rasterhw.golden_model.snu.formats import (
-    FRAME_HEIGHT,
-    FRAME_WIDTH,
-    MEM_CYCLE,
-    N_BANKS,
-    RGB_BITS,
-    Z_BITS,
-)
+from rasterhw.golden_model.snu import formats as F
+from rasterhw.hdl.params import params
 from rasterhw.hdl.snu.pixelbus_bank import (
-    RAM_VERILOG,
     Command,
     PixelBusBank,
     bank_write_layout,
@@ -26,6 +19,7 @@ from rasterhw.hdl.snu.pixelbus_bank import (
 __all__ = ["Command", "PixelBus"]
 
 
+@params("width", "height", "z_bits", "n_banks", "mem_cycle", "bank_depth", "addr_bits", "ram")
 class PixelBus(wiring.Component):
     """The pixel bus shared by two geometry pipelines, over a 5-way interleaved frame buffer.
 
@@ -81,11 +75,11 @@ class PixelBus(wiring.Component):
     def __init__(
         self,
         *,
-        width: int = FRAME_WIDTH,
-        height: int = FRAME_HEIGHT,
-        z_bits: int = Z_BITS,
-        n_banks: int = N_BANKS,
-        mem_cycle: int = MEM_CYCLE,
+        width: int = F.FRAME_WIDTH,
+        height: int = F.FRAME_HEIGHT,
+        z_bits: int = F.Z_BITS,
+        n_banks: int = F.N_BANKS,
+        mem_cycle: int = F.MEM_CYCLE,
         ram: str = "auto",
     ) -> None:
         for name, v in (("width", width), ("height", height)):
@@ -112,7 +106,7 @@ class PixelBus(wiring.Component):
                 "i_cmd": In(stream.Signature(Command)),
                 "rd_addr": In(self._addr_bits),
                 "rd_buf": In(1),
-                "rd_rgb": Out(RGB_BITS),
+                "rd_rgb": Out(F.RGB_BITS),
                 "rd_z": Out(z_bits),
                 "cycle": Out(32),
                 "busy": Out(1),
@@ -121,23 +115,12 @@ class PixelBus(wiring.Component):
             }
         )
 
-    width = property(lambda self: self._width)
-    height = property(lambda self: self._height)
-    z_bits = property(lambda self: self._z_bits)
-    n_banks = property(lambda self: self._n_banks)
-    mem_cycle = property(lambda self: self._mem_cycle)
-    bank_depth = property(lambda self: self._bank_depth)
-    addr_bits = property(lambda self: self._addr_bits)
-    ram = property(lambda self: self._ram)
-
     @property
     def clear_cycles(self) -> int:
         """Clocks a clear keeps the banks busy after its accept."""
         return self._bank_depth
 
-    def extra_verilog(self) -> str:
-        """Hand-written Verilog this block instantiates (the RAM model when ``ram="verilog"``)."""
-        return RAM_VERILOG if self.ram == "verilog" else ""
+    extra_verilog = PixelBusBank.extra_verilog
 
     def elaborate(self, platform):
         m = Module()

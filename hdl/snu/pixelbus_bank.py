@@ -14,6 +14,7 @@ from rasterhw.golden_model.snu.formats import (
     RGB_BITS,
     Z_BITS,
 )
+from rasterhw.hdl.params import params
 
 __all__ = ["RAM_KINDS", "RAM_VERILOG", "Command", "PixelBusBank", "bank_write_layout"]
 
@@ -92,6 +93,7 @@ def check_bank_params(*, z_bits: int, mem_cycle: int, ram: str) -> None:
         raise ValueError(f"ram must be one of {', '.join(RAM_KINDS)}, not {ram!r}")
 
 
+@params("depth", "z_bits", "mem_cycle", "addr_bits", "ram")
 class PixelBusBank(wiring.Component):
     """One bank: read stored Z, compare, write RGB+Z when the bus Z is strictly larger.
 
@@ -161,28 +163,9 @@ class PixelBusBank(wiring.Component):
             }
         )
 
-    @property
-    def depth(self) -> int:
-        return self._depth
-
-    @property
-    def z_bits(self) -> int:
-        return self._z_bits
-
-    @property
-    def mem_cycle(self) -> int:
-        return self._mem_cycle
-
-    @property
-    def addr_bits(self) -> int:
-        return self._addr_bits
-
-    @property
-    def ram(self) -> str:
-        return self._ram
-
     def extra_verilog(self) -> str:
-        """Hand-written Verilog this block instantiates (the RAM model when ``ram="verilog"``)."""
+        """Hand-written Verilog this block instantiates (the RAM model when ``ram="verilog"``; the
+        pixel bus, ``PixelBus``, shares this method)."""
         return RAM_VERILOG if self._ram == "verilog" else ""
 
     def elaborate(self, platform):

@@ -15,6 +15,7 @@ from amaranth import Module, Mux, Signal, unsigned
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
+from rasterhw.hdl.params import params
 from rasterhw.hdl.zbm.initial import ZbmInitialProcessor
 from rasterhw.hdl.zbm.layouts import GAP, GAP_PENDING, PIXEL2, check_interleave, check_schedule
 from rasterhw.hdl.zbm.loop import ZbmLoop
@@ -23,6 +24,7 @@ from rasterhw.hdl.zbm.merger import ZbmMerger
 __all__ = ["ZbmChip"]
 
 
+@params("schedule", "interleave", "chip", "width")
 class ZbmChip(wiring.Component):
     """One ZB/M chip.
 
@@ -90,22 +92,6 @@ class ZbmChip(wiring.Component):
             "lines": Out(16),
             "gap": Out(GAP),
         })
-
-    @property
-    def schedule(self) -> str:
-        return self._schedule
-
-    @property
-    def interleave(self) -> int:
-        return self._interleave
-
-    @property
-    def chip(self) -> int:
-        return self._chip
-
-    @property
-    def width(self) -> int:
-        return self._width
 
     @property
     def chip_pixels(self) -> int:

@@ -11,6 +11,7 @@ from amaranth import Module, Mux, Signal, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
+from rasterhw.hdl.params import params
 from rasterhw.hdl.zbm.layouts import (
     FLIT,
     GAP,
@@ -25,6 +26,7 @@ from rasterhw.hdl.zbm.layouts import (
 __all__ = ["ZbmInitialProcessor"]
 
 
+@params("schedule", "interleave", "chip")
 class ZbmInitialProcessor(wiring.Component):
     """Turns a segment (``SEG_HEADER`` + one ``FLIT`` per channel) into this chip's packet.
 
@@ -81,18 +83,6 @@ class ZbmInitialProcessor(wiring.Component):
         if schedule == "paper":
             members["gap"] = In(GAP)
         super().__init__(members)
-
-    @property
-    def schedule(self) -> str:
-        return self._schedule
-
-    @property
-    def interleave(self) -> int:
-        return self._interleave
-
-    @property
-    def chip(self) -> int:
-        return self._chip
 
     def elaborate(self, platform):
         m = Module()

@@ -13,6 +13,7 @@ from amaranth import Module, Mux, Signal, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
+from rasterhw.hdl.params import params
 from rasterhw.hdl.zbm.layouts import GAP, GAP_PENDING, PACKET, PIXEL2, PKT_HEADER, check_interleave
 from rasterhw.hdl.zbm.pixel import ZbmPixelProcessor
 
@@ -23,6 +24,7 @@ __all__ = ["ZbmLoop", "PACKET", "LOOP_GAP"]
 LOOP_GAP = F.PACKET_FLITS
 
 
+@params("interleave", "width")
 class ZbmLoop(wiring.Component):
     """Segment processor + 8 pixel processors.
 
@@ -77,14 +79,6 @@ class ZbmLoop(wiring.Component):
             "mb_rd": In(1),
             "mb_data": Out(PIXEL2),
         })
-
-    @property
-    def interleave(self) -> int:
-        return self._interleave
-
-    @property
-    def width(self) -> int:
-        return self._width
 
     @property
     def chip_pixels(self) -> int:

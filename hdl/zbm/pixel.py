@@ -16,6 +16,7 @@ from amaranth.lib import data, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
+from rasterhw.hdl.params import params
 from rasterhw.hdl.zbm.layouts import FLIT, PIXEL2, PKT_HEADER, SAMPLE, check_interleave
 
 __all__ = ["ZbmPixelProcessor", "LoopSignature", "flit_to_sample_field", "EMPTY_PIXEL2"]
@@ -47,6 +48,7 @@ def flit_to_sample_field(channel: str, value):
     return Mux(r < 0, 0, Mux(r > top, top, r[:width]))
 
 
+@params("index", "interleave", "depth")
 class ZbmPixelProcessor(wiring.Component):
     """One pixel processor of the segment loop.
 
@@ -94,18 +96,6 @@ class ZbmPixelProcessor(wiring.Component):
             "mb_rd": In(1),
             "mb_data": Out(PIXEL2),
         })
-
-    @property
-    def index(self) -> int:
-        return self._index
-
-    @property
-    def interleave(self) -> int:
-        return self._interleave
-
-    @property
-    def depth(self) -> int:
-        return self._depth
 
     def elaborate(self, platform):
         m = Module()

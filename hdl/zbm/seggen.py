@@ -24,6 +24,7 @@ from amaranth.lib import data, enum, fifo, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
+from rasterhw.hdl.params import params
 from rasterhw.hdl.zbm.layouts import (
     EP_CHANNEL,
     EP_HEADER,
@@ -58,6 +59,7 @@ class _State(enum.Enum, shape=3):
     OVERFLOW = 6     # a due pair does not fit: stalled for good (sticky ``overflow``)
 
 
+@params("schedule", "width", "height", "capacity")
 class ZbmSegmentGenerator(wiring.Component):
     """Edge pairs -> per-line segments for the chips of one unit.
 
@@ -123,22 +125,6 @@ class ZbmSegmentGenerator(wiring.Component):
         if schedule == "paper":
             members["zbm_gap"] = In(GAP)
         super().__init__(members)
-
-    @property
-    def schedule(self) -> str:
-        return self._schedule
-
-    @property
-    def width(self) -> int:
-        return self._width
-
-    @property
-    def height(self) -> int:
-        return self._height
-
-    @property
-    def capacity(self) -> int:
-        return self._capacity
 
     def elaborate(self, platform):
         m = Module()

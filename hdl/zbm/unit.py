@@ -13,6 +13,7 @@ from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.hdl.broadcast import StreamBroadcast
+from rasterhw.hdl.params import params
 from rasterhw.hdl.zbm.chip import ZbmChip
 from rasterhw.hdl.zbm.layouts import PIXEL2, check_interleave, check_schedule
 from rasterhw.hdl.zbm.pixel import EMPTY_PIXEL2
@@ -21,6 +22,7 @@ from rasterhw.hdl.zbm.seggen import EP_WORD_BITS, ZbmSegmentGenerator
 __all__ = ["ZbmUnit"]
 
 
+@params("interleave", "head", "schedule")
 class ZbmUnit(wiring.Component):
     """Segment generator + ``interleave`` ZB/M chips.
 
@@ -81,18 +83,6 @@ class ZbmUnit(wiring.Component):
         if not head:
             members["i_merge"] = In(stream.Signature(PIXEL2)).array(interleave)
         super().__init__(members)
-
-    @property
-    def interleave(self) -> int:
-        return self._interleave
-
-    @property
-    def head(self) -> bool:
-        return self._head
-
-    @property
-    def schedule(self) -> str:
-        return self._schedule
 
     def chip_pixels(self, chip: int) -> int:
         return -(-(self._width - chip) // self._interleave)

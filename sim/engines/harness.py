@@ -11,7 +11,9 @@ testbench side:
   ``ready`` pattern (always, ``itertools.cycle([1, 1, 1, 0])``, seeded random ...);
 * :func:`stream_protocol_checker` — a background testbench that fails the simulation when a
   source breaks the rules (``valid`` dropped or payload changed before the transfer), and logs
-  every transfer for an in-order scoreboard.
+  every transfer for an in-order scoreboard;
+* :func:`run_stream` — a one-stream-in, one-stream-out block run word for word: seeded idle gaps
+  on ``i``, seeded random back-pressure on ``o``, the rules checked on ``o``.
 
 Usage::
 
@@ -23,9 +25,12 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
 
+import numpy as np
 from amaranth.lib import data
+from amaranth.sim import Simulator
 
-__all__ = ["as_plain", "random_gap", "stream_get", "stream_protocol_checker", "stream_put", "stream_sink"]
+__all__ = ["as_plain", "random_gap", "run_stream", "stream_get", "stream_protocol_checker", "stream_put",
+           "stream_sink"]
 
 
 async def stream_put(ctx, port, payload, *, gap: int = 0, domain: str = "sync") -> None:
@@ -121,6 +126,42 @@ def stream_protocol_checker(port, name: str = "stream", log: list | None = None,
                 held = None
 
     return checker
+
+
+def run_stream(dut, words, *, seed: int = 0, p_stall: float = 0.3, p_gap: float = 0.3, n_out: int | None = None,
+               after=None) -> list:
+    """Run ``dut`` (streams ``i`` in, ``o`` out, ``sync`` domain) in pysim on ``words``: before
+    each word 1-2 idle clocks with probability ``p_gap``, ``o.ready`` low with probability
+    ``p_stall`` every clock (both seeded), the stream rules checked on ``o``. Runs until
+    ``n_out`` words (default ``len(words)``) came out; then, one clock later, ``await
+    after(ctx)`` if given (to read the block's counters). Returns the output words."""
+    sim = Simulator(dut)
+    sim.add_clock(1e-8)
+    got: list = []
+    n_out = len(words) if n_out is None else n_out
+    rng = np.random.default_rng(seed)
+    gaps = [int(rng.random() < p_gap) * int(rng.integers(1, 3)) for _ in words]
+
+    async def src(ctx):
+        for w, g in zip(words, gaps, strict=True):
+            await stream_put(ctx, dut.i, w, gap=g)
+
+    r = np.random.default_rng(seed + 1)
+    ready = (int(r.random() >= p_stall) for _ in iter(int, 1))   # random back-pressure, every clock
+
+    async def wait(ctx):
+        while len(got) < n_out:
+            await ctx.tick()
+        if after is not None:
+            await ctx.tick()
+            await after(ctx)
+
+    sim.add_testbench(src, background=True)
+    sim.add_testbench(stream_protocol_checker(dut.o, "o"), background=True)
+    sim.add_testbench(stream_sink(dut.o, got, ready=ready), background=True)
+    sim.add_testbench(wait)
+    sim.run()
+    return got
 
 
 def as_plain(v):

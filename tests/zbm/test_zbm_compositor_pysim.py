@@ -5,13 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from amaranth.sim import Simulator
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.composite import composite
 from rasterhw.golden_model.zbm.words import pixel2_words
 from rasterhw.hdl.zbm.compositor import ZbmCompositor
-from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put, stream_sink
+from rasterhw.sim.engines.harness import run_stream
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 
@@ -36,30 +35,7 @@ def random_pixels(rng: np.random.Generator, shape) -> G.DoubleZ:
 
 
 def run_compositor(words, *, background=(0, 0, 0), seed=0, p_stall=0.3, p_gap=0.3):
-    dut = ZbmCompositor(background=background)
-    sim = Simulator(dut)
-    sim.add_clock(1e-8)
-    got = []
-    rng = np.random.default_rng(seed)
-    gaps = [int(rng.random() < p_gap) * int(rng.integers(1, 3)) for _ in words]
-
-    async def src(ctx):
-        for w, g in zip(words, gaps, strict=True):
-            await stream_put(ctx, dut.i, w, gap=g)
-
-    r = np.random.default_rng(seed + 1)
-    ready = (int(r.random() >= p_stall) for _ in iter(int, 1))   # random back-pressure, every clock
-
-    async def wait(ctx):
-        while len(got) < len(words):
-            await ctx.tick()
-
-    sim.add_testbench(src, background=True)
-    sim.add_testbench(stream_protocol_checker(dut.o, "o"), background=True)
-    sim.add_testbench(stream_sink(dut.o, got, ready=ready), background=True)
-    sim.add_testbench(wait)
-    sim.run()
-    return got
+    return run_stream(ZbmCompositor(background=background), words, seed=seed, p_stall=p_stall, p_gap=p_gap)
 
 
 def rgb_words(img: np.ndarray) -> list[int]:

@@ -4,43 +4,24 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from amaranth.sim import Simulator
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.mapping import default_maps, map_samples
 from rasterhw.golden_model.zbm.stimulus import random_doublez
 from rasterhw.golden_model.zbm.words import pixel2_words
 from rasterhw.hdl.zbm.mapper import ZbmMapper
-from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put, stream_sink
+from rasterhw.sim.engines.harness import run_stream
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 
 
 def run_mapper(words, tex, il, *, seed=0, p_stall=0.3, p_gap=0.3):
     dut = ZbmMapper(texture=tex, illum=il)
-    sim = Simulator(dut)
-    sim.add_clock(1e-8)
-    got, out = [], {}
-    rng = np.random.default_rng(seed)
-    gaps = [int(rng.random() < p_gap) * int(rng.integers(1, 3)) for _ in words]
+    out = {}
 
-    async def src(ctx):
-        for w, g in zip(words, gaps, strict=True):
-            await stream_put(ctx, dut.i, w, gap=g)
-
-    r = np.random.default_rng(seed + 1)
-    ready = (int(r.random() >= p_stall) for _ in iter(int, 1))   # random back-pressure, every clock
-
-    async def wait(ctx):
-        while len(got) < len(words):
-            await ctx.tick()
-        await ctx.tick()
+    async def counters(ctx):
         out["tex"], out["il"] = ctx.get(dut.texture_lookups), ctx.get(dut.illum_lookups)
 
-    sim.add_testbench(src, background=True)
-    sim.add_testbench(stream_protocol_checker(dut.o, "o"), background=True)
-    sim.add_testbench(stream_sink(dut.o, got, ready=ready), background=True)
-    sim.add_testbench(wait)
-    sim.run()
+    got = run_stream(dut, words, seed=seed, p_stall=p_stall, p_gap=p_gap, after=counters)
     return got, out
 
 

@@ -1,0 +1,143 @@
+"""The DSLB drain of an EXPERTS PXP, its ports and parameter checks, shared by both PXPs
+(``pxp.py``, the line Z-buffer; ``pxp_span.py``, the paper's span PXP).
+
+Paper (seed 000, 3.2): "DSLBもDMM同様、2重系の構成とし、PXPによる書き込みと、FBへの転送のための読み出し
+とを並行して同時に行なう" -- the DSLB is double-banked; one bank is written by the resolve side while
+the other is read out towards the frame buffer. The drain walks its bank left to right: without
+A.J., over ``[lo, hi)``, one pixel per two cycles (read, offer); with A.J. (c), over the guarded
+range ``[lo-1, hi+1)`` within the frame, one pixel per three cycles (read the DSLB, read the
+visible segment's edges from the segment table or DMM/P bank, blend the boundary and offer the
+pixel on its left: ``aj.py``), offering only ``[lo, hi)``; where the range ends at the frame's
+right edge (no guard pixel), a flush cycle offers its last pixel. The resolve side hands a
+finished bank over with :meth:`Drain.hand` once :attr:`Drain.dbusy` is low. The paper does not
+give the drain's rate; these are ours, as the golden cycle models (``pxp_cycles``,
+``span_cycles``) count them.
+"""
+
+from __future__ import annotations
+
+from amaranth import Signal, unsigned
+from amaranth.lib import enum, stream
+from amaranth.lib.wiring import In, Out
+from rasterhw.golden_model.experts.formats import ADDR_BITS
+from rasterhw.hdl.experts.aj import aj_boundary
+
+__all__ = ["Drain", "check_pxp_params", "pxp_members"]
+
+
+def check_pxp_params(*, width, aj) -> None:
+    """The parameters both PXPs take: frame width 1..1024 (Q10.6 x), A.J. ``"none"`` or ``"c"``."""
+    if isinstance(width, bool) or not isinstance(width, int) or not 1 <= width <= 1024:
+        raise ValueError(f"width must be an integer in 1..1024, not {width!r}")
+    if aj not in ("none", "c"):
+        raise ValueError(f"aj must be 'none' or 'c', not {aj!r}")
+
+
+def pxp_members(i_layout, pixel_bits: int) -> dict:
+    """The ports both PXPs have: words in (``i_layout``), pixel words out, the range ``[lo, hi)``,
+    the finish-time counter and the lines handed over."""
+    return {
+        "i": In(stream.Signature(i_layout)),
+        "o": Out(stream.Signature(unsigned(pixel_bits))),
+        "lo": In(10),
+        "hi": In(11),
+        "line_cycles": Out(16),
+        "lines": Out(16),
+    }
+
+
+class _D(enum.Enum, shape=3):
+    IDLE = 0
+    DRD = 1       # read the DSLB
+    DOUT = 2      # without A.J.: offer the pixel
+    DSEG = 3      # with A.J.: read the visible segment's entry
+    DAJ = 4       # with A.J.: blend the boundary, offer the pixel on its left
+    FLUSH = 5     # with A.J.: offer the range's last pixel
+
+
+class Drain:
+    """Drain-side logic of a PXP, added to module ``m``.
+
+    ``o``: the PXP's pixel output stream; ``drd``: the DSLB's drain read port (words with ``pix``,
+    ``addr`` and ``slot`` fields of layout ``word``), bank bit at ``bank_bit``; with ``aj``:
+    ``trd``, the read port of the segment entries (layout ``ent``, bank bit at ``ent_bank_bit``),
+    ``width`` and ``ib`` (intensity bits) for the blend. ``done_comb(drain)``: combinational
+    statements for the cycle the drain finishes its bank (e.g. freeing a DMM/P bank).
+    """
+
+    def __init__(self, m, *, o, drd, word, bank_bit: int, width: int, ib: int, aj: bool,
+                 trd=None, ent=None, ent_bank_bit: int = 0, done_comb=None):
+        pb = len(o.payload)
+        self.aj = aj
+        self.dstate = dstate = Signal(_D)
+        self.dbusy = dbusy = Signal()
+        self.dbank = dbank = Signal()
+        self.dx = dx = Signal(11)
+        self.dlo = dlo = Signal(10)
+        self.dhi = dhi = Signal(11)
+        self.dghi = dghi = Signal(11)
+        dstored = Signal(word)
+        m.d.comb += [dstored.eq(drd.data), o.payload.eq(dstored.pix), o.valid.eq(0), drd.en.eq(0)]
+
+        if aj:
+            m.d.comb += trd.en.eq(0)
+            p_pix = Signal(pb)            # pixel dx-1 before A.J.
+            p_out = Signal(pb)            # pixel dx-1 as it will be output
+            p_addr = Signal(ADDR_BITS)
+            p_ent = Signal(ent)
+            self.p_ok = p_ok = Signal()   # there is a pixel dx-1 in the walk
+            c_pix = Signal(pb)
+            c_addr = Signal(ADDR_BITS)
+            c_ent = Signal(ent)
+            m.d.comb += c_ent.eq(trd.data)
+            o_prev, o_cur = aj_boundary(m, dx=dx, width=width, ib=ib, p_ok=p_ok, p_pix=p_pix, p_out=p_out,
+                                        p_addr=p_addr, p_ent=p_ent, c_pix=c_pix, c_addr=c_addr, c_ent=c_ent)
+            emit = Signal()
+            m.d.comb += emit.eq(p_ok & (dx >= dlo + 1) & (dx <= dhi))
+
+        def drain_done():
+            m.d.sync += [dbusy.eq(0), dstate.eq(_D.IDLE)]
+            if done_comb is not None:
+                m.d.comb += done_comb(self)
+
+        with m.If(dbusy), m.Switch(dstate):
+            with m.Case(_D.DRD):
+                m.d.comb += [drd.addr.eq((dbank << bank_bit) | dx), drd.en.eq(1)]
+                m.d.sync += dstate.eq(_D.DSEG if aj else _D.DOUT)
+            with m.Case(_D.DOUT):
+                m.d.comb += o.valid.eq(1)
+                with m.If(o.ready):
+                    m.d.sync += dx.eq(dx + 1)
+                    with m.If(dx + 1 >= dhi):
+                        drain_done()
+                    with m.Else():
+                        m.d.sync += dstate.eq(_D.DRD)
+            if aj:
+                with m.Case(_D.DSEG):
+                    m.d.comb += [trd.addr.eq((dbank << ent_bank_bit) | dstored.slot), trd.en.eq(1)]
+                    m.d.sync += [c_pix.eq(dstored.pix), c_addr.eq(dstored.addr), dstate.eq(_D.DAJ)]
+                with m.Case(_D.DAJ):
+                    m.d.comb += [o.valid.eq(emit), o.payload.eq(o_prev)]
+                    with m.If(~emit | o.ready):
+                        m.d.sync += [p_pix.eq(c_pix), p_out.eq(o_cur), p_addr.eq(c_addr), p_ent.eq(c_ent),
+                                     p_ok.eq(1), dx.eq(dx + 1)]
+                        with m.If(dx + 1 >= dghi):
+                            with m.If(dghi == dhi):
+                                m.d.sync += dstate.eq(_D.FLUSH)
+                            with m.Else():
+                                drain_done()
+                        with m.Else():
+                            m.d.sync += dstate.eq(_D.DRD)
+                with m.Case(_D.FLUSH):
+                    m.d.comb += [o.valid.eq(1), o.payload.eq(p_out)]
+                    with m.If(o.ready):
+                        drain_done()
+
+    def hand(self, *, bank, lo, hi, glo, ghi) -> list:
+        """Sync statements that hand the resolved ``bank`` (range ``[lo, hi)``, guarded
+        ``[glo, ghi)``) to the drain; only while :attr:`dbusy` is low."""
+        stmts = [self.dbusy.eq(1), self.dbank.eq(bank), self.dlo.eq(lo), self.dhi.eq(hi), self.dghi.eq(ghi),
+                 self.dx.eq(glo), self.dstate.eq(_D.DRD)]
+        if self.aj:
+            stmts.append(self.p_ok.eq(0))
+        return stmts
