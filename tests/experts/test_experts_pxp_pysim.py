@@ -17,6 +17,20 @@ from rasterhw.hdl.experts.unit import ExpertsPxpUnit
 from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put, stream_sink
 
 
+def _line_watch(dut, n_lines: int, got: list, n_expect: int, cycles: list):
+    """A testbench process that logs the PXP's per-line cycle count as each line ends, and stops
+    once ``n_lines`` lines have ended and ``n_expect`` pixels came out."""
+    async def watch(ctx):
+        seen = 0
+        async for _clk, _rst, n, c in ctx.tick().sample(dut.lines, dut.line_cycles):
+            if n != seen:
+                cycles.append(c)
+                seen = n
+            if seen == n_lines and len(got) >= n_expect:
+                return
+    return watch
+
+
 @cache
 def _frame(name: str = "experts-tilt-1000", aj: str = "none"):
     return render_frame(run_geometry(build_scene(name), 512, 512, z_bits=16), model="bit", aj=aj)
@@ -41,15 +55,7 @@ def _run(lines, lo, hi, *, ready=None, gap=0, name="experts-tilt-1000", fr=None,
 
     expect = [p for y in lines for p in line_pixels(fr, y, lo, hi)]
 
-    async def watch(ctx):
-        seen = 0
-        async for _clk, _rst, n, c in ctx.tick().sample(dut.lines, dut.line_cycles):
-            if n != seen:
-                cycles.append(c)
-                seen = n
-            if seen == len(lines) and len(got) >= len(expect):
-                return
-
+    watch = _line_watch(dut, len(lines), got, len(expect), cycles)
     sim.add_testbench(feed)
     sim.add_testbench(stream_sink(dut.o, got, ready=ready), background=True)
     sim.add_testbench(stream_protocol_checker(dut.o, "o", log), background=True)
@@ -174,15 +180,7 @@ def test_random_asls_against_the_per_pixel_reference(seed):
 
     expect = [p for segs in lines for p in reference_line(segs, lo, hi)]
 
-    async def watch(ctx):
-        seen = 0
-        async for _clk, _rst, n, c in ctx.tick().sample(dut.lines, dut.line_cycles):
-            if n != seen:
-                cycles.append(c)
-                seen = n
-            if seen == len(lines) and len(got) >= len(expect):
-                return
-
+    watch = _line_watch(dut, len(lines), got, len(expect), cycles)
     sim.add_testbench(feed)
     sim.add_testbench(stream_sink(dut.o, got), background=True)
     sim.add_testbench(watch)
