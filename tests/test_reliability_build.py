@@ -79,6 +79,25 @@ def _descendants(pid: int) -> list[int]:
     return kids + [g for k in kids for g in _descendants(k)]
 
 
+def _interrupt_in_compile(cmd: list[str], env: dict, build: Path, work_glob: str, sig, delay: float,
+                          wait_s: float) -> tuple[subprocess.Popen, str]:
+    """Start ``cmd``, wait until its compiler runs (a work folder matching ``work_glob`` under
+    ``build`` with an ``obj_dir/*.mk``), wait ``delay`` seconds more, send ``sig``; then check
+    that none of its processes survived. Gives the process and its stderr."""
+    p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    t0 = time.time()
+    while not list(build.glob(f"{work_glob}/obj_dir/*.mk")) and time.time() - t0 < wait_s and p.poll() is None:
+        time.sleep(0.05)
+    time.sleep(delay)
+    kids = _descendants(p.pid)
+    p.send_signal(sig)
+    _out, err = p.communicate(timeout=120)
+    time.sleep(0.3)
+    left = [k for k in kids if os.path.exists(f"/proc/{k}") and open(f"/proc/{k}/stat").read().split()[2] != "Z"]
+    assert not left, f"processes survived {sig.name}: {left}"
+    return p, err
+
+
 @pytest.mark.cocotb
 @pytest.mark.heavy
 def test_interrupted_cold_build_then_the_same_build_succeeds(tmp_path):
@@ -91,20 +110,10 @@ def test_interrupted_cold_build_then_the_same_build_succeeds(tmp_path):
     script = textwrap.dedent(SCRIPT.format(src=str(src)))
     rng = random.Random(33)
     for sig in (signal.SIGINT, signal.SIGTERM):
-        p = subprocess.Popen([PY, "-c", script], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        # wait until the compiler runs (a work folder with an obj_dir), then a random moment more
-        t0 = time.time()
-        while not list(build.glob(".rel-count-*.tmp-*/obj_dir/*.mk")) and time.time() - t0 < 120 and p.poll() is None:
-            time.sleep(0.05)
-        time.sleep(rng.uniform(0.5, 4.0))
-        kids = _descendants(p.pid)
-        p.send_signal(sig)
-        p.communicate(timeout=60)
-        time.sleep(0.3)
+        # the compiler runs (a work folder with an obj_dir), then a random moment more
+        p, _err = _interrupt_in_compile([PY, "-c", script], env, build, ".rel-count-*.tmp-*", sig,
+                                        rng.uniform(0.5, 4.0), 120)
         assert p.returncode != 0, "the build finished before the signal: nothing was interrupted"
-        left = [k for k in kids if os.path.exists(f"/proc/{k}")
-                and open(f"/proc/{k}/stat").read().split()[2] != "Z"]
-        assert not left, f"processes survived {sig.name}: {left}"
         assert not list(build.glob(".rel-count-*")), f"a work folder was left by {sig.name}"
         assert not [d for d in build.glob("rel-count-*") if d.is_dir()], "an unfinished build folder was left"
     r = subprocess.run([PY, "-c", script], env=env, capture_output=True, text=True, timeout=600)
@@ -187,18 +196,8 @@ def test_interrupted_cold_sim_then_the_same_command_passes(tmp_path):
            "--interleave", "2", "--engine", "verilator", "-o", str(tmp_path / "z.png"), "--json"]
     rng = random.Random(1033)
     for sig in (signal.SIGINT, signal.SIGTERM):
-        p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        t0 = time.time()
-        while not list(build.glob(".*.tmp-*/obj_dir/*.mk")) and time.time() - t0 < 300 and p.poll() is None:
-            time.sleep(0.05)
-        time.sleep(rng.uniform(0.2, 3.0))
-        kids = _descendants(p.pid)
-        p.send_signal(sig)
-        _out, err = p.communicate(timeout=120)
+        p, err = _interrupt_in_compile(cmd, env, build, ".*.tmp-*", sig, rng.uniform(0.2, 3.0), 300)
         assert p.returncode != 0 and "Traceback" not in err, err
-        time.sleep(0.3)
-        assert not [k for k in kids if os.path.exists(f"/proc/{k}")
-                    and open(f"/proc/{k}/stat").read().split()[2] != "Z"]
         assert not list(build.glob(".*.tmp-*")) and not (tmp_path / "z.png").exists()
     r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=900)
     assert r.returncode == 0, r.stderr
