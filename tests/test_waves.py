@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 import pytest
+from counter_bench import counter_verilog
 from rasterhw.sim.cli.main import main
 
 ARGS = ["sim", "pixelbus", "--scene", "experts-solid-5", "--size", "40x16", "--engine", "pysim", "--json"]
@@ -37,14 +38,7 @@ def test_pysim_waves_must_be_vcd(tmp_path, capsys):
     assert "writes VCD" in capsys.readouterr().err
 
 
-COUNTER = """module tb_wave_count (input clk, output reg done, output reg [7:0] cycles);
-  initial begin done = 0; cycles = 0; end
-  always @(posedge clk) begin
-    cycles <= cycles + 1;
-    if (cycles == 8'd19) done <= 1;
-  end
-endmodule
-"""
+COUNTER = counter_verilog("tb_wave_count", 19)
 
 
 @pytest.mark.cocotb

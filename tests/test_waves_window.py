@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from counter_bench import counter_verilog
 from rasterhw.sim.cli.main import main
 from rasterhw.sim.engines import waves
 
@@ -153,14 +154,7 @@ def test_window_past_the_end_of_the_run_is_one_clear_error(tmp_path, capsys):
     assert "the run ended after" in capsys.readouterr().err
 
 
-COUNTER = """module tb_wave_window (input clk, output reg done, output reg [7:0] cycles);
-  initial begin done = 0; cycles = 0; end
-  always @(posedge clk) begin
-    cycles <= cycles + 1;
-    if (cycles == 8'd39) done <= 1;
-  end
-endmodule
-"""
+COUNTER = counter_verilog("tb_wave_window", 39)
 
 
 @pytest.mark.cocotb
