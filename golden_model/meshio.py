@@ -185,15 +185,20 @@ def _check_obj_faces(path: Path, text: str) -> bool:
         if len(corners) < 3:
             raise RasterhwError(f"{path}: line {lineno}: face has {len(corners)} vertices (a face needs at least 3)")
         for c in corners:
-            v = c.split("/", 1)[0]
-            try:
-                iv = int(v)
-            except ValueError:
-                raise RasterhwError(f"{path}: line {lineno}: face vertex {c[:40]!r} is not an integer index") from None
-            if iv == 0:
-                raise RasterhwError(f"{path}: line {lineno}: face vertex index 0 (OBJ indices start at 1, "
-                                    "or count back from -1)")
+            _face_index(c.split("/", 1)[0], c, path, lineno)
     return rewrite
+
+
+def _face_index(part: str, corner: str, path, lineno: int) -> int:
+    """One index of an OBJ face corner (``v``, ``vt`` or ``vn``), as written: a non-zero integer."""
+    try:
+        i = int(part)
+    except ValueError:
+        raise RasterhwError(f"{path}: line {lineno}: face vertex {corner[:40]!r} is not an integer index") from None
+    if i == 0:
+        raise RasterhwError(f"{path}: line {lineno}: face vertex index 0 (OBJ indices start at 1, "
+                            "or count back from -1)")
+    return i
 
 
 def _normalise_obj(path: Path, text: str) -> str:
@@ -248,13 +253,7 @@ def _normalise_obj(path: Path, text: str) -> str:
                     if part == "" and kind != "v":
                         idx.append(None)
                         continue
-                    try:
-                        i = int(part)
-                    except ValueError:
-                        raise RasterhwError(f"{path}: line {at}: face vertex {c[:40]!r} is not an integer index") from None
-                    if i == 0:
-                        raise RasterhwError(f"{path}: line {at}: face vertex index 0 (OBJ indices start at 1, "
-                                            "or count back from -1)")
+                    i = _face_index(part, c, path, at)
                     if i < 0:
                         i = counts[kind] + i + 1   # relative: -1 is the last one read so far
                         if i < 1:
