@@ -250,3 +250,20 @@ def test_a_worker_with_other_code_refuses_the_task():
     assert run_task(t, code_digest())["pixels_written"] == 64
     with pytest.raises(RasterhwError, match="another version of the code"):
         run_task(t, "0" * 64)
+
+
+def test_report_runs_on_the_cluster_equal_serial(cluster, tmp_path):
+    """The demo's HDL runs and a report's runs are tasks like a sweep's (tasks.run_tasks): on the
+    hand-started cluster they give what they give in this process (the demo's frame, PNG bytes,
+    included), apart from timings and who ran them."""
+    from rasterhw.sim.flow.tasks import call, run_tasks
+
+    tasks = [call("rasterhw.sim.report.demo:hdl_run", machine="experts", block="pxp", engine="pysim", scene="c50",
+                  width=16, height=8),
+             Task("render", "experts", {"sn": 2}, scene="c50", size=(16, 16))]
+    far = run_tasks(tasks, scheduler=cluster["address"], store=tmp_path / "a", fresh=True)
+    near = run_tasks(tasks, scheduler="serial", store=tmp_path / "b", fresh=True)
+    assert far[0]["mismatches"] == 0 and far[0]["frame_png"]
+    assert _same(far) == _same(near)
+    pids = _worker_pids(cluster["address"])
+    assert all(r["worker"] in pids and r["pid"] == pids[r["worker"]] for r in far)

@@ -35,15 +35,23 @@ def _emit(obj) -> None:
 @click.option("--all", "all_blocks", is_flag=True, help="Every registered block, one after the other.")
 @click.option("--small", is_flag=True, help="With --all: the small test sizes (each block's Flow.small in its machine.py).")
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")
+@click.option("--scheduler", default="local", show_default=True, metavar="serial|local[:N]|tcp://HOST:PORT",
+              help="With --all: where the blocks' syntheses run (a task each: docs/scale.md).")
+@click.option("--store", type=click.Path(file_okay=False), default=None,
+              help="With --all: folder keeping every finished task's result (default: build/tasks).")
+@click.option("--fresh", is_flag=True, help="With --all: recompute every task, even those in the store.")
 def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: bool, small: bool,
-          as_json: bool) -> None:
+          as_json: bool, scheduler: str, store: str | None, fresh: bool) -> None:
     """Synthesise BLOCK (or --all) with Yosys: gate equivalents, flip-flops, RAM bits."""
     from rasterhw.sim.flow.synth import summary_row, synth_all, synth_report, synthesise
+    from rasterhw.sim.flow.tasks import default_store, parse_scheduler
 
+    parse_scheduler(scheduler)
     if all_blocks:
         if block or params:
             raise RasterhwError("--all takes no BLOCK or -p")
-        rows = synth_all(small=small, memory=memory, progress=True)
+        rows = synth_all(small=small, memory=memory, progress=not as_json, scheduler=scheduler,
+                         store=store or default_store(), fresh=fresh)
         if as_json:
             _emit([summary_row(r) for r in rows])
             return

