@@ -5,19 +5,27 @@ level (``hdl/sparse/``) and a "процессор со стеком" (eq. (8): `
 which keeps the windows still to be split on a stack and runs one coverage-test unit over all
 levels. This is its golden model, in plain Python integers as the hardware would hold them:
 
-* set-up: the broadcast record rewritten for processor ``(a, b)`` (``A' = pA``, ``B' = qB``,
-  ``C' = C + aA + bB``, depth plane likewise), the root window pushed;
-* loop: pop a window of level ``i - 1``; test its four sub-windows in the order
-  ``(0,0), (1,0), (0,1), (1,1)``, one per cycle (τ = one cycle), with the same tests as the
-  pipeline (window rectangle against the edges and the bounding box below level ``n``, the
-  top-left point test at level ``n``); push the survivors so that the first is popped first;
-  a pixel goes to the pixel processor (Z test into the local memory) in the cycle of its test;
-* a record costs ``SETUP_CYCLES`` plus one cycle per test (``cycles.service_times(vp="stack")``).
+* set-up (``SETUP_CYCLES`` = 3: take the record, rewrite it, load the root): the broadcast
+  record rewritten for processor ``(a, b)`` (``A' = pA``, ``B' = qB``, ``C' = C + aA + bB``,
+  depth plane likewise); the root window goes into the current-window register;
+* loop, one cycle per coverage test (τ = one cycle): test the current window's four sub-windows
+  in the order ``(0,0), (1,0), (0,1), (1,1)`` with the same tests as the pipeline (window
+  rectangle against the edges and the bounding box below level ``n``, the top-left point test at
+  level ``n``). A surviving sub-window of the first three is pushed onto the stack; a surviving
+  fourth becomes the next current window at once (it would be pushed and popped in one cycle);
+  otherwise the top of the stack is popped into the register in the cycle of the fourth test. A
+  pixel goes to the pixel processor (Z test into the local memory) in the cycle of its test. The
+  record is done in the cycle of a fourth test with no survivor and an empty stack, and the next
+  record is taken on the next cycle;
+* so a record costs ``SETUP_CYCLES`` plus one cycle per test (``cycles.service_times(vp="stack")``),
+  and the order is depth first, the last surviving sub-window first (ours: the paper gives the
+  stack processor's cost, (6), not its order).
 
-The window counts do not depend on the order of the search, so the stack processor's image and
-counts equal the breadth-first golden search's (:func:`.search.sparse_render`, tested); what it
-adds is the order, the stack's depth (at most ``3 (n - 1) + 1`` entries: three siblings waiting
-per level plus the root) and its cycle count per record.
+This is the register-level behaviour of ``hdl/sparse/stack_vp.py`` (``StackProcessor``), which is
+held to it bit and cycle for cycle. The window counts do not depend on the order of the search, so
+the stack processor's image and counts equal the breadth-first golden search's
+(:func:`.search.sparse_render`, tested); what it adds is the order, the stack's depth (at most
+``3 (n - 1)`` entries: three siblings waiting per level above the pixel level) and its cycles.
 """
 
 from __future__ import annotations
@@ -38,8 +46,10 @@ _HALF = _SUB // 2
 def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int = 2, beta: int = 2) -> dict:
     """Run processor ``(a, b)`` of a ``p x q`` matrix as a stack processor over every broadcast
     record. Returns its local memories ``tri`` and ``zq`` (``2**n x 2**n``, -1 where empty),
-    ``cycles`` (per record: set-up plus tests), ``tests`` per level (``(n,)``), ``max_stack``
-    (the deepest the stack grew) and ``writes`` (pixels that passed the Z test)."""
+    ``cycles`` (per record: set-up plus tests), ``accept`` (the cycle each record is taken when the
+    records wait at the input from cycle 0: ``accept[t] = sum(cycles[:t])``), ``busy``
+    (``sum(cycles)``), ``tests`` per level (``(n,)``), ``max_stack`` (the most windows the stack
+    held) and ``writes`` (pixels that passed the Z test)."""
     from rasterhw.golden_model.sparse.fixed import depth_plane
 
     p, q = parse_matrix(matrix)
@@ -72,15 +82,15 @@ def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int
         E0 = [int(es.C[k, t]) + a * int(es.A[k, t]) + b * int(es.B[k, t]) for k in range(3)]
         z0, zu, zv = int(Z0[t, b, a]), int(Zu[t]), int(Zv[t])
         tri = int(es.tri[t])
-        stack = [(0, 0, 0, E0)]  # (level of the window, u, v, edge values at its first pixel)
+        cur = (0, 0, 0, E0)  # the current window: (level, u, v, edge values at its first pixel)
+        stack = []
         ntest = 0
-        while stack:
-            max_stack = max(max_stack, len(stack))
-            lvl, u, v, E = stack.pop()
+        while cur is not None:
+            lvl, u, v, E = cur
             i = lvl + 1
             N = 1 << (n - i)
-            keep = []
-            for du, dv in order:
+            nxt = None
+            for c, (du, dv) in enumerate(order):
                 ntest += 1
                 tests[i] += 1
                 uc, vc = u + du * N, v + dv * N
@@ -92,17 +102,21 @@ def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int
                     y1 = (q * (vc + N - 1) + b) * _SUB + _HALF + beta * _HALF
                     ok = (x1 >= bx0 and x0 <= bx1 and y1 >= by0 and y0 <= by1
                           and all(Ec[k] + pos[k] * (N - 1) + ext[k] >= thr[k] for k in range(3)))
-                    if ok:
-                        keep.append((i, uc, vc, Ec))
+                    if ok and c < 3:
+                        stack.append((i, uc, vc, Ec))
+                        max_stack = max(max_stack, len(stack))
+                    elif ok:
+                        nxt = (i, uc, vc, Ec)
                 elif all(Ec[k] >= thr[k] for k in range(3)):
                     zq = min(max((z0 + zu * uc + zv * vc) >> Z_FRAC_BITS, 0), zmax)
                     adr = vc * Ns + uc
                     if zq < ztab[adr]:
                         ztab[adr], ttab[adr] = zq, tri
                         writes += 1
-            stack.extend(reversed(keep))  # the first survivor on top
+            cur = nxt if nxt is not None else (stack.pop() if stack else None)
         cycles[t] = SETUP_CYCLES + ntest
     tri_m = np.array(ttab, dtype=np.int64).reshape(Ns, Ns)
     zq_m = np.where(tri_m >= 0, np.array(ztab, dtype=np.int64).reshape(Ns, Ns), -1)
-    return {"tri": tri_m, "zq": zq_m, "cycles": cycles, "tests": np.array(tests[1:], dtype=np.int64),
+    accept = np.concatenate([[0], np.cumsum(cycles)[:-1]]).astype(np.int64) if T else cycles.copy()
+    return {"tri": tri_m, "zq": zq_m, "cycles": cycles, "accept": accept, "busy": int(cycles.sum()), "tests": np.array(tests[1:], dtype=np.int64),
             "max_stack": max_stack, "writes": writes, "n": n}

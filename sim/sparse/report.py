@@ -673,11 +673,11 @@ def _stack_rows(row, scene: str, size: int) -> str:
         f"golden search (of {f.tri_id.size})", paper=None, formula=0, measured=diff, unit="pixels", source="golden")
     row("(8) / stack", f"{lab}: stack processors' cycles per record equal the stack cycle model (1 = yes)",
         paper=None, formula=1, measured=int(same_cycles), unit="", source="golden")
-    row("(8) / stack", f"{lab}: deepest stack over every processor and record (formula: the bound 3 (n - 1) + 1)",
-        paper=None, formula=3 * (n - 1) + 1, measured=deepest, unit="entries", source="golden")
+    row("(8) / stack", f"{lab}: deepest stack over every processor and record (formula: the bound 3 (n - 1))",
+        paper=None, formula=3 * (n - 1), measured=deepest, unit="entries", source="golden")
     return (f"`golden_model/sparse/stack.py` ran every processor of {lab} depth first: {diff} pixels differ from the "
             f"breadth-first search, its per-record cycles {'equal' if same_cycles else 'DIFFER from'} the stack "
-            f"cycle model's, and the deepest stack held {deepest} windows (bound {3 * (n - 1) + 1}).\n")
+            f"cycle model's, and the deepest stack held {deepest} windows (bound {3 * (n - 1)}).\n")
 
 
 def _load_rows(row, W: int, ntri: int) -> list[str]:
