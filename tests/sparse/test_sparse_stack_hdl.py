@@ -1,0 +1,43 @@
+"""The HDL stack processor (hdl/sparse/stack_vp.py) in pysim, bit and cycle for cycle the golden
+stack processor (golden_model/sparse/stack.py): local memory, the cycle each record is taken, busy
+cycles (= the stack cycle model's 3 + tests per record), tests per level, the stack's depth."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from rasterhw.golden_model.reference import random_triangles
+from rasterhw.golden_model.sparse.cycles import service_times
+from rasterhw.golden_model.sparse.search import sparse_render
+from rasterhw.golden_model.sparse.stack import stack_processor
+from rasterhw.sim.sparse.stack_run import compare_stack, run_stack_pysim
+
+
+@pytest.mark.parametrize(("matrix", "size", "count", "area", "procs"), [
+    ("2x2", (16, 16), 10, 14.0, [(0, 0), (1, 1)]),
+    ("4x2", (32, 16), 8, 60.0, [(3, 1)]),
+    ("1x1", (32, 32), 4, 150.0, [(0, 0)]),   # n = 5: a deep stack
+])
+def test_stack_hdl_bit_and_cycle_exact(matrix, size, count, area, procs):
+    tris = random_triangles(*size, count, mean_area=area, seed=21)
+    f = sparse_render(tris, matrix, depth="fixed", per_record=True)
+    s = service_times(f.stats["windows_per_record"], vp="stack")
+    for a, b in procs:
+        h = run_stack_pysim(tris, matrix, a, b)
+        g = stack_processor(tris, matrix, a, b)
+        assert compare_stack(h, g) == {"mismatches": 0, "cycle_mismatches": 0}
+        assert np.count_nonzero(h["tri"] >= 0) > 5 and h["writes"] > 5    # a real picture
+        k = b * f.p + a
+        assert h["busy"] == int(s[k].sum())                                # the stack cycle model
+        assert np.array_equal(np.diff(h["accept"]), s[k][:-1])             # record t+1 taken 3 + tests later
+        assert h["records"] == len(g["cycles"])
+        assert h["cycles"] >= h["busy"] and h["cycles"] <= h["busy"] + 4   # pixel pipeline drain only
+        assert 1 < h["max_stack"] <= 3 * (f.n - 1)
+
+
+def test_stack_hdl_rejects_bad_parameters():
+    from rasterhw.hdl.sparse.stack_vp import StackProcessor
+
+    for kw in ({"n": 0}, {"n": 3, "p": 3}, {"n": 3, "q": 128}, {"n": 3, "alpha": 16}, {"n": 3, "z_bits": 0}):
+        with pytest.raises(ValueError):
+            StackProcessor(**kw)
