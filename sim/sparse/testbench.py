@@ -16,7 +16,7 @@ from rasterhw.golden_model.sparse.search import sparse_render
 from rasterhw.sim import registry
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 
-__all__ = ["MatrixBench", "ReadOut", "VPBench"]
+__all__ = ["MatrixBench", "ReadOut", "StackVPBench", "VPBench"]
 
 
 class ReadOut(wiring.Component):
@@ -142,3 +142,10 @@ class MatrixBench(_SparseBench):
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         g, zq = self._golden(params, stim)
         return Expected({"o": _words(g.tri_id, zq, params["z_bits"])})
+
+
+class StackVPBench(VPBench):
+    """``sparse-stack-vp``: the stack-based processor (``hdl/sparse/stack_vp.py``) in the place of
+    ``sparse-vp``: the same records in, the same local memory out, against the same golden pixels."""
+
+    block = "sparse-stack-vp"
