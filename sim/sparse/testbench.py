@@ -26,12 +26,13 @@ class ReadOut(wiring.Component):
     taken at once and starts the read-out when the block is no longer ``busy``: the read address
     sweeps ``0 .. words - 1`` (``address(m, addr)`` drives the block's read port; one cycle of read
     latency) and ``o`` carries ``{rd_tri, rd_z}`` of each address, two cycles a word, each held
-    until taken. ``fixed``: constant inputs of the block (``{name: value}``)."""
+    until taken. ``fixed``: constant inputs of the block (``{name: value}``). ``tail``: the block's
+    counters (output names) sent after the memory, one word each (zero-extended), in order."""
 
-    def __init__(self, block, *, words: int, address, fixed: dict, z_bits: int):
+    def __init__(self, block, *, words: int, address, fixed: dict, z_bits: int, tail: tuple[str, ...] = ()):
         from rasterhw.hdl.sparse.layouts import BROADCAST
 
-        self.block, self._words, self._address, self._fixed = block, words, address, fixed
+        self.block, self._words, self._address, self._fixed, self._tail = block, words, address, fixed, tuple(tail)
         self._rec = BROADCAST.size
         super().__init__({"i": In(stream.Signature(BROADCAST.size + 1)),
                           "o": Out(stream.Signature(TRI_BITS + z_bits + 1))})
@@ -60,7 +61,19 @@ class ReadOut(wiring.Component):
                 with m.If(self.o.valid & self.o.ready):
                     m.d.sync += [addr.eq(addr + 1), primed.eq(0)]
                     with m.If(addr == self._words - 1):
-                        m.next = "DONE"
+                        m.next = "TAIL" if self._tail else "DONE"
+            if self._tail:
+                k = Signal(range(len(self._tail)))
+                with m.State("TAIL"):
+                    m.d.comb += self.o.valid.eq(1)
+                    with m.Switch(k):
+                        for j, name in enumerate(self._tail):
+                            with m.Case(j):
+                                m.d.comb += self.o.payload.eq(getattr(b, name))
+                    with m.If(self.o.ready):
+                        m.d.sync += k.eq(k + 1)
+                        with m.If(k == len(self._tail) - 1):
+                            m.next = "DONE"
             with m.State("DONE"):
                 pass
         return m
@@ -146,6 +159,31 @@ class MatrixBench(_SparseBench):
 
 class StackVPBench(VPBench):
     """``sparse-stack-vp``: the stack-based processor (``hdl/sparse/stack_vp.py``) in the place of
-    ``sparse-vp``: the same records in, the same local memory out, against the same golden pixels."""
+    ``sparse-vp``: the same records in and the same local memory out, then its counters (busy
+    cycles, records, the stack's depth, pixel writes, tests per level), against the golden stack
+    processor (``golden_model/sparse/stack.py``): bit and cycle exact (busy cycles = the stack
+    cycle model's ``3 + tests`` per record, whatever the input's gaps)."""
 
     block = "sparse-stack-vp"
+
+    @staticmethod
+    def counters(n: int) -> tuple[str, ...]:
+        return ("busy_cycles", "records", "max_stack", "writes") + tuple(f"tests_{i}" for i in range(1, n + 1))
+
+    def dut(self, params: dict):
+        vp = registry.load(registry.blocks()[self.block])(**params)
+        n = params["n"]
+
+        def address(m, b, addr):
+            m.d.comb += b.rd_addr.eq(addr[:2 * n])
+
+        return ReadOut(vp, words=1 << (2 * n), address=address, fixed={"a": params["p"] - 1, "b": params["q"] - 1},
+                       z_bits=params["z_bits"], tail=self.counters(n))
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        from rasterhw.golden_model.sparse.stack import stack_processor
+
+        p, q = params["p"], params["q"]
+        g = stack_processor(stim.source, (p, q), p - 1, q - 1)
+        tail = [g["busy"], len(g["cycles"]), g["max_stack"], g["writes"]] + [int(v) for v in g["tests"]]
+        return Expected({"o": _words(g["tri"], g["zq"], params["z_bits"]) + tail})
