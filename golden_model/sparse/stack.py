@@ -33,24 +33,45 @@ from __future__ import annotations
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles
-from rasterhw.golden_model.sparse.cycles import SETUP_CYCLES
+from rasterhw.golden_model.sparse.cycles import KE_EDGES, SETUP_CYCLES
 from rasterhw.golden_model.sparse.edges import edge_setup
 from rasterhw.golden_model.sparse.formats import Z_FRAC_BITS, parse_matrix, sparse_geometry
 
-__all__ = ["stack_processor"]
+__all__ = ["param_cycles", "stack_processor"]
 
 _SUB = 1 << SUBPIXEL_BITS
 _HALF = _SUB // 2
 
 
-def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int = 2, beta: int = 2) -> dict:
+def param_cycles(credit: int, kp: int, ke: int) -> tuple[int, int]:
+    """Formula (5)'s surface-parameter term as the stack processor spends it, one survivor at a
+    time: a surviving window (or pixel) of a level needs ``kp`` parameter additions on the ``ke``
+    edge adders; ``credit`` additions are left from the level's last parameter cycle. Returns
+    (cycles to spend now, credit left). Over ``w`` survivors of one level of one record (credit
+    from 0) the cycles add up to ``ceil(w kp / ke)``, ``cycles.stage_cycles``' term (tested)."""
+    need = kp - credit
+    if need <= 0:
+        return 0, -need
+    c = -(-need // ke)
+    return c, c * ke - need
+
+
+def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int = 2, beta: int = 2,
+                    kp: int = 0, ke: int = KE_EDGES, colour: bool = False) -> dict:
     """Run processor ``(a, b)`` of a ``p x q`` matrix as a stack processor over every broadcast
     record. Returns its local memories ``tri`` and ``zq`` (``2**n x 2**n``, -1 where empty),
     ``cycles`` (per record: set-up plus tests), ``accept`` (the cycle each record is taken when the
     records wait at the input from cycle 0: ``accept[t] = sum(cycles[:t])``), ``busy``
     (``sum(cycles)``), ``tests`` per level (``(n,)``), ``max_stack`` (the most windows the stack
-    held) and ``writes`` (pixels that passed the Z test)."""
-    from rasterhw.golden_model.sparse.fixed import depth_plane
+    held) and ``writes`` (pixels that passed the Z test).
+
+    ``kp`` > 0 prices ``kp`` surface parameters as formula (5) does (``ke`` edge adders,
+    :func:`param_cycles` per surviving window and pixel, the level's credit reset per record):
+    ``cycles`` then equal ``cycles.service_times(vp="stack", kp=kp, ke=ke)``. ``colour``: the
+    vertex colours as three more linear functions (``fixed.colour_planes``, rewritten for the
+    lattice as the edges) evaluated at each written pixel and rounded as ``fixed.colour_rgb8``:
+    ``rgb`` (``2**n x 2**n x 3``, 0 where empty)."""
+    from rasterhw.golden_model.sparse.fixed import COLOUR_BITS, colour_planes, depth_plane
 
     p, q = parse_matrix(matrix)
     n = sparse_geometry(tris.width, tris.height, p, q)
@@ -59,11 +80,17 @@ def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int
             raise RasterhwError(f"sparse stack: {name} must be an integer, not {v!r}")
     if not (0 <= a < p and 0 <= b < q):
         raise RasterhwError(f"sparse stack: processor ({a}, {b}) is outside a {p}x{q} matrix")
+    for name, v, lo in (("kp", kp, 0), ("ke", ke, 1)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
+            raise RasterhwError(f"sparse stack: {name} must be an integer >= {lo}, not {v!r}")
     xy, _, _ = tris.validate(who="sparse stack", max_coord=float(1 << 13))
     es = edge_setup(xy)
     Z0, Zu, Zv = depth_plane(tris, es, p, q)
-    zmax = (1 << tris.z_bits) - 1
+    pl = colour_planes(tris, es) if colour else None  # (3 channels, [C00, Cx, Cy], T)
+    cmax, chalf = (1 << COLOUR_BITS) - 1, 1 << (Z_FRAC_BITS - 1)
     Ns = 1 << n
+    ctab = [(0, 0, 0)] * (Ns * Ns)
+    zmax = (1 << tris.z_bits) - 1
     ztab = [zmax + 1] * (Ns * Ns)
     ttab = [-1] * (Ns * Ns)
     T = es.tri.size
@@ -83,8 +110,13 @@ def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int
         z0, zu, zv = int(Z0[t, b, a]), int(Zu[t]), int(Zv[t])
         tri = int(es.tri[t])
         cur = (0, 0, 0, E0)  # the current window: (level, u, v, edge values at its first pixel)
+        if colour:
+            col = [(int(pl[ch, 0, t]) + a * int(pl[ch, 1, t]) + b * int(pl[ch, 2, t]), p * int(pl[ch, 1, t]),
+                    q * int(pl[ch, 2, t])) for ch in range(3)]
+        credit = [0] * (n + 1)
         stack = []
         ntest = 0
+        npar = 0
         while cur is not None:
             lvl, u, v, E = cur
             i = lvl + 1
@@ -102,21 +134,31 @@ def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int
                     y1 = (q * (vc + N - 1) + b) * _SUB + _HALF + beta * _HALF
                     ok = (x1 >= bx0 and x0 <= bx1 and y1 >= by0 and y0 <= by1
                           and all(Ec[k] + pos[k] * (N - 1) + ext[k] >= thr[k] for k in range(3)))
+                    if ok and kp:
+                        dc, credit[i] = param_cycles(credit[i], kp, ke)
+                        npar += dc
                     if ok and c < 3:
                         stack.append((i, uc, vc, Ec))
                         max_stack = max(max_stack, len(stack))
                     elif ok:
                         nxt = (i, uc, vc, Ec)
                 elif all(Ec[k] >= thr[k] for k in range(3)):
+                    if kp:
+                        dc, credit[i] = param_cycles(credit[i], kp, ke)
+                        npar += dc
                     zq = min(max((z0 + zu * uc + zv * vc) >> Z_FRAC_BITS, 0), zmax)
                     adr = vc * Ns + uc
                     if zq < ztab[adr]:
                         ztab[adr], ttab[adr] = zq, tri
                         writes += 1
+                        if colour:
+                            ctab[adr] = tuple(min(max((c0 + cu * uc + cv * vc + chalf) >> Z_FRAC_BITS, 0), cmax)
+                                              for c0, cu, cv in col)
             cur = nxt if nxt is not None else (stack.pop() if stack else None)
-        cycles[t] = SETUP_CYCLES + ntest
+        cycles[t] = SETUP_CYCLES + ntest + npar
     tri_m = np.array(ttab, dtype=np.int64).reshape(Ns, Ns)
     zq_m = np.where(tri_m >= 0, np.array(ztab, dtype=np.int64).reshape(Ns, Ns), -1)
     accept = np.concatenate([[0], np.cumsum(cycles)[:-1]]).astype(np.int64) if T else cycles.copy()
-    return {"tri": tri_m, "zq": zq_m, "cycles": cycles, "accept": accept, "busy": int(cycles.sum()), "tests": np.array(tests[1:], dtype=np.int64),
+    out_rgb = np.array(ctab, dtype=np.int64).reshape(Ns, Ns, 3) if colour else None
+    return {"rgb": out_rgb, "tri": tri_m, "zq": zq_m, "cycles": cycles, "accept": accept, "busy": int(cycles.sum()), "tests": np.array(tests[1:], dtype=np.int64),
             "max_stack": max_stack, "writes": writes, "n": n}
