@@ -37,10 +37,25 @@ from rasterhw.golden_model.sparse.cycles import KE_EDGES, SETUP_CYCLES
 from rasterhw.golden_model.sparse.edges import edge_setup
 from rasterhw.golden_model.sparse.formats import Z_FRAC_BITS, parse_matrix, sparse_geometry
 
-__all__ = ["param_cycles", "stack_processor"]
+__all__ = ["broadcast_records_rgb", "param_cycles", "stack_processor"]
 
 _SUB = 1 << SUBPIXEL_BITS
 _HALF = _SUB // 2
+
+
+def broadcast_records_rgb(tris: ScreenTriangles) -> list[dict]:
+    """``fixed.broadcast_records`` with the colour planes: ``c00``, ``cx``, ``cy`` (3 channels each,
+    8-bit levels with ``Z_FRAC_BITS`` fraction bits over full-raster pixel indices), what the HDL
+    stack processor takes with ``colour=True`` (``BROADCAST_RGB``)."""
+    from rasterhw.golden_model.sparse.fixed import broadcast_records, colour_planes
+
+    recs = broadcast_records(tris)
+    xy, _, _ = tris.validate(who="sparse broadcast", max_coord=float(1 << 13))
+    pl = colour_planes(tris, edge_setup(xy))
+    for t, r in enumerate(recs):
+        for j, key in enumerate(("c00", "cx", "cy")):
+            r[key] = [int(pl[ch, j, t]) for ch in range(3)]
+    return recs
 
 
 def param_cycles(credit: int, kp: int, ke: int) -> tuple[int, int]:

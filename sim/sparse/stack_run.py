@@ -14,7 +14,8 @@ from rasterhw.golden_model.sparse.formats import TRI_BITS, parse_matrix, sparse_
 __all__ = ["compare_stack", "run_stack_pysim"]
 
 
-def run_stack_pysim(tris: ScreenTriangles, matrix, a: int, b: int, *, max_cycles: int = 2_000_000) -> dict:
+def run_stack_pysim(tris: ScreenTriangles, matrix, a: int, b: int, *, colour: bool = False, kp: int = 0,
+                    max_cycles: int = 2_000_000) -> dict:
     """Processor ``(a, b)`` of the ``p x q`` matrix as the HDL stack processor in pysim. Returns
     ``tri``, ``zq`` (-1 where empty), ``accept`` (cycle each record was taken), ``busy``
     (the ``busy_cycles`` counter), ``tests`` per level, ``max_stack``, ``writes``, ``records``."""
@@ -25,8 +26,13 @@ def run_stack_pysim(tris: ScreenTriangles, matrix, a: int, b: int, *, max_cycles
     n = sparse_geometry(tris.width, tris.height, p, q)
     if not (0 <= a < p and 0 <= b < q):
         raise RasterhwError(f"sparse stack HDL: processor ({a}, {b}) is outside a {p}x{q} matrix")
-    recs = broadcast_records(tris)
-    dut = StackProcessor(n=n, p=p, q=q, z_bits=tris.z_bits)
+    if colour:
+        from rasterhw.golden_model.sparse.stack import broadcast_records_rgb
+
+        recs = broadcast_records_rgb(tris)
+    else:
+        recs = broadcast_records(tris)
+    dut = StackProcessor(n=n, p=p, q=q, z_bits=tris.z_bits, colour=colour, kp=kp)
     N = 1 << n
     res: dict = {"accept": []}
 
@@ -59,13 +65,18 @@ def run_stack_pysim(tris: ScreenTriangles, matrix, a: int, b: int, *, max_cycles
             res[k] = int(ctx.get(getattr(dut, k)))
         tri = np.full(N * N, -1, dtype=np.int64)
         zq = np.full(N * N, -1, dtype=np.int64)
+        rgb = np.zeros((N * N, 3), dtype=np.int64)
         for adr in range(N * N):
             ctx.set(dut.rd_addr, adr)
             await ctx.tick()
             t, z = int(ctx.get(dut.rd_tri)), int(ctx.get(dut.rd_z))
             if t != (1 << TRI_BITS) - 1:
                 tri[adr], zq[adr] = t, z
+                if colour:
+                    c = int(ctx.get(dut.rd_rgb))
+                    rgb[adr] = (c & 255, (c >> 8) & 255, c >> 16)
         res["tri"], res["zq"] = tri.reshape(N, N), zq.reshape(N, N)
+        res["rgb"] = rgb.reshape(N, N, 3) if colour else None
 
     sim = Simulator(dut)
     sim.add_clock(1e-8)
@@ -78,9 +89,12 @@ def run_stack_pysim(tris: ScreenTriangles, matrix, a: int, b: int, *, max_cycles
 
 def compare_stack(hdl: dict, gold: dict) -> dict:
     """Differences between an HDL run and ``stack_processor``'s: ``mismatches`` (pixels whose
-    triangle or depth differ) and ``cycle_mismatches`` (of: every record's take cycle, busy cycles,
+    triangle, depth or colour differ) and ``cycle_mismatches`` (of: every record's take cycle, busy cycles,
     tests per level, the stack's depth, pixel writes)."""
-    mism = int(np.count_nonzero((hdl["tri"] != gold["tri"]) | (hdl["zq"] != gold["zq"])))
+    bad = (hdl["tri"] != gold["tri"]) | (hdl["zq"] != gold["zq"])
+    if hdl.get("rgb") is not None or gold.get("rgb") is not None:
+        bad |= (hdl["rgb"] != gold["rgb"]).any(axis=-1)
+    mism = int(np.count_nonzero(bad))
     cyc = int(np.count_nonzero(hdl["accept"] != gold["accept"])) if hdl["accept"].shape == gold["accept"].shape \
         else max(len(hdl["accept"]), len(gold["accept"]))
     cyc += int(np.count_nonzero(hdl["tests"] != gold["tests"]))

@@ -35,9 +35,31 @@ def test_stack_hdl_bit_and_cycle_exact(matrix, size, count, area, procs):
         assert 1 < h["max_stack"] <= 3 * (f.n - 1)
 
 
+@pytest.mark.parametrize(("matrix", "size", "procs"), [("2x2", (16, 16), [(1, 0)]), ("1x1", (16, 16), [(0, 0)])])
+def test_stack_hdl_colour_and_formula_5_cycles(matrix, size, procs):
+    """Depth and R, G, B as linear functions; (5)'s k_p = 4 parameters on k_e = 3 edge adders."""
+    from rasterhw.golden_model.sparse.fixed import colour_rgb8
+
+    tris = random_triangles(*size, 6, mean_area=40.0, seed=5)
+    f = sparse_render(tris, matrix, depth="fixed", per_record=True)
+    s4 = service_times(f.stats["windows_per_record"], vp="stack", kp=4)
+    full = colour_rgb8(tris, f.tri_id, f.p, f.q).astype(np.int64)
+    for a, b in procs:
+        h = run_stack_pysim(tris, matrix, a, b, colour=True, kp=4)
+        g = stack_processor(tris, matrix, a, b, colour=True, kp=4)
+        assert compare_stack(h, g) == {"mismatches": 0, "cycle_mismatches": 0}
+        assert np.array_equal(h["rgb"], full[b::f.q, a::f.p])      # colour: bit for bit
+        assert (h["rgb"][h["tri"] >= 0] > 0).any()
+        k = b * f.p + a
+        assert h["busy"] == int(s4[k].sum())                       # 3 + tests + ceil(w_i k_p / k_e)
+        assert np.array_equal(np.diff(h["accept"]), s4[k][:-1])
+        assert h["busy"] > stack_processor(tris, matrix, a, b)["busy"]
+
+
 def test_stack_hdl_rejects_bad_parameters():
     from rasterhw.hdl.sparse.stack_vp import StackProcessor
 
-    for kw in ({"n": 0}, {"n": 3, "p": 3}, {"n": 3, "q": 128}, {"n": 3, "alpha": 16}, {"n": 3, "z_bits": 0}):
+    for kw in ({"n": 0}, {"n": 3, "p": 3}, {"n": 3, "q": 128}, {"n": 3, "alpha": 16}, {"n": 3, "z_bits": 0},
+               {"n": 3, "kp": -1}, {"n": 3, "ke": 0}, {"n": 3, "colour": 1}, {"n": 3, "kp": True}):
         with pytest.raises(ValueError):
             StackProcessor(**kw)
