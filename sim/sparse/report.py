@@ -720,8 +720,10 @@ def _stack_vs_pipeline_rows(row, *, scenes: tuple[str, ...], sizes: tuple[int, .
             lab = f"{scene} {W}x{W}, {matrix}"
             hv = coupled_matrix_vp(f, D)
             runs = {"pipeline (HDL VP cycle model)": (hv["frame_cycles"], np.array(hv["busy"], dtype=float), n)}
-            for vp, name in (("pipeline", "pipeline as a server (9)"), ("stack", "stack (golden = HDL stack processor)")):
-                r = cy.coupled_matrix(cy.service_times(w, vp=vp), D)
+            for vp, name, kp in (("pipeline", "pipeline as a server (9)", 0),
+                                 ("stack", "stack (golden = HDL stack processor)", 0),
+                                 ("stack", "stack, depth + RGB priced as (5), k_p = 4, k_e = 3", 4)):
+                r = cy.coupled_matrix(cy.service_times(w, vp=vp, kp=kp), D)
                 runs[name] = (r.frame_cycles, r.busy.astype(float), 1 if vp == "stack" else n)
             ref = hv["frame_cycles"]
             for name, (fr, busy, units) in runs.items():
@@ -751,9 +753,6 @@ def _stack_hdl_rows(row, engine: str, *, scenes: tuple[str, ...]) -> list[str]:
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.reference import random_triangles
     from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.sparse.fixed import broadcast_records
-    from rasterhw.hdl.pack import pack
-    from rasterhw.hdl.sparse.layouts import BROADCAST
     from rasterhw.sim.engines import run
     from rasterhw.sim.sparse.testbench import StackVPBench
     from rasterhw.sim.testbench import Stimulus
@@ -767,30 +766,34 @@ def _stack_hdl_rows(row, engine: str, *, scenes: tuple[str, ...]) -> list[str]:
                 "verilator).\n"]
     tb = StackVPBench()
     src = f"hdl:{engine}"
-    tab = ["| frame | processor | pixels differing | counters differing | busy cycles HDL | golden (3 + tests) | "
-           "deepest stack |", "|---|---|---|---|---|---|---|"]
+    tab = ["| frame | processor | configuration | pixels differing | counters differing | busy cycles HDL | "
+           "golden | deepest stack |", "|---|---|---|---|---|---|---|---|"]
     for lab, tris, p in cases:
         n = (tris.width // p).bit_length() - 1
-        prm = tb.params(n=n, p=p, q=p)
-        recs = broadcast_records(tris)
-        stim = Stimulus({"i": [pack(BROADCAST, r) for r in recs] + [1 << BROADCAST.size]}, what=lab, source=tris)
-        exp = tb.expect(prm, stim)
-        got = run(tb, prm, stim, engine=engine, expect_words={"o": len(exp.words["o"])})
-        words = 1 << (2 * n)
-        e, g = exp.words["o"], got.words["o"]
-        pix = sum(int(x != y) for x, y in zip(e[:words], g[:words], strict=True))
-        cnt = sum(int(x != y) for x, y in zip(e[words:], g[words:], strict=True))
-        names = StackVPBench.counters(n)
-        hb, gb = g[words + names.index("busy_cycles")], e[words + names.index("busy_cycles")]
-        proc = f"({p - 1}, {p - 1})"
-        tab.append(f"| {lab} | {proc} | {pix} | {cnt} of {len(names)} | {hb} | {gb} | {g[words + names.index('max_stack')]} |")
-        row("(8) / stack HDL", f"{lab}, processor {proc}: local-memory words of the HDL stack processor differing from "
-            f"the golden stack processor (of {words})", paper=None, formula=None, measured=pix, unit="pixels", source=src)
-        row("(8) / stack HDL", f"{lab}, processor {proc}: counters of the HDL stack processor differing from the golden "
-            f"model (busy cycles, records, stack depth, writes, tests per level: {len(names)})", paper=None,
-            formula=None, measured=cnt, unit="counters", source=src)
-        row("(8) / stack HDL", f"{lab}, processor {proc}: busy cycles of the HDL stack processor (golden: 3 + tests per "
-            "record)", paper=None, formula=None, measured=hb, unit="cycles", source=src)
+        for conf, kw in (("depth, k_p = 0", {}), ("depth + RGB, k_p = 4, k_e = 3 (5)", {"colour": True, "kp": 4})):
+            prm = tb.params(n=n, p=p, q=p, **kw)
+            stim = StackVPBench.records(tris, prm, what=lab)
+            exp = tb.expect(prm, stim)
+            got = run(tb, prm, stim, engine=engine, expect_words={"o": len(exp.words["o"])})
+            words = 1 << (2 * n)
+            e, g = exp.words["o"], got.words["o"]
+            pix = sum(int(x != y) for x, y in zip(e[:words], g[:words], strict=True))
+            cnt = sum(int(x != y) for x, y in zip(e[words:], g[words:], strict=True))
+            names = StackVPBench.counters(n)
+            hb, gb = g[words + names.index("busy_cycles")], e[words + names.index("busy_cycles")]
+            proc = f"({p - 1}, {p - 1})"
+            tab.append(f"| {lab} | {proc} | {conf} | {pix} | {cnt} of {len(names)} | {hb} | {gb} | "
+                       f"{g[words + names.index('max_stack')]} |")
+            what = "triangle and depth" + (" and colour" if kw else "")
+            row("(8) / stack HDL", f"{lab}, processor {proc}, {conf}: local-memory words ({what}) of the HDL stack "
+                f"processor differing from the golden stack processor (of {words})", paper=None, formula=None,
+                measured=pix, unit="pixels", source=src)
+            row("(8) / stack HDL", f"{lab}, processor {proc}, {conf}: counters of the HDL stack processor differing "
+                f"from the golden model (busy cycles, records, stack depth, writes, tests per level: {len(names)})",
+                paper=None, formula=None, measured=cnt, unit="counters", source=src)
+            row("(8) / stack HDL", f"{lab}, processor {proc}, {conf}: busy cycles of the HDL stack processor (golden: "
+                "3 + tests + parameter cycles per record)", paper=None, formula=None, measured=hb, unit="cycles",
+                source=src)
     return ["## The stack-based processor in HDL\n",
             "`hdl/sparse/stack_vp.py` (`StackProcessor`, block `sparse-stack-vp`) on the engines' testbench "
             "(`sim/sparse/testbench.py` `StackVPBench`): the broadcast records back to back, then its local memory and "

@@ -188,6 +188,8 @@ def test_stack_against_pipeline_rows(report):
     pv = got[f"{lab}: frame cycles, pipeline (HDL VP cycle model), input FIFO depth 64"]["measured"]
     sv = got[f"{lab}: frame cycles, pipeline as a server (9), input FIFO depth 64"]["measured"]
     assert st > pv > 0 and st > sv > 0          # one test unit against n = 4 stage units
+    st4 = next(r["measured"] for q, r in got.items() if q.startswith(f"{lab}: frame cycles, stack, depth + RGB"))
+    assert st4 > st
     ratio = next(r for q, r in got.items() if q.startswith(f"{lab}: stack frame / pipeline frame"))
     assert ratio["measured"] == pytest.approx(st / pv, abs=1e-4) and 1 < ratio["formula"] <= 4
     for q, r in got.items():
@@ -205,7 +207,7 @@ def test_stack_hdl_rows_on_pysim():
         rows.append({"figure": fig, "quantity": qty, **kw})
 
     sec = _stack_hdl_rows(row, "pysim", scenes=())
-    assert len(rows) == 3 and all(r["source"] == "hdl:pysim" for r in rows)
-    pix, cnt, busy = (r["measured"] for r in rows)
-    assert pix == 0 and cnt == 0 and busy > 100
-    assert "| 0 | 0 of" in sec[-1]
+    assert len(rows) == 6 and all(r["source"] == "hdl:pysim" for r in rows)
+    pix, cnt, busy, pix4, cnt4, busy4 = (r["measured"] for r in rows)
+    assert pix == cnt == pix4 == cnt4 == 0 and 100 < busy < busy4    # parameters cost cycles as (5) prices them
+    assert sec[-1].count("| 0 | 0 of") == 2
