@@ -57,7 +57,8 @@ def build_matrix(*, n: int, p: int, q: int, z_bits: int = 24, fifo_depth: int = 
               "NS": ns, "LIMW": in_depth.bit_length(), "CW": max(1, (max(p * q, 2) - 1).bit_length()),
               "SW": max(1, (ns - 1).bit_length())}
     exe, secs = build_plain_verilator("sparse-matrix", TOP, [BENCH], params=params, defines={"RASTERHW_CYCLES": 1},
-                                      generated={"sparse_cell.v": cell, "sparse_matrix.v": top})
+                                      generated={"sparse_cell.v": cell, "sparse_matrix.v": top,
+                                                 "tb_sparse_load.vh": (BENCH.parent / "tb_sparse_load.vh").read_text()})
     return exe, secs, {"verilog_bytes_cell": len(cell), "verilog_bytes_matrix": len(top)}
 
 

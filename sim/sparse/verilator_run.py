@@ -51,7 +51,8 @@ def _build(*, n: int, p: int, q: int, z_bits: int) -> tuple[Path, float]:
                     for i in range(n))
     return build_plain_verilator("sparse-vp", TOP, [BENCH_DIR / "tb_sparse_vp.v"], params=params,
                                  defines={"RASTERHW_CYCLES": 1},
-                                 generated={"sparse_vp.v": src, "tb_sparse_vp_ports.vh": ports})
+                                 generated={"sparse_vp.v": src, "tb_sparse_vp_ports.vh": ports,
+                                            "tb_sparse_load.vh": (BENCH_DIR / "tb_sparse_load.vh").read_text()})
 
 
 def _read_hex(path: Path) -> np.ndarray:
