@@ -20,6 +20,7 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.sparse.formats import TRI_BITS
 from rasterhw.sim.engines.memh import memh_uint64, read_memh
 from rasterhw.sim.engines.runner import build_plain_verilator, run_plain_verilator
+from rasterhw.sim.sparse.verilator_run import SHARED_VH
 from rasterhw.sim.workdirs import release, temp_run_folder
 
 __all__ = ["IN_DEPTH", "build_matrix", "run_matrix_pysim", "run_matrix_verilator"]
@@ -58,7 +59,7 @@ def build_matrix(*, n: int, p: int, q: int, z_bits: int = 24, fifo_depth: int = 
               "SW": max(1, (ns - 1).bit_length())}
     exe, secs = build_plain_verilator("sparse-matrix", TOP, [BENCH], params=params, defines={"RASTERHW_CYCLES": 1},
                                       generated={"sparse_cell.v": cell, "sparse_matrix.v": top,
-                                                 "tb_sparse_load.vh": (BENCH.parent / "tb_sparse_load.vh").read_text()})
+                                                 **{f: (BENCH.parent / f).read_text() for f in SHARED_VH}})
     return exe, secs, {"verilog_bytes_cell": len(cell), "verilog_bytes_matrix": len(top)}
 
 

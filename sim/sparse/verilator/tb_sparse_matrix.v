@@ -13,6 +13,7 @@ module tb_sparse_matrix #(parameter N = 7, parameter LP = 2, parameter LQ = 2, p
   localparam XW = N + LP;
   localparam YW = N + LQ;
   localparam AW = XW + YW;
+  localparam READOUT = 4;
   reg [BW-1:0] rom [0:MAXT-1];
   reg [TW+ZW-1:0] outmem [0:(1 << AW) - 1];
   reg [31:0] stats [0:P * NS + 1];
@@ -57,13 +58,7 @@ module tb_sparse_matrix #(parameter N = 7, parameter LP = 2, parameter LQ = 2, p
           if (sc == P - 1) phase <= 4;
         end else ss <= ss + 1;
       end
-      4: begin  // the read address is registered here and the port has one cycle of latency:
-                // the word for raddr - 2 arrives now
-        if (raddr >= 2) outmem[raddr - 2] <= {rd_tri, rd_z};
-        rd <= raddr[AW-1:0];
-        raddr <= raddr + 1;
-        if (raddr == (1 << AW) + 1) phase <= 5;
-      end
+`include "tb_sparse_readout.vh"
       5: done <= 1;
     endcase
   end

@@ -17,9 +17,11 @@ module tb_sparse_vp #(parameter N = 7, parameter BW = 600, parameter MAXT = 1638
   reg [31:0] lf;
   reg [31:0] idx;
   reg rst;
+  localparam AW = 2 * N;
+  localparam READOUT = 3;
   reg [2:0] phase;  // 0 reset, 1 feed, 2 drain, 3 read-out, 4 done
-  reg [2*N+1:0] raddr;
-  reg [2*N-1:0] rd_addr;
+  reg [AW+1:0] raddr;
+  reg [AW-1:0] rd;
   wire busy, i_ready;
   wire [ZW-1:0] rd_z;
   wire [TW-1:0] rd_tri;
@@ -31,10 +33,10 @@ module tb_sparse_vp #(parameter N = 7, parameter BW = 600, parameter MAXT = 1638
     if (!$value$plusargs("idle=%d", IDLE)) IDLE = 0;
     if (!$value$plusargs("seed=%d", SEED)) SEED = 1;
     offer = 1; lf = 32'h9E3779B9 ^ (SEED * 32'd7919 + 32'd1);
-    idx = 0; phase = 0; done = 0; cycles = 0; raddr = 0; rd_addr = 0; rst = 1;
+    idx = 0; phase = 0; done = 0; cycles = 0; raddr = 0; rd = 0; rst = 1;
   end
   sparse_vp dut (.clk(clk), .rst(rst), .a(pa[5:0]), .b(pb[5:0]), .i__payload(rom[idx[13:0]]),
-                 .i__valid(phase == 1 && idx < ntri && offer), .i__ready(i_ready), .rd_addr(rd_addr), .rd_z(rd_z),
+                 .i__valid(phase == 1 && idx < ntri && offer), .i__ready(i_ready), .rd_addr(rd), .rd_z(rd_z),
                  .rd_tri(rd_tri), .writes(writes), .busy(busy)
 `include "tb_sparse_vp_ports.vh"
                  );
@@ -54,13 +56,7 @@ module tb_sparse_vp #(parameter N = 7, parameter BW = 600, parameter MAXT = 1638
         cycles <= cycles + 1;
         if (!busy) phase <= 3;
       end
-      3: begin  // rd_addr is registered here and the read port has one cycle of latency:
-                // the word for raddr - 2 arrives now
-        if (raddr >= 2) outmem[raddr - 2] <= {rd_tri, rd_z};
-        rd_addr <= raddr[2*N-1:0];
-        raddr <= raddr + 1;
-        if (raddr == (1 << (2 * N)) + 1) phase <= 4;
-      end
+`include "tb_sparse_readout.vh"
       4: done <= 1;
     endcase
   end
