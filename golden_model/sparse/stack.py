@@ -39,6 +39,8 @@ from rasterhw.golden_model.sparse.formats import Z_FRAC_BITS, parse_matrix, spar
 
 __all__ = ["broadcast_records_rgb", "param_cycles", "stack_processor"]
 
+#: cycles the pixel processor (``hdl/sparse/pixel.py``: read, then compare and write) holds a pixel
+PIXEL_LATENCY = 2
 _SUB = 1 << SUBPIXEL_BITS
 _HALF = _SUB // 2
 
@@ -77,7 +79,8 @@ def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int
     record. Returns its local memories ``tri`` and ``zq`` (``2**n x 2**n``, -1 where empty),
     ``cycles`` (per record: set-up plus tests), ``accept`` (the cycle each record is taken when the
     records wait at the input from cycle 0: ``accept[t] = sum(cycles[:t])``), ``busy``
-    (``sum(cycles)``), ``tests`` per level (``(n,)``), ``max_stack`` (the most windows the stack
+    (``sum(cycles)``), ``tail`` (per record: cycles its last pixels keep the pixel processor busy
+    after the record is done), ``tests`` per level (``(n,)``), ``max_stack`` (the most windows the stack
     held) and ``writes`` (pixels that passed the Z test).
 
     ``kp`` > 0 prices ``kp`` surface parameters as formula (5) does (``ke`` edge adders,
@@ -110,6 +113,7 @@ def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int
     ttab = [-1] * (Ns * Ns)
     T = es.tri.size
     cycles = np.zeros(T, dtype=np.int64)
+    tail = np.zeros(T, dtype=np.int64)
     tests = [0] * (n + 1)
     max_stack = 0
     writes = 0
@@ -124,6 +128,7 @@ def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int
         E0 = [int(es.C[k, t]) + a * int(es.A[k, t]) + b * int(es.B[k, t]) for k in range(3)]
         z0, zu, zv = int(Z0[t, b, a]), int(Zu[t]), int(Zv[t])
         tri = int(es.tri[t])
+        last_px = -1  # cycle (from the take) of the record's last pixel sent to the pixel processor
         cur = (0, 0, 0, E0)  # the current window: (level, u, v, edge values at its first pixel)
         if colour:
             col = [(int(pl[ch, 0, t]) + a * int(pl[ch, 1, t]) + b * int(pl[ch, 2, t]), p * int(pl[ch, 1, t]),
@@ -158,6 +163,7 @@ def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int
                     elif ok:
                         nxt = (i, uc, vc, Ec)
                 elif all(Ec[k] >= thr[k] for k in range(3)):
+                    last_px = SETUP_CYCLES + ntest - 1 + npar
                     if kp:
                         dc, credit[i] = param_cycles(credit[i], kp, ke)
                         npar += dc
@@ -171,9 +177,13 @@ def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int
                                               for c0, cu, cv in col)
             cur = nxt if nxt is not None else (stack.pop() if stack else None)
         cycles[t] = SETUP_CYCLES + ntest + npar
+        # the pixel processor holds a pixel for PIXEL_LATENCY cycles after its test (the colour
+        # write one more): what the record's last pixels keep busy after the record is done
+        lat = PIXEL_LATENCY + (1 if colour else 0)
+        tail[t] = max(0, last_px + lat + 1 - int(cycles[t])) if last_px >= 0 else 0
     tri_m = np.array(ttab, dtype=np.int64).reshape(Ns, Ns)
     zq_m = np.where(tri_m >= 0, np.array(ztab, dtype=np.int64).reshape(Ns, Ns), -1)
     accept = np.concatenate([[0], np.cumsum(cycles)[:-1]]).astype(np.int64) if T else cycles.copy()
     out_rgb = np.array(ctab, dtype=np.int64).reshape(Ns, Ns, 3) if colour else None
-    return {"rgb": out_rgb, "tri": tri_m, "zq": zq_m, "cycles": cycles, "accept": accept, "busy": int(cycles.sum()), "tests": np.array(tests[1:], dtype=np.int64),
+    return {"rgb": out_rgb, "tri": tri_m, "zq": zq_m, "tail": tail, "cycles": cycles, "accept": accept, "busy": int(cycles.sum()), "tests": np.array(tests[1:], dtype=np.int64),
             "max_stack": max_stack, "writes": writes, "n": n}

@@ -103,16 +103,17 @@ def run_matrix_verilator(recs: list[dict], *, n: int, p: int, q: int, limit: int
 
 
 def run_matrix_pysim(recs: list[dict], *, n: int, p: int, q: int, limit: int, z_bits: int = 24,
-                     fifo_depth: int = 8, in_depth: int = 8, gaps=None) -> dict:
+                     fifo_depth: int = 8, in_depth: int = 8, gaps=None, vp: str = "pipeline") -> dict:
     """The matrix in Amaranth pysim, every cell elaborated, with the Verilator bench's protocol (a
     record offered on every cycle from the first; ``gaps``: a per-cycle offer pattern instead).
-    Same keys as :func:`run_matrix_verilator` (``sim_cycles`` and ``run_s`` of the whole run)."""
+    Same keys as :func:`run_matrix_verilator` (``sim_cycles`` and ``run_s`` of the whole run).
+    ``vp="stack"``: every processor the stack-based one."""
     from amaranth.sim import Simulator
     from rasterhw.hdl.sparse.cell import cell_stats
     from rasterhw.hdl.sparse.matrix import Matrix
 
     _check(recs, limit, in_depth)
-    dut = Matrix(n=n, p=p, q=q, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth)
+    dut = Matrix(n=n, p=p, q=q, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth, vp=vp)
     W, H = p << n, q << n
     res = {"tri": np.full((H, W), -1, dtype=np.int64), "zq": np.full((H, W), -1, dtype=np.int64)}
     names = cell_stats(n)

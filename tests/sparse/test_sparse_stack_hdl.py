@@ -63,3 +63,30 @@ def test_stack_hdl_rejects_bad_parameters():
                {"n": 3, "kp": -1}, {"n": 3, "ke": 0}, {"n": 3, "colour": 1}, {"n": 3, "kp": True}):
         with pytest.raises(ValueError):
             StackProcessor(**kw)
+
+
+@pytest.mark.parametrize("limit", [1, 8])
+def test_coupled_matrix_of_stack_processors_cycle_exact(limit):
+    """hdl/sparse/matrix.py with vp="stack": every cell a stack processor behind its input FIFO,
+    cycle for cycle cycles.coupled_matrix on the stack processors' service times (frame, broadcast
+    stalls, FIFO peaks, busy cycles), the frame's end moved only by the last pixels' drain."""
+    from rasterhw.golden_model.sparse.cycles import coupled_matrix
+    from rasterhw.golden_model.sparse.fixed import broadcast_records
+    from rasterhw.sim.sparse.matrix_run import run_matrix_pysim
+
+    tris = random_triangles(16, 16, 12, mean_area=16.0, seed=12 + limit)
+    f = sparse_render(tris, "2x2", depth="fixed", per_record=True)
+    gz = np.where(f.tri_id >= 0, np.rint(f.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    h = run_matrix_pysim(broadcast_records(tris), n=f.n, p=2, q=2, limit=limit, z_bits=tris.z_bits, vp="stack")
+    assert np.array_equal(h["tri"], f.tri_id) and np.array_equal(h["zq"], gz)
+    s = service_times(f.stats["windows_per_record"], vp="stack")
+    g = coupled_matrix(s, limit)
+    tail = np.stack([stack_processor(tris, "2x2", k % 2, k // 2)["tail"] for k in range(4)])
+    assert h["cycles"] == int((g.pop + s + tail).max())
+    assert h["cycles"] - g.frame_cycles in (0, 1, 2)
+    assert h["stall_cycles"] == g.stall_cycles and (limit > 1 or g.stall_cycles > 0)
+    assert h["stats"]["fifo_peak"].tolist() == g.fifo_peak.tolist()
+    assert h["stats"]["busy_cycles"].tolist() == g.busy.tolist()
+    assert h["stats"]["records"].tolist() == [f.triangles] * 4
+    tests = np.stack([h["stats"][f"tests_{i}"] for i in range(1, f.n + 1)], axis=1)
+    assert np.array_equal(tests, f.tests_per_proc[:, 1:])
