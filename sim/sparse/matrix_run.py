@@ -40,14 +40,17 @@ def _check(recs, limit: int, in_depth: int) -> None:
 
 
 def build_matrix(*, n: int, p: int, q: int, z_bits: int = 24, fifo_depth: int = 8,
-                 in_depth: int = IN_DEPTH) -> tuple[Path, float, dict]:
-    """Build once per parameter set; returns ``(binary, build seconds or 0, Verilog sizes)``."""
+                 in_depth: int = IN_DEPTH, vp: str = "pipeline") -> tuple[Path, float, dict]:
+    """Build once per parameter set; returns ``(binary, build seconds or 0, Verilog sizes)``.
+    ``vp="stack"``: every cell's processor the stack-based one."""
     from rasterhw.hdl.sparse.cell import MatrixCell, cell_stats
     from rasterhw.hdl.sparse.layouts import BROADCAST
     from rasterhw.hdl.sparse.matrix import CELL_MODULE, Matrix
     from rasterhw.sim.engines.verilog_cache import convert_cached
 
     kw = dict(n=n, p=p, q=q, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth)
+    if vp != "pipeline":  # the pipeline's cache keys stay as they were
+        kw["vp"] = vp
     cell = convert_cached("sparse-matrix", lambda: MatrixCell(**kw), params=kw,
                           module=CELL_MODULE)
     top = convert_cached("sparse-matrix", lambda: Matrix(**kw, cells="instance"), params={**kw, "cells": "instance"},
@@ -70,14 +73,14 @@ def _pack(recs) -> bytes:
 
 
 def run_matrix_verilator(recs: list[dict], *, n: int, p: int, q: int, limit: int, z_bits: int = 24,
-                         fifo_depth: int = 8, in_depth: int = IN_DEPTH) -> dict:
+                         fifo_depth: int = 8, in_depth: int = IN_DEPTH, vp: str = "pipeline") -> dict:
     """The matrix on Verilator: ``tri`` / ``zq`` (full raster, -1 where empty), ``cycles`` (the
     matrix's frame counter), ``stall_cycles``, ``stats`` (counter name -> (p*q,) array), ``run_s``,
     ``build_s``, ``sim_cycles`` (bench clocks, read-out included), Verilog sizes."""
     from rasterhw.hdl.sparse.cell import cell_stats
 
     _check(recs, limit, in_depth)
-    exe, build_s, sizes = build_matrix(n=n, p=p, q=q, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth)
+    exe, build_s, sizes = build_matrix(n=n, p=p, q=q, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth, vp=vp)
     run_dir = temp_run_folder(exe.parent.parent)
     (run_dir / "in.bin").write_bytes(_pack(recs))
     W, H = p << n, q << n

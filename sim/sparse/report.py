@@ -253,6 +253,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     # ---------------------------------------------------------------- stack-based against pipeline processors
     coupled_sec += _stack_vs_pipeline_rows(row, scenes=stack_scenes, sizes=stack_sizes)
     coupled_sec += _stack_hdl_rows(row, engine, scenes=stack_scenes)
+    coupled_sec += _stack_matrix_hdl_rows(row, engine)
 
     # ---------------------------------------------------------------- plots
     plots = _plots(out_dir, spr, mono, Sg, S_GRID)
@@ -798,6 +799,62 @@ def _stack_hdl_rows(row, engine: str, *, scenes: tuple[str, ...]) -> list[str]:
             "`hdl/sparse/stack_vp.py` (`StackProcessor`, block `sparse-stack-vp`) on the engines' testbench "
             "(`sim/sparse/testbench.py` `StackVPBench`): the broadcast records back to back, then its local memory and "
             "its counters read out, against `golden_model/sparse/stack.py`.\n", "\n".join(tab) + "\n"]
+
+
+def _stack_matrix_hdl_rows(row, engine: str) -> list[str]:
+    """The coupled matrix of HDL stack processors (``hdl/sparse/matrix.py``, ``vp="stack"``, one
+    simulation) at input FIFO depths 64 and 1: frame cycles, broadcast stalls and FIFO peaks against
+    the golden coupled model on the stack service times (plus the last pixels' drain)."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.reference import random_triangles
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.sparse.cycles import coupled_matrix, service_times
+    from rasterhw.golden_model.sparse.fixed import broadcast_records
+    from rasterhw.golden_model.sparse.search import sparse_render
+    from rasterhw.golden_model.sparse.stack import stack_processor
+    from rasterhw.sim.sparse.matrix_run import run_matrix_pysim, run_matrix_verilator
+
+    if engine == "verilator":
+        W, p, lab, run, depths = 512, 4, "c300 512x512, 4x4", run_matrix_verilator, (64, 1)
+        tris = run_geometry(build_scene("c300"), W, W)
+    elif engine == "pysim":  # its input FIFOs built 8 deep
+        W, p, lab, run, depths = 16, 2, "12 random triangles of 16 px, 16x16, 2x2", run_matrix_pysim, (8, 1)
+        tris = random_triangles(W, W, 12, mean_area=16.0, seed=SEED)
+    else:
+        return []
+    src = f"hdl:{engine}"
+    f = sparse_render(tris, (p, p), depth="fixed", per_record=True)
+    gz = np.where(f.tri_id >= 0, np.rint(f.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    s = service_times(f.stats["windows_per_record"], vp="stack")
+    tail = np.stack([stack_processor(tris, (p, p), k % p, k // p)["tail"] for k in range(p * p)])
+    tab = ["| input FIFO depth | frame cycles, HDL | golden | stall cycles, HDL | golden | FIFO peak, HDL = golden | "
+           "pixels differing | busy and tests equal |", "|---|---|---|---|---|---|---|---|"]
+    for D in depths:
+        h = run(broadcast_records(tris), n=f.n, p=p, q=p, limit=D, z_bits=tris.z_bits, vp="stack")
+        g = coupled_matrix(s, D)
+        gf = int((g.pop + s + tail).max())
+        pix = int(np.count_nonzero((h["tri"] != f.tri_id) | (h["zq"] != gz)))
+        peak_ok = h["stats"]["fifo_peak"].tolist() == g.fifo_peak.tolist()
+        tests = np.stack([h["stats"][f"tests_{i}"] for i in range(1, f.n + 1)], axis=1)
+        same = h["stats"]["busy_cycles"].tolist() == g.busy.tolist() and np.array_equal(tests, f.tests_per_proc[:, 1:])
+        tab.append(f"| {D} | {h['cycles']} | {gf} | {h['stall_cycles']} | {g.stall_cycles} | "
+                   f"{int(h['stats']['fifo_peak'].max())} ({'=' if peak_ok else '≠'}) | {pix} | {'yes' if same else 'NO'} |")
+        row("(8) / stack HDL matrix", f"{lab}: coupled matrix of HDL stack processors, input FIFO depth {D}: frame "
+            "cycles (golden: coupled model on the stack service times plus the last pixels' drain)", paper=None,
+            formula=None, measured=h["cycles"], unit="cycles", source=src)
+        row("(8) / stack HDL matrix", f"{lab}: coupled matrix of HDL stack processors, input FIFO depth {D}: frame "
+            "cycles HDL minus golden", paper=None, formula=None, measured=h["cycles"] - gf, unit="cycles", source=src)
+        row("(8) / stack HDL matrix", f"{lab}: coupled matrix of HDL stack processors, input FIFO depth {D}: broadcast "
+            "stall cycles HDL minus golden", paper=None, formula=None, measured=h["stall_cycles"] - g.stall_cycles,
+            unit="cycles", source=src)
+        row("(8) / stack HDL matrix", f"{lab}: coupled matrix of HDL stack processors, input FIFO depth {D}: pixels "
+            f"differing from the golden search (of {f.tri_id.size})", paper=None, formula=None, measured=pix,
+            unit="pixels", source=src)
+    return ["## The coupled matrix of stack processors in HDL\n",
+            f"`hdl/sparse/matrix.py` with `vp=\"stack\"` on {lab}, one simulation ({engine}), against "
+            "`cycles.coupled_matrix` on the stack processors' service times; the HDL frame ends when the last "
+            "pixel leaves the pixel processor (the golden model's per-record drain, `stack_processor`'s `tail`).\n",
+            "\n".join(tab) + "\n"]
 
 
 def _load_rows(row, W: int, ntri: int) -> list[str]:

@@ -211,3 +211,23 @@ def test_stack_hdl_rows_on_pysim():
     pix, cnt, busy, pix4, cnt4, busy4 = (r["measured"] for r in rows)
     assert pix == cnt == pix4 == cnt4 == 0 and 100 < busy < busy4    # parameters cost cycles as (5) prices them
     assert sec[-1].count("| 0 | 0 of") == 2
+
+
+@pytest.mark.slow   # ~20 s: two pysim matrices; the same HDL is checked quickly in test_sparse_stack_hdl.py
+def test_stack_matrix_hdl_rows_on_pysim():
+    from rasterhw.sim.sparse.report import _stack_matrix_hdl_rows
+
+    rows = []
+
+    def row(fig, qty, **kw):
+        rows.append({"figure": fig, "quantity": qty, **kw})
+
+    sec = _stack_matrix_hdl_rows(row, "pysim")
+    assert len(rows) == 8 and all(r["source"] == "hdl:pysim" for r in rows)
+    got = {r["quantity"].split(": ", 1)[1]: r["measured"] for r in rows}
+    for D in (8, 1):
+        pre = f"coupled matrix of HDL stack processors, input FIFO depth {D}: "
+        assert got[pre + "frame cycles HDL minus golden"] == 0
+        assert got[pre + "broadcast stall cycles HDL minus golden"] == 0
+        assert got[pre + "pixels differing from the golden search (of 256)"] == 0
+    assert "| yes |" in sec[-1] and "NO" not in sec[-1]
