@@ -17,6 +17,10 @@ _VP_FIFO_DEPTH = Option(name="vp_fifo_depth", type=int, default=8,
                         help="coupled matrix: depth of the FIFOs between a processor's levels, 2..64 (a build "
                              "parameter)")
 
+_VP = Option(name="vp", default="pipeline", choices=("pipeline", "stack"),
+             help="coupled matrix: the video processors' raster processor: the pipeline (one stage per level, "
+                  "the default) or the paper's stack processor (one coverage-test unit and a stack)")
+
 _NO_CLOCK = Clock("sync", "sparse video processor: the paper names no clock", None, "clock")
 
 MACHINE = Machine(
@@ -35,7 +39,7 @@ MACHINE = Machine(
     sims=(SimBlock(name="sparse", help="every video processor of the matrix in HDL, interleaved local memories "
                                        "against the bit-accurate golden model",
                    simulate="rasterhw.sim.sparse.sim:simulate", default_scene="c300",
-                   options=(_MATRIX, _COUPLED, _FIFO_DEPTH, _VP_FIFO_DEPTH),
+                   options=(_MATRIX, _COUPLED, _FIFO_DEPTH, _VP_FIFO_DEPTH, _VP),
                    bytes_per_pixel=700),),
     report="rasterhw.sim.sparse.report:rows",
     bench="rasterhw.sim.sparse.bench:bench",

@@ -90,3 +90,21 @@ def test_coupled_matrix_of_stack_processors_cycle_exact(limit):
     assert h["stats"]["records"].tolist() == [f.triangles] * 4
     tests = np.stack([h["stats"][f"tests_{i}"] for i in range(1, f.n + 1)], axis=1)
     assert np.array_equal(tests, f.tests_per_proc[:, 1:])
+
+
+def test_sim_sparse_vp_stack_pysim_and_bad_options():
+    """``rasterhw sim sparse --vp stack``: the coupled matrix of stack processors against its golden
+    coupled model (cycle_mismatches 0); --vp belongs to the coupled matrix."""
+    from rasterhw.golden_model.errors import RasterhwError
+    from rasterhw.sim.sparse.sim import simulate, simulate_coupled
+
+    tris = random_triangles(16, 16, 10, mean_area=16.0, seed=9)
+    r = simulate_coupled(tris, "2x2", engine="pysim", fifo_depth=1, vp="stack")
+    assert r["vp"] == "stack" and r["mismatches"] == 0 and r["cycle_mismatches"] == 0
+    assert r["cycles_compared"] > 10 and r["stall_cycles"] > 0 and r["fifo_peak_max"] == 1
+    with pytest.raises(RasterhwError, match="--vp must be"):
+        simulate_coupled(tris, "2x2", engine="pysim", vp="tree")
+    with pytest.raises(RasterhwError, match="no inner FIFOs"):
+        simulate_coupled(tris, "2x2", engine="pysim", vp="stack", vp_fifo_depth=2)
+    with pytest.raises(RasterhwError, match="drop --no-coupled"):
+        simulate("c50", 32, 32, engine="pysim", matrix="2x2", coupled=False, vp="stack")
