@@ -15,7 +15,7 @@ from rasterhw.golden_model.sparse.formats import (
     Z_ACC_BITS,
     Z_FRAC_BITS,
 )
-from rasterhw.hdl.sparse.layouts import BROADCAST, HEADER, WINDOW
+from rasterhw.hdl.sparse.layouts import BROADCAST, HEADER
 from rasterhw.hdl.sparse.pixel import PixelProcessor
 from rasterhw.hdl.sparse.vp import VideoProcessor
 
@@ -76,7 +76,7 @@ class StackProcessor(wiring.Component):
     def __init__(self, *, n: int, p: int = 4, q: int = 4, alpha: int = 2, beta: int = 2, z_bits: int = 24,
                  colour: bool = False, kp: int = 0, ke: int = 3):
         try:
-            VideoProcessor._check(self, n, p, q, alpha, beta)
+            VideoProcessor._check(self, n, p, q, alpha, beta)  # the pipeline's checks; sets _lp, _lq
             if not isinstance(z_bits, int) or not 1 <= z_bits <= 32:
                 raise ValueError(f"z_bits must be an integer in 1..32, not {z_bits!r}")
             if not isinstance(colour, bool):
@@ -200,7 +200,6 @@ class StackProcessor(wiring.Component):
         for k in range(3):
             m.d.comb += px.i.payload.E[k].eq(out.E[k])
         m.d.comb += [rd.addr.eq(sp - 1), wr.addr.eq(sp), wr.data.eq(out)]
-        assert WINDOW.size  # the pixel stream is the pipeline's WINDOW
         rgb_busy = Const(0)
         if self._colour:
             rgb_busy = self._colour_memory(m, px, out, n)
