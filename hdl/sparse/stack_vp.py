@@ -109,7 +109,7 @@ class StackProcessor(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        n, p, q = self._n, self._p, self._q
+        n = self._n
         lp, lq, ls = self._lp, self._lq, SUBPIXEL_BITS
         lvl_bits = max(1, (n - 1).bit_length())
         fields = {"lvl": unsigned(lvl_bits), "E": data.ArrayLayout(signed(EDGE_BITS), 3),

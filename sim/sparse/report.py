@@ -715,7 +715,7 @@ def _stack_vs_pipeline_rows(row, *, scenes: tuple[str, ...], sizes: tuple[int, .
         for W in sizes:
             tris = run_geometry(build_scene(scene), W, W)
             f = sparse_render(tris, matrix, depth="fixed", trace=True, per_record=True)
-            n, P = f.n, f.p * f.q
+            n = f.n
             w = f.stats["windows_per_record"]
             tests = f.tests_per_proc[:, 1:].sum(axis=1).astype(float)  # (P,) coverage tests per processor
             lab = f"{scene} {W}x{W}, {matrix}"
@@ -756,7 +756,6 @@ def _stack_hdl_rows(row, engine: str, *, scenes: tuple[str, ...]) -> list[str]:
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.sim.engines import run
     from rasterhw.sim.sparse.testbench import StackVPBench
-    from rasterhw.sim.testbench import Stimulus
 
     if engine == "verilator":
         cases = [(f"{sc} 512x512, 4x4", run_geometry(build_scene(sc), 512, 512), 4) for sc in scenes]
