@@ -3,7 +3,7 @@ instance of the matrix shares)."""
 
 from __future__ import annotations
 
-from amaranth.hdl import Module, Signal
+from amaranth.hdl import Const, Module, Signal
 from amaranth.lib import fifo, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import MATRIX_LOG2_MAX, TRI_BITS
@@ -42,13 +42,25 @@ class MatrixCell(wiring.Component):
     stat_sel : In, stat : Out(32) — counter ``stat_sel`` of :func:`cell_stats`: the processor's
         per-level tests and stalls, its pixel writes, the cycles its ``busy`` was high, the largest
         FIFO level, the records it took.
+
+    ``vp="stack"``: the processor is the stack-based one (``hdl/sparse/stack_vp.py``); its stalls
+    read 0 (it never waits for an output) and ``busy_cycles`` is its own count of the cycles it
+    holds a record (the take cycle, set-up and tests: ``cycles.service_times(vp="stack")``).
     """
 
     def __init__(self, *, n: int, p: int, q: int, alpha: int = 2, beta: int = 2, z_bits: int = 24,
-                 fifo_depth: int = 8, in_depth: int = 64):
+                 fifo_depth: int = 8, in_depth: int = 64, vp: str = "pipeline"):
         if not isinstance(in_depth, int) or not 1 <= in_depth <= 1024:
             raise ValueError(f"in_depth must be an integer in 1..1024, not {in_depth!r}")
-        self._vp = VideoProcessor(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth)
+        if vp == "pipeline":
+            self._vp = VideoProcessor(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth)
+        elif vp == "stack":
+            from rasterhw.hdl.sparse.stack_vp import StackProcessor
+
+            self._vp = StackProcessor(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits)
+        else:
+            raise ValueError(f"vp must be 'pipeline' or 'stack', not {vp!r}")
+        self._stack = vp == "stack"
         self._n, self._in_depth = n, in_depth
         super().__init__({"a": In(MATRIX_LOG2_MAX), "b": In(MATRIX_LOG2_MAX), "limit": In(range(in_depth + 1)),
                           "push": In(1), "rec": In(BROADCAST), "room": Out(1), "busy": Out(1),
@@ -73,8 +85,11 @@ class MatrixCell(wiring.Component):
             m.d.sync += peak.eq(f.level)
         with m.If(vp.i.valid & vp.i.ready):
             m.d.sync += records.eq(records + 1)
-        vals = ([getattr(vp, f"tests_{i}") for i in range(1, n + 1)] + [getattr(vp, f"stalls_{i}") for i in range(1, n + 1)]
-                + [vp.writes, busy_cycles, peak, records])
+        if self._stack:
+            stalls, busy_cycles = [Const(0, 32)] * n, vp.busy_cycles
+        else:
+            stalls = [getattr(vp, f"stalls_{i}") for i in range(1, n + 1)]
+        vals = [getattr(vp, f"tests_{i}") for i in range(1, n + 1)] + stalls + [vp.writes, busy_cycles, peak, records]
         with m.Switch(self.stat_sel):
             for k, v in enumerate(vals):
                 with m.Case(k):

@@ -34,7 +34,8 @@ class Matrix(wiring.Component):
     ``cells="inline"`` elaborates every cell (pysim); ``cells="instance"`` instantiates the Verilog
     module :data:`CELL_MODULE` by name, ``p*q`` times, so the generated Verilog holds one processor
     module however large the matrix (the cell's Verilog is generated once, separately:
-    ``MatrixCell`` of the same parameters converted with that name).
+    ``MatrixCell`` of the same parameters converted with that name). ``vp="stack"``: every cell's
+    processor is the stack-based one (``hdl/sparse/stack_vp.py``) instead of the pipeline.
 
     Members
     -------
@@ -51,11 +52,11 @@ class Matrix(wiring.Component):
     """
 
     def __init__(self, *, n: int, p: int = 2, q: int = 2, alpha: int = 2, beta: int = 2, z_bits: int = 24,
-                 fifo_depth: int = 8, in_depth: int = 64, cells: str = "inline"):
+                 fifo_depth: int = 8, in_depth: int = 64, cells: str = "inline", vp: str = "pipeline"):
         if cells not in ("inline", "instance"):
             raise ValueError(f"cells must be 'inline' or 'instance', not {cells!r}")
         self._kw = dict(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth,
-                        in_depth=in_depth)
+                        in_depth=in_depth, vp=vp)
         # the processor's checks run here (a bad parameter set fails before any instance is made)
         self._cells = [MatrixCell(**self._kw)] if cells == "instance" else [MatrixCell(**self._kw) for _ in range(p * q)]
         if cells == "instance":
@@ -119,7 +120,8 @@ class Matrix(wiring.Component):
 
 
 def make_matrix(*, n: int = 4, p: int = 2, q: int = 2, alpha: int = 2, beta: int = 2, z_bits: int = 24,
-                fifo_depth: int = 8, in_depth: int = 64) -> Matrix:
+                fifo_depth: int = 8, in_depth: int = 64, vp: str = "pipeline") -> Matrix:
     """Factory for ``rasterhw verilog sparse-matrix`` (default: 2x2 processors on a 32x32 raster,
     every cell elaborated)."""
-    return Matrix(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth)
+    return Matrix(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth,
+                  vp=vp)

@@ -8,6 +8,7 @@ loaded at run time (``$readmemh``) and the words and cycle stamps dumped at the 
 from __future__ import annotations
 
 import hashlib
+import inspect
 import time
 from pathlib import Path
 
@@ -103,7 +104,9 @@ class BenchTop(Elaboratable):
 
 
 def _build(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[str, int]) -> tuple[Path, float]:
-    key = {**params, "inputs": inputs, "outputs": outputs, "bench": _SELF}
+    # the testbench's own module builds the DUT's adapter (e.g. a read-out): its bytes are design too
+    tb_src = hashlib.sha1(Path(inspect.getfile(type(tb))).read_bytes()).hexdigest()[:12]
+    key = {**params, "inputs": inputs, "outputs": outputs, "bench": _SELF, "testbench": tb_src}
     text = convert_cached(
         tb.block, lambda: BenchTop(tb.dut(params), inputs, outputs, tb.domains), params=key, module="rasterhw_bench",
         convert=lambda top, mod: canonical_port_lists(verilog.convert(top, name=mod, ports=top.ports)) + _extra(top.dut))

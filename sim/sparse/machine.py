@@ -17,6 +17,10 @@ _VP_FIFO_DEPTH = Option(name="vp_fifo_depth", type=int, default=8,
                         help="coupled matrix: depth of the FIFOs between a processor's levels, 2..64 (a build "
                              "parameter)")
 
+_VP = Option(name="vp", default="pipeline", choices=("pipeline", "stack"),
+             help="coupled matrix: the video processors' raster processor: the pipeline (one stage per level, "
+                  "the default) or the paper's stack processor (one coverage-test unit and a stack)")
+
 _NO_CLOCK = Clock("sync", "sparse video processor: the paper names no clock", None, "clock")
 
 MACHINE = Machine(
@@ -30,22 +34,26 @@ MACHINE = Machine(
              render="rasterhw.golden_model.sparse.render:render",
              options=(_MATRIX,), bytes_per_pixel=700),  # measured ~540 (peak RSS, 1024 x 1024)
     ),
-    blocks={"sparse-vp": "rasterhw.hdl.sparse.vp:make_vp", "sparse-matrix": "rasterhw.hdl.sparse.matrix:make_matrix"},
+    blocks={"sparse-vp": "rasterhw.hdl.sparse.vp:make_vp", "sparse-matrix": "rasterhw.hdl.sparse.matrix:make_matrix",
+            "sparse-stack-vp": "rasterhw.hdl.sparse.stack_vp:make_stack_vp"},
     sims=(SimBlock(name="sparse", help="every video processor of the matrix in HDL, interleaved local memories "
                                        "against the bit-accurate golden model",
                    simulate="rasterhw.sim.sparse.sim:simulate", default_scene="c300",
-                   options=(_MATRIX, _COUPLED, _FIFO_DEPTH, _VP_FIFO_DEPTH),
+                   options=(_MATRIX, _COUPLED, _FIFO_DEPTH, _VP_FIFO_DEPTH, _VP),
                    bytes_per_pixel=700),),
     report="rasterhw.sim.sparse.report:rows",
     bench="rasterhw.sim.sparse.bench:bench",
     testbenches={"sparse-vp": "rasterhw.sim.sparse.testbench:VPBench",
-                 "sparse-matrix": "rasterhw.sim.sparse.testbench:MatrixBench"},
+                 "sparse-matrix": "rasterhw.sim.sparse.testbench:MatrixBench",
+                 "sparse-stack-vp": "rasterhw.sim.sparse.testbench:StackVPBench"},
     soak={"sparse": "rasterhw.sim.sparse.soak:sparse_round"},
     flows={"sparse-vp": Flow(small={"n": 4, "p": 2, "q": 2}, clocks=(_NO_CLOCK,)),
-           "sparse-matrix": Flow(small={"n": 3, "in_depth": 4}, clocks=(_NO_CLOCK,))},
+           "sparse-matrix": Flow(small={"n": 3, "in_depth": 4}, clocks=(_NO_CLOCK,)),
+           "sparse-stack-vp": Flow(small={"n": 4, "p": 2, "q": 2}, clocks=(_NO_CLOCK,))},
     fpga_note="The sparse video processor's paper names no clock (docs/sparse.md).",
     status="golden model (image = reference), formulas (1)-(12), Monte-Carlo window counts, figs. 3-6; "
            "video processor in Amaranth, bit-exact in pysim and Verilator; the whole matrix (broadcast, input FIFOs, "
            "back-pressure, interleaved read-out) in one simulation, bit- and cycle-exact at 1024² 4x4; golden cycle models of the coupled "
-           "matrix (FIFO sizing), of the HDL video processor (cycle-exact) and of a stack-based processor",
+           "matrix (FIFO sizing), of the HDL video processor (cycle-exact) and of a stack-based processor; the stack-based "
+           "processor in Amaranth, bit- and cycle-exact against its golden model",
 )

@@ -20,6 +20,7 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.sparse.formats import TRI_BITS
 from rasterhw.sim.engines.memh import memh_uint64, read_memh
 from rasterhw.sim.engines.runner import build_plain_verilator, run_plain_verilator
+from rasterhw.sim.sparse.verilator_run import SHARED_VH
 from rasterhw.sim.workdirs import release, temp_run_folder
 
 __all__ = ["IN_DEPTH", "build_matrix", "run_matrix_pysim", "run_matrix_verilator"]
@@ -39,14 +40,17 @@ def _check(recs, limit: int, in_depth: int) -> None:
 
 
 def build_matrix(*, n: int, p: int, q: int, z_bits: int = 24, fifo_depth: int = 8,
-                 in_depth: int = IN_DEPTH) -> tuple[Path, float, dict]:
-    """Build once per parameter set; returns ``(binary, build seconds or 0, Verilog sizes)``."""
+                 in_depth: int = IN_DEPTH, vp: str = "pipeline") -> tuple[Path, float, dict]:
+    """Build once per parameter set; returns ``(binary, build seconds or 0, Verilog sizes)``.
+    ``vp="stack"``: every cell's processor the stack-based one."""
     from rasterhw.hdl.sparse.cell import MatrixCell, cell_stats
     from rasterhw.hdl.sparse.layouts import BROADCAST
     from rasterhw.hdl.sparse.matrix import CELL_MODULE, Matrix
     from rasterhw.sim.engines.verilog_cache import convert_cached
 
     kw = dict(n=n, p=p, q=q, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth)
+    if vp != "pipeline":  # the pipeline's cache keys stay as they were
+        kw["vp"] = vp
     cell = convert_cached("sparse-matrix", lambda: MatrixCell(**kw), params=kw,
                           module=CELL_MODULE)
     top = convert_cached("sparse-matrix", lambda: Matrix(**kw, cells="instance"), params={**kw, "cells": "instance"},
@@ -57,7 +61,8 @@ def build_matrix(*, n: int, p: int, q: int, z_bits: int = 24, fifo_depth: int = 
               "NS": ns, "LIMW": in_depth.bit_length(), "CW": max(1, (max(p * q, 2) - 1).bit_length()),
               "SW": max(1, (ns - 1).bit_length())}
     exe, secs = build_plain_verilator("sparse-matrix", TOP, [BENCH], params=params, defines={"RASTERHW_CYCLES": 1},
-                                      generated={"sparse_cell.v": cell, "sparse_matrix.v": top})
+                                      generated={"sparse_cell.v": cell, "sparse_matrix.v": top,
+                                                 **{f: (BENCH.parent / f).read_text() for f in SHARED_VH}})
     return exe, secs, {"verilog_bytes_cell": len(cell), "verilog_bytes_matrix": len(top)}
 
 
@@ -68,14 +73,14 @@ def _pack(recs) -> bytes:
 
 
 def run_matrix_verilator(recs: list[dict], *, n: int, p: int, q: int, limit: int, z_bits: int = 24,
-                         fifo_depth: int = 8, in_depth: int = IN_DEPTH) -> dict:
+                         fifo_depth: int = 8, in_depth: int = IN_DEPTH, vp: str = "pipeline") -> dict:
     """The matrix on Verilator: ``tri`` / ``zq`` (full raster, -1 where empty), ``cycles`` (the
     matrix's frame counter), ``stall_cycles``, ``stats`` (counter name -> (p*q,) array), ``run_s``,
     ``build_s``, ``sim_cycles`` (bench clocks, read-out included), Verilog sizes."""
     from rasterhw.hdl.sparse.cell import cell_stats
 
     _check(recs, limit, in_depth)
-    exe, build_s, sizes = build_matrix(n=n, p=p, q=q, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth)
+    exe, build_s, sizes = build_matrix(n=n, p=p, q=q, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth, vp=vp)
     run_dir = temp_run_folder(exe.parent.parent)
     (run_dir / "in.bin").write_bytes(_pack(recs))
     W, H = p << n, q << n
@@ -101,16 +106,17 @@ def run_matrix_verilator(recs: list[dict], *, n: int, p: int, q: int, limit: int
 
 
 def run_matrix_pysim(recs: list[dict], *, n: int, p: int, q: int, limit: int, z_bits: int = 24,
-                     fifo_depth: int = 8, in_depth: int = 8, gaps=None) -> dict:
+                     fifo_depth: int = 8, in_depth: int = 8, gaps=None, vp: str = "pipeline") -> dict:
     """The matrix in Amaranth pysim, every cell elaborated, with the Verilator bench's protocol (a
     record offered on every cycle from the first; ``gaps``: a per-cycle offer pattern instead).
-    Same keys as :func:`run_matrix_verilator` (``sim_cycles`` and ``run_s`` of the whole run)."""
+    Same keys as :func:`run_matrix_verilator` (``sim_cycles`` and ``run_s`` of the whole run).
+    ``vp="stack"``: every processor the stack-based one."""
     from amaranth.sim import Simulator
     from rasterhw.hdl.sparse.cell import cell_stats
     from rasterhw.hdl.sparse.matrix import Matrix
 
     _check(recs, limit, in_depth)
-    dut = Matrix(n=n, p=p, q=q, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth)
+    dut = Matrix(n=n, p=p, q=q, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth, vp=vp)
     W, H = p << n, q << n
     res = {"tri": np.full((H, W), -1, dtype=np.int64), "zq": np.full((H, W), -1, dtype=np.int64)}
     names = cell_stats(n)

@@ -43,7 +43,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
          samples: int = 20000, scenes: tuple[str, ...] = ("c300", "sp27"), s_grid: tuple[float, ...] = S_GRID,
          coupled_size: int = 1 << M_BITS, coupled_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8", "16x16"),
          load_triangles: int = 3000, coupled_vp_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8"),
-         stack_size: int = 512, coupled_scene: str = "c300", **known):
+         stack_size: int = 512, coupled_scene: str = "c300",
+         stack_scenes: tuple[str, ...] = ("c300", "sp27"), stack_sizes: tuple[int, ...] = (512, 1 << M_BITS), **known):
     """Rows and markdown sections of the sparse-raster report (see the module docstring)."""
     M = int(samples)
     S_GRID = tuple(s_grid)  # noqa: N806 (the module default, narrowed by tests)
@@ -248,6 +249,11 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     coupled_sec = _coupled_rows(row, out_dir, size=coupled_size, matrices=coupled_matrices,
                                 load_triangles=load_triangles, vp_matrices=coupled_vp_matrices,
                                 stack_size=stack_size, scene=coupled_scene)
+
+    # ---------------------------------------------------------------- stack-based against pipeline processors
+    coupled_sec += _stack_vs_pipeline_rows(row, scenes=stack_scenes, sizes=stack_sizes)
+    coupled_sec += _stack_hdl_rows(row, engine, scenes=stack_scenes)
+    coupled_sec += _stack_matrix_hdl_rows(row, engine)
 
     # ---------------------------------------------------------------- plots
     plots = _plots(out_dir, spr, mono, Sg, S_GRID)
@@ -673,11 +679,181 @@ def _stack_rows(row, scene: str, size: int) -> str:
         f"golden search (of {f.tri_id.size})", paper=None, formula=0, measured=diff, unit="pixels", source="golden")
     row("(8) / stack", f"{lab}: stack processors' cycles per record equal the stack cycle model (1 = yes)",
         paper=None, formula=1, measured=int(same_cycles), unit="", source="golden")
-    row("(8) / stack", f"{lab}: deepest stack over every processor and record (formula: the bound 3 (n - 1) + 1)",
-        paper=None, formula=3 * (n - 1) + 1, measured=deepest, unit="entries", source="golden")
+    row("(8) / stack", f"{lab}: deepest stack over every processor and record (formula: the bound 3 (n - 1))",
+        paper=None, formula=3 * (n - 1), measured=deepest, unit="entries", source="golden")
     return (f"`golden_model/sparse/stack.py` ran every processor of {lab} depth first: {diff} pixels differ from the "
             f"breadth-first search, its per-record cycles {'equal' if same_cycles else 'DIFFER from'} the stack "
-            f"cycle model's, and the deepest stack held {deepest} windows (bound {3 * (n - 1) + 1}).\n")
+            f"cycle model's, and the deepest stack held {deepest} windows (bound {3 * (n - 1)}).\n")
+
+
+#: the matrix input FIFO depth of the stack-against-pipeline rows (the HDL matrix's default build)
+STACK_CMP_DEPTH = 64
+
+
+def _stack_vs_pipeline_rows(row, *, scenes: tuple[str, ...], sizes: tuple[int, ...], matrix: str = "4x4") -> list[str]:
+    """The same frames through a 4x4 matrix of stack-based processors and of pipeline processors:
+    frame cycles, each processor's load (busy / frame, least and most loaded) and the load of its
+    coverage-test units (stack: one unit, tests / frame; pipeline: n stage units, sum of the stages'
+    tests / (n frame), the frame's R_p). Stack: the golden stack cycle model (3 + tests per record; the
+    HDL ``StackProcessor`` is cycle-exact with it). Pipeline: the golden cycle model of the HDL video
+    processor as built (``vpcycles.coupled_matrix_vp``, cycle-exact with ``hdl/sparse/vp.py``) and the
+    pipeline as a server of (9)."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.sparse import cycles as cy
+    from rasterhw.golden_model.sparse.search import sparse_render
+    from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
+
+    D = STACK_CMP_DEPTH
+    fig = "(8) / (9) stack vs pipeline"
+    tab = [f"Matrix {matrix}, input FIFO depth {D}, GP issue interval {cy.GP_ISSUE_INTERVAL} (ours). Processor load = "
+           "busy cycles / frame cycles (least … most loaded processor); unit load = coverage tests / (units × frame), "
+           "mean over processors (stack: 1 unit; pipeline: n units, one per level).\n",
+           "| frame | processor | frame cycles | / pipeline (HDL) | processor load | unit load |",
+           "|---|---|---|---|---|---|"]
+    for scene in scenes:
+        for W in sizes:
+            tris = run_geometry(build_scene(scene), W, W)
+            f = sparse_render(tris, matrix, depth="fixed", trace=True, per_record=True)
+            n = f.n
+            w = f.stats["windows_per_record"]
+            tests = f.tests_per_proc[:, 1:].sum(axis=1).astype(float)  # (P,) coverage tests per processor
+            lab = f"{scene} {W}x{W}, {matrix}"
+            hv = coupled_matrix_vp(f, D)
+            runs = {"pipeline (HDL VP cycle model)": (hv["frame_cycles"], np.array(hv["busy"], dtype=float), n)}
+            for vp, name, kp in (("pipeline", "pipeline as a server (9)", 0),
+                                 ("stack", "stack (golden = HDL stack processor)", 0),
+                                 ("stack", "stack, depth + RGB priced as (5), k_p = 4, k_e = 3", 4)):
+                r = cy.coupled_matrix(cy.service_times(w, vp=vp, kp=kp), D)
+                runs[name] = (r.frame_cycles, r.busy.astype(float), 1 if vp == "stack" else n)
+            ref = hv["frame_cycles"]
+            for name, (fr, busy, units) in runs.items():
+                load = busy / fr
+                ul = float((tests / (units * fr)).mean())
+                tab.append(f"| {lab} | {name} | {fr} | {fr / ref:.3f} | {load.min():.4f} … {load.max():.4f} | {ul:.4f} |")
+                row(fig, f"{lab}: frame cycles, {name}, input FIFO depth {D}", paper=None, formula=None, measured=fr,
+                    unit="cycles", source="golden")
+                row(fig, f"{lab}: least loaded processor's busy / frame, {name}", paper=None, formula=None,
+                    measured=round(float(load.min()), 4), unit="", source="golden")
+                row(fig, f"{lab}: coverage-test unit load, tests / (units x frame), {name} ({units} unit"
+                    f"{'s' if units > 1 else ''})", paper=None, formula=None, measured=round(ul, 4), unit="",
+                    source="golden")
+            st = runs["stack (golden = HDL stack processor)"][0]
+            tf = th.stage_times(_formula_frame(np.asarray(tris.xy), n, f.p), kp_ke=0.0)
+            row(fig, f"{lab}: stack frame / pipeline frame (HDL VP cycle model) (formula: P_p / P_s = n R_p of (10) "
+                "on (1)'s counts, k_p/k_e = 0)", paper=None, formula=round(float(tf.sum() / tf.max()), 4),
+                measured=round(st / ref, 4), unit="ratio", source="golden")
+    return ["## Stack-based against pipeline processors on the same frames\n", "\n".join(tab) + "\n"]
+
+
+def _stack_hdl_rows(row, engine: str, *, scenes: tuple[str, ...]) -> list[str]:
+    """The HDL stack processor (``hdl/sparse/stack_vp.py``, block ``sparse-stack-vp``) on the engines'
+    testbench: processor (3, 3) of a 4x4 matrix on each scene at 512² (Verilator), or a small random
+    frame (pysim): pixels and counters (busy cycles, records, stack depth, writes, tests per level)
+    against the golden stack processor."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.reference import random_triangles
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.sim.engines import run
+    from rasterhw.sim.sparse.testbench import StackVPBench
+
+    if engine == "verilator":
+        cases = [(f"{sc} 512x512, 4x4", run_geometry(build_scene(sc), 512, 512), 4) for sc in scenes]
+    elif engine == "pysim":
+        cases = [("20 random triangles of 40 px, 32x32, 2x2", random_triangles(32, 32, 20, mean_area=40.0, seed=SEED), 2)]
+    else:
+        return [f"## The stack-based processor in HDL\n\nNo rows: engine {engine!r} is not supported (pysim or "
+                "verilator).\n"]
+    tb = StackVPBench()
+    src = f"hdl:{engine}"
+    tab = ["| frame | processor | configuration | pixels differing | counters differing | busy cycles HDL | "
+           "golden | deepest stack |", "|---|---|---|---|---|---|---|---|"]
+    for lab, tris, p in cases:
+        n = (tris.width // p).bit_length() - 1
+        for conf, kw in (("depth, k_p = 0", {}), ("depth + RGB, k_p = 4, k_e = 3 (5)", {"colour": True, "kp": 4})):
+            prm = tb.params(n=n, p=p, q=p, **kw)
+            stim = StackVPBench.records(tris, prm, what=lab)
+            exp = tb.expect(prm, stim)
+            got = run(tb, prm, stim, engine=engine, expect_words={"o": len(exp.words["o"])})
+            words = 1 << (2 * n)
+            e, g = exp.words["o"], got.words["o"]
+            pix = sum(int(x != y) for x, y in zip(e[:words], g[:words], strict=True))
+            cnt = sum(int(x != y) for x, y in zip(e[words:], g[words:], strict=True))
+            names = StackVPBench.counters(n)
+            hb, gb = g[words + names.index("busy_cycles")], e[words + names.index("busy_cycles")]
+            proc = f"({p - 1}, {p - 1})"
+            tab.append(f"| {lab} | {proc} | {conf} | {pix} | {cnt} of {len(names)} | {hb} | {gb} | "
+                       f"{g[words + names.index('max_stack')]} |")
+            what = "triangle and depth" + (" and colour" if kw else "")
+            row("(8) / stack HDL", f"{lab}, processor {proc}, {conf}: local-memory words ({what}) of the HDL stack "
+                f"processor differing from the golden stack processor (of {words})", paper=None, formula=None,
+                measured=pix, unit="pixels", source=src)
+            row("(8) / stack HDL", f"{lab}, processor {proc}, {conf}: counters of the HDL stack processor differing "
+                f"from the golden model (busy cycles, records, stack depth, writes, tests per level: {len(names)})",
+                paper=None, formula=None, measured=cnt, unit="counters", source=src)
+            row("(8) / stack HDL", f"{lab}, processor {proc}, {conf}: busy cycles of the HDL stack processor (golden: "
+                "3 + tests + parameter cycles per record)", paper=None, formula=None, measured=hb, unit="cycles",
+                source=src)
+    return ["## The stack-based processor in HDL\n",
+            "`hdl/sparse/stack_vp.py` (`StackProcessor`, block `sparse-stack-vp`) on the engines' testbench "
+            "(`sim/sparse/testbench.py` `StackVPBench`): the broadcast records back to back, then its local memory and "
+            "its counters read out, against `golden_model/sparse/stack.py`.\n", "\n".join(tab) + "\n"]
+
+
+def _stack_matrix_hdl_rows(row, engine: str) -> list[str]:
+    """The coupled matrix of HDL stack processors (``hdl/sparse/matrix.py``, ``vp="stack"``, one
+    simulation) at input FIFO depths 64 and 1: frame cycles, broadcast stalls and FIFO peaks against
+    the golden coupled model on the stack service times (plus the last pixels' drain)."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.reference import random_triangles
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.sparse.cycles import coupled_matrix, service_times
+    from rasterhw.golden_model.sparse.fixed import broadcast_records
+    from rasterhw.golden_model.sparse.search import sparse_render
+    from rasterhw.golden_model.sparse.stack import stack_processor
+    from rasterhw.sim.sparse.matrix_run import run_matrix_pysim, run_matrix_verilator
+
+    if engine == "verilator":
+        W, p, lab, run, depths = 512, 4, "c300 512x512, 4x4", run_matrix_verilator, (64, 1)
+        tris = run_geometry(build_scene("c300"), W, W)
+    elif engine == "pysim":  # its input FIFOs built 8 deep
+        W, p, lab, run, depths = 16, 2, "12 random triangles of 16 px, 16x16, 2x2", run_matrix_pysim, (8, 1)
+        tris = random_triangles(W, W, 12, mean_area=16.0, seed=SEED)
+    else:
+        return []
+    src = f"hdl:{engine}"
+    f = sparse_render(tris, (p, p), depth="fixed", per_record=True)
+    gz = np.where(f.tri_id >= 0, np.rint(f.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    s = service_times(f.stats["windows_per_record"], vp="stack")
+    tail = np.stack([stack_processor(tris, (p, p), k % p, k // p)["tail"] for k in range(p * p)])
+    tab = ["| input FIFO depth | frame cycles, HDL | golden | stall cycles, HDL | golden | FIFO peak, HDL = golden | "
+           "pixels differing | busy and tests equal |", "|---|---|---|---|---|---|---|---|"]
+    for D in depths:
+        h = run(broadcast_records(tris), n=f.n, p=p, q=p, limit=D, z_bits=tris.z_bits, vp="stack")
+        g = coupled_matrix(s, D)
+        gf = int((g.pop + s + tail).max())
+        pix = int(np.count_nonzero((h["tri"] != f.tri_id) | (h["zq"] != gz)))
+        peak_ok = h["stats"]["fifo_peak"].tolist() == g.fifo_peak.tolist()
+        tests = np.stack([h["stats"][f"tests_{i}"] for i in range(1, f.n + 1)], axis=1)
+        same = h["stats"]["busy_cycles"].tolist() == g.busy.tolist() and np.array_equal(tests, f.tests_per_proc[:, 1:])
+        tab.append(f"| {D} | {h['cycles']} | {gf} | {h['stall_cycles']} | {g.stall_cycles} | "
+                   f"{int(h['stats']['fifo_peak'].max())} ({'=' if peak_ok else '≠'}) | {pix} | {'yes' if same else 'NO'} |")
+        row("(8) / stack HDL matrix", f"{lab}: coupled matrix of HDL stack processors, input FIFO depth {D}: frame "
+            "cycles (golden: coupled model on the stack service times plus the last pixels' drain)", paper=None,
+            formula=None, measured=h["cycles"], unit="cycles", source=src)
+        row("(8) / stack HDL matrix", f"{lab}: coupled matrix of HDL stack processors, input FIFO depth {D}: frame "
+            "cycles HDL minus golden", paper=None, formula=None, measured=h["cycles"] - gf, unit="cycles", source=src)
+        row("(8) / stack HDL matrix", f"{lab}: coupled matrix of HDL stack processors, input FIFO depth {D}: broadcast "
+            "stall cycles HDL minus golden", paper=None, formula=None, measured=h["stall_cycles"] - g.stall_cycles,
+            unit="cycles", source=src)
+        row("(8) / stack HDL matrix", f"{lab}: coupled matrix of HDL stack processors, input FIFO depth {D}: pixels "
+            f"differing from the golden search (of {f.tri_id.size})", paper=None, formula=None, measured=pix,
+            unit="pixels", source=src)
+    return ["## The coupled matrix of stack processors in HDL\n",
+            f"`hdl/sparse/matrix.py` with `vp=\"stack\"` on {lab}, one simulation ({engine}), against "
+            "`cycles.coupled_matrix` on the stack processors' service times; the HDL frame ends when the last "
+            "pixel leaves the pixel processor (the golden model's per-record drain, `stack_processor`'s `tail`).\n",
+            "\n".join(tab) + "\n"]
 
 
 def _load_rows(row, W: int, ntri: int) -> list[str]:

@@ -92,15 +92,35 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
             "run_s": round(run_s, 4)}
 
 
+def _stack_golden(tris, p: int, q: int, fifo_depth: int) -> dict:
+    """The golden coupled model of a matrix of stack processors, keyed as ``coupled_matrix_vp``'s:
+    ``cycles.coupled_matrix`` on the stack service times, the frame extended by the last pixels'
+    drain (``stack_processor``'s per-record ``tail``), and the per-level tests."""
+    from rasterhw.golden_model.sparse.cycles import coupled_matrix, service_times
+    from rasterhw.golden_model.sparse.stack import stack_processor
+
+    f = sparse_render(tris, (p, q), depth="fixed", per_record=True)
+    s = service_times(f.stats["windows_per_record"], vp="stack")
+    tail = np.stack([stack_processor(tris, (p, q), k % p, k // p)["tail"] for k in range(p * q)])
+    r = coupled_matrix(s, fifo_depth)
+    frame = int((r.pop + s + tail).max()) if s.size else 0
+    return {"frame_cycles": frame, "stall_cycles": r.stall_cycles, "fifo_peak": r.fifo_peak.tolist(),
+            "fifo_peak_max": int(r.fifo_peak.max(initial=0)), "busy": r.busy.tolist(),
+            "idle": (frame - r.busy).tolist(), "tests": f.tests_per_proc[:, 1:].tolist()}
+
+
 def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_depth: int = 64,
-                     vp_fifo_depth: int = 8, progress: bool = False) -> dict:
+                     vp_fifo_depth: int = 8, progress: bool = False, vp: str = "pipeline") -> dict:
     """The whole matrix in one simulation (``hdl/sparse/matrix.py``): the image against the golden
     model pixel by pixel, and the frame's cycles, broadcast stalls, FIFO peaks and every processor's
     busy cycles and per-level tests against the coupled matrix's golden cycle model
     (``golden_model/sparse/vpcycles.py``, ``coupled_matrix_vp``): ``cycle_mismatches`` counts
     the counters that differ. ``fifo_depth``: the input FIFOs' run-time limit (built
     :data:`~rasterhw.sim.sparse.matrix_run.IN_DEPTH` deep); ``vp_fifo_depth``: the FIFOs between
-    the processor's levels (a build parameter; 8 as every driver builds it)."""
+    the processor's levels (a build parameter; 8 as every driver builds it). ``vp="stack"``: every
+    processor the stack-based one (``hdl/sparse/stack_vp.py``), against the golden coupled model on
+    the stack processors' service times (:func:`_stack_golden`); ``busy`` is then the processor's
+    own count of the cycles it holds a record."""
     from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
     from rasterhw.sim.sparse.matrix_run import IN_DEPTH, run_matrix_pysim, run_matrix_verilator
 
@@ -110,16 +130,25 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
         raise RasterhwError(f"sparse sim: engine must be 'pysim' or 'verilator', not {engine!r}")
     if isinstance(vp_fifo_depth, bool) or not isinstance(vp_fifo_depth, int) or not 2 <= vp_fifo_depth <= 64:
         raise RasterhwError(f"sparse sim: --vp-fifo-depth must be an integer in 2..64, not {vp_fifo_depth!r}")
+    if vp not in ("pipeline", "stack"):
+        raise RasterhwError(f"sparse sim: --vp must be 'pipeline' or 'stack', not {vp!r}")
+    if vp == "stack" and vp_fifo_depth != 8:
+        raise RasterhwError("sparse sim: --vp-fifo-depth is the pipeline processor's; the stack processor has no "
+                            "inner FIFOs")
     in_depth = IN_DEPTH  # one build for every run-time depth
     t0 = time.perf_counter()
     recs = broadcast_records(tris)
     run = run_matrix_verilator if engine == "verilator" else run_matrix_pysim
-    h = run(recs, n=n, p=p, q=q, limit=fifo_depth, z_bits=tris.z_bits, fifo_depth=vp_fifo_depth, in_depth=in_depth)
+    h = run(recs, n=n, p=p, q=q, limit=fifo_depth, z_bits=tris.z_bits, fifo_depth=vp_fifo_depth, in_depth=in_depth,
+            vp=vp)
     hdl_s = time.perf_counter() - t0
     t1 = time.perf_counter()
     g = sparse_render(tris, (p, q), depth="fixed", trace=True)
     gz = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
-    gc = coupled_matrix_vp(g, fifo_depth, fifo_depth=vp_fifo_depth)
+    if vp == "stack":
+        gc = _stack_golden(tris, p, q, fifo_depth)
+    else:
+        gc = coupled_matrix_vp(g, fifo_depth, fifo_depth=vp_fifo_depth)
     golden_s = time.perf_counter() - t1
     mism = int(np.count_nonzero((h["tri"] != g.tri_id) | (h["zq"] != gz)))
     st = h["stats"]
@@ -134,7 +163,7 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
     if progress:
         print(f"coupled {p}x{q}: {frame} cycles (golden {gc['frame_cycles']}), stalls {h['stall_cycles']}, "
               f"FIFO peak {int(st['fifo_peak'].max())}", file=sys.stderr, flush=True)
-    return {"engine": engine, "coupled": True, "cycles": frame, "clock_hz": None,
+    return {"engine": engine, "coupled": True, "vp": vp, "cycles": frame, "clock_hz": None,
             "pixels_compared": int(h["tri"].size), "mismatches": mism, "cycle_mismatches": cyc_mism,
             "cycles_compared": len(pairs), "matrix": f"{p}x{q}", "n": n, "triangles": len(recs),
             "fifo_depth": fifo_depth, "fifo_depth_built": in_depth, "vp_fifo_depth": vp_fifo_depth,
@@ -167,7 +196,8 @@ def depth_image(zq: np.ndarray, z_bits: int) -> np.ndarray:
 
 
 def simulate(scene, width: int, height: int, *, engine: str = "verilator", progress: bool = False,
-             matrix: str = "4x4", coupled: bool = True, fifo_depth: int = 64, vp_fifo_depth: int = 8) -> dict:
+             matrix: str = "4x4", coupled: bool = True, fifo_depth: int = 64, vp_fifo_depth: int = 8,
+             vp: str = "pipeline") -> dict:
     """The registry's sim-block contract (``scene`` a Scene or a built-in name). ``coupled``: the
     whole matrix in one simulation (:func:`simulate_coupled`); otherwise every processor alone on
     the full stream, one simulation each (:func:`simulate_tris`, ``"coupled": false``)."""
@@ -180,8 +210,8 @@ def simulate(scene, width: int, height: int, *, engine: str = "verilator", progr
     tris = run_geometry(scene, width, height)
     if coupled:
         return simulate_coupled(tris, (p, q), engine=engine, fifo_depth=fifo_depth, vp_fifo_depth=vp_fifo_depth,
-                                progress=progress)
-    if fifo_depth != 64 or vp_fifo_depth != 8:
-        raise RasterhwError("sparse sim: --fifo-depth and --vp-fifo-depth are options of the coupled matrix "
+                                progress=progress, vp=vp)
+    if fifo_depth != 64 or vp_fifo_depth != 8 or vp != "pipeline":
+        raise RasterhwError("sparse sim: --fifo-depth, --vp-fifo-depth and --vp are options of the coupled matrix "
                             "(drop --no-coupled)")
     return {**simulate_tris(tris, (p, q), engine=engine, progress=progress), "coupled": False}

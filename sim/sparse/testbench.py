@@ -16,7 +16,7 @@ from rasterhw.golden_model.sparse.search import sparse_render
 from rasterhw.sim import registry
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 
-__all__ = ["MatrixBench", "ReadOut", "VPBench"]
+__all__ = ["MatrixBench", "ReadOut", "StackVPBench", "VPBench"]
 
 
 class ReadOut(wiring.Component):
@@ -26,15 +26,18 @@ class ReadOut(wiring.Component):
     taken at once and starts the read-out when the block is no longer ``busy``: the read address
     sweeps ``0 .. words - 1`` (``address(m, addr)`` drives the block's read port; one cycle of read
     latency) and ``o`` carries ``{rd_tri, rd_z}`` of each address, two cycles a word, each held
-    until taken. ``fixed``: constant inputs of the block (``{name: value}``)."""
+    until taken. ``fixed``: constant inputs of the block (``{name: value}``). ``tail``: the block's
+    counters (output names) sent after the memory, one word each (zero-extended), in order."""
 
-    def __init__(self, block, *, words: int, address, fixed: dict, z_bits: int):
+    def __init__(self, block, *, words: int, address, fixed: dict, z_bits: int, tail: tuple[str, ...] = (),
+                 record_bits: int | None = None, rgb: bool = False):
         from rasterhw.hdl.sparse.layouts import BROADCAST
 
-        self.block, self._words, self._address, self._fixed = block, words, address, fixed
-        self._rec = BROADCAST.size
-        super().__init__({"i": In(stream.Signature(BROADCAST.size + 1)),
-                          "o": Out(stream.Signature(TRI_BITS + z_bits + 1))})
+        self.block, self._words, self._address, self._fixed, self._tail = block, words, address, fixed, tuple(tail)
+        self._rec = BROADCAST.size if record_bits is None else record_bits
+        self._rgb = rgb
+        super().__init__({"i": In(stream.Signature(self._rec + 1)),
+                          "o": Out(stream.Signature(TRI_BITS + z_bits + 1 + (24 if rgb else 0)))})
 
     def elaborate(self, platform):
         m = Module()
@@ -45,7 +48,8 @@ class ReadOut(wiring.Component):
         addr = Signal(range(self._words + 1))
         primed = Signal()
         self._address(m, b, addr)
-        m.d.comb += [b.i.payload.eq(self.i.payload[:self._rec]), self.o.payload.eq(Cat(b.rd_z, b.rd_tri))]
+        word = Cat(b.rd_z, b.rd_tri, b.rd_rgb) if self._rgb else Cat(b.rd_z, b.rd_tri)
+        m.d.comb += [b.i.payload.eq(self.i.payload[:self._rec]), self.o.payload.eq(word)]
         with m.FSM():
             with m.State("FEED"):
                 m.d.comb += [b.i.valid.eq(self.i.valid & ~end), self.i.ready.eq(end | b.i.ready)]
@@ -60,7 +64,19 @@ class ReadOut(wiring.Component):
                 with m.If(self.o.valid & self.o.ready):
                     m.d.sync += [addr.eq(addr + 1), primed.eq(0)]
                     with m.If(addr == self._words - 1):
-                        m.next = "DONE"
+                        m.next = "TAIL" if self._tail else "DONE"
+            if self._tail:
+                k = Signal(range(len(self._tail)))
+                with m.State("TAIL"):
+                    m.d.comb += self.o.valid.eq(1)
+                    with m.Switch(k):
+                        for j, name in enumerate(self._tail):
+                            with m.Case(j):
+                                m.d.comb += self.o.payload.eq(getattr(b, name))
+                    with m.If(self.o.ready):
+                        m.d.sync += k.eq(k + 1)
+                        with m.If(k == len(self._tail) - 1):
+                            m.next = "DONE"
             with m.State("DONE"):
                 pass
         return m
@@ -142,3 +158,65 @@ class MatrixBench(_SparseBench):
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         g, zq = self._golden(params, stim)
         return Expected({"o": _words(g.tri_id, zq, params["z_bits"])})
+
+
+class StackVPBench(VPBench):
+    """``sparse-stack-vp``: the stack-based processor (``hdl/sparse/stack_vp.py``) in the place of
+    ``sparse-vp``: the same records in and the same local memory out, then its counters (busy
+    cycles, records, the stack's depth, pixel writes, tests per level), against the golden stack
+    processor (``golden_model/sparse/stack.py``): bit and cycle exact (busy cycles = the stack
+    cycle model's ``3 + tests`` per record, plus (5)'s parameter cycles with ``kp``, whatever the
+    input's gaps). With ``colour`` the records carry the colour planes and each memory word its
+    colour (``rgb << (TRI_BITS + z_bits + 1)``)."""
+
+    block = "sparse-stack-vp"
+
+    @staticmethod
+    def counters(n: int) -> tuple[str, ...]:
+        return ("busy_cycles", "records", "max_stack", "writes") + tuple(f"tests_{i}" for i in range(1, n + 1))
+
+    def dut(self, params: dict):
+        vp = registry.load(registry.blocks()[self.block])(**params)
+        n = params["n"]
+
+        def address(m, b, addr):
+            m.d.comb += b.rd_addr.eq(addr[:2 * n])
+
+        from rasterhw.hdl.sparse.stack_vp import BROADCAST_RGB
+
+        col = params.get("colour", False)
+        return ReadOut(vp, words=1 << (2 * n), address=address, fixed={"a": params["p"] - 1, "b": params["q"] - 1},
+                       z_bits=params["z_bits"], tail=self.counters(n),
+                       record_bits=BROADCAST_RGB.size if col else None, rgb=col)
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        st = super().stimulus(params, seed)
+        return self.records(st.source, params, what=st.what) if params.get("colour") else st
+
+    @staticmethod
+    def records(tris, params: dict, what: str = "") -> Stimulus:
+        """The broadcast records of ``tris`` for this block (with the colour planes when ``colour``)
+        and the end word."""
+        from rasterhw.golden_model.sparse.stack import broadcast_records_rgb
+        from rasterhw.hdl.pack import pack
+        from rasterhw.hdl.sparse.layouts import BROADCAST
+        from rasterhw.hdl.sparse.stack_vp import BROADCAST_RGB
+
+        lay = BROADCAST_RGB if params.get("colour") else BROADCAST
+        recs = broadcast_records_rgb(tris) if params.get("colour") else broadcast_records(tris)
+        return Stimulus({"i": [pack(lay, r) for r in recs] + [1 << lay.size]}, what=what, source=tris)
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        from rasterhw.golden_model.sparse.stack import stack_processor
+
+        p, q = params["p"], params["q"]
+        col = params.get("colour", False)
+        g = stack_processor(stim.source, (p, q), p - 1, q - 1, colour=col, kp=params.get("kp", 0),
+                            ke=params.get("ke", 3))
+        tail = [g["busy"], len(g["cycles"]), g["max_stack"], g["writes"]] + [int(v) for v in g["tests"]]
+        words = _words(g["tri"], g["zq"], params["z_bits"])
+        if col:
+            rgb = g["rgb"].reshape(-1, 3)
+            sh = TRI_BITS + params["z_bits"] + 1
+            words = [w | (int(c[0]) | int(c[1]) << 8 | int(c[2]) << 16) << sh for w, c in zip(words, rgb, strict=True)]
+        return Expected({"o": words + tail})

@@ -22,6 +22,8 @@ from rasterhw.sim.workdirs import release, temp_run_folder
 __all__ = ["build", "pack_records", "run_processor_verilator"]
 
 BENCH_DIR = Path(__file__).resolve().parent / "verilator"
+#: what ``tb_sparse_vp.v`` and ``tb_sparse_matrix.v`` share (handed to both builds: their bytes key them)
+SHARED_VH = ("tb_sparse_load.vh", "tb_sparse_readout.vh")
 TOP = "tb_sparse_vp"
 MAXT = 16384
 
@@ -51,7 +53,8 @@ def _build(*, n: int, p: int, q: int, z_bits: int) -> tuple[Path, float]:
                     for i in range(n))
     return build_plain_verilator("sparse-vp", TOP, [BENCH_DIR / "tb_sparse_vp.v"], params=params,
                                  defines={"RASTERHW_CYCLES": 1},
-                                 generated={"sparse_vp.v": src, "tb_sparse_vp_ports.vh": ports})
+                                 generated={"sparse_vp.v": src, "tb_sparse_vp_ports.vh": ports,
+                                            **{f: (BENCH_DIR / f).read_text() for f in SHARED_VH}})
 
 
 def _read_hex(path: Path) -> np.ndarray:

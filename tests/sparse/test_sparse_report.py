@@ -14,7 +14,8 @@ def report(tmp_path_factory):
     out = tmp_path_factory.mktemp("sparse_report")
     return rows(samples=100, out_dir=out, scenes=("sp8",), s_grid=(0.1, 1.8, 10.0, 23.3, 100.0, 157.0, 1000.0),
                 engine="none", coupled_size=64, coupled_matrices=("2x2",), load_triangles=40,
-                coupled_vp_matrices=("2x2",), stack_size=64, coupled_scene="c50"), out
+                coupled_vp_matrices=("2x2",), stack_size=64, coupled_scene="c50", stack_scenes=("c50",),
+                stack_sizes=(64,)), out
     # HDL rows: tests/sparse/test_sparse_vp_*.py; the coupled rows at a useful size: the fixture below
 
 
@@ -177,3 +178,56 @@ def test_coupled_hdl_rows_in_pysim():
     assert 0 < rp["measured"] <= 1 and 0 < rp["formula"] <= 1
     qp = next(r for r in rows if r["figure"] == "(12) / HDL busy")
     assert 0 < qp["measured"] <= 1
+
+
+def test_stack_against_pipeline_rows(report):
+    (rows, sections), _ = report
+    got = {r["quantity"]: r for r in rows if r["figure"] == "(8) / (9) stack vs pipeline"}
+    lab = "c50 64x64, 4x4"
+    st = got[f"{lab}: frame cycles, stack (golden = HDL stack processor), input FIFO depth 64"]["measured"]
+    pv = got[f"{lab}: frame cycles, pipeline (HDL VP cycle model), input FIFO depth 64"]["measured"]
+    sv = got[f"{lab}: frame cycles, pipeline as a server (9), input FIFO depth 64"]["measured"]
+    assert st > pv > 0 and st > sv > 0          # one test unit against n = 4 stage units
+    st4 = next(r["measured"] for q, r in got.items() if q.startswith(f"{lab}: frame cycles, stack, depth + RGB"))
+    assert st4 > st
+    ratio = next(r for q, r in got.items() if q.startswith(f"{lab}: stack frame / pipeline frame"))
+    assert ratio["measured"] == pytest.approx(st / pv, abs=1e-4) and 1 < ratio["formula"] <= 4
+    for q, r in got.items():
+        if "busy / frame" in q or "unit load" in q:
+            assert 0 < r["measured"] <= 1, q
+    assert any("Stack-based against pipeline" in s for s in sections)
+
+
+def test_stack_hdl_rows_on_pysim():
+    from rasterhw.sim.sparse.report import _stack_hdl_rows
+
+    rows = []
+
+    def row(fig, qty, **kw):
+        rows.append({"figure": fig, "quantity": qty, **kw})
+
+    sec = _stack_hdl_rows(row, "pysim", scenes=())
+    assert len(rows) == 6 and all(r["source"] == "hdl:pysim" for r in rows)
+    pix, cnt, busy, pix4, cnt4, busy4 = (r["measured"] for r in rows)
+    assert pix == cnt == pix4 == cnt4 == 0 and 100 < busy < busy4    # parameters cost cycles as (5) prices them
+    assert sec[-1].count("| 0 | 0 of") == 2
+
+
+@pytest.mark.slow   # ~20 s: two pysim matrices; the same HDL is checked quickly in test_sparse_stack_hdl.py
+def test_stack_matrix_hdl_rows_on_pysim():
+    from rasterhw.sim.sparse.report import _stack_matrix_hdl_rows
+
+    rows = []
+
+    def row(fig, qty, **kw):
+        rows.append({"figure": fig, "quantity": qty, **kw})
+
+    sec = _stack_matrix_hdl_rows(row, "pysim")
+    assert len(rows) == 8 and all(r["source"] == "hdl:pysim" for r in rows)
+    got = {r["quantity"].split(": ", 1)[1]: r["measured"] for r in rows}
+    for D in (8, 1):
+        pre = f"coupled matrix of HDL stack processors, input FIFO depth {D}: "
+        assert got[pre + "frame cycles HDL minus golden"] == 0
+        assert got[pre + "broadcast stall cycles HDL minus golden"] == 0
+        assert got[pre + "pixels differing from the golden search (of 256)"] == 0
+    assert "| yes |" in sec[-1] and "NO" not in sec[-1]

@@ -1,7 +1,7 @@
 // Timing-free Verilator bench for the generated `sparse_matrix` (rasterhw.hdl.sparse.matrix, cells
 // instantiated by name: one `sparse_cell` module for every processor).
 // Plays the broadcast records of +in= (binary: one BW-bit big-endian word per triangle, +ntri= of
-// them) into the matrix with no gaps from the first cycle after reset, with the input FIFOs limited
+// them; read by tb_sparse_load.vh, shared with tb_sparse_vp) into the matrix with no gaps from the first cycle after reset, with the input FIFOs limited
 // to +limit= entries at run time; waits until the matrix is idle; reads every processor's counters
 // (stat_cell x stat_sel) and the matrix's frame and stall cycles into +stats=, then sweeps the full
 // raster through the interleaved read port and writes {tri, z} per pixel (row-major) to +out=.
@@ -13,11 +13,12 @@ module tb_sparse_matrix #(parameter N = 7, parameter LP = 2, parameter LQ = 2, p
   localparam XW = N + LP;
   localparam YW = N + LQ;
   localparam AW = XW + YW;
+  localparam READOUT = 4;
   reg [BW-1:0] rom [0:MAXT-1];
   reg [TW+ZW-1:0] outmem [0:(1 << AW) - 1];
   reg [31:0] stats [0:P * NS + 1];
-  reg [1023:0] in_file, out_file, stats_file;
-  integer ntri, limit, fd, got;
+`include "tb_sparse_load.vh"
+  integer limit;
   reg [31:0] idx;
   reg rst;
   reg [2:0] phase;  // 0 reset, 1 feed, 2 drain, 3 counters, 4 read-out, 5 done
@@ -29,18 +30,7 @@ module tb_sparse_matrix #(parameter N = 7, parameter LP = 2, parameter LQ = 2, p
   wire [TW-1:0] rd_tri;
   wire [31:0] frame_cycles, stall_cycles, stat;
   initial begin
-    if (!$value$plusargs("in=%s", in_file)) in_file = "in.bin";
-    if (!$value$plusargs("out=%s", out_file)) out_file = "out.hex";
-    if (!$value$plusargs("stats=%s", stats_file)) stats_file = "stats.hex";
-    if (!$value$plusargs("ntri=%d", ntri)) ntri = 0;
     if (!$value$plusargs("limit=%d", limit)) limit = 1;
-    if (ntri > 0) begin
-      fd = $fopen(in_file, "rb");
-      if (fd == 0) $fatal(1, "tb_sparse_matrix: cannot open %0s", in_file);
-      got = $fread(rom, fd);
-      $fclose(fd);
-      if (got != ntri * ((BW + 7) / 8)) $fatal(1, "tb_sparse_matrix: %0s holds %0d bytes, not %0d records", in_file, got, ntri);
-    end
     idx = 0; phase = 0; done = 0; cycles = 0; raddr = 0; rd = 0; rst = 1; sc = 0; ss = 0;
   end
   sparse_matrix dut (.clk(clk), .rst(rst), .i__payload(rom[idx[13:0]]), .i__valid(phase == 1 && idx < ntri),
@@ -68,13 +58,7 @@ module tb_sparse_matrix #(parameter N = 7, parameter LP = 2, parameter LQ = 2, p
           if (sc == P - 1) phase <= 4;
         end else ss <= ss + 1;
       end
-      4: begin  // the read address is registered here and the port has one cycle of latency:
-                // the word for raddr - 2 arrives now
-        if (raddr >= 2) outmem[raddr - 2] <= {rd_tri, rd_z};
-        rd <= raddr[AW-1:0];
-        raddr <= raddr + 1;
-        if (raddr == (1 << AW) + 1) phase <= 5;
-      end
+`include "tb_sparse_readout.vh"
       5: done <= 1;
     endcase
   end

@@ -1,5 +1,6 @@
 // Timing-free Verilator bench for the generated `sparse_vp` (rasterhw.hdl.sparse.vp).
-// Plays the broadcast records of +in= (binary: one BW-bit big-endian word per triangle, +ntri= of them) into
+// Plays the broadcast records of +in= (binary: one BW-bit big-endian word per triangle, +ntri= of them;
+// read by tb_sparse_load.vh, shared with tb_sparse_matrix) into
 // processor (+a=, +b=) -- with no gaps, or (+idle=K, 1..255, +seed=S) with random idle clocks:
 // a record not yet offered is offered only when a seeded 8-bit xorshift number is >= K, and an
 // offered one is held until taken (the stream rules) -- waits until the processor is idle, then sweeps the local
@@ -10,60 +11,43 @@ module tb_sparse_vp #(parameter N = 7, parameter BW = 600, parameter MAXT = 1638
   reg [BW-1:0] rom [0:MAXT-1];
   reg [TW+ZW-1:0] outmem [0:(1 << (2 * N)) - 1];
   reg [31:0] stats [0:2 * N + 1];
-  reg [1023:0] in_file, out_file, stats_file;
-  integer ntri, pa, pb, i, IDLE, SEED, fd, got;
+`include "tb_sparse_load.vh"
+  integer pa, pb, i, IDLE, SEED;
   reg offer;
   reg [31:0] lf;
   reg [31:0] idx;
   reg rst;
+  localparam AW = 2 * N;
+  localparam READOUT = 3;
   reg [2:0] phase;  // 0 reset, 1 feed, 2 drain, 3 read-out, 4 done
-  reg [2*N+1:0] raddr;
-  reg [2*N-1:0] rd_addr;
+  reg [AW+1:0] raddr;
+  reg [AW-1:0] rd;
   wire busy, i_ready;
   wire [ZW-1:0] rd_z;
   wire [TW-1:0] rd_tri;
   wire [31:0] writes;
   wire [32 * N - 1:0] tests_v, stalls_v;
   initial begin
-    if (!$value$plusargs("in=%s", in_file)) in_file = "in.hex";
-    if (!$value$plusargs("out=%s", out_file)) out_file = "out.hex";
-    if (!$value$plusargs("stats=%s", stats_file)) stats_file = "stats.hex";
-    if (!$value$plusargs("ntri=%d", ntri)) ntri = 0;
     if (!$value$plusargs("a=%d", pa)) pa = 0;
     if (!$value$plusargs("b=%d", pb)) pb = 0;
     if (!$value$plusargs("idle=%d", IDLE)) IDLE = 0;
     if (!$value$plusargs("seed=%d", SEED)) SEED = 1;
-    if (ntri > 0) begin  // binary, BW / 8 bytes per record, big-endian (a $readmemh parse costs more
-                         // than the run's clock loop)
-      fd = $fopen(in_file, "rb");
-      if (fd == 0) $fatal(1, "tb_sparse_vp: cannot open %0s", in_file);
-      got = $fread(rom, fd);
-      $fclose(fd);
-      if (got != ntri * ((BW + 7) / 8)) $fatal(1, "tb_sparse_vp: %0s holds %0d bytes, not %0d records", in_file, got, ntri);
-    end
     offer = 1; lf = 32'h9E3779B9 ^ (SEED * 32'd7919 + 32'd1);
-    idx = 0; phase = 0; done = 0; cycles = 0; raddr = 0; rd_addr = 0; rst = 1;
+    idx = 0; phase = 0; done = 0; cycles = 0; raddr = 0; rd = 0; rst = 1;
   end
   sparse_vp dut (.clk(clk), .rst(rst), .a(pa[5:0]), .b(pb[5:0]), .i__payload(rom[idx[13:0]]),
-                 .i__valid(phase == 1 && idx < ntri && offer), .i__ready(i_ready), .rd_addr(rd_addr), .rd_z(rd_z),
+                 .i__valid(phase == 1 && idx < ntri && offer), .i__ready(i_ready), .rd_addr(rd), .rd_z(rd_z),
                  .rd_tri(rd_tri), .writes(writes), .busy(busy)
 `include "tb_sparse_vp_ports.vh"
                  );
-  function [31:0] xorshift(input [31:0] x);
-    reg [31:0] t;
-    begin
-      t = x ^ (x << 13);
-      t = t ^ (t >> 17);
-      xorshift = t ^ (t << 5);
-    end
-  endfunction
+`include "xorshift.vh"
 
   always @(posedge clk) begin
     case (phase)
       0: begin rst <= 0; phase <= 1; end
       1: begin
         cycles <= cycles + 1;
-        lf <= xorshift(lf);
+        lf <= xorshift32(lf);
         if (!offer || i_ready) offer <= (lf[7:0] >= IDLE);
         if (idx < ntri && offer && i_ready) idx <= idx + 1;
         if (idx >= ntri) phase <= 2;
@@ -72,13 +56,7 @@ module tb_sparse_vp #(parameter N = 7, parameter BW = 600, parameter MAXT = 1638
         cycles <= cycles + 1;
         if (!busy) phase <= 3;
       end
-      3: begin  // rd_addr is registered here and the read port has one cycle of latency:
-                // the word for raddr - 2 arrives now
-        if (raddr >= 2) outmem[raddr - 2] <= {rd_tri, rd_z};
-        rd_addr <= raddr[2*N-1:0];
-        raddr <= raddr + 1;
-        if (raddr == (1 << (2 * N)) + 1) phase <= 4;
-      end
+`include "tb_sparse_readout.vh"
       4: done <= 1;
     endcase
   end
