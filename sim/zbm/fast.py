@@ -50,7 +50,7 @@ from rasterhw.sim.zbm.stimfiles import (
 from rasterhw.sim.zbm.unit_bench import run_unit_bench, unit_watchdog
 from rasterhw.sim.zbm.unit_verilog import chain_verilog, chip_verilog
 
-__all__ = ["FAST_DIR", "PLAIN_BUILD", "SPEED_BUILD", "build_fast", "build_unit_fast", "chip_speed_fast",
+__all__ = ["FAST_DIR", "PGO_OPT", "PLAIN_BUILD", "SPEED_BUILD", "build_fast", "build_unit_fast", "chip_speed_fast",
            "compare_builds", "run_chip_fast", "run_unit_fast", "unit_profile"]
 
 FAST_DIR = REPO_ROOT / "cocotb_tests" / "zbm" / "fast"
@@ -103,11 +103,13 @@ def run_chip_fast(seg_words: list[int], up_words: list[int], *, lines: int, chip
 
 
 #: the build of ``rasterhw sim zbm --engine verilator`` (and the soak, the bench's "after" row):
-#: each unit's identical modules merged (one C++ class per distinct module, e.g. the pixel
-#: processor once instead of 64 times at I = 8) and g++ -O2 on the per-cycle code; gcc
-#: profile-guided optimisation on top when a profile of this design is cached (``pgo="auto"``) or
-#: asked for (``pgo=True``: trained here first, see :func:`unit_profile`)
-SPEED_BUILD = {"merge": True, "opt": "-O2"}
+#: each unit's identical modules merged, the pixel processor kept out of line
+#: (``sim/zbm/unit_verilog.py``); with a gcc profile of the design (cached: ``pgo="auto"``, or
+#: trained first: ``pgo=True``, see :func:`unit_profile`) g++ -O2 and profile-guided optimisation,
+#: else g++ -O1 as before, so the test suite's cold builds (which never train) cost no more
+SPEED_BUILD = {"merge": True, "opt": None}
+#: g++ level of the profiled builds (and of the instrumented build that trains them)
+PGO_OPT = "-O2"
 #: the build before issue 31 (the bench's "before" row): one module per instance, g++ -O1
 PLAIN_BUILD = {"merge": False, "opt": "-O1", "pgo": False}
 #: the scene a unit's profile is trained on (the scenes it is checked on, c300 and the tests'
@@ -145,7 +147,7 @@ def _profile_dir(gen_exe: Path) -> Path:
 
 
 def unit_profile(*, interleave: int, width: int, height: int, units: int, sdepth: int,
-                 capacity: int = F.AEP_CAPACITY, schedule: str = "overlap", opt: str = "-O2",
+                 capacity: int = F.AEP_CAPACITY, schedule: str = "overlap", opt: str = PGO_OPT,
                  train: bool = True, scene: str = TRAIN_SCENE) -> Path | None:
     """The gcc profile of the merged unit-chain bench with these parameters: the instrumented
     build (``-fprofile-generate``) run once on ``scene`` (:data:`TRAIN_SCENE`; its triangles dealt to the
@@ -190,12 +192,13 @@ def unit_profile(*, interleave: int, width: int, height: int, units: int, sdepth
 
 def run_unit_fast(eps_per_unit: list, *, width: int, height: int, interleave: int,
                   capacity: int = F.AEP_CAPACITY, schedule: str = "overlap", stall: int = 0, seed: int = 1,
-                  gap_seed: int | None = None, line_log: bool = False, opt: str = SPEED_BUILD["opt"],
+                  gap_seed: int | None = None, line_log: bool = False, opt: str | None = SPEED_BUILD["opt"],
                   keep: bool = False, sdepth: int | None = None, merge: bool = SPEED_BUILD["merge"],
                   pgo: bool | str = "auto") -> dict:
     """Run a chain of units (unit k gets ``eps_per_unit[k]``) on plain Verilator.
 
-    The build: :data:`SPEED_BUILD` by default (``merge``, ``opt``); ``pgo``: ``"auto"`` uses the
+    The build: :data:`SPEED_BUILD` by default (``merge``; ``opt`` None: -O2 with a profile, -O1
+    without; a given level is used either way); ``pgo``: ``"auto"`` uses the
     design's cached profile when there is one (never trains: the test suite's builds stay
     plain), ``True`` trains it first if needed (:func:`unit_profile`; ``rasterhw bench`` and
     ``RASTERHW_PGO=1``), ``False`` never (the environment's ``RASTERHW_PGO=0`` turns ``"auto"``
@@ -215,12 +218,13 @@ def run_unit_fast(eps_per_unit: list, *, width: int, height: int, interleave: in
     words = [edge_pair_words(e) for e in eps_per_unit]
     total = sum(len(w) for w in words)
     kw = {"interleave": interleave, "width": width, "height": height, "units": len(words), "capacity": capacity,
-          "schedule": schedule, "opt": opt, "merge": merge}
+          "schedule": schedule}
     sdepth = stimulus_depth(total, sdepth)
     prof = None
     if pgo and merge:
-        prof = unit_profile(**{k: v for k, v in kw.items() if k != "merge"}, sdepth=sdepth, train=pgo is True)
-    exe, build_s = build_unit_fast(nwords=total, sdepth=sdepth, pgo=prof, **kw)
+        prof = unit_profile(**kw, sdepth=sdepth, opt=opt or PGO_OPT, train=pgo is True)
+    opt = opt or (PGO_OPT if prof is not None else "-O1")
+    exe, build_s = build_unit_fast(nwords=total, sdepth=sdepth, pgo=prof, merge=merge, opt=opt, **kw)
     res = _run_unit_exe(exe, eps_per_unit, width=width, height=height, stall=stall, seed=seed, gap_seed=gap_seed,
                         line_log=line_log, keep=keep)
     return {**res, "build_s": build_s, "build": {"merge": merge, "opt": opt, "pgo": prof is not None}}

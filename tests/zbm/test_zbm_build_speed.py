@@ -4,7 +4,7 @@ never what it computes: on a small frame, the same words and the same segment-cl
 build before issue 31 (one module per instance), with the profile trained on one scene (c50) and
 the check run on another (sp8). The merged build alone is also held word-, cycle- and line-log-exact
 with the cocotb bench by ``test_zbm_unit_fast.py`` (its default build is now the merged one).
-Cold: three small builds (plain -O0, instrumented -O2, profiled -O2)."""
+Cold: three small builds (plain -O0, instrumented -O2, profiled -O2): marked slow."""
 
 from __future__ import annotations
 
@@ -26,7 +26,11 @@ pytestmark = pytest.mark.cocotb
 W, H, IL = 48, 16, 2
 
 
+@pytest.mark.slow
 def test_speed_build_same_frame_same_cycles_as_the_plain_build():
+    """Three builds (~1 min of CPU; 4 min at load 12): slow. The quick version in CI is
+    ``test_zbm_unit_fast.py``, whose plain-Verilator build is now the merged one with the pixel
+    processor out of line: the same words, cycles and line log as the cocotb bench (unmerged)."""
     tris = run_geometry(build_scene("sp8"), W, H)
     eps = G.edge_pairs(tris)
     gold = doublez_words(G.render_zbm(tris, interleave=IL).pixels)
