@@ -277,33 +277,67 @@ def run_units_equal_clocks(per_unit: list, *, width: int, height: int, interleav
 
 
 def compare_builds(tris, *, width: int, height: int, interleave: int, units: int = 1,
-                   builds: dict[str, dict] | None = None, rounds: int = 3) -> dict[str, dict]:
+                   builds: dict[str, dict] | None = None, rounds: int = 3, base=None) -> dict[str, dict]:
     """The same frame through several builds of the unit bench, alternating (round 1: every
     build, round 2: every build, ...; the machine's load changes across a minute, so the builds
     are compared in the same minutes), each frame compared with the golden one. ``builds``:
     ``{label: run_unit_fast build arguments}`` (default: :data:`PLAIN_BUILD` as ``"plain"``,
-    :data:`SPEED_BUILD` with PGO as ``"speed"``). Returns per label ``{"cycles_per_s"`` (median of
-    the rounds' clock-loop rates), ``"rates"``, ``"cycles"``, ``"mismatches"`` (pixels, worst
-    round), ``"build_s"`` (cold build seconds, 0 when it was built before), ``"build"}``."""
+    :data:`SPEED_BUILD` with PGO as ``"speed"``). Every build is made (and trained) by a first run
+    that is not counted. Returns per label ``{"cycles_per_s"`` (median of the rounds' clock-loop
+    rates: wall clock, so it moves with the machine's load), ``"rates"``, ``"cycles"``,
+    ``"mismatches"`` (pixels, worst round), ``"build_s"`` (cold build seconds of the first run),
+    ``"build"``, ``"cpu_s"`` (the binary's CPU seconds per round: load, clock loop and dump)``}``.
+    ``base`` (triangles of a smaller scene): also run it, on the same build, every round, and give
+    ``"cpu_cycles_per_s"`` = the cycles ``tris`` has more than ``base`` over the CPU seconds it
+    takes more (medians): the clock loop's rate in CPU time, which the load moves much less."""
+    import resource
+
     from rasterhw.golden_model.zbm.words import doublez_words
 
     builds = builds if builds is not None else {"plain": PLAIN_BUILD, "speed": {**SPEED_BUILD, "pgo": True}}
-    eps = G.edge_pairs(tris)
-    per = [eps.take(np.flatnonzero(eps.tag % units == k)) for k in range(units)]
-    g0, g1 = doublez_words(G.render_zbm(tris, interleave=interleave, units=units).pixels)
-    out: dict[str, dict] = {k: {"rates": [], "cycles": set(), "mismatches": 0, "build_s": 0.0} for k in builds}
+
+    def frame(t):
+        eps = G.edge_pairs(t)
+        return ([eps.take(np.flatnonzero(eps.tag % units == k)) for k in range(units)],
+                doublez_words(G.render_zbm(t, interleave=interleave, units=units).pixels))
+
+    from rasterhw.golden_model.zbm.words import edge_pair_words
+
+    frames = {"main": frame(tris), **({"base": frame(base)} if base is not None else {})}
+    sdepth = stimulus_depth(sum(len(edge_pair_words(e)) for e in frames["main"][0]))   # one build for both
+    out: dict[str, dict] = {k: {"rates": [], "cycles": set(), "mismatches": 0, "cpu_s": [], "base_cpu_s": []}
+                            for k in builds}
+
+    def one(label, which):
+        per, (g0, g1) = frames[which]
+        c0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        r = run_unit_fast(per, width=width, height=height, interleave=interleave, sdepth=sdepth, **builds[label])
+        c1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        bad = int(np.count_nonzero((r["s0"] != g0) | (r["s1"] != g1)))
+        return r, c1.ru_utime + c1.ru_stime - c0.ru_utime - c0.ru_stime, bad
+
+    for label in builds:   # build (and train) first, not counted
+        r, _, bad = one(label, "main")
+        out[label].update(build_s=r["build_s"], build=r["build"], mismatches=bad)
     for _ in range(rounds):
-        for label, b in builds.items():
-            r = run_unit_fast(per, width=width, height=height, interleave=interleave, **b)
+        for label in builds:
             o = out[label]
+            r, cpu, bad = one(label, "main")
             o["rates"].append(r["cycles"] / r["run_s"])
             o["cycles"].add(int(r["cycles"]))
-            o["mismatches"] = max(o["mismatches"], int(np.count_nonzero((r["s0"] != g0) | (r["s1"] != g1))))
-            o["build_s"] += r["build_s"]
-            o["build"] = r["build"]
+            o["cpu_s"].append(cpu)
+            o["mismatches"] = max(o["mismatches"], bad)
+            if base is not None:
+                rb, cpu_b, bad_b = one(label, "base")
+                o["base_cpu_s"].append(cpu_b)
+                o["base_cycles"] = int(rb["cycles"])
+                o["mismatches"] = max(o["mismatches"], bad_b)
     for o in out.values():
         o["cycles_per_s"] = float(np.median(o["rates"]))
         o["cycles"] = sorted(o["cycles"])
+        if base is not None:
+            extra = float(np.median(o["cpu_s"]) - np.median(o["base_cpu_s"]))
+            o["cpu_cycles_per_s"] = (o["cycles"][-1] - o["base_cycles"]) / extra if extra > 0 else float("nan")
     return out
 
 
