@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import hashlib
 import re
+from functools import lru_cache
 from pathlib import Path
 
 from amaranth.back import verilog
@@ -49,6 +50,13 @@ def _pixel_processor(name: str, copies: int, size: int) -> bool:
     return re.search(r"\.loop\.pp\d+$", name.strip()) is not None
 
 
+@lru_cache(maxsize=8)
+def _merged(text: str) -> str:
+    """``text`` merged, the pixel processor out of line (once per text and process: a run looks
+    its profile up and then builds, both from the same sources)."""
+    return merge_identical_modules(text, no_inline=_pixel_processor)
+
+
 def chain_verilog(*, interleave: int, width: int, height: int, units: int = 1,
                   capacity: int = F.AEP_CAPACITY, schedule: str = "overlap", merge: bool = False) -> list[Path]:
     """Verilog sources of ``units`` chained ``zbm-unit``\\s: the head ``zbm_unit``, the others
@@ -57,7 +65,7 @@ def chain_verilog(*, interleave: int, width: int, height: int, units: int = 1,
     merged (:func:`rasterhw.sim.engines.verilog.merge_identical_modules`: at I = 8, 132 modules ->
     27, 3.2 MB -> 0.52 MB; the same circuit) and the pixel processor marked to stay out of line
     (:func:`_pixel_processor`): the speed build of ``sim zbm``."""
-    m = (lambda t: merge_identical_modules(t, no_inline=_pixel_processor)) if merge else (lambda t: t)
+    m = _merged if merge else (lambda t: t)
     p = {"interleave": interleave, "width": width, "height": height, "capacity": capacity, "schedule": schedule}
     head = generate_cached("zbm-unit", head=True, **p)
     srcs = [_file("zbm_unit", m(head))]
