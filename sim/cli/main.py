@@ -366,7 +366,7 @@ def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, re
     """Reproduce a paper's figures: paper value, formula value, measured value, ratio.
 
     A report's independent runs (ZB/M Table 1, pixel rate, skew and chains; EXPERTS balance;
-    fpga place and route) run as tasks on --scheduler (docs/scale.md)."""
+    fpga place and route; the sparse FIFO-depth sweep) run as tasks on --scheduler (docs/scale.md)."""
     from rasterhw.sim.flow.tasks import default_store, parse_scheduler
     from rasterhw.sim.report.rows import run_report, systems
 

@@ -44,7 +44,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
          coupled_size: int = 1 << M_BITS, coupled_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8", "16x16"),
          load_triangles: int = 3000, coupled_vp_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8"),
          stack_size: int = 512, coupled_scene: str = "c300",
-         stack_scenes: tuple[str, ...] = ("c300", "sp27"), stack_sizes: tuple[int, ...] = (512, 1 << M_BITS), **known):
+         stack_scenes: tuple[str, ...] = ("c300", "sp27"), stack_sizes: tuple[int, ...] = (512, 1 << M_BITS),
+         scheduler: str = "serial", store=None, fresh: bool = False, **known):
     """Rows and markdown sections of the sparse-raster report (see the module docstring)."""
     M = int(samples)
     S_GRID = tuple(s_grid)  # noqa: N806 (the module default, narrowed by tests)
@@ -248,7 +249,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     # ---------------------------------------------------------------- the coupled matrix (golden)
     coupled_sec = _coupled_rows(row, out_dir, size=coupled_size, matrices=coupled_matrices,
                                 load_triangles=load_triangles, vp_matrices=coupled_vp_matrices,
-                                stack_size=stack_size, scene=coupled_scene)
+                                stack_size=stack_size, scene=coupled_scene, scheduler=scheduler, store=store,
+                                fresh=fresh, progress=progress)
 
     # ---------------------------------------------------------------- stack-based against pipeline processors
     coupled_sec += _stack_vs_pipeline_rows(row, scenes=stack_scenes, sizes=stack_sizes)
@@ -449,14 +451,15 @@ REF_DEPTH = 8
 
 def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], load_triangles: int,
                   vp_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8"), stack_size: int = 512,
-                  scene: str = "c300") -> list[str]:
+                  scene: str = "c300", scheduler: str = "serial", store=None, fresh: bool = False,
+                  progress: bool = False) -> list[str]:
     """Frame cycles against FIFO depth, R_p and Q_p from busy cycles, the stack processor and the
     k_p/k_e cost: :mod:`rasterhw.golden_model.sparse.cycles` on the golden search's per-record
     window counts of ``scene`` at ``size`` x ``size`` (the paper's 1024 x 1024 in the report)."""
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.golden_model.sparse import cycles as cy
-    from rasterhw.golden_model.sparse.search import sparse_render
+    from rasterhw.sim.flow.tasks import call, run_tasks
 
     W = size
     m_bits = W.bit_length() - 1
@@ -464,8 +467,16 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
     xy = np.asarray(tris.xy)
     lab = f"{scene} {W}x{W}"
     gp = f"GP issue interval {cy.GP_ISSUE_INTERVAL} cycle (ours)"
-    mono = sparse_render(tris, "1x1", depth="fixed")
-    T_mono = float(mono.tests.sum())
+    # the golden runs (the monoprocessor, each matrix's coupled sweep, each HDL-processor sweep)
+    # are independent tasks (sim/flow/tasks.py: serial by default, any Dask scheduler by address)
+    tasks = [call(f"{_SELF}:mono_tests", scene=scene, size=W)]
+    tasks += [call(f"{_SELF}:coupled_point", scene=scene, size=W, matrix=m) for m in matrices]
+    tasks += [call(f"{_SELF}:coupled_vp_point", scene=scene, size=W, matrix=m) for m in vp_matrices]
+    res = run_tasks(tasks, scheduler=scheduler, store=store, fresh=fresh, progress=progress,
+                    desc=f"sparse coupled matrix ({lab})")
+    T_mono = float(res[0]["tests"])
+    points = res[1:1 + len(matrices)]
+    vp_points = res[1 + len(matrices):]
     fw_mono = _formula_frame(xy, m_bits, 1)
     curves = {}
     sweep_tab = ["| matrix | FIFO depth D | frame cycles | / unbounded FIFO | broadcast stall cycles | FIFO peak (max) | "
@@ -474,26 +485,21 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
               "Q_a formula (7) | Q_p golden | Q_p formula (12) | stack / pipeline frame | formula n R_p |",
               "|---|---|---|---|---|---|---|---|---|---|---|"]
     kp_tab: list[str] = []
-    for m in matrices:
+    for m, pt in zip(matrices, points, strict=True):
         p = int(m.split("x")[0])
         P = p * p
-        f = sparse_render(tris, m, depth="fixed", per_record=True)
-        n = f.n
-        w = f.stats["windows_per_record"]
-        s_pipe = cy.service_times(w)
-        alone = int(1 + s_pipe.sum(axis=1).max())
+        n = pt["n"]
+        alone = pt["alone"]
         fr = {}
-        for D in FIFO_DEPTHS:
-            r = cy.coupled_matrix(s_pipe, D)
-            fr[D] = r.frame_cycles
-            util = r.busy / r.frame_cycles
-            sweep_tab.append(f"| {m} | {D} | {r.frame_cycles} | {r.frame_cycles / alone:.4f} | {r.stall_cycles} | "
-                             f"{int(r.fifo_peak.max())} | {util.min():.3f} … {util.max():.3f} |")
+        for D, r in zip(FIFO_DEPTHS, pt["depths"], strict=True):
+            fr[D] = r["frame_cycles"]
+            sweep_tab.append(f"| {m} | {D} | {r['frame_cycles']} | {r['frame_cycles'] / alone:.4f} | "
+                             f"{r['stall_cycles']} | {r['fifo_peak_max']} | {r['util_min']:.3f} … {r['util_max']:.3f} |")
             row("FIFO sizing (coupled)", f"{lab}, {m}: frame cycles, FIFO depth {D} (pipeline VPs, {gp})",
-                paper=None, formula=None, measured=r.frame_cycles, unit="cycles", source="golden")
+                paper=None, formula=None, measured=r["frame_cycles"], unit="cycles", source="golden")
             if D == 1:
                 row("FIFO sizing (coupled)", f"{lab}, {m}: broadcast stall cycles, FIFO depth 1", paper=None,
-                    formula=None, measured=r.stall_cycles, unit="cycles", source="golden")
+                    formula=None, measured=r["stall_cycles"], unit="cycles", source="golden")
         sweep_tab.append(f"| {m} | unbounded | {alone} | 1 | 0 | — | — |")
         curves[m] = [fr[D] / alone for D in FIFO_DEPTHS]
         for D in (1, 8, 64):
@@ -505,15 +511,13 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
             "frame", paper=None, formula=None, measured=d1 if d1 is not None else -1, unit="entries",
             source="golden")
         # R_p, Q_a, Q_p from busy cycles (pipeline VP as our HDL prices it: headers, k_p = 0)
-        sb = cy.stage_cycles(w).sum(axis=1)  # (P, n) busy cycles per stage
-        Bi = sb.sum(axis=0).astype(float)
+        Bi = np.asarray(pt["stage_busy"], dtype=float)  # busy cycles per stage, summed over processors
         Rp = float(Bi.sum() / (n * Bi.max()))
         fw = _formula_frame(xy, n, p)
         tf = th.stage_times(fw, kp_ke=0.0)
         Rp_f = float(tf.sum() / (n * tf.max()))
-        rc = cy.coupled_matrix(s_pipe, REF_DEPTH)
-        Rp_c = float(Bi.sum() / (n * P * rc.frame_cycles))
-        Qa = T_mono / float(f.tests.sum())
+        Rp_c = float(Bi.sum() / (n * P * pt["ref_frame"]))
+        Qa = T_mono / float(pt["tests"])
         Qa_f = float(th.total_time(fw_mono, kp_ke=0.0) / (P * th.total_time(fw, kp_ke=0.0)))
         row("(10) / golden", f"{lab}, {m}: R_p = sum_i B_i / (n max_i B_i) from the golden pipeline's busy cycles "
             "B_i per stage (summed over processors; header cycles included; formula: (10) on (1)'s counts for "
@@ -528,13 +532,11 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
         row("(12) / golden", f"{lab}, {m}: Q_p = Q_a R_p (golden busy cycles; formula (12))", paper=None,
             formula=round(Qa_f * Rp_f, 4), measured=round(Qa * Rp, 4), unit="", source="golden")
         # the stack-based processor on the same frame
-        s_st = cy.service_times(w, vp="stack")
-        rs = cy.coupled_matrix(s_st, REF_DEPTH)
-        sp_st = rs.frame_cycles / rc.frame_cycles
+        sp_st = pt["stack_frame"] / pt["ref_frame"]
         tf0h = th.stage_times(fw, kp_ke=0.0)
         row("(10) / stack", f"{lab}, {m}: frame cycles of the stack-based processors, FIFO depth {REF_DEPTH} "
             f"(set-up {cy.SETUP_CYCLES} + every coverage test, one per cycle)", paper=None, formula=None,
-            measured=rs.frame_cycles, unit="cycles", source="golden")
+            measured=pt["stack_frame"], unit="cycles", source="golden")
         row("(10) / stack", f"{lab}, {m}: stack frame / pipeline frame, FIFO depth {REF_DEPTH} (formula: "
             "P_p / P_s = n R_p of (10) on (1)'s counts, k_p/k_e = 0)", paper=None,
             formula=round(float(tf0h.sum() / tf0h.max()), 4), measured=round(sp_st, 4), unit="ratio",
@@ -543,10 +545,8 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
                       f"{Qa_f * Rp_f:.4f} | {sp_st:.3f} | {tf0h.sum() / tf0h.max():.3f} |")
         if m == "4x4":
             # surface parameters priced as (5): depth and RGB (k_p = 4) on the k_e = 3 edge adders
-            for vp, s0 in (("pipeline", s_pipe), ("stack", s_st)):
-                s4 = cy.service_times(w, vp=vp, kp=4)
-                f0 = cy.coupled_matrix(s0, REF_DEPTH).frame_cycles
-                f4 = cy.coupled_matrix(s4, REF_DEPTH).frame_cycles
+            for vp in ("pipeline", "stack"):
+                f0, f4 = pt["kp_frames"][vp]
                 t0, t4 = th.stage_times(fw, kp_ke=0.0), th.stage_times(fw, kp_ke=4 / 3)
                 ff = float(t4.max() / t0.max()) if vp == "pipeline" else float(t4.sum() / t0.sum())
                 row("(5) k_p/k_e", f"{lab}, {m}: frame with depth and RGB priced (k_p = 4, k_e = 3: "
@@ -554,7 +554,7 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
                     f"{REF_DEPTH} (formula: (5) on (1)'s counts, k_p/k_e = 4/3 against 0)", paper=None,
                     formula=round(ff, 4), measured=round(f4 / f0, 4), unit="ratio", source="golden")
                 kp_tab.append(f"{vp}: {f0} → {f4} cycles (×{f4 / f0:.3f}; formula ×{ff:.3f})")
-    vp_tab = _coupled_vp_rows(row, tris, lab, vp_matrices)
+    vp_tab = _coupled_vp_rows(row, lab, vp_matrices, vp_points)
     stack_txt = _stack_rows(row, scene, stack_size)
     gp_tab = _gp_rate_rows(row, scene, stack_size)
     load_tab = _load_rows(row, W, load_triangles)
@@ -597,22 +597,85 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
             f"![FIFO sizing]({plot})\n"]
 
 
-def _coupled_vp_rows(row, tris, lab: str, matrices: tuple[str, ...]) -> list[str]:
-    """Frame cycles, stalls and FIFO peaks of the coupled matrix whose processors are the HDL video
-    processor's cycle model, at FIFO depths 1 and 64 (and 8 on 4x4)."""
+_SELF = "rasterhw.sim.sparse.report"
+
+
+def _vp_depths(matrix: str) -> tuple[int, ...]:
+    return (1, 8, 64) if matrix == "4x4" else (1, 64)
+
+
+def mono_tests(scene: str, size: int) -> dict:
+    """Coverage tests of the monoprocessor (1x1 on the full raster) on ``scene`` at ``size``^2 (a task)."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.sparse.search import sparse_render
+
+    tris = run_geometry(build_scene(scene), size, size)
+    return {"tests": int(sparse_render(tris, "1x1", depth="fixed").tests.sum())}
+
+
+def coupled_point(scene: str, size: int, matrix: str) -> dict:
+    """One matrix of the coupled FIFO sweep (a task): the golden cycle model of pipeline video
+    processors at every FIFO depth, the busy cycles per stage, the stack-based processors' frame,
+    and on 4x4 the frames with surface parameters priced as (5)."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.sparse import cycles as cy
+    from rasterhw.golden_model.sparse.search import sparse_render
+
+    tris = run_geometry(build_scene(scene), size, size)
+    f = sparse_render(tris, matrix, depth="fixed", per_record=True)
+    w = f.stats["windows_per_record"]
+    s_pipe = cy.service_times(w)
+    depths = []
+    for D in FIFO_DEPTHS:
+        r = cy.coupled_matrix(s_pipe, D)
+        util = r.busy / r.frame_cycles
+        depths.append({"frame_cycles": int(r.frame_cycles), "stall_cycles": int(r.stall_cycles),
+                       "fifo_peak_max": int(r.fifo_peak.max()), "util_min": float(util.min()),
+                       "util_max": float(util.max())})
+    s_st = cy.service_times(w, vp="stack")
+    out = {"n": int(f.n), "alone": int(1 + s_pipe.sum(axis=1).max()), "depths": depths,
+           "stage_busy": [int(v) for v in cy.stage_cycles(w).sum(axis=1).sum(axis=0)],
+           "ref_frame": int(cy.coupled_matrix(s_pipe, REF_DEPTH).frame_cycles),
+           "stack_frame": int(cy.coupled_matrix(s_st, REF_DEPTH).frame_cycles), "tests": int(f.tests.sum())}
+    if matrix == "4x4":
+        out["kp_frames"] = {vp: [int(cy.coupled_matrix(s0, REF_DEPTH).frame_cycles),
+                                 int(cy.coupled_matrix(cy.service_times(w, vp=vp, kp=4), REF_DEPTH).frame_cycles)]
+                            for vp, s0 in (("pipeline", s_pipe), ("stack", s_st))}
+    return out
+
+
+def coupled_vp_point(scene: str, size: int, matrix: str) -> dict:
+    """One matrix of the coupled sweep whose processors are the HDL video processor's cycle model
+    (a task): frame cycles, stalls, largest FIFO peak and least busy processor per FIFO depth."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
     from rasterhw.golden_model.sparse.search import sparse_render
     from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
 
+    tris = run_geometry(build_scene(scene), size, size)
+    f = sparse_render(tris, matrix, depth="fixed", trace=True)
+    pts = []
+    for D in _vp_depths(matrix):
+        r = coupled_matrix_vp(f, D)
+        pts.append({"frame_cycles": int(r["frame_cycles"]), "stall_cycles": int(r["stall_cycles"]),
+                    "fifo_peak_max": int(r["fifo_peak_max"]), "busy_min": int(min(r["busy"]))})
+    return {"depths": pts}
+
+
+def _coupled_vp_rows(row, lab: str, matrices: tuple[str, ...], points: list[dict]) -> list[str]:
+    """Frame cycles, stalls and FIFO peaks of the coupled matrix whose processors are the HDL video
+    processor's cycle model, at FIFO depths 1 and 64 (and 8 on 4x4): rows from
+    :func:`coupled_vp_point`'s results."""
     tab = ["| matrix | FIFO depth D | frame cycles | broadcast stall cycles | FIFO peak (max) | "
            "processor busy / frame, least loaded |", "|---|---|---|---|---|---|"]
-    for m in matrices:
-        f = sparse_render(tris, m, depth="fixed", trace=True)
+    for m, pt in zip(matrices, points, strict=True):
         fr = {}
-        for D in ((1, 8, 64) if m == "4x4" else (1, 64)):
-            r = coupled_matrix_vp(f, D)
+        for D, r in zip(_vp_depths(m), pt["depths"], strict=True):
             fr[D] = r["frame_cycles"]
             tab.append(f"| {m} | {D} | {r['frame_cycles']} | {r['stall_cycles']} | {r['fifo_peak_max']} | "
-                       f"{min(r['busy']) / r['frame_cycles']:.3f} |")
+                       f"{r['busy_min'] / r['frame_cycles']:.3f} |")
             row("FIFO sizing (coupled, HDL VPs)", f"{lab}, {m}: frame cycles, FIFO depth {D} (video processors: "
                 "the HDL's cycle model)", paper=None, formula=None, measured=r["frame_cycles"], unit="cycles",
                 source="golden")
