@@ -279,7 +279,8 @@ def run_verilator(jb: dict, *, width: int, idle: int = 0, stall: int = 0, seed: 
                                      f"+lo0={jb['lo0']}", f"+hi0={jb['hi0']}", f"+idle={idle}",
                                      f"+stall={stall}", f"+seed={seed}"],
                                run_dir=run_dir, maxcyc=(int(jb["cycles"].sum()) * 2 + 10000) * (1 + (idle + stall) // 16))
-    out = {"pixels": _read_hex(run_dir / "out.hex"), "cycles": _read_hex(run_dir / "cyc.hex"),
+    # the bench dumps its whole frame and line memories (NOUT_MAX / NLINE_MAX words): this run's part
+    out = {"pixels": _read_hex(run_dir / "out.hex")[:nout], "cycles": _read_hex(run_dir / "cyc.hex")[:nline],
            "run_s": meta["run_s"], "sim_cycles": meta["sim_cycles"], "build_s": build_s}
     release(run_dir)
     return out
