@@ -53,10 +53,10 @@ def slp_in_layout() -> data.StructLayout:
         "r0": unsigned(10),            # first line (BAND: band start)
         "r1": unsigned(10),            # last line (BAND: band end, exclusive)
         "ll": unsigned(1),             # the long edge a->c is the left edge
-        "xa": signed(16),              # vertex a, Q10.6 (BOUND: the bound, pixels)
-        "ya": signed(16),
-        "xb": signed(16),              # vertex b
-        "yb": signed(16),
+        "xa": signed(17),              # vertex a: the unsigned Q10.6 of formats.py, signed (BOUND: the bound, pixels)
+        "ya": signed(17),
+        "xb": signed(17),              # vertex b
+        "yb": signed(17),
         "inc_ac": signed(48),          # edge increments per line, Q.22 (slp.rom_div)
         "inc_ab": signed(48),
         "inc_bc": signed(48),

@@ -108,3 +108,21 @@ def test_asl_update_asb_is_the_golden_asb(name):
             assert asb(tws[s["addr"]], y) == s
             n += 1
     assert n > 300
+
+
+@pytest.mark.parametrize(("scene", "size"), [("c300", 512), ("experts-2000", 512), ("c50", 64)])
+def test_every_triangle_word_fits_the_slp_input_fields(scene, size):
+    """The SLP's input fields hold every value the golden set-up gives (c300 at 512 x 512 puts a
+    vertex on x = 512, 32768 in Q.6: it once wrapped to -32768 in a 16-bit field and the SLP never
+    finished)."""
+    from rasterhw.hdl.experts.slp import slp_in_layout
+
+    fr = render_frame(run_geometry(build_scene(scene), size, size, z_bits=16), model="bit", aj="c")
+    tws = tri_words(fr.setup)
+    for name, field in slp_in_layout():
+        if name not in tws[0]:
+            continue
+        s = field.shape
+        lo, hi = (-(1 << (s.width - 1)), (1 << (s.width - 1)) - 1) if s.signed else (0, (1 << s.width) - 1)
+        vals = [t[name] for t in tws]
+        assert lo <= min(vals) and max(vals) <= hi, (name, min(vals), max(vals), s)
