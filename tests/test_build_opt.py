@@ -10,7 +10,7 @@ import pytest
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.engines import runner
 
-SRC = Path(__file__).parent / "counter_bench.py"   # any file: only the key is computed here
+SRC = Path(__file__).parent / "wave_helpers.py"   # any file: only the key is computed here
 
 
 def test_the_level_replaces_only_the_default(monkeypatch):

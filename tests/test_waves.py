@@ -6,35 +6,28 @@ import json
 from pathlib import Path
 
 import pytest
-from counter_bench import counter_verilog
-from rasterhw.sim.cli.main import main
+from wave_helpers import counter_verilog, run_cli
 
 ARGS = ["sim", "pixelbus", "--scene", "experts-solid-5", "--size", "40x16", "--engine", "pysim", "--json"]
 
 
-def _run(argv) -> int:
-    try:
-        main(argv)
-    except SystemExit as e:
-        return e.code or 0
-    return 0
 
 
 def test_waves_written_on_request_only(tmp_path, capsys):
     vcd = tmp_path / "run.vcd"
-    assert _run([*ARGS, "-o", str(tmp_path / "a.png"), "--waves", str(vcd)]) == 0
+    assert run_cli([*ARGS, "-o", str(tmp_path / "a.png"), "--waves", str(vcd)]) == 0
     res = json.loads(capsys.readouterr().out)
     assert res["waves"] == [str(vcd)] and res["mismatches"] == 0
     text = vcd.read_text()
     assert "$enddefinitions" in text and "$var" in text
-    assert _run([*ARGS, "-o", str(tmp_path / "b.png")]) == 0
+    assert run_cli([*ARGS, "-o", str(tmp_path / "b.png")]) == 0
     res = json.loads(capsys.readouterr().out)
     assert "waves" not in res
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png", "b.png", "run.gtkw", "run.vcd"]
 
 
 def test_pysim_waves_must_be_vcd(tmp_path, capsys):
-    assert _run([*ARGS, "--waves", str(tmp_path / "run.fst")]) == 2
+    assert run_cli([*ARGS, "--waves", str(tmp_path / "run.fst")]) == 2
     assert "writes VCD" in capsys.readouterr().err
 
 
@@ -73,7 +66,7 @@ def test_sim_on_plain_verilator_writes_one_trace_per_processor(tmp_path, capsys)
     vcd = tmp_path / "sp.vcd"
     args = ["sim", "sparse", "--scene", "c50", "--size", "32x32", "--matrix", "2x2", "--engine", "verilator",
             "--no-coupled", "--json", "--waves", str(vcd)]   # no -o: sim sparse gives no frame image (issue 33)
-    assert _run(args) == 0
+    assert run_cli(args) == 0
     res = json.loads(capsys.readouterr().out)
     assert res["mismatches"] == 0 and len(res["waves"]) == 4
     for w in res["waves"]:
@@ -86,7 +79,7 @@ def test_fst_without_the_writer_headers_is_one_clear_error(tmp_path, capsys, mon
     monkeypatch.setattr(waves, "fst_writer_available", lambda: False)
     args = ["sim", "sparse", "--scene", "c50", "--size", "32x32", "--matrix", "2x2", "--engine", "verilator",
             "--waves", str(tmp_path / "sp.fst"), "-o", str(tmp_path / "sp.png")]
-    assert _run(args) == 2
+    assert run_cli(args) == 2
     err = capsys.readouterr().err
     assert "lz4.h" in err and ".vcd" in err
     assert list(tmp_path.iterdir()) == []

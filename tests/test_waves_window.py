@@ -11,19 +11,12 @@ import sys
 from pathlib import Path
 
 import pytest
-from counter_bench import counter_verilog
-from rasterhw.sim.cli.main import main
 from rasterhw.sim.engines import waves
+from wave_helpers import counter_verilog, run_cli
 
 ARGS = ["sim", "pixelbus", "--scene", "snu-100px", "--size", "16x16", "--engine", "pysim", "--json"]
 
 
-def _run(argv) -> int:
-    try:
-        main(argv)
-    except SystemExit as e:
-        return e.code or 0
-    return 0
 
 
 def _gtkw_traces(gtkw: Path) -> list[str]:
@@ -74,7 +67,7 @@ def _rising_edges(vcd: Path) -> list[int]:
 
 def test_pysim_gtkw_groups_the_stream_ports_and_names_only_signals_of_the_vcd(tmp_path, capsys):
     vcd = tmp_path / "run.vcd"
-    assert _run([*ARGS, "-o", str(tmp_path / "a.png"), "--waves", str(vcd)]) == 0
+    assert run_cli([*ARGS, "-o", str(tmp_path / "a.png"), "--waves", str(vcd)]) == 0
     res = json.loads(capsys.readouterr().out)
     assert res["gtkw"] == [str(vcd.with_suffix(".gtkw"))]
     # Amaranth's own save file (the generic engine declared the testbench's ports)
@@ -89,8 +82,8 @@ def test_pysim_gtkw_groups_the_stream_ports_and_names_only_signals_of_the_vcd(tm
 
 def test_pysim_window_keeps_only_the_cycles_asked_for(tmp_path, capsys):
     full, cut = tmp_path / "full.vcd", tmp_path / "cut.vcd"
-    assert _run([*ARGS, "-o", str(tmp_path / "a.png"), "--waves", str(full)]) == 0
-    assert _run([*ARGS, "-o", str(tmp_path / "b.png"), "--waves", str(cut), "--trace-start", "20",
+    assert run_cli([*ARGS, "-o", str(tmp_path / "a.png"), "--waves", str(full)]) == 0
+    assert run_cli([*ARGS, "-o", str(tmp_path / "b.png"), "--waves", str(cut), "--trace-start", "20",
                  "--trace-end", "40"]) == 0
     capsys.readouterr()
     edges = _rising_edges(full)
@@ -149,7 +142,7 @@ def test_bad_window_is_one_line_exit_2(tmp_path, extra, says):
 
 
 def test_window_past_the_end_of_the_run_is_one_clear_error(tmp_path, capsys):
-    assert _run([*ARGS, "-o", str(tmp_path / "a.png"), "--waves", str(tmp_path / "w.vcd"),
+    assert run_cli([*ARGS, "-o", str(tmp_path / "a.png"), "--waves", str(tmp_path / "w.vcd"),
                  "--trace-start", "100000"]) == 2
     assert "the run ended after" in capsys.readouterr().err
 
