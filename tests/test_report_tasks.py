@@ -148,3 +148,18 @@ def test_bad_scheduler_is_one_line_before_anything_runs(args, tmp_path):
                        timeout=120)
     assert p.returncode == 2 and p.stderr.strip().startswith("error: --scheduler must be")
     assert len(p.stderr.strip().splitlines()) == 1 and not (tmp_path / "x").exists()
+
+
+def test_zbm_mapping_rows_run_as_tasks():
+    """The mapping rows' HDL frames are tasks of the report's list (none with ``--fast``), and a
+    mapping task gives what calling ``mapping_accesses`` directly gives; the rows read its result."""
+    from rasterhw.sim.zbm import report
+    from rasterhw.sim.zbm.mapping_hdl import mapping_accesses
+
+    assert report.mapping_tasks(fast=True) == []
+    full = report.mapping_tasks()
+    assert [(t.name, dict(t.params)) for t in full] == [
+        ("rasterhw.sim.zbm.mapping_hdl:mapping_accesses", {"scene": s}) for s in report.REAL_SCENES]
+    small = dict(scene="c50", width=64, height=64, interleave=2)
+    got = run_tasks([call("rasterhw.sim.zbm.mapping_hdl:mapping_accesses", **small)], scheduler="serial")
+    assert _same(got) == _same([mapping_accesses(**small)]) and got[0]["texture_lookups"] > 0

@@ -89,9 +89,12 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: 
         jobs.append((s, i, eng, fast and eng == "pysim" and i in FAST_SKIP_INTERLEAVES))
     t1 = [call("rasterhw.sim.zbm.report:measure_steady_state", interleave=i, engine=eng, schedule=s)
           for s, i, eng, skip in jobs if not skip]
-    got = run_tasks(t1 + scaling.report_tasks(engine=ext_engine, fast=fast), scheduler=scheduler, store=store,
+    t_scaling = scaling.report_tasks(engine=ext_engine, fast=fast)
+    got = run_tasks(t1 + t_scaling + mapping_tasks(fast=fast), scheduler=scheduler, store=store,
                     fresh=fresh, progress=progress, desc=f"ZB/M HDL runs ({scheduler})")
-    t1_results, scaling_results = got[:len(t1)], got[len(t1):]
+    t1_results = got[:len(t1)]
+    scaling_results = got[len(t1):len(t1) + len(t_scaling)]
+    mapping_results = got[len(t1) + len(t_scaling):]
     for sched, i, eng, skip in jobs:
         label = "paper schedule" if sched == "paper" else "overlapped schedule (ours)"
         why = None
@@ -122,7 +125,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: 
     out += mapping_mode_rows()
     out += scaling.report_rows(engine=ext_engine, fast=fast, results=scaling_results)
     out += scene_rows(progress)
-    out += mapping_rows(fast=fast, progress=progress)
+    out += mapping_rows(mapping_results, progress=progress)
     area, area_note = area_rows(fast=fast, progress=progress, scheduler=scheduler, store=store, fresh=fresh)
     out += area
     sections = [f"HDL rows in this run: Table 1, paper schedule on `{hdl_engine}`, ours on `pysim`; "
@@ -315,21 +318,32 @@ def scene_rows(progress: bool) -> list[dict]:
     return out
 
 
-def mapping_rows(*, fast: bool = False, progress: bool = False) -> list[dict]:
+def mapping_tasks(*, fast: bool = False) -> list:
+    """The HDL half of :func:`mapping_rows`: one task per scene, the frame's merged words through
+    ``ZbmMapper`` -> ``ZbmCompositor`` in pysim (``sim/zbm/mapping_hdl.py: mapping_accesses``, which
+    checks its words and pixels against the golden model). ``fast``: none (~2-4 min of pysim per
+    512 x 512 frame; the rows stay, unmeasured)."""
+    from rasterhw.sim.flow.tasks import call
+
+    return [] if fast else [call("rasterhw.sim.zbm.mapping_hdl:mapping_accesses", scene=name)
+                            for name in REAL_SCENES]
+
+
+def mapping_rows(results: list[dict], *, progress: bool = False) -> list[dict]:
     """Mapping after the merge (sec. 3.3): mapping-memory reads per frame on c300 and sp27.
 
     Golden rows: ``map_samples`` on the golden merged frame, and one texture + one illumination
-    read per rasterised sample (what mapping before the Z test costs). HDL rows: the frame's merged
-    words through ``ZbmMapper`` -> ``ZbmCompositor`` in pysim (``sim/zbm/mapping_hdl.py``), its
-    lookup counters, its mapped words and composited pixels checked against the golden model.
-    ``fast``: the HDL rows stay, unmeasured (~2-4 min of pysim per 512 x 512 frame)."""
+    read per rasterised sample (what mapping before the Z test costs). HDL rows: ``results``, the
+    :func:`mapping_tasks` results in scene order (run on the report's scheduler), the HDL mapper's
+    lookup counters and the composited pixels' mismatches; none (``--fast``): those rows stay,
+    unmeasured."""
     from rasterhw.sim.report.rows import FAST_SKIP
-    from rasterhw.sim.zbm.mapping_hdl import mapping_accesses, mapping_golden
+    from rasterhw.sim.zbm.mapping_hdl import mapping_golden
 
     out = []
     for name in tqdm(REAL_SCENES, desc="ZB/M mapping after the merge", disable=not progress, leave=False):
         g = mapping_golden(name)
-        hw = None if fast else mapping_accesses(name, golden=g)
+        hw = results[REAL_SCENES.index(name)] if results else None
         why = FAST_SKIP if hw is None else None
         cfg = f"{g['width']}x{g['height']}, interleave {g['interleave']}, planar screen-space uv"
         before = 2 * g["lookups_if_mapped_before_merge"]
