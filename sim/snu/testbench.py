@@ -13,7 +13,8 @@ import numpy as np
 from rasterhw.golden_model.snu import pixelbus as golden
 from rasterhw.golden_model.snu.formats import RGB_BITS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
-from rasterhw.golden_model.snu.words import payload_words
+from rasterhw.golden_model.snu.words import payload_fields
+from rasterhw.sim.engines.packed import pack_fields
 from rasterhw.sim.snu.readout import ReadOut
 from rasterhw.sim.testbench import Expected, Run, Stimulus, Testbench
 
@@ -24,11 +25,15 @@ def _addr_bits(n: int) -> int:
     return max(1, (n - 1).bit_length())     # the blocks' max(1, ceil_log2(n))
 
 
-def _port_words(stream: PixelStream, idx: np.ndarray, aw: int, gaps) -> tuple[list[int], list[int] | None]:
-    """The writes ``idx`` as port words, then the end token (the payload's top bit + 1)."""
-    end = 1 << (stream.z_bits + RGB_BITS + aw)
-    words = [*payload_words(stream, idx, aw), end]
-    return words, (None if gaps is None else [*np.asarray(gaps, dtype=np.int64)[idx].tolist(), 0])
+def _port_words(stream: PixelStream, idx: np.ndarray, aw: int, gaps) -> tuple[np.ndarray, np.ndarray | None]:
+    """The writes ``idx`` as port words, then the end token (the payload's top bit + 1), packed
+    (``sim/engines/packed.py``: one row of bytes per word, no Python int per write)."""
+    def then(col, last=0):
+        return np.append(np.asarray(col, dtype=np.int64), last)
+    end = np.zeros(idx.size + 1, np.int64)
+    end[-1] = 1
+    words = pack_fields([(end, 1)] + [(then(col), bits) for col, bits in payload_fields(stream, idx, aw)])
+    return words, (None if gaps is None else then(np.asarray(gaps, dtype=np.int64)[idx]))
 
 
 def _stream(rng: np.random.Generator, width: int, height: int, n: int, pipes: int, z_bits: int,
