@@ -229,6 +229,40 @@ def run_frame_hdl(stream: PixelStream, gaps: np.ndarray, first_bench_gap: list[i
             "prepare_s": t1 - t0, "run_s": t2 - t1, "sim_cycles": meta["sim_cycles"], "loop_s": meta["run_s"]}
 
 
+def run_frame_engine(stream: PixelStream, gaps: np.ndarray, sched: dict, *, engine: str = "verilator") -> dict:
+    """The frame on the generic engines (``FrameBench``: ``sim/snu/frame_adapter.py``), the same
+    keys as :func:`run_frame_hdl` plus ``mismatches`` (read-out and schedule words that differ
+    from the golden ``sched``)."""
+    from rasterhw.sim import engines
+    from rasterhw.sim.snu.testbench import FrameBench
+    from rasterhw.sim.testbench import compare
+
+    w, h = stream.width, stream.height
+    t0 = time.perf_counter()
+    tb = FrameBench()
+    params = tb.params(width=w, height=h, z_bits=stream.z_bits, ram="memory" if -(-w * h // N_BANKS) <= 4096 else "verilog")
+    g = np.asarray(gaps, dtype=np.int64).copy()
+    for p in range(2):
+        i = np.flatnonzero(stream.pipe == p)
+        if i.size:
+            g[i[0]] = sched["first_bench_gap"][p]
+    if len(stream) and int(g.max()) >= (1 << GAP_BITS):
+        raise RasterhwError(f"a producer gap of {int(g.max())} clocks does not fit {GAP_BITS} bits")
+    stim = tb.stimulus_of(params, stream, g, schedule=sched)
+    exp = tb.expect(params, stim)
+    t1 = time.perf_counter()
+    r = engines.run(tb, params, stim, engine=engine, expect_words={k: len(v) for k, v in exp.words.items()},
+                    max_cycles=int(sched["cycles"]) + w * h + 10_000)
+    t2 = time.perf_counter()
+    cmp = compare(exp, r, cycle_exact=False)
+    words = np.array(r.words["o"], dtype=np.int64)
+    zmask = (1 << stream.z_bits) - 1
+    got = dict(zip(("t_clear", "t_start", "t_pixels_done", "t_swap", "cycles"), r.words["o_sched"], strict=False))
+    return {**got, "rgb": (words >> stream.z_bits).reshape(h, w), "z": (words & zmask).reshape(h, w),
+            "mismatches": cmp["mismatches"], "build_s": r.build_s, "prepare_s": t1 - t0 + (r.wall_s - r.build_s - r.run_s),
+            "run_s": t2 - t1, "sim_cycles": r.cycles, "loop_s": r.run_s}
+
+
 def frame_run(scene, width: int, height: int, *, cpu: i860.I860 | None = None, progress: bool = False,
               bus_only_bound: bool = False) -> dict:
     """The whole frame (module docstring). Returns the ``simulate_pixelbus`` keys (``block``,

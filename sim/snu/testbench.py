@@ -15,10 +15,11 @@ from rasterhw.golden_model.snu.formats import RGB_BITS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.golden_model.snu.words import payload_fields
 from rasterhw.sim.engines.packed import pack_fields
+from rasterhw.sim.snu.frame_adapter import GAP_BITS, SCHEDULE, FrameAdapter
 from rasterhw.sim.snu.readout import ReadOut
 from rasterhw.sim.testbench import Expected, Run, Stimulus, Testbench
 
-__all__ = ["BankBench", "BusBench", "frame_of"]
+__all__ = ["BankBench", "BusBench", "FrameBench", "frame_of"]
 
 
 def _addr_bits(n: int) -> int:
@@ -133,3 +134,37 @@ class BusBench(Testbench):
         cycles = int(acc.max()) + params["mem_cycle"] + s.width * s.height + 1 if len(s) else None
         return Expected({"o": _frame_words(rgb, z, params["z_bits"])}, cycles=cycles)
 
+
+class FrameBench(BusBench):
+    """``pixelbus`` drawing one whole frame (``sim/snu/frame.py``): CLEAR, the two pipelines'
+    writes each after its 16-bit producer gap, SWAP, the display buffer out on ``o`` and the
+    schedule on ``o_sched`` (:class:`~rasterhw.sim.snu.frame_adapter.FrameAdapter`). Not the
+    block's registered testbench (that is :class:`BusBench`); the frame runs it on the engines.
+    Golden: ``golden_schedule`` and ``pixelbus_frame`` (``stim.source``: ``(stream, schedule)``)."""
+
+    def dut(self, params: dict):
+        return FrameAdapter(Testbench.dut(self, params), self.inputs, params["width"] * params["height"])
+
+    def outputs_of(self, params: dict) -> tuple[str, ...]:
+        return ("o", "o_sched")
+
+    def stimulus_of(self, params: dict, stream: PixelStream, gaps=None, what: str = "", *, schedule=None) -> Stimulus:
+        """Each pipeline's writes as ``{end, gap, write}`` words (``gaps``: the producer gaps, the
+        first write's counted from the pipelines' release), then the end token; ``schedule``:
+        ``sim/snu/frame.py: golden_schedule`` of the same stream and gaps."""
+        aw = _addr_bits(params["width"] * params["height"])
+        g = np.zeros(len(stream), np.int64) if gaps is None else np.asarray(gaps, dtype=np.int64)
+        words = {}
+        for p, port in enumerate(self.inputs):
+            idx = np.flatnonzero(stream.pipe == p)
+            end = np.zeros(idx.size + 1, np.int64)
+            end[-1] = 1
+            cols = [(g[idx], GAP_BITS)] + payload_fields(stream, idx, aw)
+            words[port] = pack_fields([(end, 1)] + [(np.append(np.asarray(c, dtype=np.int64), 0), b) for c, b in cols])
+        return Stimulus(words, what=what, source=(stream, schedule))
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        s, sched = stim.source
+        rgb, z = golden.pixelbus_frame(s, accept=sched["accept"], mem_cycle=params["mem_cycle"],
+                                       n_banks=params["n_banks"])
+        return Expected({"o": _frame_words(rgb, z, params["z_bits"]), "o_sched": [int(sched[k]) for k in SCHEDULE]})
