@@ -85,6 +85,10 @@ class Testbench:
     outputs: tuple[str, ...] = ("o",)
     domains: tuple[str, ...] = ("sync",)
     port_domains: dict[str, str] = {}   # port (or port array, e.g. "o_merge") -> its domain; default sync
+    #: C++ optimisation of the Verilator engine's model: -O1 builds fast for the many short runs;
+    #: a testbench of one long run (millions of clocks) may ask for -O2 (``$RASTERHW_VERILATOR_OPT``
+    #: then applies, as for every -O2 build)
+    verilator_opt: str = "-O1"
 
     # ------------------------------------------------------------------ parameters and the DUT
     def params(self, **given) -> dict:

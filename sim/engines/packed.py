@@ -27,27 +27,32 @@ def _nbytes(bits: int) -> int:
 def pack_fields(fields: list[tuple[np.ndarray, int]]) -> np.ndarray:
     """``fields``: ``(values, bits)`` columns, the most significant first (each ``0 <= values <
     2**bits``, ``bits`` <= 64, at most 128 bits in all) -> the words ``{fields...}`` packed,
-    ``(N, ceil(total / 8))`` uint8 big-endian."""
+    ``(N, ceil(total / 8))`` uint8 big-endian (a view of a ``(N, 16)`` array)."""
     total = sum(b for _, b in fields)
     if total > 2 * _LIMB or any(not 0 < b <= _LIMB for _, b in fields):
         raise RasterhwError(f"pack_fields: fields of 1..64 bits, 128 bits in all, not {[b for _, b in fields]}")
     n = len(fields[0][0]) if fields else 0
+    limbs = np.zeros((n, 2), ">u8")   # {hi, lo}, big-endian: the bytes are the packed word
     hi, lo = np.zeros(n, _U), np.zeros(n, _U)
+    used = 0   # bits packed so far; hi stays zero while they fit lo
     for values, b in fields:
         v = np.asarray(values)
         if v.shape != (n,):
             raise RasterhwError(f"pack_fields: a column of shape {v.shape}, expected ({n},)")
         if n and (int(v.min()) < 0 or (b < _LIMB and int(v.max()) >> b)):
             raise RasterhwError(f"pack_fields: a value does not fit {b} bits")
-        v = v.astype(_U)
+        v = v.view(_U) if v.dtype == np.int64 else v.astype(_U)   # non-negative: the same bits
         if b == _LIMB:
-            hi, lo = lo, v
+            hi, lo = lo, v.copy()
         else:
-            hi = (hi << _U(b)) | (lo >> _U(_LIMB - b))
-            lo = (lo << _U(b)) | v
-    k = _nbytes(total)
-    both = np.stack([hi, lo], axis=1).astype(">u8").view(np.uint8).reshape(n, 16)
-    return np.ascontiguousarray(both[:, 16 - k:])
+            if used + b > _LIMB:
+                hi <<= _U(b)
+                hi |= lo >> _U(_LIMB - b)
+            lo <<= _U(b)
+            lo |= v
+        used += b
+    limbs[:, 0], limbs[:, 1] = hi, lo
+    return limbs.view(np.uint8)[:, 16 - _nbytes(total):]
 
 
 def as_bytes(words, bits: int) -> np.ndarray:

@@ -112,7 +112,7 @@ def _build(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[st
     text = convert_cached(
         tb.block, lambda: BenchTop(tb.dut(params), inputs, outputs, tb.domains), params=key, module="rasterhw_bench",
         convert=lambda top, mod: canonical_port_lists(verilog.convert(top, name=mod, ports=top.ports)) + _extra(top.dut))
-    return build_plain_verilator(f"tb-{tb.block}", "rasterhw_bench", [HARNESS_V], params={}, opt="-O1",
+    return build_plain_verilator(f"tb-{tb.block}", "rasterhw_bench", [HARNESS_V], params={}, opt=tb.verilator_opt,
                                  defines={"RASTERHW_CYCLES": 1}, generated={"rasterhw_bench.v": text})
 
 
