@@ -21,6 +21,7 @@ from __future__ import annotations
 from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
+from rasterhw.sim.snu.readout import ReadOut, sweep
 from rasterhw.sim.testbench import port_of
 
 __all__ = ["GAP_BITS", "FrameAdapter", "SCHEDULE"]
@@ -46,9 +47,7 @@ class FrameAdapter(wiring.Component):
         sig["o_sched"] = Out(stream.Signature(32))
         super().__init__(sig)
 
-    def extra_verilog(self) -> str:
-        """The block's hand-written Verilog (its RAM model), for the Verilator bench."""
-        return self.block.extra_verilog() if hasattr(self.block, "extra_verilog") else ""
+    extra_verilog = ReadOut.extra_verilog   # the block's RAM model, for the Verilator bench
 
     def elaborate(self, platform):
         m = Module()
@@ -99,15 +98,6 @@ class FrameAdapter(wiring.Component):
                 m.d.comb += self.o_sched.payload.eq(t[name])
         with m.If(self.o_sched.valid & self.o_sched.ready):
             m.d.sync += k.eq(k + 1)
-        sweeping, finished = Signal(), Signal()
-        ptr = Signal(range(self._words + 1))
-        take = self.o.valid & self.o.ready
-        with m.If(swapped & ~sweeping & ~finished):
-            m.d.sync += sweeping.eq(1)
-        with m.If(take):
-            m.d.sync += ptr.eq(ptr + 1)
-            with m.If(ptr == self._words - 1):
-                m.d.sync += [sweeping.eq(0), finished.eq(1)]
-        m.d.comb += [b.rd_buf.eq(1), b.rd_addr.eq(Mux(take, ptr + 1, ptr)),
-                     self.o.valid.eq(sweeping), self.o.payload.eq(Cat(b.rd_z, b.rd_rgb))]
+        m.d.comb += b.rd_buf.eq(1)
+        sweep(m, b, self.o, self._words, swapped)
         return m
