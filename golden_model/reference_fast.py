@@ -5,9 +5,12 @@ every step is written to be read. This module draws the same pixels, bit for bit
 compiled loop (:func:`_band`) that is a serial Z-buffer written out plainly:
 
 * for each triangle in submission order, the same set-up as ``reference._setup`` (the same
-  float64 operations, in the same order, on the same snapped integers), computed on the spot;
+  float64 operations, in the same order, on the same snapped integers), computed on the spot,
+  one edge at a time (:func:`_edge`);
 * for each scan line of its bounding box (clipped to the band being drawn), the same exact
-  span from ``ceil`` / ``floor`` of the same quotients ``N_i / sS_i``, clamped to the box;
+  span from ``ceil`` / ``floor`` of the same quotients ``N_i / sS_i``, clamped to the box, one
+  edge at a time (:func:`_clip`); both per-edge helpers are inlined by numba, so the loop runs
+  as if they were written out three times;
 * for each pixel of the span, the same barycentric weights and depth, the same expressions
   evaluated in the same order (``w1 = (S1*col + K1) / E`` ...,
   ``z = (z0*w0 + z1*w1) + z2*w2``), in a first pass over the span with no branches (so the
@@ -57,6 +60,42 @@ def _jit(fn):
         return numba.njit(cache=True, nogil=True)(fn)
     except (RuntimeError, OSError):
         return numba.njit(cache=False, nogil=True)(fn)
+
+
+def _inline(fn):
+    """A helper of :func:`_band`, inlined into it by numba (its IR, not a call), so writing a
+    per-edge step once costs nothing in the hot loop; compiled and cached with its caller."""
+    return numba.njit(inline="always", nogil=True)(fn)
+
+
+HALF = 128.0  # SUBPIXEL // 2
+SUB = 256.0  # SUBPIXEL
+
+
+@_inline
+def _edge(dx, dy, Xa, Ya, s):  # pragma: no cover - compiled
+    """Set-up of the edge from vertex ``(Xa, Ya)`` along ``(dx, dy)`` in a triangle of
+    orientation ``s`` (``reference._setup``): ``(k, S, sS, na, nb)`` with ``k = -dx*Ya -
+    dy*(HALF - Xa)``, ``S = -SUB*dy``, and the fill rule's ``sS*col >= N = na*Yc + nb``,
+    ``na = -s*dx``, ``nb = thr - s*k`` (``thr`` 0 on top/left edges, else 1)."""
+    k = -dx * Ya - dy * (HALF - Xa)
+    S = -SUB * dy
+    thr = 0.0 if (s * dy < 0 or (s * dy == 0 and s * dx > 0)) else 1.0
+    return k, S, s * S, -s * dx, thr - s * k
+
+
+@_inline
+def _clip(lo, hi, N, sS):  # pragma: no cover - compiled
+    """The span ``lo .. hi`` cut by one edge: ``sS > 0`` bounds it below (``ceil(N / sS)``),
+    ``sS < 0`` above (``floor``); a horizontal edge (``sS == 0``) passes the whole row
+    (``N <= 0``) or none of it (``N > 0``: an empty span, ``hi = -1`` below any ``lo >= 0``)."""
+    if sS > 0:
+        return max(lo, np.ceil(N / sS)), hi
+    if sS < 0:
+        return lo, min(hi, np.floor(N / sS))
+    if N > 0:
+        return lo, -1.0
+    return lo, hi
 
 
 @_jit
@@ -128,8 +167,6 @@ def _band(X, Y, z, col, pid, W, H, y0, y1, bg, bg8, want_rgb8, rgb8, want_colour
     fragments = 0
     written = 0
     covered = 0
-    half = 128.0  # SUBPIXEL // 2
-    sub = 256.0  # SUBPIXEL
     for t in range(X.shape[0]):
         Xv0, Xv1, Xv2 = X[t, 0], X[t, 1], X[t, 2]
         Yv0, Yv1, Yv2 = Y[t, 0], Y[t, 1], Y[t, 2]
@@ -143,10 +180,10 @@ def _band(X, Y, z, col, pid, W, H, y0, y1, bg, bg8, want_rgb8, rgb8, want_colour
         area = dx0 * (Yv0 - Yv1) - dy0 * (Xv0 - Xv1)
         if area == 0:
             continue
-        r0 = max(np.ceil((min(Yv0, Yv1, Yv2) - half) / sub), 0.0)
-        r1 = min(np.floor((max(Yv0, Yv1, Yv2) - half) / sub), float(H - 1))
-        c0 = max(np.ceil((min(Xv0, Xv1, Xv2) - half) / sub), 0.0)
-        c1 = min(np.floor((max(Xv0, Xv1, Xv2) - half) / sub), float(W - 1))
+        r0 = max(np.ceil((min(Yv0, Yv1, Yv2) - HALF) / SUB), 0.0)
+        r1 = min(np.floor((max(Yv0, Yv1, Yv2) - HALF) / SUB), float(H - 1))
+        c0 = max(np.ceil((min(Xv0, Xv1, Xv2) - HALF) / SUB), 0.0)
+        c1 = min(np.floor((max(Xv0, Xv1, Xv2) - HALF) / SUB), float(W - 1))
         if r1 < r0 or c1 < c0:
             continue
         ra = max(int(r0), y0)
@@ -154,26 +191,9 @@ def _band(X, Y, z, col, pid, W, H, y0, y1, bg, bg8, want_rgb8, rgb8, want_colour
         if rb < ra:
             continue
         s = 1.0 if area > 0 else -1.0
-        # Per edge: k = -dx*Ya - dy*(half - Xa), S = -SUBPIXEL*dy, the fill rule's
-        # sS*col >= N = na*Yc + nb, na = -s*dx, nb = thr - s*k (thr 0 on top/left edges).
-        k0 = -dx0 * Yv1 - dy0 * (half - Xv1)
-        k1 = -dx1 * Yv2 - dy1 * (half - Xv2)
-        k2 = -dx2 * Yv0 - dy2 * (half - Xv0)
-        S0 = -sub * dy0
-        S1 = -sub * dy1
-        S2 = -sub * dy2
-        sS0 = s * S0
-        sS1 = s * S1
-        sS2 = s * S2
-        thr0 = 0.0 if (s * dy0 < 0 or (s * dy0 == 0 and s * dx0 > 0)) else 1.0
-        thr1 = 0.0 if (s * dy1 < 0 or (s * dy1 == 0 and s * dx1 > 0)) else 1.0
-        thr2 = 0.0 if (s * dy2 < 0 or (s * dy2 == 0 and s * dx2 > 0)) else 1.0
-        na0 = -s * dx0
-        na1 = -s * dx1
-        na2 = -s * dx2
-        nb0 = thr0 - s * k0
-        nb1 = thr1 - s * k1
-        nb2 = thr2 - s * k2
+        _, _, sS0, na0, nb0 = _edge(dx0, dy0, Xv1, Yv1, s)
+        k1, S1, sS1, na1, nb1 = _edge(dx1, dy1, Xv2, Yv2, s)
+        k2, S2, sS2, na2, nb2 = _edge(dx2, dy2, Xv0, Yv0, s)
         za, zb, zc = z[t, 0], z[t, 1], z[t, 2]
         pt = pid[t]
         # the vertex colours, held in registers (the outputs may alias anything for the compiler)
@@ -182,31 +202,10 @@ def _band(X, Y, z, col, pid, W, H, y0, y1, bg, bg8, want_rgb8, rgb8, want_colour
         cc0, cc1, cc2 = col[t, 2, 0], col[t, 2, 1], col[t, 2, 2]
         for row in range(ra, rb + 1):
             Yc = float(row * 256 + 128)
-            # The span: sS > 0 bounds it below (ceil), sS < 0 above (floor); a horizontal edge
-            # (sS == 0) passes the whole row (N <= 0) or none of it (N > 0).
-            lo = c0
-            hi = c1
-            N = na0 * Yc + nb0
-            if sS0 > 0:
-                lo = max(lo, np.ceil(N / sS0))
-            elif sS0 < 0:
-                hi = min(hi, np.floor(N / sS0))
-            elif N > 0:
-                continue
-            N = na1 * Yc + nb1
-            if sS1 > 0:
-                lo = max(lo, np.ceil(N / sS1))
-            elif sS1 < 0:
-                hi = min(hi, np.floor(N / sS1))
-            elif N > 0:
-                continue
-            N = na2 * Yc + nb2
-            if sS2 > 0:
-                lo = max(lo, np.ceil(N / sS2))
-            elif sS2 < 0:
-                hi = min(hi, np.floor(N / sS2))
-            elif N > 0:
-                continue
+            # The span: the bounding box's columns cut by the three edges.
+            lo, hi = _clip(c0, c1, na0 * Yc + nb0, sS0)
+            lo, hi = _clip(lo, hi, na1 * Yc + nb1, sS1)
+            lo, hi = _clip(lo, hi, na2 * Yc + nb2, sS2)
             if hi < lo:
                 continue
             clo = int(lo)

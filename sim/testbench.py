@@ -10,7 +10,9 @@ in order, and the cycle count where the golden cycle model gives one). The engin
 same way: they own clocks, stream sources with idle gaps, sinks with seeded back-pressure, cycle
 stamps, build caches and run folders. This module and the engines know no machine.
 
-Words are plain integers: a stream's payload as one packed word (``payload.as_value()``).
+Words are integers: a stream's payload as one packed word (``payload.as_value()``); a port's words
+in a :class:`Stimulus` are a list of ints or, for millions of words, the same values packed as
+``(N, bytes)`` uint8 rows, big-endian (``sim/engines/packed.py``; outputs are always ints).
 
 Cycles: clock edges are counted from 0 at the first rising edge of the run (no reset: the
 design starts at its ``init`` values in every engine); a transfer's stamp is the index of the
@@ -22,6 +24,7 @@ from __future__ import annotations
 import inspect
 from dataclasses import dataclass, field
 
+import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
 
@@ -32,14 +35,15 @@ __all__ = ["Expected", "Run", "Stimulus", "Testbench", "compare", "find_testbenc
 class Stimulus:
     """Words for every input port, and the idle clocks before each word (none: back to back)."""
 
-    words: dict[str, list[int]]
+    words: dict[str, list[int]]                  # or (N, bytes) uint8 rows per port (module docstring)
     gaps: dict[str, list[int]] = field(default_factory=dict)
     what: str = ""                               # one line for logs: scene / seed / settings
     source: object = None                        # the golden model's input the words were made from
 
-    def gaps_of(self, port: str) -> list[int]:
+    def gaps_of(self, port: str) -> np.ndarray:
+        """The idle clocks before each word of ``port``, (N,) int64 (zeros where none are given)."""
         g = self.gaps.get(port)
-        return [0] * len(self.words[port]) if g is None else list(g)
+        return np.zeros(len(self.words[port]), np.int64) if g is None else np.asarray(g, dtype=np.int64)
 
 
 @dataclass(frozen=True)
@@ -81,6 +85,10 @@ class Testbench:
     outputs: tuple[str, ...] = ("o",)
     domains: tuple[str, ...] = ("sync",)
     port_domains: dict[str, str] = {}   # port (or port array, e.g. "o_merge") -> its domain; default sync
+    #: C++ optimisation of the Verilator engine's model: -O1 builds fast for the many short runs;
+    #: a testbench of one long run (millions of clocks) may ask for -O2 (``$RASTERHW_VERILATOR_OPT``
+    #: then applies, as for every -O2 build)
+    verilator_opt: str = "-O1"
 
     # ------------------------------------------------------------------ parameters and the DUT
     def params(self, **given) -> dict:

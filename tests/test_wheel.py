@@ -29,7 +29,8 @@ def wheel(tmp_path_factory) -> Path:
 def test_the_wheel_carries_benches_and_templates_and_nothing_of_the_checkout(wheel):
     names = zipfile.ZipFile(wheel).namelist()
     for need in ("rasterhw/cocotb_tests/harness.v", "rasterhw/cocotb_tests/plain_main.cpp",
-                 "rasterhw/cocotb_tests/xorshift.vh", "rasterhw/sim/report/templates/index.html.j2"):
+                 "rasterhw/cocotb_tests/xorshift.vh", "rasterhw/sim/report/templates/index.html.j2",
+                 "rasterhw/sim/vzbuf/paper_tables.csv"):
         assert need in names, need
     assert any(n.startswith("rasterhw/sim/") and n.endswith(".v") for n in names)   # a machine's own bench
     assert any(n.endswith("licenses/LICENSE") for n in names)

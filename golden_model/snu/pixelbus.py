@@ -91,66 +91,56 @@ def pixelbus_accept_cycles(
     n = len(stream)
     gap = np.zeros(n, dtype=np.int64) if gaps is None else np.asarray(gaps, dtype=np.int64)
     _gaps(stream, gaps)  # shape and sign checks
-    bank = stream.addr % n_banks
-    i0, i1 = np.flatnonzero(stream.pipe == 0), np.flatnonzero(stream.pipe == 1)
-    b0, b1 = bank[i0].tolist(), bank[i1].tolist()
-    g0, g1 = gap[i0].tolist(), gap[i1].tolist()
-    n0, n1 = len(b0), len(b1)
-    a0, a1 = [0] * n0, [0] * n1
+    # The writes grouped by pipeline, order kept: pipeline p's are at head[p] .. end[p] - 1 of
+    # B (bank), G (gap) and A (accept cycle, filled in); head[p] is its next write.
+    order = np.argsort(stream.pipe, kind="stable")
+    B = (stream.addr[order] % n_banks).tolist()
+    G = gap[order].tolist()
+    A = [0] * n
+    end = np.cumsum(np.bincount(stream.pipe, minlength=N_PIPES)).tolist()
+    head = [0] + end[:-1]
     free = [0] * n_banks  # first cycle each bank can accept again
     inf = 1 << 62
-    # Each pipeline's head write is a candidate at the first cycle of its own parity (pipe 0
-    # even, pipe 1 odd) at which it is valid and its bank is free; the earlier candidate is
+    # Each pipeline's head write is a candidate at the first cycle of its own parity (pipeline
+    # p: t + ((t ^ p) & 1)) at which it is valid and its bank is free; the earlier candidate is
     # committed (they never tie). Committing changes only its own pipeline's valid time and
-    # one bank, so the other candidate is recomputed only when its head uses that bank.
-    h0 = h1 = 0
-    c0 = c1 = inf
-    if n0:
-        t = g0[0]
-        c0 = t + (t & 1)
-    if n1:
-        t = g1[0]
-        c1 = t | 1
+    # one bank (free from then on at a later cycle than before), so the other candidate moves,
+    # to the bank's free cycle at the earliest, only when its head uses that bank.
+    cand = [inf] * N_PIPES
+    for p in range(N_PIPES):
+        if head[p] < end[p]:
+            t = G[head[p]]
+            cand[p] = t + ((t ^ p) & 1)
     while True:
-        if c0 < c1:
-            b = b0[h0]
-            a0[h0] = c0
-            free[b] = c0 + mem_cycle
-            h0 += 1
-            if h0 < n0:
-                v = c0 + 1 + g0[h0]
-                f = free[b0[h0]]
-                t = v if v > f else f
-                c0 = t + (t & 1)
-            else:
-                c0 = inf
-            if h1 < n1 and b1[h1] == b:
-                v = (a1[h1 - 1] + 1 + g1[h1]) if h1 else g1[0]
-                f = free[b]
-                t = v if v > f else f
-                c1 = t | 1
-        elif c1 < inf:
-            b = b1[h1]
-            a1[h1] = c1
-            free[b] = c1 + mem_cycle
-            h1 += 1
-            if h1 < n1:
-                v = c1 + 1 + g1[h1]
-                f = free[b1[h1]]
-                t = v if v > f else f
-                c1 = t | 1
-            else:
-                c1 = inf
-            if h0 < n0 and b0[h0] == b:
-                v = (a0[h0 - 1] + 1 + g0[h0]) if h0 else g0[0]
-                f = free[b]
-                t = v if v > f else f
-                c0 = t + (t & 1)
+        if cand[0] < cand[1]:
+            p, q = 0, 1
         else:
+            p, q = 1, 0
+        c = cand[p]
+        if c >= inf:
             break
+        h = head[p]
+        b = B[h]
+        A[h] = c
+        free[b] = c + mem_cycle
+        h += 1
+        head[p] = h
+        if h < end[p]:  # pipeline p's next write: valid the clock after c plus its gap
+            t = c + 1 + G[h]
+            f = free[B[h]]
+            if f > t:
+                t = f
+            cand[p] = t + ((t ^ p) & 1)
+        else:
+            cand[p] = inf
+        h = head[q]
+        if h < end[q] and B[h] == b:  # the other head waits for bank b
+            t = free[b]
+            t += (t ^ q) & 1
+            if t > cand[q]:
+                cand[q] = t
     accept = np.zeros(n, dtype=np.int64)
-    accept[i0] = a0
-    accept[i1] = a1
+    accept[order] = A
     return accept
 
 

@@ -7,11 +7,10 @@ import numpy as np
 from rasterhw.golden_model.snu.formats import RGB_BITS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 
-__all__ = ["payload_words"]
+__all__ = ["payload_fields"]
 
 
-def payload_words(stream: PixelStream, idx: np.ndarray, addr_bits: int) -> list[int]:
-    """The pixel writes ``idx`` of ``stream`` as port payloads ``z << (RGB + A) | rgb << A | addr``."""
-    zs = RGB_BITS + addr_bits
-    return [(int(z) << zs) | (int(c) << addr_bits) | int(a) for a, c, z in
-            zip(stream.addr[idx].tolist(), stream.rgb[idx].tolist(), stream.z[idx].tolist(), strict=True)]
+def payload_fields(stream: PixelStream, idx: np.ndarray, addr_bits: int) -> list[tuple[np.ndarray, int]]:
+    """The pixel writes ``idx`` of ``stream`` as ``(column, bits)`` fields, most significant first:
+    ``z``, ``rgb``, ``addr`` (for packing millions of words without a Python int each)."""
+    return [(stream.z[idx], stream.z_bits), (stream.rgb[idx], RGB_BITS), (stream.addr[idx], addr_bits)]

@@ -56,7 +56,7 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
         raise RasterhwError("say how many words to collect per output port (expect_words)")
     if max_cycles is None:
         words = sum(len(w) for w in stim.words.values()) + sum(expect_words.values())
-        gaps = sum(sum(g) for g in stim.gaps.values())
+        gaps = sum(int(np.sum(g, dtype=np.int64)) for g in stim.gaps.values())
         max_cycles = (10_000 + 64 * words + gaps) * (1 + stall // 32)
     return ENGINES[engine](tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
                            max_cycles=max_cycles)

@@ -10,6 +10,7 @@ import time
 from amaranth.sim import Simulator
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.engines.harness import as_plain, stream_protocol_checker, stream_put
+from rasterhw.sim.engines.packed import as_ints
 from rasterhw.sim.engines.pattern import ready_pattern
 from rasterhw.sim.engines.waves import declare_streams
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
@@ -51,7 +52,8 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
     errors: list[str] = []
     for name in tb.inputs:
         port = port_of(dut, name)
-        sim.add_testbench(_source(port, stim.words[name], stim.gaps_of(name), tb.domain_of(name)),
+        sim.add_testbench(_source(port, as_ints(stim.words[name]), stim.gaps_of(name).tolist(),
+                                  tb.domain_of(name)),
                           background=True)
     words: dict[str, list[int]] = {}
     stamps: dict[str, list[int]] = {}

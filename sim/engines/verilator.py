@@ -2,7 +2,8 @@
 ``rasterhw_stream_source`` per input port, one ``rasterhw_stream_sink`` per output port, both in
 ``cocotb_tests/harness.v``; every clock domain of the block driven by the one clock), built once
 per design and memory depth with the one C++ main (``cocotb_tests/plain_main.cpp``), the stimulus
-loaded at run time (``$readmemh``) and the words and cycle stamps dumped at the end
+loaded at run time (``$fread`` of each port's packed ``{gap, word}`` records, :mod:`packed`: no
+Python int or text line per word) and the words and cycle stamps dumped at the end
 (``$writememh``)."""
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from amaranth.hdl import (
 )
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.engines.memh import memh_uint64, read_memh
+from rasterhw.sim.engines.packed import as_bytes, records
 from rasterhw.sim.engines.runner import HARNESS_V, build_plain_verilator, run_plain_verilator
 from rasterhw.sim.engines.verilog import canonical_port_lists
 from rasterhw.sim.engines.verilog_cache import convert_cached
@@ -84,7 +86,7 @@ class BenchTop(Elaboratable):
             ok = Signal(name=f"{t}_done")
             m.submodules[f"src_{t}"] = Instance(
                 "rasterhw_stream_source", p_PW=len(_payload(port)), p_GW=GAP_BITS, p_DEPTH=depth,
-                p_FILE_ARG=f"{t}=%s", p_COUNT_ARG=f"{t}_n=%d",
+                p_FILE_ARG=f"{t}=%s", p_COUNT_ARG=f"{t}_n=%d", p_BINARY=1,
                 i_clk=ClockSignal("sync"), i_rst=Const(0, 1), i_base=Const(0, 32), i_count=Const(0, 32),
                 i_repeats=Const(1, 32),
                 o_valid=port.valid, i_ready=port.ready, o_payload=_payload(port), o_done=ok)
@@ -110,7 +112,7 @@ def _build(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[st
     text = convert_cached(
         tb.block, lambda: BenchTop(tb.dut(params), inputs, outputs, tb.domains), params=key, module="rasterhw_bench",
         convert=lambda top, mod: canonical_port_lists(verilog.convert(top, name=mod, ports=top.ports)) + _extra(top.dut))
-    return build_plain_verilator(f"tb-{tb.block}", "rasterhw_bench", [HARNESS_V], params={}, opt="-O1",
+    return build_plain_verilator(f"tb-{tb.block}", "rasterhw_bench", [HARNESS_V], params={}, opt=tb.verilator_opt,
                                  defines={"RASTERHW_CYCLES": 1}, generated={"rasterhw_bench.v": text})
 
 
@@ -132,8 +134,8 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
             if g_arr.size and (g_arr.min() < 0 or g_arr.max() >= 1 << GAP_BITS):
                 raise RasterhwError(f"{tb.block}: gaps on {n} must lie in 0..{(1 << GAP_BITS) - 1}")
             pw = widths[n]
-            (run_dir / f"{t}.hex").write_text("".join(f"{(g << pw) | w:x}\n" for w, g in zip(words, gaps, strict=True)))
-            plus += [f"+{t}={run_dir / f'{t}.hex'}", f"+{t}_n={len(words)}"]
+            (run_dir / f"{t}.bin").write_bytes(records(as_bytes(words, pw), pw, g_arr, GAP_BITS).tobytes())
+            plus += [f"+{t}={run_dir / f'{t}.bin'}", f"+{t}_n={len(words)}"]
         for k, n in enumerate(outs):
             t = _tag(n)
             plus += [f"+{t}={run_dir / f'{t}.out'}", f"+{t}_cyc={run_dir / f'{t}.cyc'}", f"+{t}_n={expect_words[n]}",

@@ -15,7 +15,7 @@ from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.sim.testbench import port_of
 
-__all__ = ["ReadOut"]
+__all__ = ["ReadOut", "sweep"]
 
 
 class ReadOut(wiring.Component):
@@ -60,16 +60,23 @@ class ReadOut(wiring.Component):
             ended.append(seen)
         m.d.comb += [b.i_cmd.valid.eq(0), b.rd_buf.eq(0)]
 
-        sweeping, finished = Signal(), Signal()
-        ptr = Signal(range(self._words + 1))
-        take = self.o.valid & self.o.ready
-        with m.If(Cat(*ended).all() & ~b.busy & ~sweeping & ~finished):
-            m.d.sync += sweeping.eq(1)
-        with m.If(take):
-            m.d.sync += ptr.eq(ptr + 1)
-            with m.If(ptr == self._words - 1):
-                m.d.sync += [sweeping.eq(0), finished.eq(1)]
-        # present the next address on a transfer, so the data is there in the next clock
-        m.d.comb += [b.rd_addr.eq(Mux(take, ptr + 1, ptr)),
-                     self.o.valid.eq(sweeping), self.o.payload.eq(Cat(b.rd_z, b.rd_rgb))]
+        sweep(m, b, self.o, self._words, Cat(*ended).all() & ~b.busy)
         return m
+
+
+def sweep(m: Module, block, o, words: int, start) -> None:
+    """In ``m``: once ``start`` is high, sweep ``block.rd_addr`` over ``0 .. words - 1`` and stream
+    each word out on ``o`` as ``{rgb, z}``, one per clock while ``o.ready`` is high (the address,
+    so the payload, held while the sink stalls); once only."""
+    sweeping, finished = Signal(), Signal()
+    ptr = Signal(range(words + 1))
+    take = o.valid & o.ready
+    with m.If(start & ~sweeping & ~finished):
+        m.d.sync += sweeping.eq(1)
+    with m.If(take):
+        m.d.sync += ptr.eq(ptr + 1)
+        with m.If(ptr == words - 1):
+            m.d.sync += [sweeping.eq(0), finished.eq(1)]
+    # present the next address on a transfer, so the data is there in the next clock
+    m.d.comb += [block.rd_addr.eq(Mux(take, ptr + 1, ptr)), o.valid.eq(sweeping),
+                 o.payload.eq(Cat(block.rd_z, block.rd_rgb))]

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from rasterhw.sim.report.plots import saved_figure
 from rasterhw.sim.report.rows import make_row
 
 PAPER_BUS_RATE = 12e6  # 3.2: "화소 버스의 통신속은 12 Mpixel/sec" (as printed)
@@ -171,26 +172,18 @@ def _model_section() -> list[str]:
 
 
 def _plot_table1(rows: list[dict], out_dir: Path) -> list[str]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     clk = [r for r in rows if r["figure"] == "table 1"
            and r["quantity"].endswith("(i860 model, assembler schedule, one triangle)")]
     names = [r["quantity"].split(":")[0] for r in clk]
     x = range(len(names))
-    fig, ax = plt.subplots(figsize=(8, 3.6))
-    ax.bar([i - 0.2 for i in x], [r["paper"] for r in clk], width=0.4, label="paper (table 1)")
-    ax.bar([i + 0.2 for i in x], [r["measured"] for r in clk], width=0.4, label="i860 model (assembler)")
-    ax.set_xticks(list(x), [n.replace("_", "\n") for n in names], fontsize=8)
-    ax.set_ylabel("i860 clocks per triangle")
-    ax.set_title("SNU table 1: clocks per triangle by stage")
-    ax.legend()
-    fig.tight_layout()
     path = out_dir / "snu_table1.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    with saved_figure(path, figsize=(8, 3.6)) as ax:
+        ax.bar([i - 0.2 for i in x], [r["paper"] for r in clk], width=0.4, label="paper (table 1)")
+        ax.bar([i + 0.2 for i in x], [r["measured"] for r in clk], width=0.4, label="i860 model (assembler)")
+        ax.set_xticks(list(x), [n.replace("_", "\n") for n in names], fontsize=8)
+        ax.set_ylabel("i860 clocks per triangle")
+        ax.set_title("SNU table 1: clocks per triangle by stage")
+        ax.legend()
     return ["## Plots", "", f"![table 1 clocks]({path.name})", "",
             "Clocks: the i860 timing model scheduling each stage's instructions (paper's recipe); where it "
             "differs from table 1, `docs/snu_geometry.md` says why, stage by stage.", ""]

@@ -13,22 +13,33 @@ import numpy as np
 from rasterhw.golden_model.snu import pixelbus as golden
 from rasterhw.golden_model.snu.formats import RGB_BITS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
-from rasterhw.golden_model.snu.words import payload_words
+from rasterhw.golden_model.snu.words import payload_fields
+from rasterhw.sim.engines.packed import pack_fields
+from rasterhw.sim.snu.frame_adapter import GAP_BITS, SCHEDULE, FrameAdapter
 from rasterhw.sim.snu.readout import ReadOut
 from rasterhw.sim.testbench import Expected, Run, Stimulus, Testbench
 
-__all__ = ["BankBench", "BusBench", "frame_of"]
+__all__ = ["BankBench", "BusBench", "FrameBench", "frame_of"]
 
 
 def _addr_bits(n: int) -> int:
     return max(1, (n - 1).bit_length())     # the blocks' max(1, ceil_log2(n))
 
 
-def _port_words(stream: PixelStream, idx: np.ndarray, aw: int, gaps) -> tuple[list[int], list[int] | None]:
-    """The writes ``idx`` as port words, then the end token (the payload's top bit + 1)."""
-    end = 1 << (stream.z_bits + RGB_BITS + aw)
-    words = [*payload_words(stream, idx, aw), end]
-    return words, (None if gaps is None else [*np.asarray(gaps, dtype=np.int64)[idx].tolist(), 0])
+def _port_words(stream: PixelStream, idx: np.ndarray, aw: int, gaps) -> tuple[np.ndarray, np.ndarray | None]:
+    """The writes ``idx`` as port words, then the end token (the payload's top bit + 1), packed
+    (``sim/engines/packed.py``: one row of bytes per word, no Python int per write)."""
+    fields = payload_fields(stream, idx, aw)
+    words = _then_end(pack_fields([(np.zeros(idx.size, np.int64), 1)] + fields), 1 + sum(b for _, b in fields))
+    return words, (None if gaps is None else np.append(np.asarray(gaps, dtype=np.int64)[idx], 0))
+
+
+def _then_end(words: np.ndarray, bits: int) -> np.ndarray:
+    """Packed ``words`` of ``bits`` bits, then the end token: the top bit alone."""
+    end = np.zeros((1, words.shape[1]), np.uint8)
+    pad = 8 * words.shape[1] - bits          # unused bits above the word in its first byte
+    end[0, pad // 8] = 1 << (7 - pad % 8)
+    return np.concatenate([words, end])
 
 
 def _stream(rng: np.random.Generator, width: int, height: int, n: int, pipes: int, z_bits: int,
@@ -128,3 +139,37 @@ class BusBench(Testbench):
         cycles = int(acc.max()) + params["mem_cycle"] + s.width * s.height + 1 if len(s) else None
         return Expected({"o": _frame_words(rgb, z, params["z_bits"])}, cycles=cycles)
 
+
+class FrameBench(BusBench):
+    """``pixelbus`` drawing one whole frame (``sim/snu/frame.py``): CLEAR, the two pipelines'
+    writes each after its 16-bit producer gap, SWAP, the display buffer out on ``o`` and the
+    schedule on ``o_sched`` (:class:`~rasterhw.sim.snu.frame_adapter.FrameAdapter`). Not the
+    block's registered testbench (that is :class:`BusBench`); the frame runs it on the engines.
+    Golden: ``golden_schedule`` and ``pixelbus_frame`` (``stim.source``: ``(stream, schedule)``)."""
+
+    verilator_opt = "-O2"   # one run of ~17 M clocks: the clock loop outweighs the longer build
+
+    def dut(self, params: dict):
+        return FrameAdapter(Testbench.dut(self, params), self.inputs, params["width"] * params["height"])
+
+    def outputs_of(self, params: dict) -> tuple[str, ...]:
+        return ("o", "o_sched")
+
+    def stimulus_of(self, params: dict, stream: PixelStream, gaps=None, what: str = "", *, schedule=None) -> Stimulus:
+        """Each pipeline's writes as ``{end, gap, write}`` words (``gaps``: the producer gaps, the
+        first write's counted from the pipelines' release), then the end token; ``schedule``:
+        ``sim/snu/frame.py: golden_schedule`` of the same stream and gaps."""
+        aw = _addr_bits(params["width"] * params["height"])
+        g = np.zeros(len(stream), np.int64) if gaps is None else np.asarray(gaps, dtype=np.int64)
+        words = {}
+        for p, port in enumerate(self.inputs):
+            idx = np.flatnonzero(stream.pipe == p)
+            fields = [(np.zeros(idx.size, np.int64), 1), (g[idx], GAP_BITS)] + payload_fields(stream, idx, aw)
+            words[port] = _then_end(pack_fields(fields), sum(b for _, b in fields))
+        return Stimulus(words, what=what, source=(stream, schedule))
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        s, sched = stim.source
+        rgb, z = golden.pixelbus_frame(s, accept=sched["accept"], mem_cycle=params["mem_cycle"],
+                                       n_banks=params["n_banks"])
+        return Expected({"o": _frame_words(rgb, z, params["z_bits"]), "o_sched": [int(sched[k]) for k in SCHEDULE]})

@@ -16,6 +16,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from rasterhw.sim.report.plots import saved_figure
 from rasterhw.sim.report.rows import make_row
 from tqdm import tqdm
 
@@ -490,29 +491,21 @@ def area_rows(*, fast: bool = False, progress: bool = False, scheduler: str = "s
 
 
 def _plot(measured: dict[str, dict[int, float]], out_dir: Path, engine: str) -> list[str]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     xs = sorted(PAPER_KPOLYS)
     xp, xo = sorted(measured["paper"]), sorted(measured["overlap"])   # a fast run measures fewer
-    fig, ax = plt.subplots(figsize=(6, 3.6))
-    ax.plot(xs, [PAPER_KPOLYS[i] for i in xs], "o--", label="paper (table 1)")
-    ax.plot(xp, [polygons_per_s(measured["paper"][i]) / 1e3 for i in xp], "s-",
-            label=f"paper schedule (HDL cycles, {engine})")
-    ax.plot(xo, [polygons_per_s(measured["overlap"][i]) / 1e3 for i in xo], "^-",
-            label="overlapped, ours (HDL cycles, pysim)")
-    ax.set_xscale("log", base=2)
-    ax.set_xticks(xs, [str(i) for i in xs])
-    ax.set_xlabel("chips interleaved on a scan line")
-    ax.set_ylabel("K polygons/s per unit")
-    ax.set_title("ZB/M throughput against interleave (5x5 edge pairs, 25 MHz)")
-    ax.legend()
-    fig.tight_layout()
     path = out_dir / "zbm_table1.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    with saved_figure(path, figsize=(6, 3.6)) as ax:
+        ax.plot(xs, [PAPER_KPOLYS[i] for i in xs], "o--", label="paper (table 1)")
+        ax.plot(xp, [polygons_per_s(measured["paper"][i]) / 1e3 for i in xp], "s-",
+                label=f"paper schedule (HDL cycles, {engine})")
+        ax.plot(xo, [polygons_per_s(measured["overlap"][i]) / 1e3 for i in xo], "^-",
+                label="overlapped, ours (HDL cycles, pysim)")
+        ax.set_xscale("log", base=2)
+        ax.set_xticks(xs, [str(i) for i in xs])
+        ax.set_xlabel("chips interleaved on a scan line")
+        ax.set_ylabel("K polygons/s per unit")
+        ax.set_title("ZB/M throughput against interleave (5x5 edge pairs, 25 MHz)")
+        ax.legend()
     return ["## Plots", "", f"![throughput against interleave]({path.name})", "",
             f"Measured: one ZB/M unit (paper schedule: {engine}; ours: pysim) on the paper's workload, {2 * N_PAIRS} edge pairs in one run; "
             f"(cycle line {10 * N_PAIRS} done - cycle line {5 * N_PAIRS} done) / {N_PAIRS}; equal to the exact "

@@ -289,6 +289,7 @@ def test_bank_testbench_reads_out_after_the_last_memory_cycle():
 @pytest.mark.parametrize("pipe", [0, 1])
 def test_bus_testbench_with_one_pipeline_empty(pipe):
     from rasterhw.sim.engines import run
+    from rasterhw.sim.engines.packed import as_ints
     from rasterhw.sim.snu.testbench import frame_of
     from rasterhw.sim.testbench import compare, find_testbench
 
@@ -299,7 +300,7 @@ def test_bus_testbench_with_one_pipeline_empty(pipe):
     tb = find_testbench("pixelbus")
     p = tb.params(width=20, height=8)
     stim = tb.stimulus_of(p, s)
-    assert stim.words[f"i_pipe{1 - pipe}"] == [1 << (24 + 24 + 8)]     # only the end token
+    assert as_ints(stim.words[f"i_pipe{1 - pipe}"]) == [1 << (24 + 24 + 8)]     # only the end token
     exp = tb.expect(p, stim)
     r = run(tb, p, stim, engine="pysim", stall=100, seed=3, expect_words={"o": 160})
     c = compare(exp, r, cycle_exact=False)
