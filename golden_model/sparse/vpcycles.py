@@ -76,7 +76,8 @@ class VPCycleModel:
     ``step(in_valid) -> accepted``: one clock cycle with the broadcast input's ``valid``; returns
     whether the processor took the record in that cycle. ``busy`` is the HDL's ``busy`` output
     for the current cycle (before ``step``). Counters ``tests[i]`` (coverage tests of stage ``i + 1``)
-    and ``stalls[i]`` are the HDL stage's. ``kp``, ``ke``: formula (5)'s parameter cycles, as
+    and ``stalls[i]`` are the HDL stage's; ``stage_busy[i]`` counts the cycles stage ``i + 1`` was
+    not idle (testing, sending a header, stalled or waiting for parameter additions). ``kp``, ``ke``: formula (5)'s parameter cycles, as
     ``VideoProcessor(kp=..., ke=...)`` spends them.
     """
 
@@ -113,6 +114,7 @@ class VPCycleModel:
         self.fresh = [False] * n
         self.tests = [0] * n
         self.stalls = [0] * n
+        self.stage_busy = [0] * n
         self.px_next = 0
         self.v1 = self.v2 = False
         self.held = 0
@@ -149,6 +151,8 @@ class VPCycleModel:
         st_next = list(self.st)
         for s in range(n):
             ok_s, new_in = self.ok[s], self.new[s]
+            if self.st[s]:
+                self.stage_busy[s] += 1
 
             def accept(s=s, new_in=new_in):
                 # take the next window (and its header if it starts a triangle)
