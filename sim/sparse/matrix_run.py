@@ -9,7 +9,7 @@ offers a record on every cycle from the first, drains, reads every counter and s
 raster. The input FIFOs are built ``in_depth`` entries deep; ``limit`` (the run's FIFO depth) is
 a plusarg, so a depth sweep reuses one build. With ``colour`` the records are ``BROADCAST_RGB``
 (``stack.broadcast_records_rgb``) and the bench writes the interleaved colour memories as well
-(``+rgb=``, define ``RASTERHW_RGB``).
+(``+rgb=``; the generated ``tb_sparse_matrix_cfg.vh`` defines ``RASTERHW_RGB``).
 """
 
 from __future__ import annotations
@@ -65,9 +65,9 @@ def build_matrix(*, n: int, p: int, q: int, z_bits: int = 24, fifo_depth: int = 
     params = {"N": n, "LP": lp, "LQ": lq, "BW": layouts(colour)[0].size, "MAXT": MAXT, "ZW": z_bits + 1, "TW": TRI_BITS,
               "NS": ns, "LIMW": in_depth.bit_length(), "CW": max(1, (max(p * q, 2) - 1).bit_length()),
               "SW": max(1, (ns - 1).bit_length())}
-    defines = {"RASTERHW_CYCLES": 1, **({"RASTERHW_RGB": 1} if colour else {})}
-    exe, secs = build_plain_verilator("sparse-matrix", TOP, [BENCH], params=params, defines=defines,
+    exe, secs = build_plain_verilator("sparse-matrix", TOP, [BENCH], params=params, defines={"RASTERHW_CYCLES": 1},
                                       generated={"sparse_cell.v": cell, "sparse_matrix.v": top,
+                                                 "tb_sparse_matrix_cfg.vh": "`define RASTERHW_RGB\n" if colour else "",
                                                  **{f: (BENCH.parent / f).read_text() for f in SHARED_VH}})
     return exe, secs, {"verilog_bytes_cell": len(cell), "verilog_bytes_matrix": len(top)}
 

@@ -5,8 +5,10 @@
 // to +limit= entries at run time; waits until the matrix is idle; reads every processor's counters
 // (stat_cell x stat_sel) and the matrix's frame and stall cycles into +stats=, then sweeps the full
 // raster through the interleaved read port and writes {tri, z} per pixel (row-major) to +out=.
-// With RASTERHW_RGB defined (a matrix built with colour) it also writes each pixel's colour
-// (R | G << 8 | B << 16, from the port rd_rgb) to +rgb=.
+// With RASTERHW_RGB defined (a matrix built with colour: the driver's generated
+// tb_sparse_matrix_cfg.vh defines it) it also writes each pixel's colour (R | G << 8 | B << 16,
+// from the port rd_rgb) to +rgb=.
+`include "tb_sparse_matrix_cfg.vh"
 module tb_sparse_matrix #(parameter N = 7, parameter LP = 2, parameter LQ = 2, parameter BW = 600,
                           parameter MAXT = 16384, parameter ZW = 25, parameter TW = 16, parameter NS = 18,
                           parameter LIMW = 7, parameter CW = 4, parameter SW = 5)
