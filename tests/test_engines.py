@@ -24,7 +24,7 @@ SMALL = {
     "zbm-chip": {"interleave": 2, "chip": 1, "width": 32},
     "zbm-loop": {"interleave": 2, "width": 32},
     "sparse-matrix": {"n": 3, "p": 2, "q": 2, "in_depth": 4},
-    "sparse-vp": {"n": 3, "p": 2, "q": 2},
+    "sparse-vp": {"n": 3, "p": 2, "q": 2, "colour": True, "kp": 4},
     "sparse-stack-vp": {"n": 3, "p": 2, "q": 2, "colour": True, "kp": 4},
     "zbm-merger": {"fifo_depth": 4},
     "zbm-pixel": {"index": 3, "interleave": 1, "width": 128},

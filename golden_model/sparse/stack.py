@@ -177,10 +177,9 @@ def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int
                                               for c0, cu, cv in col)
             cur = nxt if nxt is not None else (stack.pop() if stack else None)
         cycles[t] = SETUP_CYCLES + ntest + npar
-        # the pixel processor holds a pixel for PIXEL_LATENCY cycles after its test (the colour
-        # write one more): what the record's last pixels keep busy after the record is done
-        lat = PIXEL_LATENCY + (1 if colour else 0)
-        tail[t] = max(0, last_px + lat + 1 - int(cycles[t])) if last_px >= 0 else 0
+        # the pixel processor holds a pixel for PIXEL_LATENCY cycles after its test (its colour is
+        # written with its depth): what the record's last pixels keep busy after the record is done
+        tail[t] = max(0, last_px + PIXEL_LATENCY + 1 - int(cycles[t])) if last_px >= 0 else 0
     tri_m = np.array(ttab, dtype=np.int64).reshape(Ns, Ns)
     zq_m = np.where(tri_m >= 0, np.array(ztab, dtype=np.int64).reshape(Ns, Ns), -1)
     accept = np.concatenate([[0], np.cumsum(cycles)[:-1]]).astype(np.int64) if T else cycles.copy()

@@ -14,7 +14,12 @@ each broadcast record -- and its last busy cycle are the HDL's:
 * ``2 (n + 1)`` ``SyncFIFOBuffered`` FIFOs (Amaranth 0.5: an inner memory of ``depth - 1`` entries
   and an output register; ``w_rdy = inner_level != depth - 1``; an entry written on cycle ``c``
   is at the output on cycle ``c + 2``);
-* the pixel processor: takes one pixel per cycle, two register stages (``idle`` when both empty).
+* the pixel processor: takes one pixel per cycle, two register stages (``idle`` when both empty);
+* with surface parameters priced (``kp`` > 0, formula (5)): after a survivor has gone out, the stage
+  waits ``param_cycles`` whole cycles (``PARAM``) while ``kp`` additions run on ``ke`` adders, the
+  additions left over from a cycle kept for the stage's next survivor of the same triangle; after a
+  fourth sub-window the next window is taken in the last of those cycles. (Colour itself costs no
+  cycle: it travels in the same FIFO words.)
 
 Only the control flow is modelled: which sub-windows survive and which windows start a triangle
 come from the golden search (``sparse_render(..., trace=True)``), which the HDL is held to bit for
@@ -29,6 +34,8 @@ from __future__ import annotations
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.sparse.cycles import KE_EDGES
+from rasterhw.golden_model.sparse.stack import param_cycles
 
 __all__ = ["HDL_FIFO_DEPTH", "VPCycleModel", "coupled_matrix_vp", "vp_standalone", "vp_streams"]
 
@@ -68,16 +75,23 @@ class VPCycleModel:
 
     ``step(in_valid) -> accepted``: one clock cycle with the broadcast input's ``valid``; returns
     whether the processor took the record in that cycle. ``busy`` is the HDL's ``busy`` output
-    for the current cycle (before ``step``). Counters ``tests[i]`` (busy cycles of stage ``i + 1``)
-    and ``stalls[i]`` are the HDL stage's.
+    for the current cycle (before ``step``). Counters ``tests[i]`` (coverage tests of stage ``i + 1``)
+    and ``stalls[i]`` are the HDL stage's; ``stage_busy[i]`` counts the cycles stage ``i + 1`` was
+    not idle (testing, sending a header, stalled or waiting for parameter additions). ``kp``, ``ke``: formula (5)'s parameter cycles, as
+    ``VideoProcessor(kp=..., ke=...)`` spends them.
     """
 
     def __init__(self, oks: list[np.ndarray], news: list[np.ndarray], new_px: np.ndarray, *,
-                 fifo_depth: int = HDL_FIFO_DEPTH, setup_fifo_depth: int | None = None):
+                 fifo_depth: int = HDL_FIFO_DEPTH, setup_fifo_depth: int | None = None, kp: int = 0,
+                 ke: int = KE_EDGES):
         setup_fifo_depth = fifo_depth if setup_fifo_depth is None else setup_fifo_depth
         for name, v in (("fifo_depth", fifo_depth), ("setup_fifo_depth", setup_fifo_depth)):
             if isinstance(v, bool) or not isinstance(v, int) or v < 2:
                 raise RasterhwError(f"sparse VP cycles: {name} must be an integer >= 2, not {v!r}")
+        for name, v, lo in (("kp", kp, 0), ("ke", ke, 1)):
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
+                raise RasterhwError(f"sparse VP cycles: {name} must be an integer >= {lo}, not {v!r}")
+        self.kp, self.ke = int(kp), int(ke)
         self.n = n = len(oks)
         self.ok = [[tuple(bool(b) for b in row) for row in o] for o in oks]
         self.new = [list(map(bool, x)) for x in news] + [list(map(bool, new_px))]
@@ -89,7 +103,10 @@ class VPCycleModel:
         self.hl = [0] * (n + 1)
         self.hv = [False] * (n + 1)
         self.setup = 0  # 0 IDLE, 1 HDR, 2 ROOT
-        self.st = [0] * n  # 0 IDLE, 1 TEST
+        self.st = [0] * n  # 0 IDLE, 1 TEST, 2 PARAM
+        self.credit = [0] * n  # parameter additions left from the stage's last parameter cycle
+        self.pcount = [0] * n  # parameter cycles still to wait
+        self.pend = [False] * n  # ... then take the next window
         self.child = [0] * n
         self.cur = [0] * n  # index of the window held
         self.nxt = [0] * n  # index of the next window to take
@@ -97,6 +114,7 @@ class VPCycleModel:
         self.fresh = [False] * n
         self.tests = [0] * n
         self.stalls = [0] * n
+        self.stage_busy = [0] * n
         self.px_next = 0
         self.v1 = self.v2 = False
         self.held = 0
@@ -133,6 +151,8 @@ class VPCycleModel:
         st_next = list(self.st)
         for s in range(n):
             ok_s, new_in = self.ok[s], self.new[s]
+            if self.st[s]:
+                self.stage_busy[s] += 1
 
             def accept(s=s, new_in=new_in):
                 # take the next window (and its header if it starts a triangle)
@@ -148,6 +168,7 @@ class VPCycleModel:
                     if need:
                         self.sent[s] = False
                         self.fresh[s] = False
+                        self.credit[s] = 0
                     st_next[s] = 1
                 else:
                     st_next[s] = 0
@@ -155,7 +176,16 @@ class VPCycleModel:
             if self.st[s] == 0:
                 accept()
                 continue
+            if self.st[s] == 2:
+                self.pcount[s] -= 1
+                if self.pcount[s] == 0:
+                    if self.pend[s]:
+                        accept()
+                    else:
+                        st_next[s] = 1
+                continue
             c = self.child[s]
+            extra = 0
             ok = ok_s[self.cur[s]][c]
             advance = False
             if ok and not self.sent[s]:
@@ -168,6 +198,8 @@ class VPCycleModel:
                 if wl[s + 1] != caps[s + 1]:
                     advance = True
                     self.fresh[s] = False
+                    if self.kp:
+                        extra, self.credit[s] = param_cycles(self.credit[s], self.kp, self.ke)
                 else:
                     self.stalls[s] += 1
             else:
@@ -175,7 +207,10 @@ class VPCycleModel:
             if advance:
                 self.tests[s] += 1
                 self.child[s] = c + 1
-                if c == 3:
+                if extra:
+                    self.pcount[s], self.pend[s] = extra, c == 3
+                    st_next[s] = 2
+                elif c == 3:
                     accept()
         # ---- pixel processor
         take = False
@@ -207,16 +242,16 @@ class VPCycleModel:
         self.held = held
         self.setup = setup_next
         self.st = st_next
-        self.active = sum(st_next)
+        self.active = sum(1 for v in st_next if v)
         return accepted
 
 
 def vp_standalone(oks, news, new_px, records: int, *, fifo_depth: int = HDL_FIFO_DEPTH,
-                  max_cycles: int = 50_000_000) -> dict:
+                  max_cycles: int = 50_000_000, kp: int = 0, ke: int = KE_EDGES) -> dict:
     """The Verilator bench's run of one processor: ``cycles`` (as the bench counts them),
     ``accept`` (cycle each record was taken, from the first cycle after reset), ``tests``,
     ``stalls`` per level."""
-    vp = VPCycleModel(oks, news, new_px, fifo_depth=fifo_depth)
+    vp = VPCycleModel(oks, news, new_px, fifo_depth=fifo_depth, kp=kp, ke=ke)
     acc = []
     c = 0
     idx = 0
@@ -239,13 +274,14 @@ def vp_standalone(oks, news, new_px, records: int, *, fifo_depth: int = HDL_FIFO
 
 
 def coupled_matrix_vp(frame, depth: int, *, issue_interval: int = 1, fifo_depth: int = HDL_FIFO_DEPTH,
-                      setup_fifo_depth: int | None = None,
+                      setup_fifo_depth: int | None = None, kp: int = 0, ke: int = KE_EDGES,
                       max_cycles: int = 100_000_000) -> dict:
     """The coupled matrix of :mod:`.cycles` (same broadcast, FIFO and counting rules) with every
     processor the HDL video processor as built (:class:`VPCycleModel`) instead of a server: a
     processor takes the record at the head of its matrix FIFO on a cycle on which its set-up is
     idle (``i.ready``), and ``busy`` is the HDL's ``busy`` output. ``frame`` must be drawn with
-    ``trace=True``. Returns the keys of :meth:`~.cycles.CoupledResult.as_dict` plus ``accept``
+    ``trace=True``. ``kp``, ``ke``: every processor prices its surface parameters as formula (5)
+    (:class:`VPCycleModel`). Returns the keys of :meth:`~.cycles.CoupledResult.as_dict` plus ``accept``
     ((P, T) cycle each processor took each record) and ``broadcast`` ((T,))."""
     from rasterhw.golden_model.sparse.cycles import _check_int
 
@@ -253,8 +289,8 @@ def coupled_matrix_vp(frame, depth: int, *, issue_interval: int = 1, fifo_depth:
     g = _check_int("issue interval", issue_interval, 1)
     P = frame.p * frame.q
     T = frame.triangles
-    vps = [VPCycleModel(*vp_streams(frame, k), fifo_depth=fifo_depth, setup_fifo_depth=setup_fifo_depth)
-           for k in range(P)]
+    vps = [VPCycleModel(*vp_streams(frame, k), fifo_depth=fifo_depth, setup_fifo_depth=setup_fifo_depth, kp=kp,
+                        ke=ke) for k in range(P)]
     lev = [0] * P
     peak = [0] * P
     busy = [0] * P

@@ -7,7 +7,8 @@ from amaranth.hdl import Const, Module, Signal
 from amaranth.lib import fifo, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import MATRIX_LOG2_MAX, TRI_BITS
-from rasterhw.hdl.sparse.layouts import BROADCAST
+from rasterhw.hdl.sparse.layouts import layouts
+from rasterhw.hdl.sparse.stack_vp import StackProcessor
 from rasterhw.hdl.sparse.vp import VideoProcessor
 
 __all__ = ["MatrixCell", "cell_stats"]
@@ -46,36 +47,46 @@ class MatrixCell(wiring.Component):
     ``vp="stack"``: the processor is the stack-based one (``hdl/sparse/stack_vp.py``); its stalls
     read 0 (it never waits for an output) and ``busy_cycles`` is its own count of the cycles it
     holds a record (the take cycle, set-up and tests: ``cycles.service_times(vp="stack")``).
+
+    ``colour``, ``kp``, ``ke``: the processor's surface parameters (R, G, B broadcast with the
+    edges: ``rec`` is ``BROADCAST_RGB`` and ``rd_rgb`` reads the colour memory) and formula (5)'s
+    cost of their additions, either processor (``hdl/sparse/vp.py``, ``hdl/sparse/stack_vp.py``).
     """
 
     def __init__(self, *, n: int, p: int, q: int, alpha: int = 2, beta: int = 2, z_bits: int = 24,
-                 fifo_depth: int = 8, in_depth: int = 64, vp: str = "pipeline"):
+                 fifo_depth: int = 8, in_depth: int = 64, vp: str = "pipeline", colour: bool = False, kp: int = 0,
+                 ke: int = 3):
         if not isinstance(in_depth, int) or not 1 <= in_depth <= 1024:
             raise ValueError(f"in_depth must be an integer in 1..1024, not {in_depth!r}")
+        par = dict(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, colour=colour, kp=kp, ke=ke)
         if vp == "pipeline":
-            self._vp = VideoProcessor(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth)
+            self._vp = VideoProcessor(**par, fifo_depth=fifo_depth)
         elif vp == "stack":
-            from rasterhw.hdl.sparse.stack_vp import StackProcessor
-
-            self._vp = StackProcessor(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits)
+            self._vp = StackProcessor(**par)
         else:
             raise ValueError(f"vp must be 'pipeline' or 'stack', not {vp!r}")
         self._stack = vp == "stack"
-        self._n, self._in_depth = n, in_depth
-        super().__init__({"a": In(MATRIX_LOG2_MAX), "b": In(MATRIX_LOG2_MAX), "limit": In(range(in_depth + 1)),
-                          "push": In(1), "rec": In(BROADCAST), "room": Out(1), "busy": Out(1),
-                          "rd_addr": In(2 * n), "rd_z": Out(z_bits + 1), "rd_tri": Out(TRI_BITS),
-                          "stat_sel": In(range(len(cell_stats(n)))), "stat": Out(32)})
+        self._n, self._in_depth, self._colour = n, in_depth, colour
+        self._rec = layouts(colour)[0]
+        ports = {"a": In(MATRIX_LOG2_MAX), "b": In(MATRIX_LOG2_MAX), "limit": In(range(in_depth + 1)),
+                 "push": In(1), "rec": In(self._rec), "room": Out(1), "busy": Out(1),
+                 "rd_addr": In(2 * n), "rd_z": Out(z_bits + 1), "rd_tri": Out(TRI_BITS),
+                 "stat_sel": In(range(len(cell_stats(n)))), "stat": Out(32)}
+        if colour:
+            ports["rd_rgb"] = Out(24)
+        super().__init__(ports)
 
     def elaborate(self, platform):
         m = Module()
         n = self._n
         m.submodules.vp = vp = self._vp
-        m.submodules.fifo = f = fifo.SyncFIFO(width=BROADCAST.size, depth=self._in_depth)
+        m.submodules.fifo = f = fifo.SyncFIFO(width=self._rec.size, depth=self._in_depth)
         m.d.comb += [vp.a.eq(self.a), vp.b.eq(self.b), f.w_data.eq(self.rec), f.w_en.eq(self.push),
                      self.room.eq(f.level < self.limit), vp.i.payload.eq(f.r_data), vp.i.valid.eq(f.r_rdy),
                      f.r_en.eq(vp.i.ready), vp.rd_addr.eq(self.rd_addr), self.rd_z.eq(vp.rd_z),
                      self.rd_tri.eq(vp.rd_tri), self.busy.eq(vp.busy | (f.level != 0))]
+        if self._colour:
+            m.d.comb += self.rd_rgb.eq(vp.rd_rgb)
         busy_cycles = Signal(32)
         peak = Signal(range(self._in_depth + 1))
         records = Signal(32)

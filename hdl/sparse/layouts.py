@@ -16,7 +16,7 @@ from rasterhw.golden_model.sparse.formats import (
     Z_ACC_BITS,
 )
 
-__all__ = ["BROADCAST", "HEADER", "WINDOW", "Z_FRAC_BITS_HDL"]
+__all__ = ["BROADCAST", "BROADCAST_RGB", "HEADER", "HEADER_RGB", "WINDOW", "WINDOW_RGB", "Z_FRAC_BITS_HDL", "layouts"]
 
 from rasterhw.golden_model.sparse.formats import Z_FRAC_BITS as Z_FRAC_BITS_HDL  # noqa: E402
 
@@ -56,3 +56,21 @@ WINDOW = data.StructLayout({
     "u": unsigned(UV_BITS),                             # first sparse pixel of the window
     "v": unsigned(UV_BITS),
 })
+
+#: colour (R, G, B) as three more linear functions, 8-bit levels with ``Z_FRAC_BITS`` fraction bits
+_RGB = data.ArrayLayout(signed(Z_ACC_BITS), 3)
+
+#: the broadcast record with the vertex colours' planes (``fixed.colour_planes``, over full-raster
+#: pixel indices): value at pixel (0, 0) and the per-pixel steps; ``BROADCAST`` is its low bits
+BROADCAST_RGB = data.StructLayout({**dict(BROADCAST.members), "c00": _RGB, "cx": _RGB, "cy": _RGB})
+
+#: the header with the processor's colour steps (``cu = p*cx``, ``cv = q*cy``)
+HEADER_RGB = data.StructLayout({**dict(HEADER.members), "cu": _RGB, "cv": _RGB})
+
+#: a window with its colour at (u, v)
+WINDOW_RGB = data.StructLayout({**dict(WINDOW.members), "c": _RGB})
+
+
+def layouts(colour: bool) -> tuple[data.StructLayout, data.StructLayout, data.StructLayout]:
+    """``(broadcast, header, window)`` layouts, with the colour planes when ``colour``."""
+    return (BROADCAST_RGB, HEADER_RGB, WINDOW_RGB) if colour else (BROADCAST, HEADER, WINDOW)

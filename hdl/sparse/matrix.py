@@ -8,7 +8,7 @@ from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import TRI_BITS
 from rasterhw.hdl.sparse.cell import MatrixCell, cell_stats
-from rasterhw.hdl.sparse.layouts import BROADCAST
+from rasterhw.hdl.sparse.layouts import layouts
 
 __all__ = ["CELL_MODULE", "Matrix", "make_matrix"]
 
@@ -36,6 +36,9 @@ class Matrix(wiring.Component):
     module however large the matrix (the cell's Verilog is generated once, separately:
     ``MatrixCell`` of the same parameters converted with that name). ``vp="stack"``: every cell's
     processor is the stack-based one (``hdl/sparse/stack_vp.py``) instead of the pipeline.
+    ``colour``, ``kp``, ``ke``: every processor's surface parameters and their cost (formula (5));
+    with ``colour`` the broadcast carries ``BROADCAST_RGB`` and ``rd_rgb`` reads the interleaved
+    colour memories (R | G << 8 | B << 16, 0 where empty) beside ``rd_z`` / ``rd_tri``.
 
     Members
     -------
@@ -52,11 +55,12 @@ class Matrix(wiring.Component):
     """
 
     def __init__(self, *, n: int, p: int = 2, q: int = 2, alpha: int = 2, beta: int = 2, z_bits: int = 24,
-                 fifo_depth: int = 8, in_depth: int = 64, cells: str = "inline", vp: str = "pipeline"):
+                 fifo_depth: int = 8, in_depth: int = 64, cells: str = "inline", vp: str = "pipeline",
+                 colour: bool = False, kp: int = 0, ke: int = 3):
         if cells not in ("inline", "instance"):
             raise ValueError(f"cells must be 'inline' or 'instance', not {cells!r}")
         self._kw = dict(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth,
-                        in_depth=in_depth, vp=vp)
+                        in_depth=in_depth, vp=vp, colour=colour, kp=kp, ke=ke)
         # the processor's checks run here (a bad parameter set fails before any instance is made)
         self._cells = [MatrixCell(**self._kw)] if cells == "instance" else [MatrixCell(**self._kw) for _ in range(p * q)]
         if cells == "instance":
@@ -64,11 +68,15 @@ class Matrix(wiring.Component):
             self._cells[0]._MustUse__silence = self._cells[0]._vp._MustUse__silence = True
         self._mode = cells
         self._n, self._p, self._q, self._z_bits, self._in_depth = n, p, q, z_bits, in_depth
+        self._colour = colour
         lp, lq = p.bit_length() - 1, q.bit_length() - 1
-        super().__init__({"i": In(stream.Signature(BROADCAST)), "limit": In(range(in_depth + 1)),
-                          "rd_x": In(n + lp), "rd_y": In(n + lq), "rd_z": Out(z_bits + 1), "rd_tri": Out(TRI_BITS),
-                          "busy": Out(1), "cycles": Out(32), "stall_cycles": Out(32),
-                          "stat_cell": In(range(max(p * q, 2))), "stat_sel": In(range(len(cell_stats(n)))), "stat": Out(32)})
+        ports = {"i": In(stream.Signature(layouts(colour)[0])), "limit": In(range(in_depth + 1)),
+                 "rd_x": In(n + lp), "rd_y": In(n + lq), "rd_z": Out(z_bits + 1), "rd_tri": Out(TRI_BITS),
+                 "busy": Out(1), "cycles": Out(32), "stall_cycles": Out(32),
+                 "stat_cell": In(range(max(p * q, 2))), "stat_sel": In(range(len(cell_stats(n)))), "stat": Out(32)}
+        if colour:
+            ports["rd_rgb"] = Out(24)
+        super().__init__(ports)
 
     def elaborate(self, platform):
         m = Module()
@@ -83,6 +91,8 @@ class Matrix(wiring.Component):
             c = {"room": Signal(name=f"room{k}"), "busy": Signal(name=f"busy{k}"),
                  "rd_z": Signal(zb + 1, name=f"rd_z{k}"), "rd_tri": Signal(TRI_BITS, name=f"rd_tri{k}"),
                  "stat": Signal(32, name=f"stat{k}")}
+            if self._colour:
+                c["rd_rgb"] = Signal(24, name=f"rd_rgb{k}")
             ins = {"a": k % p, "b": k // p, "limit": self.limit, "push": push, "rec": self.i.payload.as_value(),
                    "rd_addr": addr, "stat_sel": self.stat_sel}
             if self._mode == "inline":
@@ -112,6 +122,8 @@ class Matrix(wiring.Component):
             for k, c in enumerate(ports):
                 with m.Case(k):
                     m.d.comb += [self.rd_z.eq(c["rd_z"]), self.rd_tri.eq(c["rd_tri"])]
+                    if self._colour:
+                        m.d.comb += self.rd_rgb.eq(c["rd_rgb"])
         with m.Switch(self.stat_cell):
             for k, c in enumerate(ports):
                 with m.Case(k):
@@ -120,8 +132,9 @@ class Matrix(wiring.Component):
 
 
 def make_matrix(*, n: int = 4, p: int = 2, q: int = 2, alpha: int = 2, beta: int = 2, z_bits: int = 24,
-                fifo_depth: int = 8, in_depth: int = 64, vp: str = "pipeline") -> Matrix:
+                fifo_depth: int = 8, in_depth: int = 64, vp: str = "pipeline", colour: bool = False, kp: int = 0,
+                ke: int = 3) -> Matrix:
     """Factory for ``rasterhw verilog sparse-matrix`` (default: 2x2 processors on a 32x32 raster,
-    every cell elaborated)."""
+    every cell elaborated, depth only, parameter additions unpriced)."""
     return Matrix(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth,
-                  vp=vp)
+                  vp=vp, colour=colour, kp=kp, ke=ke)

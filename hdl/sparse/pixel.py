@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from amaranth.hdl import Module, Signal, unsigned
+from amaranth.hdl import Module, Mux, Signal, signed, unsigned
 from amaranth.lib import memory, stream, wiring
 from amaranth.lib.wiring import In, Out
-from rasterhw.golden_model.sparse.formats import TRI_BITS, Z_FRAC_BITS
-from rasterhw.hdl.sparse.layouts import HEADER, WINDOW
+from rasterhw.golden_model.sparse.fixed import COLOUR_BITS
+from rasterhw.golden_model.sparse.formats import TRI_BITS, Z_ACC_BITS, Z_FRAC_BITS
+from rasterhw.hdl.sparse.layouts import layouts
 
 __all__ = ["PixelProcessor"]
 
@@ -25,16 +26,24 @@ class PixelProcessor(wiring.Component):
     rd_z : Out(z_bits + 1), rd_tri : Out(TRI_BITS).
     writes : Out(32) — pixels written (passed the Z test).
     idle : Out(1).
+    rd_rgb : Out(24) (``colour`` only) — R | G << 8 | B << 16 at ``rd_addr`` (one cycle latency).
+
+    ``colour``: the pixels are ``WINDOW_RGB`` (the headers ``HEADER_RGB``); each pixel's colour is
+    rounded as ``fixed.colour_rgb8`` (``clamp((c + 2**15) >> 16, 0, 255)``) beside its depth and
+    written into a third local memory (0 where empty) with its depth, in the same cycle.
 
     Throughput: one pixel per cycle (accept, read, compare/write pipelined; the compare read is
     transparent for the write, so back-to-back pixels at one address see each other).
     """
 
-    def __init__(self, *, n: int, z_bits: int = 24):
-        self._n, self._z_bits = n, z_bits
-        super().__init__({"i": In(stream.Signature(WINDOW)), "i_hdr": In(stream.Signature(HEADER)),
-                          "rd_addr": In(2 * n),
-                          "rd_z": Out(z_bits + 1), "rd_tri": Out(TRI_BITS), "writes": Out(32), "idle": Out(1)})
+    def __init__(self, *, n: int, z_bits: int = 24, colour: bool = False):
+        self._n, self._z_bits, self._colour = n, z_bits, colour
+        _, header, window = layouts(colour)
+        ports = {"i": In(stream.Signature(window)), "i_hdr": In(stream.Signature(header)), "rd_addr": In(2 * n),
+                 "rd_z": Out(z_bits + 1), "rd_tri": Out(TRI_BITS), "writes": Out(32), "idle": Out(1)}
+        if colour:
+            ports["rd_rgb"] = Out(3 * COLOUR_BITS)
+        super().__init__(ports)
 
     def elaborate(self, platform):
         m = Module()
@@ -79,4 +88,22 @@ class PixelProcessor(wiring.Component):
         with m.If(v2 & (z2 < zr.data)):
             m.d.comb += [zw.en.eq(1), tw.en.eq(1)]
             m.d.sync += self.writes.eq(self.writes + 1)
+        if self._colour:
+            self._rgb(m, depth, a2, zw.en)
         return m
+
+    def _rgb(self, m, depth, a2, wen):
+        """The colour memory: the pixel's R, G, B rounded on its way in, carried beside the
+        pipeline's depth and written with it."""
+        m.submodules.cmem = cmem = memory.Memory(shape=unsigned(3 * COLOUR_BITS), depth=depth, init=[0] * depth)
+        cw, cr = cmem.write_port(), cmem.read_port()
+        m.d.comb += [cr.addr.eq(self.rd_addr), self.rd_rgb.eq(cr.data)]
+        half, top = 1 << (Z_FRAC_BITS - 1), (1 << COLOUR_BITS) - 1
+        rgb = Signal(3 * COLOUR_BITS)
+        for ch in range(3):
+            lv = Signal(signed(Z_ACC_BITS + 1), name=f"lv{ch}")
+            m.d.comb += lv.eq((self.i.payload.c[ch] + half) >> Z_FRAC_BITS)
+            m.d.comb += rgb[COLOUR_BITS * ch:COLOUR_BITS * (ch + 1)].eq(Mux(lv < 0, 0, Mux(lv > top, top, lv[:COLOUR_BITS])))
+        c1, c2 = Signal(3 * COLOUR_BITS), Signal(3 * COLOUR_BITS)
+        m.d.sync += [c1.eq(rgb), c2.eq(c1)]
+        m.d.comb += [cw.addr.eq(a2), cw.data.eq(c2), cw.en.eq(wen)]

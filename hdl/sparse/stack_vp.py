@@ -13,21 +13,13 @@ from rasterhw.golden_model.sparse.formats import (
     TRI_BITS,
     UV_BITS,
     Z_ACC_BITS,
-    Z_FRAC_BITS,
 )
-from rasterhw.hdl.sparse.layouts import BROADCAST, HEADER
+from rasterhw.hdl.sparse.layouts import layouts
 from rasterhw.hdl.sparse.pixel import PixelProcessor
-from rasterhw.hdl.sparse.vp import VideoProcessor
+from rasterhw.hdl.sparse.stage import param_charge
+from rasterhw.hdl.sparse.vp import check_params, rewrite_record
 
-__all__ = ["BROADCAST_RGB", "StackProcessor", "make_stack_vp"]
-
-#: the broadcast record with the vertex colours as three more linear functions (8-bit levels,
-#: ``Z_FRAC_BITS`` fraction bits, over full-raster pixel indices: ``fixed.colour_planes``); the
-#: pipeline's ``BROADCAST`` is its low bits
-BROADCAST_RGB = data.StructLayout({**dict(BROADCAST.members),
-                                   "c00": data.ArrayLayout(signed(Z_ACC_BITS), 3),
-                                   "cx": data.ArrayLayout(signed(Z_ACC_BITS), 3),
-                                   "cy": data.ArrayLayout(signed(Z_ACC_BITS), 3)})
+__all__ = ["StackProcessor", "make_stack_vp"]
 
 
 class StackProcessor(wiring.Component):
@@ -52,8 +44,8 @@ class StackProcessor(wiring.Component):
     * The stack holds ``3 (n - 1)`` windows (three waiting siblings per level above the pixels).
     * **Surface parameters** (``colour``): the record is ``BROADCAST_RGB``; R, G, B are carried with
       every window and stepped with the edges, like depth; a written pixel's colour
-      (``clamp((c + 2**15) >> 16)``, ``fixed.colour_rgb8``'s rounding) goes into a third local memory
-      (``rd_rgb``). **Their cost** (``kp`` > 0): formula (5)'s ``w_i k_p / k_e`` — every surviving
+      (``clamp((c + 2**15) >> 16)``, ``fixed.colour_rgb8``'s rounding) goes into the pixel
+      processor's colour memory with its depth (``rd_rgb``), as in the pipeline processor. **Their cost** (``kp`` > 0): formula (5)'s ``w_i k_p / k_e`` — every surviving
       window or pixel of level ``i`` needs ``kp`` parameter additions on the ``ke`` edge adders,
       paid in whole cycles in which the test unit waits, with what is left of a cycle's ``ke``
       additions kept per level for the next survivor of the same record (``stack.param_cycles``):
@@ -76,21 +68,15 @@ class StackProcessor(wiring.Component):
     def __init__(self, *, n: int, p: int = 4, q: int = 4, alpha: int = 2, beta: int = 2, z_bits: int = 24,
                  colour: bool = False, kp: int = 0, ke: int = 3):
         try:
-            VideoProcessor._check(self, n, p, q, alpha, beta)  # the pipeline's checks; sets _lp, _lq
-            if not isinstance(z_bits, int) or not 1 <= z_bits <= 32:
-                raise ValueError(f"z_bits must be an integer in 1..32, not {z_bits!r}")
-            if not isinstance(colour, bool):
-                raise ValueError(f"colour must be True or False, not {colour!r}")
-            for name, v, lo in (("kp", kp, 0), ("ke", ke, 1)):
-                if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= 15:
-                    raise ValueError(f"{name} must be an integer in {lo}..15, not {v!r}")
+            self._lp, self._lq = check_params(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, colour=colour,
+                                              kp=kp, ke=ke)
         except ValueError:
             self._MustUse__silence = True  # a rejected parameter set is not an unused design
             raise
         self._n, self._p, self._q, self._alpha, self._beta, self._z_bits = n, p, q, alpha, beta, z_bits
         self._colour, self._kp, self._ke = colour, kp, ke
         ports = {"a": In(MATRIX_LOG2_MAX), "b": In(MATRIX_LOG2_MAX),
-                 "i": In(stream.Signature(BROADCAST_RGB if colour else BROADCAST)),
+                 "i": In(stream.Signature(layouts(colour)[0])),
                  "rd_addr": In(2 * n), "rd_z": Out(z_bits + 1), "rd_tri": Out(TRI_BITS), "writes": Out(32),
                  "busy": Out(1), "busy_cycles": Out(32), "records": Out(32), "max_stack": Out(8)}
         if colour:
@@ -121,37 +107,26 @@ class StackProcessor(wiring.Component):
         m.submodules.stack = st = memory.Memory(shape=entry, depth=D, init=[])
         wr = st.write_port()
         rd = st.read_port(domain="comb")
-        m.submodules.pixel = px = PixelProcessor(n=n, z_bits=self._z_bits)
+        m.submodules.pixel = px = PixelProcessor(n=n, z_bits=self._z_bits, colour=self._colour)
         m.d.comb += [px.rd_addr.eq(self.rd_addr), self.rd_z.eq(px.rd_z), self.rd_tri.eq(px.rd_tri),
                      self.writes.eq(px.writes)]
+        if self._colour:
+            m.d.comb += self.rd_rgb.eq(px.rd_rgb)
 
-        bc = Signal(BROADCAST_RGB if self._colour else BROADCAST)
-        hdr = Signal(HEADER)
+        broadcast, header, _ = layouts(self._colour)
+        bc = Signal(broadcast)
+        hdr = Signal(header)
         cur = Signal(entry)
         sp = Signal(range(D + 1))
         child = Signal(2)
         du, dv = child[0], child[1]
         a, b = self.a, self.b
 
-        # set-up: the header and the root window from the latched record (as VideoProcessor's)
-        hdr_c = Signal(HEADER)
+        # set-up: the header and the root window from the latched record (the pipeline's arithmetic)
+        hdr_c = Signal(header)
         root = Signal(entry)
-        for k in range(3):
-            absA = Mux(bc.A[k] < 0, -bc.A[k], bc.A[k])
-            absB = Mux(bc.B[k] < 0, -bc.B[k], bc.B[k])
-            m.d.comb += [hdr_c.Ap[k].eq(bc.A[k] << lp), hdr_c.Bp[k].eq(bc.B[k] << lq), hdr_c.thr[k].eq(bc.thr[k]),
-                         hdr_c.ext[k].eq((absA * self._alpha + absB * self._beta) >> 1),
-                         root.E[k].eq(bc.C[k] + a * bc.A[k] + b * bc.B[k])]
-        for k in range(4):
-            m.d.comb += hdr_c.bbox[k].eq(bc.bbox[k])
-        m.d.comb += [hdr_c.zu.eq(bc.zx << lp), hdr_c.zv.eq(bc.zy << lq), hdr_c.tri.eq(bc.tri),
-                     root.z.eq(bc.z00 + a * bc.zx + b * bc.zy)]
-        # colour: its per-processor increments beside the header's, its corner value in the window
-        cu = [Signal(signed(Z_ACC_BITS), name=f"cu{ch}") for ch in range(3)]
-        cv = [Signal(signed(Z_ACC_BITS), name=f"cv{ch}") for ch in range(3)]
-        if self._colour:
-            for ch in range(3):
-                m.d.comb += root.c[ch].eq(bc.c00[ch] + a * bc.cx[ch] + b * bc.cy[ch])
+        rewrite_record(m, bc, hdr_c, root, a=a, b=b, lp=lp, lq=lq, alpha=self._alpha, beta=self._beta,
+                       colour=self._colour)
 
         # the sub-window under test: shift by sh = n - 1 - level (the child side 2**sh)
         sh = Signal(range(n))
@@ -165,7 +140,7 @@ class StackProcessor(wiring.Component):
             m.d.comb += out.E[k].eq(cur.E[k] + Mux(du, hdr.Ap[k] << sh, 0) + Mux(dv, hdr.Bp[k] << sh, 0))
         if self._colour:
             for ch in range(3):
-                m.d.comb += out.c[ch].eq(cur.c[ch] + Mux(du, cu[ch] << sh, 0) + Mux(dv, cv[ch] << sh, 0))
+                m.d.comb += out.c[ch].eq(cur.c[ch] + Mux(du, hdr.cu[ch] << sh, 0) + Mux(dv, hdr.cv[ch] << sh, 0))
         last = Signal()
         m.d.comb += last.eq(cur.lvl == n - 1)
         pt, win = [], []
@@ -199,10 +174,9 @@ class StackProcessor(wiring.Component):
                      px.i.payload.z.eq(out.z), px.i_hdr.payload.eq(hdr), px.i_hdr.valid.eq(px.i.valid)]
         for k in range(3):
             m.d.comb += px.i.payload.E[k].eq(out.E[k])
+            if self._colour:
+                m.d.comb += px.i.payload.c[k].eq(out.c[k])
         m.d.comb += [rd.addr.eq(sp - 1), wr.addr.eq(sp), wr.data.eq(out)]
-        rgb_busy = Const(0)
-        if self._colour:
-            rgb_busy = self._colour_memory(m, px, out, n)
 
         # formula (5)'s parameter cycles: per level, additions left from its last parameter cycle
         kp, ke = self._kp, self._ke
@@ -218,13 +192,7 @@ class StackProcessor(wiring.Component):
                 with m.Switch(cur.lvl):
                     for lvl in range(n):
                         with m.Case(lvl):
-                            with m.Switch(credit[lvl]):
-                                for c in range(cmax):
-                                    need = kp - c
-                                    dc, left = (0, -need) if need <= 0 else (-(-need // ke), -(-need // ke) * ke - need)
-                                    with m.Case(c):
-                                        m.d.comb += extra.eq(dc)
-                                        m.d.sync += credit[lvl].eq(left)
+                            param_charge(m, credit[lvl], extra, kp, ke)
         with m.FSM(name="stack"):
             with m.State("IDLE"):
                 m.d.comb += [self.i.ready.eq(1), idle.eq(1)]
@@ -234,9 +202,6 @@ class StackProcessor(wiring.Component):
                     m.next = "HDR"
             with m.State("HDR"):
                 m.d.sync += [hdr.eq(hdr_c), self.busy_cycles.eq(self.busy_cycles + 1)]
-                if self._colour:
-                    for ch in range(3):
-                        m.d.sync += [cu[ch].eq(bc.cx[ch] << lp), cv[ch].eq(bc.cy[ch] << lq)]
                 m.next = "ROOT"
             with m.State("ROOT"):
                 m.d.sync += [cur.eq(root), child.eq(0), self.busy_cycles.eq(self.busy_cycles + 1)]
@@ -278,34 +243,8 @@ class StackProcessor(wiring.Component):
                     m.d.sync += [cur.eq(rd.data), sp.eq(sp - 1)]
                 with m.Elif(extra == 0):
                     m.next = "IDLE"
-        m.d.comb += self.busy.eq(~idle | ~px.idle | rgb_busy)
+        m.d.comb += self.busy.eq(~idle | ~px.idle)
         return m
-
-    def _colour_memory(self, m, px, out, n):
-        """The written pixels' colour: R, G, B rounded at the pixel's test, carried beside the pixel
-        processor's two stages, written into the colour memory in the cycle after its Z write
-        (seen as its ``writes`` count moving). Returns the 'still carrying a pixel' signal."""
-        depth = 1 << (2 * n)
-        m.submodules.cmem = cmem = memory.Memory(shape=unsigned(24), depth=depth, init=[0] * depth)
-        cw = cmem.write_port()
-        cr = cmem.read_port()
-        m.d.comb += [cr.addr.eq(self.rd_addr), self.rd_rgb.eq(cr.data)]
-        half = 1 << (Z_FRAC_BITS - 1)
-        rgb = Signal(24)
-        for ch in range(3):
-            lv = Signal(signed(Z_ACC_BITS + 1), name=f"lv{ch}")
-            m.d.comb += lv.eq((out.c[ch] + half) >> Z_FRAC_BITS)
-            m.d.comb += rgb[8 * ch:8 * ch + 8].eq(Mux(lv < 0, 0, Mux(lv > 255, 255, lv[:8])))
-        v = [Signal(name=f"cv_{k}") for k in range(3)]
-        adr = [Signal(2 * n, name=f"cadr_{k}") for k in range(3)]
-        col = [Signal(24, name=f"crgb_{k}") for k in range(3)]
-        wprev = Signal(32)
-        take = px.i.valid & px.i.ready
-        m.d.sync += [v[0].eq(take), adr[0].eq((out.v << n) | out.u), col[0].eq(rgb), wprev.eq(px.writes)]
-        for k in (1, 2):
-            m.d.sync += [v[k].eq(v[k - 1]), adr[k].eq(adr[k - 1]), col[k].eq(col[k - 1])]
-        m.d.comb += [cw.addr.eq(adr[2]), cw.data.eq(col[2]), cw.en.eq(v[2] & (px.writes != wprev))]
-        return v[0] | v[1] | v[2]
 
 
 def make_stack_vp(*, n: int = 7, p: int = 4, q: int = 4, alpha: int = 2, beta: int = 2,

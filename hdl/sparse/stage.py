@@ -6,9 +6,23 @@ from amaranth.hdl import Module, Mux, Signal, signed
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import EDGE_BITS, MATRIX_LOG2_MAX, SUBPIXEL_BITS
-from rasterhw.hdl.sparse.layouts import HEADER, WINDOW
+from rasterhw.hdl.sparse.layouts import layouts
 
-__all__ = ["LevelStage"]
+__all__ = ["LevelStage", "param_charge"]
+
+
+def param_charge(m: Module, credit: Signal, extra: Signal, kp: int, ke: int) -> None:
+    """Formula (5)'s parameter additions for one surviving window (or pixel), in the current
+    control block: ``kp`` additions on ``ke`` edge adders, ``credit`` additions left over from the
+    level's last parameter cycle (``golden_model/sparse/stack.py``, ``param_cycles``): ``extra`` (comb)
+    is the whole cycles to spend now, ``credit`` (sync) what is left of them."""
+    with m.Switch(credit):
+        for c in range(max(ke, kp + 1)):
+            need = kp - c
+            dc, left = (0, -need) if need <= 0 else (-(-need // ke), -(-need // ke) * ke - need)
+            with m.Case(c):
+                m.d.comb += extra.eq(dc)
+                m.d.sync += credit.eq(left)
 
 
 class LevelStage(wiring.Component):
@@ -35,19 +49,28 @@ class LevelStage(wiring.Component):
 
     Throughput: 4 cycles per window (the next window is taken in the cycle of the last test),
     plus one cycle per triangle that has survivors here (its header).
+
+    ``colour``: windows and headers carry R, G, B (``WINDOW_RGB``, ``HEADER_RGB``), stepped like
+    depth. ``kp`` > 0: formula (5)'s parameter additions, ``kp`` per survivor on ``ke`` edge adders
+    (:func:`param_charge`, the credit reset with every triangle), paid after the survivor has gone
+    out in whole cycles in which the stage waits (``PARAM``); after a fourth sub-window the next
+    window is taken in the last of them. A triangle then holds the stage
+    ``4 w_(i-1) + [w_i > 0] + ceil(w_i kp / ke)`` cycles (``cycles.stage_cycles``) plus its stalls.
     """
 
     def __init__(self, *, level: int, n: int, p: int, q: int, alpha: int = 2, beta: int = 2,
-                 test: str = "exact"):
+                 test: str = "exact", colour: bool = False, kp: int = 0, ke: int = 3):
         if not 1 <= level <= n:
             raise ValueError(f"level must be in 1..{n}, not {level!r}")
         if test not in ("exact", "edges"):
             raise ValueError(f"test must be 'exact' or 'edges', not {test!r}")
         self._level, self._n, self._p, self._q = level, n, p, q
         self._alpha, self._beta, self._test = alpha, beta, test
+        self._colour, self._kp, self._ke = colour, kp, ke
+        _, header, window = layouts(colour)
         super().__init__({"a": In(MATRIX_LOG2_MAX), "b": In(MATRIX_LOG2_MAX),
-                          "i": In(stream.Signature(WINDOW)), "i_hdr": In(stream.Signature(HEADER)),
-                          "o": Out(stream.Signature(WINDOW)), "o_hdr": Out(stream.Signature(HEADER)),
+                          "i": In(stream.Signature(window)), "i_hdr": In(stream.Signature(header)),
+                          "o": Out(stream.Signature(window)), "o_hdr": Out(stream.Signature(header)),
                           "tests": Out(32), "stalls": Out(32), "idle": Out(1)})
 
     @property
@@ -60,13 +83,14 @@ class LevelStage(wiring.Component):
         sh = n - lvl  # log2 of the sub-window side N
         N = 1 << sh
         last = lvl == n
-        hdr = Signal(HEADER)
-        win = Signal(WINDOW)
+        _, header, window = layouts(self._colour)
+        hdr = Signal(header)
+        win = Signal(window)
         sent = Signal()   # this triangle's header has gone out of this level
         fresh = Signal()  # ... and its first window has not
         child = Signal(2)
         du, dv = child[0], child[1]
-        out = Signal(WINDOW)
+        out = Signal(window)
         ok = Signal()
         half = 1 << (SUBPIXEL_BITS - 1)
 
@@ -77,6 +101,9 @@ class LevelStage(wiring.Component):
             m.d.comb += out.E[k].eq(win.E[k] + Mux(du, hdr.Ap[k] << sh, 0) + Mux(dv, hdr.Bp[k] << sh, 0))
         m.d.comb += [out.z.eq(win.z + Mux(du, hdr.zu << sh, 0) + Mux(dv, hdr.zv << sh, 0)),
                      out.u.eq(win.u + (du << sh)), out.v.eq(win.v + (dv << sh))]
+        if self._colour:
+            for ch in range(3):
+                m.d.comb += out.c[ch].eq(win.c[ch] + Mux(du, hdr.cu[ch] << sh, 0) + Mux(dv, hdr.cv[ch] << sh, 0))
         conds = []
         for k in range(3):
             if last:
@@ -104,6 +131,13 @@ class LevelStage(wiring.Component):
             acc = acc & c
         m.d.comb += ok.eq(acc)
 
+        kp, ke = self._kp, self._ke
+        if kp:
+            credit = Signal(range(max(ke, kp + 1)))
+            extra = Signal(range(kp + 2))
+            pcount = Signal(range(kp + 2))
+            pend = Signal()  # the parameter cycles follow a fourth sub-window: take the next window
+
         def accept():
             need = self.i.payload.new
             m.d.comb += [self.i.ready.eq(~need | self.i_hdr.valid), self.i_hdr.ready.eq(self.i.valid & need)]
@@ -111,6 +145,8 @@ class LevelStage(wiring.Component):
                 m.d.sync += [win.eq(self.i.payload), child.eq(0)]
                 with m.If(need):
                     m.d.sync += [hdr.eq(self.i_hdr.payload), sent.eq(0), fresh.eq(0)]
+                    if kp:
+                        m.d.sync += credit.eq(0)
                 m.next = "TEST"
             with m.Else():
                 m.next = "IDLE"
@@ -130,12 +166,30 @@ class LevelStage(wiring.Component):
                     m.d.comb += [self.o.valid.eq(1), self.o.payload.eq(out), advance.eq(self.o.ready)]
                     with m.If(self.o.ready):
                         m.d.sync += fresh.eq(0)
+                        if kp:
+                            param_charge(m, credit, extra, kp, ke)
                     with m.Else():
                         m.d.sync += self.stalls.eq(self.stalls + 1)
                 with m.Else():
                     m.d.comb += advance.eq(1)
                 with m.If(advance):
                     m.d.sync += [self.tests.eq(self.tests + 1), child.eq(child + 1)]
-                    with m.If(child == 3):
-                        accept()  # the next window is taken in the cycle of the last test: 4 cycles a window
+                    if kp:
+                        with m.If(extra != 0):
+                            m.d.sync += [pcount.eq(extra), pend.eq(child == 3)]
+                            m.next = "PARAM"
+                        with m.Elif(child == 3):
+                            accept()
+                    else:
+                        with m.If(child == 3):
+                            accept()  # the next window is taken in the cycle of the last test: 4 cycles a window
+            if kp:
+                with m.State("PARAM"):
+                    # the stage waits while the edge adders step the survivor's surface parameters
+                    m.d.sync += pcount.eq(pcount - 1)
+                    with m.If(pcount == 1):
+                        with m.If(pend):
+                            accept()
+                        with m.Else():
+                            m.next = "TEST"
         return m

@@ -40,7 +40,7 @@ REPORT_TIMEOUT_S = 2400.0
 
 #: parameters left out of a row's label (not sizes)
 _UNLABELLED = {"ram", "schedule", "head", "index", "chip", "aj", "alpha", "beta", "mem_cycle",
-               "intensity_bits", "z_bits", "colour_bits"}
+               "intensity_bits", "z_bits", "colour_bits", "colour", "kp", "ke"}
 
 
 def _cfg(block: str, params: dict, kind: str) -> str:

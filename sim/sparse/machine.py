@@ -21,6 +21,13 @@ _VP = Option(name="vp", default="pipeline", choices=("pipeline", "stack"),
              help="coupled matrix: the video processors' raster processor: the pipeline (one stage per level, "
                   "the default) or the paper's stack processor (one coverage-test unit and a stack)")
 
+_COLOUR = Option(name="colour", type=bool, default=False,
+                 help="coupled matrix: surface parameters: the vertex colours broadcast as three linear functions, "
+                      "written with the Z test, compared with the golden colour (colour_mismatches)")
+_KP = Option(name="kp", type=int, default=0,
+             help="coupled matrix: formula (5)'s cost in cycles of kp parameter additions per surviving window on "
+                  "k_e = 3 edge adders, 0..15 (0: unpriced, as depth alone; 4: depth + RGB)")
+
 _NO_CLOCK = Clock("sync", "sparse video processor: the paper names no clock", None, "clock")
 
 MACHINE = Machine(
@@ -39,7 +46,7 @@ MACHINE = Machine(
     sims=(SimBlock(name="sparse", help="every video processor of the matrix in HDL, interleaved local memories "
                                        "against the bit-accurate golden model",
                    simulate="rasterhw.sim.sparse.sim:simulate", default_scene="c300",
-                   options=(_MATRIX, _COUPLED, _FIFO_DEPTH, _VP_FIFO_DEPTH, _VP),
+                   options=(_MATRIX, _COUPLED, _FIFO_DEPTH, _VP_FIFO_DEPTH, _VP, _COLOUR, _KP),
                    bytes_per_pixel=700),),
     report="rasterhw.sim.sparse.report:rows",
     bench="rasterhw.sim.sparse.bench:bench",

@@ -11,9 +11,11 @@ import time
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.pipeline import run_geometry
-from rasterhw.golden_model.sparse.fixed import broadcast_records
+from rasterhw.golden_model.sparse.cycles import KE_EDGES
+from rasterhw.golden_model.sparse.fixed import broadcast_records, colour_rgb8
 from rasterhw.golden_model.sparse.formats import parse_matrix, sparse_geometry
 from rasterhw.golden_model.sparse.search import interleave, sparse_render
+from rasterhw.golden_model.sparse.stack import broadcast_records_rgb
 
 __all__ = ["simulate", "simulate_coupled", "simulate_tris"]
 
@@ -92,16 +94,17 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
             "run_s": round(run_s, 4)}
 
 
-def _stack_golden(tris, p: int, q: int, fifo_depth: int) -> dict:
+def _stack_golden(tris, p: int, q: int, fifo_depth: int, *, kp: int = 0) -> dict:
     """The golden coupled model of a matrix of stack processors, keyed as ``coupled_matrix_vp``'s:
-    ``cycles.coupled_matrix`` on the stack service times, the frame extended by the last pixels'
-    drain (``stack_processor``'s per-record ``tail``), and the per-level tests."""
+    ``cycles.coupled_matrix`` on the stack service times (formula (5)'s parameter cycles with
+    ``kp``), the frame extended by the last pixels' drain (``stack_processor``'s per-record
+    ``tail``), and the per-level tests."""
     from rasterhw.golden_model.sparse.cycles import coupled_matrix, service_times
     from rasterhw.golden_model.sparse.stack import stack_processor
 
     f = sparse_render(tris, (p, q), depth="fixed", per_record=True)
-    s = service_times(f.stats["windows_per_record"], vp="stack")
-    tail = np.stack([stack_processor(tris, (p, q), k % p, k // p)["tail"] for k in range(p * q)])
+    s = service_times(f.stats["windows_per_record"], vp="stack", kp=kp)
+    tail = np.stack([stack_processor(tris, (p, q), k % p, k // p, kp=kp)["tail"] for k in range(p * q)])
     r = coupled_matrix(s, fifo_depth)
     frame = int((r.pop + s + tail).max()) if s.size else 0
     return {"frame_cycles": frame, "stall_cycles": r.stall_cycles, "fifo_peak": r.fifo_peak.tolist(),
@@ -110,7 +113,8 @@ def _stack_golden(tris, p: int, q: int, fifo_depth: int) -> dict:
 
 
 def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_depth: int = 64,
-                     vp_fifo_depth: int = 8, progress: bool = False, vp: str = "pipeline") -> dict:
+                     vp_fifo_depth: int = 8, progress: bool = False, vp: str = "pipeline", colour: bool = False,
+                     kp: int = 0) -> dict:
     """The whole matrix in one simulation (``hdl/sparse/matrix.py``): the image against the golden
     model pixel by pixel, and the frame's cycles, broadcast stalls, FIFO peaks and every processor's
     busy cycles and per-level tests against the coupled matrix's golden cycle model
@@ -120,7 +124,11 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
     the processor's levels (a build parameter; 8 as every driver builds it). ``vp="stack"``: every
     processor the stack-based one (``hdl/sparse/stack_vp.py``), against the golden coupled model on
     the stack processors' service times (:func:`_stack_golden`); ``busy`` is then the processor's
-    own count of the cycles it holds a record."""
+    own count of the cycles it holds a record. ``colour``: the vertex colours broadcast as three
+    more linear functions and written with the Z test, the HDL's colour memories against
+    ``fixed.colour_rgb8`` (``colour_mismatches``; the frame image is then the HDL's colour); ``kp``:
+    formula (5)'s cost of ``kp`` parameter additions per surviving window on ``k_e`` = 3 edge
+    adders, in cycles, in the HDL and in both golden cycle models."""
     from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
     from rasterhw.sim.sparse.matrix_run import IN_DEPTH, run_matrix_pysim, run_matrix_verilator
 
@@ -132,25 +140,34 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
         raise RasterhwError(f"sparse sim: --vp-fifo-depth must be an integer in 2..64, not {vp_fifo_depth!r}")
     if vp not in ("pipeline", "stack"):
         raise RasterhwError(f"sparse sim: --vp must be 'pipeline' or 'stack', not {vp!r}")
+    if not isinstance(colour, bool):
+        raise RasterhwError(f"sparse sim: --colour is a flag, not {colour!r}")
+    if isinstance(kp, bool) or not isinstance(kp, int) or not 0 <= kp <= 15:
+        raise RasterhwError(f"sparse sim: --kp must be an integer in 0..15, not {kp!r}")
     if vp == "stack" and vp_fifo_depth != 8:
         raise RasterhwError("sparse sim: --vp-fifo-depth is the pipeline processor's; the stack processor has no "
                             "inner FIFOs")
     in_depth = IN_DEPTH  # one build for every run-time depth
     t0 = time.perf_counter()
-    recs = broadcast_records(tris)
+    recs = broadcast_records_rgb(tris) if colour else broadcast_records(tris)
     run = run_matrix_verilator if engine == "verilator" else run_matrix_pysim
     h = run(recs, n=n, p=p, q=q, limit=fifo_depth, z_bits=tris.z_bits, fifo_depth=vp_fifo_depth, in_depth=in_depth,
-            vp=vp)
+            vp=vp, colour=colour, kp=kp, ke=KE_EDGES)
     hdl_s = time.perf_counter() - t0
     t1 = time.perf_counter()
     g = sparse_render(tris, (p, q), depth="fixed", trace=True)
     gz = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
     if vp == "stack":
-        gc = _stack_golden(tris, p, q, fifo_depth)
+        gc = _stack_golden(tris, p, q, fifo_depth, kp=kp)
     else:
-        gc = coupled_matrix_vp(g, fifo_depth, fifo_depth=vp_fifo_depth)
+        gc = coupled_matrix_vp(g, fifo_depth, fifo_depth=vp_fifo_depth, kp=kp, ke=KE_EDGES)
+    grgb = colour_rgb8(tris, g.tri_id, p, q) if colour else None
     golden_s = time.perf_counter() - t1
     mism = int(np.count_nonzero((h["tri"] != g.tri_id) | (h["zq"] != gz)))
+    col = {}
+    if colour:
+        col = {"colour_mismatches": int(np.count_nonzero((h["rgb"] != grgb).any(axis=-1))),
+               "colour_pixels_compared": int(h["tri"].size)}
     st = h["stats"]
     tests = np.stack([st[f"tests_{i}"] for i in range(1, n + 1)], axis=1)
     pairs = [(h["cycles"], gc["frame_cycles"]), (h["stall_cycles"], gc["stall_cycles"])]
@@ -163,8 +180,15 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
     if progress:
         print(f"coupled {p}x{q}: {frame} cycles (golden {gc['frame_cycles']}), stalls {h['stall_cycles']}, "
               f"FIFO peak {int(st['fifo_peak'].max())}", file=sys.stderr, flush=True)
+    if colour:
+        image = {"frame_rgb": h["rgb"].astype(np.uint8),
+                 "frame_note": "the HDL's colour memories (R, G, B as linear functions), read out interleaved"}
+    else:
+        image = {"frame_rgb": depth_image(h["zq"], tris.z_bits),
+                 "frame_note": "the HDL's video memory holds depth only: the image is its depth buffer (near = bright)"}
     return {"engine": engine, "coupled": True, "vp": vp, "cycles": frame, "clock_hz": None,
             "pixels_compared": int(h["tri"].size), "mismatches": mism, "cycle_mismatches": cyc_mism,
+            "colour": colour, **col, "kp": kp, "ke": KE_EDGES,
             "cycles_compared": len(pairs), "matrix": f"{p}x{q}", "n": n, "triangles": len(recs),
             "fifo_depth": fifo_depth, "fifo_depth_built": in_depth, "vp_fifo_depth": vp_fifo_depth,
             "gp_issue_interval": 1,
@@ -182,9 +206,7 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
             "cycles_per_s": round(h["sim_cycles"] / h["run_s"], 1) if h["run_s"] > 0 else None,
             "hdl_wall_s": round(hdl_s, 3), "golden_wall_s": round(golden_s, 3),
             "wall_s": round(time.perf_counter() - t0, 3),
-            **{k: h[k] for k in ("verilog_bytes_cell", "verilog_bytes_matrix") if k in h},
-            "frame_rgb": depth_image(h["zq"], tris.z_bits),
-            "frame_note": "the HDL's video memory holds depth only: the image is its depth buffer (near = bright)"}
+            **{k: h[k] for k in ("verilog_bytes_cell", "verilog_bytes_matrix") if k in h}, **image}
 
 
 def depth_image(zq: np.ndarray, z_bits: int) -> np.ndarray:
@@ -197,7 +219,7 @@ def depth_image(zq: np.ndarray, z_bits: int) -> np.ndarray:
 
 def simulate(scene, width: int, height: int, *, engine: str = "verilator", progress: bool = False,
              matrix: str = "4x4", coupled: bool = True, fifo_depth: int = 64, vp_fifo_depth: int = 8,
-             vp: str = "pipeline") -> dict:
+             vp: str = "pipeline", colour: bool = False, kp: int = 0) -> dict:
     """The registry's sim-block contract (``scene`` a Scene or a built-in name). ``coupled``: the
     whole matrix in one simulation (:func:`simulate_coupled`); otherwise every processor alone on
     the full stream, one simulation each (:func:`simulate_tris`, ``"coupled": false``)."""
@@ -210,8 +232,8 @@ def simulate(scene, width: int, height: int, *, engine: str = "verilator", progr
     tris = run_geometry(scene, width, height)
     if coupled:
         return simulate_coupled(tris, (p, q), engine=engine, fifo_depth=fifo_depth, vp_fifo_depth=vp_fifo_depth,
-                                progress=progress, vp=vp)
-    if fifo_depth != 64 or vp_fifo_depth != 8 or vp != "pipeline":
-        raise RasterhwError("sparse sim: --fifo-depth, --vp-fifo-depth and --vp are options of the coupled matrix "
-                            "(drop --no-coupled)")
+                                progress=progress, vp=vp, colour=colour, kp=kp)
+    if fifo_depth != 64 or vp_fifo_depth != 8 or vp != "pipeline" or colour or kp:
+        raise RasterhwError("sparse sim: --fifo-depth, --vp-fifo-depth, --vp, --colour and --kp are options of the "
+                            "coupled matrix (drop --no-coupled)")
     return {**simulate_tris(tris, (p, q), engine=engine, progress=progress), "coupled": False}

@@ -117,25 +117,62 @@ class VPBench(_SparseBench):
     """``sparse-vp``: processor ``(p - 1, q - 1)`` of the matrix (the last, every offset non-zero):
     broadcast records and an end word in (``i``), its local memory out (``o``, ``{tri, z}`` per
     sparse address ``v * 2**n + u``, empty ``{all ones, 2**z_bits}``), against the golden search's
-    pixels of that processor (``(u p + a, v q + b)`` of the full raster)."""
+    pixels of that processor (``(u p + a, v q + b)`` of the full raster). With ``colour`` the
+    records carry the colour planes and each memory word its colour (``rgb << (TRI_BITS + z_bits + 1)``,
+    against ``fixed.colour_rgb8``)."""
 
     block = "sparse-vp"
 
+    def tail(self, params: dict) -> tuple[str, ...]:
+        """Counters sent after the memory (none for the pipeline processor)."""
+        return ()
+
     def dut(self, params: dict):
+        from rasterhw.hdl.sparse.layouts import layouts
+
         vp = registry.load(registry.blocks()[self.block])(**params)
         n = params["n"]
 
         def address(m, b, addr):
             m.d.comb += b.rd_addr.eq(addr[:2 * n])
 
+        col = params.get("colour", False)
         return ReadOut(vp, words=1 << (2 * n), address=address, fixed={"a": params["p"] - 1, "b": params["q"] - 1},
-                       z_bits=params["z_bits"])
+                       z_bits=params["z_bits"], tail=self.tail(params), record_bits=layouts(col)[0].size, rgb=col)
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        st = super().stimulus(params, seed)
+        return self.records(st.source, params, what=st.what) if params.get("colour") else st
+
+    @staticmethod
+    def records(tris, params: dict, what: str = "") -> Stimulus:
+        """The broadcast records of ``tris`` for this block (with the colour planes when ``colour``)
+        and the end word."""
+        from rasterhw.golden_model.sparse.stack import broadcast_records_rgb
+        from rasterhw.hdl.pack import pack
+        from rasterhw.hdl.sparse.layouts import layouts
+
+        lay = layouts(bool(params.get("colour")))[0]
+        recs = broadcast_records_rgb(tris) if params.get("colour") else broadcast_records(tris)
+        return Stimulus({"i": [pack(lay, r) for r in recs] + [1 << lay.size]}, what=what, source=tris)
+
+    @staticmethod
+    def with_rgb(words: list[int], rgb: np.ndarray, z_bits: int) -> list[int]:
+        """Memory words with each pixel's colour above them (``rgb``: ``(.., 3)``)."""
+        sh = TRI_BITS + z_bits + 1
+        return [w | (int(c[0]) | int(c[1]) << 8 | int(c[2]) << 16) << sh
+                for w, c in zip(words, rgb.reshape(-1, 3), strict=True)]
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
+        from rasterhw.golden_model.sparse.fixed import colour_rgb8
+
         g, zq = self._golden(params, stim)
         p, q = params["p"], params["q"]
         a, b = p - 1, q - 1
-        return Expected({"o": _words(g.tri_id[b::q, a::p], zq[b::q, a::p], params["z_bits"])})
+        words = _words(g.tri_id[b::q, a::p], zq[b::q, a::p], params["z_bits"])
+        if params.get("colour"):
+            words = self.with_rgb(words, colour_rgb8(stim.source, g.tri_id, p, q)[b::q, a::p], params["z_bits"])
+        return Expected({"o": words})
 
 
 class MatrixBench(_SparseBench):
@@ -175,36 +212,8 @@ class StackVPBench(VPBench):
     def counters(n: int) -> tuple[str, ...]:
         return ("busy_cycles", "records", "max_stack", "writes") + tuple(f"tests_{i}" for i in range(1, n + 1))
 
-    def dut(self, params: dict):
-        vp = registry.load(registry.blocks()[self.block])(**params)
-        n = params["n"]
-
-        def address(m, b, addr):
-            m.d.comb += b.rd_addr.eq(addr[:2 * n])
-
-        from rasterhw.hdl.sparse.stack_vp import BROADCAST_RGB
-
-        col = params.get("colour", False)
-        return ReadOut(vp, words=1 << (2 * n), address=address, fixed={"a": params["p"] - 1, "b": params["q"] - 1},
-                       z_bits=params["z_bits"], tail=self.counters(n),
-                       record_bits=BROADCAST_RGB.size if col else None, rgb=col)
-
-    def stimulus(self, params: dict, seed: int) -> Stimulus:
-        st = super().stimulus(params, seed)
-        return self.records(st.source, params, what=st.what) if params.get("colour") else st
-
-    @staticmethod
-    def records(tris, params: dict, what: str = "") -> Stimulus:
-        """The broadcast records of ``tris`` for this block (with the colour planes when ``colour``)
-        and the end word."""
-        from rasterhw.golden_model.sparse.stack import broadcast_records_rgb
-        from rasterhw.hdl.pack import pack
-        from rasterhw.hdl.sparse.layouts import BROADCAST
-        from rasterhw.hdl.sparse.stack_vp import BROADCAST_RGB
-
-        lay = BROADCAST_RGB if params.get("colour") else BROADCAST
-        recs = broadcast_records_rgb(tris) if params.get("colour") else broadcast_records(tris)
-        return Stimulus({"i": [pack(lay, r) for r in recs] + [1 << lay.size]}, what=what, source=tris)
+    def tail(self, params: dict) -> tuple[str, ...]:
+        return self.counters(params["n"])
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         from rasterhw.golden_model.sparse.stack import stack_processor
@@ -216,7 +225,5 @@ class StackVPBench(VPBench):
         tail = [g["busy"], len(g["cycles"]), g["max_stack"], g["writes"]] + [int(v) for v in g["tests"]]
         words = _words(g["tri"], g["zq"], params["z_bits"])
         if col:
-            rgb = g["rgb"].reshape(-1, 3)
-            sh = TRI_BITS + params["z_bits"] + 1
-            words = [w | (int(c[0]) | int(c[1]) << 8 | int(c[2]) << 16) << sh for w, c in zip(words, rgb, strict=True)]
+            words = self.with_rgb(words, g["rgb"], params["z_bits"])
         return Expected({"o": words + tail})

@@ -62,14 +62,15 @@ def _read_hex(path: Path) -> np.ndarray:
     return np.array([int(w, 16) for w in words], dtype=object)
 
 
-def pack_records(recs: list[dict]) -> bytes:
-    """The bench's stimulus file: one big-endian word of the BROADCAST layout per triangle
-    (``ceil(BROADCAST.size / 8)`` bytes, read with ``$fread``)."""
+def pack_records(recs: list[dict], *, colour: bool = False) -> bytes:
+    """The bench's stimulus file: one big-endian word of the BROADCAST layout (``BROADCAST_RGB``
+    with ``colour``) per triangle (``ceil(size / 8)`` bytes, read with ``$fread``)."""
     from rasterhw.hdl.pack import pack
-    from rasterhw.hdl.sparse.layouts import BROADCAST
+    from rasterhw.hdl.sparse.layouts import layouts
 
-    nbytes = -(-BROADCAST.size // 8)
-    return b"".join(pack(BROADCAST, r).to_bytes(nbytes, "big") for r in recs)
+    lay = layouts(colour)[0]
+    nbytes = -(-lay.size // 8)
+    return b"".join(pack(lay, r).to_bytes(nbytes, "big") for r in recs)
 
 
 def run_processor_verilator(recs: list[dict], *, n: int, p: int, q: int, a: int, b: int, z_bits: int = 24,

@@ -5,6 +5,10 @@
 // to +limit= entries at run time; waits until the matrix is idle; reads every processor's counters
 // (stat_cell x stat_sel) and the matrix's frame and stall cycles into +stats=, then sweeps the full
 // raster through the interleaved read port and writes {tri, z} per pixel (row-major) to +out=.
+// With RASTERHW_RGB defined (a matrix built with colour: the driver's generated
+// tb_sparse_matrix_cfg.vh defines it) it also writes each pixel's colour (R | G << 8 | B << 16,
+// from the port rd_rgb) to +rgb=.
+`include "tb_sparse_matrix_cfg.vh"
 module tb_sparse_matrix #(parameter N = 7, parameter LP = 2, parameter LQ = 2, parameter BW = 600,
                           parameter MAXT = 16384, parameter ZW = 25, parameter TW = 16, parameter NS = 18,
                           parameter LIMW = 7, parameter CW = 4, parameter SW = 5)
@@ -17,6 +21,12 @@ module tb_sparse_matrix #(parameter N = 7, parameter LP = 2, parameter LQ = 2, p
   reg [BW-1:0] rom [0:MAXT-1];
   reg [TW+ZW-1:0] outmem [0:(1 << AW) - 1];
   reg [31:0] stats [0:P * NS + 1];
+`ifdef RASTERHW_RGB
+  reg [23:0] outrgb [0:(1 << AW) - 1];
+  reg [1023:0] rgb_file;
+  wire [23:0] rd_rgb;
+  initial if (!$value$plusargs("rgb=%s", rgb_file)) rgb_file = "rgb.hex";
+`endif
 `include "tb_sparse_load.vh"
   integer limit;
   reg [31:0] idx;
@@ -36,7 +46,11 @@ module tb_sparse_matrix #(parameter N = 7, parameter LP = 2, parameter LQ = 2, p
   sparse_matrix dut (.clk(clk), .rst(rst), .i__payload(rom[idx[13:0]]), .i__valid(phase == 1 && idx < ntri),
                      .i__ready(i_ready), .limit(limit[LIMW-1:0]), .rd_x(rd[XW-1:0]), .rd_y(rd[AW-1:XW]),
                      .rd_z(rd_z), .rd_tri(rd_tri), .busy(busy), .cycles(frame_cycles), .stall_cycles(stall_cycles),
-                     .stat_cell(sc[CW-1:0]), .stat_sel(ss[SW-1:0]), .stat(stat));
+                     .stat_cell(sc[CW-1:0]), .stat_sel(ss[SW-1:0]), .stat(stat)
+`ifdef RASTERHW_RGB
+                     , .rd_rgb(rd_rgb)
+`endif
+                     );
 
   always @(posedge clk) begin
     case (phase)
@@ -67,5 +81,8 @@ module tb_sparse_matrix #(parameter N = 7, parameter LP = 2, parameter LQ = 2, p
     stats[1] = stall_cycles;
     $writememh(out_file, outmem);
     $writememh(stats_file, stats);
+`ifdef RASTERHW_RGB
+    $writememh(rgb_file, outrgb);
+`endif
   end
 endmodule

@@ -5,6 +5,9 @@
 // next phase.
       READOUT: begin
         if (raddr >= 2) outmem[raddr - 2] <= {rd_tri, rd_z};
+`ifdef RASTERHW_RGB
+        if (raddr >= 2) outrgb[raddr - 2] <= rd_rgb;  // a bench that defines it declares outrgb, rd_rgb
+`endif
         rd <= raddr[AW-1:0];
         raddr <= raddr + 1;
         if (raddr == (1 << AW) + 1) phase <= READOUT + 1;
