@@ -49,7 +49,7 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
     for d in tb.domains:
         sim.add_clock(1e-8, domain=d)
     errors: list[str] = []
-    for name in tb.inputs:
+    for name in tb.inputs_of(params):
         port = port_of(dut, name)
         sim.add_testbench(_source(port, stim.words[name], stim.gaps_of(name), tb.domain_of(name)),
                           background=True)
@@ -61,9 +61,9 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
         d = tb.domain_of(name)
         sim.add_testbench(stream_protocol_checker(port, name, domain=d, errors=errors), background=True)
         sim.add_testbench(_sink(port, expect_words[name], words[name], stamps[name],
-                                ready_pattern(seed + k, stall), d, max_cycles, name))
+                                ready_pattern(tb.sink_seed(params, k, seed), stall), d, max_cycles, name))
     # with --waves: the GTKWave save file shows these ports, one group each (sim/engines/waves.py)
-    declare_streams(sim, {name: port_of(dut, name) for name in (*tb.inputs, *tb.outputs_of(params))})
+    declare_streams(sim, {name: port_of(dut, name) for name in (*tb.inputs_of(params), *tb.outputs_of(params))})
     t1 = time.perf_counter()
     sim.run()
     if errors:
