@@ -62,6 +62,7 @@ class Run:
     build_s: float = 0.0
     run_s: float = 0.0
     protocol_errors: int = 0                     # clocks that broke the stream rules, every port
+    status: dict = field(default_factory=dict)   # the testbench's status values at the end (Testbench.status)
     build: dict = field(default_factory=dict)    # how the model was built (engine's words: opt, pgo, ...)
 
     @property
@@ -107,6 +108,11 @@ class Testbench:
 
     def outputs_of(self, params: dict) -> tuple[str, ...]:
         return self.outputs
+
+    def status(self, dut, params: dict) -> dict:
+        """Values of the block read when the run ends, beside its streams (``{name: Amaranth value}``,
+        64 bits together at most, e.g. a frame counter or a sticky overflow): ``Run.status``."""
+        return {}
 
     def sink_seed(self, params: dict, port: int, seed: int) -> int:
         """The back-pressure seed of output ``port`` (its index) in a run seeded ``seed``."""

@@ -24,7 +24,7 @@ def _source(port, words, gaps, domain):
     return bench
 
 
-def _sink(port, need, words, stamps, ready, domain, max_cycles, name):
+def _sink(port, need, words, stamps, ready, domain, max_cycles, name, finished, read_status):
     async def bench(ctx):
         k = 0
         while len(words) < need:
@@ -38,6 +38,8 @@ def _sink(port, need, words, stamps, ready, domain, max_cycles, name):
             if k > max_cycles:
                 raise RasterhwError(f"pysim: {name} gave {len(words)} of {need} words in {max_cycles} cycles")
         ctx.set(port.ready, 0)
+        finished.append(name)
+        read_status(ctx)   # the last sink to finish reads the status values
     return bench
 
 
@@ -55,17 +57,26 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
                           background=True)
     words: dict[str, list[int]] = {}
     stamps: dict[str, list[int]] = {}
-    for k, name in enumerate(tb.outputs_of(params)):
+    outs = tb.outputs_of(params)
+    status_values, status, finished = tb.status(dut, params), {}, []
+
+    def read_status(ctx):
+        if len(finished) == len(outs):
+            status.update({n: int(ctx.get(v)) for n, v in status_values.items()})
+
+    for k, name in enumerate(outs):
         port = port_of(dut, name)
         words[name], stamps[name] = [], []
         d = tb.domain_of(name)
         sim.add_testbench(stream_protocol_checker(port, name, domain=d, errors=errors), background=True)
         sim.add_testbench(_sink(port, expect_words[name], words[name], stamps[name],
-                                ready_pattern(tb.sink_seed(params, k, seed), stall), d, max_cycles, name))
+                                ready_pattern(tb.sink_seed(params, k, seed), stall), d, max_cycles, name, finished,
+                                read_status))
     # with --waves: the GTKWave save file shows these ports, one group each (sim/engines/waves.py)
     declare_streams(sim, {name: port_of(dut, name) for name in (*tb.inputs_of(params), *tb.outputs_of(params))})
     t1 = time.perf_counter()
     sim.run()
     if errors:
         raise RasterhwError(f"pysim: {tb.block} broke the stream rules: {errors[0]}")
-    return Run("pysim", words, stamps, wall_s=time.perf_counter() - t0, run_s=time.perf_counter() - t1)
+    return Run("pysim", words, stamps, wall_s=time.perf_counter() - t0, run_s=time.perf_counter() - t1,
+               status=status)

@@ -36,7 +36,7 @@ from rasterhw.sim.paths import BUILD_ROOT
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
 from rasterhw.sim.workdirs import build_lock, release, temp_run_folder
 
-__all__ = ["GAP_BITS", "PGO_OPT", "BenchTop", "profile", "run"]
+__all__ = ["GAP_BITS", "PGO_OPT", "BenchTop", "profile", "run", "unpack_status"]
 
 GAP_BITS = 8          # idle clocks before a word: 0..255
 _SELF = hashlib.sha1(Path(__file__).read_bytes()).hexdigest()[:12]   # this file is part of the design
@@ -66,14 +66,17 @@ class BenchTop(Elaboratable):
     ``clk``, ``done`` (every source played out and every sink full), ``cycles`` (edges so far) and
     ``errors`` (clocks that broke the stream rules, every port: ``rasterhw_stream_check``)."""
 
-    def __init__(self, dut, inputs: dict[str, int], outputs: dict[str, int], domains: tuple[str, ...]):
+    def __init__(self, dut, inputs: dict[str, int], outputs: dict[str, int], domains: tuple[str, ...],
+                 status: dict | None = None):
         self.dut = dut
+        self._status = dict(status or {})
         self._inputs, self._outputs, self._domains = inputs, outputs, domains
         self.cd = ClockDomain("sync", reset_less=True)
         self.done = Signal(name="done")
         self.cycles = Signal(32, name="cycles")
         self.errors = Signal(32, name="errors")
-        self.ports = [self.cd.clk, self.done, self.cycles, self.errors]
+        self.status = Signal(64, name="status")   # the testbench's status values, packed in order
+        self.ports = [self.cd.clk, self.done, self.cycles, self.errors, self.status]
 
     def elaborate(self, platform):
         m = Module()
@@ -108,6 +111,8 @@ class BenchTop(Elaboratable):
             dones.append(ok)
             errors.append(_check(m, t, port))
         m.d.comb += [self.done.eq(Cat(*dones).all()), self.errors.eq(sum(errors, Const(0, 32)))]
+        if self._status:
+            m.d.comb += self.status.eq(Cat(*self._status.values()))
         return m
 
 
@@ -129,16 +134,36 @@ def _design(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[s
     key = {**params, "inputs": inputs, "outputs": outputs, "bench": _SELF, "testbench": tb_src,
            **({"speed": True} if speed else {})}
 
+    def top():
+        dut = tb.dut(params)
+        return BenchTop(dut, inputs, outputs, tb.domains, _status(tb, dut, params))
+
     def convert(top, mod):
         text = canonical_port_lists(verilog.convert(top, name=mod, ports=top.ports)) + _extra(top.dut)
         return tb.sim_verilog(params, text) if speed else text
 
-    text = convert_cached(tb.block, lambda: BenchTop(tb.dut(params), inputs, outputs, tb.domains), params=key,
-                          module="rasterhw_bench", convert=convert)
+    text = convert_cached(tb.block, top, params=key, module="rasterhw_bench", convert=convert)
     return f"tb-{tb.block}", {"rasterhw_bench.v": text}
 
 
-_DEFINES = {"RASTERHW_CYCLES": 1, "RASTERHW_ERRORS": 1}
+_DEFINES = {"RASTERHW_CYCLES": 1, "RASTERHW_ERRORS": 1, "RASTERHW_STATUS": 1}
+
+
+def _status(tb: Testbench, dut, params: dict) -> dict:
+    """The testbench's status values (checked: 64 bits together at most)."""
+    st = tb.status(dut, params)
+    if sum(len(v) for v in st.values()) > 64:
+        raise RasterhwError(f"{tb.block}: status values wider than 64 bits together")
+    return st
+
+
+def unpack_status(st: dict, word: int) -> dict[str, int]:
+    """A packed status word -> ``{name: value}`` (the order and widths of ``st``)."""
+    out, at = {}, 0
+    for name, v in st.items():
+        out[name] = (word >> at) & ((1 << len(v)) - 1)
+        at += len(v)
+    return out
 
 
 def _build(design, opt: str, pgo=None) -> tuple[Path, float]:
@@ -151,19 +176,22 @@ def _build(design, opt: str, pgo=None) -> tuple[Path, float]:
 PGO_OPT = "-O2"
 
 
-def _settings(build: dict | None) -> tuple[bool, str | None, bool | str]:
-    """(speed, opt, pgo) of a ``build`` argument (see :func:`rasterhw.sim.engines.run`)."""
+def _settings(build: dict | None) -> tuple[bool, str | None, bool | str, int]:
+    """(speed, opt, pgo, depth) of a ``build`` argument (see :func:`rasterhw.sim.engines.run`)."""
     b = dict(build or {})
-    unknown = sorted(set(b) - {"speed", "opt", "pgo"})
+    unknown = sorted(set(b) - {"speed", "opt", "pgo", "depth"})
     if unknown:
-        raise RasterhwError(f"build settings: no {', '.join(unknown)} (speed, opt, pgo)")
+        raise RasterhwError(f"build settings: no {', '.join(unknown)} (speed, opt, pgo, depth)")
+    depth = b.get("depth", 0)
+    if not isinstance(depth, int) or isinstance(depth, bool) or depth < 0:
+        raise RasterhwError(f"build settings: depth must be a word count, not {depth!r}")
     pgo = b.get("pgo", False)
     env = os.environ.get("RASTERHW_PGO", "")
     if pgo == "auto" and env in ("0", "1"):
         pgo = env == "1"
     if pgo not in (False, True, "auto"):
         raise RasterhwError(f"build settings: pgo must be False, True or 'auto', not {pgo!r}")
-    return bool(b.get("speed", False)), b.get("opt", "-O1" if not build else None), pgo
+    return bool(b.get("speed", False)), b.get("opt", "-O1" if not build else None), pgo, depth
 
 
 def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outputs: dict[str, int],
@@ -207,8 +235,8 @@ def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outp
 def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, expect_words: dict[str, int],
         max_cycles: int, build: dict | None = None) -> Run:
     t0 = time.perf_counter()
-    speed, opt, pgo = _settings(build)
-    inputs = {n: _depth(len(stim.words[n])) for n in tb.inputs_of(params)}
+    speed, opt, pgo, depth = _settings(build)
+    inputs = {n: _depth(max(len(stim.words[n]), depth - 2)) for n in tb.inputs_of(params)}
     outputs = {n: _depth(expect_words[n]) for n in tb.outputs_of(params)}
     design = _design(tb, params, inputs, outputs, speed)
     prof = profile(tb, params, design, inputs=inputs, outputs=outputs, opt=opt or PGO_OPT,
@@ -217,8 +245,9 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
     exe, build_s = _build(design, opt, pgo=prof)
     words, stamps, meta, _ = _run_exe(exe, tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
                                       inputs=inputs, max_cycles=max_cycles)
+    status = unpack_status(_status(tb, tb.dut(params), params), int(meta.get("status", 0)))
     return Run("verilator", words, stamps, wall_s=time.perf_counter() - t0, build_s=build_s, run_s=meta["run_s"],
-               protocol_errors=int(meta.get("errors", 0)),
+               protocol_errors=int(meta.get("errors", 0)), status=status,
                build={"speed": speed, "opt": opt, "pgo": prof is not None})
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 import re
 
 import numpy as np
+from amaranth.hdl import Cat
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
@@ -33,7 +34,7 @@ from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 from rasterhw.sim.zbm.line_bench import LineBench
 from rasterhw.sim.zbm.stimfiles import random_gaps
 
-__all__ = ["ChipBench", "LoopBench", "MergerBench", "PixelBench", "SeggenBench", "UnitBench", "pixel_visits"]
+__all__ = ["ChipBench", "LoopBench", "MergerBench", "PixelBench", "SeggenBench", "UnitBench", "deal", "pixel_visits"]
 
 
 class SeggenBench(Testbench):
@@ -102,6 +103,11 @@ class UnitBench(Testbench):
     def domain_of(self, port: str) -> str:
         return "merge" if "o_merge" in port else "sync"
 
+    def status(self, dut, params: dict) -> dict:
+        """``frames_ok``: every unit finished exactly one frame; ``overflow``: a unit's sticky overflow."""
+        units = dut.units if params.get("units", 1) > 1 else [dut]
+        return {"frames_ok": Cat(*[u.frames == 1 for u in units]).all(), "overflow": Cat(*[u.overflow for u in units]).any()}
+
     def sink_seed(self, params: dict, port: int, seed: int) -> int:
         return 0x9E3779B9 ^ ((seed * 7919 + port * 104729 + 1) & 0xFFFF_FFFF)
 
@@ -112,27 +118,28 @@ class UnitBench(Testbench):
         tris = random_triangles(rng, n, w, h, size=float(rng.uniform(3, max(4, min(w, h) / 2))))
         while len(tris.xy) > 1 and G.max_active_edge_pairs(G.edge_pairs(tris))[0] > params["capacity"]:
             tris = first_triangles(tris, len(tris.xy) - 1)
-        st = self.scene_stimulus(params, tris)
-        return Stimulus(st.words, what=f"{len(tris.xy)} random triangles, seed {seed}", source=tris)
+        return self.scene_stimulus(params, deal(G.edge_pairs(tris), params["units"]),
+                                   what=f"{len(tris.xy)} random triangles, seed {seed}")
 
-    def scene_stimulus(self, params: dict, tris, *, gap_seed: int | None = None, what: str = "") -> Stimulus:
-        """Screen triangles dealt to the units round-robin (triangle i -> unit i % units, as
-        ``render_zbm``), each unit's edge-pair words on its input; ``gap_seed``: random idle gaps
-        (``stimfiles.random_gaps`` over all units' words in order, as the cocotb bench plays them)."""
-        eps = G.edge_pairs(tris)
+    def scene_stimulus(self, params: dict, eps_per_unit: list, *, gap_seed: int | None = None,
+                       what: str = "") -> Stimulus:
+        """Unit ``k``'s edge pairs (:func:`deal`: a scene's, as ``render_zbm`` deals them) as its
+        edge-pair words; ``gap_seed``: random idle gaps (``stimfiles.random_gaps`` over all units'
+        words in order, as the cocotb bench plays them; None: none)."""
         ins = self.inputs_of(params)
-        u = len(ins)
-        words = [edge_pair_words(eps.take(np.flatnonzero(eps.tag % u == k))) for k in range(u)]
+        if len(eps_per_unit) != len(ins):
+            raise RasterhwError(f"zbm-unit: {len(eps_per_unit)} edge-pair lists for {len(ins)} units")
+        words = [edge_pair_words(e) for e in eps_per_unit]
         gaps = random_gaps(sum(map(len, words)), gap_seed).tolist()
         at = np.cumsum([0] + [len(w) for w in words])
         return Stimulus(dict(zip(ins, words, strict=True)),
                         gaps={p: gaps[at[k]:at[k + 1]] for k, p in enumerate(ins)} if gap_seed is not None else {},
-                        what=what, source=tris)
+                        what=what, source=list(eps_per_unit))
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         i = params["interleave"]
-        g0, g1 = doublez_words(G.render_zbm(stim.source, interleave=i, units=params.get("units", 1),
-                                            capacity=params["capacity"]).pixels)
+        g0, g1 = doublez_words(G.chain_frame(stim.source, params["width"], params["height"],
+                                             capacity=params["capacity"]))
         outs = self.outputs_of(params)
         return Expected({outs[c]: merge_words(g0[:, c::i], g1[:, c::i]) for c in range(i)})
 
@@ -170,7 +177,13 @@ class UnitBench(Testbench):
     def train_stimulus(self, params: dict) -> Stimulus:
         """c50 (:data:`TRAIN_SCENE`; the frames a profile is checked on are others) at the block's size."""
         tris = run_geometry(build_scene(TRAIN_SCENE), params["width"], params["height"])
-        return self.scene_stimulus(params, tris, what=f"scene {TRAIN_SCENE}")
+        return self.scene_stimulus(params, deal(G.edge_pairs(tris), params["units"]), what=f"scene {TRAIN_SCENE}")
+
+
+def deal(eps, units: int) -> list:
+    """A frame's edge pairs dealt to ``units`` units as ``render_zbm`` deals its triangles
+    (triangle i -> unit i % units)."""
+    return [eps.take(np.flatnonzero(eps.tag % units == k)) for k in range(units)]
 
 
 _M64 = (1 << 64) - 1
@@ -285,9 +298,14 @@ class ChipBench(Testbench):
         lines = len(segs.line_start) - 1
         npx = -(-(w - c) // i)
         ups = [random_doublez(rng, npx) for _ in range(lines)]
-        words = [wd for y in range(lines) for wd in segment_words(segs, y)]
+        return self.scene_stimulus(params, segs, ups, what=f"{lines} lines of random segments, seed {seed}")
+
+    def scene_stimulus(self, params: dict, segs, ups: list, *, what: str = "") -> Stimulus:
+        """Lines ``0 .. len(ups) - 1`` of ``segs`` (a frame's golden segments) on the segment port,
+        ``ups[y]`` (the chip's pixels of line ``y``) on the upstream merge port."""
+        words = [wd for y in range(len(ups)) for wd in segment_words(segs, y)]
         return Stimulus({"i_seg": words, "i_merge": [wd for u in ups for wd in pixel2_words(u)]},
-                        what=f"{lines} lines of random segments, seed {seed}", source=(segs, ups))
+                        what=what, source=(segs, ups))
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         segs, ups = stim.source
