@@ -35,7 +35,8 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
     number of idle clocks (geometric: each clock idle with probability ``idle``, at most 255),
     drawn from ``seed`` and the port, the same on every engine.
     ``stall`` (0..255): every output's ``ready`` is low on a clock when the low byte of a seeded
-    xorshift is below it (0: always ready); ``seed`` seeds it (port k uses ``seed + k``).
+    xorshift is below it (0: always ready); ``seed`` seeds it (port k uses ``tb.sink_seed(params, k, seed)``,
+    ``seed + k`` unless the testbench says otherwise).
     ``expect_words``: words to collect per output port (the run ends when all have come);
     ``max_cycles``: a watchdog (default: 10,000 + 64 clocks per word in and out, scaled up by the
     idle gaps and the stalls; a block that stops gives a one-line error, not a hang).
