@@ -300,6 +300,10 @@ class ChipBench(Testbench):
         ups = [random_doublez(rng, npx) for _ in range(lines)]
         return self.scene_stimulus(params, segs, ups, what=f"{lines} lines of random segments, seed {seed}")
 
+    def status(self, dut, params: dict) -> dict:
+        """``lines``: scan lines the chip has finished (its ``lines`` counter)."""
+        return {"lines": dut.lines}
+
     def scene_stimulus(self, params: dict, segs, ups: list, *, what: str = "") -> Stimulus:
         """Lines ``0 .. len(ups) - 1`` of ``segs`` (a frame's golden segments) on the segment port,
         ``ups[y]`` (the chip's pixels of line ``y``) on the upstream merge port."""
