@@ -68,7 +68,7 @@ class UnitBench(Testbench):
     cocotb bench). A random frame: 2..40 random screen triangles (seeded), the first ones that fit
     the active-edge-pair memory; a scene: :meth:`scene_stimulus` (``rasterhw sim zbm``, the soak).
 
-    The back-pressure of slot ``c`` is the cocotb unit bench's (``cocotb_tests/zbm/tb_zbm_unit_core.v``:
+    The back-pressure of slot ``c`` is the cocotb unit bench's (``cocotb_tests/zbm/tb_zbm_unit.v``:
     seed ``0x9E3779B9 ^ (7919 seed + 104729 c + 1)``), so a run equals that bench's, stalls
     included. The speed build (``build={"speed": True}``): identical modules merged, the pixel
     processor kept out of line (:meth:`sim_verilog`); its gcc profile is trained on c50."""
