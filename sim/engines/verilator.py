@@ -243,19 +243,21 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
                    train=pgo is True) if pgo else None
     opt = opt or (PGO_OPT if prof is not None else "-O1")
     exe, build_s = _build(design, opt, pgo=prof)
+    dut = tb.dut(params)   # for the port widths and the status values' names and widths (not simulated)
     words, stamps, meta, _ = _run_exe(exe, tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
-                                      inputs=inputs, max_cycles=max_cycles)
-    status = unpack_status(_status(tb, tb.dut(params), params), int(meta.get("status", 0)))
+                                      inputs=inputs, max_cycles=max_cycles, dut=dut)
+    status = unpack_status(_status(tb, dut, params), int(meta.get("status", 0)))
     return Run("verilator", words, stamps, wall_s=time.perf_counter() - t0, build_s=build_s, run_s=meta["run_s"],
                protocol_errors=int(meta.get("errors", 0)), status=status,
                build={"speed": speed, "opt": opt, "pgo": prof is not None})
 
 
 def _run_exe(exe: Path, tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int,
-             expect_words: dict[str, int], inputs: dict[str, int], max_cycles: int, profile: Path | None = None):
+             expect_words: dict[str, int], inputs: dict[str, int], max_cycles: int, profile: Path | None = None,
+             dut=None):
     """One run of a bench binary: (words, stamps, the main's JSON line, cycles)."""
     outs = tb.outputs_of(params)
-    dut = tb.dut(params)
+    dut = tb.dut(params) if dut is None else dut
     widths = {n: len(_payload(port_of(dut, n))) for n in inputs}
     run_dir = temp_run_folder(exe.parent.parent)
     try:
