@@ -29,7 +29,12 @@ from amaranth.hdl import (
 )
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.engines.memh import memh_uint64, read_memh
-from rasterhw.sim.engines.runner import HARNESS_V, build_plain_verilator, plain_build_dir, run_plain_verilator
+from rasterhw.sim.engines.runner import (
+    HARNESS_V,
+    build_plain_verilator,
+    plain_build_dir,
+    run_plain_verilator,
+)
 from rasterhw.sim.engines.verilog import canonical_port_lists
 from rasterhw.sim.engines.verilog_cache import convert_cached
 from rasterhw.sim.paths import BUILD_ROOT

@@ -10,6 +10,8 @@ import numpy as np
 from amaranth.hdl import Cat
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.pipeline import run_geometry
+from rasterhw.golden_model.scenes import build_scene
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.stimulus import (
     first_triangles,
@@ -17,8 +19,6 @@ from rasterhw.golden_model.zbm.stimulus import (
     random_doublez,
     random_triangles,
 )
-from rasterhw.golden_model.pipeline import run_geometry
-from rasterhw.golden_model.scenes import build_scene
 from rasterhw.golden_model.zbm.words import (
     doublez_words,
     edge_pair_words,
