@@ -3,9 +3,9 @@
 // output `done`; this main toggles `clk` until `done` (or +maxcyc= rising edges), then
 // RASTERHW_TAIL more edges (for state the bench stores after `done`), times the loop with
 // std::chrono and prints one JSON line:
-//   {"sim_cycles": rising edges before done, "done", "run_s"[, "cycles"][, "lines"]}
-// where "cycles" / "lines" are the top's outputs of those names when the build defines
-// RASTERHW_CYCLES / RASTERHW_LINES. `final` blocks (the benches' dumps) run at the end.
+//   {"sim_cycles": rising edges before done, "done", "run_s"[, "cycles"][, "lines"][, "errors"][, "status"]}
+// where "cycles" / "lines" / "errors" / "status" (up to 64 bits) are the top's outputs of those names
+// when the build defines RASTERHW_CYCLES / RASTERHW_LINES / RASTERHW_ERRORS / RASTERHW_STATUS. `final` blocks (the benches' dumps) run at the end.
 // A build with --trace-fst or --trace (waves on request: sim/engines/waves.py) writes the run's trace to
 // the file named by +waves=PATH, two time steps per clock (rising edges at odd steps); with
 // +trace_start=N / +trace_end=M only edges N .. M-1 (counted from 0, the tail included): the trace
@@ -107,6 +107,12 @@ int main(int argc, char** argv) {
 #endif
 #ifdef RASTERHW_LINES
     std::printf(", \"lines\": %u", (unsigned)top->lines);
+#endif
+#ifdef RASTERHW_ERRORS
+    std::printf(", \"errors\": %u", (unsigned)top->errors);
+#endif
+#ifdef RASTERHW_STATUS
+    std::printf(", \"status\": %llu", (unsigned long long)top->status);
 #endif
     std::printf("}\n");
     return done ? 0 : 2;

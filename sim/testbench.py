@@ -65,6 +65,9 @@ class Run:
     wall_s: float = 0.0
     build_s: float = 0.0
     run_s: float = 0.0
+    protocol_errors: int = 0                     # clocks that broke the stream rules, every port
+    status: dict = field(default_factory=dict)   # the testbench's status values at the end (Testbench.status)
+    build: dict = field(default_factory=dict)    # how the model was built (engine's words: opt, pgo, ...)
 
     @property
     def cycles(self) -> int:
@@ -108,8 +111,30 @@ class Testbench:
         """A fresh instance of the block (engines elaborate it once per run)."""
         return registry.load(registry.blocks()[self.block])(**params)
 
+    def inputs_of(self, params: dict) -> tuple[str, ...]:
+        return self.inputs
+
     def outputs_of(self, params: dict) -> tuple[str, ...]:
         return self.outputs
+
+    def status(self, dut, params: dict) -> dict:
+        """Values of the block read when the run ends, beside its streams (``{name: Amaranth value}``,
+        64 bits together at most, e.g. a frame counter or a sticky overflow): ``Run.status``."""
+        return {}
+
+    def sink_seed(self, params: dict, port: int, seed: int) -> int:
+        """The back-pressure seed of output ``port`` (its index) in a run seeded ``seed``."""
+        return seed + port
+
+    # ------------------------------------------------------------------ the speed build (optional)
+    def sim_verilog(self, params: dict, text: str) -> str:
+        """The Verilog a simulator compiles for a speed build (``build={"speed": True}``): ``text``
+        (the bench top with the block) reshaped for speed, the same circuit; default unchanged."""
+        return text
+
+    def train_stimulus(self, params: dict) -> Stimulus | None:
+        """The stimulus a speed build's gcc profile is trained on (None: no profile)."""
+        return None
 
     def domain_of(self, port: str) -> str:
         """The clock domain of stream port ``port`` (``o_merge[3]`` looks up ``o_merge`` too)."""

@@ -15,8 +15,8 @@
 // `cycles`: segment-clock cycles (unit 0's counter) when the last merge word was taken.
 // The run also ends (early) on the watchdog (`timeout`) or a unit's sticky `overflow`.
 module tb_zbm_unit #(
-  // what the core takes (tb_zbm_unit_core.v): interleave (merge slots), units, frame width and
-  // height, gap bits, stimulus memory depth (> all words + 1)
+  // interleave (merge slots), units, frame width and height, gap bits, stimulus memory depth
+  // (> all words + 1)
   parameter I = 8, U = 1, W = 64, H = 16, GW = 8, SDEPTH = 1024
 ) (
   output reg finished,
@@ -54,15 +54,123 @@ module tb_zbm_unit #(
   rasterhw_reset #(.CYCLES(6), .DELAY(0.5)) seg_reset (.clk(clk), .rst(rst));
   rasterhw_reset #(.CYCLES(6), .DELAY(0.5)) merge_reset (.clk(mclk), .rst(mrst));
 
-  // --- the units, their players and the merge-slot sinks (tb_zbm_unit_core.v) -------------
+  // --- the units, their players and the merge-slot sinks ------------------------------------
   wire [I-1:0] slot_done;
   wire [32*I-1:0] slot_y;
-  wire [31:0] cycles0;
-  wire any_overflow, all_frames;
-  tb_zbm_unit_core #(.I(I), .U(U), .W(W), .H(H), .GW(GW), .SDEPTH(SDEPTH)) core (
-    .clk(clk), .rst(rst), .mclk(mclk), .mrst(mrst), .stall(STALL), .seed(SEED),
-    .slot_done(slot_done), .slot_y(slot_y), .cycles0(cycles0), .any_overflow(any_overflow),
-    .all_frames(all_frames), .proto_errors(proto_errors));
+  reg all_frames;
+  localparam EW = 168;
+  localparam MW = 128;
+  localparam NPIX = W * H;
+
+  reg [31:0] idx [0:2*U-1];
+  reg [MW-1:0] frame [0:NPIX-1];
+  reg [8*512-1:0] findex;
+  integer k0;
+  initial begin
+    if (!$value$plusargs("index=%s", findex)) $fatal(1, "tb_zbm_unit: +index= missing");
+    $readmemh(findex, idx);
+    for (k0 = 0; k0 < NPIX; k0 = k0 + 1) frame[k0] = {MW{1'b1}};
+  end
+
+  // --- device under test ----------------------------------------------------------------
+  wire [U-1:0] i_valid, i_ready;
+  wire [EW*U-1:0] i_payload;
+  wire [I-1:0] o_valid, o_ready;
+  wire [MW*I-1:0] o_payload;
+  wire [32*U-1:0] dut_cycles;
+  wire [16*U-1:0] dut_frames;
+  wire [U-1:0] dut_overflow;
+  wire [31:0] cycles0 = dut_cycles[31:0];
+  wire any_overflow = |dut_overflow;
+
+  zbm_chain_flat dut (
+    .clk(clk), .rst(rst), .merge_clk(mclk), .merge_rst(mrst),
+    .i_valid(i_valid), .i_ready(i_ready), .i_payload(i_payload),
+    .o_valid(o_valid), .o_ready(o_ready), .o_payload(o_payload),
+    .cycles(dut_cycles), .frames(dut_frames), .overflow(dut_overflow)
+  );
+
+  // --- one player per unit input stream ---------------------------------------------------
+  wire [32*U-1:0] in_err;
+  genvar k;
+  generate
+    for (k = 0; k < U; k = k + 1) begin : player
+      wire [31:0] base = idx[2*k];
+      wire [31:0] count = idx[2*k+1];
+      wire v, done;
+      wire r = i_ready[k];
+      wire [EW-1:0] p;
+      assign i_valid[k] = v;
+      assign i_payload[k*EW +: EW] = p;
+      // every player loads the whole stimulus file and plays its own unit's words
+      rasterhw_stream_player #(.PW(EW), .GW(GW), .DEPTH(SDEPTH), .FILE_ARG("stim=%s")) u (
+        .clk(clk), .rst(rst), .base(base), .count(count), .repeats(32'd1),
+        .valid(v), .ready(r), .payload(p), .done(done));
+      wire [31:0] transfers;
+      rasterhw_stream_check #(.PW(EW)) chk (.clk(clk), .rst(rst), .valid(v), .ready(r), .payload(p),
+                                       .errors(in_err[32*k +: 32]), .transfers(transfers));
+    end
+  endgenerate
+
+  // --- one sink per merge slot: random back-pressure, frame address from arrival order ---
+  `include "xorshift.vh"   // xorshift32, the one copy (cocotb_tests/xorshift.vh)
+
+  wire [32*I-1:0] faddr;
+  wire [32*I-1:0] out_err;
+  genvar c;
+  generate
+    for (c = 0; c < I; c = c + 1) begin : slot
+      localparam integer NPX = (W - c + I - 1) / I;
+      reg [31:0] lf;
+      reg [31:0] q, y;
+      wire v = o_valid[c];
+      wire r = !mrst && (lf[7:0] >= STALL);
+      wire [MW-1:0] p = o_payload[c*MW +: MW];
+      assign o_ready[c] = r;
+      assign slot_done[c] = (y == H);
+      assign slot_y[32*c +: 32] = y;
+      assign faddr[32*c +: 32] = y * W + q * I + c;
+      always @(posedge mclk) begin
+        if (mrst) begin
+          lf <= 32'h9E3779B9 ^ (SEED * 32'd7919 + c * 32'd104729 + 32'd1);
+          q <= 32'd0;
+          y <= 32'd0;
+        end else begin
+          lf <= xorshift32(lf);
+          if (v && r && y < H) begin
+            if (q == NPX - 1) begin
+              q <= 32'd0;
+              y <= y + 32'd1;
+            end else begin
+              q <= q + 32'd1;
+            end
+          end
+        end
+      end
+      wire [31:0] transfers;
+      rasterhw_stream_check #(.PW(MW)) chk (.clk(mclk), .rst(mrst), .valid(v), .ready(r), .payload(p),
+                                       .errors(out_err[32*c +: 32]), .transfers(transfers));
+    end
+  endgenerate
+
+  integer s;
+  always @(posedge mclk) begin
+    if (!mrst) begin
+      for (s = 0; s < I; s = s + 1)
+        if (o_valid[s] && o_ready[s] && !slot_done[s]) frame[faddr[32*s +: 32]] <= o_payload[s*MW +: MW];
+    end
+  end
+
+  reg [31:0] proto_sum;
+  assign proto_errors = proto_sum;
+  integer e;
+  always @(*) begin
+    proto_sum = 32'd0;
+    for (e = 0; e < U; e = e + 1) proto_sum = proto_sum + in_err[32*e +: 32];
+    for (e = 0; e < I; e = e + 1) proto_sum = proto_sum + out_err[32*e +: 32];
+    all_frames = 1'b1;
+    for (e = 0; e < U; e = e + 1) all_frames = all_frames && (dut_frames[16*e +: 16] == 16'd1);
+  end
 
   // --- per-line log (optional, +lines=FILE): line_t[y] = unit 0's segment-clock count in the
   // merge cycle in which the last chip slot finished merge output line y (steady-state timing).
@@ -91,7 +199,7 @@ module tb_zbm_unit #(
       cycles <= cycles0;
       overflow <= any_overflow;
       frames_ok <= all_frames;
-      $writememh(fout, core.frame);
+      $writememh(fout, frame);
       if (log_lines) $writememh(flines, line_t);
       finished <= 1'b1;
     end

@@ -77,11 +77,11 @@ async def zbm_unit_frame(dut):
         units, interleave = int(exp["units"]), int(exp["interleave"])
         for k in range(units):
             logs_in.append([])
-            p = dut.core.player[k]   # the players and sinks are in tb_zbm_unit_core.v
+            p = dut.player[k]
             start_checker(dut.clk, p.v, p.r, p.p, name=f"i[{k}]", log=logs_in[k], reset=dut.rst)
         for c in range(interleave):
             logs_out.append([])
-            s = dut.core.slot[c]
+            s = dut.slot[c]
             start_checker(dut.mclk, s.v, s.r, s.p, name=f"o_merge[{c}]", log=logs_out[c], reset=dut.mrst)
     await RisingEdge(dut.finished)
     meta = _write_result(dut, frames_ok=bool(to_int(dut.frames_ok)), overflow=bool(to_int(dut.overflow)))

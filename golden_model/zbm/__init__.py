@@ -23,12 +23,18 @@ from rasterhw.golden_model.zbm.formats import Z_SCALE
 from rasterhw.golden_model.zbm.initial import initial_processor
 from rasterhw.golden_model.zbm.mapping import default_maps, map_samples
 from rasterhw.golden_model.zbm.merger import merge, merge_chain
-from rasterhw.golden_model.zbm.render import ZbmResult, render_scene, render_zbm, render_zbm_float
+from rasterhw.golden_model.zbm.render import (
+    ZbmResult,
+    chain_frame,
+    render_scene,
+    render_zbm,
+    render_zbm_float,
+)
 from rasterhw.golden_model.zbm.seggen import Segments, max_active_edge_pairs, segment_generator
 from rasterhw.golden_model.zbm.unit import unit_scanline
 
 __all__ = [
     "Z_SCALE", "DoubleZ", "EdgePairs", "Segments", "ZbmResult", "chip_scanline", "composite",
     "default_maps", "edge_pairs", "initial_processor", "map_samples", "max_active_edge_pairs", "merge",
-    "merge_chain", "render_scene", "render_zbm", "render_zbm_float", "segment_generator", "unit_scanline",
+    "chain_frame", "merge_chain", "render_scene", "render_zbm", "render_zbm_float", "segment_generator", "unit_scanline",
 ]

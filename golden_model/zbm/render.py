@@ -41,7 +41,7 @@ from rasterhw.golden_model.zbm.merger import merge_chain
 from rasterhw.golden_model.zbm.seggen import segment_generator
 from rasterhw.golden_model.zbm.unit import _unit_frame_fast, segment_fragments, unit_scanline
 
-__all__ = ["ZbmResult", "render_zbm", "render_zbm_float", "render_scene"]
+__all__ = ["ZbmResult", "chain_frame", "render_zbm", "render_zbm_float", "render_scene"]
 
 
 @dataclass
@@ -96,6 +96,14 @@ def render_zbm(tris: ScreenTriangles, *, interleave: int = 8, units: int = 1, mo
         # what mapping before the Z test would cost: one lookup pair per fragment
         stats["lookups_if_mapped_before_merge"] = stats["fragments"]
     return ZbmResult(composite(shown, background), final, unit_bufs, stats)
+
+
+def chain_frame(eps_per_unit: list, width: int, height: int, *, capacity: int = AEP_CAPACITY) -> DoubleZ:
+    """The double-Z frame of a chain of units, unit ``k`` drawing ``eps_per_unit[k]`` (unit 0 at
+    the head), merged along the chain: what :func:`render_zbm` computes from triangles dealt
+    round-robin, for edge pairs given per unit."""
+    return merge_chain([_unit_frame_fast(segment_generator(e, height, width=width, capacity=capacity), height, width)[0]
+                        for e in eps_per_unit])
 
 
 def render_zbm_float(tris: ScreenTriangles, *, alpha=None, background=(0.0, 0.0, 0.0)) -> dict:

@@ -27,14 +27,16 @@ ENGINES = {"pysim": pysim.run, "verilator": verilator.run}
 
 
 def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", idle: float = 0.0, stall: int = 0,
-        seed: int = 1, expect_words: dict[str, int] | None = None, max_cycles: int | None = None) -> Run:
+        seed: int = 1, expect_words: dict[str, int] | None = None, max_cycles: int | None = None,
+        build: dict | None = None) -> Run:
     """Run ``stim`` through block ``tb.block`` with ``params`` on ``engine``.
 
     ``idle`` (0 <= idle < 1): every input word without a gap of its own in ``stim`` waits a random
     number of idle clocks (geometric: each clock idle with probability ``idle``, at most 255),
     drawn from ``seed`` and the port, the same on every engine.
     ``stall`` (0..255): every output's ``ready`` is low on a clock when the low byte of a seeded
-    xorshift is below it (0: always ready); ``seed`` seeds it (port k uses ``seed + k``).
+    xorshift is below it (0: always ready); ``seed`` seeds it (port k uses ``tb.sink_seed(params, k, seed)``,
+    ``seed + k`` unless the testbench says otherwise).
     ``expect_words``: words to collect per output port (the run ends when all have come);
     ``max_cycles``: a watchdog (default: 10,000 + 64 clocks per word in and out, scaled up by the
     idle gaps and the stalls; a block that stops gives a one-line error, not a hang).
@@ -46,20 +48,23 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
     if not (isinstance(idle, (int, float)) and 0 <= idle < 1):
         raise RasterhwError(f"idle must be a probability in [0, 1), not {idle!r}")
     n_out = len(tb.outputs_of(params))
-    if stall and any((seed + k) & 0xFFFF_FFFF == 0 for k in range(n_out)):
+    if stall and any(tb.sink_seed(params, k, seed) & 0xFFFF_FFFF == 0 for k in range(n_out)):
         # output k's back-pressure is the xorshift seeded seed + k: from 0 it stays 0 (never ready)
         raise RasterhwError(f"seed {seed} gives an output a back-pressure seed of 0 (xorshift stays 0: "
                             "ready never rises); use another seed")
     if idle:
-        stim = with_gaps(stim, idle, seed, tb.inputs)
+        stim = with_gaps(stim, idle, seed, tb.inputs_of(params))
     if expect_words is None:
         raise RasterhwError("say how many words to collect per output port (expect_words)")
     if max_cycles is None:
         words = sum(len(w) for w in stim.words.values()) + sum(expect_words.values())
         gaps = sum(int(np.sum(g, dtype=np.int64)) for g in stim.gaps.values())
         max_cycles = (10_000 + 64 * words + gaps) * (1 + stall // 32)
+    if build and engine != "verilator":
+        raise RasterhwError(f"build settings are for the verilator engine, not {engine}")
+    kw = {"build": build} if build else {}
     return ENGINES[engine](tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
-                           max_cycles=max_cycles)
+                           max_cycles=max_cycles, **kw)
 
 
 def with_gaps(stim: Stimulus, idle: float, seed: int, ports) -> Stimulus:

@@ -25,20 +25,42 @@ def _source(port, words, gaps, domain):
     return bench
 
 
-def _sink(port, need, words, stamps, ready, domain, max_cycles, name):
+def _sinks(sinks: list, domain, max_cycles, finished, read_status):
+    """One process for every sink of ``domain`` (a block with many output ports, e.g. 8 merge slots,
+    costs one await per clock, not one per port). ``sinks``: ``(name, port, need, words, stamps,
+    ready pattern)``; each sink draws its pattern once per clock until it has its words, then
+    holds ``ready`` low."""
     async def bench(ctx):
+        left = [s for s in sinks if len(s[3]) < s[2]]
+        for name, port, *_ in sinks:
+            if not any(s[0] == name for s in left):
+                ctx.set(port.ready, 0)
+        sigs = [x for s in left for x in (s[1].valid, s[1].payload)]
+        held = {s[0]: None for s in left}   # the ready each port holds (set only when it changes)
         k = 0
-        while len(words) < need:
-            r = next(ready)
-            ctx.set(port.ready, r)
-            _, _, valid, payload = await ctx.tick(domain).sample(port.valid, port.payload)
-            if valid and r:
-                words.append(as_plain(payload))
-                stamps.append(k)
+        while left:
+            rs = [next(s[5]) for s in left]
+            for s, r in zip(left, rs, strict=True):
+                if held[s[0]] is not r:
+                    ctx.set(s[1].ready, r)
+                    held[s[0]] = r
+            _, _, *vals = await ctx.tick(domain).sample(*sigs)
+            for j, (s, r) in enumerate(zip(left, rs, strict=True)):
+                if vals[2 * j] and r:
+                    s[3].append(as_plain(vals[2 * j + 1]))
+                    s[4].append(k)
             k += 1
-            if k > max_cycles:
+            done = [s for s in left if len(s[3]) >= s[2]]
+            if done:
+                for s in done:
+                    ctx.set(s[1].ready, 0)
+                    finished.append(s[0])
+                left = [s for s in left if len(s[3]) < s[2]]
+                sigs = [x for s in left for x in (s[1].valid, s[1].payload)]
+            if left and k > max_cycles:
+                name, _, need, words = left[0][:4]
                 raise RasterhwError(f"pysim: {name} gave {len(words)} of {need} words in {max_cycles} cycles")
-        ctx.set(port.ready, 0)
+        read_status(ctx)   # the last sink to finish reads the status values
     return bench
 
 
@@ -50,24 +72,35 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
     for d in tb.domains:
         sim.add_clock(1e-8, domain=d)
     errors: list[str] = []
-    for name in tb.inputs:
+    for name in tb.inputs_of(params):
         port = port_of(dut, name)
         sim.add_testbench(_source(port, as_ints(stim.words[name]), stim.gaps_of(name).tolist(),
                                   tb.domain_of(name)),
                           background=True)
     words: dict[str, list[int]] = {}
     stamps: dict[str, list[int]] = {}
-    for k, name in enumerate(tb.outputs_of(params)):
+    outs = tb.outputs_of(params)
+    status_values, status, finished = tb.status(dut, params), {}, []
+
+    def read_status(ctx):
+        if len(finished) == len(outs):
+            status.update({n: int(ctx.get(v)) for n, v in status_values.items()})
+
+    by_domain: dict[str, list] = {}
+    for k, name in enumerate(outs):
         port = port_of(dut, name)
         words[name], stamps[name] = [], []
         d = tb.domain_of(name)
         sim.add_testbench(stream_protocol_checker(port, name, domain=d, errors=errors), background=True)
-        sim.add_testbench(_sink(port, expect_words[name], words[name], stamps[name],
-                                ready_pattern(seed + k, stall), d, max_cycles, name))
+        by_domain.setdefault(d, []).append((name, port, expect_words[name], words[name], stamps[name],
+                                            ready_pattern(tb.sink_seed(params, k, seed), stall)))
+    for d, sinks in by_domain.items():
+        sim.add_testbench(_sinks(sinks, d, max_cycles, finished, read_status))
     # with --waves: the GTKWave save file shows these ports, one group each (sim/engines/waves.py)
-    declare_streams(sim, {name: port_of(dut, name) for name in (*tb.inputs, *tb.outputs_of(params))})
+    declare_streams(sim, {name: port_of(dut, name) for name in (*tb.inputs_of(params), *tb.outputs_of(params))})
     t1 = time.perf_counter()
     sim.run()
     if errors:
         raise RasterhwError(f"pysim: {tb.block} broke the stream rules: {errors[0]}")
-    return Run("pysim", words, stamps, wall_s=time.perf_counter() - t0, run_s=time.perf_counter() - t1)
+    return Run("pysim", words, stamps, wall_s=time.perf_counter() - t0, run_s=time.perf_counter() - t1,
+               status=status)

@@ -250,7 +250,7 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
     :func:`verilator_make_vars`. The folder ``build/<name>-<digest>`` is keyed on all of these and
     the bytes of every source, so an unchanged design is never rebuilt and a changed one always is.
     ``pgo``: gcc profile-guided optimisation of the model's per-cycle code, opt-in (the caller
-    trains and keeps the profile: ``sim/zbm/fast.py unit_profile``): ``"generate"`` builds an instrumented model (its runs under
+    trains and keeps the profile: ``sim/engines/verilator.py profile``): ``"generate"`` builds an instrumented model (its runs under
     :func:`run_plain_verilator` with ``profile=`` write the profile); a folder holding that
     profile builds the model optimised with it (``-fprofile-use``; the profile's bytes are part of
     the build's key).

@@ -10,6 +10,9 @@ from __future__ import annotations
 
 import hashlib
 import inspect
+import json
+import os
+import shutil
 import time
 from pathlib import Path
 
@@ -28,13 +31,19 @@ from amaranth.hdl import (
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.engines.memh import memh_uint64, read_memh
 from rasterhw.sim.engines.packed import as_bytes, records
-from rasterhw.sim.engines.runner import HARNESS_V, build_plain_verilator, run_plain_verilator
+from rasterhw.sim.engines.runner import (
+    HARNESS_V,
+    build_plain_verilator,
+    plain_build_dir,
+    run_plain_verilator,
+)
 from rasterhw.sim.engines.verilog import canonical_port_lists
 from rasterhw.sim.engines.verilog_cache import convert_cached
+from rasterhw.sim.paths import BUILD_ROOT
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
-from rasterhw.sim.workdirs import release, temp_run_folder
+from rasterhw.sim.workdirs import build_lock, release, temp_run_folder
 
-__all__ = ["GAP_BITS", "BenchTop", "run"]
+__all__ = ["GAP_BITS", "PGO_OPT", "BenchTop", "profile", "run", "unpack_status"]
 
 GAP_BITS = 8          # idle clocks before a word: 0..255
 _SELF = hashlib.sha1(Path(__file__).read_bytes()).hexdigest()[:12]   # this file is part of the design
@@ -61,15 +70,20 @@ def _payload(port):
 
 class BenchTop(Elaboratable):
     """The block with a source on every input port and a sink on every output port; ports
-    ``clk``, ``done`` (every source played out and every sink full) and ``cycles`` (edges so far)."""
+    ``clk``, ``done`` (every source played out and every sink full), ``cycles`` (edges so far) and
+    ``errors`` (clocks that broke the stream rules, every port: ``rasterhw_stream_check``)."""
 
-    def __init__(self, dut, inputs: dict[str, int], outputs: dict[str, int], domains: tuple[str, ...]):
+    def __init__(self, dut, inputs: dict[str, int], outputs: dict[str, int], domains: tuple[str, ...],
+                 status: dict | None = None):
         self.dut = dut
+        self._status = dict(status or {})
         self._inputs, self._outputs, self._domains = inputs, outputs, domains
         self.cd = ClockDomain("sync", reset_less=True)
         self.done = Signal(name="done")
         self.cycles = Signal(32, name="cycles")
-        self.ports = [self.cd.clk, self.done, self.cycles]
+        self.errors = Signal(32, name="errors")
+        self.status = Signal(64, name="status")   # the testbench's status values, packed in order
+        self.ports = [self.cd.clk, self.done, self.cycles, self.errors, self.status]
 
     def elaborate(self, platform):
         m = Module()
@@ -80,7 +94,7 @@ class BenchTop(Elaboratable):
                 m.d.comb += ClockSignal(d).eq(ClockSignal("sync"))
         m.submodules.dut = self.dut
         m.d.sync += self.cycles.eq(self.cycles + 1)
-        dones = []
+        dones, errors = [], []
         for name, depth in self._inputs.items():
             port, t = port_of(self.dut, name), _tag(name)
             ok = Signal(name=f"{t}_done")
@@ -91,6 +105,7 @@ class BenchTop(Elaboratable):
                 i_repeats=Const(1, 32),
                 o_valid=port.valid, i_ready=port.ready, o_payload=_payload(port), o_done=ok)
             dones.append(ok)
+            errors.append(_check(m, t, port))
         for name, depth in self._outputs.items():
             port, t = port_of(self.dut, name), _tag(name)
             ok = Signal(name=f"{t}_done")
@@ -101,34 +116,162 @@ class BenchTop(Elaboratable):
                 i_clk=ClockSignal("sync"), i_cycle=self.cycles, i_valid=port.valid, o_ready=port.ready,
                 i_payload=_payload(port), o_done=ok)
             dones.append(ok)
-        m.d.comb += self.done.eq(Cat(*dones).all())
+            errors.append(_check(m, t, port))
+        m.d.comb += [self.done.eq(Cat(*dones).all()), self.errors.eq(sum(errors, Const(0, 32)))]
+        if self._status:
+            m.d.comb += self.status.eq(Cat(*self._status.values()))
         return m
 
 
-def _build(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[str, int]) -> tuple[Path, float]:
+def _check(m: Module, tag: str, port) -> Signal:
+    """A stream-rule checker on ``port`` (``rasterhw_stream_check``); its count of bad clocks."""
+    err = Signal(32, name=f"{tag}_errors")
+    m.submodules[f"check_{tag}"] = Instance(
+        "rasterhw_stream_check", p_PW=len(_payload(port)), i_clk=ClockSignal("sync"), i_rst=Const(0, 1),
+        i_valid=port.valid, i_ready=port.ready, i_payload=_payload(port), o_errors=err,
+        o_transfers=Signal(32, name=f"{tag}_transfers"))
+    return err
+
+
+def _design(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[str, int], speed: bool):
+    """(build name, generated files) of the bench top around ``tb``'s block; ``speed``: the
+    testbench's speed Verilog (:meth:`Testbench.sim_verilog`)."""
     # the testbench's own module builds the DUT's adapter (e.g. a read-out): its bytes are design too
     tb_src = hashlib.sha1(Path(inspect.getfile(type(tb))).read_bytes()).hexdigest()[:12]
-    key = {**params, "inputs": inputs, "outputs": outputs, "bench": _SELF, "testbench": tb_src}
-    text = convert_cached(
-        tb.block, lambda: BenchTop(tb.dut(params), inputs, outputs, tb.domains), params=key, module="rasterhw_bench",
-        convert=lambda top, mod: canonical_port_lists(verilog.convert(top, name=mod, ports=top.ports)) + _extra(top.dut))
-    return build_plain_verilator(f"tb-{tb.block}", "rasterhw_bench", [HARNESS_V], params={}, opt=tb.verilator_opt,
-                                 defines={"RASTERHW_CYCLES": 1}, generated={"rasterhw_bench.v": text})
+    key = {**params, "inputs": inputs, "outputs": outputs, "bench": _SELF, "testbench": tb_src,
+           **({"speed": True} if speed else {})}
+
+    def top():
+        dut = tb.dut(params)
+        return BenchTop(dut, inputs, outputs, tb.domains, _status(tb, dut, params))
+
+    def convert(top, mod):
+        text = canonical_port_lists(verilog.convert(top, name=mod, ports=top.ports)) + _extra(top.dut)
+        return tb.sim_verilog(params, text) if speed else text
+
+    text = convert_cached(tb.block, top, params=key, module="rasterhw_bench", convert=convert)
+    return f"tb-{tb.block}", {"rasterhw_bench.v": text}
+
+
+_DEFINES = {"RASTERHW_CYCLES": 1, "RASTERHW_ERRORS": 1, "RASTERHW_STATUS": 1}
+
+
+def _status(tb: Testbench, dut, params: dict) -> dict:
+    """The testbench's status values (checked: 64 bits together at most)."""
+    st = tb.status(dut, params)
+    if sum(len(v) for v in st.values()) > 64:
+        raise RasterhwError(f"{tb.block}: status values wider than 64 bits together")
+    return st
+
+
+def unpack_status(st: dict, word: int) -> dict[str, int]:
+    """A packed status word -> ``{name: value}`` (the order and widths of ``st``)."""
+    out, at = {}, 0
+    for name, v in st.items():
+        out[name] = (word >> at) & ((1 << len(v)) - 1)
+        at += len(v)
+    return out
+
+
+def _build(design, opt: str, pgo=None) -> tuple[Path, float]:
+    name, generated = design
+    return build_plain_verilator(name, "rasterhw_bench", [HARNESS_V], params={}, opt=opt, defines=_DEFINES,
+                                 generated=generated, pgo=pgo)
+
+
+#: the g++ level of profile-guided builds (and of the instrumented build that trains them)
+PGO_OPT = "-O2"
+
+
+def _settings(build: dict | None) -> tuple[bool, str | None, bool | str, int]:
+    """(speed, opt, pgo, depth) of a ``build`` argument (see :func:`rasterhw.sim.engines.run`)."""
+    b = dict(build or {})
+    unknown = sorted(set(b) - {"speed", "opt", "pgo", "depth"})
+    if unknown:
+        raise RasterhwError(f"build settings: no {', '.join(unknown)} (speed, opt, pgo, depth)")
+    depth = b.get("depth", 0)
+    if not isinstance(depth, int) or isinstance(depth, bool) or depth < 0:
+        raise RasterhwError(f"build settings: depth must be a word count, not {depth!r}")
+    pgo = b.get("pgo", False)
+    env = os.environ.get("RASTERHW_PGO", "")
+    if pgo == "auto" and env in ("0", "1"):
+        pgo = env == "1"
+    if pgo not in (False, True, "auto"):
+        raise RasterhwError(f"build settings: pgo must be False, True or 'auto', not {pgo!r}")
+    return bool(b.get("speed", False)), b.get("opt", "-O1" if not build else None), pgo, depth
+
+
+def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outputs: dict[str, int],
+            opt: str = PGO_OPT, train: bool = True) -> Path | None:
+    """The gcc profile of ``design`` (the bench top with these memory depths): the instrumented build
+    run once on the testbench's training stimulus (:meth:`Testbench.train_stimulus`), its output
+    checked against the golden model (a wrong training run is an error, not a profile), kept in
+    ``build/pgo/<the instrumented build's folder>/``. Paid once per design: a cached profile is
+    returned as it is; ``train=False`` returns None instead of training, and so does a testbench
+    without a training stimulus or one that does not fit these memories."""
+    name, generated = design
+    prof = BUILD_ROOT / "pgo" / plain_build_dir(name, "rasterhw_bench", [HARNESS_V], params={}, opt=opt,
+                                                 defines=_DEFINES, generated=generated, pgo="generate").name
+    if (prof / "trained.json").exists():
+        return prof
+    stim = tb.train_stimulus(params) if train else None
+    if stim is None:
+        return None
+    exp = tb.expect(params, stim)
+    want = {n: len(w) for n, w in exp.words.items()}
+    if any(len(stim.words[n]) + 2 > inputs[n] for n in inputs) or any(want[n] + 2 > outputs[n] for n in outputs):
+        return None
+    exe, _ = _build(design, opt, pgo="generate")
+    with build_lock(prof, what=f"{tb.block} profile"):
+        if (prof / "trained.json").exists():
+            return prof
+        shutil.rmtree(prof, ignore_errors=True)
+        prof.mkdir(parents=True)
+        got = _run_exe(exe, tb, params, stim, stall=0, seed=1, expect_words=want, inputs=inputs,
+                       max_cycles=(10_000 + 64 * (sum(want.values()) + sum(map(len, stim.words.values())))),
+                       profile=prof)
+        bad = sum(a != b for p in want for a, b in zip(exp.words[p], got[0][p], strict=True))
+        if bad:
+            shutil.rmtree(prof, ignore_errors=True)
+            raise RasterhwError(f"{tb.block} profile: the instrumented build's training run ({stim.what}) "
+                                f"gave {bad} words that are not golden")
+        (prof / "trained.json").write_text(json.dumps({"what": stim.what, "cycles": got[3]}) + "\n")
+    return prof
 
 
 def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, expect_words: dict[str, int],
-        max_cycles: int) -> Run:
+        max_cycles: int, build: dict | None = None) -> Run:
     t0 = time.perf_counter()
+    speed, opt, pgo, depth = _settings(build)
+    if not build:
+        opt = tb.verilator_opt   # the testbench's level (e.g. a long frame's bench builds at -O2)
+    inputs = {n: _depth(max(len(stim.words[n]), depth - 2)) for n in tb.inputs_of(params)}
+    outputs = {n: _depth(expect_words[n]) for n in tb.outputs_of(params)}
+    design = _design(tb, params, inputs, outputs, speed)
+    prof = profile(tb, params, design, inputs=inputs, outputs=outputs, opt=opt or PGO_OPT,
+                   train=pgo is True) if pgo else None
+    opt = opt or (PGO_OPT if prof is not None else tb.verilator_opt)
+    exe, build_s = _build(design, opt, pgo=prof)
+    dut = tb.dut(params)   # for the port widths and the status values' names and widths (not simulated)
+    words, stamps, meta, _ = _run_exe(exe, tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
+                                      inputs=inputs, max_cycles=max_cycles, dut=dut)
+    status = unpack_status(_status(tb, dut, params), int(meta.get("status", 0)))
+    return Run("verilator", words, stamps, wall_s=time.perf_counter() - t0, build_s=build_s, run_s=meta["run_s"],
+               protocol_errors=int(meta.get("errors", 0)), status=status,
+               build={"speed": speed, "opt": opt, "pgo": prof is not None})
+
+
+def _run_exe(exe: Path, tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int,
+             expect_words: dict[str, int], inputs: dict[str, int], max_cycles: int, profile: Path | None = None,
+             dut=None):
+    """One run of a bench binary: (words, stamps, the main's JSON line, cycles)."""
     outs = tb.outputs_of(params)
-    inputs = {n: _depth(len(stim.words[n])) for n in tb.inputs}
-    outputs = {n: _depth(expect_words[n]) for n in outs}
-    dut = tb.dut(params)
-    widths = {n: len(_payload(port_of(dut, n))) for n in tb.inputs}
-    exe, build_s = _build(tb, params, inputs, outputs)
+    dut = tb.dut(params) if dut is None else dut
+    widths = {n: len(_payload(port_of(dut, n))) for n in inputs}
     run_dir = temp_run_folder(exe.parent.parent)
     try:
         plus = []
-        for n in tb.inputs:
+        for n in inputs:
             t, words, gaps = _tag(n), stim.words[n], stim.gaps_of(n)
             g_arr = np.asarray(gaps, dtype=np.int64)
             if g_arr.size and (g_arr.min() < 0 or g_arr.max() >= 1 << GAP_BITS):
@@ -139,8 +282,8 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
         for k, n in enumerate(outs):
             t = _tag(n)
             plus += [f"+{t}={run_dir / f'{t}.out'}", f"+{t}_cyc={run_dir / f'{t}.cyc'}", f"+{t}_n={expect_words[n]}",
-                     f"+{t}_stall={stall}", f"+{t}_seed={seed + k}"]
-        meta = run_plain_verilator(exe, plus, run_dir=run_dir, maxcyc=max_cycles)
+                     f"+{t}_stall={stall}", f"+{t}_seed={tb.sink_seed(params, k, seed) & 0xFFFF_FFFF}"]
+        meta = run_plain_verilator(exe, plus, run_dir=run_dir, maxcyc=max_cycles, profile=profile)
         words, stamps = {}, {}
         for n in outs:
             t, k = _tag(n), expect_words[n]
@@ -149,7 +292,7 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
             words[n], stamps[n] = words[n][:k], stamps[n][:k]
     finally:
         release(run_dir)
-    return Run("verilator", words, stamps, wall_s=time.perf_counter() - t0, build_s=build_s, run_s=meta["run_s"])
+    return words, stamps, meta, max((s[-1] + 1 for s in stamps.values() if s), default=0)
 
 
 def _extra(dut) -> str:

@@ -151,7 +151,7 @@ def measure_table1(interleave: int, *, schedule: str = "overlap", engine: str = 
         marks, mism = r["line_cycles"], None
     else:
         g0, g1 = unit_golden_words(eps, height, width=width, interleave=interleave)
-        from rasterhw.sim.zbm.fast import run_units_equal_clocks
+        from rasterhw.sim.zbm.scene_run import run_units_equal_clocks
 
         r = run_units_equal_clocks([eps], width=width, height=height, interleave=interleave, engine=engine,
                                    schedule=schedule, line_log=True)

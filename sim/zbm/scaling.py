@@ -71,7 +71,7 @@ def skew(*, interleave: int = 1, offset: int = 2, n_edge_pairs: int = 4, schedul
     where both units are busy: (t(line w0 + 5n - 1) - t(line w0 - 1)) / n, w0 = 5 (n // 2).
     """
     from rasterhw.sim.zbm.cycles_hdl import table1_width
-    from rasterhw.sim.zbm.fast import run_units_equal_clocks
+    from rasterhw.sim.zbm.scene_run import run_units_equal_clocks
 
     n = n_edge_pairs
     width = table1_width(interleave)
@@ -117,7 +117,7 @@ def chain(units: int, *, interleave: int = 1, width: int = 64, height: int = 48,
     ``render_zbm`` word for word. Returns cycles, polygons/s at 25 MHz, the merge-bus occupancy
     (merge words per clock on a slot's link: ``chip_pixels * height / cycles``) and the merge
     bound ``height * (chip_pixels + 2)`` (the bus alone, measured per line by ``pixel_rate``)."""
-    from rasterhw.sim.zbm.fast import run_units_equal_clocks
+    from rasterhw.sim.zbm.scene_run import run_units_equal_clocks
 
     if not (isinstance(units, int) and 1 <= units <= 16):
         raise RasterhwError(f"units must be 1..16, not {units!r}")

@@ -14,13 +14,15 @@ from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.cycles import check_schedule
 from rasterhw.golden_model.zbm.words import doublez_words, words_to_doublez
+from rasterhw.sim.engines import run as run_engine
+from rasterhw.sim.testbench import find_testbench
 from rasterhw.sim.zbm.edge_check import check_edge_pairs
-from rasterhw.sim.zbm.fast import run_unit_fast
-from rasterhw.sim.zbm.unit_bench import run_unit_bench
-from rasterhw.sim.zbm.units_pysim import run_units_pysim
+from rasterhw.sim.zbm.testbench import deal
+from rasterhw.sim.zbm.unit_bench import run_unit_bench, unit_watchdog
 from tqdm import tqdm
 
-__all__ = ["CLOCK_HZ", "ENGINES", "float_tolerance", "simulate_zbm"]
+__all__ = ["CLOCK_HZ", "ENGINES", "PLAIN_BUILD", "SPEED_BUILD", "float_tolerance", "run_scene", "run_units_equal_clocks",
+           "simulate_zbm"]
 
 ENGINES = ("pysim", "verilator", "icarus")
 CLOCK_HZ = 25e6          # the paper's segment clock (sec. 6.1)
@@ -67,6 +69,55 @@ def float_tolerance(tris, px: G.DoubleZ, rgb8: np.ndarray, eps: G.EdgePairs, tag
 
 
 # ====================================================================== the driver
+#: the build of ``sim zbm --engine verilator`` (and the soak, the bench's "after" row): the unit
+#: testbench's speed Verilog (identical modules merged, the pixel processor out of line); with a
+#: cached gcc profile of the design g++ -O2 and profile-guided optimisation, else -O1
+#: (``RASTERHW_PGO=1`` or ``rasterhw bench`` trains the profile; ``RASTERHW_PGO=0`` never uses one)
+SPEED_BUILD = {"speed": True, "pgo": "auto"}
+#: the build before issue 31 (the bench's "before" row): one module per instance, g++ -O1
+PLAIN_BUILD = {"speed": False, "opt": "-O1", "pgo": False}
+
+
+def run_scene(eps_per_unit: list, *, width: int, height: int, interleave: int, schedule: str = "overlap",
+              capacity: int = F.AEP_CAPACITY, engine: str = "verilator", stall: int = 0, seed: int = 1,
+              gap_seed: int | None = None, build: dict | None = None, line_log: bool = False) -> dict:
+    """Edge pairs through ``len(eps_per_unit)`` chained ZB/M units (unit ``k`` gets
+    ``eps_per_unit[k]``; a scene's: ``testbench.deal``) on the generic engine (the ``zbm-unit``
+    testbench, :class:`rasterhw.sim.zbm.testbench.UnitBench`): ``{"s0", "s1": (H, W) uint64 frame,
+    "cycles" (segment clocks until the last merge word), "proto_errors", "run_s" (the clock loop on
+    Verilator; the simulation on pysim), "build_s", "build", "frames_ok", "overflow", ["line_cycles"]}``. ``build``:
+    Verilator build settings (default :data:`SPEED_BUILD`); ``stall``, ``seed``: back-pressure on
+    every merge slot; ``gap_seed``: random idle gaps on the edge-pair input (None: none)."""
+    tb = find_testbench("zbm-unit")
+    p = tb.params(interleave=interleave, width=width, height=height, capacity=capacity, schedule=schedule,
+                  units=len(eps_per_unit))
+    stim = tb.scene_stimulus(p, eps_per_unit, gap_seed=gap_seed)
+    exp = tb.expect(p, stim)
+    want = {k: len(v) for k, v in exp.words.items()}
+    cap = unit_watchdog(sum(map(len, stim.words.values())), width=width, height=height, stall=stall)
+    got = run_engine(tb, p, stim, engine=engine, stall=stall, seed=seed, expect_words=want, max_cycles=cap,
+                     build=(SPEED_BUILD if build is None else build) if engine == "verilator" else None)
+    s0, s1 = tb.frame(p, got.words)
+    out = {"s0": s0, "s1": s1, "cycles": got.cycles, "proto_errors": got.protocol_errors, "run_s": got.run_s,
+           "build_s": got.build_s, "build": got.build, **got.status}
+    if line_log:
+        out["line_cycles"] = tb.line_cycles(p, got.stamps)
+    return out
+
+
+def run_units_equal_clocks(per_unit: list, *, width: int, height: int, interleave: int, engine: str,
+                           schedule: str, line_log: bool = False) -> dict:
+    """A chain of units with equal, in-phase clocks (the Table 1, skew and chain runs): on
+    Verilator the generic engine (:func:`run_scene`, held word-, cycle- and line-log-exact with the
+    cocotb bench by ``tests/zbm/test_zbm_unit_fast.py``; it builds and runs several times faster),
+    on Icarus the cocotb bench. g++ ``-O0``: these frames are small, the build is what costs."""
+    if engine == "verilator":
+        return run_scene(per_unit, width=width, height=height, interleave=interleave, schedule=schedule,
+                         line_log=line_log, build={"speed": True, "opt": "-O0"})
+    return run_unit_bench(per_unit, width=width, height=height, interleave=interleave, sim=engine, phase=0,
+                          speed_run=True, schedule=schedule, line_log=line_log, opt="-O0")
+
+
 def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: int = 1,
                  engine: str = "verilator", schedule: str = "overlap", progress: bool = False) -> dict:
     """Run ``scene`` through ``units`` ZB/M units (``interleave`` chips each) in HDL and check it.
@@ -118,23 +169,18 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
     gold = G.render_zbm(tris, interleave=interleave, units=units)
     g0, g1 = doublez_words(gold.pixels)
     step("HDL build + simulation" if engine != "pysim" else "HDL simulation (pysim)")
-    per_unit = [eps.take(np.flatnonzero(eps.tag % units == k)) for k in range(units)]
     t1 = time.perf_counter()
-    if engine == "pysim":
-        r = run_units_pysim(per_unit, width=width, height=height, interleave=interleave, schedule=schedule)
-        sim_s, build_s = time.perf_counter() - t1, 0.0
-    elif engine == "verilator":
-        # plain Verilator, no cocotb (held bit- and cycle-exact with the cocotb bench by
-        # tests/zbm/test_zbm_unit_fast.py); compared with the golden frame below, in Python
-        r = run_unit_fast(per_unit, width=width, height=height, interleave=interleave, schedule=schedule)
-        sim_s, build_s = r["run_s"], r["build_s"]
-    else:
-        # compared with the golden frame below, in Python
+    per_unit = deal(eps, units)
+    if engine == "icarus":
+        # the cocotb bench (Icarus has no plain engine); compared with the golden frame below, in Python
         r = run_unit_bench(per_unit, width=width, height=height, interleave=interleave, sim=engine, phase=0,
                            speed_run=True, schedule=schedule)
         sim_s, build_s = r["run_s"], r["prepare_s"] + r["build_s"]
         if r.get("timeout"):
             raise RasterhwError(f"ZB/M {engine}: the bench's watchdog fired after {r['cycles']} cycles")
+    else:
+        r = run_scene(per_unit, width=width, height=height, interleave=interleave, schedule=schedule, engine=engine)
+        sim_s, build_s = (r["run_s"], r["build_s"]) if engine == "verilator" else (time.perf_counter() - t1, 0.0)
     step("compare + composite")
     bad = (r["s0"] != g0) | (r["s1"] != g1)
     mismatches = int(np.count_nonzero(bad))

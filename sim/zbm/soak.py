@@ -17,7 +17,7 @@ from rasterhw.golden_model.scenes import build_scene
 from rasterhw.golden_model.zbm.stimulus import first_triangles, random_triangles
 from rasterhw.golden_model.zbm.words import doublez_words
 from rasterhw.sim.zbm.edge_check import check_edge_pairs
-from rasterhw.sim.zbm.fast import run_unit_fast
+from rasterhw.sim.zbm.scene_run import SPEED_BUILD, run_scene
 from rasterhw.sim.zbm.unit_bench import run_unit_bench
 
 __all__ = ["zbm_round"]
@@ -28,7 +28,7 @@ ZBM_W, ZBM_H, ZBM_I = 256, 256, 2
 ZBM_MAX_EDGE_PAIRS = 1021
 ZBM_SDEPTH = 16384
 #: every this many rounds (from round 0) runs two clocks at a random ratio under cocotb; the
-#: others run equal clocks on plain Verilator (several times faster per round)
+#: others run equal clocks on the generic Verilator engine (several times faster per round)
 ZBM_RATIO_EVERY = 4
 
 
@@ -66,10 +66,10 @@ def zbm_round(rng: np.random.Generator, k: int) -> dict:
     if k % ZBM_RATIO_EVERY == 0:   # two clocks at a random ratio: the cocotb bench (Verilator --timing)
         r = run_unit_bench([eps], width=ZBM_W, height=ZBM_H, interleave=ZBM_I, sim="verilator", ratio=ratio,
                            stall=stall, seed=seed, gap_seed=gap_seed, expect=exp, sdepth=ZBM_SDEPTH)
-    else:   # equal clocks: the plain-Verilator bench (held cycle-exact with the cocotb one)
+    else:   # equal clocks: the generic engine (held cycle-exact with the cocotb bench)
         ratio = (5, 5)
-        r = run_unit_fast([eps], width=ZBM_W, height=ZBM_H, interleave=ZBM_I, stall=stall, seed=seed,
-                          gap_seed=gap_seed, sdepth=ZBM_SDEPTH)
+        r = run_scene([eps], width=ZBM_W, height=ZBM_H, interleave=ZBM_I, stall=stall, seed=seed,
+                      gap_seed=gap_seed, build={**SPEED_BUILD, "depth": ZBM_SDEPTH})
     bad = int(np.count_nonzero((r["s0"] != exp[0]) | (r["s1"] != exp[1])))
     bad += int(r.get("proto_errors", 0)) + int(not r.get("frames_ok", True))
     return {"pixels": ZBM_W * ZBM_H, "mismatches": bad, "run_s": r["run_s"],

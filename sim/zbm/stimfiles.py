@@ -1,4 +1,4 @@
-"""The ZB/M benches' stimulus and dump files (``cocotb_tests/zbm/``, ``fast/``): words with idle
+"""The ZB/M cocotb benches' stimulus and dump files (``cocotb_tests/zbm/``): words with idle
 gaps in ``$readmemh`` hex files, the unit benches' index file, 128-bit frame dumps read back."""
 
 from __future__ import annotations
@@ -59,7 +59,7 @@ def stimulus_depth(words: int, depth: int | None = None) -> int:
 
 
 def write_unit_stimulus(run_dir: Path, words: list[list[int]], gap_seed: int | None) -> tuple[list[int], list[int]]:
-    """The unit benches' stimulus files (tb_zbm_unit.v, fast/tb_zbm_unit_fast.v): every unit's
+    """The cocotb unit bench's stimulus files (tb_zbm_unit.v): every unit's
     loader words in one ``stim.hex`` (with random idle gaps from ``gap_seed``, None: none) and
     ``index.hex``, two lines per unit (first word, number of words). Returns (words, index)."""
     flat, index = [], []

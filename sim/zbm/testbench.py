@@ -1,11 +1,17 @@
+# amaranth: UnusedElaboratable=no
 """Testbenches of the ZB/M blocks (``sim/testbench.py``): what each block takes and what the golden
 model says it gives; the engines (``sim/engines/``) run them."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
+from amaranth.hdl import Cat
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.pipeline import run_geometry
+from rasterhw.golden_model.scenes import build_scene
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.stimulus import (
     first_triangles,
@@ -21,11 +27,14 @@ from rasterhw.golden_model.zbm.words import (
     pixel2_words,
     segment_words,
 )
+from rasterhw.hdl.zbm.chain import ZbmChain
 from rasterhw.sim import registry
+from rasterhw.sim.engines.verilog import merge_identical_modules
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 from rasterhw.sim.zbm.line_bench import LineBench
+from rasterhw.sim.zbm.stimfiles import random_gaps
 
-__all__ = ["ChipBench", "LoopBench", "MergerBench", "PixelBench", "SeggenBench", "UnitBench", "pixel_visits"]
+__all__ = ["ChipBench", "LoopBench", "MergerBench", "PixelBench", "SeggenBench", "UnitBench", "deal", "pixel_visits"]
 
 
 class SeggenBench(Testbench):
@@ -51,18 +60,56 @@ class SeggenBench(Testbench):
 
 
 class UnitBench(Testbench):
-    """``zbm-unit`` (the head unit of a chain): edge-pair words in (``i``), every chip's merge-bus
-    words out (``o_merge[c]``, chip ``c`` owning columns ``c, c + I, ...``, line by line), the
-    double-Z samples of ``golden_model/zbm/render.py: render_zbm``. The merge clock runs with the
-    segment clock (the two-clock ratios stay with the cocotb bench). A random frame: 2..40 random
-    screen triangles (seeded), the first ones that fit the active-edge-pair memory."""
+    """``zbm-unit`` (the head unit of a chain, or ``units`` chained units: parameter ``units``,
+    default 1): edge-pair words in (``i``; unit ``k`` of a chain: ``units[k].i``), every chip's
+    merge-bus words out (``o_merge[c]``, the last unit's in a chain; chip ``c`` owning columns
+    ``c, c + I, ...``, line by line), the double-Z samples of ``golden_model/zbm/render.py:
+    render_zbm``. The merge clock runs with the segment clock (the two-clock ratios stay with the
+    cocotb bench). A random frame: 2..40 random screen triangles (seeded), the first ones that fit
+    the active-edge-pair memory; a scene: :meth:`scene_stimulus` (``rasterhw sim zbm``, the soak).
+
+    The back-pressure of slot ``c`` is the cocotb unit bench's (``cocotb_tests/zbm/tb_zbm_unit.v``:
+    seed ``0x9E3779B9 ^ (7919 seed + 104729 c + 1)``), so a run equals that bench's, stalls
+    included. The speed build (``build={"speed": True}``): identical modules merged, the pixel
+    processor kept out of line (:meth:`sim_verilog`); its gcc profile is trained on c50."""
 
     block = "zbm-unit"
     domains = ("sync", "merge")
     port_domains = {"o_merge": "merge"}
 
+    def params(self, **given) -> dict:
+        units = given.pop("units", 1)
+        if not isinstance(units, (int, np.integer)) or isinstance(units, bool) or not 1 <= units <= 16:
+            raise RasterhwError(f"units must be an integer in 1..16, not {units!r}")
+        return {**super().params(**given), "units": int(units)}
+
+    def dut(self, params: dict):
+        p = {k: v for k, v in params.items() if k != "units"}
+        factory = registry.load(registry.blocks()[self.block])
+        if params.get("units", 1) == 1:
+            return factory(**p)
+        return ZbmChain([factory(**{**p, "head": k == 0}) for k in range(params["units"])])
+
+    def _prefix(self, params: dict, k: int) -> str:
+        return "" if params.get("units", 1) == 1 else f"units[{k}]."
+
+    def inputs_of(self, params: dict) -> tuple[str, ...]:
+        return tuple(f"{self._prefix(params, k)}i" for k in range(params.get("units", 1)))
+
     def outputs_of(self, params: dict) -> tuple[str, ...]:
-        return tuple(f"o_merge[{c}]" for c in range(params["interleave"]))
+        last = self._prefix(params, params.get("units", 1) - 1)
+        return tuple(f"{last}o_merge[{c}]" for c in range(params["interleave"]))
+
+    def domain_of(self, port: str) -> str:
+        return "merge" if "o_merge" in port else "sync"
+
+    def status(self, dut, params: dict) -> dict:
+        """``frames_ok``: every unit finished exactly one frame; ``overflow``: a unit's sticky overflow."""
+        units = dut.units if params.get("units", 1) > 1 else [dut]
+        return {"frames_ok": Cat(*[u.frames == 1 for u in units]).all(), "overflow": Cat(*[u.overflow for u in units]).any()}
+
+    def sink_seed(self, params: dict, port: int, seed: int) -> int:
+        return 0x9E3779B9 ^ ((seed * 7919 + port * 104729 + 1) & 0xFFFF_FFFF)
 
     def stimulus(self, params: dict, seed: int) -> Stimulus:
         rng = np.random.default_rng(seed)
@@ -71,13 +118,85 @@ class UnitBench(Testbench):
         tris = random_triangles(rng, n, w, h, size=float(rng.uniform(3, max(4, min(w, h) / 2))))
         while len(tris.xy) > 1 and G.max_active_edge_pairs(G.edge_pairs(tris))[0] > params["capacity"]:
             tris = first_triangles(tris, len(tris.xy) - 1)
-        return Stimulus({"i": edge_pair_words(G.edge_pairs(tris))}, what=f"{len(tris.xy)} random triangles, "
-                        f"seed {seed}", source=tris)
+        return self.scene_stimulus(params, deal(G.edge_pairs(tris), params["units"]),
+                                   what=f"{len(tris.xy)} random triangles, seed {seed}")
+
+    def scene_stimulus(self, params: dict, eps_per_unit: list, *, gap_seed: int | None = None,
+                       what: str = "") -> Stimulus:
+        """Unit ``k``'s edge pairs (:func:`deal`: a scene's, as ``render_zbm`` deals them) as its
+        edge-pair words; ``gap_seed``: random idle gaps (``stimfiles.random_gaps`` over all units'
+        words in order, as the cocotb bench plays them; None: none)."""
+        ins = self.inputs_of(params)
+        if len(eps_per_unit) != len(ins):
+            raise RasterhwError(f"zbm-unit: {len(eps_per_unit)} edge-pair lists for {len(ins)} units")
+        words = [edge_pair_words(e) for e in eps_per_unit]
+        gaps = random_gaps(sum(map(len, words)), gap_seed).tolist()
+        at = np.cumsum([0] + [len(w) for w in words])
+        return Stimulus(dict(zip(ins, words, strict=True)),
+                        gaps={p: gaps[at[k]:at[k + 1]] for k, p in enumerate(ins)} if gap_seed is not None else {},
+                        what=what, source=list(eps_per_unit))
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         i = params["interleave"]
-        g0, g1 = doublez_words(G.render_zbm(stim.source, interleave=i).pixels)
-        return Expected({f"o_merge[{c}]": merge_words(g0[:, c::i], g1[:, c::i]) for c in range(i)})
+        g0, g1 = doublez_words(G.chain_frame(stim.source, params["width"], params["height"],
+                                             capacity=params["capacity"]))
+        outs = self.outputs_of(params)
+        return Expected({outs[c]: merge_words(g0[:, c::i], g1[:, c::i]) for c in range(i)})
+
+    def frame(self, params: dict, words: dict[str, list[int]]) -> tuple[np.ndarray, np.ndarray]:
+        """The merge words of every slot as the frame's (s0, s1) (H, W) uint64 samples (all ones
+        where a slot gave no word, as the benches' frame memories)."""
+        i, w, h = params["interleave"], params["width"], params["height"]
+        s0 = np.full((h, w), ~np.uint64(0), np.uint64)
+        s1 = s0.copy()
+        for c, port in enumerate(self.outputs_of(params)):
+            npx = len(range(c, w, i))
+            got = words.get(port, [])[:h * npx]
+            n = len(got) // npx * npx
+            lo = np.fromiter((x & _M64 for x in got[:n]), np.uint64, n)
+            hi = np.fromiter((x >> 64 for x in got[:n]), np.uint64, n)
+            s0[:n // npx, c::i], s1[:n // npx, c::i] = lo.reshape(-1, npx), hi.reshape(-1, npx)
+        return s0, s1
+
+    def line_cycles(self, params: dict, stamps: dict[str, list[int]]) -> list[int]:
+        """Per line ``y``: the cycles until every slot had given line ``y`` (its last word's edge + 1),
+        the cocotb bench's per-line log."""
+        i, w, h = params["interleave"], params["width"], params["height"]
+        out = np.zeros(h, np.int64)
+        for c, port in enumerate(self.outputs_of(params)):
+            npx = len(range(c, w, i))
+            st = np.asarray(stamps[port][:h * npx], np.int64)
+            out = np.maximum(out, st[npx - 1::npx] + 1)
+        return out.tolist()
+
+    def sim_verilog(self, params: dict, text: str) -> str:
+        """Each identical module once, the pixel processor kept out of line (``_pixel_processor``):
+        at I = 8, 132 modules -> 27, the same circuit."""
+        return merge_identical_modules(text, no_inline=_pixel_processor)
+
+    def train_stimulus(self, params: dict) -> Stimulus:
+        """c50 (:data:`TRAIN_SCENE`; the frames a profile is checked on are others) at the block's size."""
+        tris = run_geometry(build_scene(TRAIN_SCENE), params["width"], params["height"])
+        return self.scene_stimulus(params, deal(G.edge_pairs(tris), params["units"]), what=f"scene {TRAIN_SCENE}")
+
+
+def deal(eps, units: int) -> list:
+    """A frame's edge pairs dealt to ``units`` units as ``render_zbm`` deals its triangles
+    (triangle i -> unit i % units)."""
+    return [eps.take(np.flatnonzero(eps.tag % units == k)) for k in range(units)]
+
+
+_M64 = (1 << 64) - 1
+#: the scene a unit's gcc profile is trained on
+TRAIN_SCENE = "c50"
+
+
+def _pixel_processor(name: str, copies: int, size: int) -> bool:
+    """The module the speed build keeps out of line: the loop's pixel processor (``hdl/zbm/loop.py``
+    submodules ``pp0`` ... ``pp7``; 8 x I copies of one circuit). Measured on c300, I = 8, with g++
+    -O2 and PGO: out of line 0.73-0.75 s of CPU per frame, every module inlined 0.76-0.87 s; without
+    PGO the pixel processor alone out of line was slower than inlined (docs/zbm.md, Simulation speed)."""
+    return re.search(r"\.loop\.pp\d+$", name.strip()) is not None
 
 
 class MergerBench(Testbench):
@@ -179,9 +298,18 @@ class ChipBench(Testbench):
         lines = len(segs.line_start) - 1
         npx = -(-(w - c) // i)
         ups = [random_doublez(rng, npx) for _ in range(lines)]
-        words = [wd for y in range(lines) for wd in segment_words(segs, y)]
+        return self.scene_stimulus(params, segs, ups, what=f"{lines} lines of random segments, seed {seed}")
+
+    def status(self, dut, params: dict) -> dict:
+        """``lines``: scan lines the chip has finished (its ``lines`` counter)."""
+        return {"lines": dut.lines}
+
+    def scene_stimulus(self, params: dict, segs, ups: list, *, what: str = "") -> Stimulus:
+        """Lines ``0 .. len(ups) - 1`` of ``segs`` (a frame's golden segments) on the segment port,
+        ``ups[y]`` (the chip's pixels of line ``y``) on the upstream merge port."""
+        words = [wd for y in range(len(ups)) for wd in segment_words(segs, y)]
         return Stimulus({"i_seg": words, "i_merge": [wd for u in ups for wd in pixel2_words(u)]},
-                        what=f"{lines} lines of random segments, seed {seed}", source=(segs, ups))
+                        what=what, source=(segs, ups))
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         segs, ups = stim.source

@@ -41,9 +41,8 @@ TEST_MODULE = "cocotb_tests.zbm.test_zbm"
 # (the 357 s first build and 5.5 k cycles/s of the c300 unit run). The benches read only the
 # wrappers' own signals: zbm_public.vlt makes those (read-only) public and nothing else.
 VERILATOR_ARGS = ("--no-public-flat-rw", str(BENCH_DIR / "zbm_public.vlt"))
-#: the unit bench's Verilog beside the generated units: its top, the part it shares with the plain
-#: bench (fast/tb_zbm_unit_fast.v), and the harness
-UNIT_BENCH = (HARNESS_V, BENCH_DIR / "tb_zbm_unit_core.v", BENCH_DIR / "tb_zbm_unit.v")
+#: the unit bench's Verilog beside the generated units: its top and the harness
+UNIT_BENCH = (HARNESS_V, BENCH_DIR / "tb_zbm_unit.v")
 # The cocotb test module imports NumPy inside the simulator process: one BLAS thread, so that
 # idle OpenBLAS workers do not compete with the simulation for this machine's 2 cores.
 SIM_ENV = {"OPENBLAS_NUM_THREADS": "1"}

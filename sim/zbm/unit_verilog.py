@@ -6,17 +6,11 @@ to ``build/zbm-verilog/<module>-<digest of the text>.v``."""
 from __future__ import annotations
 
 import hashlib
-import re
-from functools import lru_cache
 from pathlib import Path
 
 from amaranth.back import verilog
 from rasterhw.golden_model.zbm import formats as F
-from rasterhw.sim.engines.verilog import (
-    canonical_port_lists,
-    generate_verilog,
-    merge_identical_modules,
-)
+from rasterhw.sim.engines.verilog import canonical_port_lists, generate_verilog
 from rasterhw.sim.engines.verilog_cache import convert_cached, generate_cached
 from rasterhw.sim.outfile import write_text
 from rasterhw.sim.paths import REPO_ROOT
@@ -42,38 +36,19 @@ def chip_verilog(*, interleave: int, chip: int, width: int) -> Path:
     return _file("zbm_chip", generate_cached("zbm-chip", interleave=interleave, chip=chip, width=width))
 
 
-def _pixel_processor(name: str, copies: int, size: int) -> bool:
-    """The module the speed build keeps out of line: the loop's pixel processor (``hdl/zbm/loop.py``
-    submodules ``pp0`` ... ``pp7``; 8 x I copies of one circuit). Measured on c300, I = 8, with g++
-    -O2 and PGO: out of line 0.73-0.75 s of CPU per frame, every module inlined 0.76-0.87 s; without
-    PGO the pixel processor alone out of line was slower than inlined (docs/zbm.md, Simulation speed)."""
-    return re.search(r"\.loop\.pp\d+$", name.strip()) is not None
-
-
-@lru_cache(maxsize=8)
-def _merged(text: str) -> str:
-    """``text`` merged, the pixel processor out of line (once per text and process: a run looks
-    its profile up and then builds, both from the same sources)."""
-    return merge_identical_modules(text, no_inline=_pixel_processor)
-
-
 def chain_verilog(*, interleave: int, width: int, height: int, units: int = 1,
-                  capacity: int = F.AEP_CAPACITY, schedule: str = "overlap", merge: bool = False) -> list[Path]:
+                  capacity: int = F.AEP_CAPACITY, schedule: str = "overlap") -> list[Path]:
     """Verilog sources of ``units`` chained ``zbm-unit``\\s: the head ``zbm_unit``, the others
     (``head=False``, with merge inputs) renamed ``zbm_unit_tail`` so both can live in one
-    simulation, and the chain's top ``zbm_chain_flat``. ``merge``: each unit's identical modules
-    merged (:func:`rasterhw.sim.engines.verilog.merge_identical_modules`: at I = 8, 132 modules ->
-    27, 3.2 MB -> 0.52 MB; the same circuit) and the pixel processor marked to stay out of line
-    (:func:`_pixel_processor`): the speed build of ``sim zbm``."""
-    m = _merged if merge else (lambda t: t)
+    simulation, and the chain's top ``zbm_chain_flat`` (the cocotb unit bench's)."""
     p = {"interleave": interleave, "width": width, "height": height, "capacity": capacity, "schedule": schedule}
     head = generate_cached("zbm-unit", head=True, **p)
-    srcs = [_file("zbm_unit", m(head))]
+    srcs = [_file("zbm_unit", head)]
     if units > 1:
         tail = convert_cached("zbm-unit", lambda: None, params={**p, "head": False}, module="zbm_unit_tail",
                               convert=lambda _d, _m: generate_verilog("zbm-unit", head=False, **p)
                               .replace("zbm_unit", "zbm_unit_tail"))
-        srcs.append(_file("zbm_unit_tail", m(tail)))
+        srcs.append(_file("zbm_unit_tail", tail))
     ovf = "overflow" in head.split("module zbm_unit(", 1)[1].split(";", 1)[0]
     top = convert_cached("zbm-unit", lambda: ChainFlat(interleave=interleave, units=units, has_overflow=ovf),
                          params={"interleave": interleave, "units": units, "overflow": ovf, "top": _CHAIN_SELF},

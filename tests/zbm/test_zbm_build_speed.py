@@ -1,10 +1,10 @@
-"""The speed build of the plain-Verilator unit bench (``sim/zbm/fast.py`` ``SPEED_BUILD``: identical
-modules merged, the pixel processor out of line, g++ -O2, gcc PGO) changes how fast the model runs,
-never what it computes: on a small frame, the same words and the same segment-clock count as the
-build before issue 31 (one module per instance), with the profile trained on one scene (c50) and
-the check run on another (sp8). The merged build alone is also held word-, cycle- and line-log-exact
-with the cocotb bench by ``test_zbm_unit_fast.py`` (its default build is now the merged one).
-Cold: three small builds (plain -O0, instrumented -O2, profiled -O2): marked slow."""
+"""The speed build of the ``zbm-unit`` testbench on the generic Verilator engine (``UnitBench.sim_verilog``:
+identical modules merged, the pixel processor out of line; g++ -O2 with gcc PGO, the profile trained on
+``UnitBench.train_stimulus``) changes how fast the model runs, never what it computes: on a small frame,
+the same words and the same segment-clock count as the build before issue 31 (one module per instance),
+with the profile trained on one scene (c50) and the check run on another (sp8). The merged build alone
+is also held word-, cycle- and line-log-exact with the cocotb bench by ``test_zbm_unit_engine.py`` (its
+build is the merged one). Cold: three small builds (plain -O0, instrumented -O2, profiled -O2): marked slow."""
 
 from __future__ import annotations
 
@@ -15,10 +15,12 @@ import pytest
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
-from rasterhw.golden_model.zbm.words import doublez_words, edge_pair_words
-from rasterhw.sim.zbm import fast as ZF
-from rasterhw.sim.zbm.stimfiles import stimulus_depth
-from rasterhw.sim.zbm.unit_verilog import chain_verilog
+from rasterhw.golden_model.zbm.words import doublez_words
+from rasterhw.sim.engines import verilator
+from rasterhw.sim.engines.verilog import generate_verilog
+from rasterhw.sim.testbench import find_testbench
+from rasterhw.sim.zbm.scene_run import SPEED_BUILD, run_scene
+from rasterhw.sim.zbm.testbench import TRAIN_SCENE
 
 pytestmark = pytest.mark.cocotb
 
@@ -29,33 +31,43 @@ W, H, IL = 48, 16, 2
 @pytest.mark.slow
 def test_speed_build_same_frame_same_cycles_as_the_plain_build():
     """Three builds (~1 min of CPU; 4 min at load 12): slow. The quick version in CI is
-    ``test_zbm_unit_fast.py``, whose plain-Verilator build is now the merged one with the pixel
+    ``test_zbm_unit_engine.py``, whose engine build is the merged one with the pixel
     processor out of line: the same words, cycles and line log as the cocotb bench (unmerged)."""
     tris = run_geometry(build_scene("sp8"), W, H)
     eps = G.edge_pairs(tris)
     gold = doublez_words(G.render_zbm(tris, interleave=IL).pixels)
-    plain = ZF.run_unit_fast([eps], width=W, height=H, interleave=IL, merge=False, opt="-O0", pgo=False,
-                             line_log=True)
-    prof = ZF.unit_profile(interleave=IL, width=W, height=H, units=1, sdepth=stimulus_depth(len(edge_pair_words(eps))))
-    assert json.loads((prof / "trained.json").read_text())["scene"] == ZF.TRAIN_SCENE != "sp8"
+    plain = run_scene([eps], width=W, height=H, interleave=IL, build={"speed": False, "opt": "-O0", "pgo": False},
+                      line_log=True)
+    speed = run_scene([eps], width=W, height=H, interleave=IL, build={**SPEED_BUILD, "pgo": True}, line_log=True)
+    assert speed["build"] == {"speed": True, "opt": "-O2", "pgo": True}
+    # the profile: trained on c50 (not the frame checked here), with gcc's files
+    tb = find_testbench("zbm-unit")
+    p = tb.params(interleave=IL, width=W, height=H)
+    stim = tb.scene_stimulus(p, [eps])
+    inputs = {"i": verilator._depth(len(stim.words["i"]))}
+    outputs = {n: verilator._depth(len(w)) for n, w in tb.expect(p, stim).words.items()}
+    prof = verilator.profile(tb, p, verilator._design(tb, p, inputs, outputs, True), inputs=inputs, outputs=outputs,
+                             train=False)
+    assert prof is not None
+    assert json.loads((prof / "trained.json").read_text())["what"] == f"scene {TRAIN_SCENE}" != "scene sp8"
+    assert TRAIN_SCENE != "sp8"
     assert sorted(prof.glob("*.gcda")), "the training run wrote no profile"
-    speed = ZF.run_unit_fast([eps], width=W, height=H, interleave=IL, **ZF.SPEED_BUILD, pgo=True, line_log=True)
-    assert speed["build"] == {"merge": True, "opt": "-O2", "pgo": True}
     for r in (plain, speed):
         assert np.array_equal(r["s0"], gold[0]) and np.array_equal(r["s1"], gold[1])
         assert r["proto_errors"] == 0 and r["frames_ok"] == 1 and r["overflow"] == 0
     assert speed["cycles"] == plain["cycles"] > H
     assert speed["line_cycles"] == plain["line_cycles"]
     # "auto" finds the cached profile (and never trains one): the same binary as pgo=True
-    auto = ZF.run_unit_fast([eps], width=W, height=H, interleave=IL, **ZF.SPEED_BUILD)
+    auto = run_scene([eps], width=W, height=H, interleave=IL, build=SPEED_BUILD)
     assert auto["build"]["pgo"] and auto["build_s"] == 0.0 and auto["cycles"] == plain["cycles"]
 
 
 def test_merged_unit_keeps_one_pixel_processor_out_of_line():
     """What the speed build compiles: the I = 2 unit's 16 pixel processors are one module, marked
     for Verilator to keep out of line; the unmerged text has them all."""
-    merged = chain_verilog(interleave=IL, width=W, height=H, merge=True)[0].read_text()
-    full = chain_verilog(interleave=IL, width=W, height=H, merge=False)[0].read_text()
+    tb = find_testbench("zbm-unit")
+    full = generate_verilog("zbm-unit", interleave=IL, width=W, height=H)
+    merged = tb.sim_verilog(tb.params(interleave=IL, width=W, height=H), full)
     pp = [ln for ln in full.splitlines() if ln.startswith("module ") and ".pp" in ln.split("(")[0]]
     assert len(pp) == 2 * 8
     kept = [ln for ln in merged.splitlines() if ln.startswith("module ") and ".pp" in ln.split("(")[0]]

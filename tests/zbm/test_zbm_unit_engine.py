@@ -1,8 +1,9 @@
-"""The plain-Verilator unit path (``rasterhw.sim.zbm.fast.run_unit_fast``, what ``rasterhw sim zbm
---engine verilator``, the bench and the soak run) against the cocotb unit bench
-(``run_unit_bench`` with equal, in-phase clocks) and the golden model: the same frame bit for bit,
-the same segment-clock cycle count and per-line log, under random idle gaps and back-pressure.
-Cold: one plain build (g++ -O1, ~30 s); the cocotb build is shared with test_zbm_cocotb.py."""
+"""The ``zbm-unit`` testbench on the generic Verilator engine (``rasterhw.sim.zbm.scene_run.run_scene``,
+what ``rasterhw sim zbm --engine verilator``, the bench and the soak run; its speed Verilog) against
+the cocotb unit bench (``run_unit_bench`` with equal, in-phase clocks) and the golden model: the same
+frame bit for bit, the same segment-clock cycle count and per-line log, under random idle gaps and
+back-pressure. Cold: one engine build (g++ -O1, ~30 s); the cocotb build is shared with
+test_zbm_cocotb.py. (Was test_zbm_unit_fast.py, on the plain bench ``sim/zbm/fast.py``.)"""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.golden_model.zbm.words import doublez_words
-from rasterhw.sim.zbm import fast as ZF
+from rasterhw.sim.zbm.scene_run import run_scene
 from rasterhw.sim.zbm.stimfiles import stimulus_depth
 from rasterhw.sim.zbm.unit_bench import run_unit_bench, unit_watchdog
 
@@ -26,8 +27,8 @@ def _compare(units: int, stall: int, gap_seed, seed: int, schedule: str = "overl
     gold = doublez_words(G.render_zbm(tris, interleave=2, units=units).pixels)
     eps = G.edge_pairs(tris)
     per = [eps.take(np.flatnonzero(eps.tag % units == k)) for k in range(units)]
-    fast = ZF.run_unit_fast(per, width=W, height=H, interleave=2, stall=stall, seed=seed, gap_seed=gap_seed,
-                            line_log=True, opt="-O1", schedule=schedule)
+    fast = run_scene(per, width=W, height=H, interleave=2, stall=stall, seed=seed, gap_seed=gap_seed,
+                     line_log=True, build={"speed": True, "opt": "-O1"}, schedule=schedule)
     ref = run_unit_bench(per, width=W, height=H, interleave=2, sim="verilator", ratio=(5, 5), phase=0,
                            stall=stall, seed=seed, gap_seed=gap_seed, speed_run=True, line_log=True,
                            schedule=schedule)
@@ -40,11 +41,11 @@ def _compare(units: int, stall: int, gap_seed, seed: int, schedule: str = "overl
 
 
 @pytest.mark.parametrize(("stall", "gap_seed"), [(0, None), (90, 7)])
-def test_unit_fast_equals_cocotb_bench(stall, gap_seed):
+def test_unit_engine_equals_cocotb_bench(stall, gap_seed):
     _compare(1, stall, gap_seed, seed=11 + stall)
 
 
-def test_unit_fast_backpressure_costs_cycles():
+def test_unit_engine_backpressure_costs_cycles():
     free = _compare(1, 0, None, seed=3)
     slow = _compare(1, 120, None, seed=3)
     assert slow["cycles"] > free["cycles"]
@@ -52,15 +53,16 @@ def test_unit_fast_backpressure_costs_cycles():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("schedule", ["overlap", "paper"])
-def test_two_units_fast_equals_cocotb_bench(schedule):
+def test_two_units_engine_equals_cocotb_bench(schedule):
     """Chains (the report's chain and skew rows run on the plain bench): the same words, cycles and
     per-line log as the cocotb bench, in both schedules."""
     _compare(2, 40, 5, seed=4, schedule=schedule)
 
 
-def test_unit_fast_rejects_bad_stall():
+def test_unit_engine_rejects_bad_stall():
     with pytest.raises(RasterhwError, match="stall"):
-        ZF.run_unit_fast([], width=W, height=H, interleave=2, stall=300)
+        run_scene([G.edge_pairs(random_triangles(np.random.default_rng(1), 3, W, H))], width=W, height=H,
+                  interleave=2, stall=300)
 
 
 def test_stimulus_depth_shared_by_runs_of_different_sizes():
@@ -73,7 +75,7 @@ def test_stimulus_depth_shared_by_runs_of_different_sizes():
 def test_watchdog_covers_heavy_backpressure_and_a_slow_merge_clock():
     """Soak seed 20261203 round 1100: stall 254 (ready high 2 clocks in 256) with the merge clock
     1.4 x slower than the segment clock (half periods 5 : 7) outran the cocotb bench's watchdog,
-    which had no term for either (the plain bench's had one for the stall only). Here a small frame
+    which had no term for either (the plain bench's had one for the stall only; the engine run uses it). Here a small frame
     with a merge clock 3.5 x slower (2 : 7): it finishes, every word golden, past the old budget
     and inside the shared watchdog."""
     tris = random_triangles(np.random.default_rng(5), 30, W, H, size=10)
@@ -86,5 +88,5 @@ def test_watchdog_covers_heavy_backpressure_and_a_slow_merge_clock():
     old = 200 * (total + 64) + 40 * H * (W + 64)          # the cocotb bench's watchdog before
     assert old < r["cycles"] < unit_watchdog(total, width=W, height=H, stall=254, ratio=(2, 7))
     assert unit_watchdog(total, width=W, height=H) == old   # unchanged for free-running runs
-    fast = ZF.run_unit_fast([eps], width=W, height=H, interleave=2, stall=255, seed=3)
+    fast = run_scene([eps], width=W, height=H, interleave=2, stall=255, seed=3, build={"speed": True, "opt": "-O1"})
     assert np.array_equal(fast["s0"], gold[0])
