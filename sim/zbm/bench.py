@@ -119,7 +119,7 @@ def bench(*, repeat: int = 11, hdl: bool = True, progress: bool = False) -> list
          "note": f"median of 5 rounds alternating with the row below; cycles {plain['cycles']}; "
                  f"{plain['mismatches']} mismatches"},
         {"name": "ZB/M unit, same frame, speed build (identical modules merged, pixel processor out of line, "
-                 "g++ -O2, gcc PGO trained on c50), simulation rate", "value": speed["cycles_per_s"],
+                 "g++ -O2 -march=native, link-time optimised, gcc PGO trained on c50), simulation rate", "value": speed["cycles_per_s"],
          "unit": "cycles/s",
          "note": f"target >= 3e5 (issue 31); {speed['cycles_per_s'] / plain['cycles_per_s']:.2f}x the row above; "
                  f"cycles {speed['cycles']}; {speed['mismatches']} mismatches"},
