@@ -183,8 +183,9 @@ def _build(design, opt: str, pgo=None) -> tuple[Path, float]:
 PGO_OPT = "-O2"
 
 
-def _settings(build: dict | None) -> tuple[bool, str | None, bool | str, int]:
-    """(speed, opt, pgo, depth) of a ``build`` argument (see :func:`rasterhw.sim.engines.run`)."""
+def _settings(build: dict | None, default_opt: str) -> tuple[bool, str | None, bool | str, int]:
+    """(speed, opt, pgo, depth) of a ``build`` argument (see :func:`rasterhw.sim.engines.run`);
+    no ``build``: ``default_opt`` (the testbench's level)."""
     b = dict(build or {})
     unknown = sorted(set(b) - {"speed", "opt", "pgo", "depth"})
     if unknown:
@@ -198,7 +199,7 @@ def _settings(build: dict | None) -> tuple[bool, str | None, bool | str, int]:
         pgo = env == "1"
     if pgo not in (False, True, "auto"):
         raise RasterhwError(f"build settings: pgo must be False, True or 'auto', not {pgo!r}")
-    return bool(b.get("speed", False)), b.get("opt", "-O1" if not build else None), pgo, depth
+    return bool(b.get("speed", False)), b.get("opt", default_opt if not build else None), pgo, depth
 
 
 def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outputs: dict[str, int],
@@ -242,9 +243,7 @@ def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outp
 def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, expect_words: dict[str, int],
         max_cycles: int, build: dict | None = None) -> Run:
     t0 = time.perf_counter()
-    speed, opt, pgo, depth = _settings(build)
-    if not build:
-        opt = tb.verilator_opt   # the testbench's level (e.g. a long frame's bench builds at -O2)
+    speed, opt, pgo, depth = _settings(build, tb.verilator_opt)
     inputs = {n: _depth(max(len(stim.words[n]), depth - 2)) for n in tb.inputs_of(params)}
     outputs = {n: _depth(expect_words[n]) for n in tb.outputs_of(params)}
     design = _design(tb, params, inputs, outputs, speed)
