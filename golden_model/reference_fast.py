@@ -45,7 +45,7 @@ import tempfile
 import numba
 import numpy as np
 
-__all__ = ["band", "cuts", "compile_all"]
+__all__ = ["band", "prepare", "compile_all"]
 
 
 def _jit(fn):
@@ -70,6 +70,10 @@ def _inline(fn):
 
 HALF = 128.0  # SUBPIXEL // 2
 SUB = 256.0  # SUBPIXEL
+#: fragments per batch of the weights pass (a batch is whole rows of one triangle)
+BATCH = 256
+#: the weights pass runs over a multiple of this many lanes (the vector loop's step)
+PAD = 16
 
 
 @_inline
@@ -98,46 +102,73 @@ def _clip(lo, hi, N, sS):  # pragma: no cover - compiled
     return lo, hi
 
 
-@_jit
+@_inline
 def _to8(v):  # pragma: no cover - compiled
     """``Frame.to_rgb8`` of one channel: ``floor(v * 255 + 0.5)`` clamped to 0..255. Below 0
-    the result is 0, from 256 on it is 255, and in between ``floor`` is the truncation."""
+    the result is 0, from 256 on it is 255, and in between ``floor`` is the truncation. Written
+    as two selects (no branches), so a loop of them vectorises."""
     q = v * 255.0 + 0.5
-    if q < 0.0:
-        return np.uint8(0)
-    if q >= 256.0:
-        return np.uint8(255)
+    q = 255.0 if q >= 256.0 else q
+    q = 0.0 if q < 0.0 else q
     return np.uint8(np.int32(q))
 
 
 @_jit
-def _row_work(Y, X, W, H, y0, y1):  # pragma: no cover - compiled
-    """Bounding-box pixels per row of rows ``y0 .. y1 - 1`` (an estimate of the work, to cut
-    the frame into row bands of equal work; any cut draws the same pixels)."""
-    d = np.zeros(y1 - y0 + 1, np.int64)
-    for t in range(X.shape[0]):
-        r0 = max(np.ceil((min(Y[t, 0], Y[t, 1], Y[t, 2]) - 128.0) / 256.0), float(y0))
-        r1 = min(np.floor((max(Y[t, 0], Y[t, 1], Y[t, 2]) - 128.0) / 256.0), float(y1 - 1))
-        c0 = max(np.ceil((min(X[t, 0], X[t, 1], X[t, 2]) - 128.0) / 256.0), 0.0)
-        c1 = min(np.floor((max(X[t, 0], X[t, 1], X[t, 2]) - 128.0) / 256.0), float(W - 1))
+def _prepare(xy, W, H, y0, y1, n):  # pragma: no cover - compiled; tested through prepare()
+    """The snapped coordinates ``X``, ``Y`` (T, 3) of ``xy`` (T, 3, 2), and ``n + 1`` row
+    boundaries from ``y0`` to ``y1`` that split the bounding-box pixels of the triangles evenly
+    (an estimate of the work; any cut draws the same pixels)."""
+    T = xy.shape[0]
+    X = np.empty((T, 3))
+    Y = np.empty((T, 3))
+    for t in range(T):
+        for v in range(3):  # screen.snap: floor(v * 256 + 0.5), the same operations
+            X[t, v] = np.floor(xy[t, v, 0] * SUB + 0.5)
+            Y[t, v] = np.floor(xy[t, v, 1] * SUB + 0.5)
+    cut = np.empty(n + 1, np.int64)
+    for k in range(n + 1):
+        cut[k] = y0 + (y1 - y0) * k // n
+    if n == 1:
+        return X, Y, cut
+    d = np.zeros(y1 - y0 + 1, np.int64)  # per row: pixels of the bounding boxes, as differences
+    for t in range(T):
+        r0 = max(np.ceil((min(Y[t, 0], Y[t, 1], Y[t, 2]) - HALF) / SUB), float(y0))
+        r1 = min(np.floor((max(Y[t, 0], Y[t, 1], Y[t, 2]) - HALF) / SUB), float(y1 - 1))
+        c0 = max(np.ceil((min(X[t, 0], X[t, 1], X[t, 2]) - HALF) / SUB), 0.0)
+        c1 = min(np.floor((max(X[t, 0], X[t, 1], X[t, 2]) - HALF) / SUB), float(W - 1))
         if r1 >= r0 and c1 >= c0:
             w = int(c1 - c0) + 1
             d[int(r0) - y0] += w
             d[int(r1) - y0 + 1] -= w
-    return np.cumsum(d[:-1])
+    total = 0
+    run = 0
+    for r in range(y1 - y0):
+        run += d[r]
+        total += run
+    if total == 0:
+        return X, Y, cut
+    done = 0  # work of the rows before row y0 + r
+    run = 0
+    k = 1
+    for r in range(y1 - y0):
+        run += d[r]
+        done += run
+        while k < n and done * n > total * k:  # row y0 + r takes the band past k/n of the work
+            cut[k] = y0 + r
+            k += 1
+    return X, Y, cut
 
 
-def cuts(X, Y, W: int, H: int, y0: int, y1: int, n: int) -> list[int]:
-    """``n + 1`` row boundaries from ``y0`` to ``y1`` splitting the bounding-box work evenly."""
-    work = np.cumsum(_row_work(Y, X, int(W), int(H), int(y0), int(y1)))
-    if work.size == 0 or work[-1] == 0:
-        return [y0 + (y1 - y0) * k // n for k in range(n + 1)]
-    inner = np.searchsorted(work, work[-1] * np.arange(1, n) / n, side="right") + y0
-    return [y0] + [int(c) for c in np.clip(inner, y0, y1)] + [y1]
+def prepare(xy: np.ndarray, W: int, H: int, y0: int, y1: int, n: int) -> tuple[np.ndarray, np.ndarray, list[int]]:
+    """``(X, Y, cuts)``: the snapped vertex coordinates (T, 3) of ``xy`` (T, 3, 2, float64; as
+    :func:`rasterhw.golden_model.screen.snap`, bit for bit), and ``n + 1`` row boundaries from
+    ``y0`` to ``y1`` splitting the bounding-box work of the rows into ``n`` even bands."""
+    X, Y, cut = _prepare(np.ascontiguousarray(xy, dtype=np.float64), int(W), int(H), int(y0), int(y1), int(n))
+    return X, Y, cut.tolist()
 
 
 @_jit
-def _band(X, Y, z, col, pid, W, H, y0, y1, bg, bg8, want_rgb8, rgb8, want_colour, colour, depth,
+def _band(X, Y, z, col, pid, W, H, y0, y1, bg, want_rgb8, rgb8, want_colour, colour, depth,
           want_tri, tri, want_poly, poly):  # pragma: no cover - compiled; tested through band()
     """Rows ``y0 .. y1 - 1`` of a ``W x H`` frame. Every output array holds exactly those rows
     (pixel ``(row, col)`` at ``(row - y0) * W + col``, flat, colour channels interleaved); the
@@ -150,20 +181,33 @@ def _band(X, Y, z, col, pid, W, H, y0, y1, bg, bg8, want_rgb8, rgb8, want_colour
         tri[:npix] = -1
     if want_poly:
         poly[:npix] = -1
-    if want_rgb8:
+    g0, g1, g2 = _to8(bg[0]), _to8(bg[1]), _to8(bg[2])  # the background in 8 bits (Frame.to_rgb8)
+    if want_rgb8 and g0 == g1 and g1 == g2:
+        rgb8[:3 * npix] = g0
+    elif want_rgb8:
         for p in range(npix):
-            rgb8[3 * p] = bg8[0]
-            rgb8[3 * p + 1] = bg8[1]
-            rgb8[3 * p + 2] = bg8[2]
+            rgb8[3 * p] = g0
+            rgb8[3 * p + 1] = g1
+            rgb8[3 * p + 2] = g2
     if want_colour:
         for p in range(npix):
             colour[3 * p] = bg[0]
             colour[3 * p + 1] = bg[1]
             colour[3 * p + 2] = bg[2]
-    bw0 = np.empty(W)  # one scan line's weights and depths
-    bw1 = np.empty(W)
-    bw2 = np.empty(W)
-    bz = np.empty(W)
+    # One batch of spans (whole rows of one triangle, BATCH fragments or a little more): the
+    # numerators E_1, E_2 of its fragments, then their weights and depths, then the span list.
+    cap = BATCH + W + PAD
+    e1 = np.zeros(cap)  # zeros: the padding lanes of the weights pass hold finite values
+    e2 = np.zeros(cap)
+    bz = np.empty(cap)
+    bc0 = np.empty(cap)
+    bc1 = np.empty(cap)
+    bc2 = np.empty(cap)
+    b80 = np.empty(cap, np.uint8)
+    b81 = np.empty(cap, np.uint8)
+    b82 = np.empty(cap, np.uint8)
+    sp = np.empty(cap, np.int64)  # pixel of each span's first fragment
+    sn = np.empty(cap, np.int64)  # its length
     fragments = 0
     written = 0
     covered = 0
@@ -200,66 +244,92 @@ def _band(X, Y, z, col, pid, W, H, y0, y1, bg, bg8, want_rgb8, rgb8, want_colour
         ca0, ca1, ca2 = col[t, 0, 0], col[t, 0, 1], col[t, 0, 2]
         cb0, cb1, cb2 = col[t, 1, 0], col[t, 1, 1], col[t, 1, 2]
         cc0, cc1, cc2 = col[t, 2, 0], col[t, 2, 1], col[t, 2, 2]
+        m = 0  # fragments in the batch
+        ns = 0  # spans in the batch
         for row in range(ra, rb + 1):
             Yc = float(row * 256 + 128)
             # The span: the bounding box's columns cut by the three edges.
             lo, hi = _clip(c0, c1, na0 * Yc + nb0, sS0)
             lo, hi = _clip(lo, hi, na1 * Yc + nb1, sS1)
             lo, hi = _clip(lo, hi, na2 * Yc + nb2, sS2)
-            if hi < lo:
-                continue
-            clo = int(lo)
-            chi = int(hi)
-            fragments += chi - clo + 1
-            K1 = dx1 * Yc + k1  # E_1, E_2 at column 0 of the row
-            K2 = dx2 * Yc + k2
-            base = (row - y0) * W + clo
-            n = chi - clo + 1
-            # Pass 1, no branches (the compiler vectorises it): weights and depth of the span.
-            for i in range(n):
-                colf = float(clo + i)
-                a1 = (S1 * colf + K1) / area
-                a2 = (S2 * colf + K2) / area
-                a0 = (1.0 - a1) - a2
-                bw0[i] = a0
-                bw1[i] = a1
-                bw2[i] = a2
-                bz[i] = (za * a0 + zb * a1) + zc * a2
-            # Pass 2: the serial Z test, and the outputs of the fragments that pass.
-            for i in range(n):
-                zz = bz[i]
-                p = base + i
-                held = depth[p]
-                if zz < held:
-                    if held == np.inf:
-                        covered += 1
-                    depth[p] = zz
-                    written += 1
-                    if want_tri:
-                        tri[p] = t
-                    if want_poly:
-                        poly[p] = pt
-                    if want_colour or want_rgb8:
-                        w0 = bw0[i]
-                        w1 = bw1[i]
-                        w2 = bw2[i]
-                        v0 = (w0 * ca0 + w1 * cb0) + w2 * cc0
-                        v1 = (w0 * ca1 + w1 * cb1) + w2 * cc1
-                        v2 = (w0 * ca2 + w1 * cb2) + w2 * cc2
+            if hi >= lo:
+                clo = int(lo)
+                n = int(hi) - clo + 1
+                fragments += n
+                K1 = dx1 * Yc + k1  # E_1, E_2 at column 0 of the row
+                K2 = dx2 * Yc + k2
+                for i in range(n):
+                    colf = float(clo + i)
+                    e1[m + i] = S1 * colf + K1
+                    e2[m + i] = S2 * colf + K2
+                sp[ns] = (row - y0) * W + clo
+                sn[ns] = n
+                ns += 1
+                m += n
+            if m == 0 or (m < BATCH and row < rb):
+                continue  # the batch goes on (it ends at BATCH fragments or the triangle's last row)
+            # Weights, depth and colour of every fragment of the batch, no branches: the compiler
+            # vectorises these loops (divisions included). The count is rounded up to a multiple
+            # of PAD so that no scalar remainder loop runs; the extra lanes compute harmless values
+            # that are never read. One loop per set of outputs, each writing only what it needs.
+            mp = (m + PAD - 1) & -PAD
+            if want_colour:
+                for i in range(mp):
+                    a1 = e1[i] / area
+                    a2 = e2[i] / area
+                    a0 = (1.0 - a1) - a2
+                    bz[i] = (za * a0 + zb * a1) + zc * a2
+                    bc0[i] = (a0 * ca0 + a1 * cb0) + a2 * cc0
+                    bc1[i] = (a0 * ca1 + a1 * cb1) + a2 * cc1
+                    bc2[i] = (a0 * ca2 + a1 * cb2) + a2 * cc2
+            elif want_rgb8:
+                for i in range(mp):
+                    a1 = e1[i] / area
+                    a2 = e2[i] / area
+                    a0 = (1.0 - a1) - a2
+                    bz[i] = (za * a0 + zb * a1) + zc * a2
+                    b80[i] = _to8((a0 * ca0 + a1 * cb0) + a2 * cc0)
+                    b81[i] = _to8((a0 * ca1 + a1 * cb1) + a2 * cc1)
+                    b82[i] = _to8((a0 * ca2 + a1 * cb2) + a2 * cc2)
+            else:
+                for i in range(mp):
+                    a1 = e1[i] / area
+                    a2 = e2[i] / area
+                    bz[i] = (za * ((1.0 - a1) - a2) + zb * a1) + zc * a2
+            # The serial Z test, span by span, and the outputs of the fragments that pass.
+            j = 0
+            for q in range(ns):
+                p = sp[q]
+                for i in range(j, j + sn[q]):
+                    zz = bz[i]
+                    held = depth[p]
+                    if zz < held:
+                        if held == np.inf:
+                            covered += 1
+                        depth[p] = zz
+                        written += 1
+                        if want_tri:
+                            tri[p] = t
+                        if want_poly:
+                            poly[p] = pt
                         if want_colour:
+                            v0, v1, v2 = bc0[i], bc1[i], bc2[i]
                             colour[3 * p] = v0
                             colour[3 * p + 1] = v1
                             colour[3 * p + 2] = v2
-                        if want_rgb8:
-                            rgb8[3 * p] = _to8(v0)
-                            rgb8[3 * p + 1] = _to8(v1)
-                            rgb8[3 * p + 2] = _to8(v2)
+                            if want_rgb8:
+                                rgb8[3 * p] = _to8(v0)
+                                rgb8[3 * p + 1] = _to8(v1)
+                                rgb8[3 * p + 2] = _to8(v2)
+                        elif want_rgb8:
+                            rgb8[3 * p] = b80[i]
+                            rgb8[3 * p + 1] = b81[i]
+                            rgb8[3 * p + 2] = b82[i]
+                    p += 1
+                j += sn[q]
+            m = 0
+            ns = 0
     return fragments, written, covered
-
-
-def rgb8_of(bg: np.ndarray) -> np.ndarray:
-    """The background in 8 bits, by ``Frame.to_rgb8``'s rule."""
-    return np.clip(np.floor(bg * 255.0 + 0.5), 0, 255).astype(np.uint8)
 
 
 _EMPTY = {np.dtype(np.uint8): np.empty(0, np.uint8), np.dtype(np.float64): np.empty(0, np.float64),
@@ -267,12 +337,12 @@ _EMPTY = {np.dtype(np.uint8): np.empty(0, np.uint8), np.dtype(np.float64): np.em
 
 
 def band(X, Y, z, col, pid, W: int, H: int, y0: int, y1: int, bg: np.ndarray, *, depth: np.ndarray,
-         rgb8=None, colour=None, tri=None, poly=None, bg8=None) -> tuple[int, int, int]:
+         rgb8=None, colour=None, tri=None, poly=None) -> tuple[int, int, int]:
     """Draw rows ``y0 .. y1 - 1`` into flat arrays that hold exactly those rows (see
-    :func:`_band`); ``None`` = not wanted. ``X``, ``Y``: snapped vertex coordinates (T, 3);
-    ``z`` (T, 3), ``col`` (T, 3, 3) float64, ``pid`` (T,) int64, all C-contiguous; ``bg8``:
-    :func:`rgb8_of` ``(bg)``, if already known."""
-    return _band(X, Y, z, col, pid, int(W), int(H), int(y0), int(y1), bg, rgb8_of(bg) if bg8 is None else bg8,
+    :func:`_band`); ``None`` = not wanted. ``X``, ``Y``: snapped vertex coordinates (T, 3)
+    (:func:`prepare`); ``z`` (T, 3), ``col`` (T, 3, 3), ``bg`` (3,) float64, ``pid`` (T,)
+    int64, all C-contiguous."""
+    return _band(X, Y, z, col, pid, int(W), int(H), int(y0), int(y1), bg,
                  rgb8 is not None, _EMPTY[np.dtype(np.uint8)] if rgb8 is None else rgb8,
                  colour is not None, _EMPTY[np.dtype(np.float64)] if colour is None else colour,
                  depth,
@@ -283,8 +353,7 @@ def band(X, Y, z, col, pid, W: int, H: int, y0: int, y1: int, bg: np.ndarray, *,
 def compile_all() -> None:
     """Compile (or load from numba's cache) the variants the package uses: the Frame's outputs
     and the output contract's RGB8 with 32- or 64-bit ids."""
-    X = np.array([[128.0, 1280.0, 128.0]])
-    Y = np.array([[128.0, 128.0, 1280.0]])
+    X, Y, _ = prepare(np.array([[[0.5, 0.5], [5.0, 0.5], [0.5, 5.0]]]), 8, 8, 0, 8, 2)
     z = np.zeros((1, 3))
     col = np.zeros((1, 3, 3))
     pid = np.zeros(1, np.int64)

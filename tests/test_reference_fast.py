@@ -123,12 +123,14 @@ def test_random_scenes_reach_the_cases():
          settings=quick)
 
 
-@pytest.mark.parametrize("threads", [2, 3])
-def test_bands_and_tiles_are_bit_identical(threads, monkeypatch):
-    """Row bands in threads and tiles of rows on the fast path: the whole frame, bit for bit."""
+@pytest.mark.parametrize("threads, per_thread", [(2, 1), (2, 3), (3, 5)])
+def test_bands_and_tiles_are_bit_identical(threads, per_thread, monkeypatch):
+    """Row bands in threads (each thread taking bands in turn) and tiles of rows on the fast
+    path: the whole frame, bit for bit."""
     tris = R.random_triangles(200, 150, 700, mean_area=120, seed=5)
     spec = R.rasterise(tris, engine="numpy")
     monkeypatch.setattr(R, "THREADS", threads)
+    monkeypatch.setattr(R, "FAST_BANDS_PER_THREAD", per_thread)
     monkeypatch.setattr(R, "_exec", None)
     monkeypatch.setattr(R, "THREAD_MIN_PIXELS", 1)
     assert len(R._bands(200, 150, tris.n_triangles)) == threads
@@ -139,6 +141,21 @@ def test_bands_and_tiles_are_bit_identical(threads, monkeypatch):
     assert counts == {"fragments": spec.fragments, "pixels_written": spec.pixels_written,
                       "pixels_covered": spec.pixels_covered}
     monkeypatch.setattr(R, "_exec", None)
+
+
+@pytest.mark.parametrize("size, n, area", [((700, 48), 30, 9000.0), ((300, 260), 6, 60000.0)])
+def test_big_triangles_span_many_batches(size, n, area):
+    """Rows longer than the kernel's batch (``BATCH`` fragments), batches that end inside a
+    triangle and triangles bigger than the frame: the same bits as the specification."""
+    from rasterhw.golden_model import reference_fast as F
+
+    w, h = size
+    tris = R.random_triangles(w, h, n, mean_area=area, seed=11)
+    spec, fast = both(tris, background=(0.25, 0.5, 1.0))
+    assert_same(spec, fast)
+    assert spec.fragments > 4 * F.BATCH and w > F.BATCH  # rows and triangles of several batches
+    t = R.render(tris, R.Target(w, h, rgb8=True, tri_id=True), background=(0.25, 0.5, 1.0))
+    assert_target_is_frame(t, spec)
 
 
 @pytest.mark.parametrize("engine", ["numpy", "numba"])
