@@ -70,10 +70,6 @@ def _inline(fn):
 
 HALF = 128.0  # SUBPIXEL // 2
 SUB = 256.0  # SUBPIXEL
-#: fragments per batch of the weights pass (a batch is whole rows of one triangle)
-BATCH = 256
-#: the weights pass runs over a multiple of this many lanes (the vector loop's step)
-PAD = 16
 
 
 @_inline
@@ -102,14 +98,15 @@ def _clip(lo, hi, N, sS):  # pragma: no cover - compiled
     return lo, hi
 
 
-@_inline
+@_jit
 def _to8(v):  # pragma: no cover - compiled
     """``Frame.to_rgb8`` of one channel: ``floor(v * 255 + 0.5)`` clamped to 0..255. Below 0
-    the result is 0, from 256 on it is 255, and in between ``floor`` is the truncation. Written
-    as two selects (no branches), so a loop of them vectorises."""
+    the result is 0, from 256 on it is 255, and in between ``floor`` is the truncation."""
     q = v * 255.0 + 0.5
-    q = 255.0 if q >= 256.0 else q
-    q = 0.0 if q < 0.0 else q
+    if q < 0.0:
+        return np.uint8(0)
+    if q >= 256.0:
+        return np.uint8(255)
     return np.uint8(np.int32(q))
 
 
@@ -181,7 +178,7 @@ def _band(X, Y, z, col, pid, W, H, y0, y1, bg, want_rgb8, rgb8, want_colour, col
         tri[:npix] = -1
     if want_poly:
         poly[:npix] = -1
-    g0, g1, g2 = _to8(bg[0]), _to8(bg[1]), _to8(bg[2])  # the background in 8 bits (Frame.to_rgb8)
+    g0, g1, g2 = _to8(bg[0]), _to8(bg[1]), _to8(bg[2])
     if want_rgb8 and g0 == g1 and g1 == g2:
         rgb8[:3 * npix] = g0
     elif want_rgb8:
@@ -194,20 +191,10 @@ def _band(X, Y, z, col, pid, W, H, y0, y1, bg, want_rgb8, rgb8, want_colour, col
             colour[3 * p] = bg[0]
             colour[3 * p + 1] = bg[1]
             colour[3 * p + 2] = bg[2]
-    # One batch of spans (whole rows of one triangle, BATCH fragments or a little more): the
-    # numerators E_1, E_2 of its fragments, then their weights and depths, then the span list.
-    cap = BATCH + W + PAD
-    e1 = np.zeros(cap)  # zeros: the padding lanes of the weights pass hold finite values
-    e2 = np.zeros(cap)
-    bz = np.empty(cap)
-    bc0 = np.empty(cap)
-    bc1 = np.empty(cap)
-    bc2 = np.empty(cap)
-    b80 = np.empty(cap, np.uint8)
-    b81 = np.empty(cap, np.uint8)
-    b82 = np.empty(cap, np.uint8)
-    sp = np.empty(cap, np.int64)  # pixel of each span's first fragment
-    sn = np.empty(cap, np.int64)  # its length
+    bw0 = np.empty(W)  # one scan line's weights and depths
+    bw1 = np.empty(W)
+    bw2 = np.empty(W)
+    bz = np.empty(W)
     fragments = 0
     written = 0
     covered = 0
@@ -244,91 +231,60 @@ def _band(X, Y, z, col, pid, W, H, y0, y1, bg, want_rgb8, rgb8, want_colour, col
         ca0, ca1, ca2 = col[t, 0, 0], col[t, 0, 1], col[t, 0, 2]
         cb0, cb1, cb2 = col[t, 1, 0], col[t, 1, 1], col[t, 1, 2]
         cc0, cc1, cc2 = col[t, 2, 0], col[t, 2, 1], col[t, 2, 2]
-        m = 0  # fragments in the batch
-        ns = 0  # spans in the batch
         for row in range(ra, rb + 1):
             Yc = float(row * 256 + 128)
             # The span: the bounding box's columns cut by the three edges.
             lo, hi = _clip(c0, c1, na0 * Yc + nb0, sS0)
             lo, hi = _clip(lo, hi, na1 * Yc + nb1, sS1)
             lo, hi = _clip(lo, hi, na2 * Yc + nb2, sS2)
-            if hi >= lo:
-                clo = int(lo)
-                n = int(hi) - clo + 1
-                fragments += n
-                K1 = dx1 * Yc + k1  # E_1, E_2 at column 0 of the row
-                K2 = dx2 * Yc + k2
-                for i in range(n):
-                    colf = float(clo + i)
-                    e1[m + i] = S1 * colf + K1
-                    e2[m + i] = S2 * colf + K2
-                sp[ns] = (row - y0) * W + clo
-                sn[ns] = n
-                ns += 1
-                m += n
-            if m == 0 or (m < BATCH and row < rb):
-                continue  # the batch goes on (it ends at BATCH fragments or the triangle's last row)
-            # Weights, depth and colour of every fragment of the batch, no branches: the compiler
-            # vectorises these loops (divisions included). The count is rounded up to a multiple
-            # of PAD so that no scalar remainder loop runs; the extra lanes compute harmless values
-            # that are never read. One loop per set of outputs, each writing only what it needs.
-            mp = (m + PAD - 1) & -PAD
-            if want_colour:
-                for i in range(mp):
-                    a1 = e1[i] / area
-                    a2 = e2[i] / area
-                    a0 = (1.0 - a1) - a2
-                    bz[i] = (za * a0 + zb * a1) + zc * a2
-                    bc0[i] = (a0 * ca0 + a1 * cb0) + a2 * cc0
-                    bc1[i] = (a0 * ca1 + a1 * cb1) + a2 * cc1
-                    bc2[i] = (a0 * ca2 + a1 * cb2) + a2 * cc2
-            elif want_rgb8:
-                for i in range(mp):
-                    a1 = e1[i] / area
-                    a2 = e2[i] / area
-                    a0 = (1.0 - a1) - a2
-                    bz[i] = (za * a0 + zb * a1) + zc * a2
-                    b80[i] = _to8((a0 * ca0 + a1 * cb0) + a2 * cc0)
-                    b81[i] = _to8((a0 * ca1 + a1 * cb1) + a2 * cc1)
-                    b82[i] = _to8((a0 * ca2 + a1 * cb2) + a2 * cc2)
-            else:
-                for i in range(mp):
-                    a1 = e1[i] / area
-                    a2 = e2[i] / area
-                    bz[i] = (za * ((1.0 - a1) - a2) + zb * a1) + zc * a2
-            # The serial Z test, span by span, and the outputs of the fragments that pass.
-            j = 0
-            for q in range(ns):
-                p = sp[q]
-                for i in range(j, j + sn[q]):
-                    zz = bz[i]
-                    held = depth[p]
-                    if zz < held:
-                        if held == np.inf:
-                            covered += 1
-                        depth[p] = zz
-                        written += 1
-                        if want_tri:
-                            tri[p] = t
-                        if want_poly:
-                            poly[p] = pt
+            if hi < lo:
+                continue
+            clo = int(lo)
+            chi = int(hi)
+            fragments += chi - clo + 1
+            K1 = dx1 * Yc + k1  # E_1, E_2 at column 0 of the row
+            K2 = dx2 * Yc + k2
+            base = (row - y0) * W + clo
+            n = chi - clo + 1
+            # Pass 1, no branches (the compiler vectorises it): weights and depth of the span.
+            for i in range(n):
+                colf = float(clo + i)
+                a1 = (S1 * colf + K1) / area
+                a2 = (S2 * colf + K2) / area
+                a0 = (1.0 - a1) - a2
+                bw0[i] = a0
+                bw1[i] = a1
+                bw2[i] = a2
+                bz[i] = (za * a0 + zb * a1) + zc * a2
+            # Pass 2: the serial Z test, and the outputs of the fragments that pass.
+            for i in range(n):
+                zz = bz[i]
+                p = base + i
+                held = depth[p]
+                if zz < held:
+                    if held == np.inf:
+                        covered += 1
+                    depth[p] = zz
+                    written += 1
+                    if want_tri:
+                        tri[p] = t
+                    if want_poly:
+                        poly[p] = pt
+                    if want_colour or want_rgb8:
+                        w0 = bw0[i]
+                        w1 = bw1[i]
+                        w2 = bw2[i]
+                        v0 = (w0 * ca0 + w1 * cb0) + w2 * cc0
+                        v1 = (w0 * ca1 + w1 * cb1) + w2 * cc1
+                        v2 = (w0 * ca2 + w1 * cb2) + w2 * cc2
                         if want_colour:
-                            v0, v1, v2 = bc0[i], bc1[i], bc2[i]
                             colour[3 * p] = v0
                             colour[3 * p + 1] = v1
                             colour[3 * p + 2] = v2
-                            if want_rgb8:
-                                rgb8[3 * p] = _to8(v0)
-                                rgb8[3 * p + 1] = _to8(v1)
-                                rgb8[3 * p + 2] = _to8(v2)
-                        elif want_rgb8:
-                            rgb8[3 * p] = b80[i]
-                            rgb8[3 * p + 1] = b81[i]
-                            rgb8[3 * p + 2] = b82[i]
-                    p += 1
-                j += sn[q]
-            m = 0
-            ns = 0
+                        if want_rgb8:
+                            rgb8[3 * p] = _to8(v0)
+                            rgb8[3 * p + 1] = _to8(v1)
+                            rgb8[3 * p + 2] = _to8(v2)
     return fragments, written, covered
 
 

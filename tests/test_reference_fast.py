@@ -7,6 +7,7 @@ the engine switch (RASTERHW_REFERENCE); the fallback without numba; numba's cach
 from __future__ import annotations
 
 import hashlib
+import itertools
 import os
 import subprocess
 import sys
@@ -144,18 +145,34 @@ def test_bands_and_tiles_are_bit_identical(threads, per_thread, monkeypatch):
 
 
 @pytest.mark.parametrize("size, n, area", [((700, 48), 30, 9000.0), ((300, 260), 6, 60000.0)])
-def test_big_triangles_span_many_batches(size, n, area):
-    """Rows longer than the kernel's batch (``BATCH`` fragments), batches that end inside a
-    triangle and triangles bigger than the frame: the same bits as the specification."""
-    from rasterhw.golden_model import reference_fast as F
-
+def test_big_triangles_and_long_rows(size, n, area):
+    """Spans of hundreds of pixels, triangles bigger than the frame, clipped on every side, drawn
+    in row bands: the same bits as the specification."""
     w, h = size
     tris = R.random_triangles(w, h, n, mean_area=area, seed=11)
     spec, fast = both(tris, background=(0.25, 0.5, 1.0))
     assert_same(spec, fast)
-    assert spec.fragments > 4 * F.BATCH and w > F.BATCH  # rows and triangles of several batches
+    assert spec.fragments > 10 * w and spec.pixels_written > spec.pixels_covered
     t = R.render(tris, R.Target(w, h, rgb8=True, tri_id=True), background=(0.25, 0.5, 1.0))
     assert_target_is_frame(t, spec)
+
+
+_SNAP = st.one_of(st.floats(-65536, 65536, allow_nan=False), st.integers(-2**24, 2**24).map(lambda v: v / 512.0))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(_SNAP, min_size=6, max_size=60).filter(lambda v: len(v) % 6 == 0), st.integers(1, 7))
+def test_prepare_snaps_like_screen_snap_and_cuts_in_order(coords, n):
+    """``prepare`` snaps exactly as ``screen.snap`` (ties of half a sub-pixel included), and its
+    cuts run from the first row to the last, never decreasing."""
+    from rasterhw.golden_model import reference_fast as F
+    from rasterhw.golden_model.screen import snap
+
+    xy = np.array(coords).reshape(-1, 3, 2)
+    X, Y, cuts = F.prepare(xy, 64, 48, 5, 40, n)
+    assert X.tobytes() == snap(xy[:, :, 0]).tobytes() and Y.tobytes() == snap(xy[:, :, 1]).tobytes()
+    assert len(cuts) == n + 1 and cuts[0] == 5 and cuts[-1] == 40
+    assert all(a <= b for a, b in itertools.pairwise(cuts))
 
 
 @pytest.mark.parametrize("engine", ["numpy", "numba"])
