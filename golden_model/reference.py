@@ -128,7 +128,7 @@ def _check(tris: ScreenTriangles, background) -> tuple[np.ndarray, np.ndarray, n
     bg = np.asarray(background, dtype=np.float64)
     if bg.shape != (3,) or not np.all(np.isfinite(bg)):
         raise RasterhwError(f"background must be three finite numbers, not {background!r}")
-    return xy, z, col, pid.astype(np.int64), bg
+    return xy, z, col, np.asarray(pid, dtype=np.int64), bg  # no copy when already int64 (read only)
 
 
 def _setup(xy: np.ndarray, width: int, height: int) -> dict:
