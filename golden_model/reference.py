@@ -128,7 +128,7 @@ def _check(tris: ScreenTriangles, background) -> tuple[np.ndarray, np.ndarray, n
     bg = np.asarray(background, dtype=np.float64)
     if bg.shape != (3,) or not np.all(np.isfinite(bg)):
         raise RasterhwError(f"background must be three finite numbers, not {background!r}")
-    return xy, z, col, pid.astype(np.int64), bg
+    return xy, z, col, np.asarray(pid, dtype=np.int64), bg  # no copy when already int64 (read only)
 
 
 def _setup(xy: np.ndarray, width: int, height: int) -> dict:
@@ -478,31 +478,38 @@ def _fast_draw(xy, z, vcol, pid, bg, W: int, H: int, y0: int, y1: int, *, depth=
     as :func:`_bands` row bands in threads (the kernel releases the GIL). Returns
     ``(fragments, pixels_written, pixels_covered)``."""
     fast = _fast_module()
-    X = np.ascontiguousarray(snap(xy[:, :, 0]))
-    Y = np.ascontiguousarray(snap(xy[:, :, 1]))
+    n = len(_bands(W, y1 - y0, xy.shape[0]))
+    X, Y, cuts = fast.prepare(xy, W, H, y0, y1, n * FAST_BANDS_PER_THREAD if n > 1 else 1)
     z = np.ascontiguousarray(z, dtype=np.float64)
     vcol = np.ascontiguousarray(vcol, dtype=np.float64)
     pid = np.ascontiguousarray(pid, dtype=np.int64)
     bg = np.ascontiguousarray(bg, dtype=np.float64)
-    bg8 = fast.rgb8_of(bg)
 
     def one(rows):
         a, b = rows
         lo, hi = (a - y0) * W, (b - y0) * W
-        return fast.band(X, Y, z, vcol, pid, W, H, a, b, bg, bg8=bg8,
+        return fast.band(X, Y, z, vcol, pid, W, H, a, b, bg,
                          depth=depth[lo:hi] if depth is not None else _zbuf(hi - lo),
                          rgb8=None if rgb8 is None else rgb8[3 * lo:3 * hi],
                          colour=None if colour is None else colour[3 * lo:3 * hi],
                          tri=None if tri is None else tri[lo:hi], poly=None if poly is None else poly[lo:hi])
 
-    n = len(_bands(W, y1 - y0, X.shape[0]))
     if n == 1:
         parts = [one((y0, y1))]
-    else:  # bands of equal bounding-box work; the calling thread draws the first
-        c = fast.cuts(X, Y, W, H, y0, y1, n)
-        bands = list(itertools.pairwise(c))
-        rest = [_executor().submit(one, b) for b in bands[1:]]
-        parts = [one(bands[0])] + [f.result() for f in rest]
+    else:  # bands of equal bounding-box work, taken in turn by the calling thread and the workers
+        bands = [b for b in itertools.pairwise(cuts) if b[1] > b[0]]
+        taken = itertools.count()  # next() is atomic (the GIL): each band is drawn once
+
+        def drain():
+            out = []
+            while (i := next(taken)) < len(bands):
+                out.append(one(bands[i]))
+            return out
+
+        rest = [_executor().submit(drain) for _ in range(n - 1)]
+        parts = drain()
+        for f in rest:
+            parts += f.result()
     return tuple(int(sum(p[i] for p in parts)) for i in range(3))
 
 
@@ -592,6 +599,9 @@ THREAD_MIN_TRIANGLES = 64
 #: threads for the row bands: one per CPU, at most 2 (the machines this runs on; llvmpipe,
 #: which the bench compares with, also runs one rasteriser thread per CPU)
 THREADS = max(1, min(2, os.cpu_count() or 1))
+#: row bands per thread on the fast path: the threads take them in turn, so when one thread
+#: waits for a core (a busy machine) the others draw its share
+FAST_BANDS_PER_THREAD = 3
 _pool_lock = threading.Lock()
 _exec = None
 

@@ -45,7 +45,7 @@ import tempfile
 import numba
 import numpy as np
 
-__all__ = ["band", "cuts", "compile_all"]
+__all__ = ["band", "prepare", "compile_all"]
 
 
 def _jit(fn):
@@ -111,33 +111,61 @@ def _to8(v):  # pragma: no cover - compiled
 
 
 @_jit
-def _row_work(Y, X, W, H, y0, y1):  # pragma: no cover - compiled
-    """Bounding-box pixels per row of rows ``y0 .. y1 - 1`` (an estimate of the work, to cut
-    the frame into row bands of equal work; any cut draws the same pixels)."""
-    d = np.zeros(y1 - y0 + 1, np.int64)
-    for t in range(X.shape[0]):
-        r0 = max(np.ceil((min(Y[t, 0], Y[t, 1], Y[t, 2]) - 128.0) / 256.0), float(y0))
-        r1 = min(np.floor((max(Y[t, 0], Y[t, 1], Y[t, 2]) - 128.0) / 256.0), float(y1 - 1))
-        c0 = max(np.ceil((min(X[t, 0], X[t, 1], X[t, 2]) - 128.0) / 256.0), 0.0)
-        c1 = min(np.floor((max(X[t, 0], X[t, 1], X[t, 2]) - 128.0) / 256.0), float(W - 1))
+def _prepare(xy, W, H, y0, y1, n):  # pragma: no cover - compiled; tested through prepare()
+    """The snapped coordinates ``X``, ``Y`` (T, 3) of ``xy`` (T, 3, 2), and ``n + 1`` row
+    boundaries from ``y0`` to ``y1`` that split the bounding-box pixels of the triangles evenly
+    (an estimate of the work; any cut draws the same pixels)."""
+    T = xy.shape[0]
+    X = np.empty((T, 3))
+    Y = np.empty((T, 3))
+    for t in range(T):
+        for v in range(3):  # screen.snap: floor(v * 256 + 0.5), the same operations
+            X[t, v] = np.floor(xy[t, v, 0] * SUB + 0.5)
+            Y[t, v] = np.floor(xy[t, v, 1] * SUB + 0.5)
+    cut = np.empty(n + 1, np.int64)
+    for k in range(n + 1):
+        cut[k] = y0 + (y1 - y0) * k // n
+    if n == 1:
+        return X, Y, cut
+    d = np.zeros(y1 - y0 + 1, np.int64)  # per row: pixels of the bounding boxes, as differences
+    for t in range(T):
+        r0 = max(np.ceil((min(Y[t, 0], Y[t, 1], Y[t, 2]) - HALF) / SUB), float(y0))
+        r1 = min(np.floor((max(Y[t, 0], Y[t, 1], Y[t, 2]) - HALF) / SUB), float(y1 - 1))
+        c0 = max(np.ceil((min(X[t, 0], X[t, 1], X[t, 2]) - HALF) / SUB), 0.0)
+        c1 = min(np.floor((max(X[t, 0], X[t, 1], X[t, 2]) - HALF) / SUB), float(W - 1))
         if r1 >= r0 and c1 >= c0:
             w = int(c1 - c0) + 1
             d[int(r0) - y0] += w
             d[int(r1) - y0 + 1] -= w
-    return np.cumsum(d[:-1])
+    total = 0
+    run = 0
+    for r in range(y1 - y0):
+        run += d[r]
+        total += run
+    if total == 0:
+        return X, Y, cut
+    done = 0  # work of the rows before row y0 + r
+    run = 0
+    k = 1
+    for r in range(y1 - y0):
+        run += d[r]
+        done += run
+        while k < n and done * n > total * k:  # row y0 + r takes the band past k/n of the work
+            cut[k] = y0 + r
+            k += 1
+    return X, Y, cut
 
 
-def cuts(X, Y, W: int, H: int, y0: int, y1: int, n: int) -> list[int]:
-    """``n + 1`` row boundaries from ``y0`` to ``y1`` splitting the bounding-box work evenly."""
-    work = np.cumsum(_row_work(Y, X, int(W), int(H), int(y0), int(y1)))
-    if work.size == 0 or work[-1] == 0:
-        return [y0 + (y1 - y0) * k // n for k in range(n + 1)]
-    inner = np.searchsorted(work, work[-1] * np.arange(1, n) / n, side="right") + y0
-    return [y0] + [int(c) for c in np.clip(inner, y0, y1)] + [y1]
+def prepare(xy: np.ndarray, W: int, H: int, y0: int, y1: int, n: int) -> tuple[np.ndarray, np.ndarray, list[int]]:
+    """``(X, Y, cuts)``: the snapped vertex coordinates (T, 3) of ``xy`` (T, 3, 2, float64; as
+    :func:`rasterhw.golden_model.screen.snap`, bit for bit), and ``n + 1`` row boundaries from
+    ``y0`` to ``y1`` splitting the bounding-box work of the rows into ``n`` even bands."""
+    X, Y, cut = _prepare(np.ascontiguousarray(xy, dtype=np.float64), int(W), int(H), int(y0), int(y1), int(n))
+    return X, Y, cut.tolist()
 
 
 @_jit
-def _band(X, Y, z, col, pid, W, H, y0, y1, bg, bg8, want_rgb8, rgb8, want_colour, colour, depth,
+def _band(X, Y, z, col, pid, W, H, y0, y1, bg, want_rgb8, rgb8, want_colour, colour, depth,
           want_tri, tri, want_poly, poly):  # pragma: no cover - compiled; tested through band()
     """Rows ``y0 .. y1 - 1`` of a ``W x H`` frame. Every output array holds exactly those rows
     (pixel ``(row, col)`` at ``(row - y0) * W + col``, flat, colour channels interleaved); the
@@ -150,11 +178,14 @@ def _band(X, Y, z, col, pid, W, H, y0, y1, bg, bg8, want_rgb8, rgb8, want_colour
         tri[:npix] = -1
     if want_poly:
         poly[:npix] = -1
-    if want_rgb8:
+    g0, g1, g2 = _to8(bg[0]), _to8(bg[1]), _to8(bg[2])
+    if want_rgb8 and g0 == g1 and g1 == g2:
+        rgb8[:3 * npix] = g0
+    elif want_rgb8:
         for p in range(npix):
-            rgb8[3 * p] = bg8[0]
-            rgb8[3 * p + 1] = bg8[1]
-            rgb8[3 * p + 2] = bg8[2]
+            rgb8[3 * p] = g0
+            rgb8[3 * p + 1] = g1
+            rgb8[3 * p + 2] = g2
     if want_colour:
         for p in range(npix):
             colour[3 * p] = bg[0]
@@ -257,22 +288,17 @@ def _band(X, Y, z, col, pid, W, H, y0, y1, bg, bg8, want_rgb8, rgb8, want_colour
     return fragments, written, covered
 
 
-def rgb8_of(bg: np.ndarray) -> np.ndarray:
-    """The background in 8 bits, by ``Frame.to_rgb8``'s rule."""
-    return np.clip(np.floor(bg * 255.0 + 0.5), 0, 255).astype(np.uint8)
-
-
 _EMPTY = {np.dtype(np.uint8): np.empty(0, np.uint8), np.dtype(np.float64): np.empty(0, np.float64),
           np.dtype(np.int64): np.empty(0, np.int64)}
 
 
 def band(X, Y, z, col, pid, W: int, H: int, y0: int, y1: int, bg: np.ndarray, *, depth: np.ndarray,
-         rgb8=None, colour=None, tri=None, poly=None, bg8=None) -> tuple[int, int, int]:
+         rgb8=None, colour=None, tri=None, poly=None) -> tuple[int, int, int]:
     """Draw rows ``y0 .. y1 - 1`` into flat arrays that hold exactly those rows (see
-    :func:`_band`); ``None`` = not wanted. ``X``, ``Y``: snapped vertex coordinates (T, 3);
-    ``z`` (T, 3), ``col`` (T, 3, 3) float64, ``pid`` (T,) int64, all C-contiguous; ``bg8``:
-    :func:`rgb8_of` ``(bg)``, if already known."""
-    return _band(X, Y, z, col, pid, int(W), int(H), int(y0), int(y1), bg, rgb8_of(bg) if bg8 is None else bg8,
+    :func:`_band`); ``None`` = not wanted. ``X``, ``Y``: snapped vertex coordinates (T, 3)
+    (:func:`prepare`); ``z`` (T, 3), ``col`` (T, 3, 3), ``bg`` (3,) float64, ``pid`` (T,)
+    int64, all C-contiguous."""
+    return _band(X, Y, z, col, pid, int(W), int(H), int(y0), int(y1), bg,
                  rgb8 is not None, _EMPTY[np.dtype(np.uint8)] if rgb8 is None else rgb8,
                  colour is not None, _EMPTY[np.dtype(np.float64)] if colour is None else colour,
                  depth,
@@ -283,8 +309,7 @@ def band(X, Y, z, col, pid, W: int, H: int, y0: int, y1: int, bg: np.ndarray, *,
 def compile_all() -> None:
     """Compile (or load from numba's cache) the variants the package uses: the Frame's outputs
     and the output contract's RGB8 with 32- or 64-bit ids."""
-    X = np.array([[128.0, 1280.0, 128.0]])
-    Y = np.array([[128.0, 128.0, 1280.0]])
+    X, Y, _ = prepare(np.array([[[0.5, 0.5], [5.0, 0.5], [0.5, 5.0]]]), 8, 8, 0, 8, 2)
     z = np.zeros((1, 3))
     col = np.zeros((1, 3, 3))
     pid = np.zeros(1, np.int64)

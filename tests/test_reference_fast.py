@@ -7,6 +7,7 @@ the engine switch (RASTERHW_REFERENCE); the fallback without numba; numba's cach
 from __future__ import annotations
 
 import hashlib
+import itertools
 import os
 import subprocess
 import sys
@@ -123,12 +124,14 @@ def test_random_scenes_reach_the_cases():
          settings=quick)
 
 
-@pytest.mark.parametrize("threads", [2, 3])
-def test_bands_and_tiles_are_bit_identical(threads, monkeypatch):
-    """Row bands in threads and tiles of rows on the fast path: the whole frame, bit for bit."""
+@pytest.mark.parametrize("threads, per_thread", [(2, 1), (2, 3), (3, 5)])
+def test_bands_and_tiles_are_bit_identical(threads, per_thread, monkeypatch):
+    """Row bands in threads (each thread taking bands in turn) and tiles of rows on the fast
+    path: the whole frame, bit for bit."""
     tris = R.random_triangles(200, 150, 700, mean_area=120, seed=5)
     spec = R.rasterise(tris, engine="numpy")
     monkeypatch.setattr(R, "THREADS", threads)
+    monkeypatch.setattr(R, "FAST_BANDS_PER_THREAD", per_thread)
     monkeypatch.setattr(R, "_exec", None)
     monkeypatch.setattr(R, "THREAD_MIN_PIXELS", 1)
     assert len(R._bands(200, 150, tris.n_triangles)) == threads
@@ -139,6 +142,37 @@ def test_bands_and_tiles_are_bit_identical(threads, monkeypatch):
     assert counts == {"fragments": spec.fragments, "pixels_written": spec.pixels_written,
                       "pixels_covered": spec.pixels_covered}
     monkeypatch.setattr(R, "_exec", None)
+
+
+@pytest.mark.parametrize("size, n, area", [((700, 48), 30, 9000.0), ((300, 260), 6, 60000.0)])
+def test_big_triangles_and_long_rows(size, n, area):
+    """Spans of hundreds of pixels, triangles bigger than the frame, clipped on every side, drawn
+    in row bands: the same bits as the specification."""
+    w, h = size
+    tris = R.random_triangles(w, h, n, mean_area=area, seed=11)
+    spec, fast = both(tris, background=(0.25, 0.5, 1.0))
+    assert_same(spec, fast)
+    assert spec.fragments > 10 * w and spec.pixels_written > spec.pixels_covered
+    t = R.render(tris, R.Target(w, h, rgb8=True, tri_id=True), background=(0.25, 0.5, 1.0))
+    assert_target_is_frame(t, spec)
+
+
+_SNAP = st.one_of(st.floats(-65536, 65536, allow_nan=False), st.integers(-2**24, 2**24).map(lambda v: v / 512.0))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(_SNAP, min_size=6, max_size=60).filter(lambda v: len(v) % 6 == 0), st.integers(1, 7))
+def test_prepare_snaps_like_screen_snap_and_cuts_in_order(coords, n):
+    """``prepare`` snaps exactly as ``screen.snap`` (ties of half a sub-pixel included), and its
+    cuts run from the first row to the last, never decreasing."""
+    from rasterhw.golden_model import reference_fast as F
+    from rasterhw.golden_model.screen import snap
+
+    xy = np.array(coords).reshape(-1, 3, 2)
+    X, Y, cuts = F.prepare(xy, 64, 48, 5, 40, n)
+    assert X.tobytes() == snap(xy[:, :, 0]).tobytes() and Y.tobytes() == snap(xy[:, :, 1]).tobytes()
+    assert len(cuts) == n + 1 and cuts[0] == 5 and cuts[-1] == 40
+    assert all(a <= b for a, b in itertools.pairwise(cuts))
 
 
 @pytest.mark.parametrize("engine", ["numpy", "numba"])
