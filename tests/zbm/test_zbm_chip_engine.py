@@ -33,7 +33,7 @@ def _stimulus(seed: int = 5):
     return chip_stimulus(segs, H, up, chip=CHIP, interleave=ILV, width=W)
 
 
-@pytest.mark.heavy
+@pytest.mark.heavy(2)
 def test_engine_chip_matches_golden_and_cocotb_cycles():
     seg_w, up_w, exp = _stimulus()
     assert len(seg_w) > H   # some segments, not only end-of-line records
