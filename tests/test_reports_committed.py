@@ -56,8 +56,8 @@ def _compare(system: str, tmp_path: Path) -> list[dict]:
 
 #: the test run's reduced configuration of a fast report (``"module.NAME": value`` set for the run):
 #: the same rows come back (a row left unmeasured keeps its name, with its reason), from fewer
-#: HDL builds. ZB/M: the 2-unit chain is not built (cold, its Verilog conversion and -O0 build were
-#: about a quarter of the 159 s of CPU this test took); the skew pair still runs two chained units
+#: HDL builds. ZB/M: the 2-unit chain is not built (cold, its Verilog conversion, -O0 build and run
+#: took 45 s of the 159 s of CPU this test took: docs/speed.md); the skew pair still runs two chained units
 #: on Verilator word for word against the golden model (``skew`` raises on a mismatch), so chains
 #: stay checked in every test run. The whole fast report: the ``slow`` test below.
 REDUCED = {"zbm": {"rasterhw.sim.zbm.scaling.FAST_SKIP_CHAIN": (2, 4, 8)}}
