@@ -1,7 +1,12 @@
-"""Test-run order: tests marked ``heavy`` (minutes on a cold machine: Verilator builds, report
-regeneration, soak rounds) are handed out first, so that ``pytest -n 2`` does not end with one
-worker running a long test alone while the other is idle; ``heavy(n)`` with a larger ``n`` goes
-earlier still (the longest ones). Nothing else changes order."""
+"""Test-run order: tests marked ``heavy`` (tens of seconds on a cold machine: Verilator builds,
+report regeneration, soak rounds) are handed out first, so that ``pytest -n 2`` does not end with
+one worker running a long test alone while the other is idle; ``heavy(n)`` with a larger ``n``
+goes earlier still (the longest ones). Nothing else changes order.
+
+Under pytest-xdist the tests are handed out one at a time, in that order (``--maxschedchunk 1``
+unless given): its default ``load`` scheduling first sends each worker a block of a quarter of
+the collection, so every heavy test, sorted to the front, went to the first worker's block and
+the second worker ran the light ones beside them (measured: docs/speed.md)."""
 
 from __future__ import annotations
 
@@ -11,6 +16,12 @@ import os
 # effective_opt): ~40 % less compile time on the large benches, the same results; a test run
 # keeps its own build folders (the level is in every build's key)
 os.environ.setdefault("RASTERHW_VERILATOR_OPT", "-O1")
+
+
+def pytest_configure(config):
+    # pytest-xdist's option (None: not given on the command line); absent without xdist
+    if getattr(config.option, "maxschedchunk", 0) is None:
+        config.option.maxschedchunk = 1
 
 
 def pytest_collection_modifyitems(config, items):

@@ -73,7 +73,7 @@ def test_verilator_random_stream_with_idle_and_protocol():
 
 def test_verilator_one_bank_stream():
     rng = np.random.default_rng(2)
-    n = 200
+    n = 400   # ~200 writes per pipeline: the stimulus memories, so the build, of random_stream's runs
     s = PixelStream(40, 16, rng.integers(0, 128, n) * 5, rng.integers(0, 1 << 24, n),
                     rng.integers(1, 1 << 24, n), rng.integers(0, 2, n))
     r = simulate_pixelbus(s, engine="verilator")
