@@ -18,6 +18,7 @@ from rasterhw.golden_model.zbm.words import doublez_words, merge_words, segment_
 from rasterhw.sim.engines.runner import (
     HARNESS_V,
     build_dir_for,
+    effective_opt,
     get_sim,
     run_cocotb,
     verilator_make_flags,
@@ -93,7 +94,7 @@ def run_chip_bench(seg_words: list[int], up_words: list[int], *, lines: int, chi
     maxcyc = repeat * (40 * len(seg_words) + 40 * lines * (npx + 16)) + 1000
     t1 = time.perf_counter()
     timings: dict = {}
-    with verilator_make_flags("-O2", coroutines=True):
+    with verilator_make_flags(effective_opt("-O2"), coroutines=True):   # the level its key names
         run_cocotb(sources=[src, HARNESS_V, BENCH_DIR / "tb_zbm_chip.v"], toplevel="tb_zbm_chip",
                    test_module=TEST_MODULE, testcase="zbm_chip_lines", build_dir=bdir, test_dir=run_dir, sim=sim,
                    parameters=params,
