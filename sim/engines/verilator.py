@@ -8,7 +8,6 @@ Python int or text line per word) and the words and cycle stamps dumped at the e
 
 from __future__ import annotations
 
-import hashlib
 import inspect
 import json
 import os
@@ -38,15 +37,14 @@ from rasterhw.sim.engines.runner import (
     run_plain_verilator,
 )
 from rasterhw.sim.engines.verilog import canonical_port_lists
-from rasterhw.sim.engines.verilog_cache import convert_cached
+from rasterhw.sim.engines.verilog_cache import convert_cached, module_sources, sources_digest
 from rasterhw.sim.paths import BUILD_ROOT
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
 from rasterhw.sim.workdirs import build_lock, release, temp_run_folder
 
-__all__ = ["GAP_BITS", "PGO_OPT", "BenchTop", "profile", "run", "unpack_status"]
+__all__ = ["GAP_BITS", "PGO_OPT", "BenchTop", "bench_sources", "profile", "run", "unpack_status"]
 
 GAP_BITS = 8          # idle clocks before a word: 0..255
-_SELF = hashlib.sha1(Path(__file__).read_bytes()).hexdigest()[:12]   # this file is part of the design
 
 
 def _tag(path: str) -> str:
@@ -133,12 +131,29 @@ def _check(m: Module, tag: str, port) -> Signal:
     return err
 
 
+def bench_sources(tb: Testbench) -> list[Path]:
+    """The Python files the bench top around ``tb``'s block is made from, beside the block's own
+    (``verilog_cache.design_sources``): this engine's module and the module of ``tb``'s class and
+    of each class it derives from (they build the DUT, its adapters and read-outs, its status
+    values and speed Verilog), each with every module of ours it imports, transitively
+    (``verilog_cache.module_sources``: the same rule as the block's)."""
+    roots = [Path(__file__)] + [f for c in type(tb).__mro__ if (f := _class_file(c)) is not None]
+    return module_sources(roots)
+
+
+def _class_file(cls) -> Path | None:
+    """The source file of class ``cls`` (None for a built-in one, such as ``object``)."""
+    try:
+        return Path(inspect.getfile(cls))
+    except TypeError:
+        return None
+
+
 def _design(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[str, int], speed: bool):
     """(build name, generated files) of the bench top around ``tb``'s block; ``speed``: the
     testbench's speed Verilog (:meth:`Testbench.sim_verilog`)."""
-    # the testbench's own module builds the DUT's adapter (e.g. a read-out): its bytes are design too
-    tb_src = hashlib.sha1(Path(inspect.getfile(type(tb))).read_bytes()).hexdigest()[:12]
-    key = {**params, "inputs": inputs, "outputs": outputs, "bench": _SELF, "testbench": tb_src,
+    # what builds the DUT and its adapters (the testbench's modules and all they import) is design too
+    key = {**params, "inputs": inputs, "outputs": outputs, "bench": sources_digest(bench_sources(tb))[:16],
            **({"speed": True} if speed else {})}
 
     def top():
