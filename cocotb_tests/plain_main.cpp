@@ -6,6 +6,12 @@
 //   {"sim_cycles": rising edges before done, "done", "run_s"[, "cycles"][, "lines"][, "errors"][, "status"]}
 // where "cycles" / "lines" / "errors" / "status" (up to 64 bits) are the top's outputs of those names
 // when the build defines RASTERHW_CYCLES / RASTERHW_LINES / RASTERHW_ERRORS / RASTERHW_STATUS. `final` blocks (the benches' dumps) run at the end.
+// Separate clocks (a build defining RASTERHW_CLOCKS=N; sim/engines/verilator.py): the top has an
+// N-bit input `clocks` instead of `clk`; bit k is clock k, with half period H and first rising edge
+// at time F from +clock_k=H,F (default 1,0: every clock the same). The main steps from one clock
+// event to the next, toggles every clock due at that time together and evaluates once (edges at
+// the same time see each other's values from before them); "sim_cycles", +maxcyc= and the trace
+// window count rising edges of clock 0, and the trace has one time step per time unit.
 // A build with --trace-fst or --trace (waves on request: sim/engines/waves.py) writes the run's trace to
 // the file named by +waves=PATH, two time steps per clock (rising edges at odd steps); with
 // +trace_start=N / +trace_end=M only edges N .. M-1 (counted from 0, the tail included): the trace
@@ -49,7 +55,9 @@ int main(int argc, char** argv) {
     if (waves) ctx->traceEverOn(true);
 #endif
     const auto top = std::make_unique<RASTERHW_TOP>(ctx.get());
+#ifndef RASTERHW_CLOCKS
     top->clk = 0;
+#endif
     top->eval();  // initial blocks: plusargs, $readmemh
 #if VM_TRACE
     bool traced = false;  // the window has been opened (and perhaps closed)
@@ -77,6 +85,55 @@ int main(int argc, char** argv) {
 #define RASTERHW_DUMP(t)
 #endif
     uint64_t n = 0, steps = 0;
+#ifdef RASTERHW_CLOCKS
+    constexpr int NCLK = RASTERHW_CLOCKS;
+    uint64_t half[NCLK], next[NCLK];
+    for (int k = 0; k < NCLK; ++k) {
+        half[k] = 1;
+        next[k] = 0;  // the time of the clock's next toggle (its first rising edge first)
+        char key[32];
+        std::snprintf(key, sizeof key, "+clock_%d=", k);
+        const size_t len = std::strlen(key);
+        for (int i = 1; i < argc; ++i) {
+            if (std::strncmp(argv[i], key, len)) continue;
+            char* end = nullptr;
+            half[k] = std::strtoull(argv[i] + len, &end, 10);
+            if (end && *end == ',') next[k] = std::strtoull(end + 1, nullptr, 10);
+        }
+        if (half[k] == 0) {
+            std::fprintf(stderr, "+clock_%d: the half period must be at least 1\n", k);
+            return 3;
+        }
+    }
+    uint64_t level = 0;  // bit k: clock k's value
+    top->clocks = 0;
+    top->eval();
+    const auto edge = [&]() {  // the next clock event: every clock due toggles, one eval
+        uint64_t t = next[0];
+        for (int k = 1; k < NCLK; ++k) t = next[k] < t ? next[k] : t;
+        bool rise0 = false;
+        for (int k = 0; k < NCLK; ++k) {
+            if (next[k] != t) continue;
+            level ^= 1ull << k;
+            if (k == 0 && (level & 1)) rise0 = true;
+            next[k] += half[k];
+        }
+        if (rise0) window(n);  // the edge about to happen
+        top->clocks = level;
+        top->eval();
+        steps = t + 1;
+        RASTERHW_DUMP(steps);
+        return rise0;
+    };
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!top->done && n < maxcyc && !ctx->gotFinish()) {
+        if (edge()) ++n;
+    }
+    const auto t1 = std::chrono::steady_clock::now();
+    for (uint64_t k = 0; k < RASTERHW_TAIL;) {
+        if (edge()) ++k;
+    }
+#else
     const auto edge = [&]() {
         window(steps / 2);  // the edge about to happen
         top->clk = 1;
@@ -95,6 +152,7 @@ int main(int argc, char** argv) {
     }
     const auto t1 = std::chrono::steady_clock::now();
     for (int k = 0; k < RASTERHW_TAIL; ++k) edge();
+#endif
     const double s = std::chrono::duration<double>(t1 - t0).count();
     const unsigned done = top->done;
     top->final();

@@ -17,6 +17,14 @@ in a :class:`Stimulus` are a list of ints or, for millions of words, the same va
 Cycles: clock edges are counted from 0 at the first rising edge of the run (no reset: the
 design starts at its ``init`` values in every engine); a transfer's stamp is the index of the
 edge at which it happened, and a run's ``cycles`` is the last output stamp + 1.
+
+Clocks: by default every clock domain of the block runs off one clock (one edge each per cycle).
+A run may give every domain its own :class:`Clock` instead (``engines.run(..., clocks=...)``: a
+half period and the time of its first rising edge, in steps of one common time unit); a port's
+stamps then count the edges of its own domain, and :meth:`Run.cycles_at` turns an edge of one
+domain into the edges of the run's first domain (its reference clock) that came before it.
+Edges of two clocks at the same time are one step: every domain's registers see the values from
+before it (as in an HDL simulator, where the flops' updates are non-blocking).
 """
 
 from __future__ import annotations
@@ -28,7 +36,50 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
 
-__all__ = ["Expected", "Run", "Stimulus", "Testbench", "compare", "find_testbench", "port_of"]
+__all__ = ["Clock", "Expected", "Run", "Stimulus", "Testbench", "clocks_of", "compare", "find_testbench", "port_of"]
+
+
+@dataclass(frozen=True)
+class Clock:
+    """One domain's clock in a run with separate clocks: ``half`` period and the time of its first
+    rising edge (edge 0) ``first``, integers in a time unit common to every domain of the run."""
+
+    half: int
+    first: int = 0
+
+    def __post_init__(self):
+        for name, v, lo in (("half period", self.half, 1), ("first edge", self.first, 0)):
+            if not isinstance(v, (int, np.integer)) or isinstance(v, bool) or v < lo:
+                raise RasterhwError(f"clock {name} must be an integer >= {lo}, not {v!r}")
+
+    def edge_time(self, k: int) -> int:
+        """The time of rising edge ``k`` (from 0)."""
+        return self.first + 2 * self.half * k
+
+    def edges_before(self, t: int) -> int:
+        """Rising edges strictly before time ``t`` (an edge at ``t`` itself is not counted)."""
+        return 0 if t <= self.first else -(-(t - self.first) // (2 * self.half))
+
+
+def clocks_of(given, domains: tuple[str, ...]) -> dict[str, Clock]:
+    """``{domain: Clock}`` from a run's ``clocks`` argument: a :class:`Clock`, a half period, or
+    ``(half, first)`` for every domain of ``domains`` (the first domain is the reference); the
+    domains in ``domains``' order; a one-line error for a missing, unknown or bad one."""
+    if not isinstance(given, dict):
+        raise RasterhwError(f"clocks must be a dict {{domain: half period or (half, first)}}, not {given!r}")
+    if set(given) != set(domains):
+        raise RasterhwError(f"clocks: give every clock domain of the block ({', '.join(domains)}), "
+                            f"not {', '.join(map(str, given)) or 'none'}")
+    out = {}
+    for d in domains:
+        c = given[d]
+        if isinstance(c, Clock):
+            out[d] = c
+        elif isinstance(c, tuple) and len(c) == 2:
+            out[d] = Clock(*c)
+        else:
+            out[d] = Clock(c)
+    return out
 
 
 @dataclass(frozen=True)
@@ -68,10 +119,21 @@ class Run:
     protocol_errors: int = 0                     # clocks that broke the stream rules, every port
     status: dict = field(default_factory=dict)   # the testbench's status values at the end (Testbench.status)
     build: dict = field(default_factory=dict)    # how the model was built (engine's words: opt, pgo, ...)
+    clocks: dict = field(default_factory=dict)   # {domain: Clock} of a run with separate clocks (else empty)
+    port_domains: dict = field(default_factory=dict)   # {output port: its domain} (separate clocks)
+
+    def cycles_at(self, port: str, edge: int) -> int:
+        """Edges of the reference clock (the first domain's) before edge ``edge`` of ``port``'s
+        domain; with one clock, ``edge`` itself."""
+        if not self.clocks:
+            return edge
+        ref = next(iter(self.clocks.values()))
+        return ref.edges_before(self.clocks[self.port_domains[port]].edge_time(edge))
 
     @property
     def cycles(self) -> int:
-        return max((s[-1] + 1 for s in self.stamps.values() if s), default=0)
+        """Reference-clock edges until the edge after the last transfer (one clock: the last stamp + 1)."""
+        return max((self.cycles_at(p, s[-1] + 1) for p, s in self.stamps.items() if s), default=0)
 
 
 class Testbench:
@@ -79,8 +141,9 @@ class Testbench:
 
     ``block``: the registry name (``rasterhw verilog --list``); ``inputs`` / ``outputs``: stream
     ports as attribute paths (``"i"``, ``"o_merge[3]"``; :meth:`outputs_of` may depend on the
-    parameters); ``domains``: the clock domains the block uses (every engine clocks them
-    together, one edge each per cycle); ``port_domains``: the ports not in ``sync``.
+    parameters); ``domains``: the clock domains the block uses, ``sync`` first (the engines clock
+    them together, one edge each per cycle, unless a run gives each its own :class:`Clock`);
+    ``port_domains``: the ports not in ``sync``.
     """
 
     block: str = ""

@@ -398,31 +398,42 @@ def test_render_reports_progress_per_tile():
 
 
 def test_pixelbus_frame_run_folder_is_removed_when_the_run_is_interrupted(monkeypatch, tmp_path):
-    """Issue 33: the SNU frame bench's run folder (115 MB at snu-100k) is a shared run folder:
-    Ctrl-C / SIGTERM (``workdirs.cleanup``) removes it, where ``tempfile.mkdtemp`` left it."""
+    """Issue 33: the SNU frame's run folder (115 MB at snu-100k) is a shared run folder: Ctrl-C
+    (and SIGTERM: ``workdirs.cleanup``, which removes every folder still registered) removes it,
+    where ``tempfile.mkdtemp`` left it. The frame runs on the generic Verilator engine
+    (``frame.run_frame_engine``, ``FrameBench``; the dedicated bench it ran on is retired): its
+    build is stubbed, its run interrupted once the stimulus is written."""
     import numpy as np
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.golden_model.snu.gouraud import scan_convert
     from rasterhw.sim import workdirs
+    from rasterhw.sim.engines import verilator
     from rasterhw.sim.snu import frame
 
     exe = tmp_path / "model" / "obj_dir" / "Vtb"
     exe.parent.mkdir(parents=True)
     seen = []
-    monkeypatch.setattr(frame, "build_plain_verilator", lambda *a, **k: (exe, 0.0))
+    monkeypatch.setattr(verilator, "build_plain_verilator", lambda *a, **k: (exe, 0.0))
 
-    def interrupted(_exe, _args, *, run_dir, maxcyc):
-        seen.append(run_dir)
+    def interrupted(_exe, _args, *, run_dir, maxcyc, profile=None):
+        seen.append((run_dir, run_dir.is_dir(), run_dir in workdirs._live, sorted(f.name for f in run_dir.iterdir())))
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(frame, "run_plain_verilator", interrupted)
+    monkeypatch.setattr(verilator, "run_plain_verilator", interrupted)
     s = scan_convert(run_geometry(build_scene("c50"), 16, 8, z_bits=24, z_far_is_zero=True))
+    p = frame.producer_gaps(run_geometry(build_scene("c50"), 16, 8, z_bits=24, z_far_is_zero=True), s)
+    sched = frame.golden_schedule(s, p["gaps"], p["first_work"], ratio=p["ratio"])
     with pytest.raises(KeyboardInterrupt):
-        frame.run_frame_hdl(s, np.zeros(len(s), np.int64), [0, 0])
-    assert seen and seen[0].is_dir()
+        frame.run_frame_engine(s, np.zeros(len(s), np.int64), sched)
+    (run_dir, was_dir, registered, files), = seen
+    # while it ran: a real folder under the build, registered for cleanup, holding the stimulus
+    assert was_dir and registered and {"i_pipe0.bin", "i_pipe1.bin"} <= set(files)
+    assert run_dir.parent == exe.parent.parent
+    # the interrupt removed it on its way out; nothing is left for cleanup either
+    assert not run_dir.exists() and run_dir not in workdirs._live
     workdirs.cleanup()                       # what the CLI's signal handling runs
-    assert not seen[0].exists()
+    assert not run_dir.exists()
 
 
 def test_decode_text_detects_what_latin1_would_garble():

@@ -19,7 +19,7 @@ from dataclasses import replace
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.engines import pysim, verilator
-from rasterhw.sim.testbench import Run, Stimulus, Testbench
+from rasterhw.sim.testbench import Run, Stimulus, Testbench, clocks_of
 
 __all__ = ["ENGINES", "run", "with_gaps"]
 
@@ -28,7 +28,7 @@ ENGINES = {"pysim": pysim.run, "verilator": verilator.run}
 
 def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", idle: float = 0.0, stall: int = 0,
         seed: int = 1, expect_words: dict[str, int] | None = None, max_cycles: int | None = None,
-        build: dict | None = None) -> Run:
+        build: dict | None = None, clocks: dict | None = None) -> Run:
     """Run ``stim`` through block ``tb.block`` with ``params`` on ``engine``.
 
     ``idle`` (0 <= idle < 1): every input word without a gap of its own in ``stim`` waits a random
@@ -39,7 +39,11 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
     ``seed + k`` unless the testbench says otherwise).
     ``expect_words``: words to collect per output port (the run ends when all have come);
     ``max_cycles``: a watchdog (default: 10,000 + 64 clocks per word in and out, scaled up by the
-    idle gaps and the stalls; a block that stops gives a one-line error, not a hang).
+    idle gaps and the stalls; a block that stops gives a one-line error, not a hang), in edges of
+    the reference clock (the block's first domain, ``sync``).
+    ``clocks``: ``{domain: Clock | half period | (half, first edge)}`` for every domain of the block
+    (``tb.domains``): separate clocks (``sim/testbench.py``: :class:`Clock`); each port's gaps,
+    back-pressure and stamps then count its own domain's edges. None: every domain on one clock.
     """
     if engine not in ENGINES:
         raise RasterhwError(f"engine must be one of {', '.join(ENGINES)}, not {engine!r}")
@@ -52,6 +56,11 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
         # output k's back-pressure is the xorshift seeded seed + k: from 0 it stays 0 (never ready)
         raise RasterhwError(f"seed {seed} gives an output a back-pressure seed of 0 (xorshift stays 0: "
                             "ready never rises); use another seed")
+    kw = {}
+    if clocks is not None:
+        if tb.domains[0] != "sync":
+            raise RasterhwError(f"{tb.block}: separate clocks need the domains with sync first, not {tb.domains}")
+        kw["clocks"] = clocks_of(clocks, tb.domains)
     if idle:
         stim = with_gaps(stim, idle, seed, tb.inputs_of(params))
     if expect_words is None:
@@ -60,9 +69,13 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
         words = sum(len(w) for w in stim.words.values()) + sum(expect_words.values())
         gaps = sum(int(np.sum(g, dtype=np.int64)) for g in stim.gaps.values())
         max_cycles = (10_000 + 64 * words + gaps) * (1 + stall // 32)
+        if "clocks" in kw:   # a slower clock than the reference takes more reference edges
+            slow = max(c.half for c in kw["clocks"].values()) / kw["clocks"]["sync"].half
+            max_cycles = int(max_cycles * max(1.0, slow))
     if build and engine != "verilator":
         raise RasterhwError(f"build settings are for the verilator engine, not {engine}")
-    kw = {"build": build} if build else {}
+    if build:
+        kw["build"] = build
     return ENGINES[engine](tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
                            max_cycles=max_cycles, **kw)
 

@@ -1,5 +1,6 @@
 """The Amaranth pysim engine: the block itself in the simulator, every clock domain clocked
-together; one source per input port (:func:`rasterhw.sim.engines.harness.stream_put` after each word's
+together (or each by its own :class:`~rasterhw.sim.testbench.Clock`: ``add_clock`` with its period
+and phase, one time unit = 1 ns); one source per input port (:func:`rasterhw.sim.engines.harness.stream_put` after each word's
 gap) and one sink per output port (back-pressure from :mod:`pattern`, every transfer stamped
 with its edge)."""
 
@@ -64,13 +65,23 @@ def _sinks(sinks: list, domain, max_cycles, finished, read_status):
     return bench
 
 
+#: seconds per time unit of a run's clocks
+_UNIT_S = 1e-9
+
+
 def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, expect_words: dict[str, int],
-        max_cycles: int) -> Run:
+        max_cycles: int, clocks: dict | None = None) -> Run:
     t0 = time.perf_counter()
     dut = tb.dut(params)
     sim = Simulator(dut)
-    for d in tb.domains:
-        sim.add_clock(1e-8, domain=d)
+    if clocks:
+        # a clock's phase is its first rising edge; every edge after time 0 (the times are relative)
+        after = max(c.half for c in clocks.values())
+        for d, c in clocks.items():
+            sim.add_clock(2 * c.half * _UNIT_S, phase=(after + c.first) * _UNIT_S, domain=d)
+    else:
+        for d in tb.domains:
+            sim.add_clock(1e-8, domain=d)
     errors: list[str] = []
     for name in tb.inputs_of(params):
         port = port_of(dut, name)
@@ -95,7 +106,9 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
         by_domain.setdefault(d, []).append((name, port, expect_words[name], words[name], stamps[name],
                                             ready_pattern(tb.sink_seed(params, k, seed), stall)))
     for d, sinks in by_domain.items():
-        sim.add_testbench(_sinks(sinks, d, max_cycles, finished, read_status))
+        # the watchdog counts reference-clock edges: as many of this domain's as fit in their time
+        limit = max_cycles if not clocks else -(-max_cycles * clocks["sync"].half // clocks[d].half)
+        sim.add_testbench(_sinks(sinks, d, limit, finished, read_status))
     # with --waves: the GTKWave save file shows these ports, one group each (sim/engines/waves.py)
     declare_streams(sim, {name: port_of(dut, name) for name in (*tb.inputs_of(params), *tb.outputs_of(params))})
     t1 = time.perf_counter()
@@ -103,4 +116,5 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
     if errors:
         raise RasterhwError(f"pysim: {tb.block} broke the stream rules: {errors[0]}")
     return Run("pysim", words, stamps, wall_s=time.perf_counter() - t0, run_s=time.perf_counter() - t1,
-               status=status)
+               status=status, clocks=dict(clocks or {}),
+               port_domains={n: tb.domain_of(n) for n in outs} if clocks else {})

@@ -1,6 +1,8 @@
 """The plain-Verilator engine: a bench top generated from Amaranth around the block (one
 ``rasterhw_stream_source`` per input port, one ``rasterhw_stream_sink`` per output port, both in
-``cocotb_tests/harness.v``; every clock domain of the block driven by the one clock), built once
+``cocotb_tests/harness.v``; every clock domain of the block driven by the one clock, or, for a run
+with separate clocks, each domain by its own bit of a ``clocks`` port that the main toggles on the
+domain's schedule: one build for every set of half periods and phases), built once
 per design and memory depth with the one C++ main (``cocotb_tests/plain_main.cpp``), the stimulus
 loaded at run time (``$fread`` of each port's packed ``{gap, word}`` records, :mod:`packed`: no
 Python int or text line per word) and the words and cycle stamps dumped at the end
@@ -8,7 +10,6 @@ Python int or text line per word) and the words and cycle stamps dumped at the e
 
 from __future__ import annotations
 
-import hashlib
 import inspect
 import json
 import os
@@ -38,15 +39,14 @@ from rasterhw.sim.engines.runner import (
     run_plain_verilator,
 )
 from rasterhw.sim.engines.verilog import canonical_port_lists
-from rasterhw.sim.engines.verilog_cache import convert_cached
+from rasterhw.sim.engines.verilog_cache import convert_cached, module_sources, sources_digest
 from rasterhw.sim.paths import BUILD_ROOT
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
 from rasterhw.sim.workdirs import build_lock, release, temp_run_folder
 
-__all__ = ["GAP_BITS", "PGO_OPT", "BenchTop", "profile", "run", "unpack_status"]
+__all__ = ["GAP_BITS", "PGO_OPT", "BenchTop", "bench_sources", "profile", "run", "unpack_status"]
 
 GAP_BITS = 8          # idle clocks before a word: 0..255
-_SELF = hashlib.sha1(Path(__file__).read_bytes()).hexdigest()[:12]   # this file is part of the design
 
 
 def _tag(path: str) -> str:
@@ -71,29 +71,51 @@ def _payload(port):
 class BenchTop(Elaboratable):
     """The block with a source on every input port and a sink on every output port; ports
     ``clk``, ``done`` (every source played out and every sink full), ``cycles`` (edges so far) and
-    ``errors`` (clocks that broke the stream rules, every port: ``rasterhw_stream_check``)."""
+    ``errors`` (clocks that broke the stream rules, every port: ``rasterhw_stream_check``).
+
+    ``port_domains`` (``{port: domain}`` of every stream port): separate clocks; the top then has
+    ``clocks`` (bit ``k``: domain ``domains[k]``'s clock, ``sync`` first) instead of ``clk``, each
+    port's source, sink and checker run on its domain's clock and a sink stamps its words with its
+    domain's edge count (``cycles`` for ``sync``). None: every domain on ``clk``."""
 
     def __init__(self, dut, inputs: dict[str, int], outputs: dict[str, int], domains: tuple[str, ...],
-                 status: dict | None = None):
+                 status: dict | None = None, port_domains: dict[str, str] | None = None):
         self.dut = dut
         self._status = dict(status or {})
         self._inputs, self._outputs, self._domains = inputs, outputs, domains
+        self._port_domains = port_domains
         self.cd = ClockDomain("sync", reset_less=True)
         self.done = Signal(name="done")
         self.cycles = Signal(32, name="cycles")
         self.errors = Signal(32, name="errors")
         self.status = Signal(64, name="status")   # the testbench's status values, packed in order
-        self.ports = [self.cd.clk, self.done, self.cycles, self.errors, self.status]
+        if port_domains is None:
+            self.ports = [self.cd.clk, self.done, self.cycles, self.errors, self.status]
+        else:
+            self.clocks = Signal(len(domains), name="clocks")
+            self.ports = [self.clocks, self.done, self.cycles, self.errors, self.status]
 
     def elaborate(self, platform):
         m = Module()
         m.domains.sync = self.cd
-        for d in self._domains:
-            if d != "sync":   # every domain of the block runs on the one clock
+        separate = self._port_domains is not None
+        counters = {"sync": self.cycles}
+        for k, d in enumerate(self._domains):
+            if d != "sync":
                 m.domains += ClockDomain(d, reset_less=True)
+            if separate:   # each domain on its own bit of `clocks`, with its own edge count
+                m.d.comb += ClockSignal(d).eq(self.clocks[k])
+                if d != "sync":
+                    counters[d] = Signal(32, name=f"cycles_{d}")
+                    m.d[d] += counters[d].eq(counters[d] + 1)
+            elif d != "sync":   # every domain of the block runs on the one clock
                 m.d.comb += ClockSignal(d).eq(ClockSignal("sync"))
         m.submodules.dut = self.dut
         m.d.sync += self.cycles.eq(self.cycles + 1)
+
+        def dom(name):
+            return self._port_domains[name] if separate else "sync"
+
         dones, errors = [], []
         for name, depth in self._inputs.items():
             port, t = port_of(self.dut, name), _tag(name)
@@ -101,11 +123,11 @@ class BenchTop(Elaboratable):
             m.submodules[f"src_{t}"] = Instance(
                 "rasterhw_stream_source", p_PW=len(_payload(port)), p_GW=GAP_BITS, p_DEPTH=depth,
                 p_FILE_ARG=f"{t}=%s", p_COUNT_ARG=f"{t}_n=%d", p_BINARY=1,
-                i_clk=ClockSignal("sync"), i_rst=Const(0, 1), i_base=Const(0, 32), i_count=Const(0, 32),
+                i_clk=ClockSignal(dom(name)), i_rst=Const(0, 1), i_base=Const(0, 32), i_count=Const(0, 32),
                 i_repeats=Const(1, 32),
                 o_valid=port.valid, i_ready=port.ready, o_payload=_payload(port), o_done=ok)
             dones.append(ok)
-            errors.append(_check(m, t, port))
+            errors.append(_check(m, t, port, dom(name)))
         for name, depth in self._outputs.items():
             port, t = port_of(self.dut, name), _tag(name)
             ok = Signal(name=f"{t}_done")
@@ -113,44 +135,67 @@ class BenchTop(Elaboratable):
                 "rasterhw_stream_sink", p_PW=len(_payload(port)), p_DEPTH=depth,
                 p_FILE_ARG=f"{t}=%s", p_CYC_ARG=f"{t}_cyc=%s", p_COUNT_ARG=f"{t}_n=%d",
                 p_STALL_ARG=f"{t}_stall=%d", p_SEED_ARG=f"{t}_seed=%d",
-                i_clk=ClockSignal("sync"), i_cycle=self.cycles, i_valid=port.valid, o_ready=port.ready,
+                i_clk=ClockSignal(dom(name)), i_cycle=counters[dom(name)], i_valid=port.valid, o_ready=port.ready,
                 i_payload=_payload(port), o_done=ok)
             dones.append(ok)
-            errors.append(_check(m, t, port))
+            errors.append(_check(m, t, port, dom(name)))
         m.d.comb += [self.done.eq(Cat(*dones).all()), self.errors.eq(sum(errors, Const(0, 32)))]
         if self._status:
             m.d.comb += self.status.eq(Cat(*self._status.values()))
         return m
 
 
-def _check(m: Module, tag: str, port) -> Signal:
-    """A stream-rule checker on ``port`` (``rasterhw_stream_check``); its count of bad clocks."""
+def _check(m: Module, tag: str, port, domain: str = "sync") -> Signal:
+    """A stream-rule checker on ``port`` (``rasterhw_stream_check``) on ``domain``'s clock; its
+    count of bad clocks."""
     err = Signal(32, name=f"{tag}_errors")
     m.submodules[f"check_{tag}"] = Instance(
-        "rasterhw_stream_check", p_PW=len(_payload(port)), i_clk=ClockSignal("sync"), i_rst=Const(0, 1),
+        "rasterhw_stream_check", p_PW=len(_payload(port)), i_clk=ClockSignal(domain), i_rst=Const(0, 1),
         i_valid=port.valid, i_ready=port.ready, i_payload=_payload(port), o_errors=err,
         o_transfers=Signal(32, name=f"{tag}_transfers"))
     return err
 
 
-def _design(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[str, int], speed: bool):
-    """(build name, generated files) of the bench top around ``tb``'s block; ``speed``: the
-    testbench's speed Verilog (:meth:`Testbench.sim_verilog`)."""
-    # the testbench's own module builds the DUT's adapter (e.g. a read-out): its bytes are design too
-    tb_src = hashlib.sha1(Path(inspect.getfile(type(tb))).read_bytes()).hexdigest()[:12]
-    key = {**params, "inputs": inputs, "outputs": outputs, "bench": _SELF, "testbench": tb_src,
-           **({"speed": True} if speed else {})}
+def bench_sources(tb: Testbench) -> list[Path]:
+    """The Python files the bench top around ``tb``'s block is made from, beside the block's own
+    (``verilog_cache.design_sources``): this engine's module and the module of ``tb``'s class and
+    of each class it derives from (they build the DUT, its adapters and read-outs, its status
+    values and speed Verilog), each with every module of ours it imports, transitively
+    (``verilog_cache.module_sources``: the same rule as the block's)."""
+    roots = [Path(__file__)] + [f for c in type(tb).__mro__ if (f := _class_file(c)) is not None]
+    return module_sources(roots)
+
+
+def _class_file(cls) -> Path | None:
+    """The source file of class ``cls`` (None for a built-in one, such as ``object``)."""
+    try:
+        return Path(inspect.getfile(cls))
+    except TypeError:
+        return None
+
+
+def _design(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[str, int], speed: bool,
+            separate: bool = False):
+    """(build name, generated files, the main's defines) of the bench top around ``tb``'s block;
+    ``speed``: the testbench's speed Verilog (:meth:`Testbench.sim_verilog`); ``separate``: one
+    clock per domain (one build serves every set of clocks: they are run-time arguments)."""
+    # what builds the DUT and its adapters (the testbench's modules and all they import) is design too
+    key = {**params, "inputs": inputs, "outputs": outputs, "bench": sources_digest(bench_sources(tb))[:16],
+           **({"speed": True} if speed else {}), **({"clocks": list(tb.domains)} if separate else {})}
+    port_domains = {n: tb.domain_of(n) for n in (*inputs, *outputs)} if separate else None
 
     def top():
         dut = tb.dut(params)
-        return BenchTop(dut, inputs, outputs, tb.domains, _status(tb, dut, params))
+        return BenchTop(dut, inputs, outputs, tb.domains, _status(tb, dut, params), port_domains)
 
     def convert(top, mod):
         text = canonical_port_lists(verilog.convert(top, name=mod, ports=top.ports)) + _extra(top.dut)
         return tb.sim_verilog(params, text) if speed else text
 
     text = convert_cached(tb.block, top, params=key, module="rasterhw_bench", convert=convert)
-    return f"tb-{tb.block}", {"rasterhw_bench.v": text}
+    if separate:   # the main toggles bit k of `clocks` on domain k's own schedule
+        return f"tb-{tb.block}-clocks", {"rasterhw_bench.v": text}, {**_DEFINES, "RASTERHW_CLOCKS": len(tb.domains)}
+    return f"tb-{tb.block}", {"rasterhw_bench.v": text}, _DEFINES
 
 
 _DEFINES = {"RASTERHW_CYCLES": 1, "RASTERHW_ERRORS": 1, "RASTERHW_STATUS": 1}
@@ -174,8 +219,8 @@ def unpack_status(st: dict, word: int) -> dict[str, int]:
 
 
 def _build(design, opt: str, pgo=None) -> tuple[Path, float]:
-    name, generated = design
-    return build_plain_verilator(name, "rasterhw_bench", [HARNESS_V], params={}, opt=opt, defines=_DEFINES,
+    name, generated, defines = design
+    return build_plain_verilator(name, "rasterhw_bench", [HARNESS_V], params={}, opt=opt, defines=defines,
                                  generated=generated, pgo=pgo)
 
 
@@ -210,9 +255,9 @@ def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outp
     ``build/pgo/<the instrumented build's folder>/``. Paid once per design: a cached profile is
     returned as it is; ``train=False`` returns None instead of training, and so does a testbench
     without a training stimulus or one that does not fit these memories."""
-    name, generated = design
+    name, generated, defines = design
     prof = BUILD_ROOT / "pgo" / plain_build_dir(name, "rasterhw_bench", [HARNESS_V], params={}, opt=opt,
-                                                 defines=_DEFINES, generated=generated, pgo="generate").name
+                                                 defines=defines, generated=generated, pgo="generate").name
     if (prof / "trained.json").exists():
         return prof
     stim = tb.train_stimulus(params) if train else None
@@ -241,29 +286,32 @@ def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outp
 
 
 def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, expect_words: dict[str, int],
-        max_cycles: int, build: dict | None = None) -> Run:
+        max_cycles: int, build: dict | None = None, clocks: dict | None = None) -> Run:
     t0 = time.perf_counter()
     speed, opt, pgo, depth = _settings(build, tb.verilator_opt)
     inputs = {n: _depth(max(len(stim.words[n]), depth - 2)) for n in tb.inputs_of(params)}
     outputs = {n: _depth(expect_words[n]) for n in tb.outputs_of(params)}
-    design = _design(tb, params, inputs, outputs, speed)
+    design = _design(tb, params, inputs, outputs, speed, separate=bool(clocks))
     prof = profile(tb, params, design, inputs=inputs, outputs=outputs, opt=opt or PGO_OPT,
                    train=pgo is True) if pgo else None
     opt = opt or (PGO_OPT if prof is not None else tb.verilator_opt)
     exe, build_s = _build(design, opt, pgo=prof)
     dut = tb.dut(params)   # for the port widths and the status values' names and widths (not simulated)
     words, stamps, meta, _ = _run_exe(exe, tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
-                                      inputs=inputs, max_cycles=max_cycles, dut=dut)
+                                      inputs=inputs, max_cycles=max_cycles, dut=dut, clocks=clocks)
     status = unpack_status(_status(tb, dut, params), int(meta.get("status", 0)))
     return Run("verilator", words, stamps, wall_s=time.perf_counter() - t0, build_s=build_s, run_s=meta["run_s"],
                protocol_errors=int(meta.get("errors", 0)), status=status,
-               build={"speed": speed, "opt": opt, "pgo": prof is not None})
+               build={"speed": speed, "opt": opt, "pgo": prof is not None}, clocks=dict(clocks or {}),
+               port_domains={n: tb.domain_of(n) for n in tb.outputs_of(params)} if clocks else {})
 
 
 def _run_exe(exe: Path, tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int,
              expect_words: dict[str, int], inputs: dict[str, int], max_cycles: int, profile: Path | None = None,
-             dut=None):
-    """One run of a bench binary: (words, stamps, the main's JSON line, cycles)."""
+             dut=None, clocks: dict | None = None):
+    """One run of a bench binary: (words, stamps, the main's JSON line, cycles). ``clocks``
+    (``{domain: Clock}``, a build with separate clocks): each domain's half period and first
+    edge, as ``+clock_K=HALF,FIRST`` (the main's default: every clock the same)."""
     outs = tb.outputs_of(params)
     dut = tb.dut(params) if dut is None else dut
     widths = {n: len(_payload(port_of(dut, n))) for n in inputs}
@@ -282,6 +330,9 @@ def _run_exe(exe: Path, tb: Testbench, params: dict, stim: Stimulus, *, stall: i
             t = _tag(n)
             plus += [f"+{t}={run_dir / f'{t}.out'}", f"+{t}_cyc={run_dir / f'{t}.cyc'}", f"+{t}_n={expect_words[n]}",
                      f"+{t}_stall={stall}", f"+{t}_seed={tb.sink_seed(params, k, seed) & 0xFFFF_FFFF}"]
+        # every edge after time 0 (the times are relative), as on pysim
+        after = max((c.half for c in (clocks or {}).values()), default=0)
+        plus += [f"+clock_{k}={c.half},{after + c.first}" for k, c in enumerate((clocks or {}).values())]
         meta = run_plain_verilator(exe, plus, run_dir=run_dir, maxcyc=max_cycles, profile=profile)
         words, stamps = {}, {}
         for n in outs:

@@ -12,19 +12,22 @@ Files go to ``build/verilog/<name>-<digest>.v``, written atomically.
 
 from __future__ import annotations
 
+import ast
 import hashlib
 import json
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from functools import cache
 from pathlib import Path
 
+import amaranth
 from amaranth.back import verilog
 from rasterhw.sim.engines.verilog import canonical_port_lists, generate_verilog
 from rasterhw.sim.outfile import write_text
 from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT
 from rasterhw.sim.registry import blocks
 
-__all__ = ["convert_cached", "design_sources", "generate_cached", "source_digest", "write_verilog"]
+__all__ = ["convert_cached", "design_sources", "generate_cached", "module_sources", "source_digest", "sources_digest",
+           "write_verilog"]
 
 PKG_ROOT = REPO_ROOT
 
@@ -43,35 +46,52 @@ def _module_file(mod: str) -> Path | None:
 
 def _imported_files(f: Path) -> set[Path]:
     """Our modules that ``f`` imports (anywhere in it: lazy imports count), by name: for
-    ``from pkg import name`` the submodule ``pkg.name`` if it is one, else ``pkg``."""
-    import ast
+    ``from pkg import name`` the submodule ``pkg.name`` if it is one, else ``pkg``; a relative
+    import (``from .helper import x``) is the file beside ``f`` it names."""
+    st = f.stat()
+    return _imports_of(f, st.st_mtime_ns, st.st_size)
 
+
+@cache
+def _imports_of(f: Path, _mtime_ns: int, _size: int) -> frozenset[Path]:
+    """:func:`_imported_files` of ``f`` as it is at this modification time and size (parsed once)."""
     out: set[Path] = set()
     for node in ast.walk(ast.parse(f.read_bytes(), str(f))):
         if isinstance(node, ast.Import):
-            mods = [a.name for a in node.names]
-        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
-            mods = []
+            out |= {m for m in (_module_file(a.name) for a in node.names) if m is not None}
+        elif isinstance(node, ast.ImportFrom) and node.level:
+            base = f.parent
+            for _ in range(node.level - 1):
+                base = base.parent
+            if node.module:
+                base = base.joinpath(*node.module.split("."))
             for a in node.names:
-                sub = _module_file(f"{node.module}.{a.name}")
-                mods.append(f"{node.module}.{a.name}" if sub is not None else node.module)
-        else:
-            continue
-        out |= {m for m in map(_module_file, mods) if m is not None}
-    return out
+                hit = _file_at(base / a.name) or _file_at(base)
+                if hit is not None:
+                    out.add(hit)
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            for a in node.names:
+                m = _module_file(f"{node.module}.{a.name}") or _module_file(node.module)
+                if m is not None:
+                    out.add(m)
+    return frozenset(out)
 
 
-def design_sources(block: str | None = None) -> list[Path]:
-    """Every Python file the generated Verilog of ``block`` (a ``rasterhw verilog --list`` name)
-    can depend on: the module of its factory, the Verilog generator (``sim/engines/verilog.py``) and,
-    transitively, every module of ours they import (its HDL submodules, the formats modules in
-    ``golden_model/`` the HDL takes its widths from), and nothing else, so an edit to another
-    block or to a golden algorithm does not regenerate (or rebuild) it. ``block=None`` (or a name
-    that is not a registered block): all of ``hdl/`` as the roots."""
-    ref = blocks().get(block) if block else None
-    root = _module_file(ref.split(":")[0]) if ref else None
-    todo = [root] if root is not None else sorted((PKG_ROOT / "hdl").rglob("*.py"))
-    todo.append(PKG_ROOT / "sim" / "engines" / "verilog.py")
+def _file_at(base: Path) -> Path | None:
+    """The module at ``base`` (``base.py`` or a package's ``base/__init__.py``), None if neither."""
+    for f in (base.with_suffix(".py"), base / "__init__.py"):
+        if f.is_file():
+            return f
+    return None
+
+
+def module_sources(roots: Iterable[Path]) -> list[Path]:
+    """The Python files ``roots`` and, transitively, every module of ours they import (anywhere in
+    a module: imports inside functions count), with the ``__init__.py`` of every package of ours
+    on the way (importing a module runs them). Ours: ``rasterhw.*`` under the package root, and
+    what a relative import names. The one rule of every cache key on Python sources here:
+    :func:`design_sources` (a block's Verilog) and the Verilator engine's bench tops."""
+    todo = [Path(r).resolve() for r in roots]
     seen: set[Path] = set()
     while todo:
         f = todo.pop()
@@ -86,16 +106,33 @@ def design_sources(block: str | None = None) -> list[Path]:
     return sorted(seen | inits)
 
 
+def sources_digest(files: Iterable[Path]) -> str:
+    """Digest of the Amaranth version and the names and bytes of ``files`` (ours by their path in
+    the package, so a checkout elsewhere gives the same digest; others by their file name)."""
+    h = hashlib.sha1(amaranth.__version__.encode())
+    for f in files:
+        h.update(str(f.relative_to(PKG_ROOT) if PKG_ROOT in f.parents else f.name).encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def design_sources(block: str | None = None) -> list[Path]:
+    """Every Python file the generated Verilog of ``block`` (a ``rasterhw verilog --list`` name)
+    can depend on: the module of its factory, the Verilog generator (``sim/engines/verilog.py``) and,
+    transitively, every module of ours they import (its HDL submodules, the formats modules in
+    ``golden_model/`` the HDL takes its widths from; :func:`module_sources`), and nothing else, so
+    an edit to another block or to a golden algorithm does not regenerate (or rebuild) it.
+    ``block=None`` (or a name that is not a registered block): all of ``hdl/`` as the roots."""
+    ref = blocks().get(block) if block else None
+    root = _module_file(ref.split(":")[0]) if ref else None
+    roots = [root] if root is not None else sorted((PKG_ROOT / "hdl").rglob("*.py"))
+    return module_sources([*roots, PKG_ROOT / "sim" / "engines" / "verilog.py"])
+
+
 @cache
 def source_digest(block: str | None = None) -> str:
     """Digest of the Amaranth version and every file of :func:`design_sources` (once per process)."""
-    import amaranth
-
-    h = hashlib.sha1(amaranth.__version__.encode())
-    for f in design_sources(block):
-        h.update(str(f.relative_to(PKG_ROOT)).encode())
-        h.update(f.read_bytes())
-    return h.hexdigest()
+    return sources_digest(design_sources(block))
 
 
 def convert_cached(name: str, factory: Callable[[], object], *, params: Mapping[str, object],
@@ -139,7 +176,6 @@ def verilog_header(name: str, **params) -> str:
     import inspect
     from importlib.metadata import PackageNotFoundError, version
 
-    import amaranth
     from rasterhw.sim.engines.verilog import make_block
     from rasterhw.sim.registry import load
 

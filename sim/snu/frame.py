@@ -16,8 +16,6 @@ Flow (``frame_run``):
 3. **Pixel bus (HDL)**: the generic Verilator engine (``sim/engines/``) with the frame adapter
    ``sim/snu/frame_adapter.py`` (``FrameBench``): CLEAR, the two streams with their 16-bit gaps,
    SWAP, read-out of the displayed frame and of the schedule; cycles from the DUT's own counter.
-   (``run_frame_hdl`` runs the older dedicated bench ``cocotb_tests/snu/tb_pixelbus_fast.v``,
-   which gives the same schedule and frame.)
 4. **Golden**: the same schedule in ``golden_model.snu.pixelbus`` (clear length, release of
    the players, every acceptance cycle, swap) and the same frame; ``mismatches`` counts pixels
    that differ plus one per schedule number that differs.
@@ -28,9 +26,7 @@ Times are reported at the paper's clocks: 12.5 MHz bus (80 ns slot), i860 at
 
 from __future__ import annotations
 
-import os
 import time
-from pathlib import Path
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
@@ -38,24 +34,13 @@ from rasterhw.golden_model.snu import i860
 from rasterhw.golden_model.snu import pixelbus as golden
 from rasterhw.golden_model.snu.formats import CLOCK_HZ, MEM_CYCLE, N_BANKS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
-from rasterhw.sim.engines.memh import memh_uint64, read_memh
-from rasterhw.sim.engines.runner import (
-    HARNESS_V,
-    REPO_ROOT,
-    build_plain_verilator,
-    run_plain_verilator,
-)
-from rasterhw.sim.workdirs import release, temp_run_folder
 
-__all__ = ["BENCH", "clear_cycles", "frame_run", "golden_schedule", "producer_gaps", "run_frame_engine",
-           "run_frame_hdl"]
+__all__ = ["clear_cycles", "frame_run", "golden_schedule", "producer_gaps", "run_frame_engine"]
 
-BENCH = REPO_ROOT / "cocotb_tests" / "snu" / "tb_pixelbus_fast.v"
-TOP = "tb_pixelbus_fast"
 GAP_BITS = 16
 #: clocks from the end of the clear (``clear_cycles`` after its accept) to the first clock the
-#: bench's players run: ``idle`` rises one clock after the clear's last word, the bench sees it
-#: and releases the players in the next clock (tb_pixelbus_fast.v, S_WAIT -> S_RUN)
+#: pipelines run: ``idle`` rises one clock after the clear's last word, the frame adapter sees it
+#: and releases the pipelines in the next clock (``sim/snu/frame_adapter.py``: ``run``, then ``t_start``)
 RELEASE_DELAY = 2
 
 
@@ -170,72 +155,11 @@ def golden_schedule(stream: PixelStream, gaps: np.ndarray, first_work: list[floa
             "cycles": t_pix + 2, "accept": acc, "first_bench_gap": first_bench}
 
 
-def _stim_bytes(gap, z, rgb, addr) -> bytes:
-    """12 bytes per write, big-endian {gap[15:0], z[23:0], rgb[23:0], addr[31:0]} (the bench's
-    $fread layout); one zero word for an empty pipeline."""
-    n = len(gap)
-    out = np.zeros((max(n, 1), 12), dtype=np.uint8)
-    for col, (v, nbytes) in zip((0, 2, 5, 8), ((gap, 2), (z, 3), (rgb, 3), (addr, 4)), strict=True):
-        v = np.asarray(v, dtype=np.uint64)
-        for k in range(nbytes):
-            out[:n, col + k] = (v >> np.uint64(8 * (nbytes - 1 - k))) & np.uint64(255)
-    return out.tobytes()
-
-
-def _read_frame(path: Path, npix: int) -> tuple[np.ndarray, np.ndarray]:
-    """The bench's {rgb, z} dump -> (rgb, z) int64 (npix,)."""
-    b = read_memh(path, npix)
-    b = np.concatenate([np.zeros((npix, max(0, 6 - b.shape[1])), np.uint8), b], axis=1)[:, -6:]
-    return memh_uint64(b, 0, 3).astype(np.int64), memh_uint64(b, 3, 6).astype(np.int64)
-
-
-def run_frame_hdl(stream: PixelStream, gaps: np.ndarray, first_bench_gap: list[int]) -> dict:
-    """Build (once) and run tb_pixelbus_fast.v on ``stream``; returns the schedule numbers, the
-    displayed frame (rgb, z) and timings."""
-    from amaranth.utils import ceil_log2
-    from rasterhw.sim.engines.verilog_cache import generate_cached
-
-    w, h = stream.width, stream.height
-    npix = w * h
-    aw = max(1, ceil_log2(npix))
-    if aw > 32:
-        raise RasterhwError("frame too large for the fast bench's 32-bit address field")
-    idx = [np.flatnonzero(stream.pipe == p) for p in range(2)]
-    sdepth = max(1024, 1 << ceil_log2(max(len(i) for i in idx) + 2))
-    t0 = time.perf_counter()
-    ram = "memory" if -(-npix // N_BANKS) <= 4096 else "verilog"
-    text = generate_cached("pixelbus", width=w, height=h, z_bits=stream.z_bits, ram=ram)
-    exe, build_s = build_plain_verilator("snu-pixelbus-fast", TOP, [HARNESS_V, BENCH],
-                                         params={"AW": aw, "ZW": stream.z_bits, "NPIX": npix, "SDEPTH": sdepth},
-                                         generated={"pixelbus.v": text}, defines={"RASTERHW_CYCLES": 1})
-    run_dir = temp_run_folder(exe.parent.parent)   # removed on Ctrl-C / SIGTERM too (workdirs.cleanup)
-    g = np.asarray(gaps, dtype=np.int64).copy()
-    counts = []
-    for p in range(2):
-        i = idx[p]
-        if i.size:
-            g[i[0]] = first_bench_gap[p]
-        (run_dir / f"stim{p}.bin").write_bytes(_stim_bytes(g[i], stream.z[i], stream.rgb[i], stream.addr[i]))
-        counts.append(int(i.size))
-    t1 = time.perf_counter()
-    maxcyc = clear_cycles(w, h) + 8 * (len(stream) + int(g.sum())) + npix + 10_000
-    meta = run_plain_verilator(exe, [f"+stim0={run_dir / 'stim0.bin'}", f"+stim1={run_dir / 'stim1.bin'}",
-                                     f"+n0={counts[0]}", f"+n1={counts[1]}", f"+out={run_dir / 'frame.hex'}",
-                                     f"+meta={run_dir / 'meta.txt'}"], run_dir=run_dir, maxcyc=maxcyc)
-    t2 = time.perf_counter()
-    rgb, z = _read_frame(run_dir / "frame.hex", npix)
-    sched = [int(x) for x in (run_dir / "meta.txt").read_text().split()]
-    if os.environ.get("PIXELBUS_KEEP") != "1":
-        release(run_dir)
-    return {"t_clear": sched[0], "t_start": sched[1], "t_pixels_done": sched[2], "t_swap": sched[3],
-            "cycles": sched[4], "rgb": rgb.reshape(h, w), "z": z.reshape(h, w), "build_s": build_s,
-            "prepare_s": t1 - t0, "run_s": t2 - t1, "sim_cycles": meta["sim_cycles"], "loop_s": meta["run_s"]}
-
-
 def run_frame_engine(stream: PixelStream, gaps: np.ndarray, sched: dict, *, engine: str = "verilator") -> dict:
-    """The frame on the generic engines (``FrameBench``: ``sim/snu/frame_adapter.py``), the same
-    keys as :func:`run_frame_hdl` plus ``mismatches`` (read-out and schedule words that differ
-    from the golden ``sched``)."""
+    """The frame on the generic engines (``FrameBench``: ``sim/snu/frame_adapter.py``): the
+    schedule numbers (:data:`~rasterhw.sim.snu.frame_adapter.SCHEDULE`), the displayed frame
+    (``rgb``, ``z``), ``mismatches`` (read-out and schedule words that differ from the golden
+    ``sched``) and timings."""
     from rasterhw.sim import engines
     from rasterhw.sim.snu.testbench import FrameBench
     from rasterhw.sim.testbench import compare

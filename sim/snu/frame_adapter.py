@@ -2,7 +2,7 @@
 """Bench adapter of the SNU headline frame: the pixel bus drawing one whole frame as the machine
 does, on the generic engines (``sim/engines/``), beside :class:`~rasterhw.sim.snu.readout.ReadOut`.
 
-The schedule is the one ``cocotb_tests/snu/tb_pixelbus_fast.v`` plays:
+The schedule (the one the frame's dedicated Verilog bench played before this adapter replaced it):
 
 1. CLEAR is offered in the first clock;
 2. once the bus is idle again the two pipelines run: each write is offered ``gap`` clocks after

@@ -80,28 +80,34 @@ PLAIN_BUILD = {"speed": False, "opt": "-O1", "pgo": False}
 
 def run_scene(eps_per_unit: list, *, width: int, height: int, interleave: int, schedule: str = "overlap",
               capacity: int = F.AEP_CAPACITY, engine: str = "verilator", stall: int = 0, seed: int = 1,
-              gap_seed: int | None = None, build: dict | None = None, line_log: bool = False) -> dict:
+              gap_seed: int | None = None, build: dict | None = None, line_log: bool = False,
+              clocks: dict | None = None) -> dict:
     """Edge pairs through ``len(eps_per_unit)`` chained ZB/M units (unit ``k`` gets
     ``eps_per_unit[k]``; a scene's: ``testbench.deal``) on the generic engine (the ``zbm-unit``
     testbench, :class:`rasterhw.sim.zbm.testbench.UnitBench`): ``{"s0", "s1": (H, W) uint64 frame,
     "cycles" (segment clocks until the last merge word), "proto_errors", "run_s" (the clock loop on
     Verilator; the simulation on pysim), "build_s", "build", "frames_ok", "overflow", ["line_cycles"]}``. ``build``:
     Verilator build settings (default :data:`SPEED_BUILD`); ``stall``, ``seed``: back-pressure on
-    every merge slot; ``gap_seed``: random idle gaps on the edge-pair input (None: none)."""
+    every merge slot; ``gap_seed``: random idle gaps on the edge-pair input (None: none); ``clocks``:
+    separate segment and merge clocks (``{"sync": Clock, "merge": Clock}``, e.g. the cocotb bench's at
+    a ratio: ``unit_bench.bench_clocks``; one build for every ratio; "cycles" and "line_cycles" stay
+    in segment clocks); None: one clock for both."""
     tb = find_testbench("zbm-unit")
     p = tb.params(interleave=interleave, width=width, height=height, capacity=capacity, schedule=schedule,
                   units=len(eps_per_unit))
     stim = tb.scene_stimulus(p, eps_per_unit, gap_seed=gap_seed)
     exp = tb.expect(p, stim)
     want = {k: len(v) for k, v in exp.words.items()}
-    cap = unit_watchdog(sum(map(len, stim.words.values())), width=width, height=height, stall=stall)
+    cap = unit_watchdog(sum(map(len, stim.words.values())), width=width, height=height, stall=stall,
+                        ratio=(clocks["sync"].half, clocks["merge"].half) if clocks else (5, 5))
     got = run_engine(tb, p, stim, engine=engine, stall=stall, seed=seed, expect_words=want, max_cycles=cap,
-                     build=(SPEED_BUILD if build is None else build) if engine == "verilator" else None)
+                     build=(SPEED_BUILD if build is None else build) if engine == "verilator" else None,
+                     clocks=clocks)
     s0, s1 = tb.frame(p, got.words)
     out = {"s0": s0, "s1": s1, "cycles": got.cycles, "proto_errors": got.protocol_errors, "run_s": got.run_s,
            "build_s": got.build_s, "build": got.build, **got.status}
     if line_log:
-        out["line_cycles"] = tb.line_cycles(p, got.stamps)
+        out["line_cycles"] = tb.line_cycles(p, got)
     return out
 
 

@@ -30,7 +30,7 @@ from rasterhw.golden_model.zbm.words import (
 from rasterhw.hdl.zbm.chain import ZbmChain
 from rasterhw.sim import registry
 from rasterhw.sim.engines.verilog import merge_identical_modules
-from rasterhw.sim.testbench import Expected, Stimulus, Testbench
+from rasterhw.sim.testbench import Expected, Run, Stimulus, Testbench
 from rasterhw.sim.zbm.line_bench import LineBench
 from rasterhw.sim.zbm.stimfiles import random_gaps
 
@@ -64,8 +64,8 @@ class UnitBench(Testbench):
     default 1): edge-pair words in (``i``; unit ``k`` of a chain: ``units[k].i``), every chip's
     merge-bus words out (``o_merge[c]``, the last unit's in a chain; chip ``c`` owning columns
     ``c, c + I, ...``, line by line), the double-Z samples of ``golden_model/zbm/render.py:
-    render_zbm``. The merge clock runs with the segment clock (the two-clock ratios stay with the
-    cocotb bench). A random frame: 2..40 random screen triangles (seeded), the first ones that fit
+    render_zbm``. The merge clock runs with the segment clock, or at any ratio and phase as a run's
+    separate clocks (``engines.run(..., clocks=...)``; ``unit_bench.bench_clocks``: the cocotb bench's). A random frame: 2..40 random screen triangles (seeded), the first ones that fit
     the active-edge-pair memory; a scene: :meth:`scene_stimulus` (``rasterhw sim zbm``, the soak).
 
     The back-pressure of slot ``c`` is the cocotb unit bench's (``cocotb_tests/zbm/tb_zbm_unit.v``:
@@ -158,15 +158,16 @@ class UnitBench(Testbench):
             s0[:n // npx, c::i], s1[:n // npx, c::i] = lo.reshape(-1, npx), hi.reshape(-1, npx)
         return s0, s1
 
-    def line_cycles(self, params: dict, stamps: dict[str, list[int]]) -> list[int]:
-        """Per line ``y``: the cycles until every slot had given line ``y`` (its last word's edge + 1),
-        the cocotb bench's per-line log."""
+    def line_cycles(self, params: dict, run: Run) -> list[int]:
+        """Per line ``y``: the segment clocks until every slot had given line ``y`` (the segment-clock
+        edges before the merge edge after its last word; one clock: that word's edge + 1), the
+        cocotb bench's per-line log."""
         i, w, h = params["interleave"], params["width"], params["height"]
         out = np.zeros(h, np.int64)
         for c, port in enumerate(self.outputs_of(params)):
             npx = len(range(c, w, i))
-            st = np.asarray(stamps[port][:h * npx], np.int64)
-            out = np.maximum(out, st[npx - 1::npx] + 1)
+            st = np.asarray(run.stamps[port][:h * npx], np.int64)
+            out = np.maximum(out, [run.cycles_at(port, int(e) + 1) for e in st[npx - 1::npx]])
         return out.tolist()
 
     def sim_verilog(self, params: dict, text: str) -> str:

@@ -25,13 +25,14 @@ from rasterhw.sim.engines.runner import (
     run_cocotb,
     verilator_make_flags,
 )
+from rasterhw.sim.testbench import Clock
 from rasterhw.sim.workdirs import keep as keep_run_folder
 from rasterhw.sim.workdirs import temp_run_folder
 from rasterhw.sim.zbm.stimfiles import GAP_BITS, read_hex_words, stimulus_depth, write_unit_stimulus
 from rasterhw.sim.zbm.unit_verilog import chain_verilog
 
-__all__ = ["BENCH_DIR", "SIM_ENV", "TEST_MODULE", "VERILATOR_ARGS", "expect_env", "plusargs", "run_unit_bench",
-           "unit_watchdog"]
+__all__ = ["BENCH_DIR", "SIM_ENV", "TEST_MODULE", "VERILATOR_ARGS", "bench_clocks", "expect_env", "plusargs",
+           "run_unit_bench", "unit_watchdog"]
 
 BENCH_DIR = REPO_ROOT / "cocotb_tests" / "zbm"
 TEST_MODULE = "cocotb_tests.zbm.test_zbm"
@@ -61,6 +62,21 @@ def plusargs(ratio: tuple[int, int], stall: int, seed: int, maxcyc: int, phase: 
         raise RasterhwError(f"stall must be in 0..255, not {stall!r}")
     return [f"+sync_half={sh}", f"+merge_half={mh}", f"+merge_phase={phase}", f"+stall={stall}", f"+seed={seed}",
             f"+maxcyc={maxcyc}"]
+
+
+#: rising edges of each clock the benches hold their reset for (``rasterhw_reset #(.CYCLES(6))``)
+RESET_EDGES = 6
+
+
+def bench_clocks(ratio: tuple[int, int], phase: int = 1) -> dict[str, Clock]:
+    """The generic engine's separate clocks (``engines.run(..., clocks=...)``, 1 ns units) that time
+    a run as this bench with ``plusargs(ratio, ..., phase)`` does after its reset: each clock's
+    first edge is its first edge out of reset (``rasterhw_two_clocks`` raises ``clk`` at
+    1 + (2k + 1) * segment half ns and ``mclk`` ``phase`` ns later on its own half period; the
+    engine has no reset, so edge 0 of each domain is the bench's edge ``RESET_EDGES``)."""
+    plusargs(ratio, 0, 1, 1, phase)   # the same checks as the bench's
+    sh, mh = ratio
+    return {"sync": Clock(sh, 1 + (2 * RESET_EDGES + 1) * sh), "merge": Clock(mh, 1 + phase + (2 * RESET_EDGES + 1) * mh)}
 
 
 def expect_env(expect, speed_run: bool) -> dict:

@@ -64,10 +64,22 @@ def test_golden_schedule():
     assert F.clear_cycles(1280, 1024) == 262_144
 
 
-def test_stimulus_bytes_layout():
-    b = F._stim_bytes(np.array([0x1234]), np.array([0xABCDEF]), np.array([0x010203]), np.array([0x0A0B0C0D]))
-    assert b == bytes.fromhex("1234" "abcdef" "010203" "0a0b0c0d")
-    assert F._stim_bytes(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0)) == bytes(12)
+def test_frame_stimulus_word_layout():
+    """A frame write on the engine (``FrameBench.stimulus_of``): packed big-endian rows of
+    ``{end, gap[15:0], z[23:0], rgb[23:0], addr}`` (64 x 64: 12 address bits, 77 bits in 10 bytes),
+    then the end token (``end`` alone); one pipeline empty: its end token only."""
+    from rasterhw.golden_model.snu.pixelstream import PixelStream
+    from rasterhw.sim.snu.testbench import FrameBench
+
+    tb = FrameBench()
+    p = tb.params(width=64, height=64)
+    s = PixelStream(64, 64, addr=np.array([0x123]), rgb=np.array([0xABCDEF]), z=np.array([0x010203]),
+                    pipe=np.array([0]))
+    w = tb.stimulus_of(p, s, np.array([0x1234]), schedule={}).words
+    assert w["i_pipe0"].shape == (2, 10)
+    assert w["i_pipe0"][0].tobytes() == (0x1234 << 60 | 0x010203 << 36 | 0xABCDEF << 12 | 0x123).to_bytes(10, "big")
+    assert w["i_pipe0"][1].tobytes() == (1 << 76).to_bytes(10, "big")
+    assert [r.tobytes() for r in w["i_pipe1"]] == [(1 << 76).to_bytes(10, "big")]
 
 
 @pytest.mark.cocotb
@@ -124,12 +136,14 @@ def test_frame_adapter_on_pysim_equals_golden():
 
 
 @pytest.mark.cocotb
-def test_frame_on_the_engine_equals_the_dedicated_bench():
-    """The generic Verilator engine with the frame adapter and tb_pixelbus_fast.v give the same
-    schedule and frame, clock for clock."""
+def test_frame_on_the_engine_is_golden_clock_for_clock():
+    """The generic Verilator engine with the frame adapter: every schedule number (clear, release,
+    pixels done, swap, frame length) the golden schedule's and the displayed frame (RGB and Z) the
+    golden frame. (It was also held equal to the dedicated bench ``tb_pixelbus_fast.v``, retired
+    once the engine ran the frame; the golden schedule is what that bench was checked against.)"""
     s, p, sch, (rgb, z) = _frame_inputs("sp27", 80, 64)
     e = F.run_frame_engine(s, p["gaps"], sch)
-    b = F.run_frame_hdl(s, p["gaps"], sch["first_bench_gap"])
     keys = ("t_clear", "t_start", "t_pixels_done", "t_swap", "cycles")
-    assert e["mismatches"] == 0 and [e[k] for k in keys] == [b[k] for k in keys] == [sch[k] for k in keys]
-    assert np.array_equal(e["rgb"], b["rgb"]) and np.array_equal(e["z"], b["z"]) and np.array_equal(e["z"], z)
+    assert e["mismatches"] == 0 and [e[k] for k in keys] == [sch[k] for k in keys]
+    assert sch["t_start"] == F.clear_cycles(80, 64) + F.RELEASE_DELAY and sch["t_swap"] == sch["t_pixels_done"] + 1
+    assert np.array_equal(e["rgb"], rgb) and np.array_equal(e["z"], z)
