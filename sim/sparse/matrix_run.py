@@ -25,7 +25,7 @@ from rasterhw.sim.engines.runner import build_plain_verilator, run_plain_verilat
 from rasterhw.sim.sparse.verilator_run import SHARED_VH, pack_records
 from rasterhw.sim.workdirs import release, temp_run_folder
 
-__all__ = ["IN_DEPTH", "build_matrix", "run_matrix_pysim", "run_matrix_verilator"]
+__all__ = ["IN_DEPTH", "build_matrix", "run_matrix", "run_matrix_pysim", "run_matrix_verilator"]
 
 BENCH = Path(__file__).resolve().parent / "verilator" / "tb_sparse_matrix.v"
 TOP = "tb_sparse_matrix"
@@ -116,6 +116,40 @@ def run_matrix_verilator(recs: list[dict], *, n: int, p: int, q: int, limit: int
     return {"tri": tri.reshape(H, W), "zq": zq.reshape(H, W), "rgb": rgb, "cycles": int(st[0]), "stall_cycles": int(st[1]),
             "stats": {name: per[:, j] for j, name in enumerate(names)}, "run_s": meta["run_s"],
             "sim_cycles": meta["sim_cycles"], "build_s": build_s, "read_s": time.perf_counter() - t0, **sizes}
+
+
+def run_matrix(tris, *, n: int, p: int, q: int, limit: int, z_bits: int = 24, fifo_depth: int = 8,
+               in_depth: int = IN_DEPTH, vp: str = "pipeline", colour: bool = False, kp: int = 0, ke: int = 3,
+               engine: str = "verilator") -> dict:
+    """The matrix on one frame of ``tris`` on a generic engine (``sim/engines/``; the testbench
+    :class:`~rasterhw.sim.sparse.testbench.FrameBench`: the records offered back to back, the
+    limit in a config word, the raster and every counter streamed out). The keys of
+    :func:`run_matrix_verilator`; ``sim_cycles`` are the bench's clocks (read-out included).
+    ``engine="verilator"`` instantiates one cell module by name; ``"pysim"`` elaborates every cell."""
+    from rasterhw.hdl.sparse.cell import cell_stats
+    from rasterhw.sim.engines import run as run_engine
+    from rasterhw.sim.sparse.testbench import FrameBench
+
+    tb = FrameBench("instance" if engine == "verilator" else "inline")
+    params = tb.params(n=n, p=p, q=q, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth, vp=vp, colour=colour,
+                       kp=kp, ke=ke)
+    try:
+        stim = tb.frame(tris, params, limit)
+    except ValueError as e:
+        raise RasterhwError(str(e)) from None
+    ntri = len(stim.words["i"]) - 2
+    if ntri > MAXT:
+        raise RasterhwError(f"sparse matrix bench holds at most {MAXT} triangles, not {ntri}")
+    W, H = p << n, q << n
+    want = W * H + 2 + p * q * len(cell_stats(n))
+    maxcyc = 400 * (ntri + 10) * (1 + n) * (1 + 64 // limit) + 4 * W * H + 10_000_000
+    # the input memory sized for MAXT records whatever the frame: one build per design
+    build = {"depth": MAXT + 2} if engine == "verilator" else None
+    got = run_engine(tb, params, stim, engine=engine, expect_words={"o": want}, max_cycles=maxcyc, build=build)
+    t0 = time.perf_counter()
+    res = tb.decode(params, got.words["o"])
+    return {**res, "run_s": got.run_s if engine == "verilator" else got.wall_s, "sim_cycles": got.cycles,
+            "build_s": got.build_s, "read_s": time.perf_counter() - t0, "protocol_errors": got.protocol_errors}
 
 
 def run_matrix_pysim(recs: list[dict], *, n: int, p: int, q: int, limit: int, z_bits: int = 24,
