@@ -3,7 +3,7 @@ every processor's input FIFO, back-pressure from the fullest, and the interleave
 simulation.
 
 Verilator: the generic engine (``sim/engines/``) runs the testbench
-:class:`~rasterhw.sim.sparse.testbench.FrameBench`: the cell (input FIFO + video processor) is
+:class:`~rasterhw.sim.sparse.testbench.MatrixFrameBench`: the cell (input FIFO + video processor) is
 generated once as the Verilog module ``sparse_cell`` and the matrix instantiates it ``p*q`` times
 by name, so the Verilog holds one processor module whatever the matrix size; the run's input FIFO
 limit rides in a config word before the records (one build serves every depth); the records are
@@ -43,7 +43,7 @@ def run_matrix(tris, *, n: int, p: int, q: int, limit: int, z_bits: int = 24, fi
                in_depth: int = IN_DEPTH, vp: str = "pipeline", colour: bool = False, kp: int = 0, ke: int = 3,
                engine: str = "verilator") -> dict:
     """The matrix on one frame of ``tris`` on a generic engine (``sim/engines/``; the testbench
-    :class:`~rasterhw.sim.sparse.testbench.FrameBench`: the records offered back to back, the
+    :class:`~rasterhw.sim.sparse.testbench.MatrixFrameBench`: the records offered back to back, the
     limit in a config word, the raster and every counter streamed out): ``tri`` / ``zq`` (full
     raster, -1 where empty), ``rgb`` (``(H, W, 3)`` with ``colour``, else None), ``cycles`` (the
     matrix's frame counter), ``stall_cycles``, ``stats`` (counter name -> (p*q,) array),
@@ -51,9 +51,9 @@ def run_matrix(tris, *, n: int, p: int, q: int, limit: int, z_bits: int = 24, fi
     ``engine="verilator"`` instantiates one cell module by name; ``"pysim"`` elaborates every cell."""
     from rasterhw.hdl.sparse.cell import cell_stats
     from rasterhw.sim.engines import run as run_engine
-    from rasterhw.sim.sparse.testbench import FrameBench
+    from rasterhw.sim.sparse.testbench import MatrixFrameBench
 
-    tb = FrameBench("instance" if engine == "verilator" else "inline")
+    tb = MatrixFrameBench("instance" if engine == "verilator" else "inline")
     params = tb.params(n=n, p=p, q=q, z_bits=z_bits, fifo_depth=fifo_depth, in_depth=in_depth, vp=vp, colour=colour,
                        kp=kp, ke=ke)
     try:

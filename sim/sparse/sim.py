@@ -132,7 +132,7 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
     recs = broadcast_records_rgb(tris) if colour else broadcast_records(tris)
     kw = dict(n=n, p=p, q=q, limit=fifo_depth, z_bits=tris.z_bits, fifo_depth=vp_fifo_depth, in_depth=in_depth, vp=vp,
               colour=colour, kp=kp, ke=KE_EDGES)
-    # Verilator: the generic engine's testbench (FrameBench); pysim: the direct bench (idle patterns, tests)
+    # Verilator: the generic engine's testbench (MatrixFrameBench); pysim: the direct bench (idle patterns, tests)
     h = run_matrix(tris, **kw) if engine == "verilator" else run_matrix_pysim(recs, **kw)
     hdl_s = time.perf_counter() - t0
     t1 = time.perf_counter()

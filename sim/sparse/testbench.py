@@ -16,7 +16,7 @@ from rasterhw.golden_model.sparse.search import sparse_render
 from rasterhw.sim import registry
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 
-__all__ = ["FrameBench", "MatrixBench", "ProcessorBench", "ReadOut", "StackVPBench", "VPBench"]
+__all__ = ["MatrixFrameBench", "MatrixBench", "ProcessorBench", "ReadOut", "StackVPBench", "VPBench"]
 
 
 class ReadOut(wiring.Component):
@@ -342,7 +342,7 @@ class ProcessorBench(VPBench):
 _CELL_DEFAULTS = {"alpha": 2, "beta": 2, "vp": "pipeline", "colour": False, "kp": 0, "ke": 3}
 
 
-class FrameBench(MatrixBench):
+class MatrixFrameBench(MatrixBench):
     """The whole matrix on one frame as ``rasterhw sim sparse`` runs it (not registered: the
     ``sparse-matrix`` block on the generic engines, :func:`rasterhw.sim.sparse.matrix_run.run_matrix`).
 

@@ -1,5 +1,5 @@
 """The frame testbenches of ``rasterhw sim sparse`` on the generic engines (sim/sparse/testbench.py:
-``FrameBench``, the whole matrix; ``ProcessorBench``, one processor): in pysim, every output word
+``MatrixFrameBench``, the whole matrix; ``ProcessorBench``, one processor): in pysim, every output word
 -- the image and every counter -- equal to the golden search and the golden cycle models, with
 the run-time settings (the input FIFOs' limit, the processor's place) in a config word."""
 
@@ -10,13 +10,13 @@ from dataclasses import replace
 import pytest
 from rasterhw.golden_model.reference import random_triangles
 from rasterhw.sim.engines import run
-from rasterhw.sim.sparse.testbench import FrameBench, ProcessorBench
+from rasterhw.sim.sparse.testbench import MatrixFrameBench, ProcessorBench
 from rasterhw.sim.testbench import compare
 
 
 @pytest.mark.parametrize(("vp", "colour", "kp", "limit"), [("pipeline", False, 0, 1), ("stack", True, 4, 2)])
 def test_frame_bench_words_and_counters_equal_golden(vp, colour, kp, limit):
-    tb = FrameBench("inline")
+    tb = MatrixFrameBench("inline")
     p = tb.params(n=2, p=2, q=2, in_depth=4, vp=vp, colour=colour, kp=kp)
     tris = random_triangles(8, 8, 10, mean_area=10.0, seed=4)
     stim = tb.frame(tris, p, limit)
