@@ -37,7 +37,8 @@ def test_verilator_matrix_idle_input_same_frame_more_cycles():
     slow = simulate_tris(tris, "4x4", engine="verilator", idle=200, seed=5)
     assert slow["mismatches"] == 0 and slow["tests_match_golden"] and slow["writes"] == slow["pixels_written_golden"]
     assert slow["tests_per_level_hdl"] == free["tests_per_level_hdl"]
-    assert slow["cycles"] > free["cycles"]
+    assert slow["sim_cycles"] > free["sim_cycles"]   # the idle clocks cost bench clocks (a compute-bound
+    # processor at 256x256 may finish on the same cycle: its count starts at the first record)
     with pytest.raises(RasterhwError, match="idle"):
         simulate_tris(tris, "4x4", engine="verilator", idle=300)
     with pytest.raises(RasterhwError, match="idle"):
