@@ -70,7 +70,7 @@ def test_sim_on_plain_verilator_writes_one_trace_per_processor(tmp_path, capsys)
     res = json.loads(capsys.readouterr().out)
     assert res["mismatches"] == 0 and len(res["waves"]) == 4
     for w in res["waves"]:
-        assert "tb_sparse_vp" in Path(w).read_text()[:4000]
+        assert "rasterhw_bench" in Path(w).read_text()[:4000]   # the engine's bench top (ProcessorBench)
 
 
 def test_fst_without_the_writer_headers_is_one_clear_error(tmp_path, capsys, monkeypatch):

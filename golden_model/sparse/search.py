@@ -278,6 +278,7 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
     order = np.lexsort((tri, laddr))
     la_s, key_s, tri_s = laddr[order], key[order], tri[order]
     written = 0
+    writes_pp = np.zeros(P, dtype=np.int64)
     nloc = P * Ns * Ns
     depth_loc = np.full(nloc, np.inf)
     tri_loc = np.full(nloc, -1, dtype=np.int64)
@@ -295,6 +296,7 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
         wr = newg.copy()
         wr[1:] |= c[1:] < run[:-1]
         written = int(np.count_nonzero(wr))
+        writes_pp = np.bincount(proc[order][wr], minlength=P)
         # Winner of each address: the fragment of smallest rank in its group.
         first = np.flatnonzero(newg)
         best = np.minimum.reduceat(rank, first)
@@ -325,5 +327,5 @@ def sparse_render(tris: ScreenTriangles, matrix="4x4", *, alpha: int = 2, beta: 
         windows=windows, tests=tests, windows_aperture_n=ap_n, windows_per_proc=wpp,
         tests_per_proc=tpp, fragments=int(F), pixels_written=written, triangles=int(T),
         stats={"alpha": al, "beta": be, "test": test, "depth": depth, "frag_x": x, "frag_y": y, "frag_proc": proc,
-               "frag_tri": tri, **({"windows_per_record": wrec} if per_record else {}),
+               "frag_tri": tri, "writes_per_proc": writes_pp, **({"windows_per_record": wrec} if per_record else {}),
                **({"trace": tr} if trace else {})})

@@ -33,11 +33,17 @@ from __future__ import annotations
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles
-from rasterhw.golden_model.sparse.cycles import KE_EDGES, SETUP_CYCLES
+from rasterhw.golden_model.sparse.cycles import (
+    KE_EDGES,
+    SETUP_CYCLES,
+    coupled_matrix,
+    service_times,
+)
 from rasterhw.golden_model.sparse.edges import edge_setup
 from rasterhw.golden_model.sparse.formats import Z_FRAC_BITS, parse_matrix, sparse_geometry
+from rasterhw.golden_model.sparse.search import sparse_render
 
-__all__ = ["broadcast_records_rgb", "param_cycles", "stack_processor"]
+__all__ = ["broadcast_records_rgb", "coupled_stack_matrix", "param_cycles", "stack_processor"]
 
 #: cycles the pixel processor (``hdl/sparse/pixel.py``: read, then compare and write) holds a pixel
 PIXEL_LATENCY = 2
@@ -186,3 +192,21 @@ def stack_processor(tris: ScreenTriangles, matrix, a: int, b: int, *, alpha: int
     out_rgb = np.array(ctab, dtype=np.int64).reshape(Ns, Ns, 3) if colour else None
     return {"rgb": out_rgb, "tri": tri_m, "zq": zq_m, "tail": tail, "cycles": cycles, "accept": accept, "busy": int(cycles.sum()), "tests": np.array(tests[1:], dtype=np.int64),
             "max_stack": max_stack, "writes": writes, "n": n}
+
+
+def coupled_stack_matrix(tris: ScreenTriangles, p: int, q: int, fifo_depth: int, *, kp: int = 0,
+                         ke: int = KE_EDGES) -> dict:
+    """The golden coupled model of a ``p x q`` matrix of stack processors, keyed as
+    ``vpcycles.coupled_matrix_vp``'s: ``cycles.coupled_matrix`` on the stack service times
+    (formula (5)'s parameter cycles with ``kp``), the frame extended by the last pixels' drain
+    (:func:`stack_processor`'s per-record ``tail``), and the per-level tests (the stack processor
+    has no per-level stalls: ``stalls`` are 0)."""
+    f = sparse_render(tris, (p, q), depth="fixed", per_record=True)
+    s = service_times(f.stats["windows_per_record"], vp="stack", kp=kp, ke=ke)
+    tail = np.stack([stack_processor(tris, (p, q), k % p, k // p, kp=kp, ke=ke)["tail"] for k in range(p * q)])
+    r = coupled_matrix(s, fifo_depth)
+    frame = int((r.pop + s + tail).max()) if s.size else 0
+    return {"frame_cycles": frame, "stall_cycles": r.stall_cycles, "fifo_peak": r.fifo_peak.tolist(),
+            "fifo_peak_max": int(r.fifo_peak.max(initial=0)), "busy": r.busy.tolist(),
+            "idle": (frame - r.busy).tolist(), "tests": f.tests_per_proc[:, 1:].tolist(),
+            "stalls": [[0] * f.n for _ in range(p * q)]}

@@ -25,9 +25,10 @@ Only the control flow is modelled: which sub-windows survive and which windows s
 come from the golden search (``sparse_render(..., trace=True)``), which the HDL is held to bit for
 bit. ``busy`` is the HDL's: anything held in the set-up, a stage, a FIFO or the pixel pipeline.
 
-:func:`vp_standalone` replays the Verilator bench (``sim/sparse/verilator/tb_sparse_vp.v``):
-records offered back to back, ``cycles`` counted from the first cycle after reset to the first
-cycle, after the feed phase ended, on which the processor is not busy (inclusive).
+:func:`vp_standalone` replays the processor's frame bench (``sim/sparse/testbench.py``
+``ProcessorBench``): records offered back to back, ``cycles`` counted from the first cycle a record
+is offered to the first cycle, after the feed phase ended, on which the processor is not busy
+(inclusive).
 """
 
 from __future__ import annotations

@@ -102,7 +102,7 @@ class Matrix(wiring.Component):
                 m.d.comb += [v.eq(getattr(cell, name)) for name, v in c.items()]
             else:
                 m.submodules[f"cell{k}"] = Instance(
-                    CELL_MODULE, i_clk=ClockSignal(), i_rst=ResetSignal(),
+                    CELL_MODULE, i_clk=ClockSignal(), i_rst=ResetSignal(allow_reset_less=True),
                     **{f"i_{name}": v for name, v in ins.items()}, **{f"o_{name}": v for name, v in c.items()})
             ports.append(c)
         room = ports[0]["room"]

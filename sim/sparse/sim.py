@@ -4,6 +4,7 @@ model pixel by pixel (triangle index and quantised depth)."""
 
 from __future__ import annotations
 
+import itertools
 import os
 import sys
 import time
@@ -15,7 +16,7 @@ from rasterhw.golden_model.sparse.cycles import KE_EDGES
 from rasterhw.golden_model.sparse.fixed import broadcast_records, colour_rgb8
 from rasterhw.golden_model.sparse.formats import parse_matrix, sparse_geometry
 from rasterhw.golden_model.sparse.search import interleave, sparse_render
-from rasterhw.golden_model.sparse.stack import broadcast_records_rgb
+from rasterhw.golden_model.sparse.stack import broadcast_records_rgb, coupled_stack_matrix
 
 __all__ = ["simulate", "simulate_coupled", "simulate_tris"]
 
@@ -32,9 +33,7 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
     if engine == "pysim":
         from rasterhw.sim.sparse.hdl_run import run_processor as run
     elif engine == "verilator":
-        from functools import partial
-
-        from rasterhw.sim.sparse.verilator_run import pack_records, run_processor_verilator
+        from rasterhw.sim.sparse.verilator_run import run_processor_verilator
     else:
         raise RasterhwError(f"sparse sim: engine must be 'pysim' or 'verilator', not {engine!r}")
     if idle and engine != "verilator":
@@ -42,8 +41,6 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
     g = sparse_render(tris, (p, q), depth="fixed")
     gz = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
     recs = broadcast_records(tris)
-    if engine == "verilator":
-        run = partial(run_processor_verilator, packed=pack_records(recs), idle=idle)
     N = 1 << n
     loc_t = np.full((q, p, N, N), -1, dtype=np.int64)
     loc_z = np.full((q, p, N, N), -1, dtype=np.int64)
@@ -53,17 +50,18 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
     sim_cycles = 0
     procs = [(a, b) for b in range(q) for a in range(p)]
     if engine == "verilator":
-        # the processors are independent simulator processes: two at a time on this machine's
-        # cores (the build first, once); results are taken in processor order
+        # the processors are independent simulator processes: the first alone (it builds the bench
+        # once), then two at a time on this machine's cores; results are taken in processor order
         from concurrent.futures import ThreadPoolExecutor
 
-        from rasterhw.sim.sparse.verilator_run import build
+        def one(a, b):
+            return run_processor_verilator(tris, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits, idle=idle,
+                                           seed=seed + 64 * b + a)
 
-        build(n=n, p=p, q=q, z_bits=tris.z_bits)
+        first = one(*procs[0])
         pool = ThreadPoolExecutor(max_workers=max(1, min(int(workers), os.cpu_count() or 1)))
-        futures = [pool.submit(run, recs, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits, seed=seed + 64 * b + a)
-                   for a, b in procs]
-        results = (f.result() for f in futures)
+        futures = [pool.submit(one, a, b) for a, b in procs[1:]]
+        results = itertools.chain([first], (f.result() for f in futures))
     else:
         pool = None
         results = (run(recs, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits) for a, b in procs)
@@ -94,24 +92,6 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
             "run_s": round(run_s, 4)}
 
 
-def _stack_golden(tris, p: int, q: int, fifo_depth: int, *, kp: int = 0) -> dict:
-    """The golden coupled model of a matrix of stack processors, keyed as ``coupled_matrix_vp``'s:
-    ``cycles.coupled_matrix`` on the stack service times (formula (5)'s parameter cycles with
-    ``kp``), the frame extended by the last pixels' drain (``stack_processor``'s per-record
-    ``tail``), and the per-level tests."""
-    from rasterhw.golden_model.sparse.cycles import coupled_matrix, service_times
-    from rasterhw.golden_model.sparse.stack import stack_processor
-
-    f = sparse_render(tris, (p, q), depth="fixed", per_record=True)
-    s = service_times(f.stats["windows_per_record"], vp="stack", kp=kp)
-    tail = np.stack([stack_processor(tris, (p, q), k % p, k // p, kp=kp)["tail"] for k in range(p * q)])
-    r = coupled_matrix(s, fifo_depth)
-    frame = int((r.pop + s + tail).max()) if s.size else 0
-    return {"frame_cycles": frame, "stall_cycles": r.stall_cycles, "fifo_peak": r.fifo_peak.tolist(),
-            "fifo_peak_max": int(r.fifo_peak.max(initial=0)), "busy": r.busy.tolist(),
-            "idle": (frame - r.busy).tolist(), "tests": f.tests_per_proc[:, 1:].tolist()}
-
-
 def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_depth: int = 64,
                      vp_fifo_depth: int = 8, progress: bool = False, vp: str = "pipeline", colour: bool = False,
                      kp: int = 0) -> dict:
@@ -123,14 +103,14 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
     :data:`~rasterhw.sim.sparse.matrix_run.IN_DEPTH` deep); ``vp_fifo_depth``: the FIFOs between
     the processor's levels (a build parameter; 8 as every driver builds it). ``vp="stack"``: every
     processor the stack-based one (``hdl/sparse/stack_vp.py``), against the golden coupled model on
-    the stack processors' service times (:func:`_stack_golden`); ``busy`` is then the processor's
+    the stack processors' service times (``stack.coupled_stack_matrix``); ``busy`` is then the processor's
     own count of the cycles it holds a record. ``colour``: the vertex colours broadcast as three
     more linear functions and written with the Z test, the HDL's colour memories against
     ``fixed.colour_rgb8`` (``colour_mismatches``; the frame image is then the HDL's colour); ``kp``:
     formula (5)'s cost of ``kp`` parameter additions per surviving window on ``k_e`` = 3 edge
     adders, in cycles, in the HDL and in both golden cycle models."""
     from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
-    from rasterhw.sim.sparse.matrix_run import IN_DEPTH, run_matrix_pysim, run_matrix_verilator
+    from rasterhw.sim.sparse.matrix_run import IN_DEPTH, run_matrix, run_matrix_pysim
 
     p, q = parse_matrix(matrix)
     n = sparse_geometry(tris.width, tris.height, p, q)
@@ -150,15 +130,16 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
     in_depth = IN_DEPTH  # one build for every run-time depth
     t0 = time.perf_counter()
     recs = broadcast_records_rgb(tris) if colour else broadcast_records(tris)
-    run = run_matrix_verilator if engine == "verilator" else run_matrix_pysim
-    h = run(recs, n=n, p=p, q=q, limit=fifo_depth, z_bits=tris.z_bits, fifo_depth=vp_fifo_depth, in_depth=in_depth,
-            vp=vp, colour=colour, kp=kp, ke=KE_EDGES)
+    kw = dict(n=n, p=p, q=q, limit=fifo_depth, z_bits=tris.z_bits, fifo_depth=vp_fifo_depth, in_depth=in_depth, vp=vp,
+              colour=colour, kp=kp, ke=KE_EDGES)
+    # Verilator: the generic engine's testbench (MatrixFrameBench); pysim: the direct bench (idle patterns, tests)
+    h = run_matrix(tris, **kw) if engine == "verilator" else run_matrix_pysim(recs, **kw)
     hdl_s = time.perf_counter() - t0
     t1 = time.perf_counter()
     g = sparse_render(tris, (p, q), depth="fixed", trace=True)
     gz = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
     if vp == "stack":
-        gc = _stack_golden(tris, p, q, fifo_depth, kp=kp)
+        gc = coupled_stack_matrix(tris, p, q, fifo_depth, kp=kp)
     else:
         gc = coupled_matrix_vp(g, fifo_depth, fifo_depth=vp_fifo_depth, kp=kp, ke=KE_EDGES)
     grgb = colour_rgb8(tris, g.tri_id, p, q) if colour else None

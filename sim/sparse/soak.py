@@ -11,10 +11,12 @@ processor of a 4 x 4 matrix through the cocotb bench with random idle clocks on 
 ``sparse_round`` (the registered round, ``make soak``) runs the whole matrix and the cocotb bench
 at the paper's 4 x 4 and 256 x 256. ``sparse_round_ci`` (the test suite's soak) runs the same
 kinds of round on the designs the other sparse tests build: the whole matrix at 2 x 2, 32 x 32
-(``tests/sparse/test_sparse_matrix.py``) and the cocotb bench's 4 x 4 matrix at 32 x 32
+with colour and (5)'s k_p = 4 (``tests/sparse/test_sparse_matrix.py``, ``test_sparse_colour_hdl.py``;
+its colour compared too) and the cocotb bench's 4 x 4 matrix at 32 x 32
 (``tests/sparse/test_sparse_vp_cocotb.py``), so a test run compiles two fewer large models (the
 4 x 4 whole matrix at 256 x 256 took 44 s of the 93 s the test took in a fresh run); the
-triangle rounds are the same in both.
+triangle rounds (every processor of the 4 x 4 matrix at 256 x 256, ``ProcessorBench``: the design
+``tests/sparse/test_sparse_vp_verilator.py`` builds) are the same in both.
 """
 
 from __future__ import annotations
@@ -33,6 +35,8 @@ SP_W, SP_H = 256, 256
 #: (width, height, matrix) of the whole-matrix rounds and of round 0's cocotb bench
 FULL = {"matrix": (256, 256, "4x4"), "cocotb": (256, 256, "4x4")}
 CI = {"matrix": (32, 32, "2x2"), "cocotb": (32, 32, "4x4")}
+#: the whole matrix's build options per kind of soak (``simulate`` keywords)
+MATRIX_OPTIONS = {"full": {}, "ci": {"colour": True, "kp": 4}}
 
 
 def _sparse_cocotb_round(rng: np.random.Generator, w: int, h: int, matrix: str) -> dict:
@@ -65,13 +69,16 @@ def _round(rng: np.random.Generator, k: int, sizes: dict) -> dict:
         what = f"triangles n={n} area={area:.0f} seed={seed} idle={idle}"
     else:
         w, h, matrix = sizes["matrix"]
+        opts = MATRIX_OPTIONS["ci" if sizes is CI else "full"]
         name = str(rng.choice(["c50", "c100", "sp8"]))
         seed = int(rng.integers(0, 1 << 30))
         depth = int(rng.choice([1, 2, 8, 64]))
-        r = simulate(build_scene(name, seed=seed), w, h, engine="verilator", matrix=matrix, fifo_depth=depth)
-        what = f"scene {name} seed={seed}, whole {matrix} matrix {w}x{h}, input FIFO depth {depth}"
+        r = simulate(build_scene(name, seed=seed), w, h, engine="verilator", matrix=matrix, fifo_depth=depth, **opts)
+        what = f"scene {name} seed={seed}, whole {matrix} matrix {w}x{h}, input FIFO depth {depth}" + \
+            "".join(f", {k} {v}" for k, v in opts.items())
     bad = r["mismatches"] + int(not r["tests_match_golden"]) + int(r["writes"] != r["pixels_written_golden"])
     bad += r.get("cycle_mismatches", 0)  # the whole matrix: every counter against the coupled cycle model
+    bad += r.get("colour_mismatches", 0)
     return {"pixels": r["pixels_compared"], "mismatches": bad, "run_s": r.get("run_s", 0.0), "settings": what}
 
 

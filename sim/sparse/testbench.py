@@ -6,7 +6,7 @@ raster) streamed out after the input ends, against the golden search."""
 from __future__ import annotations
 
 import numpy as np
-from amaranth import Cat, Module, Signal
+from amaranth import Cat, Const, Module, Mux, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.reference import random_triangles
@@ -16,55 +16,99 @@ from rasterhw.golden_model.sparse.search import sparse_render
 from rasterhw.sim import registry
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 
-__all__ = ["MatrixBench", "ReadOut", "StackVPBench", "VPBench"]
+__all__ = ["MatrixFrameBench", "MatrixBench", "ProcessorBench", "ReadOut", "StackVPBench", "VPBench"]
 
 
 class ReadOut(wiring.Component):
-    """Bench adapter for a memory-backed block: records in, memory words out.
+    """Bench adapter for a memory-backed block: records in, memory words (and counters) out.
 
-    ``i`` carries ``{end, record}``: records go to the block's ``i``; a word with ``end`` set is
-    taken at once and starts the read-out when the block is no longer ``busy``: the read address
-    sweeps ``0 .. words - 1`` (``address(m, addr)`` drives the block's read port; one cycle of read
-    latency) and ``o`` carries ``{rd_tri, rd_z}`` of each address, two cycles a word, each held
-    until taken. ``fixed``: constant inputs of the block (``{name: value}``). ``tail``: the block's
-    counters (output names) sent after the memory, one word each (zero-extended), in order."""
+    ``i`` carries ``{end, record}`` (``{config, end, record}`` with ``config``): records go to the
+    block's ``i``; a word with ``end`` set is taken at once and starts the read-out when the block
+    is no longer ``busy``: the read address sweeps ``0 .. words - 1`` (``address(m, addr)`` drives
+    the block's read port; one cycle of read latency, the next address presented on a transfer)
+    and ``o`` carries ``{rd_tri, rd_z}`` of each address, one word a clock while ``o.ready`` is
+    high (held while it is low). ``fixed``: constant inputs of the block (``{name: value}``).
+    ``config``: inputs of the block set at run time (``{name: value before any config word}``): a
+    word with ``config`` set is taken at once and loads them from its low bits, in order
+    (:meth:`config_word`), so one build serves every value. ``tail``: the block's counters (output
+    names) sent after the memory, one word each (zero-extended), in order. ``stats``: ``(cells,
+    sels)``: then counter ``stat`` for every ``stat_cell`` in ``0 .. cells - 1`` and, within it,
+    ``stat_sel`` in ``0 .. sels - 1``. ``count``: then the adapter's own count of the block's
+    cycles: every clock from the first record offered until the block is idle after the end word
+    (the clock that sees it idle included; the plain benches' count). ``extra``: Verilog the block
+    instantiates by name (the Verilator bench compiles it beside the block)."""
 
     def __init__(self, block, *, words: int, address, fixed: dict, z_bits: int, tail: tuple[str, ...] = (),
-                 record_bits: int | None = None, rgb: bool = False):
+                 record_bits: int | None = None, rgb: bool = False, config: dict | None = None,
+                 stats: tuple[int, int] | None = None, count: bool = False, extra: str = ""):
         from rasterhw.hdl.sparse.layouts import BROADCAST
 
         self.block, self._words, self._address, self._fixed, self._tail = block, words, address, fixed, tuple(tail)
         self._rec = BROADCAST.size if record_bits is None else record_bits
-        self._rgb = rgb
-        super().__init__({"i": In(stream.Signature(self._rec + 1)),
+        self._rgb, self._config, self._stats, self._extra = rgb, dict(config or {}), stats, extra
+        self._tail += ("$cycles",) if count else ()
+        super().__init__({"i": In(stream.Signature(self._rec + 1 + bool(self._config))),
                           "o": Out(stream.Signature(TRI_BITS + z_bits + 1 + (24 if rgb else 0)))})
+
+    def extra_verilog(self) -> str:
+        return self._extra
+
+    @staticmethod
+    def config_word(record_bits: int, widths: dict, values: dict) -> int:
+        """The input word that loads ``values`` (``{name: value}``, the ``config`` inputs of widths
+        ``widths``, in order) into a :class:`ReadOut` whose records are ``record_bits`` wide."""
+        word, at = 0, 0
+        for name, w in widths.items():
+            v = int(values[name])
+            if not 0 <= v < 1 << w:
+                raise ValueError(f"config {name}={v} does not fit {w} bits")
+            word |= v << at
+            at += w
+        return word | 1 << (record_bits + 1)
 
     def elaborate(self, platform):
         m = Module()
         m.submodules.block = b = self.block
         for name, v in self._fixed.items():
             m.d.comb += getattr(b, name).eq(v)
+        at = 0
+        cfg = self.i.payload[self._rec + 1] if self._config else Const(0, 1)
+        for name, v in self._config.items():
+            port = getattr(b, name)
+            reg = Signal(len(port), init=v, name=f"cfg_{name}")
+            m.d.comb += port.eq(reg)
+            with m.If(self.i.valid & cfg):
+                m.d.sync += reg.eq(self.i.payload[at:at + len(port)])
+            at += len(port)
         end = self.i.payload[self._rec]
         addr = Signal(range(self._words + 1))
-        primed = Signal()
-        self._address(m, b, addr)
+        run_cycles, started = Signal(32), Signal()
+        take = self.o.valid & self.o.ready
         word = Cat(b.rd_z, b.rd_tri, b.rd_rgb) if self._rgb else Cat(b.rd_z, b.rd_tri)
-        m.d.comb += [b.i.payload.eq(self.i.payload[:self._rec]), self.o.payload.eq(word)]
+        m.d.comb += b.i.payload.eq(self.i.payload[:self._rec])
         with m.FSM():
             with m.State("FEED"):
-                m.d.comb += [b.i.valid.eq(self.i.valid & ~end), self.i.ready.eq(end | b.i.ready)]
-                with m.If(self.i.valid & end):
+                m.d.comb += [b.i.valid.eq(self.i.valid & ~end & ~cfg), self.i.ready.eq(end | cfg | b.i.ready)]
+                self._address(m, b, addr)
+                with m.If(b.i.valid):
+                    m.d.sync += started.eq(1)
+                with m.If(b.i.valid | started):
+                    m.d.sync += run_cycles.eq(run_cycles + 1)
+                with m.If(self.i.valid & end & ~cfg):
                     m.next = "WAIT"
             with m.State("WAIT"):
+                self._address(m, b, addr)
+                m.d.sync += run_cycles.eq(run_cycles + 1)
                 with m.If(~b.busy):
                     m.next = "READ"
             with m.State("READ"):
-                m.d.sync += primed.eq(1)
-                m.d.comb += self.o.valid.eq(primed)
-                with m.If(self.o.valid & self.o.ready):
-                    m.d.sync += [addr.eq(addr + 1), primed.eq(0)]
+                # the word of addr is on the read port now; a transfer presents the next address
+                self._address(m, b, Mux(take, addr + 1, addr))
+                m.d.comb += [self.o.valid.eq(1), self.o.payload.eq(word)]
+                with m.If(take):
+                    m.d.sync += addr.eq(addr + 1)
                     with m.If(addr == self._words - 1):
-                        m.next = "TAIL" if self._tail else "DONE"
+                        m.next = "TAIL" if self._tail else ("STATS" if self._stats else "DONE")
             if self._tail:
                 k = Signal(range(len(self._tail)))
                 with m.State("TAIL"):
@@ -72,11 +116,22 @@ class ReadOut(wiring.Component):
                     with m.Switch(k):
                         for j, name in enumerate(self._tail):
                             with m.Case(j):
-                                m.d.comb += self.o.payload.eq(getattr(b, name))
+                                m.d.comb += self.o.payload.eq(run_cycles if name == "$cycles" else getattr(b, name))
                     with m.If(self.o.ready):
                         m.d.sync += k.eq(k + 1)
                         with m.If(k == len(self._tail) - 1):
-                            m.next = "DONE"
+                            m.next = "STATS" if self._stats else "DONE"
+            if self._stats:
+                cells, sels = self._stats
+                c, s = Signal(range(cells)), Signal(range(sels))
+                with m.State("STATS"):
+                    m.d.comb += [self.o.valid.eq(1), b.stat_cell.eq(c), b.stat_sel.eq(s), self.o.payload.eq(b.stat)]
+                    with m.If(self.o.ready):
+                        m.d.sync += s.eq(s + 1)
+                        with m.If(s == sels - 1):
+                            m.d.sync += [s.eq(0), c.eq(c + 1)]
+                            with m.If(c == cells - 1):
+                                m.next = "DONE"
             with m.State("DONE"):
                 pass
         return m
@@ -195,6 +250,229 @@ class MatrixBench(_SparseBench):
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         g, zq = self._golden(params, stim)
         return Expected({"o": _words(g.tri_id, zq, params["z_bits"])})
+
+
+class ProcessorBench(VPBench):
+    """One pipeline video processor of the matrix on one frame, as ``rasterhw sim sparse
+    --no-coupled`` runs every processor (not registered: the ``sparse-vp`` block on the generic
+    engines, :func:`rasterhw.sim.sparse.verilator_run.run_processor_verilator`).
+
+    In (``i``): a config word setting the processor's place ``(a, b)`` (run-time inputs: one build
+    serves every processor), the broadcast records, the end word. Out (``o``): its local memory
+    (``{tri, z}`` per sparse address), then its per-level tests and stalls, its pixel writes and its
+    cycles (from the first record offered until idle, the clock that sees it idle included),
+    against the golden search and the processor's cycle model (``vpcycles.vp_standalone``; the
+    cycles hold for records offered back to back)."""
+
+    def __init__(self):
+        #: the Verilator engine's C++ level: a frame is one run of up to millions of clocks
+        self.verilator_opt = "-O2"
+
+    def tail(self, params: dict) -> tuple[str, ...]:
+        n = params["n"]
+        return tuple(f"tests_{i}" for i in range(1, n + 1)) + tuple(f"stalls_{i}" for i in range(1, n + 1)) + ("writes",)
+
+    def dut(self, params: dict):
+
+        vp = registry.load(registry.blocks()[self.block])(**params)
+        n = params["n"]
+
+        def address(m, b, addr):
+            m.d.comb += b.rd_addr.eq(addr[:2 * n])
+
+        return ReadOut(vp, words=1 << (2 * n), address=address, fixed={},
+                       config={"a": params["p"] - 1, "b": params["q"] - 1}, z_bits=params["z_bits"],
+                       tail=self.tail(params), count=True, record_bits=self._lay(params).size)
+
+    @staticmethod
+    def _lay(params: dict):
+        from rasterhw.hdl.sparse.layouts import layouts
+
+        return layouts(bool(params.get("colour")))[0]
+
+    def frame(self, tris, params: dict, a: int, b: int, what: str = "") -> Stimulus:
+        """The words of processor ``(a, b)``'s run: its place, the records of ``tris``, the end word."""
+        from rasterhw.golden_model.sparse.formats import MATRIX_LOG2_MAX
+        from rasterhw.hdl.pack import pack
+
+        if params.get("colour"):
+            raise ValueError("the processor bench runs the depth-only processor")
+        lay = self._lay(params)
+        cfg = ReadOut.config_word(lay.size, {"a": MATRIX_LOG2_MAX, "b": MATRIX_LOG2_MAX}, {"a": a, "b": b})
+        words = [cfg] + [pack(lay, r) for r in broadcast_records(tris)] + [1 << lay.size]
+        return Stimulus({"i": words}, what=what, source={"tris": tris, "a": a, "b": b})
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        st = _SparseBench.stimulus(self, params, seed)
+        rng = np.random.default_rng(seed)
+        a, b = int(rng.integers(0, params["p"])), int(rng.integers(0, params["q"]))
+        return self.frame(st.source, params, a, b, what=f"{st.what}, processor ({a}, {b})")
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        from rasterhw.golden_model.sparse.vpcycles import vp_standalone, vp_streams
+
+        tris, a, b = stim.source["tris"], stim.source["a"], stim.source["b"]
+        p, q = params["p"], params["q"]
+        g = sparse_render(tris, (p, q), depth="fixed", trace=True)
+        zq = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+        k = b * p + a
+        m = vp_standalone(*vp_streams(g, k), g.triangles, fifo_depth=params["fifo_depth"], kp=params["kp"],
+                          ke=params["ke"])
+        tail = [*m["tests"], *m["stalls"], int(g.stats["writes_per_proc"][k]), m["cycles"]]
+        return Expected({"o": _words(g.tri_id[b::q, a::p], zq[b::q, a::p], params["z_bits"]) + [int(v) for v in tail]})
+
+    def decode(self, params: dict, words: list[int]) -> dict:
+        """The engine's ``o`` words as ``hdl_run.run_processor``'s keys: ``tri``, ``zq`` (N x N, -1
+        where empty), ``tests``, ``stalls``, ``writes``, ``cycles``."""
+        n, zb = params["n"], params["z_bits"]
+        N = 1 << n
+        if len(words) != N * N + 2 * n + 2:
+            raise ValueError(f"sparse processor bench: {len(words)} words, expected {N * N + 2 * n + 2}")
+        low = np.array(words[:N * N], dtype=np.int64)
+        tri = low >> (zb + 1)
+        zq = low & ((1 << (zb + 1)) - 1)
+        empty = tri == (1 << TRI_BITS) - 1
+        tri[empty], zq[empty] = -1, -1
+        t = [int(v) for v in words[N * N:]]
+        return {"tri": tri.reshape(N, N), "zq": zq.reshape(N, N), "tests": t[:n], "stalls": t[n:2 * n],
+                "writes": t[2 * n], "cycles": t[2 * n + 1]}
+
+
+#: cell parameters left out of the cell Verilog's cache key at these values
+_CELL_DEFAULTS = {"alpha": 2, "beta": 2, "vp": "pipeline", "colour": False, "kp": 0, "ke": 3}
+
+
+class MatrixFrameBench(MatrixBench):
+    """The whole matrix on one frame as ``rasterhw sim sparse`` runs it (not registered: the
+    ``sparse-matrix`` block on the generic engines, :func:`rasterhw.sim.sparse.matrix_run.run_matrix`).
+
+    In (``i``): a config word setting the input FIFOs' run-time ``limit`` (1 .. ``in_depth``: one
+    build serves every depth), the broadcast records, the end word. Out (``o``): the full raster
+    (``{tri, z}`` per pixel, row-major; ``{rgb, tri, z}`` with ``colour``), then the matrix's frame
+    and broadcast-stall cycles, then every cell's counters (:func:`~rasterhw.hdl.sparse.cell.cell_stats`,
+    cell ``b * p + a``), against the golden search and the golden coupled cycle model (the
+    pipeline's ``vpcycles.coupled_matrix_vp``, the stack's ``stack.coupled_stack_matrix``); the
+    counters hold for input offered back to back (the frame counts the cycles with a record
+    offered or held). ``cells="instance"`` (Verilator only): the matrix instantiates one cell
+    module by name, generated once (a 1024 x 1024 frame's cell is 4.6 MB of Verilog, mostly its
+    local memories' initial values); ``"inline"`` elaborates every cell (pysim too)."""
+
+    def __init__(self, cells: str = "instance"):
+        self.cells = cells
+        #: the Verilator engine's C++ level: a frame is one run of up to millions of clocks
+        self.verilator_opt = "-O2"
+
+    @staticmethod
+    def names(params: dict) -> list[str]:
+        """The counter words after the raster, in order."""
+        from rasterhw.hdl.sparse.cell import cell_stats
+
+        P = params["p"] * params["q"]
+        return ["cycles", "stall_cycles"] + [f"{c}/{k}" for k in range(P) for c in cell_stats(params["n"])]
+
+    def dut(self, params: dict):
+        from rasterhw.hdl.sparse.cell import MatrixCell, cell_stats
+        from rasterhw.hdl.sparse.layouts import layouts
+        from rasterhw.hdl.sparse.matrix import CELL_MODULE, Matrix
+        from rasterhw.sim.engines.verilog_cache import convert_cached
+
+        kw = dict(params)
+        mx = Matrix(**kw, cells=self.cells)
+        extra = ""
+        if self.cells == "instance":
+            # the cell's cache key as the plain bench had it: parameters at their defaults left out
+            key = {k: kw[k] for k in ("n", "p", "q", "z_bits", "fifo_depth", "in_depth")}
+            key.update({k: kw[k] for k, v in _CELL_DEFAULTS.items() if kw[k] != v})
+            extra = convert_cached("sparse-matrix", lambda: MatrixCell(**kw), params=key, module=CELL_MODULE)
+        w, h = self.raster(params)
+        xb = (w - 1).bit_length()
+
+        def address(m, b, addr):
+            m.d.comb += [b.rd_x.eq(addr[:xb]), b.rd_y.eq(addr[xb:])]
+
+        return ReadOut(mx, words=w * h, address=address, fixed={}, config={"limit": params["in_depth"]},
+                       z_bits=params["z_bits"], tail=("cycles", "stall_cycles"),
+                       stats=(params["p"] * params["q"], len(cell_stats(params["n"]))),
+                       record_bits=layouts(params["colour"])[0].size, rgb=params["colour"], extra=extra)
+
+    def frame(self, tris, params: dict, limit: int, what: str = "") -> Stimulus:
+        """The words of one frame: the limit, the records of ``tris``, the end word."""
+        from rasterhw.golden_model.sparse.stack import broadcast_records_rgb
+        from rasterhw.hdl.pack import pack
+        from rasterhw.hdl.sparse.layouts import layouts
+
+        if isinstance(limit, bool) or not isinstance(limit, int) or not 1 <= limit <= params["in_depth"]:
+            raise ValueError(f"sparse matrix: FIFO depth must be an integer in 1..{params['in_depth']}, not {limit!r}")
+        lay = layouts(params["colour"])[0]
+        recs = broadcast_records_rgb(tris) if params["colour"] else broadcast_records(tris)
+        cfg = ReadOut.config_word(lay.size, {"limit": params["in_depth"].bit_length()}, {"limit": limit})
+        words = [cfg] + [pack(lay, r) for r in recs] + [1 << lay.size]
+        return Stimulus({"i": words}, what=what, source={"tris": tris, "limit": limit})
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        st = super().stimulus(params, seed)
+        limit = int(np.random.default_rng(seed).integers(1, params["in_depth"] + 1))
+        return self.frame(st.source, params, limit, what=f"{st.what}, input FIFO limit {limit}")
+
+    def golden_counters(self, params: dict, stim: Stimulus) -> dict:
+        """The golden coupled cycle model of the frame: ``coupled_matrix_vp``'s keys (``stalls``
+        per processor and level) and ``writes`` per processor."""
+        from rasterhw.golden_model.sparse.cycles import KE_EDGES
+        from rasterhw.golden_model.sparse.stack import coupled_stack_matrix
+        from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
+
+        tris, limit = stim.source["tris"], stim.source["limit"]
+        p, q = params["p"], params["q"]
+        g = sparse_render(tris, (p, q), depth="fixed", trace=True)
+        if params["vp"] == "stack":
+            gc = coupled_stack_matrix(tris, p, q, limit, kp=params["kp"], ke=params["ke"])
+        else:
+            gc = coupled_matrix_vp(g, limit, fifo_depth=params["fifo_depth"], kp=params["kp"],
+                                   ke=params.get("ke", KE_EDGES))
+        return {**gc, "writes": g.stats["writes_per_proc"].tolist(), "records": g.triangles, "frame": g}
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        from rasterhw.golden_model.sparse.fixed import colour_rgb8
+
+        tris = stim.source["tris"]
+        gc = self.golden_counters(params, stim)
+        g = gc["frame"]
+        zq = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+        words = _words(g.tri_id, zq, params["z_bits"])
+        if params["colour"]:
+            words = VPBench.with_rgb(words, colour_rgb8(tris, g.tri_id, params["p"], params["q"]), params["z_bits"])
+        cells = []
+        for k in range(params["p"] * params["q"]):
+            cells += list(gc["tests"][k]) + list(gc["stalls"][k]) + [gc["writes"][k], gc["busy"][k],
+                                                                     gc["fifo_peak"][k], gc["records"]]
+        return Expected({"o": words + [gc["frame_cycles"], gc["stall_cycles"]] + [int(v) for v in cells]})
+
+    def decode(self, params: dict, words: list[int]) -> dict:
+        """The engine's ``o`` words as ``run_matrix_pysim``'s keys: ``tri``, ``zq``, ``rgb`` (or
+        None), ``cycles``, ``stall_cycles``, ``stats`` (counter name -> (p*q,) array)."""
+        from rasterhw.hdl.sparse.cell import cell_stats
+
+        w, h = self.raster(params)
+        zb = params["z_bits"]
+        names = cell_stats(params["n"])
+        P = params["p"] * params["q"]
+        if len(words) != w * h + 2 + P * len(names):
+            raise ValueError(f"sparse frame bench: {len(words)} words, expected {w * h + 2 + P * len(names)}")
+        px = words[:w * h]
+        if params["colour"]:
+            sh = TRI_BITS + zb + 1
+            rgb_w = np.array([v >> sh for v in px], dtype=np.int64)
+            low = np.array([v & ((1 << sh) - 1) for v in px], dtype=np.int64)
+            rgb = np.stack([(rgb_w >> (8 * ch)) & 255 for ch in range(3)], axis=-1).reshape(h, w, 3)
+        else:
+            low, rgb = np.array(px, dtype=np.int64), None
+        tri = low >> (zb + 1)
+        zq = low & ((1 << (zb + 1)) - 1)
+        empty = tri == (1 << TRI_BITS) - 1
+        tri[empty], zq[empty] = -1, -1
+        st = np.array(words[w * h + 2:], dtype=np.int64).reshape(P, len(names))
+        return {"tri": tri.reshape(h, w), "zq": zq.reshape(h, w), "rgb": rgb, "cycles": int(words[w * h]),
+                "stall_cycles": int(words[w * h + 1]), "stats": {nm: st[:, j] for j, nm in enumerate(names)}}
 
 
 class StackVPBench(VPBench):

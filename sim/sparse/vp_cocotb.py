@@ -1,7 +1,7 @@
 """cocotb bench of one sparse video processor (``cocotb_tests/sparse/test_vp.py``), Verilator or Icarus.
 
-The scene runs (``rasterhw sim sparse``) use the timing-free plain-Verilator bench of
-:mod:`rasterhw.sim.sparse.verilator_run`, whose input never idles; this bench drives the generated
+The scene runs (``rasterhw sim sparse``) use the generic engine's timing-free Verilator bench
+(:mod:`rasterhw.sim.sparse.verilator_run`, ``ProcessorBench``); this bench drives the generated
 Verilog from Python with idle clocks, a stream checker and an in-order scoreboard on the input,
 and reads the local memory back through the video-controller port.
 """

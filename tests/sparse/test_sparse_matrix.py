@@ -72,14 +72,17 @@ def test_verilog_holds_one_processor_module_for_256_processors():
 def test_verilator_matrix_cycle_exact_and_depth_is_run_time():
     """The whole matrix on Verilator at 2x2 (one build, two run-time FIFO depths): image and every
     counter equal to the golden model and its coupled cycle model; depth 1 stalls the broadcast and
-    its FIFOs never hold more than one record."""
+    its FIFOs never hold more than one record. The design is the one the colour test
+    (``test_sparse_colour_hdl.py``) and the soak's CI rounds build -- the matrix with colour and
+    (5)'s k_p = 4 -- so the suite compiles it once; the colour is checked too."""
     from rasterhw.sim.sparse.sim import simulate_coupled
 
     tris = random_triangles(32, 32, 40, mean_area=40.0, seed=7)
-    r1 = simulate_coupled(tris, "2x2", fifo_depth=1)
-    r64 = simulate_coupled(tris, "2x2", fifo_depth=64)
+    r1 = simulate_coupled(tris, "2x2", fifo_depth=1, colour=True, kp=4)
+    r64 = simulate_coupled(tris, "2x2", fifo_depth=64, colour=True, kp=4)
     for r in (r1, r64):
         assert r["coupled"] and r["mismatches"] == 0 and r["pixels_compared"] == 32 * 32
+        assert r["colour_mismatches"] == 0
         # frame, stalls; per processor its FIFO peak, busy cycles and tests of its 4 levels
         assert r["cycle_mismatches"] == 0 and r["cycles_compared"] == 2 + 2 * 4 + 4 * 4
         assert r["tests_match_golden"]
