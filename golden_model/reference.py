@@ -56,7 +56,6 @@ from __future__ import annotations
 import itertools
 import os
 import statistics
-import sys
 import threading
 import time
 import tracemalloc
@@ -65,6 +64,7 @@ from pathlib import Path
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.fastpath import FastPath
 from rasterhw.golden_model.screen import SUBPIXEL_BITS, ScreenTriangles, snap
 
 __all__ = ["SUBPIXEL", "MAX_COORD", "ENGINE_ENV", "Frame", "Target", "choose_engine", "rasterise", "render",
@@ -424,43 +424,20 @@ def rasterise(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0), engine: str 
 #: ``numba`` (the compiled fast path; an error where numba cannot load), or ``auto`` / unset
 #: (numba where it loads, else NumPy with one line on stderr).
 ENGINE_ENV = "RASTERHW_REFERENCE"
-_ENGINES = ("auto", "numba", "numpy")
-_fast_lock = threading.Lock()
-_fast_mod = None  # the reference_fast module once loaded, False once it failed to
+_FAST = FastPath("rasterhw.golden_model.reference_fast", env=ENGINE_ENV, spec="numpy",
+                 fallback="the reference rasteriser runs its NumPy specification (same pixels, slower)")
 
 
 def _fast_module():
-    """:mod:`reference_fast` (imported on first use: importing numba takes ~0.4 s), or None
-    where it cannot be loaded; the first failure prints one line on stderr."""
-    global _fast_mod
-    with _fast_lock:
-        if _fast_mod is None:
-            try:
-                from rasterhw.golden_model import reference_fast
-                _fast_mod = reference_fast
-            except Exception as e:  # ImportError, or numba / llvmlite failing to load
-                _fast_mod = False
-                why = (str(e).splitlines() or [type(e).__name__])[0]
-                print(f"rasterhw: numba cannot be loaded ({why}); the reference rasteriser runs its "
-                      f"NumPy specification (same pixels, slower)", file=sys.stderr)
-        return _fast_mod or None
+    """:mod:`reference_fast` (imported on first use), or None where it cannot be loaded; the
+    first failure prints one line on stderr."""
+    return _FAST.module()
 
 
 def choose_engine(engine: str | None = None) -> str:
     """``"numba"`` or ``"numpy"``: the engine that draws for ``engine`` (``None`` = the
     environment variable :data:`ENGINE_ENV`, default ``auto``)."""
-    want = engine if engine is not None else (os.environ.get(ENGINE_ENV) or "auto")
-    if want not in _ENGINES:
-        src = "engine" if engine is not None else ENGINE_ENV
-        raise RasterhwError(f"{src} must be one of {', '.join(_ENGINES)}, not {want!r}")
-    if want == "numpy":
-        return "numpy"
-    if _fast_module() is None:
-        if want == "numba":
-            raise RasterhwError("the numba engine was asked for, but numba cannot be loaded "
-                                f"(unset {ENGINE_ENV} or set it to numpy)")
-        return "numpy"
-    return "numba"
+    return _FAST.choose(engine)
 
 
 def _zbuf(n: int) -> np.ndarray:

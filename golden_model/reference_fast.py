@@ -27,39 +27,21 @@ reassociated or fused into a multiply-add. ``tests/test_reference_fast.py`` hold
 bit-identical on c300, sp27, c300 at 1280x1024 and on hypothesis-generated scenes, and the
 brute-force tests of ``tests/test_reference*.py`` run on both.
 
-The kernel is compiled on first use and cached on disk (``cache=True``): by default in
-``__pycache__`` beside this file (numba's own choice, which falls back to the user's cache
-directory, ``~/.cache/numba``, when the installed package is read-only; ``NUMBA_CACHE_DIR``
-overrides both). Where neither place is writable, :func:`_jit` points numba at
-``$TMPDIR/rasterhw-numba-UID`` and, failing that, compiles without a cache.
+The kernel is compiled on first use and cached on disk (``cache=True``; where:
+:func:`rasterhw.golden_model.numba_jit.njit_cached`).
 
-This module imports numba at the top: :mod:`reference` imports it lazily and falls back to the
-NumPy code, with one line on stderr, when that fails.
+This module imports numba at the top: :mod:`reference` loads it on first use
+(:class:`rasterhw.golden_model.fastpath.FastPath`) and falls back to the NumPy code, with one line
+on stderr, when that fails.
 """
 
 from __future__ import annotations
 
-import os
-import tempfile
-
 import numba
 import numpy as np
+from rasterhw.golden_model.numba_jit import njit_cached as _jit
 
 __all__ = ["band", "prepare", "compile_all"]
-
-
-def _jit(fn):
-    """``numba.njit(cache=True, nogil=True)``, with a cache directory of our own where numba
-    finds no writable one (no ``__pycache__`` beside the module, no user cache directory)."""
-    try:
-        return numba.njit(cache=True, nogil=True)(fn)
-    except RuntimeError:  # "cannot cache function ...: no locator available"
-        pass
-    try:
-        numba.config.CACHE_DIR = os.path.join(tempfile.gettempdir(), f"rasterhw-numba-{os.getuid()}")
-        return numba.njit(cache=True, nogil=True)(fn)
-    except (RuntimeError, OSError):
-        return numba.njit(cache=False, nogil=True)(fn)
 
 
 def _inline(fn):

@@ -35,13 +35,43 @@ from __future__ import annotations
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.golden_model.sparse.cycles import KE_EDGES
+from rasterhw.golden_model.fastpath import FastPath
+from rasterhw.golden_model.sparse.cycles import KE_EDGES, _check_int
 from rasterhw.golden_model.sparse.stack import param_cycles
 
-__all__ = ["HDL_FIFO_DEPTH", "VPCycleModel", "coupled_matrix_vp", "vp_standalone", "vp_streams"]
+__all__ = ["ENGINE_ENV", "HDL_FIFO_DEPTH", "VPCycleModel", "choose_engine", "coupled_matrix_vp", "vp_standalone",
+           "vp_streams"]
 
 #: ``VideoProcessor(fifo_depth=8)``, the default every driver builds
 HDL_FIFO_DEPTH = 8
+
+#: Environment variable choosing the engine of :func:`coupled_matrix_vp` and :func:`vp_standalone`
+#: when a call does not: ``python`` (this module's code, the specification), ``numba`` (the compiled
+#: fast path, :mod:`.vpcycles_fast`; an error where numba cannot load), or ``auto`` / unset (numba
+#: where it loads, else Python with one line on stderr).
+ENGINE_ENV = "RASTERHW_VPCYCLES"
+_FAST = FastPath("rasterhw.golden_model.sparse.vpcycles_fast", env=ENGINE_ENV, spec="python",
+                 fallback="the sparse video processor's cycle model runs its Python specification (same "
+                      "cycles, slower)")
+
+
+def choose_engine(engine: str | None = None) -> str:
+    """``"numba"`` or ``"python"``: the engine that runs the cycle model for ``engine`` (``None`` =
+    the environment variable :data:`ENGINE_ENV`, default ``auto``)."""
+    return _FAST.choose(engine)
+
+
+def _check_params(fifo_depth, setup_fifo_depth, kp, ke) -> list[int]:
+    """The processor's parameters checked; returns the FIFOs' inner capacities but the last's
+    (0: the set-up's, then every level's: ``[setup_fifo_depth - 1, fifo_depth - 1]``)."""
+    setup_fifo_depth = fifo_depth if setup_fifo_depth is None else setup_fifo_depth
+    for name, v in (("fifo_depth", fifo_depth), ("setup_fifo_depth", setup_fifo_depth)):
+        if isinstance(v, bool) or not isinstance(v, int) or v < 2:
+            raise RasterhwError(f"sparse VP cycles: {name} must be an integer >= 2, not {v!r}")
+    for name, v, lo in (("kp", kp, 0), ("ke", ke, 1)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
+            raise RasterhwError(f"sparse VP cycles: {name} must be an integer >= {lo}, not {v!r}")
+    return [setup_fifo_depth - 1, fifo_depth - 1]
 
 
 def vp_streams(frame, k: int) -> tuple[list[np.ndarray], list[np.ndarray], np.ndarray]:
@@ -85,19 +115,13 @@ class VPCycleModel:
     def __init__(self, oks: list[np.ndarray], news: list[np.ndarray], new_px: np.ndarray, *,
                  fifo_depth: int = HDL_FIFO_DEPTH, setup_fifo_depth: int | None = None, kp: int = 0,
                  ke: int = KE_EDGES):
-        setup_fifo_depth = fifo_depth if setup_fifo_depth is None else setup_fifo_depth
-        for name, v in (("fifo_depth", fifo_depth), ("setup_fifo_depth", setup_fifo_depth)):
-            if isinstance(v, bool) or not isinstance(v, int) or v < 2:
-                raise RasterhwError(f"sparse VP cycles: {name} must be an integer >= 2, not {v!r}")
-        for name, v, lo in (("kp", kp, 0), ("ke", ke, 1)):
-            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
-                raise RasterhwError(f"sparse VP cycles: {name} must be an integer >= {lo}, not {v!r}")
+        cap0, cap = _check_params(fifo_depth, setup_fifo_depth, kp, ke)
         self.kp, self.ke = int(kp), int(ke)
         self.n = n = len(oks)
         self.ok = [[tuple(bool(b) for b in row) for row in o] for o in oks]
         self.new = [list(map(bool, x)) for x in news] + [list(map(bool, new_px))]
         # inner capacity of FIFO k (0: the set-up's, into level 1)
-        self.caps = [setup_fifo_depth - 1] + [fifo_depth - 1] * n
+        self.caps = [cap0] + [cap] * n
         # FIFO k (0..n) feeds stage k + 1 (the pixel processor for k = n); w: windows, h: headers
         self.wl = [0] * (n + 1)   # inner levels
         self.wv = [False] * (n + 1)  # output registers valid
@@ -248,10 +272,19 @@ class VPCycleModel:
 
 
 def vp_standalone(oks, news, new_px, records: int, *, fifo_depth: int = HDL_FIFO_DEPTH,
-                  max_cycles: int = 50_000_000, kp: int = 0, ke: int = KE_EDGES) -> dict:
+                  max_cycles: int = 50_000_000, kp: int = 0, ke: int = KE_EDGES, engine: str | None = None) -> dict:
     """The Verilator bench's run of one processor: ``cycles`` (as the bench counts them),
     ``accept`` (cycle each record was taken, from the first cycle after reset), ``tests``,
-    ``stalls`` per level."""
+    ``stalls`` per level. ``engine``: ``"python"`` (this code, the specification), ``"numba"`` (the
+    compiled fast path, the same results), ``None`` / ``"auto"`` (:func:`choose_engine`)."""
+    if choose_engine(engine) == "numba":
+        cap0, cap = _check_params(fifo_depth, None, kp, ke)
+        fast = _FAST.module()
+        status, c, acc, tests, stalls = fast.standalone((oks, news, new_px), records, [cap0] + [cap] * len(oks),
+                                                        int(kp), int(ke), max_cycles)
+        if status:
+            raise RasterhwError(f"sparse VP cycles: runaway {'feed' if status == fast.RUNAWAY_FEED else 'drain'}")
+        return {"cycles": c, "accept": acc.tolist(), "tests": tests.tolist(), "stalls": stalls.tolist()}
     vp = VPCycleModel(oks, news, new_px, fifo_depth=fifo_depth, kp=kp, ke=ke)
     acc = []
     c = 0
@@ -276,18 +309,40 @@ def vp_standalone(oks, news, new_px, records: int, *, fifo_depth: int = HDL_FIFO
 
 def coupled_matrix_vp(frame, depth: int, *, issue_interval: int = 1, fifo_depth: int = HDL_FIFO_DEPTH,
                       setup_fifo_depth: int | None = None, kp: int = 0, ke: int = KE_EDGES,
-                      max_cycles: int = 100_000_000) -> dict:
+                      max_cycles: int = 100_000_000, engine: str | None = None) -> dict:
     """The coupled matrix of :mod:`.cycles` (same broadcast, FIFO and counting rules) with every
     processor the HDL video processor as built (:class:`VPCycleModel`) instead of a server: a
     processor takes the record at the head of its matrix FIFO on a cycle on which its set-up is
     idle (``i.ready``), and ``busy`` is the HDL's ``busy`` output. ``frame`` must be drawn with
     ``trace=True``. ``kp``, ``ke``: every processor prices its surface parameters as formula (5)
     (:class:`VPCycleModel`). Returns the keys of :meth:`~.cycles.CoupledResult.as_dict` plus ``accept``
-    ((P, T) cycle each processor took each record) and ``broadcast`` ((T,))."""
-    from rasterhw.golden_model.sparse.cycles import _check_int
-
+    ((P, T) cycle each processor took each record) and ``broadcast`` ((T,)). ``engine``:
+    ``"python"`` (this code, the specification), ``"numba"`` (the compiled fast path,
+    :mod:`.vpcycles_fast`, the same results), ``None`` / ``"auto"`` (:func:`choose_engine`)."""
     D = _check_int("FIFO depth", depth, 1)
     g = _check_int("issue interval", issue_interval, 1)
+    P = frame.p * frame.q
+    T = frame.triangles
+    if choose_engine(engine) == "numba":
+        cap0, cap = _check_params(fifo_depth, setup_fifo_depth, kp, ke)
+        streams = [vp_streams(frame, k) for k in range(P)]
+        caps = [cap0] + [cap] * len(streams[0][0])
+        status, c, offer, bc, acc, peak_a, busy_a, tests, stalls = _FAST.module().coupled(
+            streams, T, D, g, caps, int(kp), int(ke), max_cycles)
+        if status:
+            raise RasterhwError("sparse VP cycles: runaway coupled frame")
+        tests, stalls = tests.tolist(), stalls.tolist()
+    else:
+        c, offer, bc, acc, peak_a, busy_a, tests, stalls = _coupled_python(frame, D, g, fifo_depth, setup_fifo_depth,
+                                                                           kp, ke, max_cycles)
+    return {"frame_cycles": c, "stall_cycles": int((bc - offer).sum()), "fifo_peak": peak_a.tolist(),
+            "fifo_peak_max": int(peak_a.max(initial=0)), "busy": busy_a.tolist(), "idle": (c - busy_a).tolist(),
+            "depth": D, "issue_interval": g, "accept": acc, "broadcast": bc, "tests": tests, "stalls": stalls}
+
+
+def _coupled_python(frame, D, g, fifo_depth, setup_fifo_depth, kp, ke, max_cycles):
+    """:func:`coupled_matrix_vp`'s loop, the specification: ``(frame_cycles, offer, broadcast,
+    accept, fifo_peak, busy, tests, stalls)``."""
     P = frame.p * frame.q
     T = frame.triangles
     vps = [VPCycleModel(*vp_streams(frame, k), fifo_depth=fifo_depth, setup_fifo_depth=setup_fifo_depth, kp=kp,
@@ -328,9 +383,5 @@ def coupled_matrix_vp(frame, depth: int, *, issue_interval: int = 1, fifo_depth:
         c += 1
         if c > max_cycles:
             raise RasterhwError("sparse VP cycles: runaway coupled frame")
-    busy_a = np.array(busy, dtype=np.int64)
-    peak_a = np.array(peak, dtype=np.int64)
-    return {"frame_cycles": c, "stall_cycles": int((bc - offer).sum()), "fifo_peak": peak_a.tolist(),
-            "fifo_peak_max": int(peak_a.max(initial=0)), "busy": busy_a.tolist(), "idle": (c - busy_a).tolist(),
-            "depth": D, "issue_interval": g, "accept": acc, "broadcast": bc,
-            "tests": [vp.tests for vp in vps], "stalls": [vp.stalls for vp in vps]}
+    return (c, offer, bc, acc, np.array(peak, dtype=np.int64), np.array(busy, dtype=np.int64),
+            [vp.tests for vp in vps], [vp.stalls for vp in vps])
