@@ -151,6 +151,9 @@ class Testbench:
     outputs: tuple[str, ...] = ("o",)
     domains: tuple[str, ...] = ("sync",)
     port_domains: dict[str, str] = {}   # port (or port array, e.g. "o_merge") -> its domain; default sync
+    #: output ports whose sink is always ready, whatever the run's ``stall`` (a log the block writes
+    #: as things happen and cannot hold back, e.g. a per-line counter)
+    always_ready: tuple[str, ...] = ()
     #: C++ optimisation of the Verilator engine's model: -O1 builds fast for the many short runs;
     #: a testbench of one long run (millions of clocks) may ask for -O2 (``$RASTERHW_VERILATOR_OPT``
     #: then applies, as for every -O2 build)
@@ -184,6 +187,10 @@ class Testbench:
         """Values of the block read when the run ends, beside its streams (``{name: Amaranth value}``,
         64 bits together at most, e.g. a frame counter or a sticky overflow): ``Run.status``."""
         return {}
+
+    def stall_of(self, port: str, stall: int) -> int:
+        """The back-pressure of output ``port`` in a run with ``stall`` (0 for :attr:`always_ready` ports)."""
+        return 0 if port in self.always_ready else stall
 
     def sink_seed(self, params: dict, port: int, seed: int) -> int:
         """The back-pressure seed of output ``port`` (its index) in a run seeded ``seed``."""

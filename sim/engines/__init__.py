@@ -36,7 +36,8 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
     drawn from ``seed`` and the port, the same on every engine.
     ``stall`` (0..255): every output's ``ready`` is low on a clock when the low byte of a seeded
     xorshift is below it (0: always ready); ``seed`` seeds it (port k uses ``tb.sink_seed(params, k, seed)``,
-    ``seed + k`` unless the testbench says otherwise).
+    ``seed + k`` unless the testbench says otherwise); a testbench's ``always_ready`` outputs are
+    never back-pressured.
     ``expect_words``: words to collect per output port (the run ends when all have come);
     ``max_cycles``: a watchdog (default: 10,000 + 64 clocks per word in and out, scaled up by the
     idle gaps and the stalls; a block that stops gives a one-line error, not a hang), in edges of
@@ -51,8 +52,9 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
         raise RasterhwError(f"stall must be an integer in 0..255, not {stall!r}")
     if not (isinstance(idle, (int, float)) and 0 <= idle < 1):
         raise RasterhwError(f"idle must be a probability in [0, 1), not {idle!r}")
-    n_out = len(tb.outputs_of(params))
-    if stall and any(tb.sink_seed(params, k, seed) & 0xFFFF_FFFF == 0 for k in range(n_out)):
+    outs = tb.outputs_of(params)
+    if stall and any(tb.sink_seed(params, k, seed) & 0xFFFF_FFFF == 0 for k, n in enumerate(outs)
+                     if tb.stall_of(n, stall)):
         # output k's back-pressure is the xorshift seeded seed + k: from 0 it stays 0 (never ready)
         raise RasterhwError(f"seed {seed} gives an output a back-pressure seed of 0 (xorshift stays 0: "
                             "ready never rises); use another seed")

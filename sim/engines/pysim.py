@@ -104,7 +104,7 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
         d = tb.domain_of(name)
         sim.add_testbench(stream_protocol_checker(port, name, domain=d, errors=errors), background=True)
         by_domain.setdefault(d, []).append((name, port, expect_words[name], words[name], stamps[name],
-                                            ready_pattern(tb.sink_seed(params, k, seed), stall)))
+                                            ready_pattern(tb.sink_seed(params, k, seed), tb.stall_of(name, stall))))
     for d, sinks in by_domain.items():
         # the watchdog counts reference-clock edges: as many of this domain's as fit in their time
         limit = max_cycles if not clocks else -(-max_cycles * clocks["sync"].half // clocks[d].half)

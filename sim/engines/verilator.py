@@ -228,23 +228,25 @@ def _build(design, opt: str, pgo=None) -> tuple[Path, float]:
 PGO_OPT = "-O2"
 
 
-def _settings(build: dict | None, default_opt: str) -> tuple[bool, str | None, bool | str, int]:
-    """(speed, opt, pgo, depth) of a ``build`` argument (see :func:`rasterhw.sim.engines.run`);
+def _settings(build: dict | None, default_opt: str) -> tuple[bool, str | None, bool | str, int, int]:
+    """(speed, opt, pgo, depth, out_depth) of a ``build`` argument (see :func:`rasterhw.sim.engines.run`);
     no ``build``: ``default_opt`` (the testbench's level)."""
     b = dict(build or {})
-    unknown = sorted(set(b) - {"speed", "opt", "pgo", "depth"})
+    unknown = sorted(set(b) - {"speed", "opt", "pgo", "depth", "out_depth"})
     if unknown:
-        raise RasterhwError(f"build settings: no {', '.join(unknown)} (speed, opt, pgo, depth)")
-    depth = b.get("depth", 0)
-    if not isinstance(depth, int) or isinstance(depth, bool) or depth < 0:
-        raise RasterhwError(f"build settings: depth must be a word count, not {depth!r}")
+        raise RasterhwError(f"build settings: no {', '.join(unknown)} (speed, opt, pgo, depth, out_depth)")
+    for key in ("depth", "out_depth"):
+        v = b.get(key, 0)
+        if not isinstance(v, int) or isinstance(v, bool) or v < 0:
+            raise RasterhwError(f"build settings: {key} must be a word count, not {v!r}")
+    depth, out_depth = b.get("depth", 0), b.get("out_depth", 0)
     pgo = b.get("pgo", False)
     env = os.environ.get("RASTERHW_PGO", "")
     if pgo == "auto" and env in ("0", "1"):
         pgo = env == "1"
     if pgo not in (False, True, "auto"):
         raise RasterhwError(f"build settings: pgo must be False, True or 'auto', not {pgo!r}")
-    return bool(b.get("speed", False)), b.get("opt", default_opt if not build else None), pgo, depth
+    return bool(b.get("speed", False)), b.get("opt", default_opt if not build else None), pgo, depth, out_depth
 
 
 def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outputs: dict[str, int],
@@ -288,9 +290,10 @@ def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outp
 def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, expect_words: dict[str, int],
         max_cycles: int, build: dict | None = None, clocks: dict | None = None) -> Run:
     t0 = time.perf_counter()
-    speed, opt, pgo, depth = _settings(build, tb.verilator_opt)
+    speed, opt, pgo, depth, out_depth = _settings(build, tb.verilator_opt)
+    # memories: the words of this run, or (depth / out_depth) at least so many, one build for many runs
     inputs = {n: _depth(max(len(stim.words[n]), depth - 2)) for n in tb.inputs_of(params)}
-    outputs = {n: _depth(expect_words[n]) for n in tb.outputs_of(params)}
+    outputs = {n: _depth(max(expect_words[n], out_depth - 2)) for n in tb.outputs_of(params)}
     design = _design(tb, params, inputs, outputs, speed, separate=bool(clocks))
     prof = profile(tb, params, design, inputs=inputs, outputs=outputs, opt=opt or PGO_OPT,
                    train=pgo is True) if pgo else None
@@ -329,7 +332,7 @@ def _run_exe(exe: Path, tb: Testbench, params: dict, stim: Stimulus, *, stall: i
         for k, n in enumerate(outs):
             t = _tag(n)
             plus += [f"+{t}={run_dir / f'{t}.out'}", f"+{t}_cyc={run_dir / f'{t}.cyc'}", f"+{t}_n={expect_words[n]}",
-                     f"+{t}_stall={stall}", f"+{t}_seed={tb.sink_seed(params, k, seed) & 0xFFFF_FFFF}"]
+                     f"+{t}_stall={tb.stall_of(n, stall)}", f"+{t}_seed={tb.sink_seed(params, k, seed) & 0xFFFF_FFFF}"]
         # every edge after time 0 (the times are relative), as on pysim
         after = max((c.half for c in (clocks or {}).values()), default=0)
         plus += [f"+clock_{k}={c.half},{after + c.first}" for k, c in enumerate((clocks or {}).values())]

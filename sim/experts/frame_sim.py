@@ -23,7 +23,7 @@ import time
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.experts.model import equal_bounds, render_frame
-from rasterhw.sim.experts.pxp_sim import ENGINES, hdl_image, jobs, run_pysim, run_verilator
+from rasterhw.sim.experts.pxp_sim import ENGINES, hdl_image, jobs, run_jobs
 
 __all__ = ["simulate_frame", "decode_slp"]
 
@@ -120,14 +120,14 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
     if len(lists) != height * pn:
         raise RasterhwError(f"experts: the SLP HDL gave lists for {len(lists) // max(pn, 1)} of {height} lines")
     jb = jobs(fr, sn, pn, pxp="span", slp=lists)
-    res = run_pysim(jb, width=width) if engine == "pysim" else run_verilator(jb, width=width)
+    res = run_jobs(jb, width=width, engine=engine)
     px = res["pixels"]
     n = min(px.size, jb["pixels"].size)
     mism = int(np.count_nonzero(px[:n] != jb["pixels"][:n])) + abs(px.size - jb["pixels"].size)
     cyc = res["cycles"][:jb["lines"]]
     pxp_cyc_mism = int(np.count_nonzero(cyc != jb["cycles"][:cyc.size])) + (jb["lines"] - cyc.size)
     slp_frame = max(sw["cycles"] for sw in sws)
-    cycles = int(got.cycles) + int(res.get("sim_cycles") or res.get("last_pixel") or 0)
+    cycles = int(got.cycles) + int(res["sim_cycles"])
     run_s = got.run_s + res["run_s"]
     pxp_frame = int(jb["pxp_frame_cycles"].max())
     return {"engine": engine, "cycles": cycles, "clock_hz": None,

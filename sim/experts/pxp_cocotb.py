@@ -1,9 +1,9 @@
 """cocotb bench of one EXPERTS PXP (``cocotb_tests/experts/test_pxp.py``) on Verilator or Icarus.
 
-The scene runs (``rasterhw sim pxp``) use the timing-free plain-Verilator bench of
-:mod:`rasterhw.sim.experts.pxp_sim`, whose input never idles and whose output never stalls. This bench is
-the other half: Python drives the generated Verilog with idle clocks on the segment stream and
-back-pressure on the pixel stream, stream checkers on both ports, and in-order scoreboards.
+The scene runs (``rasterhw sim pxp``, :mod:`rasterhw.sim.experts.pxp_sim`) run the PXP's testbench on
+the generic engines (pysim, plain Verilator). This bench is the other half: cocotb drives the
+generated Verilog with idle clocks on the segment stream and back-pressure on the pixel stream,
+stream checkers on both ports, and in-order scoreboards in Python.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ __all__ = ["run_cocotb_bench"]
 
 def run_cocotb_bench(jb: dict, *, width: int = 512, sim: str | None = None, idle: float = 0.0,
                      stall: float = 0.0, seed: int = 1) -> dict:
-    """Run the jobs ``jb`` (:func:`rasterhw.sim.experts.pxp_sim.job_list`) under cocotb.
+    """Run the jobs ``jb`` (:func:`rasterhw.sim.experts.pxp_jobs.job_list`) under cocotb.
 
     Raises :class:`~rasterhw.golden_model.errors.RasterhwError` if the bench's checks fail
     (a pixel, a line's cycles, the stream rules, the order of transfers)."""

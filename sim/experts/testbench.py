@@ -5,7 +5,7 @@ together, fed with the golden SLP's segment words of a random frame."""
 from __future__ import annotations
 
 import numpy as np
-from amaranth import Module, Signal
+from amaranth import EnableInserter, Module, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.experts.model import render_frame
@@ -13,39 +13,71 @@ from rasterhw.golden_model.experts.pxp_cycles import line_segments
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.sim import registry
-from rasterhw.sim.experts.pxp_sim import SEG_BITS, SPAN_BITS, job_list, span_job_list
+from rasterhw.sim.experts.pxp_jobs import (
+    RANGE_BITS,
+    SEG_BITS,
+    SPAN_BITS,
+    job_list,
+    range_word,
+    span_job_list,
+)
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 
 __all__ = ["DmmBench", "GroupBench", "PxpBench", "PxpSpanBench", "PxpUnitBench", "RangeFromTokens", "SlpBench",
-           "slp_words"]
-
-_RANGE_BITS = 21          # next_hi[10:0], next_lo[9:0] above the segment payload (the jobs' words)
+           "job_stimulus", "slp_words"]
 
 
 class RangeFromTokens(wiring.Component):
-    """Bench adapter: a PXP (or DMM/P + PXP) whose line range ``lo``/``hi`` rides on the stimulus.
+    """Bench adapter: a PXP (or DMM/P + PXP) whose line range ``lo``/``hi`` rides on the stimulus,
+    and its per-line log.
 
-    ``i`` carries ``{next_hi[10:0], next_lo[9:0], segment}``; the segment goes to the block, and when
-    a ``last`` token is taken the range of the next line is put on ``lo``/``hi`` (which the block
-    samples when that line starts). The first line's range is ``[0, width)``. No register on the
-    stream: the block sees every word in the cycle the bench offers it."""
+    ``i`` carries ``{flag, next_hi[10:0], next_lo[9:0], word}`` (``sim/experts/pxp_jobs.py``). The
+    first word is a range word (``flag`` set, :func:`~rasterhw.sim.experts.pxp_jobs.range_word`):
+    the adapter takes it itself, puts its range on ``lo``/``hi``, and only then starts the block's
+    clock (``EnableInserter``: the block's edge ``k`` is the run's edge ``k + 1``, so the first
+    line's range is there when the block samples it, on its first edge). Every other word goes to
+    the block, and when a ``last`` token is taken the range of the next line is put on
+    ``lo``/``hi`` (which the block samples when that line starts). No register on the stream: the
+    block sees every word in the cycle the bench offers it.
+
+    ``log`` carries the block's finish-time counter ``line_cycles`` on the edge its line count
+    ``lines`` moves (one word per line, as the block's counters show it); it cannot wait, so its
+    sink must take every word when it comes (the testbenches' ``always_ready``)."""
 
     def __init__(self, block, width: int, seg_bits: int = SEG_BITS):
         self.block, self._width, self._bits = block, width, seg_bits
-        super().__init__({"i": In(stream.Signature(seg_bits + _RANGE_BITS)), "o": Out(stream.Signature(16))})
+        super().__init__({"i": In(stream.Signature(seg_bits + RANGE_BITS)), "o": Out(stream.Signature(16)),
+                          "log": Out(stream.Signature(16))})
 
     def elaborate(self, platform):
         m = Module()
-        m.submodules.block = b = self.block
+        b, bits = self.block, self._bits
+        started = Signal()        # the range word taken: the block's clock runs
+        m.submodules.block = EnableInserter({"sync": started})(b)
         lo, hi = Signal(10, init=0), Signal(11, init=self._width)
-        SEG_BITS = self._bits
-        seg = self.i.payload[:SEG_BITS]
-        m.d.comb += [b.i.valid.eq(self.i.valid), b.i.payload.eq(seg), self.i.ready.eq(b.i.ready),
-                     b.lo.eq(lo), b.hi.eq(hi)]
-        with m.If(self.i.valid & self.i.ready & seg[0]):
-            m.d.sync += [lo.eq(self.i.payload[SEG_BITS:SEG_BITS + 10]), hi.eq(self.i.payload[SEG_BITS + 10:])]
-        wiring.connect(m, b.o, wiring.flipped(self.o))
+        seg = self.i.payload[:bits]
+        is_range = self.i.payload[bits + RANGE_BITS - 1]
+        m.d.comb += [b.i.valid.eq(self.i.valid & started & ~is_range), b.i.payload.eq(seg),
+                     self.i.ready.eq(is_range | (started & b.i.ready)), b.lo.eq(lo), b.hi.eq(hi)]
+        with m.If(self.i.valid & self.i.ready & (is_range | seg[0])):
+            m.d.sync += [lo.eq(self.i.payload[bits:bits + 10]), hi.eq(self.i.payload[bits + 10:bits + 21])]
+        with m.If(self.i.valid & is_range):
+            m.d.sync += started.eq(1)
+        m.d.comb += [self.o.valid.eq(b.o.valid & started), self.o.payload.eq(b.o.payload),
+                     b.o.ready.eq(self.o.ready & started)]
+        seen = Signal(16)
+        m.d.comb += [self.log.valid.eq(b.lines != seen), self.log.payload.eq(b.line_cycles)]
+        with m.If(self.log.valid & self.log.ready):
+            m.d.sync += seen.eq(b.lines)
         return m
+
+
+def job_stimulus(jb: dict, what: str = "") -> Stimulus:
+    """The jobs ``jb`` (``pxp_jobs.job_list`` / ``span_job_list``) as the PXP testbenches' input:
+    the first job's range word, then the jobs' words."""
+    bits = jb.get("seg_bits", SEG_BITS)
+    return Stimulus({"i": [range_word(jb["lo0"], jb["hi0"], bits), *jb["words"]]},
+                    what=what or f"{jb['lines']} PXP lines", source=jb)
 
 
 def _frame(params: dict, seed: int):
@@ -72,12 +104,24 @@ def _lines(rng, width: int, n: int, *, whole: bool = False) -> list[tuple[int, i
 
 
 class PxpBench(Testbench):
-    """``experts-pxp``: one line's segments and ``last`` token at a time in (``i``, the range of
-    the next line on the token), the line's pixel words out (``o``), as the golden PXP gives them;
-    cycles from the golden cycle model (``golden_model/experts/pxp_cycles.py: schedule``)."""
+    """``experts-pxp``: the first line's range word, then one line's segments and ``last`` token
+    at a time in (``i``, the range of the next line on the token), the line's pixel words out
+    (``o``), as the golden PXP gives them; cycles from the golden cycle model
+    (``golden_model/experts/pxp_cycles.py: schedule``).
+
+    ``PxpBench(log=True)`` (the scene runs, ``sim/experts/pxp_sim.py: run_jobs``) also collects
+    the adapter's line log (``log``: every line's finish-time counter, never back-pressured),
+    expected equal to the cycle model's line cycles."""
 
     block = "experts-pxp"
     whole_lines = False     # every line the whole width (the range never changes)
+    always_ready = ("log",)
+
+    def __init__(self, log: bool = False):
+        self.log = log
+
+    def outputs_of(self, params: dict) -> tuple[str, ...]:
+        return ("o", "log") if self.log else ("o",)
 
     def dut(self, params: dict):
         return RangeFromTokens(registry.load(registry.blocks()[self.block])(**params), params["width"])
@@ -93,23 +137,28 @@ class PxpBench(Testbench):
         if cap is not None:   # lines the block can hold (more would stall it for good, by design)
             todo = [t for t in todo if len(line_segments(fr, *t, aj=fr.aj)) <= cap] or todo[:0]
         jb = job_list(fr, todo)
-        return Stimulus({"i": jb["words"]}, what=f"{name} at {params['width']}, {jb['lines']} lines, seed {seed}",
-                        source=jb)
+        return job_stimulus(jb, f"{name} at {params['width']}, {jb['lines']} lines, seed {seed}")
+
+    def words(self, jb: dict) -> dict[str, list[int]]:
+        """The golden model's words of every output port."""
+        return {"o": jb["pixels"].tolist(), **({"log": jb["cycles"].tolist()} if self.log else {})}
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         jb = stim.source
-        # the model's cycle 0 is line 0's first clear cycle, one edge after the run's first (which
-        # takes the first word), and the last pixel leaves on the edge after its drain cycle: the
-        # run's edges up to the last pixel are last_pixel + 2 (as tests/experts/test_experts_pxp_pysim.py)
-        return Expected({"o": jb["pixels"].tolist()}, cycles=int(jb["last_pixel"]) + 2)
+        # the model's cycle 0 is line 0's first clear cycle, one PXP edge after its first, and the
+        # last pixel leaves on the edge after its drain cycle: the PXP's edges up to the last pixel
+        # are last_pixel + 2 (as tests/experts/test_experts_pxp_pysim.py); the run's edge 0 takes
+        # the range word (the PXP's clock starts after it): + 1
+        return Expected(self.words(jb), cycles=int(jb["last_pixel"]) + 3)
 
 
 class PxpSpanBench(PxpBench):
-    """``experts-pxp-span`` (the paper's PXP): per line the DMM/P words the SLP writes -- the
-    line's whole ASL, this PXP's block boundary bucket list, the ``last`` token with the block
-    leading segment pointer (and the next line's range for the adapter) -- in (``i``), the range's
-    pixel words out (``o``), as the golden bit model gives them; cycles from
-    ``golden_model/experts/span_cycles.py: schedule`` (last pixel's edge + 1)."""
+    """``experts-pxp-span`` (the paper's PXP): the first line's range word, then per line the
+    DMM/P words the SLP writes -- the line's whole ASL, this PXP's block boundary bucket list, the
+    ``last`` token with the block leading segment pointer (and the next line's range for the
+    adapter) -- in (``i``), the range's pixel words out (``o``), as the golden bit model gives
+    them; cycles from ``golden_model/experts/span_cycles.py: schedule`` (last pixel's edge + 1,
+    + 1 for the range word); ``log=True``: the line log too (:class:`PxpBench`)."""
 
     block = "experts-pxp-span"
 
@@ -120,12 +169,11 @@ class PxpSpanBench(PxpBench):
         rng, name, fr = _frame(params, seed)
         todo = _lines(rng, params["width"], int(rng.integers(2, 9)))
         jb = span_job_list(fr, todo)
-        return Stimulus({"i": jb["words"]}, what=f"{name} at {params['width']}, {jb['lines']} lines, seed {seed}",
-                        source=jb)
+        return job_stimulus(jb, f"{name} at {params['width']}, {jb['lines']} lines, seed {seed}")
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         jb = stim.source
-        return Expected({"o": jb["pixels"].tolist()}, cycles=int(jb["last_pixel"]) + 1)
+        return Expected(self.words(jb), cycles=int(jb["last_pixel"]) + 2)
 
 
 class PxpUnitBench(PxpBench):
