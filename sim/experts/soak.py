@@ -5,7 +5,8 @@ A round (512 x 512, anti-jagging (c)) renders a random EXPERTS / cube scene (see
 Sn x Pn and range method (static, i, ii); every PXP pixel is compared, and every line's cycle
 count: equal to the model's in half the rounds (input back to back, output always ready), no
 faster than the model's in the other half (random idle clocks on the input, random back-pressure
-on the output of the plain bench). Round 0 instead runs random lines through the cocotb bench
+on the pixel output: the Verilator engine's, ``pxp_sim.run_jobs``). Round 0 instead runs random
+lines through the cocotb bench
 with the same kinds of timing (stream checkers, scoreboards).
 """
 
