@@ -52,14 +52,15 @@ def test_experts_1000_frame_on_verilator(pxp):
 
 
 def test_a_frame_smaller_than_the_bench_memory_compares_its_own_pixels():
-    """The plain bench dumps its whole frame memory (2^18 words); a 512 x 16 frame is compared on
-    its own 8,192 pixels (the dump's tail once counted as 253,952 mismatches)."""
+    """The Verilator engine's pixel sink is 2^19 words deep for every scene run (one build); a
+    512 x 16 frame is compared on its own 8,192 pixels (the old plain bench's dump of its whole
+    memory once counted its tail as 253,952 mismatches)."""
     r = simulate_scene(build_scene("c50"), 512, 16, engine="verilator", sn=2, pn=2, aj="c")
     assert r["pixels_compared"] == 512 * 16 and r["mismatches"] == 0 and r["cycle_mismatches"] == 0
 
 
 def test_verilator_idle_and_backpressure_same_pixels_no_line_faster():
-    """Random input idle clocks and output back-pressure on the plain-Verilator PXP bench: every
+    """Random input idle clocks and output back-pressure on the Verilator engine (``run_jobs``): every
     pixel still equals the golden model and no line finishes faster than the cycle model, while
     the run takes more clocks than the cycle-exact one; bad settings are one-line errors."""
     sc = build_scene("experts-tilt-1000")
