@@ -34,7 +34,7 @@ def _key(monkeypatch, tb) -> dict:
         return "// not converted\n"
 
     monkeypatch.setattr(verilator, "convert_cached", fake)
-    verilator._design(tb, {"width": 16}, {"i": 16}, {"o": 16}, False)
+    verilator.bench_design(tb, {"width": 16}, {"i": 16}, {"o": 16}, False)
     return seen[-1]
 
 

@@ -1,7 +1,9 @@
 """The engines that run any registered :class:`~rasterhw.sim.testbench.Testbench`: Amaranth pysim
-(``pysim.py``) and plain Verilator with the one C++ main (``verilator.py``), both with the same
-stream sources (idle gaps from the stimulus) and sinks (seeded back-pressure, ``pattern.py``), so a
-run gives the same words and the same cycle stamps on either. They know no machine.
+(``pysim.py``), plain Verilator with the one C++ main (``verilator.py``), and cocotb on Verilator
+or Icarus (``cocotb.py``: the plain engine's bench top, clocked by one generic cocotb test), all
+with the same stream sources (idle gaps from the stimulus) and sinks (seeded back-pressure,
+``pattern.py``), so a run gives the same words and the same cycle stamps on each. They know no
+machine.
 
 Usage::
 
@@ -15,15 +17,17 @@ Usage::
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.engines import pysim, verilator
+from rasterhw.sim.engines import cocotb, pysim, verilator
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, clocks_of
 
 __all__ = ["ENGINES", "run", "with_gaps"]
 
-ENGINES = {"pysim": pysim.run, "verilator": verilator.run}
+ENGINES = {"pysim": pysim.run, "verilator": verilator.run,
+           **{name: partial(cocotb.run, sim=sim) for name, sim in cocotb.SIMULATORS.items()}}
 
 
 def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", idle: float = 0.0, stall: int = 0,

@@ -44,7 +44,8 @@ from rasterhw.sim.paths import BUILD_ROOT
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
 from rasterhw.sim.workdirs import build_lock, release, temp_run_folder
 
-__all__ = ["GAP_BITS", "PGO_OPT", "BenchTop", "bench_sources", "profile", "run", "unpack_status"]
+__all__ = ["GAP_BITS", "PGO_OPT", "BenchTop", "bench_design", "bench_sources", "collected", "memory_depths", "profile", "run",
+           "status_of", "stream_plusargs", "unpack_status"]
 
 GAP_BITS = 8          # idle clocks before a word: 0..255
 
@@ -174,7 +175,7 @@ def _class_file(cls) -> Path | None:
         return None
 
 
-def _design(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[str, int], speed: bool,
+def bench_design(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[str, int], speed: bool,
             separate: bool = False):
     """(build name, generated files, the main's defines) of the bench top around ``tb``'s block;
     ``speed``: the testbench's speed Verilog (:meth:`Testbench.sim_verilog`); ``separate``: one
@@ -186,7 +187,7 @@ def _design(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[s
 
     def top():
         dut = tb.dut(params)
-        return BenchTop(dut, inputs, outputs, tb.domains, _status(tb, dut, params), port_domains)
+        return BenchTop(dut, inputs, outputs, tb.domains, status_of(tb, dut, params), port_domains)
 
     def convert(top, mod):
         text = canonical_port_lists(verilog.convert(top, name=mod, ports=top.ports)) + _extra(top.dut)
@@ -201,7 +202,7 @@ def _design(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[s
 _DEFINES = {"RASTERHW_CYCLES": 1, "RASTERHW_ERRORS": 1, "RASTERHW_STATUS": 1}
 
 
-def _status(tb: Testbench, dut, params: dict) -> dict:
+def status_of(tb: Testbench, dut, params: dict) -> dict:
     """The testbench's status values (checked: 64 bits together at most)."""
     st = tb.status(dut, params)
     if sum(len(v) for v in st.values()) > 64:
@@ -291,61 +292,81 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
         max_cycles: int, build: dict | None = None, clocks: dict | None = None) -> Run:
     t0 = time.perf_counter()
     speed, opt, pgo, depth, out_depth = _settings(build, tb.verilator_opt)
-    # memories: the words of this run, or (depth / out_depth) at least so many, one build for many runs
-    inputs = {n: _depth(max(len(stim.words[n]), depth - 2)) for n in tb.inputs_of(params)}
-    outputs = {n: _depth(max(expect_words[n], out_depth - 2)) for n in tb.outputs_of(params)}
-    design = _design(tb, params, inputs, outputs, speed, separate=bool(clocks))
-    prof = profile(tb, params, design, inputs=inputs, outputs=outputs, opt=opt or PGO_OPT,
+    inputs, outputs = memory_depths(tb, params, stim, expect_words, depth=depth, out_depth=out_depth)
+    top = bench_design(tb, params, inputs, outputs, speed, separate=bool(clocks))
+    prof = profile(tb, params, top, inputs=inputs, outputs=outputs, opt=opt or PGO_OPT,
                    train=pgo is True) if pgo else None
     opt = opt or (PGO_OPT if prof is not None else tb.verilator_opt)
-    exe, build_s = _build(design, opt, pgo=prof)
+    exe, build_s = _build(top, opt, pgo=prof)
     dut = tb.dut(params)   # for the port widths and the status values' names and widths (not simulated)
     words, stamps, meta, _ = _run_exe(exe, tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
                                       inputs=inputs, max_cycles=max_cycles, dut=dut, clocks=clocks)
-    status = unpack_status(_status(tb, dut, params), int(meta.get("status", 0)))
+    status = unpack_status(status_of(tb, dut, params), int(meta.get("status", 0)))
     return Run("verilator", words, stamps, wall_s=time.perf_counter() - t0, build_s=build_s, run_s=meta["run_s"],
                protocol_errors=int(meta.get("errors", 0)), status=status,
                build={"speed": speed, "opt": opt, "pgo": prof is not None}, clocks=dict(clocks or {}),
                port_domains={n: tb.domain_of(n) for n in tb.outputs_of(params)} if clocks else {})
 
 
+def memory_depths(tb: Testbench, params: dict, stim: Stimulus, expect_words: dict[str, int], *, depth: int = 0,
+                  out_depth: int = 0) -> tuple[dict[str, int], dict[str, int]]:
+    """The bench top's memory words per input and per output port: this run's words, or ``depth``
+    / ``out_depth`` at least (one build for many runs), rounded up (:func:`_depth`)."""
+    inputs = {n: _depth(max(len(stim.words[n]), depth - 2)) for n in tb.inputs_of(params)}
+    outputs = {n: _depth(max(expect_words[n], out_depth - 2)) for n in tb.outputs_of(params)}
+    return inputs, outputs
+
+
 def _run_exe(exe: Path, tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int,
              expect_words: dict[str, int], inputs: dict[str, int], max_cycles: int, profile: Path | None = None,
              dut=None, clocks: dict | None = None):
-    """One run of a bench binary: (words, stamps, the main's JSON line, cycles). ``clocks``
-    (``{domain: Clock}``, a build with separate clocks): each domain's half period and first
-    edge, as ``+clock_K=HALF,FIRST`` (the main's default: every clock the same)."""
-    outs = tb.outputs_of(params)
-    dut = tb.dut(params) if dut is None else dut
-    widths = {n: len(_payload(port_of(dut, n))) for n in inputs}
+    """One run of a bench binary: (words, stamps, the main's JSON line, cycles)."""
     run_dir = temp_run_folder(exe.parent.parent)
     try:
-        plus = []
-        for n in inputs:
-            t, words, gaps = _tag(n), stim.words[n], stim.gaps_of(n)
-            g_arr = np.asarray(gaps, dtype=np.int64)
-            if g_arr.size and (g_arr.min() < 0 or g_arr.max() >= 1 << GAP_BITS):
-                raise RasterhwError(f"{tb.block}: gaps on {n} must lie in 0..{(1 << GAP_BITS) - 1}")
-            pw = widths[n]
-            (run_dir / f"{t}.bin").write_bytes(records(as_bytes(words, pw), pw, g_arr, GAP_BITS).tobytes())
-            plus += [f"+{t}={run_dir / f'{t}.bin'}", f"+{t}_n={len(words)}"]
-        for k, n in enumerate(outs):
-            t = _tag(n)
-            plus += [f"+{t}={run_dir / f'{t}.out'}", f"+{t}_cyc={run_dir / f'{t}.cyc'}", f"+{t}_n={expect_words[n]}",
-                     f"+{t}_stall={tb.stall_of(n, stall)}", f"+{t}_seed={tb.sink_seed(params, k, seed) & 0xFFFF_FFFF}"]
-        # every edge after time 0 (the times are relative), as on pysim
-        after = max((c.half for c in (clocks or {}).values()), default=0)
-        plus += [f"+clock_{k}={c.half},{after + c.first}" for k, c in enumerate((clocks or {}).values())]
+        plus = stream_plusargs(run_dir, tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
+                               inputs=inputs, dut=dut, clocks=clocks)
         meta = run_plain_verilator(exe, plus, run_dir=run_dir, maxcyc=max_cycles, profile=profile)
-        words, stamps = {}, {}
-        for n in outs:
-            t, k = _tag(n), expect_words[n]
-            words[n] = _ints(read_memh(run_dir / f"{t}.out", None)) if k else []
-            stamps[n] = _ints(read_memh(run_dir / f"{t}.cyc", None)) if k else []
-            words[n], stamps[n] = words[n][:k], stamps[n][:k]
+        words, stamps = collected(run_dir, tb.outputs_of(params), expect_words)
     finally:
         release(run_dir)
     return words, stamps, meta, max((s[-1] + 1 for s in stamps.values() if s), default=0)
+
+
+def stream_plusargs(run_dir: Path, tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int,
+                    expect_words: dict[str, int], inputs: dict[str, int], dut=None,
+                    clocks: dict | None = None) -> list[str]:
+    """The bench top's plusargs for one run in ``run_dir`` (any simulator): every input's packed
+    ``{gap, word}`` records written to ``run_dir``, every sink's dump files, word count,
+    back-pressure and seed. ``clocks`` (``{domain: Clock}``, a build with separate clocks): each
+    domain's half period and first edge, as ``+clock_K=HALF,FIRST`` (default: every clock the same)."""
+    dut = tb.dut(params) if dut is None else dut
+    widths = {n: len(_payload(port_of(dut, n))) for n in inputs}
+    plus = []
+    for n in inputs:
+        t, words, gaps = _tag(n), stim.words[n], stim.gaps_of(n)
+        g_arr = np.asarray(gaps, dtype=np.int64)
+        if g_arr.size and (g_arr.min() < 0 or g_arr.max() >= 1 << GAP_BITS):
+            raise RasterhwError(f"{tb.block}: gaps on {n} must lie in 0..{(1 << GAP_BITS) - 1}")
+        pw = widths[n]
+        (run_dir / f"{t}.bin").write_bytes(records(as_bytes(words, pw), pw, g_arr, GAP_BITS).tobytes())
+        plus += [f"+{t}={run_dir / f'{t}.bin'}", f"+{t}_n={len(words)}"]
+    for k, n in enumerate(tb.outputs_of(params)):
+        t = _tag(n)
+        plus += [f"+{t}={run_dir / f'{t}.out'}", f"+{t}_cyc={run_dir / f'{t}.cyc'}", f"+{t}_n={expect_words[n]}",
+                 f"+{t}_stall={tb.stall_of(n, stall)}", f"+{t}_seed={tb.sink_seed(params, k, seed) & 0xFFFF_FFFF}"]
+    # every edge after time 0 (the times are relative), as on pysim
+    after = max((c.half for c in (clocks or {}).values()), default=0)
+    return plus + [f"+clock_{k}={c.half},{after + c.first}" for k, c in enumerate((clocks or {}).values())]
+
+
+def collected(run_dir: Path, outs, expect_words: dict[str, int]) -> tuple[dict[str, list[int]], dict[str, list[int]]]:
+    """(words, stamps) per output port from the sinks' dumps in ``run_dir``."""
+    words, stamps = {}, {}
+    for n in outs:
+        t, k = _tag(n), expect_words[n]
+        words[n] = _ints(read_memh(run_dir / f"{t}.out", None))[:k] if k else []
+        stamps[n] = _ints(read_memh(run_dir / f"{t}.cyc", None))[:k] if k else []
+    return words, stamps
 
 
 def _extra(dut) -> str:

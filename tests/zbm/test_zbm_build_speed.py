@@ -46,7 +46,7 @@ def test_speed_build_same_frame_same_cycles_as_the_plain_build():
     stim = tb.scene_stimulus(p, [eps])
     inputs = {"i": verilator._depth(len(stim.words["i"]))}
     outputs = {n: verilator._depth(len(w)) for n, w in tb.expect(p, stim).words.items()}
-    prof = verilator.profile(tb, p, verilator._design(tb, p, inputs, outputs, True), inputs=inputs, outputs=outputs,
+    prof = verilator.profile(tb, p, verilator.bench_design(tb, p, inputs, outputs, True), inputs=inputs, outputs=outputs,
                              train=False)
     assert prof is not None
     assert json.loads((prof / "trained.json").read_text())["what"] == f"scene {TRAIN_SCENE}" != "scene sp8"
