@@ -9,7 +9,9 @@ step each, until ``done`` (or ``+maxcyc=`` rising edges). Separate clocks (``+nc
 ``k`` of ``clocks`` is clock ``k`` with half period ``H`` and first rising edge at time ``F``
 (``+clock_k=H,F``); each step goes to the next clock event and toggles every clock due then
 together (event time ``t`` is simulated at ``2 t``, the values settle at ``2 t + 1``, where
-``done`` is read); ``+maxcyc=`` and ``sim_cycles`` count rising edges of clock 0.
+``done`` is read); ``+maxcyc=`` and ``sim_cycles`` count rising edges of clock 0. After ``done``
+every clock rises once more (after the JSON's values are read): a simulator without SystemVerilog
+``final`` blocks has the sinks dump on that edge instead (``harness.v``, ``RASTERHW_NO_FINAL``).
 """
 
 from __future__ import annotations
@@ -67,5 +69,25 @@ async def bench(dut):
     status = dut.status.value   # undriven (z) when the testbench has no status values: 0, as on Verilator
     meta = {"sim_cycles": n, "done": int(dut.done.value), "run_s": run_s, "cycles": int(dut.cycles.value),
             "errors": int(dut.errors.value), "status": int(status) if status.is_resolvable else 0}
+    # one more rising edge of every clock: a simulator without `final` (Icarus at -g2005) has the
+    # sinks dump their words on it (harness.v, RASTERHW_NO_FINAL); read above, so nothing counted changes
+    if nclk == 0:
+        dut.clk.value = 1
+        await Timer(1, "ns")
+        dut.clk.value = 0
+        await Timer(1, "ns")
+    else:
+        rose = 0
+        while rose != (1 << nclk) - 1:
+            t = min(nxt)
+            await Timer(2 * t - now, "ns")
+            for k in range(nclk):
+                if nxt[k] == t:
+                    level ^= 1 << k
+                    nxt[k] += half[k]
+                    rose |= (level & (1 << k))
+            dut.clocks.value = level
+            await Timer(1, "ns")
+            now = 2 * t + 1
     with open(cocotb.plusargs["meta"], "w") as f:
         f.write(json.dumps(meta) + "\n")

@@ -240,10 +240,24 @@ module rasterhw_stream_sink #(
     q = 0;
     lf = seed;
   end
+`ifndef RASTERHW_NO_FINAL
   final begin
     if (fwords != 0) $writememh(fwords, words, 0, (q == 0) ? 0 : q - 1);
     if (fcyc != 0) $writememh(fcyc, stamps, 0, (q == 0) ? 0 : q - 1);
   end
+`else
+  // a Verilog-2005 simulator (Icarus at -g2005: at -g2012 it no longer runs the initial-value
+  // trigger of yosys's `always @*` processes): no `final`; the dumps are written on the first
+  // rising edge at which the sink is done (the cocotb engine's test gives every clock one more)
+  reg dumped = 1'b0;
+  always @(posedge clk) begin
+    if (done && !dumped) begin
+      if (fwords != 0) $writememh(fwords, words, 0, (q == 0) ? 0 : q - 1);
+      if (fcyc != 0) $writememh(fcyc, stamps, 0, (q == 0) ? 0 : q - 1);
+      dumped <= 1'b1;
+    end
+  end
+`endif
   // the 32-bit xorshift; sim/engines/pattern.py draws the same sequence for the pysim engine
 `include "xorshift.vh"
   assign ready = ({24'd0, lf[7:0]} >= stall);

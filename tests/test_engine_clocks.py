@@ -8,6 +8,8 @@ cycle count and per-line log (the run the soak's ratio rounds used to need cocot
 
 from __future__ import annotations
 
+import shutil
+
 import numpy as np
 import pytest
 from rasterhw.golden_model import zbm as G
@@ -68,22 +70,26 @@ def test_pysim_merger_at_clock_ratios_is_golden(clocks):
 
 
 @pytest.mark.cocotb
-def test_verilator_gives_the_pysim_words_and_stamps_at_clock_ratios():
+@pytest.mark.parametrize("engine", ["verilator", pytest.param("cocotb-verilator", marks=pytest.mark.slow),
+                                    pytest.param("cocotb-icarus", marks=pytest.mark.skipif(
+                                        shutil.which("iverilog") is None, reason="iverilog not on PATH"))])
+def test_verilator_gives_the_pysim_words_and_stamps_at_clock_ratios(engine):
     """One separate-clock build of the merger serves every ratio; each gives pysim's words and
-    per-domain stamps; equal clocks in phase give the one-clock run's stamps."""
+    per-domain stamps; equal clocks in phase give the one-clock run's stamps. The same on cocotb
+    (the generic test toggles the clocks on the plain main's schedule)."""
     tb, p, stim, exp, need = _merger(5)
     for clocks in RATIOS:
         kw = {"idle": 0.25, "stall": 90, "seed": 7, "expect_words": need, "clocks": clocks}
         a = run(tb, p, stim, engine="pysim", **kw)
-        b = run(tb, p, stim, engine="verilator", **kw)
+        b = run(tb, p, stim, engine=engine, **kw)
         assert compare(exp, b)["mismatches"] == 0 and b.protocol_errors == 0, clocks
         assert (a.words, a.stamps) == (b.words, b.stamps), clocks
         assert a.cycles == b.cycles
-    for engine in ("pysim", "verilator"):
-        kw = {"engine": engine, "stall": 90, "seed": 7, "expect_words": need}
+    for eng in ("pysim", engine):
+        kw = {"engine": eng, "stall": 90, "seed": 7, "expect_words": need}
         same = run(tb, p, stim, clocks={"sync": 5, "merge": 5}, **kw)
         one = run(tb, p, stim, **kw)
-        assert (same.words, same.stamps, same.cycles) == (one.words, one.stamps, one.cycles), engine
+        assert (same.words, same.stamps, same.cycles) == (one.words, one.stamps, one.cycles), eng
 
 
 W, H = 64, 16

@@ -1,8 +1,10 @@
-"""The generic engines (sim/engines/) on registered testbenches (sim/testbench.py): Amaranth pysim
-and plain Verilator give the same words and the same cycle stamps, with idle gaps and
-back-pressure, equal to the golden model's words."""
+"""The generic engines (sim/engines/) on registered testbenches (sim/testbench.py): Amaranth pysim,
+plain Verilator and cocotb (on Verilator and on Icarus) give the same words and the same cycle
+stamps, with idle gaps and back-pressure, equal to the golden model's words."""
 
 from __future__ import annotations
+
+import shutil
 
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
@@ -77,6 +79,27 @@ def test_verilator_gives_the_pysim_words_and_cycle_stamps(block):
         b = run(tb, p, stim, engine="verilator", expect_words=_need(exp), **kw)
         assert compare(exp, b)["mismatches"] == 0, kw
         assert (a.words, a.stamps) == (b.words, b.stamps), kw
+
+
+#: Icarus runs every block's bench where it is installed (its builds take about a second); cocotb on
+#: Verilator one block in the suite (a build is a Verilator model with cocotb's VPI), every block slow
+ICARUS = pytest.mark.skipif(shutil.which("iverilog") is None, reason="iverilog not on PATH")
+COCOTB_CASES = [("cocotb-verilator", "zbm-merger"),
+                *[pytest.param("cocotb-verilator", b, marks=pytest.mark.slow) for b in sorted(SMALL) if b != "zbm-merger"],
+                *[pytest.param("cocotb-icarus", b, marks=ICARUS) for b in sorted(SMALL)]]
+
+
+@pytest.mark.cocotb
+@pytest.mark.parametrize("engine,block", COCOTB_CASES)
+def test_cocotb_gives_the_pysim_words_and_cycle_stamps(engine, block):
+    """The generic cocotb test clocks the plain engine's bench top on either simulator: no bench
+    of the block's own, the same words, stamps and status values as pysim."""
+    tb, p, stim, exp = _case(block, 12)
+    for kw in ({}, {"idle": 0.25, "stall": 120, "seed": 9}):
+        a = run(tb, p, stim, engine="pysim", expect_words=_need(exp), **kw)
+        b = run(tb, p, stim, engine=engine, expect_words=_need(exp), **kw)
+        assert b.engine == engine and compare(exp, b)["mismatches"] == 0 and b.protocol_errors == 0, kw
+        assert (a.words, a.stamps, a.status) == (b.words, b.stamps, b.status), kw
 
 
 def test_compare_counts_wrong_missing_and_extra_words_and_cycles():

@@ -562,7 +562,7 @@ def run_cocotb(
         # interrupted or killed: run its commands as children that die with us
         runner = child_runner(sim)
         build_args: list[str] = ([*VERILATOR_BUILD_ARGS, *map(str, verilator_args)] if sim == "verilator"
-                                 else ["-g2012"]) + [INCLUDE_ARG]
+                                 else ["-g2005", "-DRASTERHW_NO_FINAL"]) + [INCLUDE_ARG]
         build_dir = Path(build_dir)
         build_dir.mkdir(parents=True, exist_ok=True)
         t0 = time.perf_counter()
