@@ -78,8 +78,8 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
         if "clocks" in kw:   # a slower clock than the reference takes more reference edges
             slow = max(c.half for c in kw["clocks"].values()) / kw["clocks"]["sync"].half
             max_cycles = int(max_cycles * max(1.0, slow))
-    if build and engine != "verilator":
-        raise RasterhwError(f"build settings are for the verilator engine, not {engine}")
+    if build and engine != "verilator" and (engine not in cocotb.SIMULATORS or set(build) - {"depth", "out_depth"}):
+        raise RasterhwError(f"build settings are for the verilator engine (cocotb's: depth, out_depth), not {engine}")
     if build:
         kw["build"] = build
     return ENGINES[engine](tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,

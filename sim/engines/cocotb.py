@@ -38,11 +38,15 @@ SIMULATORS = {"cocotb-verilator": "verilator", "cocotb-icarus": "icarus"}
 
 
 def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, expect_words: dict[str, int],
-        max_cycles: int, clocks: dict | None = None, sim: str = "verilator") -> Run:
+        max_cycles: int, clocks: dict | None = None, build: dict | None = None, sim: str = "verilator") -> Run:
     """One run of ``stim`` through ``tb``'s block under cocotb on ``sim`` (``verilator`` or
-    ``icarus``); the arguments as :func:`rasterhw.sim.engines.run` checked them."""
+    ``icarus``); the arguments as :func:`rasterhw.sim.engines.run` checked them. ``build``:
+    ``{"depth": N, "out_depth": M}`` as on the Verilator engine (memories of at least so many
+    words: one build for runs of many sizes)."""
     t0 = time.perf_counter()
-    inputs, outputs = memory_depths(tb, params, stim, expect_words)
+    b = build or {}
+    inputs, outputs = memory_depths(tb, params, stim, expect_words, depth=b.get("depth", 0),
+                                    out_depth=b.get("out_depth", 0))
     name, generated, _ = bench_design(tb, params, inputs, outputs, speed=False, separate=bool(clocks))
     text = generated["rasterhw_bench.v"]
     bdir = build_dir_for(f"{name}-cocotb", sim, verilog=hashlib.sha256(text.encode()).hexdigest())

@@ -23,10 +23,10 @@ from rasterhw.golden_model.experts.pxp import to_rgb8
 from rasterhw.golden_model.experts.pxp_cycles import schedule
 from rasterhw.sim.experts.pxp_jobs import SEG_BITS, SPAN_BITS, job_list, span_job_list
 
-__all__ = ["ENGINES", "PXPS", "SEG_BITS", "SPAN_BITS", "job_list", "jobs", "run_jobs", "simulate_scene",
+__all__ = ["ENGINES", "PXPS", "SEG_BITS", "SPAN_BITS", "check_jobs", "job_list", "jobs", "run_jobs", "simulate_scene",
            "span_job_list", "span_ranges"]
 
-ENGINES = ("pysim", "verilator")
+ENGINES = ("pysim", "verilator", "cocotb-verilator", "cocotb-icarus")
 PXPS = ("span", "zbuffer")
 
 
@@ -144,6 +144,22 @@ def run_jobs(jb: dict, *, width: int, engine: str = "pysim", idle: int = 0, stal
     last = int(st[-1]) if st else 0
     return {"pixels": np.array(got.words["o"], np.int64), "cycles": np.array(got.words["log"], np.int64),
             "run_s": got.run_s, "build_s": got.build_s, "sim_cycles": last, "last_pixel": last}
+
+
+def check_jobs(jb: dict, *, width: int, engine: str, idle: int = 0, stall: int = 0, seed: int = 1) -> dict:
+    """:func:`run_jobs`, checked against the golden PXP: ``pixel_mismatches`` (pixel words that
+    differ, in order, and a missing or extra pixel counts too) and ``line_mismatches`` (lines whose
+    finish-time counter differs from the golden cycle model's; with idle input or back-pressure only
+    a line finishing sooner than the model says counts: waiting clocks lengthen a line)."""
+    r = run_jobs(jb, width=width, engine=engine, idle=idle, stall=stall, seed=seed)
+    want_pix, want_cyc = np.asarray(jb["pixels"], np.int64).ravel(), np.asarray(jb["cycles"], np.int64).ravel()
+    got_pix, got_cyc = r["pixels"], r["cycles"]
+    n = min(len(got_pix), len(want_pix))
+    pix = int(np.sum(got_pix[:n] != want_pix[:n])) + abs(len(got_pix) - len(want_pix))
+    m = min(len(got_cyc), len(want_cyc))
+    late = (got_cyc[:m] != want_cyc[:m]) if idle == 0 and stall == 0 else (got_cyc[:m] < want_cyc[:m])
+    lines = int(np.sum(late)) + abs(len(got_cyc) - len(want_cyc))
+    return {**r, "pixel_mismatches": pix, "line_mismatches": lines}
 
 
 def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", progress: bool = False,

@@ -6,8 +6,8 @@ Sn x Pn and range method (static, i, ii); every PXP pixel is compared, and every
 count: equal to the model's in half the rounds (input back to back, output always ready), no
 faster than the model's in the other half (random idle clocks on the input, random back-pressure
 on the pixel output: the Verilator engine's, ``pxp_sim.run_jobs``). Round 0 instead runs random
-lines through the cocotb bench
-with the same kinds of timing (stream checkers, scoreboards).
+lines of the (line) PXP under cocotb (the generic cocotb engine on Verilator) with the same kinds of
+timing (stream checkers on both ports; ``pxp_sim.check_jobs``).
 """
 
 from __future__ import annotations
@@ -17,8 +17,7 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.experts.model import render_frame
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
-from rasterhw.sim.experts.pxp_cocotb import run_cocotb_bench
-from rasterhw.sim.experts.pxp_sim import job_list, simulate_scene
+from rasterhw.sim.experts.pxp_sim import check_jobs, job_list, simulate_scene
 
 __all__ = ["pxp_round"]
 
@@ -26,8 +25,8 @@ PXP_W, PXP_H = 512, 512
 
 
 def _pxp_cocotb_round(rng: np.random.Generator) -> dict:
-    """Random lines of a random frame through the PXP's cocotb bench: random idle clocks on the
-    segment stream, random back-pressure on the pixel stream, stream checkers, scoreboards."""
+    """Random lines of a random frame through the PXP under cocotb: random idle clocks on the
+    segment stream, random back-pressure on the pixel stream, stream checkers on both."""
     name = str(rng.choice(["experts-1000", "experts-tilt-1000", "c100"]))
     seed = int(rng.integers(0, 1 << 30))
     fr = render_frame(run_geometry(build_scene(name, seed=seed), PXP_W, PXP_H, z_bits=16), model="bit", aj="c")
@@ -35,19 +34,20 @@ def _pxp_cocotb_round(rng: np.random.Generator) -> dict:
     for y in sorted(rng.choice(PXP_H, 6, replace=False).tolist()):
         lo = int(rng.integers(0, PXP_W // 2))
         todo.append((y, lo, int(rng.integers(lo + 1, PXP_W + 1))))
-    idle, stall = float(rng.choice([0.0, 0.2, 0.6])), float(rng.choice([0.0, 0.2, 0.6]))
+    idle, stall = int(rng.choice([0, 51, 154])), int(rng.choice([0, 51, 154]))   # of 256: 0, 20 %, 60 %
     jb = job_list(fr, todo)
     what = f"cocotb: scene {name} seed={seed} lines={[t[0] for t in todo]} idle={idle} stall={stall}"
     try:
-        run_cocotb_bench(jb, width=PXP_W, sim="verilator", idle=idle, stall=stall, seed=int(rng.integers(1 << 30)))
-        bad = 0
+        r = check_jobs(jb, width=PXP_W, engine="cocotb-verilator", idle=idle, stall=stall,
+                       seed=int(rng.integers(1, 1 << 30)))
+        bad = r["pixel_mismatches"] + r["line_mismatches"]
     except RasterhwError as e:
         bad, what = 1, f"{what}: {e}"
     return {"pixels": int(jb["pixels"].size), "mismatches": bad, "run_s": 0.0, "settings": what}
 
 
 def pxp_round(rng: np.random.Generator, k: int) -> dict:
-    """Round ``k``: the cocotb bench for round 0, whole frames on plain Verilator after it."""
+    """Round ``k``: lines under cocotb for round 0, whole frames on plain Verilator after it."""
     if k == 0:  # the first round of every soak: idle and back-pressure through the cocotb bench
         return _pxp_cocotb_round(rng)
     name = str(rng.choice(["experts-1000", "experts-2000", "experts-tilt-1000", "experts-uneven", "c100", "sp27"]))

@@ -6,13 +6,13 @@ in most of these rounds; 4 x 4 matrix, 256 x 256, every processor alone on the b
 or a random cube scene through the whole matrix in one simulation (a random input FIFO depth; its
 counters against the golden coupled cycle model too); every processor's local memory (triangle
 index and depth) and per-level test counts are compared. Round 0 instead runs one random
-processor of a 4 x 4 matrix through the cocotb bench with random idle clocks on its input.
+processor of a 4 x 4 matrix under cocotb (the generic cocotb engine) with random idle clocks on its input.
 
-``sparse_round`` (the registered round, ``make soak``) runs the whole matrix and the cocotb bench
+``sparse_round`` (the registered round, ``make soak``) runs the whole matrix and the cocotb run
 at the paper's 4 x 4 and 256 x 256. ``sparse_round_ci`` (the test suite's soak) runs the same
 kinds of round on the designs the other sparse tests build: the whole matrix at 2 x 2, 32 x 32
 with colour and (5)'s k_p = 4 (``tests/sparse/test_sparse_matrix.py``, ``test_sparse_colour_hdl.py``;
-its colour compared too) and the cocotb bench's 4 x 4 matrix at 32 x 32
+its colour compared too) and the cocotb run's 4 x 4 matrix at 32 x 32
 (``tests/sparse/test_sparse_vp_cocotb.py``), so a test run compiles two fewer large models (the
 4 x 4 whole matrix at 256 x 256 took 44 s of the 93 s the test took in a fresh run); the
 triangle rounds (every processor of the 4 x 4 matrix at 256 x 256, ``ProcessorBench``: the design
@@ -26,13 +26,13 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.reference import random_triangles
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.sim.sparse.sim import simulate, simulate_tris
-from rasterhw.sim.sparse.vp_cocotb import run_cocotb_bench
+from rasterhw.sim.sparse.verilator_run import check_processor
 
 __all__ = ["sparse_round", "sparse_round_ci"]
 
 #: frame of the triangle rounds (every processor of the 4 x 4 matrix alone on the stream)
 SP_W, SP_H = 256, 256
-#: (width, height, matrix) of the whole-matrix rounds and of round 0's cocotb bench
+#: (width, height, matrix) of the whole-matrix rounds and of round 0's cocotb run
 FULL = {"matrix": (256, 256, "4x4"), "cocotb": (256, 256, "4x4")}
 CI = {"matrix": (32, 32, "2x2"), "cocotb": (32, 32, "4x4")}
 #: the whole matrix's build options per kind of soak (``simulate`` keywords)
@@ -40,17 +40,19 @@ MATRIX_OPTIONS = {"full": {}, "ci": {"colour": True, "kp": 4}}
 
 
 def _sparse_cocotb_round(rng: np.random.Generator, w: int, h: int, matrix: str) -> dict:
-    """One random processor of the matrix through its cocotb bench: random idle clocks on the
-    broadcast input, a stream checker, the local memory and per-level tests read back."""
+    """One random processor of the matrix under cocotb (the generic cocotb engine on Verilator):
+    random idle clocks on the broadcast input, stream checkers, the local memory and per-level
+    tests read back."""
     n, seed = int(rng.integers(5, 60)), int(rng.integers(0, 1 << 30))
     p, q = (int(v) for v in matrix.split("x"))
     a, b = int(rng.integers(0, p)), int(rng.integers(0, q))
-    idle = float(rng.choice([0.0, 0.3, 0.7]))
+    idle = int(rng.choice([0, 77, 179]))   # of 256: 0, 30 %, 70 %
     tris = random_triangles(w, h, n, mean_area=float(rng.uniform(20, 2000)) * (w * h) / (SP_W * SP_H), seed=seed)
     what = f"cocotb {w}x{h} {matrix}: triangles n={n} seed={seed} processor=({a}, {b}) idle={idle}"
     try:
-        r = run_cocotb_bench(tris, matrix, a=a, b=b, sim="verilator", idle=idle, seed=int(rng.integers(1 << 30)))
-        px, bad = r["words_read"], 0
+        r = check_processor(tris, matrix, a=a, b=b, engine="cocotb-verilator", idle=idle,
+                            seed=int(rng.integers(1 << 30)))
+        px, bad = r["words_read"], r["mismatches"]
     except RasterhwError as e:
         px, bad, what = (w // p) * (h // q), 1, f"{what}: {e}"
     return {"pixels": px, "mismatches": bad, "run_s": 0.0, "settings": what}
