@@ -18,7 +18,7 @@ from rasterhw.sim.engines import run as run_engine
 from rasterhw.sim.testbench import find_testbench
 from rasterhw.sim.zbm.edge_check import check_edge_pairs
 from rasterhw.sim.zbm.testbench import deal
-from rasterhw.sim.zbm.unit_bench import run_unit_bench, unit_watchdog
+from rasterhw.sim.zbm.unit_bench import unit_watchdog
 from tqdm import tqdm
 
 __all__ = ["CLOCK_HZ", "ENGINES", "PLAIN_BUILD", "SPEED_BUILD", "float_tolerance", "run_scene", "run_units_equal_clocks",
@@ -116,12 +116,13 @@ def run_units_equal_clocks(per_unit: list, *, width: int, height: int, interleav
     """A chain of units with equal, in-phase clocks (the Table 1, skew and chain runs): on
     Verilator the generic engine (:func:`run_scene`, held word-, cycle- and line-log-exact with the
     cocotb bench by ``tests/zbm/test_zbm_unit_fast.py``; it builds and runs several times faster),
-    on Icarus the cocotb bench. g++ ``-O0``: these frames are small, the build is what costs."""
+    on Icarus the same testbench under cocotb (the generic cocotb engine). g++ ``-O0``: these frames are small, the build is what costs."""
     if engine == "verilator":
         return run_scene(per_unit, width=width, height=height, interleave=interleave, schedule=schedule,
                          line_log=line_log, build={"speed": True, "opt": "-O0"})
-    return run_unit_bench(per_unit, width=width, height=height, interleave=interleave, sim=engine, phase=0,
-                          speed_run=True, schedule=schedule, line_log=line_log, opt="-O0")
+    # Icarus: the same testbench under cocotb (the generic cocotb engine)
+    return run_scene(per_unit, width=width, height=height, interleave=interleave, schedule=schedule,
+                     line_log=line_log, engine="cocotb-icarus")
 
 
 def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: int = 1,
@@ -178,12 +179,10 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
     t1 = time.perf_counter()
     per_unit = deal(eps, units)
     if engine == "icarus":
-        # the cocotb bench (Icarus has no plain engine); compared with the golden frame below, in Python
-        r = run_unit_bench(per_unit, width=width, height=height, interleave=interleave, sim=engine, phase=0,
-                           speed_run=True, schedule=schedule)
-        sim_s, build_s = r["run_s"], r["prepare_s"] + r["build_s"]
-        if r.get("timeout"):
-            raise RasterhwError(f"ZB/M {engine}: the bench's watchdog fired after {r['cycles']} cycles")
+        # the unit's testbench under cocotb on Icarus (the generic cocotb engine; Icarus has no plain engine)
+        r = run_scene(per_unit, width=width, height=height, interleave=interleave, schedule=schedule,
+                      engine="cocotb-icarus")
+        sim_s, build_s = r["run_s"], r["build_s"]
     else:
         r = run_scene(per_unit, width=width, height=height, interleave=interleave, schedule=schedule, engine=engine)
         sim_s, build_s = (r["run_s"], r["build_s"]) if engine == "verilator" else (time.perf_counter() - t1, 0.0)
