@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import sys
 import time
+from dataclasses import replace
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
@@ -127,7 +128,7 @@ def run_jobs(jb: dict, *, width: int, engine: str = "pysim", idle: int = 0, stal
     if idle:
         # the range word first, always on edge 0 (the PXP's clock starts after it): gaps from the next
         g = with_gaps(stim, idle / 256, seed, ("i",)).gaps["i"]
-        stim = type(stim)(stim.words, {"i": [0, *g[1:]]}, stim.what, stim.source)
+        stim = replace(stim, gaps={"i": [0, *g[1:]]})
     npix, nlines = int(jb["pixels"].size), int(jb["lines"])
     nwords = len(stim.words["i"])
     if engine == "verilator" and (nwords + 2 > IN_DEPTH or max(npix, nlines) + 2 > OUT_DEPTH):
