@@ -164,6 +164,30 @@ def test_a_seed_that_would_never_raise_ready_is_refused():
     assert compare(exp, r)["mismatches"] == 0
 
 
+def test_always_ready_outputs_are_never_back_pressured():
+    """``Testbench.always_ready``: those outputs' sinks take every word when it comes, whatever the
+    run's ``stall`` (and a zero back-pressure seed is no matter for them)."""
+    tb, p, stim, exp = _case("zbm-merger", 3)
+    free = type("Free", (type(tb),), {"always_ready": tuple(tb.outputs_of(p))})()
+    port = tb.outputs_of(p)[0]
+    assert free.stall_of(port, 200) == 0 and tb.stall_of(port, 200) == 200
+    plain = run(tb, p, stim, engine="pysim", expect_words=_need(exp))
+    stalled = run(free, p, stim, engine="pysim", stall=200, seed=0, expect_words=_need(exp))
+    assert (stalled.words, stalled.stamps) == (plain.words, plain.stamps)
+
+
+def test_verilator_build_settings_are_checked():
+    """``build={"depth": N, "out_depth": M}``: the bench's memories hold at least so many words
+    (inputs / every output's sink: one build for runs of many sizes); bad values are one-line errors."""
+    from rasterhw.sim.engines.verilator import _settings
+    assert _settings({"depth": 1 << 10, "out_depth": 1 << 12}, "-O1")[3:] == (1 << 10, 1 << 12)
+    assert _settings(None, "-O1")[3:] == (0, 0)
+    for bad, msg in (({"out_depth": -1}, "out_depth must be"), ({"depth": 1.5}, "depth must be"),
+                     ({"fifo": 3}, "no fifo")):
+        with pytest.raises(RasterhwError, match=msg):
+            _settings(bad, "-O1")
+
+
 def test_dump_decoding_fast_path_gives_the_same_ints():
     """``verilator._ints``: words of up to 64 bits in one NumPy pass, wider ones row by row; both
     equal ``int.from_bytes`` of every dumped row (widths 1..9 bytes, extreme values)."""
