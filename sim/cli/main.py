@@ -478,7 +478,7 @@ def sim_image_name(scene: str, block: str, engine: str, options: dict) -> Path:
               + ", ".join(f"{n}: {b.default_scene}" for n, (_, b) in registry.sim_blocks().items()) + ").")
 @click.option("--size", default=None, metavar="WxH", help="Frame size (default: the scene's own).")
 @click.option("--engine", type=click.Choice(ENGINES), default="verilator", show_default=True,
-              help="Simulator: pysim (Amaranth's, no build), verilator (compiled once per design) or icarus (cocotb benches, where installed).")
+              help="Simulator: pysim (Amaranth's, no build), verilator (compiled once per design) or icarus (cocotb on Icarus Verilog, where installed; sim sparse: pysim or verilator).")
 @_click_options(_SIM_OPTIONS)
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="PNG of the HDL frame.")
 @click.option("--waves", type=click.Path(dir_okay=False), default=None,

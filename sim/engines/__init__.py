@@ -24,10 +24,12 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.engines import cocotb, pysim, verilator
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, clocks_of
 
-__all__ = ["ENGINES", "run", "with_gaps"]
+__all__ = ["ALIASES", "ENGINES", "run", "with_gaps"]
 
 ENGINES = {"pysim": pysim.run, "verilator": verilator.run,
            **{name: partial(cocotb.run, sim=sim) for name, sim in cocotb.SIMULATORS.items()}}
+#: the command line's simulator names for engines: ``icarus`` (cocotb benches' name) is cocotb on Icarus
+ALIASES = {"icarus": "cocotb-icarus"}
 
 
 def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", idle: float = 0.0, stall: int = 0,
@@ -50,8 +52,9 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
     (``tb.domains``): separate clocks (``sim/testbench.py``: :class:`Clock`); each port's gaps,
     back-pressure and stamps then count its own domain's edges. None: every domain on one clock.
     """
+    engine = ALIASES.get(engine, engine)
     if engine not in ENGINES:
-        raise RasterhwError(f"engine must be one of {', '.join(ENGINES)}, not {engine!r}")
+        raise RasterhwError(f"engine must be one of {', '.join((*ENGINES, *ALIASES))}, not {engine!r}")
     if not (isinstance(stall, int) and 0 <= stall <= 255):
         raise RasterhwError(f"stall must be an integer in 0..255, not {stall!r}")
     if not (isinstance(idle, (int, float)) and 0 <= idle < 1):

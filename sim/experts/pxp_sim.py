@@ -27,7 +27,7 @@ from rasterhw.sim.experts.pxp_jobs import SEG_BITS, SPAN_BITS, job_list, span_jo
 __all__ = ["ENGINES", "PXPS", "SEG_BITS", "SPAN_BITS", "check_jobs", "job_list", "jobs", "run_jobs", "simulate_scene",
            "span_job_list", "span_ranges"]
 
-ENGINES = ("pysim", "verilator", "cocotb-verilator", "cocotb-icarus")
+ENGINES = ("pysim", "verilator", "cocotb-verilator", "cocotb-icarus", "icarus")   # icarus: cocotb on Icarus
 PXPS = ("span", "zbuffer")
 
 

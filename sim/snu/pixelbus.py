@@ -29,7 +29,7 @@ from rasterhw.sim.testbench import compare, find_testbench
 
 __all__ = ["ENGINES", "measure_rates", "run_pysim", "simulate_pixelbus", "simulate_scene"]
 
-ENGINES = tuple(engines.ENGINES)   # pysim, verilator
+ENGINES = (*engines.ENGINES, *engines.ALIASES)   # pysim, verilator, cocotb-verilator, cocotb-icarus, icarus
 
 
 def run_pysim(
@@ -121,9 +121,7 @@ def simulate_pixelbus(stream: PixelStream, *, engine: str = "pysim", gaps: np.nd
     per second of the simulation run.
     """
     if engine not in ENGINES:
-        raise RasterhwError(f"engine must be one of {', '.join(ENGINES)}, not {engine!r}"
-                            + (" (the pixel bus runs on the generic engines; icarus is not one yet)"
-                               if engine == "icarus" else ""))
+        raise RasterhwError(f"engine must be one of {', '.join(ENGINES)}, not {engine!r}")
     if not isinstance(stream, PixelStream):
         raise RasterhwError(f"expected a PixelStream, not {type(stream).__name__}")
     stream.validate(n_pipes=golden.N_PIPES)

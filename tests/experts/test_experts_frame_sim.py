@@ -44,7 +44,7 @@ def test_registered_and_bad_arguments():
     m, b = sim_blocks()["experts"]
     assert m.name == "experts" and b.default_scene == "experts-1000"
     with pytest.raises(RasterhwError, match="engine"):
-        simulate_frame(build_scene("experts-tilt-1000"), 64, 16, engine="icarus")
+        simulate_frame(build_scene("experts-tilt-1000"), 64, 16, engine="modelsim")   # icarus runs (cocotb on Icarus); an unknown one does not
     with pytest.raises(RasterhwError, match="sn must be"):
         simulate_frame(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=0)
     with pytest.raises(RasterhwError, match="aj must be"):
