@@ -188,6 +188,12 @@ class Testbench:
         64 bits together at most, e.g. a frame counter or a sticky overflow): ``Run.status``."""
         return {}
 
+    def hier_blocks(self, params: dict) -> tuple[str, ...]:
+        """Verilog modules of the bench that the Verilator engine may verilate and compile once,
+        however many instances there are (``build={"hier": True}``: Verilator's hierarchical
+        verilation), e.g. a matrix's cell instantiated by name. None by default."""
+        return ()
+
     def stall_of(self, port: str, stall: int) -> int:
         """The back-pressure of output ``port`` in a run with ``stall`` (0 for :attr:`always_ready` ports)."""
         return 0 if port in self.always_ready else stall

@@ -129,6 +129,25 @@ def test_bad_runs_are_refused_in_one_line():
         find_testbench("nope")
 
 
+def test_hierarchical_build_needs_a_module_named_once():
+    """``build={"hier": True}``: only for a testbench that names modules to verilate once, each
+    defined once in the bench's Verilog (the marker goes after its header); refused before a build."""
+    from rasterhw.sim.engines.verilator import hier_marked
+
+    tb = find_testbench("zbm-seggen")
+    p = tb.params(**SMALL["zbm-seggen"])
+    stim = tb.stimulus(p, seed=1)
+    with pytest.raises(RasterhwError, match="names no module"):
+        run(tb, p, stim, engine="verilator", expect_words={"o": 1}, build={"hier": True})
+    with pytest.raises(RasterhwError, match="hier must be"):
+        run(tb, p, stim, engine="verilator", expect_words={"o": 1}, build={"hier": 1})
+    text = "module top(a);\n  cell c0 (a);\nendmodule\nmodule cell(a);\nendmodule\n"
+    assert "module cell(a); /*verilator hier_block*/\n" in hier_marked(text, ("cell",))
+    assert "module top(a);\n" in hier_marked(text, ("cell",))
+    with pytest.raises(RasterhwError, match="defined 0 times"):
+        hier_marked(text, ("other",))
+
+
 def test_back_pressure_pattern_is_the_benches_xorshift():
     assert xorshift32(1) == 270369 and xorshift32(270369) == 67634689   # x ^= x<<13; x ^= x>>17; x ^= x<<5
     pat = ready_pattern(7, 128)
@@ -180,8 +199,9 @@ def test_verilator_build_settings_are_checked():
     """``build={"depth": N, "out_depth": M}``: the bench's memories hold at least so many words
     (inputs / every output's sink: one build for runs of many sizes); bad values are one-line errors."""
     from rasterhw.sim.engines.verilator import _settings
-    assert _settings({"depth": 1 << 10, "out_depth": 1 << 12}, "-O1")[3:] == (1 << 10, 1 << 12)
-    assert _settings(None, "-O1")[3:] == (0, 0)
+    assert _settings({"depth": 1 << 10, "out_depth": 1 << 12}, "-O1")[3:5] == (1 << 10, 1 << 12)
+    assert _settings(None, "-O1")[3:] == (0, 0, False)
+    assert _settings({"hier": True}, "-O1")[5] is True
     for bad, msg in (({"out_depth": -1}, "out_depth must be"), ({"depth": 1.5}, "depth must be"),
                      ({"fifo": 3}, "no fifo")):
         with pytest.raises(RasterhwError, match=msg):

@@ -241,16 +241,19 @@ def build_dir_for(block: str, sim: str, *, sources: Sequence[Path] = (), **param
 
 def plain_build_dir(name: str, top: str, sources: Sequence[Path], *, params: Mapping[str, object],
                     opt: str = "-O2", defines: Mapping[str, object] | None = None,
-                    generated: Mapping[str, str] | None = None, pgo: str | Path | None = None) -> Path:
+                    generated: Mapping[str, str] | None = None, pgo: str | Path | None = None,
+                    hierarchical: bool = False) -> Path:
     """The folder :func:`build_plain_verilator` with these arguments builds in (built or not)."""
     return _plain_plan(name, top, sources, params=params, opt=opt, defines=defines, generated=generated,
-                       pgo=pgo)[1]
+                       pgo=pgo, hierarchical=hierarchical)[1]
 
 
-def _plain_plan(name, top, sources, *, params, opt, defines, generated, pgo):
+def _plain_plan(name, top, sources, *, params, opt, defines, generated, pgo, hierarchical=False):
     """(name, build folder, make variables, Verilator arguments, defines, generated files,
     profile files) of a plain build: the folder's name digests everything else."""
     generated = dict(generated or {})
+    if hierarchical and pgo is not None:
+        raise RasterhwError(f"{name}: a hierarchical build is not a profile-guided one")
     defines = {"RASTERHW_TOP": f"V{top}", **(defines or {})}
     if pgo is None:   # a profile-guided build is a speed build: always the level asked for
         opt = effective_opt(opt)
@@ -278,6 +281,9 @@ def _plain_plan(name, top, sources, *, params, opt, defines, generated, pgo):
     args = [*VERILATOR_PLAIN_ARGS, *({"fst": ["--trace-fst"], "vcd": ["--trace"]}.get(trace, []))]
     if trace:
         name = f"{name}-trace-{trace}"
+    if hierarchical:   # the modules marked /*verilator hier_block*/ are verilated and compiled once
+        args.append("--hierarchical")
+        name = f"{name}-hier"
     key = {"top": top, "args": args, "make": make, "defines": defines, "params": params}
     if native:   # -march=native: the CPU it stands for on this host
         key["native"] = native
@@ -295,7 +301,7 @@ def _plain_plan(name, top, sources, *, params, opt, defines, generated, pgo):
 def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, params: Mapping[str, object],
                           opt: str = "-O2", defines: Mapping[str, object] | None = None,
                           generated: Mapping[str, str] | None = None,
-                          pgo: str | Path | None = None) -> tuple[Path, float]:
+                          pgo: str | Path | None = None, hierarchical: bool = False) -> tuple[Path, float]:
     """Build a timing-free Verilator model of ``top`` with :data:`PLAIN_MAIN`, once per content.
 
     ``sources``: Verilog files; ``generated``: ``{file name: text}`` written into the build folder
@@ -309,12 +315,18 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
     :func:`run_plain_verilator` with ``profile=`` write the profile); a folder holding that
     profile builds the model optimised with it (``-fprofile-use``; the profile's bytes are part of
     the build's key).
+    ``hierarchical``: Verilator's hierarchical verilation (``--hierarchical``): every module the
+    generated Verilog marks ``/*verilator hier_block*/`` is verilated and compiled once however
+    many instances it has, and linked as a library (Verilator runs make itself: ``--build``; the
+    shared runtime objects are not used). Same model, much shorter build of a design made of many
+    instances of one large module, slower clock loop (the measured figures: ``docs/sparse.md``).
     Returns ``(binary, build seconds, 0.0 if it was already built)``.
     """
     if pgo is None:
         opt = effective_opt(opt)
     name, bdir, make, args, defines, generated, profile = _plain_plan(
-        name, top, sources, params=params, opt=opt, defines=defines, generated=generated, pgo=pgo)
+        name, top, sources, params=params, opt=opt, defines=defines, generated=generated, pgo=pgo,
+        hierarchical=hierarchical)
     exe = bdir / "obj_dir" / f"V{top}"
     if _built(bdir, exe):
         return exe, 0.0
@@ -378,10 +390,13 @@ def _build_plain_in(bdir: Path, name: str, top: str, sources: Sequence[Path], *,
     # (the PGO flags reach only the model's per-cycle code and the link, not the runtime objects)
     rt_flags = ["plain", rt_make, cflags, *args]
     peak = [bdir / "verilate.peak", bdir / "compile.peak"]
+    hier = "--hierarchical" in args
+    if hier:   # Verilator builds the blocks and the top itself (one make per block, in order)
+        cmd += ["--build", "-j", "2"]
     r = run_child([*_peak_rss(peak[0]), *cmd], cwd=bdir, env=env, capture_output=True, text=True)
     log = " ".join(cmd) + "\n" + r.stdout + r.stderr
     t1 = time.perf_counter()
-    if not r.returncode:
+    if not r.returncode and not hier:
         vlruntime.seed(bdir / "obj_dir", "plain", rt_flags)
         for k, data in profile.items():   # -fprofile-use reads X.gcda beside the object X.o
             (bdir / "obj_dir" / k).write_bytes(data)
@@ -393,10 +408,11 @@ def _build_plain_in(bdir: Path, name: str, top: str, sources: Sequence[Path], *,
     if r.returncode or not exe.exists():
         raise RasterhwError(f"{name}: verilator build failed ({_first_error(log)}); "
                             f"see {bdir / 'build.log'}")
-    vlruntime.harvest(bdir / "obj_dir", "plain", rt_flags)
+    if not hier:
+        vlruntime.harvest(bdir / "obj_dir", "plain", rt_flags)
     mb = [float(p.read_text()) if p.exists() else None for p in peak]
     (bdir / "build.json").write_text(json.dumps({
-        "model": name, "top": top, "params": params, "opt": opt, "build_s": round(build_s, 2),
+        "model": name, "top": top, "params": params, "opt": opt, "hierarchical": hier, "build_s": round(build_s, 2),
         "verilate_s": round(t1 - t0, 2), "compile_s": round(build_s - (t1 - t0), 2),
         "verilate_peak_mb": mb[0], "compile_peak_mb": mb[1], "built": time.strftime("%Y-%m-%d %H:%M:%S")},
         default=str) + "\n")

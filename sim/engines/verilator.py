@@ -13,6 +13,7 @@ from __future__ import annotations
 import inspect
 import json
 import os
+import re
 import shutil
 import time
 from pathlib import Path
@@ -44,7 +45,8 @@ from rasterhw.sim.paths import BUILD_ROOT
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
 from rasterhw.sim.workdirs import build_lock, release, temp_run_folder
 
-__all__ = ["GAP_BITS", "PGO_OPT", "BenchTop", "bench_design", "bench_sources", "collected", "memory_depths", "profile", "run",
+__all__ = ["GAP_BITS", "PGO_OPT", "BenchTop", "bench_design", "bench_sources", "collected", "hier_marked",
+           "memory_depths", "profile", "run",
            "status_of", "stream_plusargs", "unpack_status"]
 
 GAP_BITS = 8          # idle clocks before a word: 0..255
@@ -219,23 +221,38 @@ def unpack_status(st: dict, word: int) -> dict[str, int]:
     return out
 
 
-def _build(design, opt: str, pgo=None) -> tuple[Path, float]:
+def _build(design, opt: str, pgo=None, hier: tuple[str, ...] = ()) -> tuple[Path, float]:
     name, generated, defines = design
+    if hier:
+        generated = {k: (hier_marked(v, hier) if k.endswith(".v") else v) for k, v in generated.items()}
     return build_plain_verilator(name, "rasterhw_bench", [HARNESS_V], params={}, opt=opt, defines=defines,
-                                 generated=generated, pgo=pgo)
+                                 generated=generated, pgo=pgo, hierarchical=bool(hier))
+
+
+def hier_marked(text: str, modules: tuple[str, ...]) -> str:
+    """``text`` with ``/*verilator hier_block*/`` after the header of each of ``modules`` (every one
+    defined exactly once in it): Verilator then verilates and compiles each once, however many
+    instances it has (``build={"hier": True}``)."""
+    for mod in modules:
+        text, k = re.subn(rf"^(module {re.escape(mod)}\b[^;]*;)", r"\1 /*verilator hier_block*/", text, flags=re.M)
+        if k != 1:
+            raise RasterhwError(f"hierarchical build: module {mod} is defined {k} times in the bench's Verilog, not once")
+    return text
 
 
 #: the g++ level of profile-guided builds (and of the instrumented build that trains them)
 PGO_OPT = "-O2"
 
 
-def _settings(build: dict | None, default_opt: str) -> tuple[bool, str | None, bool | str, int, int]:
-    """(speed, opt, pgo, depth, out_depth) of a ``build`` argument (see :func:`rasterhw.sim.engines.run`);
+def _settings(build: dict | None, default_opt: str) -> tuple[bool, str | None, bool | str, int, int, bool]:
+    """(speed, opt, pgo, depth, out_depth, hier) of a ``build`` argument (see :func:`rasterhw.sim.engines.run`);
     no ``build``: ``default_opt`` (the testbench's level)."""
     b = dict(build or {})
-    unknown = sorted(set(b) - {"speed", "opt", "pgo", "depth", "out_depth"})
+    unknown = sorted(set(b) - {"speed", "opt", "pgo", "depth", "out_depth", "hier"})
     if unknown:
-        raise RasterhwError(f"build settings: no {', '.join(unknown)} (speed, opt, pgo, depth, out_depth)")
+        raise RasterhwError(f"build settings: no {', '.join(unknown)} (speed, opt, pgo, depth, out_depth, hier)")
+    if not isinstance(b.get("hier", False), bool):
+        raise RasterhwError(f"build settings: hier must be True or False, not {b['hier']!r}")
     for key in ("depth", "out_depth"):
         v = b.get(key, 0)
         if not isinstance(v, int) or isinstance(v, bool) or v < 0:
@@ -247,7 +264,7 @@ def _settings(build: dict | None, default_opt: str) -> tuple[bool, str | None, b
         pgo = env == "1"
     if pgo not in (False, True, "auto"):
         raise RasterhwError(f"build settings: pgo must be False, True or 'auto', not {pgo!r}")
-    return bool(b.get("speed", False)), b.get("opt", default_opt if not build else None), pgo, depth, out_depth
+    return bool(b.get("speed", False)), b.get("opt", default_opt if not build else None), pgo, depth, out_depth, bool(b.get("hier", False))
 
 
 def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outputs: dict[str, int],
@@ -291,20 +308,25 @@ def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outp
 def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, expect_words: dict[str, int],
         max_cycles: int, build: dict | None = None, clocks: dict | None = None) -> Run:
     t0 = time.perf_counter()
-    speed, opt, pgo, depth, out_depth = _settings(build, tb.verilator_opt)
+    speed, opt, pgo, depth, out_depth, hier = _settings(build, tb.verilator_opt)
+    blocks = tb.hier_blocks(params) if hier else ()
+    if hier and (not blocks or pgo):
+        raise RasterhwError(f"build settings: hier: {tb.block}'s testbench names no module to verilate once"
+                            if not blocks else "build settings: hier and pgo do not go together")
     inputs, outputs = memory_depths(tb, params, stim, expect_words, depth=depth, out_depth=out_depth)
     top = bench_design(tb, params, inputs, outputs, speed, separate=bool(clocks))
     prof = profile(tb, params, top, inputs=inputs, outputs=outputs, opt=opt or PGO_OPT,
                    train=pgo is True) if pgo else None
     opt = opt or (PGO_OPT if prof is not None else tb.verilator_opt)
-    exe, build_s = _build(top, opt, pgo=prof)
+    exe, build_s = _build(top, opt, pgo=prof, hier=blocks)
     dut = tb.dut(params)   # for the port widths and the status values' names and widths (not simulated)
     words, stamps, meta, _ = _run_exe(exe, tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
                                       inputs=inputs, max_cycles=max_cycles, dut=dut, clocks=clocks)
     status = unpack_status(status_of(tb, dut, params), int(meta.get("status", 0)))
     return Run("verilator", words, stamps, wall_s=time.perf_counter() - t0, build_s=build_s, run_s=meta["run_s"],
                protocol_errors=int(meta.get("errors", 0)), status=status,
-               build={"speed": speed, "opt": opt, "pgo": prof is not None}, clocks=dict(clocks or {}),
+               build={"speed": speed, "opt": opt, "pgo": prof is not None, "hier": bool(blocks)},
+               clocks=dict(clocks or {}),
                port_domains={n: tb.domain_of(n) for n in tb.outputs_of(params)} if clocks else {})
 
 

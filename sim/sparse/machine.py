@@ -28,6 +28,10 @@ _KP = Option(name="kp", type=int, default=0,
              help="coupled matrix: formula (5)'s cost in cycles of kp parameter additions per surviving window on "
                   "k_e = 3 edge adders, 0..15 (0: unpriced, as depth alone; 4: depth + RGB)")
 
+_HIERARCHICAL = Option(name="hierarchical", type=bool, default=False,
+                      help="coupled matrix on Verilator: the cell verilated and compiled once (Verilator's "
+                           "hierarchical verilation): the same model, a much shorter build, a slower clock loop")
+
 _NO_CLOCK = Clock("sync", "sparse video processor: the paper names no clock", None, "clock")
 
 MACHINE = Machine(
@@ -46,7 +50,7 @@ MACHINE = Machine(
     sims=(SimBlock(name="sparse", help="every video processor of the matrix in HDL, interleaved local memories "
                                        "against the bit-accurate golden model",
                    simulate="rasterhw.sim.sparse.sim:simulate", default_scene="c300",
-                   options=(_MATRIX, _COUPLED, _FIFO_DEPTH, _VP_FIFO_DEPTH, _VP, _COLOUR, _KP),
+                   options=(_MATRIX, _COUPLED, _FIFO_DEPTH, _VP_FIFO_DEPTH, _VP, _COLOUR, _KP, _HIERARCHICAL),
                    bytes_per_pixel=700),),
     report="rasterhw.sim.sparse.report:rows",
     bench="rasterhw.sim.sparse.bench:bench",

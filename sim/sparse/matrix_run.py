@@ -41,14 +41,16 @@ def _check(recs, limit: int, in_depth: int) -> None:
 
 def run_matrix(tris, *, n: int, p: int, q: int, limit: int, z_bits: int = 24, fifo_depth: int = 8,
                in_depth: int = IN_DEPTH, vp: str = "pipeline", colour: bool = False, kp: int = 0, ke: int = 3,
-               engine: str = "verilator") -> dict:
+               engine: str = "verilator", hierarchical: bool = False) -> dict:
     """The matrix on one frame of ``tris`` on a generic engine (``sim/engines/``; the testbench
     :class:`~rasterhw.sim.sparse.testbench.MatrixFrameBench`: the records offered back to back, the
     limit in a config word, the raster and every counter streamed out): ``tri`` / ``zq`` (full
     raster, -1 where empty), ``rgb`` (``(H, W, 3)`` with ``colour``, else None), ``cycles`` (the
     matrix's frame counter), ``stall_cycles``, ``stats`` (counter name -> (p*q,) array),
     ``run_s``, ``build_s``, ``sim_cycles`` (the bench's clocks, read-out included).
-    ``engine="verilator"`` instantiates one cell module by name; ``"pysim"`` elaborates every cell."""
+    ``engine="verilator"`` instantiates one cell module by name; ``"pysim"`` elaborates every cell.
+    ``hierarchical`` (Verilator): the cell verilated and compiled once (``build={"hier": True}``):
+    the same model, a much shorter build, a slower clock loop (``docs/sparse.md``)."""
     from rasterhw.hdl.sparse.cell import cell_stats
     from rasterhw.sim.engines import run as run_engine
     from rasterhw.sim.sparse.testbench import MatrixFrameBench
@@ -67,7 +69,9 @@ def run_matrix(tris, *, n: int, p: int, q: int, limit: int, z_bits: int = 24, fi
     want = W * H + 2 + p * q * len(cell_stats(n))
     maxcyc = 400 * (ntri + 10) * (1 + n) * (1 + 64 // limit) + 4 * W * H + 10_000_000
     # the input memory sized for MAXT records whatever the frame: one build per design
-    build = {"depth": MAXT + 2} if engine == "verilator" else None
+    build = {"depth": MAXT + 2, **({"hier": True} if hierarchical else {})} if engine == "verilator" else None
+    if hierarchical and engine != "verilator":
+        raise RasterhwError("sparse matrix: --hierarchical is a Verilator build")
     got = run_engine(tb, params, stim, engine=engine, expect_words={"o": want}, max_cycles=maxcyc, build=build)
     t0 = time.perf_counter()
     res = tb.decode(params, got.words["o"])

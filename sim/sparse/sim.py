@@ -94,7 +94,7 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
 
 def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_depth: int = 64,
                      vp_fifo_depth: int = 8, progress: bool = False, vp: str = "pipeline", colour: bool = False,
-                     kp: int = 0) -> dict:
+                     kp: int = 0, hierarchical: bool = False) -> dict:
     """The whole matrix in one simulation (``hdl/sparse/matrix.py``): the image against the golden
     model pixel by pixel, and the frame's cycles, broadcast stalls, FIFO peaks and every processor's
     busy cycles and per-level tests against the coupled matrix's golden cycle model
@@ -108,7 +108,8 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
     more linear functions and written with the Z test, the HDL's colour memories against
     ``fixed.colour_rgb8`` (``colour_mismatches``; the frame image is then the HDL's colour); ``kp``:
     formula (5)'s cost of ``kp`` parameter additions per surviving window on ``k_e`` = 3 edge
-    adders, in cycles, in the HDL and in both golden cycle models."""
+    adders, in cycles, in the HDL and in both golden cycle models. ``hierarchical`` (Verilator):
+    the cell verilated and compiled once (same results; a much shorter build, a slower clock loop)."""
     from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
     from rasterhw.sim.sparse.matrix_run import IN_DEPTH, run_matrix, run_matrix_pysim
 
@@ -124,6 +125,8 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
         raise RasterhwError(f"sparse sim: --colour is a flag, not {colour!r}")
     if isinstance(kp, bool) or not isinstance(kp, int) or not 0 <= kp <= 15:
         raise RasterhwError(f"sparse sim: --kp must be an integer in 0..15, not {kp!r}")
+    if not isinstance(hierarchical, bool) or (hierarchical and engine != "verilator"):
+        raise RasterhwError("sparse sim: --hierarchical is a flag of the Verilator build")
     if vp == "stack" and vp_fifo_depth != 8:
         raise RasterhwError("sparse sim: --vp-fifo-depth is the pipeline processor's; the stack processor has no "
                             "inner FIFOs")
@@ -133,7 +136,7 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
     kw = dict(n=n, p=p, q=q, limit=fifo_depth, z_bits=tris.z_bits, fifo_depth=vp_fifo_depth, in_depth=in_depth, vp=vp,
               colour=colour, kp=kp, ke=KE_EDGES)
     # Verilator: the generic engine's testbench (MatrixFrameBench); pysim: the direct bench (idle patterns, tests)
-    h = run_matrix(tris, **kw) if engine == "verilator" else run_matrix_pysim(recs, **kw)
+    h = run_matrix(tris, **kw, hierarchical=hierarchical) if engine == "verilator" else run_matrix_pysim(recs, **kw)
     hdl_s = time.perf_counter() - t0
     t1 = time.perf_counter()
     g = sparse_render(tris, (p, q), depth="fixed", trace=True)
@@ -200,7 +203,7 @@ def depth_image(zq: np.ndarray, z_bits: int) -> np.ndarray:
 
 def simulate(scene, width: int, height: int, *, engine: str = "verilator", progress: bool = False,
              matrix: str = "4x4", coupled: bool = True, fifo_depth: int = 64, vp_fifo_depth: int = 8,
-             vp: str = "pipeline", colour: bool = False, kp: int = 0) -> dict:
+             vp: str = "pipeline", colour: bool = False, kp: int = 0, hierarchical: bool = False) -> dict:
     """The registry's sim-block contract (``scene`` a Scene or a built-in name). ``coupled``: the
     whole matrix in one simulation (:func:`simulate_coupled`); otherwise every processor alone on
     the full stream, one simulation each (:func:`simulate_tris`, ``"coupled": false``)."""
@@ -213,8 +216,8 @@ def simulate(scene, width: int, height: int, *, engine: str = "verilator", progr
     tris = run_geometry(scene, width, height)
     if coupled:
         return simulate_coupled(tris, (p, q), engine=engine, fifo_depth=fifo_depth, vp_fifo_depth=vp_fifo_depth,
-                                progress=progress, vp=vp, colour=colour, kp=kp)
-    if fifo_depth != 64 or vp_fifo_depth != 8 or vp != "pipeline" or colour or kp:
-        raise RasterhwError("sparse sim: --fifo-depth, --vp-fifo-depth, --vp, --colour and --kp are options of the "
-                            "coupled matrix (drop --no-coupled)")
+                                progress=progress, vp=vp, colour=colour, kp=kp, hierarchical=hierarchical)
+    if fifo_depth != 64 or vp_fifo_depth != 8 or vp != "pipeline" or colour or kp or hierarchical:
+        raise RasterhwError("sparse sim: --fifo-depth, --vp-fifo-depth, --vp, --colour, --kp and --hierarchical are "
+                            "options of the coupled matrix (drop --no-coupled)")
     return {**simulate_tris(tris, (p, q), engine=engine, progress=progress), "coupled": False}

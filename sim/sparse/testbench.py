@@ -362,6 +362,13 @@ class MatrixFrameBench(MatrixBench):
         #: the Verilator engine's C++ level: a frame is one run of up to millions of clocks
         self.verilator_opt = "-O2"
 
+    def hier_blocks(self, params: dict) -> tuple[str, ...]:
+        """The cell module (``cells="instance"``): one verilation for the p*q cells
+        (``build={"hier": True}``, ``rasterhw sim sparse --hierarchical``)."""
+        from rasterhw.hdl.sparse.matrix import CELL_MODULE
+
+        return (CELL_MODULE,) if self.cells == "instance" else ()
+
     @staticmethod
     def names(params: dict) -> list[str]:
         """The counter words after the raster, in order."""

@@ -161,3 +161,25 @@ def test_verilator_coupled_matrix_colour_and_kp():
     assert r["mismatches"] == 0 and r["colour_mismatches"] == 0
     assert r["cycle_mismatches"] == 0 and r["cycles_compared"] == 2 + 2 * 4 + 4 * 4
     assert r["frame_rgb"].max() > 0 and r["stall_cycles"] > 0
+
+
+@pytest.mark.cocotb
+def test_hierarchical_build_is_the_same_model():
+    """``--hierarchical`` (the cell verilated once, Verilator's hierarchical verilation) runs the
+    frame of the test above to the same image, colour, counters and cycles as the flat build
+    (which that test builds); it is a build of its own (``tb-sparse-matrix-hier-*``)."""
+    from rasterhw.golden_model.errors import RasterhwError
+    from rasterhw.sim.sparse.sim import simulate_coupled
+
+    tris = random_triangles(32, 32, 30, mean_area=40.0, seed=11)
+    flat = simulate_coupled(tris, "2x2", fifo_depth=2, colour=True, kp=4)
+    hier = simulate_coupled(tris, "2x2", fifo_depth=2, colour=True, kp=4, hierarchical=True)
+    assert hier["mismatches"] == 0 and hier["colour_mismatches"] == 0 and hier["cycle_mismatches"] == 0
+    for k in flat:
+        if k.endswith("_s") or k == "cycles_per_s":   # timings
+            continue
+        a, b = flat[k], hier[k]
+        same = np.array_equal(a, b) if isinstance(a, np.ndarray) else a == b
+        assert same, k
+    with pytest.raises(RasterhwError, match="Verilator build"):
+        simulate_coupled(tris, "2x2", engine="pysim", hierarchical=True)
