@@ -108,6 +108,11 @@ class SparseFrame:
         """(H, W, 3) uint8 as the reference's ``Frame.to_rgb8`` (round half up, clamped)."""
         return np.clip(np.floor(self.colour * 255.0 + 0.5), 0, 255).astype(np.uint8)
 
+    def depth_words(self, z_bits: int) -> np.ndarray:
+        """(H, W) int64: the depth as the HDL stores it, ``round(depth * 2**z_bits)``, -1 where empty
+        (of a frame drawn with ``depth="fixed"``, whose depths are multiples of ``2**-z_bits``)."""
+        return np.where(self.tri_id >= 0, np.rint(self.depth * (1 << z_bits)), -1).astype(np.int64)
+
 
 def interleave(local: np.ndarray) -> np.ndarray:
     """Video controller read-out: ``(q, p, N, N, ...)`` local memories -> ``(q*N, p*N, ...)`` frame,

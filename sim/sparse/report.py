@@ -728,7 +728,7 @@ def _stack_rows(row, scene: str, size: int) -> str:
     tris = run_geometry(build_scene(scene), size, size)
     p = 4
     f = sparse_render(tris, (p, p), depth="fixed", per_record=True)
-    gz = np.where(f.tri_id >= 0, np.rint(f.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    gz = f.depth_words(tris.z_bits)
     s = service_times(f.stats["windows_per_record"], vp="stack")
     diff, same_cycles, deepest, n = 0, True, 0, f.n
     for b in range(p):
@@ -888,7 +888,7 @@ def _stack_matrix_hdl_rows(row, engine: str) -> list[str]:
         return []
     src = f"hdl:{engine}"
     f = sparse_render(tris, (p, p), depth="fixed", per_record=True)
-    gz = np.where(f.tri_id >= 0, np.rint(f.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    gz = f.depth_words(tris.z_bits)
     s = service_times(f.stats["windows_per_record"], vp="stack")
     tail = np.stack([stack_processor(tris, (p, p), k % p, k // p)["tail"] for k in range(p * p)])
     tab = ["| input FIFO depth | frame cycles, HDL | golden | stall cycles, HDL | golden | FIFO peak, HDL = golden | "

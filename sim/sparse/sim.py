@@ -39,7 +39,7 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
     if idle and engine != "verilator":
         raise RasterhwError("sparse sim: idle input clocks are a Verilator bench setting")
     g = sparse_render(tris, (p, q), depth="fixed")
-    gz = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    gz = g.depth_words(tris.z_bits)
     recs = broadcast_records(tris)
     N = 1 << n
     loc_t = np.full((q, p, N, N), -1, dtype=np.int64)
@@ -140,7 +140,7 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
     hdl_s = time.perf_counter() - t0
     t1 = time.perf_counter()
     g = sparse_render(tris, (p, q), depth="fixed", trace=True)
-    gz = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    gz = g.depth_words(tris.z_bits)
     if vp == "stack":
         gc = coupled_stack_matrix(tris, p, q, fifo_depth, kp=kp)
     else:

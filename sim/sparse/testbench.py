@@ -164,7 +164,7 @@ class _SparseBench(Testbench):
     def _golden(self, params: dict, stim: Stimulus):
         tris = stim.source
         g = sparse_render(tris, (params["p"], params["q"]), depth="fixed")
-        zq = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+        zq = g.depth_words(tris.z_bits)
         return g, zq
 
 
@@ -314,7 +314,7 @@ class ProcessorBench(VPBench):
         tris, a, b = stim.source["tris"], stim.source["a"], stim.source["b"]
         p, q = params["p"], params["q"]
         g = sparse_render(tris, (p, q), depth="fixed", trace=True)
-        zq = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+        zq = g.depth_words(tris.z_bits)
         k = b * p + a
         m = vp_standalone(*vp_streams(g, k), g.triangles, fifo_depth=params["fifo_depth"], kp=params["kp"],
                           ke=params["ke"])
@@ -444,7 +444,7 @@ class MatrixFrameBench(MatrixBench):
         tris = stim.source["tris"]
         gc = self.golden_counters(params, stim)
         g = gc["frame"]
-        zq = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+        zq = g.depth_words(tris.z_bits)
         words = _words(g.tri_id, zq, params["z_bits"])
         if params["colour"]:
             words = VPBench.with_rgb(words, colour_rgb8(tris, g.tri_id, params["p"], params["q"]), params["z_bits"])

@@ -63,7 +63,7 @@ def check_processor(tris, matrix: str = "4x4", *, a: int = 0, b: int = 0, engine
     p, q = parse_matrix(matrix)
     n = sparse_geometry(tris.width, tris.height, p, q)
     g = sparse_render(tris, (p, q), depth="fixed")
-    gz = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    gz = g.depth_words(tris.z_bits)
     want = {"tri": g.tri_id[b::q, a::p], "zq": gz[b::q, a::p], "tests": g.tests_per_proc[b * p + a, 1:]}
     want.update(expect or {})
     r = run_processor_verilator(tris, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits, idle=idle, seed=seed,

@@ -30,7 +30,7 @@ def test_matrix_cycle_exact_against_coupled_model(size, matrix, limit, ntri, are
     p, q = matrix
     tris = random_triangles(*size, ntri, mean_area=area, seed=ntri + limit)
     f = sparse_render(tris, matrix, depth="fixed", trace=True)
-    gz = np.where(f.tri_id >= 0, np.rint(f.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    gz = f.depth_words(tris.z_bits)
     h = run_matrix_pysim(tris, p=p, q=q, limit=limit)
     assert np.array_equal(h["tri"], f.tri_id)
     assert np.array_equal(h["zq"], gz)

@@ -19,7 +19,7 @@ def test_stack_processor_equals_the_breadth_first_search(scene, size, matrix):
     tris = run_geometry(build_scene(scene), size, size)
     p, q = matrix
     f = sparse_render(tris, matrix, depth="fixed", per_record=True)
-    gz = np.where(f.tri_id >= 0, np.rint(f.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    gz = f.depth_words(tris.z_bits)
     s = service_times(f.stats["windows_per_record"], vp="stack")
     writes = 0
     for b in range(q):

@@ -76,7 +76,7 @@ def test_coupled_matrix_of_stack_processors_cycle_exact(limit):
 
     tris = random_triangles(16, 16, 12, mean_area=16.0, seed=12 + limit)
     f = sparse_render(tris, "2x2", depth="fixed", per_record=True)
-    gz = np.where(f.tri_id >= 0, np.rint(f.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    gz = f.depth_words(tris.z_bits)
     h = run_matrix_pysim(broadcast_records(tris), n=f.n, p=2, q=2, limit=limit, z_bits=tris.z_bits, vp="stack")
     assert np.array_equal(h["tri"], f.tri_id) and np.array_equal(h["zq"], gz)
     s = service_times(f.stats["windows_per_record"], vp="stack")

@@ -11,7 +11,7 @@ from rasterhw.sim.sparse.hdl_run import run_matrix
 
 def _golden(tris, matrix):
     g = sparse_render(tris, matrix, depth="fixed")
-    zq = np.where(g.tri_id >= 0, np.rint(g.depth * (1 << tris.z_bits)), -1).astype(np.int64)
+    zq = g.depth_words(tris.z_bits)
     return g, zq
 
 
