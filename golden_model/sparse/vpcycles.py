@@ -39,11 +39,18 @@ from rasterhw.golden_model.fastpath import FastPath
 from rasterhw.golden_model.sparse.cycles import KE_EDGES, _check_int
 from rasterhw.golden_model.sparse.stack import param_cycles
 
-__all__ = ["ENGINE_ENV", "HDL_FIFO_DEPTH", "VPCycleModel", "choose_engine", "coupled_matrix_vp", "vp_standalone",
+__all__ = ["ENGINE_ENV", "HDL_FIFO_DEPTH", "PAPER_FIFO_DEPTH", "VPCycleModel", "choose_engine", "coupled_matrix_vp", "vp_standalone",
            "vp_streams"]
 
-#: ``VideoProcessor(fifo_depth=8)``, the default every driver builds
+#: ``VideoProcessor(fifo_depth=8)``, the default every driver builds (ours: eight-entry FIFOs between
+#: the levels, a queue of windows inside the processor)
 HDL_FIFO_DEPTH = 8
+
+#: the coupled matrix's default, the paper's processor: "Память типа FIFO на входе хранит очередь
+#: описаний геометрических примитивов" / "Описания определяют очереди на входах растровых процессоров"
+#: -- the queue of primitives is the input FIFO; between the micro-pipeline's stages (set-up, levels)
+#: the smallest buffer Amaranth's buffered FIFO takes, two entries (the sizes are not in the paper)
+PAPER_FIFO_DEPTH = 2
 
 #: Environment variable choosing the engine of :func:`coupled_matrix_vp` and :func:`vp_standalone`
 #: when a call does not: ``python`` (this module's code, the specification), ``numba`` (the compiled

@@ -48,7 +48,8 @@ def _click_options(opts: list[registry.Option]):
                 f = click.option(f"{o.flag}/--no-{o.flag[2:]}", o.name, default=None, help=o.help)(f)
             else:
                 kind = click.Choice(o.choices) if o.choices else o.type
-                f = click.option(o.flag, o.name, type=kind, default=None, help=f"{o.help} (default: {o.default})")(f)
+                shown = "" if o.default is None else f" (default: {o.default})"
+                f = click.option(o.flag, o.name, type=kind, default=None, help=o.help + shown)(f)
         return f
     return deco
 

@@ -47,7 +47,9 @@ def bench(*, repeat: int = 5, hdl: bool = True, progress: bool = False) -> list[
         cp = simulate_coupled(big, "4x4", fifo_depth=64, progress=progress)
         rows.append({"name": "sparse-matrix verilator c300 1024x1024 4x4 coupled: scene run, wall (warm)",
                      "value": cp["wall_s"], "unit": "s",
-                     "note": f"target < 60 s; clock loop {cp['run_s']} s for {cp['sim_cycles']} cycles (frame "
+                     "note": f"target < 60 s; processors: {cp['vp_buffers']}; "
+                             f"{'hierarchical' if cp['hierarchical'] else 'flat'} build; "
+                             f"clock loop {cp['run_s']} s for {cp['sim_cycles']} cycles (frame "
                              f"{cp['frame_cycles']} + read-out), golden cycle model {cp['golden_wall_s']} s; "
                              f"mismatches {cp['mismatches']}, cycle mismatches {cp['cycle_mismatches']}"})
         rows.append({"name": "sparse-vp c300 4x4: frame time (slowest processor)", "value": r["cycles"],

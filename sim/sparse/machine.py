@@ -13,9 +13,10 @@ _COUPLED = Option(name="coupled", type=bool, default=True,
 _FIFO_DEPTH = Option(name="fifo_depth", type=int, default=64,
                      help="coupled matrix: every processor's input FIFO depth, 1..64 (a run-time limit inside "
                           "one 64-entry build)")
-_VP_FIFO_DEPTH = Option(name="vp_fifo_depth", type=int, default=8,
+_VP_FIFO_DEPTH = Option(name="vp_fifo_depth", type=int, default=None,
                         help="coupled matrix: depth of the FIFOs between a processor's levels, 2..64 (a build "
-                             "parameter)")
+                             "parameter); unset: 2, the paper's processor, whose queue of primitives is its input "
+                             "FIFO; 8: ours, a queue of windows inside the processor (as --no-coupled builds it)")
 
 _VP = Option(name="vp", default="pipeline", choices=("pipeline", "stack"),
              help="coupled matrix: the video processors' raster processor: the pipeline (one stage per level, "
@@ -28,9 +29,10 @@ _KP = Option(name="kp", type=int, default=0,
              help="coupled matrix: formula (5)'s cost in cycles of kp parameter additions per surviving window on "
                   "k_e = 3 edge adders, 0..15 (0: unpriced, as depth alone; 4: depth + RGB)")
 
-_HIERARCHICAL = Option(name="hierarchical", type=bool, default=False,
+_HIERARCHICAL = Option(name="hierarchical", type=bool, default=None,
                       help="coupled matrix on Verilator: the cell verilated and compiled once (Verilator's "
-                           "hierarchical verilation): the same model, a much shorter build, a slower clock loop")
+                           "hierarchical verilation): the same model, a much shorter build, a slower clock loop; "
+                           "unset: hierarchical from 4x4 up, flat below; --no-hierarchical: always flat")
 
 _NO_CLOCK = Clock("sync", "sparse video processor: the paper names no clock", None, "clock")
 

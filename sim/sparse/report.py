@@ -575,10 +575,12 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
             "Surface parameters priced as formula (5) (4x4, FIFO depth 8): " + "; ".join(kp_tab) + ".\n",
             "## The coupled matrix with the HDL video processors (golden cycle model of the processor as built)\n",
             "`vpcycles.coupled_matrix_vp`: the same broadcast, FIFO and counting rules, each processor the cycle "
-            "model of `hdl/sparse/vp.py` (set-up FSM, level stages, eight-entry inner FIFOs, pixel processor), "
+            "model of `hdl/sparse/vp.py` (set-up FSM, level stages, inner FIFOs, pixel processor), "
             "which equals the HDL cycle for cycle (pysim tests; Verilator per-processor cycles in the HDL rows). "
-            "The processor buffers records in its inner FIFOs, so its input FIFO matters far less than for a "
-            "processor that holds one record at a time.\n",
+            "Two processors: the paper's, whose queue of primitives is its input FIFO (\"Память типа FIFO на входе "
+            "хранит очередь описаний\"; two-entry buffers between its stages, the default of `rasterhw sim "
+            "sparse`), and ours, with eight-entry FIFOs between the levels: a queue of windows inside the "
+            "processor, which makes the input FIFO's depth matter far less.\n",
             "\n".join(vp_tab) + "\n",
             "## A geometry processor only as fast as the matrix\n",
             "The GP issue interval is ours. With g = 1 the GP is never the bottleneck; here it offers a record "
@@ -648,43 +650,53 @@ def coupled_point(scene: str, size: int, matrix: str) -> dict:
 
 def coupled_vp_point(scene: str, size: int, matrix: str) -> dict:
     """One matrix of the coupled sweep whose processors are the HDL video processor's cycle model
-    (a task): frame cycles, stalls, largest FIFO peak and least busy processor per FIFO depth."""
+    (a task): frame cycles, stalls, largest FIFO peak and least busy processor per FIFO depth, for
+    the paper's processor (two-entry stage buffers, ``"paper"``) and ours (eight-entry, ``"ours"``)."""
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.golden_model.sparse.search import sparse_render
-    from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
+    from rasterhw.golden_model.sparse.vpcycles import HDL_FIFO_DEPTH, PAPER_FIFO_DEPTH, coupled_matrix_vp
 
     tris = run_geometry(build_scene(scene), size, size)
     f = sparse_render(tris, matrix, depth="fixed", trace=True)
-    pts = []
-    for D in _vp_depths(matrix):
-        r = coupled_matrix_vp(f, D)
-        pts.append({"frame_cycles": int(r["frame_cycles"]), "stall_cycles": int(r["stall_cycles"]),
-                    "fifo_peak_max": int(r["fifo_peak_max"]), "busy_min": int(min(r["busy"]))})
-    return {"depths": pts}
+    out = {}
+    for who, vpd in (("paper", PAPER_FIFO_DEPTH), ("ours", HDL_FIFO_DEPTH)):
+        pts = out[who] = []
+        for D in _vp_depths(matrix):
+            r = coupled_matrix_vp(f, D, fifo_depth=vpd)
+            pts.append({"frame_cycles": int(r["frame_cycles"]), "stall_cycles": int(r["stall_cycles"]),
+                        "fifo_peak_max": int(r["fifo_peak_max"]), "busy_min": int(min(r["busy"]))})
+    return out
+
+
+#: the two video processors of the coupled sweeps, labelled (key of :func:`coupled_vp_point`)
+_VP_CONFIGS = (("paper", "the paper's processor, two-entry stage buffers"),
+               ("ours", "our processor, eight-entry stage FIFOs"))
 
 
 def _coupled_vp_rows(row, lab: str, matrices: tuple[str, ...], points: list[dict]) -> list[str]:
     """Frame cycles, stalls and FIFO peaks of the coupled matrix whose processors are the HDL video
-    processor's cycle model, at FIFO depths 1 and 64 (and 8 on 4x4): rows from
-    :func:`coupled_vp_point`'s results."""
-    tab = ["| matrix | FIFO depth D | frame cycles | broadcast stall cycles | FIFO peak (max) | "
-           "processor busy / frame, least loaded |", "|---|---|---|---|---|---|"]
+    processor's cycle model, at FIFO depths 1 and 64 (and 8 on 4x4), for the paper's processor and
+    ours: rows from :func:`coupled_vp_point`'s results."""
+    tab = ["| matrix | processor | FIFO depth D | frame cycles | broadcast stall cycles | FIFO peak (max) | "
+           "processor busy / frame, least loaded |", "|---|---|---|---|---|---|---|"]
     for m, pt in zip(matrices, points, strict=True):
-        fr = {}
-        for D, r in zip(_vp_depths(m), pt["depths"], strict=True):
-            fr[D] = r["frame_cycles"]
-            tab.append(f"| {m} | {D} | {r['frame_cycles']} | {r['stall_cycles']} | {r['fifo_peak_max']} | "
-                       f"{r['busy_min'] / r['frame_cycles']:.3f} |")
-            row("FIFO sizing (coupled, HDL VPs)", f"{lab}, {m}: frame cycles, FIFO depth {D} (video processors: "
-                "the HDL's cycle model)", paper=None, formula=None, measured=r["frame_cycles"], unit="cycles",
-                source="golden")
-            row("FIFO sizing (coupled, HDL VPs)", f"{lab}, {m}: broadcast stall cycles, FIFO depth {D}",
-                paper=None, formula=None, measured=r["stall_cycles"], unit="cycles", source="golden")
-            row("FIFO sizing (coupled, HDL VPs)", f"{lab}, {m}: largest FIFO peak, FIFO depth {D} (never above D)",
-                paper=None, formula=None, measured=r["fifo_peak_max"], unit="entries", source="golden")
-        row("FIFO sizing (coupled, HDL VPs)", f"{lab}, {m}: frame with FIFO depth 1 / with depth 64", paper=None,
-            formula=None, measured=round(fr[1] / fr[64], 5), unit="ratio", source="golden")
+        for key, who in _VP_CONFIGS:
+            fr = {}
+            q = f"{lab}, {m}, {who}"
+            for D, r in zip(_vp_depths(m), pt[key], strict=True):
+                fr[D] = r["frame_cycles"]
+                tab.append(f"| {m} | {who} | {D} | {r['frame_cycles']} | {r['stall_cycles']} | "
+                           f"{r['fifo_peak_max']} | {r['busy_min'] / r['frame_cycles']:.3f} |")
+                row("FIFO sizing (coupled, HDL VPs)", f"{q}: frame cycles, FIFO depth {D} (video processors: "
+                    "the HDL's cycle model)", paper=None, formula=None, measured=r["frame_cycles"], unit="cycles",
+                    source="golden")
+                row("FIFO sizing (coupled, HDL VPs)", f"{q}: broadcast stall cycles, FIFO depth {D}",
+                    paper=None, formula=None, measured=r["stall_cycles"], unit="cycles", source="golden")
+                row("FIFO sizing (coupled, HDL VPs)", f"{q}: largest FIFO peak, FIFO depth {D} (never above D)",
+                    paper=None, formula=None, measured=r["fifo_peak_max"], unit="entries", source="golden")
+            row("FIFO sizing (coupled, HDL VPs)", f"{q}: frame with FIFO depth 1 / with depth 64", paper=None,
+                formula=None, measured=round(fr[1] / fr[64], 5), unit="ratio", source="golden")
     return tab
 
 
@@ -987,6 +999,7 @@ def _coupled_hdl_rows(row, engine: str, progress: bool) -> list[str]:
     from rasterhw.golden_model.reference import random_triangles
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.golden_model.sparse.search import sparse_render
+    from rasterhw.golden_model.sparse.vpcycles import HDL_FIFO_DEPTH, PAPER_FIFO_DEPTH
     from rasterhw.sim.sparse.sim import simulate_coupled
 
     if engine == "verilator":
@@ -1001,36 +1014,46 @@ def _coupled_hdl_rows(row, engine: str, progress: bool) -> list[str]:
         return [f"## The whole matrix in HDL\n\nNo rows: engine {engine!r} is not supported (pysim or verilator).\n"]
     src = f"hdl:{engine}"
     fig = "FIFO sizing (coupled, HDL)"
-    tab = ["| FIFO depth D | frame cycles, HDL | golden cycle model | stall cycles, HDL | golden | FIFO peak, HDL | "
-           "golden | counters differing | least / most loaded processor busy / frame |",
-           "|---|---|---|---|---|---|---|---|---|"]
-    runs = {}
-    for D in depths:
-        r = simulate_coupled(tris, m, engine=engine, fifo_depth=D, progress=progress)
-        runs[D] = r
-        fr = r["frame_cycles"]
-        util = np.array(r["busy"]) / fr
-        tab.append(f"| {D} | {fr} | {r['frame_cycles_golden']} | {r['stall_cycles']} | {r['stall_cycles_golden']} | "
-                   f"{r['fifo_peak_max']} | {r['fifo_peak_max_golden']} | {r['cycle_mismatches']} of "
-                   f"{r['cycles_compared']} | {util.min():.3f} … {util.max():.3f} |")
-        row(fig, f"{lab}, {m}: frame cycles of the whole matrix in one simulation, FIFO depth {D}", paper=None,
-            formula=None, measured=fr, unit="cycles", source=src)
-        row(fig, f"{lab}, {m}: frame cycles, HDL minus the golden coupled cycle model (coupled_matrix_vp: "
-            f"{r['frame_cycles_golden']}), FIFO depth {D}", paper=None, formula=0,
-            measured=fr - r["frame_cycles_golden"], unit="cycles", source=src)
-        row(fig, f"{lab}, {m}: broadcast stall cycles, FIFO depth {D} (golden cycle model: "
-            f"{r['stall_cycles_golden']})", paper=None, formula=None, measured=r["stall_cycles"], unit="cycles",
-            source=src)
-        row(fig, f"{lab}, {m}: largest FIFO peak, FIFO depth {D} (golden cycle model: {r['fifo_peak_max_golden']})",
-            paper=None, formula=None, measured=r["fifo_peak_max"], unit="entries", source=src)
-        row(fig, f"{lab}, {m}: counters differing from the golden coupled cycle model (frame, stalls, every FIFO "
-            f"peak, busy and per-level tests; of {r['cycles_compared']}), FIFO depth {D}", paper=None, formula=0,
-            measured=r["cycle_mismatches"], unit="counters", source=src)
-        row(fig, f"{lab}, {m}: pixels differing from the bit-accurate golden model (of {r['pixels_compared']}), "
-            f"FIFO depth {D}", paper=None, formula=0, measured=r["mismatches"], unit="pixels", source=src)
-    row(fig, f"{lab}, {m}: frame with FIFO depth {depths[0]} / with depth {depths[-1]} (whole matrix in HDL)",
-        paper=None, formula=None, measured=round(runs[depths[0]]["frame_cycles"] / runs[depths[-1]]["frame_cycles"], 5),
-        unit="ratio", source=src)
+    tab = ["| processor | FIFO depth D | frame cycles, HDL | golden cycle model | stall cycles, HDL | golden | "
+           "FIFO peak, HDL | golden | counters differing | least / most loaded processor busy / frame |",
+           "|---|---|---|---|---|---|---|---|---|---|"]
+    # the paper's processor (its queue of primitives is the input FIFO: two-entry stage buffers, the
+    # default) and ours (eight-entry FIFOs between the levels) beside it, labelled
+    configs = (("the paper's processor, two-entry stage buffers", PAPER_FIFO_DEPTH, depths),
+               ("our processor, eight-entry stage FIFOs", HDL_FIFO_DEPTH, (depths[0], depths[-1])))
+    if engine == "pysim":   # the small pysim frame: the paper's processor only (ours: the golden rows)
+        configs = configs[:1]
+    every = {}
+    for who, vpd, dd in configs:
+        runs = every[vpd] = {}
+        for D in dd:
+            r = simulate_coupled(tris, m, engine=engine, fifo_depth=D, vp_fifo_depth=vpd, progress=progress)
+            runs[D] = r
+            fr = r["frame_cycles"]
+            util = np.array(r["busy"]) / fr
+            tab.append(f"| {who} | {D} | {fr} | {r['frame_cycles_golden']} | {r['stall_cycles']} | "
+                       f"{r['stall_cycles_golden']} | {r['fifo_peak_max']} | {r['fifo_peak_max_golden']} | "
+                       f"{r['cycle_mismatches']} of {r['cycles_compared']} | {util.min():.3f} … {util.max():.3f} |")
+            q = f"{lab}, {m}, {who}"
+            row(fig, f"{q}: frame cycles of the whole matrix in one simulation, FIFO depth {D}", paper=None,
+                formula=None, measured=fr, unit="cycles", source=src)
+            row(fig, f"{q}: frame cycles, HDL minus the golden coupled cycle model (coupled_matrix_vp: "
+                f"{r['frame_cycles_golden']}), FIFO depth {D}", paper=None, formula=0,
+                measured=fr - r["frame_cycles_golden"], unit="cycles", source=src)
+            row(fig, f"{q}: broadcast stall cycles, FIFO depth {D} (golden cycle model: "
+                f"{r['stall_cycles_golden']})", paper=None, formula=None, measured=r["stall_cycles"], unit="cycles",
+                source=src)
+            row(fig, f"{q}: largest FIFO peak, FIFO depth {D} (golden cycle model: {r['fifo_peak_max_golden']})",
+                paper=None, formula=None, measured=r["fifo_peak_max"], unit="entries", source=src)
+            row(fig, f"{q}: counters differing from the golden coupled cycle model (frame, stalls, every FIFO "
+                f"peak, busy and per-level tests; of {r['cycles_compared']}), FIFO depth {D}", paper=None, formula=0,
+                measured=r["cycle_mismatches"], unit="counters", source=src)
+            row(fig, f"{q}: pixels differing from the bit-accurate golden model (of {r['pixels_compared']}), "
+                f"FIFO depth {D}", paper=None, formula=0, measured=r["mismatches"], unit="pixels", source=src)
+        row(fig, f"{lab}, {m}, {who}: frame with FIFO depth {dd[0]} / with depth {dd[-1]} (whole matrix in HDL)",
+            paper=None, formula=None, measured=round(runs[dd[0]]["frame_cycles"] / runs[dd[-1]]["frame_cycles"], 5),
+            unit="ratio", source=src)
+    runs = every[PAPER_FIFO_DEPTH]
     # R_p, Q_a, Q_p from the HDL's counters at the reference depth (or the deepest run)
     D = REF_DEPTH if REF_DEPTH in runs else depths[-1]
     r = runs[D]
@@ -1061,7 +1084,11 @@ def _coupled_hdl_rows(row, engine: str, progress: bool) -> list[str]:
             f"`rasterhw sim sparse` (coupled, {engine}) run inside this report: {lab}, {m}, the input FIFOs limited "
             "at run time to D entries (one build), the geometry processor offering a record every cycle (ours). "
             "Every counter of the HDL is compared with the golden coupled cycle model (`coupled_matrix_vp`, "
-            "processors as the HDL video processor's cycle model).\n",
+            "processors as the HDL video processor's cycle model). Two processors: the paper's (its queue of "
+            "primitives is the input FIFO, \"Память типа FIFO на входе хранит очередь описаний\"; two-entry "
+            "buffers between its stages, the default of `rasterhw sim sparse`) and ours (eight-entry FIFOs between "
+            "the levels, `--vp-fifo-depth 8`), whose inner queues absorb the input FIFO's depth. R_p, Q_a, Q_p "
+            "below are the paper's processor's.\n",
             "\n".join(tab) + "\n",
             f"From the HDL's counters at D = {D}: R_p {Rp:.4f} (formula (10) {Rp_f:.4f}), coupled R_p {Rp_c:.4f}, "
             f"Q_a {Qa:.4f} (formula (7) {Qa_f:.4f}), Q_p {Qa * Rp:.4f} (formula (12) {Qa_f * Rp_f:.4f}).\n"]

@@ -17,8 +17,13 @@ from rasterhw.golden_model.sparse.fixed import broadcast_records, colour_rgb8
 from rasterhw.golden_model.sparse.formats import parse_matrix, sparse_geometry
 from rasterhw.golden_model.sparse.search import interleave, sparse_render
 from rasterhw.golden_model.sparse.stack import broadcast_records_rgb, coupled_stack_matrix
+from rasterhw.golden_model.sparse.vpcycles import PAPER_FIFO_DEPTH
 
 __all__ = ["simulate", "simulate_coupled", "simulate_tris"]
+
+#: ``hierarchical=None``: Verilator's hierarchical build from this many processors up (measured at
+#: 1024² c300 4x4, docs/sparse.md: flat 1,173-2,229 s to build; hierarchical ~20 s, the clock loop slower)
+HIER_FROM_CELLS = 16
 
 
 def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bool = False, idle: int = 0,
@@ -93,15 +98,17 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
 
 
 def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_depth: int = 64,
-                     vp_fifo_depth: int = 8, progress: bool = False, vp: str = "pipeline", colour: bool = False,
-                     kp: int = 0, hierarchical: bool = False) -> dict:
+                     vp_fifo_depth: int = PAPER_FIFO_DEPTH, progress: bool = False, vp: str = "pipeline",
+                     colour: bool = False, kp: int = 0, hierarchical: bool | None = None) -> dict:
     """The whole matrix in one simulation (``hdl/sparse/matrix.py``): the image against the golden
     model pixel by pixel, and the frame's cycles, broadcast stalls, FIFO peaks and every processor's
     busy cycles and per-level tests against the coupled matrix's golden cycle model
     (``golden_model/sparse/vpcycles.py``, ``coupled_matrix_vp``): ``cycle_mismatches`` counts
     the counters that differ. ``fifo_depth``: the input FIFOs' run-time limit (built
     :data:`~rasterhw.sim.sparse.matrix_run.IN_DEPTH` deep); ``vp_fifo_depth``: the FIFOs between
-    the processor's levels (a build parameter; 8 as every driver builds it). ``vp="stack"``: every
+    the processor's levels (a build parameter): :data:`PAPER_FIFO_DEPTH` (2, the paper's processor,
+    whose queue of primitives is its input FIFO; the default) or 8 (ours, as the one-processor runs
+    build it: a queue of windows inside the processor; ``"vp_buffers"`` in the JSON says which). ``vp="stack"``: every
     processor the stack-based one (``hdl/sparse/stack_vp.py``), against the golden coupled model on
     the stack processors' service times (``stack.coupled_stack_matrix``); ``busy`` is then the processor's
     own count of the cycles it holds a record. ``colour``: the vertex colours broadcast as three
@@ -109,7 +116,9 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
     ``fixed.colour_rgb8`` (``colour_mismatches``; the frame image is then the HDL's colour); ``kp``:
     formula (5)'s cost of ``kp`` parameter additions per surviving window on ``k_e`` = 3 edge
     adders, in cycles, in the HDL and in both golden cycle models. ``hierarchical`` (Verilator):
-    the cell verilated and compiled once (same results; a much shorter build, a slower clock loop)."""
+    the cell verilated and compiled once (same results; a much shorter build, a slower clock loop);
+    ``None`` (the default): hierarchical from :data:`HIER_FROM_CELLS` processors up (a flat 4x4 at
+    1024² took 20-37 min to build, hierarchical 20 s), flat below."""
     from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
     from rasterhw.sim.sparse.matrix_run import IN_DEPTH, run_matrix, run_matrix_pysim
 
@@ -125,9 +134,11 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
         raise RasterhwError(f"sparse sim: --colour is a flag, not {colour!r}")
     if isinstance(kp, bool) or not isinstance(kp, int) or not 0 <= kp <= 15:
         raise RasterhwError(f"sparse sim: --kp must be an integer in 0..15, not {kp!r}")
+    if hierarchical is None:
+        hierarchical = engine == "verilator" and p * q >= HIER_FROM_CELLS
     if not isinstance(hierarchical, bool) or (hierarchical and engine != "verilator"):
         raise RasterhwError("sparse sim: --hierarchical is a flag of the Verilator build")
-    if vp == "stack" and vp_fifo_depth != 8:
+    if vp == "stack" and vp_fifo_depth != PAPER_FIFO_DEPTH:
         raise RasterhwError("sparse sim: --vp-fifo-depth is the pipeline processor's; the stack processor has no "
                             "inner FIFOs")
     in_depth = IN_DEPTH  # one build for every run-time depth
@@ -175,7 +186,10 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
             "colour": colour, **col, "kp": kp, "ke": KE_EDGES,
             "cycles_compared": len(pairs), "matrix": f"{p}x{q}", "n": n, "triangles": len(recs),
             "fifo_depth": fifo_depth, "fifo_depth_built": in_depth, "vp_fifo_depth": vp_fifo_depth,
-            "gp_issue_interval": 1,
+            "vp_buffers": ("none (stack processor)" if vp == "stack" else
+                           "paper (queue at the input, two-entry stage buffers)" if vp_fifo_depth == PAPER_FIFO_DEPTH
+                           else f"ours ({vp_fifo_depth}-entry FIFOs between the levels)"),
+            "hierarchical": hierarchical, "gp_issue_interval": 1,
             "frame_cycles": frame, "frame_cycles_golden": gc["frame_cycles"],
             "stall_cycles": h["stall_cycles"], "stall_cycles_golden": gc["stall_cycles"],
             "fifo_peak": st["fifo_peak"].tolist(), "fifo_peak_golden": gc["fifo_peak"],
@@ -202,11 +216,13 @@ def depth_image(zq: np.ndarray, z_bits: int) -> np.ndarray:
 
 
 def simulate(scene, width: int, height: int, *, engine: str = "verilator", progress: bool = False,
-             matrix: str = "4x4", coupled: bool = True, fifo_depth: int = 64, vp_fifo_depth: int = 8,
-             vp: str = "pipeline", colour: bool = False, kp: int = 0, hierarchical: bool = False) -> dict:
+             matrix: str = "4x4", coupled: bool = True, fifo_depth: int = 64, vp_fifo_depth: int | None = None,
+             vp: str = "pipeline", colour: bool = False, kp: int = 0, hierarchical: bool | None = None) -> dict:
     """The registry's sim-block contract (``scene`` a Scene or a built-in name). ``coupled``: the
     whole matrix in one simulation (:func:`simulate_coupled`); otherwise every processor alone on
-    the full stream, one simulation each (:func:`simulate_tris`, ``"coupled": false``)."""
+    the full stream, one simulation each (:func:`simulate_tris`, ``"coupled": false``; its
+    processors are built with eight-entry inner FIFOs, ours). ``vp_fifo_depth`` ``None``: the
+    coupled matrix's default, the paper's processor (:data:`PAPER_FIFO_DEPTH`)."""
     if isinstance(scene, str):
         from rasterhw.golden_model.scenes import build_scene
 
@@ -215,9 +231,10 @@ def simulate(scene, width: int, height: int, *, engine: str = "verilator", progr
     sparse_geometry(width, height, p, q)
     tris = run_geometry(scene, width, height)
     if coupled:
-        return simulate_coupled(tris, (p, q), engine=engine, fifo_depth=fifo_depth, vp_fifo_depth=vp_fifo_depth,
+        vpd = PAPER_FIFO_DEPTH if vp_fifo_depth is None else vp_fifo_depth
+        return simulate_coupled(tris, (p, q), engine=engine, fifo_depth=fifo_depth, vp_fifo_depth=vpd,
                                 progress=progress, vp=vp, colour=colour, kp=kp, hierarchical=hierarchical)
-    if fifo_depth != 64 or vp_fifo_depth != 8 or vp != "pipeline" or colour or kp or hierarchical:
+    if fifo_depth != 64 or vp_fifo_depth is not None or vp != "pipeline" or colour or kp or hierarchical:
         raise RasterhwError("sparse sim: --fifo-depth, --vp-fifo-depth, --vp, --colour, --kp and --hierarchical are "
                             "options of the coupled matrix (drop --no-coupled)")
     return {**simulate_tris(tris, (p, q), engine=engine, progress=progress), "coupled": False}

@@ -128,6 +128,9 @@ def test_coupled_matrix_with_colour_bit_and_cycle_exact(vp, limit, kp):
     assert r["frame_rgb"].shape == (16, 16, 3) and r["frame_rgb"].max() > 0
     plain = simulate_coupled(tris, "2x2", engine="pysim", fifo_depth=limit, vp=vp)
     assert "colour_mismatches" not in plain
+    # unset, the pipeline is the paper's processor (two-entry stage buffers); pysim is never hierarchical
+    assert plain["vp_fifo_depth"] == 2 and plain["hierarchical"] is False
+    assert plain["vp_buffers"].startswith("paper" if vp == "pipeline" else "none")
     if kp:
         assert r["frame_cycles"] > plain["frame_cycles"] and all(x > y for x, y in zip(r["busy"], plain["busy"], strict=True))
     else:
@@ -175,8 +178,9 @@ def test_hierarchical_build_is_the_same_model():
     flat = simulate_coupled(tris, "2x2", fifo_depth=2, colour=True, kp=4)
     hier = simulate_coupled(tris, "2x2", fifo_depth=2, colour=True, kp=4, hierarchical=True)
     assert hier["mismatches"] == 0 and hier["colour_mismatches"] == 0 and hier["cycle_mismatches"] == 0
+    assert (flat["hierarchical"], hier["hierarchical"]) == (False, True)   # 2x2: flat unless asked
     for k in flat:
-        if k.endswith("_s") or k == "cycles_per_s":   # timings
+        if k.endswith("_s") or k in ("cycles_per_s", "hierarchical"):   # timings; the build
             continue
         a, b = flat[k], hier[k]
         same = np.array_equal(a, b) if isinstance(a, np.ndarray) else a == b

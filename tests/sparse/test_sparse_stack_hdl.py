@@ -105,6 +105,6 @@ def test_sim_sparse_vp_stack_pysim_and_bad_options():
     with pytest.raises(RasterhwError, match="--vp must be"):
         simulate_coupled(tris, "2x2", engine="pysim", vp="tree")
     with pytest.raises(RasterhwError, match="no inner FIFOs"):
-        simulate_coupled(tris, "2x2", engine="pysim", vp="stack", vp_fifo_depth=2)
+        simulate_coupled(tris, "2x2", engine="pysim", vp="stack", vp_fifo_depth=8)
     with pytest.raises(RasterhwError, match="drop --no-coupled"):
         simulate("c50", 32, 32, engine="pysim", matrix="2x2", coupled=False, vp="stack")
