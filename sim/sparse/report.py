@@ -655,7 +655,11 @@ def coupled_vp_point(scene: str, size: int, matrix: str) -> dict:
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.golden_model.sparse.search import sparse_render
-    from rasterhw.golden_model.sparse.vpcycles import HDL_FIFO_DEPTH, PAPER_FIFO_DEPTH, coupled_matrix_vp
+    from rasterhw.golden_model.sparse.vpcycles import (
+        HDL_FIFO_DEPTH,
+        PAPER_FIFO_DEPTH,
+        coupled_matrix_vp,
+    )
 
     tris = run_geometry(build_scene(scene), size, size)
     f = sparse_render(tris, matrix, depth="fixed", trace=True)
