@@ -22,6 +22,10 @@ def pytest_configure(config):
     # pytest-xdist's option (None: not given on the command line); absent without xdist
     if getattr(config.option, "maxschedchunk", 0) is None:
         config.option.maxschedchunk = 1
+    if os.environ.get("RASTERHW_TEST_BUILDLOG"):   # where the build time goes (tests/buildlog.py)
+        from buildlog import install
+
+        install(os.environ["RASTERHW_TEST_BUILDLOG"])
 
 
 def pytest_collection_modifyitems(config, items):
