@@ -11,9 +11,12 @@ from rasterhw.golden_model.experts.model import render_frame
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.sim.engines import run
-from rasterhw.sim.experts.pxp_sim import job_list, run_jobs, span_job_list
+from rasterhw.sim.experts.pxp_sim import IN_DEPTH, OUT_DEPTH, job_list, run_jobs, span_job_list
 from rasterhw.sim.experts.testbench import PxpBench, PxpSpanBench
 from rasterhw.sim.testbench import compare
+
+
+SCENE_BUILD = {"depth": IN_DEPTH, "out_depth": OUT_DEPTH}
 
 
 def _need(exp) -> dict[str, int]:
@@ -30,7 +33,8 @@ def test_line_log_is_the_same_on_pysim_and_verilator(cls):
     assert tb.outputs_of(p) == ("o", "log") and len(exp.words["log"]) == jb["lines"] >= 2
     for kw in ({}, {"idle": 0.25, "stall": 120, "seed": 9}):
         a = run(tb, p, stim, engine="pysim", expect_words=_need(exp), **kw)
-        b = run(tb, p, stim, engine="verilator", expect_words=_need(exp), **kw)
+        # the scene runs' memories (pxp_sim.run_jobs): the build test_run_jobs_same_on_both_engines uses
+        b = run(tb, p, stim, engine="verilator", expect_words=_need(exp), build=SCENE_BUILD, **kw)
         assert (a.words, a.stamps) == (b.words, b.stamps), kw
         assert b.protocol_errors == 0
         c = compare(exp, b, cycle_exact=not kw)
