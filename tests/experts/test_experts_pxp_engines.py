@@ -15,7 +15,6 @@ from rasterhw.sim.experts.pxp_sim import IN_DEPTH, OUT_DEPTH, job_list, run_jobs
 from rasterhw.sim.experts.testbench import PxpBench, PxpSpanBench
 from rasterhw.sim.testbench import compare
 
-
 SCENE_BUILD = {"depth": IN_DEPTH, "out_depth": OUT_DEPTH}
 
 
