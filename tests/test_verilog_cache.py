@@ -75,3 +75,19 @@ def test_canonical_port_lists_sorts_plain_and_escaped_headers():
     # an escaped name ends at white space: the one after \x$1 stays before the closing parenthesis
     assert canonical_port_lists(text) == ("module top(a, b, c);\n  input a;\nendmodule\n"
                                           "module \\top.sub (\\x$1 , y);\nendmodule\n")
+
+
+def test_a_parameter_at_its_default_finds_the_same_cache_entry(tmp_path, monkeypatch):
+    """``generate_cached`` keys on the block's parameters with the defaults filled in: naming a
+    default (``z_bits=24``) or leaving it out converts once; another value converts again."""
+    from rasterhw.sim.engines import verilog_cache as vc
+
+    monkeypatch.setattr(vc, "BUILD_ROOT", tmp_path)
+    calls = []
+    real = vc.generate_verilog
+    monkeypatch.setattr(vc, "generate_verilog", lambda name, **p: calls.append(p) or real(name, **p))
+    a = vc.generate_cached("zbm-merger", fifo_depth=4)
+    b = vc.generate_cached("zbm-merger", fifo_depth=4, z_bits=24)
+    assert a == b and calls == [{"fifo_depth": 4}]
+    c = vc.generate_cached("zbm-merger", fifo_depth=4, z_bits=16)
+    assert c != a and len(calls) == 2 and len(list((tmp_path / "verilog").glob("zbm-merger-*.v"))) == 2

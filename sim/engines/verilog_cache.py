@@ -155,9 +155,23 @@ def convert_cached(name: str, factory: Callable[[], object], *, params: Mapping[
 
 
 def generate_cached(block: str, **params) -> str:
-    """``rasterhw.sim.engines.verilog.generate_verilog(block, **params)``, cached like :func:`convert_cached`."""
-    return convert_cached(block, lambda: None, params=params, module=block,
+    """``rasterhw.sim.engines.verilog.generate_verilog(block, **params)``, cached like :func:`convert_cached`;
+    keyed with the block's defaults filled in (:func:`effective_params`), so a parameter given at its
+    default and one left out find the same entry."""
+    return convert_cached(block, lambda: None, params=effective_params(block, params), module=block,
                           convert=lambda _design, _module: generate_verilog(block, **params))
+
+
+def effective_params(name: str, params: Mapping[str, object]) -> dict:
+    """``params`` with every parameter of block ``name``'s factory it leaves out at its default."""
+    import inspect
+
+    from rasterhw.sim.registry import load
+
+    sig = inspect.signature(load(blocks()[name]))
+    eff = {k: v.default for k, v in sig.parameters.items() if v.default is not inspect.Parameter.empty}
+    eff.update(params)
+    return eff
 
 
 def write_verilog(name: str, path: str | Path, **params) -> Path:
@@ -173,19 +187,15 @@ def verilog_header(name: str, **params) -> str:
     filled in), the design digest (:func:`source_digest`), the rasterhw and Amaranth versions, and
     each port of the block's signature — a stream as one line with its payload's fields, in the
     flattened names the Verilog uses (``<port>__payload`` ...)."""
-    import inspect
     from importlib.metadata import PackageNotFoundError, version
 
     from rasterhw.sim.engines.verilog import make_block
-    from rasterhw.sim.registry import load
 
     try:
         ours = version("rasterhw")
     except PackageNotFoundError:   # pragma: no cover - run from a bare checkout
         ours = "unknown"
-    sig = inspect.signature(load(blocks()[name]))
-    eff = {k: v.default for k, v in sig.parameters.items() if v.default is not inspect.Parameter.empty}
-    eff.update(params)
+    eff = effective_params(name, params)
     given = " ".join(f"-p {k}={v}" for k, v in params.items())
     lines = [f"rasterhw {ours}: block {name} (rasterhw verilog {name}{' ' + given if given else ''})",
              "parameters: " + (", ".join(f"{k}={v}" for k, v in eff.items()) or "none"),
