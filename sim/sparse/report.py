@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 from rasterhw.golden_model.sparse import montecarlo as mc
 from rasterhw.golden_model.sparse import theory as th
+from rasterhw.golden_model.sparse.vpcycles import HDL_FIFO_DEPTH, PAPER_FIFO_DEPTH
 from rasterhw.sim.report.rows import make_row
 
 SYSTEM = "sparse"
@@ -601,6 +602,12 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
 
 _SELF = "rasterhw.sim.sparse.report"
 
+#: the two video processors of the coupled sweeps: key (of :func:`coupled_vp_point`), label in the
+#: rows, depth of the FIFOs between the levels -- the paper's (its queue of primitives is the input
+#: FIFO; two-entry stage buffers, ``rasterhw sim sparse``'s default) and ours (eight-entry)
+_VP_CONFIGS = (("paper", "the paper's processor, two-entry stage buffers", PAPER_FIFO_DEPTH),
+               ("ours", "our processor, eight-entry stage FIFOs", HDL_FIFO_DEPTH))
+
 
 def _vp_depths(matrix: str) -> tuple[int, ...]:
     return (1, 8, 64) if matrix == "4x4" else (1, 64)
@@ -655,27 +662,18 @@ def coupled_vp_point(scene: str, size: int, matrix: str) -> dict:
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.golden_model.sparse.search import sparse_render
-    from rasterhw.golden_model.sparse.vpcycles import (
-        HDL_FIFO_DEPTH,
-        PAPER_FIFO_DEPTH,
-        coupled_matrix_vp,
-    )
+    from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
 
     tris = run_geometry(build_scene(scene), size, size)
     f = sparse_render(tris, matrix, depth="fixed", trace=True)
     out = {}
-    for who, vpd in (("paper", PAPER_FIFO_DEPTH), ("ours", HDL_FIFO_DEPTH)):
-        pts = out[who] = []
+    for key, _who, vpd in _VP_CONFIGS:
+        pts = out[key] = []
         for D in _vp_depths(matrix):
             r = coupled_matrix_vp(f, D, fifo_depth=vpd)
             pts.append({"frame_cycles": int(r["frame_cycles"]), "stall_cycles": int(r["stall_cycles"]),
                         "fifo_peak_max": int(r["fifo_peak_max"]), "busy_min": int(min(r["busy"]))})
     return out
-
-
-#: the two video processors of the coupled sweeps, labelled (key of :func:`coupled_vp_point`)
-_VP_CONFIGS = (("paper", "the paper's processor, two-entry stage buffers"),
-               ("ours", "our processor, eight-entry stage FIFOs"))
 
 
 def _coupled_vp_rows(row, lab: str, matrices: tuple[str, ...], points: list[dict]) -> list[str]:
@@ -685,7 +683,7 @@ def _coupled_vp_rows(row, lab: str, matrices: tuple[str, ...], points: list[dict
     tab = ["| matrix | processor | FIFO depth D | frame cycles | broadcast stall cycles | FIFO peak (max) | "
            "processor busy / frame, least loaded |", "|---|---|---|---|---|---|---|"]
     for m, pt in zip(matrices, points, strict=True):
-        for key, who in _VP_CONFIGS:
+        for key, who, _vpd in _VP_CONFIGS:
             fr = {}
             q = f"{lab}, {m}, {who}"
             for D, r in zip(_vp_depths(m), pt[key], strict=True):
@@ -1003,7 +1001,6 @@ def _coupled_hdl_rows(row, engine: str, progress: bool) -> list[str]:
     from rasterhw.golden_model.reference import random_triangles
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.golden_model.sparse.search import sparse_render
-    from rasterhw.golden_model.sparse.vpcycles import HDL_FIFO_DEPTH, PAPER_FIFO_DEPTH
     from rasterhw.sim.sparse.sim import simulate_coupled
 
     if engine == "verilator":
@@ -1021,11 +1018,10 @@ def _coupled_hdl_rows(row, engine: str, progress: bool) -> list[str]:
     tab = ["| processor | FIFO depth D | frame cycles, HDL | golden cycle model | stall cycles, HDL | golden | "
            "FIFO peak, HDL | golden | counters differing | least / most loaded processor busy / frame |",
            "|---|---|---|---|---|---|---|---|---|---|"]
-    # the paper's processor (its queue of primitives is the input FIFO: two-entry stage buffers, the
-    # default) and ours (eight-entry FIFOs between the levels) beside it, labelled
-    configs = (("the paper's processor, two-entry stage buffers", PAPER_FIFO_DEPTH, depths),
-               ("our processor, eight-entry stage FIFOs", HDL_FIFO_DEPTH, (depths[0], depths[-1])))
-    if engine == "pysim":   # the small pysim frame: the paper's processor only (ours: the golden rows)
+    # the paper's processor (the default) at every depth and ours beside it at the shallowest and the
+    # deepest; the small pysim frame: the paper's processor only (ours: the golden rows)
+    configs = [(who, vpd, depths if key == "paper" else (depths[0], depths[-1])) for key, who, vpd in _VP_CONFIGS]
+    if engine == "pysim":
         configs = configs[:1]
     every = {}
     for who, vpd, dd in configs:

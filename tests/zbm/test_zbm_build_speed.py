@@ -67,8 +67,8 @@ def test_merged_unit_keeps_one_pixel_processor_out_of_line():
     """What the speed build compiles: the I = 2 unit's 16 pixel processors are one module, marked
     for Verilator to keep out of line; the unmerged text has them all."""
     tb = find_testbench("zbm-unit")
-    # the cocotb unit bench's 64 x 16 I = 2 unit, from the Verilog cache its runs fill (its exact
-    # keywords: one conversion for both; 4.9 s warm before, uncached)
+    # the cocotb unit bench's 64 x 16 I = 2 unit, from the Verilog cache its runs fill (one
+    # conversion for both; 4.9 s warm before, uncached)
     p = {"interleave": IL, "width": 64, "height": 16, "capacity": F.AEP_CAPACITY, "schedule": "overlap"}
     full = generate_cached("zbm-unit", head=True, **p)
     merged = tb.sim_verilog(tb.params(**p), full)
