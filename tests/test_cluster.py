@@ -157,13 +157,20 @@ def test_worker_killed_mid_soak_every_round_exactly_once(cluster, tmp_path):
 
     def kill_one_mid_round():
         t0 = time.monotonic()
+        first_seen = {}
         while time.monotonic() - t0 < 60:
             lines = [ln.split() for ln in log.read_text().splitlines()]
+            now = time.monotonic()
+            for what, k, pid in lines:
+                first_seen.setdefault((what, k, pid), now)
             ended = {(k, pid) for what, k, pid in lines if what == "end"}
             # a round the soak needs (about 12 rounds make 1,200 pixels; at least 9), not one
-            # started ahead that it would cancel
+            # started ahead that it would cancel; and one seen starting within the last 0.15 s of
+            # its 0.4 s, so the kill lands before it ends (an older one could end first on a busy
+            # machine: the killed round then had finished)
             running = [(k, pid) for what, k, pid in lines
-                       if what == "start" and (k, pid) not in ended and int(k) <= 6]
+                       if what == "start" and (k, pid) not in ended and int(k) <= 6
+                       and now - first_seen[(what, k, pid)] < 0.15]
             if len(ended) >= 2 and running:
                 k, pid = running[-1]
                 os.kill(int(pid), signal.SIGKILL)
