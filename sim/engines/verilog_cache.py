@@ -15,6 +15,7 @@ from __future__ import annotations
 import ast
 import hashlib
 import json
+import threading
 from collections.abc import Callable, Iterable, Mapping
 from functools import cache
 from pathlib import Path
@@ -52,11 +53,19 @@ def _imported_files(f: Path) -> set[Path]:
     return _imports_of(f, st.st_mtime_ns, st.st_size)
 
 
+#: CPython 3.11's parser keeps one recursion-depth count per interpreter: two threads parsing at
+#: once (the sparse matrix's processors build their benches from a thread pool) can fail with
+#: "SystemError: AST constructor recursion depth mismatch" (seen in a test run); one parse at a time
+_PARSE_LOCK = threading.Lock()
+
+
 @cache
 def _imports_of(f: Path, _mtime_ns: int, _size: int) -> frozenset[Path]:
     """:func:`_imported_files` of ``f`` as it is at this modification time and size (parsed once)."""
     out: set[Path] = set()
-    for node in ast.walk(ast.parse(f.read_bytes(), str(f))):
+    with _PARSE_LOCK:
+        tree = ast.parse(f.read_bytes(), str(f))
+    for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             out |= {m for m in (_module_file(a.name) for a in node.names) if m is not None}
         elif isinstance(node, ast.ImportFrom) and node.level:
