@@ -30,6 +30,7 @@ import pkgutil
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cache
+from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 
@@ -161,7 +162,9 @@ def machines() -> dict[str, Machine]:
 
     found: dict[str, Machine] = {}
     for info in sorted(pkgutil.iter_modules(sim_pkg.__path__), key=lambda m: m.name):
-        if not info.ispkg:
+        # a package without a machine.py (engines, flow, cli, ...) is not imported to find out:
+        # importing it would run its __init__ (the engines' pulls in Amaranth and every engine)
+        if not info.ispkg or not (Path(info.module_finder.path) / info.name / "machine.py").is_file():
             continue
         try:
             mod = importlib.import_module(f"rasterhw.sim.{info.name}.machine")
