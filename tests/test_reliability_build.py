@@ -192,11 +192,13 @@ def test_interrupted_cold_sim_then_the_same_command_passes(tmp_path):
     build = tmp_path / "build"
     env = dict(os.environ, RASTERHW_BUILD=str(build),
                RASTERHW_VL_RUNTIME_DIR=str(cache_dir("plain", []).parent))
+    # interleave 1: the smallest unit (its model compiles in ~3.5 s here, interleave 2's in ~10 s;
+    # the signal comes 0.1-1.5 s into the compile)
     cmd = [PY, "-m", "rasterhw.sim.cli.main", "sim", "zbm", "--scene", "c50", "--size", "48x40",
-           "--interleave", "2", "--engine", "verilator", "-o", str(tmp_path / "z.png"), "--json"]
+           "--interleave", "1", "--engine", "verilator", "-o", str(tmp_path / "z.png"), "--json"]
     rng = random.Random(1033)
     for sig in (signal.SIGINT, signal.SIGTERM):
-        p, err = _interrupt_in_compile(cmd, env, build, ".*.tmp-*", sig, rng.uniform(0.2, 3.0), 300)
+        p, err = _interrupt_in_compile(cmd, env, build, ".*.tmp-*", sig, rng.uniform(0.1, 1.5), 300)
         assert p.returncode != 0 and "Traceback" not in err, err
         assert not list(build.glob(".*.tmp-*")) and not (tmp_path / "z.png").exists()
     r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=900)
