@@ -11,7 +11,14 @@ the second worker ran the light ones beside them (measured: docs/speed.md)."""
 from __future__ import annotations
 
 import os
+import signal
 
+# a test run started in the background by a non-interactive shell inherits SIGINT ignored, and so do
+# the processes it starts: the tests that send Ctrl-C to a command then see it run on to the end
+# (measured: three reliability tests failed so). A handler of our own is reset to the default at
+# exec, so the commands the tests start get Ctrl-C as a user's terminal gives it
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 # Verilator models the tests build at -O1 where a user's run would use -O2 (sim/engines/runner.py:
 # effective_opt): ~40 % less compile time on the large benches, the same results; a test run
 # keeps its own build folders (the level is in every build's key)
