@@ -166,13 +166,7 @@ def machines() -> dict[str, Machine]:
         # importing it would run its __init__ (the engines' pulls in Amaranth and every engine)
         if not info.ispkg or not (Path(info.module_finder.path) / info.name / "machine.py").is_file():
             continue
-        try:
-            mod = importlib.import_module(f"rasterhw.sim.{info.name}.machine")
-        except ModuleNotFoundError as e:
-            if e.name == f"rasterhw.sim.{info.name}.machine":
-                continue
-            raise
-        m = mod.MACHINE
+        m = importlib.import_module(f"rasterhw.sim.{info.name}.machine").MACHINE
         if m.name != info.name:
             raise RuntimeError(f"rasterhw.sim.{info.name}.machine registers {m.name!r}: names must match")
         found[m.name] = m
