@@ -19,6 +19,7 @@ import signal
 # exec, so the commands the tests start get Ctrl-C as a user's terminal gives it
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
+
 # Verilator models the tests build at -O1 where a user's run would use -O2 (sim/engines/runner.py:
 # effective_opt): ~40 % less compile time on the large benches, the same results; a test run
 # keeps its own build folders (the level is in every build's key)

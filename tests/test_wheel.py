@@ -12,6 +12,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
+from rasterhw.sim.engines.runner import OPT_ENV
 from rasterhw.sim.engines.vlruntime import cache_dir
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -66,8 +67,9 @@ def test_the_installed_wheel_runs_a_verilator_scene_from_an_empty_folder(wheel, 
     # keyed by Verilator's version and the flags: sim/engines/vlruntime.py, tested in
     # tests/test_vlruntime.py) and the build level are the test run's, so the wheel does not
     # compile the runtime again (~8 s of a ~16 s test)
-    env.update(RASTERHW_VL_RUNTIME_DIR=str(cache_dir("plain", []).parent),
-               **{k: os.environ[k] for k in ("RASTERHW_VERILATOR_OPT",) if k in os.environ})
+    env["RASTERHW_VL_RUNTIME_DIR"] = str(cache_dir("plain", []).parent)
+    if OPT_ENV in os.environ:
+        env[OPT_ENV] = os.environ[OPT_ENV]
     where = subprocess.run([str(py), "-c", "import rasterhw, sys; print(rasterhw.__file__)"], cwd=work, env=env,
                            capture_output=True, text=True, check=True).stdout.strip()
     assert str(ROOT) not in where and str(site) in where
