@@ -105,7 +105,7 @@ def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
     for y in range(height):
         ta = clk()
         if trace is not None:
-            trace.scalar("line loop and bypass test", 3)
+            trace.scalar("line loop", 1)
             trace.loop("a1 drop exited", active.size)
         if active.size:
             active = active[yend[active] >= y]
@@ -117,7 +117,7 @@ def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
                 s = nxt[s]
             active = np.concatenate([active, np.asarray(new, np.int64)])
             if trace is not None:
-                trace.scalar("y-list walk, append to x-list", 5 * len(new))
+                trace.scalar("x-list append", len(new))
         tb = clk()
         c.t_update2 += tb - ta
         if active.size == 0:
@@ -129,11 +129,11 @@ def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
         with np.errstate(divide="ignore", invalid="ignore"):
             didx = np.where(xr > xl, (ir - il) / (xr - xl), 0.0)
         if trace is not None:
-            trace.scalar("line set-up", 6)
+            trace.scalar("line set-up", 1)
             if mode == "real" and not full_frame:
                 trace.loop("clear", width)
             trace.loop("a1 span set-up", active.size)
-            trace.scalar("span loop set-up", 8 * active.size)
+            trace.scalar("span loop set-up", active.size)
             trace.loops_of(f"a1 z-test {mode}", hi - lo + 1)
             trace.loop("edge update", 2 * active.size)
         if mode == "real":
@@ -199,7 +199,7 @@ def algorithm2(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
     while True:
         ta = clk()
         if trace is not None:
-            trace.scalar("pass control", 10)
+            trace.scalar("pass control", 1)
             trace.loop("a2 drop exited", height)
             trace.loop("a2 take y-list head", height)
             trace.loop("a2 collect slots", height)
@@ -246,7 +246,7 @@ def algorithm2(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
         if trace is not None:
             trace.loop("a2 span set-up", ys.size)
             trace.loop(f"a2 z-test {mode}", ys.size, times=mx)   # every slot, masked, mx times
-            trace.scalar("z-test step control", 3 * mx)
+            trace.scalar("z-test step", mx)
             trace.loop("edge update", 2 * ys.size)
             trace.loop("a2 shift s-list", height)
         live = ln_o.size - np.searchsorted(ln_o[::-1], np.arange(mx), side="right")

@@ -84,23 +84,23 @@ def _trace_setup(tr, scene: Scene, sp) -> None:
     tr.loop("vertex lighting", nvert)
     tr.loop("back-face test", scene.n_polygons)
     tr.loop("collect polygons", scene.n_polygons)
-    tr.scalar("clipping: 6 planes x vertices x 8", 48 * int(sp.nv.sum()))
+    tr.scalar("clip vertex x plane", 6 * int(sp.nv.sum()))
 
 
 def _trace_segments(tr, sp, seg) -> None:
     """Segment building (fig. 1): vertex lines per polygon scalar, edge blocks and dz/dx vector,
     y-list linking scalar."""
-    tr.scalar("vertex lines per polygon: 10 per vertex", 10 * int(sp.nv.sum()))
+    tr.scalar("vertex line", int(sp.nv.sum()))
     tr.loop("edge block", 2 * seg.n)
     tr.loop("segment dzdx", seg.n)
-    tr.scalar("link into the y-list: 6 per segment", 6 * seg.n)
+    tr.scalar("y-list link", seg.n)
 
 
 def _trace_split(tr, before: int, after: int) -> None:
     tr.loop("segment lengths", before)
     tr.loop("select long segments", before)
     tr.loop("split piece", after)
-    tr.scalar("re-link the pieces: 6 per piece", 6 * after)
+    tr.scalar("y-list link", after)
 
 
 def render_frame(scene: Scene, width: int = 512, height: int = 512, *, alg: int = 2,
@@ -163,7 +163,7 @@ def render_frame(scene: Scene, width: int = 512, height: int = 512, *, alg: int 
             trace.loop("collect polygons", sh["initial"])
             for name in ("front", "back"):
                 if sh[name] is not None:
-                    trace.scalar("clipping: 6 planes x vertices x 8", 48 * int(sh[name].nv.sum()))
+                    trace.scalar("clip vertex x plane", 6 * int(sh[name].nv.sum()))
             trace.at("segments")
             for name, s_ in zip([n for n in ("front", "back") if sh[n] is not None and sh[n].nv.size], parts,
                                 strict=True):
@@ -219,7 +219,7 @@ def render_frame(scene: Scene, width: int = 512, height: int = 512, *, alg: int 
             trace.loop("vertex transform", int(np.asarray(scene.nverts).sum()))
             trace.loop("back-face test", scene.n_polygons)
             trace.loop("collect polygons", scene.n_polygons)
-            trace.scalar("clipping: 6 planes x vertices x 8", 48 * int(lsp.nv.sum()) if nl else 0)
+            trace.scalar("clip vertex x plane", 6 * int(lsp.nv.sum()) if nl else 0)
             _trace_segments(trace, lsp, lseg)
         if alg == 2:
             lseg, lsplit = split_segments(lseg, W)

@@ -425,10 +425,10 @@ def conclusions(get, scenes) -> dict:
 
 
 _Z = ("a1 z-test real", "a1 z-test shadow", "a2 z-test real", "a2 z-test shadow", "a1 span set-up", "a2 span set-up",
-      "span loop set-up", "z-test step control", "line set-up")
+      "span loop set-up", "z-test step", "line set-up")
 _U1 = ("edge update",)
 _U2 = ("a1 drop exited", "a2 drop exited", "a2 take y-list head", "a2 collect slots", "a2 shift s-list",
-       "y-list walk, append to x-list", "pass control", "line loop and bypass test")
+       "x-list append", "pass control", "line loop")
 
 
 def _parts(tr: Trace, machine: str = "vp200") -> dict:

@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pytest
 from rasterhw.golden_model.scenes import build_scene
-from rasterhw.golden_model.vzbuf.facom import PARAMS, SCALAR_COST, price
+from rasterhw.golden_model.vzbuf.facom import PARAMS, price, scalar_cp, vector_element_ns
 from rasterhw.golden_model.vzbuf.render import render_frame, table_stages
 from rasterhw.golden_model.vzbuf.trace import BODIES, Trace
 from rasterhw.sim.vzbuf.paper import TABLES
@@ -60,15 +60,64 @@ def test_price_of_one_loop_by_hand():
     vl = int(P["vr_bytes"] // (8 * P["vregs"]))
     n = vl + 1                                # two strips
     tr = _one("a1 z-test real", n)
-    ts = P["scalar_ns"] * 1e-9
+    ts = P["scalar_clock_ns"] * 1e-9
     body = BODIES["a1 z-test real"]
-    per_iter = P["loop_overhead"] + sum(c * SCALAR_COST[k] for k, _w, c in body)
+    loop = 2 * P["cp_iadd"] + P["cp_branch"]   # increment, compare, branch
+    per_iter = loop + sum(c * scalar_cp(k, w) for k, w, c in body)
     assert price(tr, "scalar")["phases"]["hsr"] == pytest.approx(n * per_iter * ts)
     t_unit = P["fp_pipes"] / (P["peak_vp100"] * 1e6)
-    want = 2 * P["strip_scalar"] * ts
-    for _k, _w, c in body:
-        want += c * (2 * P["startup_ns"] * 1e-9 + n * t_unit)
+    want = 2 * P["strip_cp"] * ts
+    for k, w, c in body:
+        per = {"add": t_unit, "mul": t_unit, "load": t_unit, "compare": t_unit,
+               "masked_store": t_unit * (1 if w == 8 else P["i4_access_factor"])}[k]
+        want += c * (2 * P["startup_ns"] * 1e-9 + n * per)
     assert price(tr, "vp100")["phases"]["hsr"] == pytest.approx(want)
+
+
+def _body(name, *ops):
+    BODIES[name] = tuple(ops)
+
+
+def test_doubling_an_element_width_changes_a_vector_load_price():
+    """Width is read: a 16-byte element moves two 8-byte words on both sides; a 4-byte element
+    takes an 8-byte slot at the default i4_access_factor (the paper's "4バイトデータに対する配慮は
+    余りなされていない"), so 4 -> 8 changes the price exactly when that factor is not 1."""
+    n = 300
+    try:
+        for w in (4, 8, 16):
+            _body(f"load {w}", ("load", w, 1))
+        t = {w: _one(f"load {w}", n) for w in (4, 8, 16)}
+        for m in ("vp100", "vp200"):
+            p8, p16 = (price(t[w], m)["vector"]["hsr"] for w in (8, 16))
+            assert p16 > 1.5 * p8, m
+            assert vector_element_ns("load", 16, m) == 2 * vector_element_ns("load", 8, m)
+            packed = {"i4_access_factor": 0.5}
+            assert price(t[4], m, params=packed)["vector"]["hsr"] < price(t[8], m, params=packed)["vector"]["hsr"]
+            assert price(t[4], m)["vector"]["hsr"] == pytest.approx(price(t[8], m)["vector"]["hsr"])
+        assert price(t[16], "scalar")["phases"]["hsr"] > price(t[8], "scalar")["phases"]["hsr"]
+        # gathers and scatters of indices vs doubles the same way
+        assert vector_element_ns("gather", 16, "vp200") == 2 * vector_element_ns("gather", 8, "vp200")
+    finally:
+        for w in (4, 8, 16):
+            BODIES.pop(f"load {w}", None)
+
+
+def test_a_divide_is_priced_differently_from_an_add():
+    n = 300
+    try:
+        _body("adds", ("add", 8, 1))
+        _body("divs", ("div", 8, 1))
+        a, d = _one("adds", n), _one("divs", n)
+        for m in ("scalar", "vp100", "vp200"):
+            assert price(d, m)["phases"]["hsr"] > price(a, m)["phases"]["hsr"], m
+        assert scalar_cp("div", 8) == PARAMS["cp_fdiv"].value != scalar_cp("add", 8)
+        assert vector_element_ns("div", 8, "vp200") == PARAMS["vdiv_factor"].value * vector_element_ns("add", 8, "vp200")
+        # and on the scalar side the width of an add is read: a 4-byte (integer) add is not a double's
+        assert scalar_cp("add", 4) == PARAMS["cp_iadd"].value < scalar_cp("add", 8)
+        assert scalar_cp("mul", 8) != scalar_cp("add", 8)
+    finally:
+        BODIES.pop("adds", None)
+        BODIES.pop("divs", None)
 
 
 def test_vp200_doubles_pipes_but_not_the_mask_pipe_and_l10_collects_on_the_scalar_unit():
