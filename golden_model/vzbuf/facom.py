@@ -49,8 +49,8 @@ from dataclasses import dataclass
 
 from rasterhw.golden_model.vzbuf.trace import BODIES, SCALAR_BODIES, Trace
 
-__all__ = ["MACHINES", "PARAMS", "Param", "bounds", "components", "length10_ratio", "price", "scalar_cp",
-           "vector_element_ns"]
+__all__ = ["MACHINES", "PARAMS", "Param", "bounds", "components", "length10_ratio", "out_of_bounds", "price",
+           "scalar_cp", "vector_element_ns"]
 
 
 @dataclass(frozen=True)
@@ -337,3 +337,11 @@ def bounds(params: dict | None = None) -> dict[str, tuple[float, float, str]]:
         "cp_branch": (1.0, 14.0, "chosen"),
         "strip_cp": (5.0, 60.0, "chosen"),
     }
+
+
+def out_of_bounds(params: dict | None = None) -> list[str]:
+    """The parameters (with ``params`` applied) that leave their :func:`bounds`, as
+    ``"name = value outside [low, high] (source)"``; empty when every one is inside."""
+    P = _params(params)
+    return [f"{k} = {P[k]:g} outside [{lo:g}, {hi:g}] ({why})" for k, (lo, hi, why) in bounds(params).items()
+            if not lo <= P[k] <= hi]
