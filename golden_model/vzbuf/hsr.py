@@ -134,6 +134,8 @@ def algorithm1(seg: SegmentBlock, width: int, height: int, buf: dict, *, mode: s
                 trace.loop("clear", width)
             trace.loop("a1 span set-up", active.size)
             trace.scalar("span loop set-up", active.size)
+            if mode == "real":
+                trace.scalar("shading decision", active.size)
             trace.loops_of(f"a1 z-test {mode}", hi - lo + 1)
             trace.loop("edge update", 2 * active.size)
         if mode == "real":

@@ -77,20 +77,27 @@ def table_stages(alg: int, shadows: str) -> dict[str, tuple[str, ...]]:
 
 
 def _trace_setup(tr, scene: Scene, sp) -> None:
-    """Set-up loops (2.2): every vertex transformed and lit, every polygon back-face tested and
-    collected; clipping (Sutherland's re-entrant clipper, polygon by polygon) stays scalar."""
+    """Set-up loops (2.2): every vertex transformed and lit, every face tested lit or unlit,
+    back-face tested and collected; clipping (Sutherland's re-entrant clipper, polygon by polygon
+    and plane by plane) stays scalar."""
     nvert = int(np.asarray(scene.nverts).sum())
     tr.loop("vertex transform", nvert)
     tr.loop("vertex lighting", nvert)
+    tr.loop("face lit test", scene.n_polygons)
     tr.loop("back-face test", scene.n_polygons)
     tr.loop("collect polygons", scene.n_polygons)
+    tr.scalar("clip polygon x plane", 6 * int(sp.nv.size))
     tr.scalar("clip vertex x plane", 6 * int(sp.nv.sum()))
 
 
 def _trace_segments(tr, sp, seg) -> None:
-    """Segment building (fig. 1): vertex lines per polygon scalar, edge blocks and dz/dx vector,
+    """Segment building (fig. 1, lost in the OCR; 2.3.2 1)): per polygon its chains and vertex
+    lines and per segment its block scalar, the polygon planes, edge blocks and dz/dx vector,
     y-list linking scalar."""
+    tr.scalar("polygon chains", int(sp.nv.size))
     tr.scalar("vertex line", int(sp.nv.sum()))
+    tr.loop("polygon plane", int(sp.nv.size))
+    tr.scalar("segment block", seg.n)
     tr.loop("edge block", 2 * seg.n)
     tr.loop("segment dzdx", seg.n)
     tr.scalar("y-list link", seg.n)
@@ -163,6 +170,7 @@ def render_frame(scene: Scene, width: int = 512, height: int = 512, *, alg: int 
             trace.loop("collect polygons", sh["initial"])
             for name in ("front", "back"):
                 if sh[name] is not None:
+                    trace.scalar("clip polygon x plane", 6 * int(sh[name].nv.size))
                     trace.scalar("clip vertex x plane", 6 * int(sh[name].nv.sum()))
             trace.at("segments")
             for name, s_ in zip([n for n in ("front", "back") if sh[n] is not None and sh[n].nv.size], parts,
@@ -219,6 +227,7 @@ def render_frame(scene: Scene, width: int = 512, height: int = 512, *, alg: int 
             trace.loop("vertex transform", int(np.asarray(scene.nverts).sum()))
             trace.loop("back-face test", scene.n_polygons)
             trace.loop("collect polygons", scene.n_polygons)
+            trace.scalar("clip polygon x plane", 6 * nl)
             trace.scalar("clip vertex x plane", 6 * int(lsp.nv.sum()) if nl else 0)
             _trace_segments(trace, lsp, lseg)
         if alg == 2:

@@ -72,11 +72,20 @@ BODIES = {
     # pointer, the z of the cross product (5 subtractions, 2 products)
     "back-face test": _b(("load", I4, 1), ("gather", F, 6), ("add", F, 5), ("mul", F, 2), ("compare", F, 1),
                          ("store", I4, 1)),
+    # the lit / unlit test of every face (2.2 b): "陽面(光源光のあたる面)と陰面(光源光のあたらない面)を
+    # 判定し"): its world normal from two edges through the vertex pointer (6 subtractions, a cross
+    # product), N.L, the sign into the polygon block's flag
+    "face lit test": _b(("load", I4, 1), ("gather", F, 9), ("add", F, 6), ("mul", F, 6), ("add", F, 3),
+                        ("mul", F, 3), ("add", F, 2), ("compare", F, 1), ("store", I4, 1)),
     # collect the surviving polygons into a list
     "collect polygons": _b(("load", I4, 1), ("compare", I4, 1), ("compress", I4, 1)),
     # segment building: edge block of every segment side (x, dx/dy, z, dz/dy, i, di/dy at its first
     # line): differences, 1/dy, three slopes, the values at the first line
     "edge block": _b(("gather", F, 8), ("add", F, 10), ("mul", F, 8), ("div", F, 1), ("store", F, 6)),
+    # the plane of every processed polygon, for its segments' dz/dx (the segment block's "dz/dx",
+    # 2.3.2 1)): three screen vertices through the vertex pointer, the normal, -a/c
+    "polygon plane": _b(("load", I4, 1), ("gather", F, 9), ("add", F, 6), ("mul", F, 6), ("add", F, 3),
+                        ("div", F, 1), ("mul", F, 1), ("store", F, 1)),
     # dz/dx of every segment from its polygon's plane
     "segment dzdx": _b(("load", I4, 1), ("gather", F, 2), ("mul", F, 1), ("store", F, 1)),
     # algorithm 2's split: mean lengths (reductions), then the test and the collection of long ones
@@ -141,6 +150,18 @@ SCALAR_BODIES = {
     # Sutherland's re-entrant clipper (2.2 c), ref. [1]): one vertex against one plane of the view
     # pyramid: read x,y,z,w, the plane distance, its sign test, write the vertex out, count it
     "clip vertex x plane": _b(("load", F, 4), ("add", F, 1), ("compare", F, 1), ("store", F, 4), ("add", I4, 1)),
+    # the clipper's own work per polygon and plane: the polygon's vertex pointer and count in, the
+    # output pointer and count out, the loop over its vertices
+    "clip polygon x plane": _b(("load", I4, 2), ("store", I4, 2), ("add", I4, 2), ("compare", I4, 1)),
+    # fig. 1 per polygon (2.3.2 1): "すべての処理対象多角形に対して、図1に示す手順で頂点データから…セグメント・
+    # ブロックを作成する": its vertex pointer and count, the top and bottom vertex, the two chains set up
+    "polygon chains": _b(("load", I4, 2), ("add", I4, 4), ("compare", I4, 2), ("store", I4, 2)),
+    # fig. 1 per segment: which chain reaches the next vertex line first, that chain advanced, the
+    # segment block written (y end, polygon, left edge, right edge: 2.3.2 1) (i)) and allocated
+    "segment block": _b(("compare", F, 1), ("load", I4, 2), ("add", I4, 2), ("store", I4, 4)),
+    # algorithm 1 with Gouraud shading, per span: "スムーズ・シェイディング処理を行うか否かの判定処理"
+    # (3.3 3) ②): the polygon's flag through the segment's polygon pointer, tested
+    "shading decision": _b(("load", I4, 1), ("load", I4, 1), ("compare", I4, 1)),
     # fig. 1 (segment building), per polygon vertex: its y through the vertex pointer, the order
     # test that finds the vertex lines, the index step
     "vertex line": _b(("load", I4, 1), ("gather", F, 1), ("compare", F, 1), ("add", I4, 2), ("store", I4, 1)),

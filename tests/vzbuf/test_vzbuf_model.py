@@ -293,3 +293,25 @@ def test_vp200_equals_the_xmp_on_a_length_10_vector_loop_and_its_scalar_unit_is_
     assert 1 / TOLERANCE <= vp / xmp <= TOLERANCE
     slow = sum(price(tr, "scalar", params={"scalar_clock_ns": 136.0})["phases"].values())
     assert slow / xmp > TOLERANCE          # the review's fitted 136 ns would break it
+
+
+def test_the_scalar_work_the_paper_describes_is_traced_per_polygon_segment_and_span():
+    """Item 3 of issue 52: the per-polygon set-up (clipper per polygon and plane, the lit/unlit
+    face test), fig. 1's per-polygon chains and per-segment blocks, the polygon planes, and
+    algorithm 1's smooth-shading decision per span, each counted from the data it runs on."""
+    sc = build_scene("c50")
+    tr = Trace()
+    f = render_frame(sc, W, H, alg=1, trace=tr)
+    polys = int(f.sp.nv.size)
+    S = tr.scalars
+    assert S[("setup", "clip polygon x plane")] == 6 * polys
+    assert S[("setup", "clip vertex x plane")] == 6 * int(f.sp.nv.sum())
+    assert S[("segments", "polygon chains")] == polys
+    assert S[("segments", "segment block")] == S[("segments", "y-list link")] == f.stats["segments"]
+    assert S[("hsr", "shading decision")] == S[("hsr", "span loop set-up")] > 0
+    assert sum(t for (p, b, n), t in tr.loops.items() if b == "face lit test" and n == sc.n_polygons) == 1
+    assert sum(n * t for (p, b, n), t in tr.loops.items() if b == "polygon plane") == polys
+    # the depth-only passes (the light's, ray casting) make no shading decision
+    tm = Trace()
+    render_frame(sc, W, H, alg=1, shadows="map", trace=tm)
+    assert tm.scalars[("light", "shading decision")] == 0
