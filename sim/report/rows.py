@@ -11,7 +11,8 @@ A row is a dict with the keys of :data:`ROW_KEYS`:
 ``unit``      unit of the three values
 ``source``    what produced ``measured`` in this run: ``golden`` (a golden model ran), ``model`` / ``model:NAME`` (a cost
               or timing model ran, e.g. on counted operations; NAME = which model or machine), ``formula`` (arithmetic on other
-              values), ``hdl:pysim``, ``hdl:verilator``, ``hdl:icarus`` (the HDL was simulated),
+              values), ``fit:NAME`` (a model calibrated on NAME, e.g. ``fit:table2``: shown as a fit, never as
+              agreement), ``hdl:pysim``, ``hdl:verilator``, ``hdl:icarus`` (the HDL was simulated),
               ``hdl:yosys`` / ``hdl:nextpnr`` (the generated Verilog was synthesised / placed)
 
 Each machine names a function ``rows(engine, progress, out_dir, **known) -> (rows, sections)``
@@ -59,8 +60,8 @@ def make_row(system: str, figure: str, quantity: str, *, paper, formula, measure
     ``measured=None`` needs a ``reason`` (why this run could not measure it): a row is never
     dropped for lack of a tool or of time, it is kept unmeasured.
     """
-    if source not in SOURCES and not (source.startswith("model:") and len(source) > 6):
-        raise ValueError(f"source must be one of {SOURCES} or model:NAME, not {source!r}")
+    if source not in SOURCES and not (source.startswith(("model:", "fit:")) and source.split(":", 1)[1]):
+        raise ValueError(f"source must be one of {SOURCES}, model:NAME or fit:NAME, not {source!r}")
     if measured is None and not reason:
         raise ValueError(f"row {quantity!r}: measured is None, so say why (reason=...)")
     row = {"system": system, "figure": figure, "quantity": quantity, "paper": paper,

@@ -18,13 +18,21 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.reference import rasterise
 from rasterhw.golden_model.scenes import build_scene as _shared_scene
-from rasterhw.golden_model.vzbuf.facom import PARAMS, price
+from rasterhw.golden_model.vzbuf.facom import LINEAR, PARAMS, bounds, length10_ratio, price
 from rasterhw.golden_model.vzbuf.render import render_frame, table_stages
 from rasterhw.golden_model.vzbuf.shadows import ray_shadow
 from rasterhw.golden_model.vzbuf.stats import table1
 from rasterhw.golden_model.vzbuf.trace import Trace
 from rasterhw.golden_model.vzbuf.workload import table1_light
 from rasterhw.sim.report.rows import make_row
+from rasterhw.sim.vzbuf.calibrate import (
+    FIT_TABLE,
+    error_factors,
+    fit,
+    predict,
+    stage_components,
+    summary,
+)
 from rasterhw.sim.vzbuf.paper import COLS, CORRECTED, RATES, RUNS, T1, TABLES, VTIME
 
 SYS = "vzbuf"
@@ -116,6 +124,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
 
     # ------------------------------------------------------------------ timing tables 2-7 (model)
     times = {}
+    comps = {}
     for table, (alg, sh) in RUNS.items():
         T = TABLES[table]
         for n in scenes:
@@ -130,6 +139,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
             labels = {k.split()[0]: k for k in table_stages(alg, sh)}
             ms = model_ms(tr, alg, sh)
             times[(table, n)] = (ms, f, tr)
+            comps[(table, n)] = stage_components(tr, alg, sh)
             for stage in (*labels, "total"):
                 for m in MODELS:
                     pm = PAPER_M[m]
@@ -184,11 +194,16 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     res = conclusions(model_get, scenes)
     pres = conclusions(_getter_paper(), scenes)
     for key, (frac, what) in res.items():
-        claim("conclusions", f"({key}) {what}: fraction of cases that hold (1 = holds)", pres[key][0], frac,
-              unit="fraction", source="model:facom")
+        claim("conclusions", f"{_cname(key)} {what}: fraction of cases that hold (1 = holds)", pres[key][0], frac,
+              unit="fraction", source=CONCLUSION_SOURCE[key])
     if tot("table 3", "c300"):
         claim("conclusions", "(e) table 3, c300, VP200 total: model / paper", 1.0, tot("table 3", "c300") / 293.0,
               source="model:vp200")
+    # the published facts the parameters are bounded by (facom.bounds; not the paper's)
+    for m in ("vp200", "vp100"):
+        claim("published bounds", f"{PAPER_M[m]} / X-MP time of V = S x V + V at vector length 10 (Lubeck, Moore, "
+              "Mendez: the VP-200 and the X-MP 'performed equally on short vectors (vector length 10)'; "
+              "bound for the VP-200 1/1.3-1.3)", None, length10_ratio(machine=m), source=f"model:{m}")
     # sensitivity: every chosen parameter at half and double, the conclusions recomputed
     kept = {k: v for k, v in times.items() if k[0] in ("table 2", "table 3")}
     for pname, par in PARAMS.items():
@@ -199,8 +214,10 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
             alt = {k: (model_ms(tr, *RUNS[k[0]], params={pname: val}), f, tr) for k, (_, f, tr) in kept.items()}
             r = conclusions(_getter_model(alt), scenes)
             for key, (frac, _what) in r.items():
-                claim("sensitivity", f"{pname} x{fac:g} (= {val:g} {par.unit}): conclusion ({key}), fraction holding",
-                      None, frac, unit="fraction", source="model:facom")
+                if key not in SENSITIVITY_KEYS:
+                    continue
+                claim("sensitivity", f"{pname} x{fac:g} (= {val:g} {par.unit}): {_sname(key)}, fraction holding",
+                      None, frac, unit="fraction", source=CONCLUSION_SOURCE[key])
     if ("table 5", "c300") in times and ("table 4", "c300") in times:
         c1 = _parts(times[("table 4", "c300")][2])
         c2 = _parts(times[("table 5", "c300")][2])
@@ -231,6 +248,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
                   (tot("table 7", n, stage="1") + tot("table 7", n, stage="2")) / tot("table 3", n))
 
     out.extend(where_the_time_goes(times, t1))
+    out.extend(agreement_rows(times, scenes))
+    out.extend(calibration_rows(comps, scenes))
 
     # ------------------------------------------------------------------ shadows vs brute force
     for n in scenes:
@@ -389,7 +408,10 @@ def _getter_paper():
 
 def conclusions(get, scenes) -> dict:
     """The issue's checks (a)-(e) on tables 2 and 3, from ``get(table, scene, machine, stage)``:
-    each -> (fraction of its cases that hold, what it says); cases with a missing value skipped."""
+    each -> (fraction of its cases that hold, what it says); cases with a missing value skipped.
+    Keys ``a`` ... ``e`` are the combined checks; ``a vp100`` ... ``b vp200`` the same per machine,
+    ``c first half`` / ``c second half`` the two halves of (c) (:data:`CONCLUSION_SOURCE` says
+    which model each reads)."""
     def frac(cases):
         cases = [c for c in cases if c is not None]
         return (sum(cases) / len(cases)) if cases else float("nan")
@@ -399,29 +421,146 @@ def conclusions(get, scenes) -> dict:
         return s / v if s and v else None
 
     both = [n for n in scenes if get("table 2", n, "vp200") and get("table 3", n, "vp200")]
-    a, b, c = [], [], []
+    a = {"vp100": [], "vp200": []}
+    b = {"vp100": [], "vp200": []}
+    c1, c2 = [], []
     for n in both:
         for m in ("vp100", "vp200"):
             g1, g2 = gain("table 2", n, m), gain("table 3", n, m)
-            a.append(None if g1 is None or g2 is None else g2 > g1)
-            b.append(None if g1 is None else 1.5 <= g1 <= 5)
-            b.append(None if g2 is None else 4 <= g2 <= 12)
+            a[m].append(None if g1 is None or g2 is None else g2 > g1)
+            b[m].append(None if g1 is None else 1.5 <= g1 <= 5)
+            b[m].append(None if g2 is None else 4 <= g2 <= 12)
     for n in (x for x in both if x in CUBES):
         h1, h2 = get("table 2", n, "vp100", "2"), get("table 2", n, "vp200", "2")
-        c.append(None if not (h1 and h2) else h2 >= 0.9 * h1)
+        c1.append(None if not (h1 and h2) else h2 >= 0.9 * h1)
         h1, h2 = get("table 3", n, "vp100", "2"), get("table 3", n, "vp200", "2")
-        c.append(None if not (h1 and h2) else h1 / h2 > 1.2)
+        c2.append(None if not (h1 and h2) else h1 / h2 > 1.2)
     d = []
     for n, want in (("c300", True), ("sp8", False)):
         t1, t2 = get("table 2", n, "vp200"), get("table 3", n, "vp200")
         d.append(None if not (t1 and t2) else (t2 < t1) == want)
     t = get("table 3", "c300", "vp200")
     e = [None if not t else 0.5 <= t / 293.0 <= 2.0]
-    return {"a": (frac(a), "algorithm 2's vectorisation gain > algorithm 1's, every scene, VP100 and VP200"),
-            "b": (frac(b), "gains within 1.5-5 (algorithm 1) and 4-12 (algorithm 2)"),
-            "c": (frac(c), "cubes: alg. 1 hidden-surface VP200 >= 0.9 x VP100, alg. 2 VP100/VP200 > 1.2"),
+    return {"a": (frac(a["vp100"] + a["vp200"]),
+                  "algorithm 2's vectorisation gain > algorithm 1's, every scene, VP100 and VP200"),
+            "a vp100": (frac(a["vp100"]), "algorithm 2's vectorisation gain > algorithm 1's, every scene"),
+            "a vp200": (frac(a["vp200"]), "algorithm 2's vectorisation gain > algorithm 1's, every scene"),
+            "b": (frac(b["vp100"] + b["vp200"]), "gains within 1.5-5 (algorithm 1) and 4-12 (algorithm 2)"),
+            "b vp100": (frac(b["vp100"]), "gains within 1.5-5 (algorithm 1) and 4-12 (algorithm 2)"),
+            "b vp200": (frac(b["vp200"]), "gains within 1.5-5 (algorithm 1) and 4-12 (algorithm 2)"),
+            "c": (frac(c1 + c2), "cubes: alg. 1 hidden-surface VP200 >= 0.9 x VP100, alg. 2 VP100/VP200 > 1.2"),
+            "c first half": (frac(c1), "cubes: algorithm 1's hidden-surface time on the VP200 >= 0.9 x the VP100's "
+                             "(table 2 stage 2; 4.1 1)(ii): 'ハードウェア量が2倍に増えても、処理時間の改善はあまり"
+                             "なかった')"),
+            "c second half": (frac(c2), "cubes: algorithm 2's hidden-surface time VP100 / VP200 > 1.2 (table 3 stage "
+                              "2; 4.1 2)(ii): '処理速度も1.5~1.9倍になっている')"),
             "d": (frac(d), "VP200: algorithm 2 total below algorithm 1's on c300, above on sp8"),
             "e": (frac(e), "table 3 c300 VP200 total within 0.5-2 x the paper's 293 ms")}
+
+
+#: which model each conclusion row reads (the machines its cases compare)
+CONCLUSION_SOURCE = {"a": "model:vp100|vp200", "a vp100": "model:vp100", "a vp200": "model:vp200",
+                     "b": "model:vp100|vp200", "b vp100": "model:vp100", "b vp200": "model:vp200",
+                     "c": "model:vp100|vp200", "c first half": "model:vp100|vp200",
+                     "c second half": "model:vp100|vp200", "d": "model:vp200", "e": "model:vp200"}
+#: the conclusions each sensitivity run recomputes
+SENSITIVITY_KEYS = ("a", "b", "c", "c first half", "c second half", "d", "e")
+
+
+def _cname(key: str) -> str:
+    """``a`` -> ``(a)``; ``c first half`` -> ``conclusion (c), first half:``; ``a vp100`` ->
+    ``conclusion (a), VP100:``."""
+    if " " not in key:
+        return f"({key})"
+    k, rest = key.split(" ", 1)
+    return f"conclusion ({k}), {PAPER_M.get(rest, rest)}:"
+
+
+def _sname(key: str) -> str:
+    """The sensitivity rows' name of a conclusion: ``conclusion (a)``, ``conclusion (c), first half``."""
+    return f"conclusion ({key})" if " " not in key else _cname(key)[:-1]
+
+
+def _gmean(xs) -> float | None:
+    xs = [x for x in xs if x and x > 0]
+    return float(np.exp(np.mean(np.log(xs)))) if xs else None
+
+
+def agreement_rows(times, scenes) -> list[dict]:
+    """Per table and machine, the uncalibrated model's geometric mean of model / paper over every
+    stage and total cell, and the median error factor max(r, 1/r) over all machines."""
+    out = []
+    for table in TABLES:
+        T = TABLES[table]
+        allf = []
+        for m in MODELS:
+            pm = PAPER_M[m]
+            if pm not in T:
+                continue
+            r = []
+            for n in scenes:
+                if (table, n) not in times:
+                    continue
+                ms = times[(table, n)][0][m]
+                for st in T[pm]:
+                    pv = T[pm][st].get(n)
+                    if pv and st in ms:
+                        r.append(ms[st] / pv)
+            if not r:
+                continue
+            allf += [max(x, 1 / x) for x in r]
+            out.append(make_row(SYS, table, f"geometric mean model / paper, {pm} (every stage and total, "
+                                "uncalibrated model)", paper=1.0, formula=None, measured=_gmean(r), unit="ratio",
+                                source=f"model:{m}"))
+        if allf:
+            out.append(make_row(SYS, table, "uncalibrated model error max(model / paper, paper / model): median "
+                                "factor (every stage and total, every machine)", paper=1.0, formula=None,
+                                measured=float(np.median(allf)), unit="factor", source="model:scalar|vp100|vp200"))
+    return out
+
+
+def calibration_rows(comps, scenes) -> list[dict]:
+    """The table-2 calibration (sim/vzbuf/calibrate.py): the fitted values beside their bounds,
+    every stage and total of tables 2-7 at those values beside the paper's, and the error of the
+    fit in sample (table 2) and out of sample (tables 3-7). Never read by the conclusions."""
+    out = []
+    if not any(k[0] == FIT_TABLE for k in comps):
+        return out
+    start = {k: PARAMS[k].value for k in LINEAR}
+    theta = fit(comps, TABLES, start)
+    b = bounds()
+    for p in LINEAR:
+        lo, hi, why = b.get(p, (None, None, "chosen"))
+        where = f"bounds {lo:.4g}-{hi:.4g} {PARAMS[p].unit}, {why.split(':')[0].split(' (')[0]}" if lo is not None \
+            else "no bounds"
+        out.append(make_row(SYS, "calibration", f"fitted {p} on {FIT_TABLE} ({where}; the model's value "
+                            f"{PARAMS[p].value:g})", paper=None, formula=None, measured=theta[p],
+                            unit=PARAMS[p].unit, source="fit:table2"))
+        if lo is not None:
+            out.append(make_row(SYS, "calibration", f"fitted {p}: inside its bounds (1 = yes)", paper=None,
+                                formula=None, measured=int(lo <= theta[p] <= hi), unit="flag", source="fit:table2"))
+    pred = {k: predict(c, theta) for k, c in comps.items()}
+    for table in TABLES:
+        T = TABLES[table]
+        alg, sh = RUNS[table]
+        labels = {k.split()[0]: k for k in table_stages(alg, sh)}
+        for n in scenes:
+            if (table, n) not in pred:
+                continue
+            for m in MODELS:
+                pm = PAPER_M[m]
+                for stage in (*labels, "total"):
+                    pv = T[pm][stage][n] if pm in T else None
+                    out.append(make_row(SYS, table, f"{n}: {labels.get(stage, 'total')}, {pm} (calibrated on "
+                                        f"{FIT_TABLE})", paper=pv, formula=None, measured=pred[(table, n)][m][stage],
+                                        unit="ms", source="fit:table2"))
+        med, gm = summary(error_factors(pred, TABLES, table))
+        which = "in-sample" if table == FIT_TABLE else "out-of-sample"
+        for what, v in (("median factor", med), ("geometric mean factor", gm)):
+            out.append(make_row(SYS, table, f"{which} error of the {FIT_TABLE} calibration, max(fit / paper, "
+                                f"paper / fit) over every stage and total: {what}", paper=1.0, formula=None,
+                                measured=v, unit="factor", source="fit:table2"))
+    return out
 
 
 _Z = ("a1 z-test real", "a1 z-test shadow", "a2 z-test real", "a2 z-test shadow", "a1 span set-up", "a2 span set-up",

@@ -202,7 +202,8 @@ def test_model_imports_without_the_paper_tables():
 def test_conclusions_check_holds_on_the_paper_and_fails_when_a_claim_is_broken():
     scenes = tuple(TABLES["table 2"]["scalar"]["total"])
     paper = conclusions(_getter_paper(), scenes)
-    assert {k: v[0] for k, v in paper.items()} == {k: 1.0 for k in "abcde"}
+    assert {k: v[0] for k, v in paper.items()} == {k: 1.0 for k in paper}
+    assert {"a", "b", "c", "d", "e", "c first half", "c second half", "a vp100", "b vp200"} <= set(paper)
     get = _getter_paper()
 
     def broken(table, n, m, stage="total"):      # algorithm 2 ten times slower on the VP200
@@ -211,6 +212,18 @@ def test_conclusions_check_holds_on_the_paper_and_fails_when_a_claim_is_broken()
 
     r = conclusions(broken, scenes)
     assert r["a"][0] < 1.0 and r["d"][0] < 1.0
+    assert r["a vp200"][0] < 1.0 and r["a vp100"][0] == 1.0      # the VP100 was not touched
+
+    def halves(table, n, m, stage="total"):   # algorithm 1's hidden surface twice as slow on the VP200
+        v = get(table, n, m, stage)
+        return 2 * v if v and table == "table 2" and m == "vp200" and stage == "2" else v
+
+    r = conclusions(halves, scenes)
+    assert r["c first half"][0] == 1.0 and r["c second half"][0] == 1.0
+    shrunk = conclusions(lambda t, n, m, stage="total": (0.5 * get(t, n, m, stage) if get(t, n, m, stage) and
+                                                          t == "table 2" and m == "vp200" and stage == "2"
+                                                          else get(t, n, m, stage)), scenes)
+    assert shrunk["c first half"][0] == 0.0 and shrunk["c second half"][0] == 1.0
 
 
 def test_damaged_table2_cell_is_the_column_sum():

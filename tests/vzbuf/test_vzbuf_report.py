@@ -25,7 +25,7 @@ def test_report_rows_shape(tmp_path):
     out, sections = rows(scenes=("sp8",), out_dir=tmp_path)
     assert out and sections
     for r in out:
-        assert set(ROW_KEYS) <= set(r) and (r["source"] in SOURCES or r["source"].startswith("model:"))
+        assert set(ROW_KEYS) <= set(r) and (r["source"] in SOURCES or r["source"].startswith(("model:", "fit:")))
         assert r["measured"] is not None
     q = {r["quantity"] for r in out}
     assert "sp8: vz2 pixels whose visible polygon differs from the reference" in q
