@@ -50,22 +50,27 @@ def predict(comp: dict, theta: dict) -> dict:
     return out
 
 
+def _entries(by_key: dict, tables: dict, table: str):
+    """(scene, machine's entry, the paper's rows of that machine) of every ``(table, scene)`` of
+    ``by_key`` (``{(table, scene): {machine: entry}}``) whose machine the paper's ``table`` has."""
+    T = tables[table]
+    for (t, n), per_m in sorted(by_key.items()):
+        if t != table:
+            continue
+        for m, entry in per_m.items():
+            if PAPER_M[m] in T:
+                yield n, entry, T[PAPER_M[m]]
+
+
 def _cells(comps: dict, tables: dict, table: str):
     """(component row, paper value) of every stage cell of ``table`` with a paper value."""
     rows, paper = [], []
-    T = tables[table]
-    for (t, n), comp in sorted(comps.items()):
-        if t != table:
-            continue
-        for m, parts in comp.items():
-            pm = PAPER_M[m]
-            if pm not in T:
-                continue
-            for s in next(iter(parts.values())):
-                pv = T[pm].get(s, {}).get(n)
-                if pv:
-                    rows.append([parts[p][s] for p in LINEAR])
-                    paper.append(float(pv))
+    for n, parts, Tm in _entries(comps, tables, table):
+        for s in next(iter(parts.values())):
+            pv = Tm.get(s, {}).get(n)
+            if pv:
+                rows.append([parts[p][s] for p in LINEAR])
+                paper.append(float(pv))
     return np.array(rows, float), np.array(paper, float)
 
 
@@ -110,19 +115,11 @@ def error_factors(pred: dict, tables: dict, table: str) -> list[float]:
     """``max(r, 1/r)`` of ``r`` = predicted / paper over every stage and total cell of ``table``
     (``pred``: ``{(table, scene): predict(...)}``)."""
     out = []
-    T = tables[table]
-    for (t, n), ms in sorted(pred.items()):
-        if t != table:
-            continue
-        for m, d in ms.items():
-            pm = PAPER_M[m]
-            if pm not in T:
-                continue
-            for s, v in d.items():
-                pv = T[pm].get(s, {}).get(n)
-                if pv and v > 0:
-                    r = v / pv
-                    out.append(max(r, 1 / r))
+    for n, d, Tm in _entries(pred, tables, table):
+        for s, v in d.items():
+            pv = Tm.get(s, {}).get(n)
+            if pv and v > 0:
+                out.append(max(v / pv, pv / v))
     return out
 
 

@@ -10,6 +10,7 @@ from rasterhw.golden_model.scenes import build_scene
 from rasterhw.golden_model.vzbuf.facom import LINEAR, PARAMS, price
 from rasterhw.golden_model.vzbuf.render import render_frame, table_stages
 from rasterhw.golden_model.vzbuf.trace import Trace
+from rasterhw.sim.report.rows import parse_table
 from rasterhw.sim.vzbuf.calibrate import error_factors, fit, predict, stage_components, summary
 from rasterhw.sim.vzbuf.paper import RUNS
 
@@ -112,3 +113,13 @@ def test_report_rows_carry_the_calibration_and_the_split_conclusions(tmp_path):
         alg, sh = RUNS[table]
         for st in (*table_stages(alg, sh), "total"):
             assert (table, f"c50: {st}, scalar (calibrated on table 2)") in fits, (table, st)
+def test_the_committed_report_carries_the_calibration_and_the_split_conclusions():
+    rows = parse_table(REPORT.read_text())
+    assert rows
+    _must_show(rows)
+    fits = {(r["figure"], r["quantity"]) for r in rows if r["source"] == "fit:table2"}
+    for table in ("table 3", "table 4", "table 5", "table 6", "table 7"):
+        alg, sh = RUNS[table]
+        for n in ("c300", "sp8"):
+            for st in (*table_stages(alg, sh), "total"):
+                assert (table, f"{n}: {st}, VP200 (calibrated on table 2)") in fits, (table, n, st)
