@@ -307,6 +307,12 @@ def length10_ratio(params: dict | None = None, machine: str = "vp200", n: int = 
     return vp / _xmp_ns(LENGTH10_BODY, n, P)
 
 
+#: bounds no published fact sets: (low, high)
+CHOSEN_BOUNDS = {"vp200_startup_factor": (0.5, 2.0), "fp_pipes": (1.0, 4.0), "vregs": (4.0, 16.0),
+                 "list_rate": (0.25, 1.0), "cp_fadd": (3.0, 14.0), "cp_fmul": (3.0, 14.0), "cp_mem": (2.0, 20.0),
+                 "cp_branch": (1.0, 14.0), "strip_cp": (5.0, 60.0)}
+
+
 def bounds(params: dict | None = None) -> dict[str, tuple[float, float, str]]:
     """Each bounded parameter -> ``(low, high, where the bound comes from)``; ``published`` in
     the text when a published fact sets it, ``chosen`` otherwise. A test fails when a parameter
@@ -324,18 +330,10 @@ def bounds(params: dict | None = None) -> dict[str, tuple[float, float, str]]:
                             "Cray-1's published 12.5 ns"),
         "startup_ns": (s_lo, s_hi, "published: the VP-200 within 30 % of the X-MP on a length-10 vector loop "
                        "(Lubeck et al.), the X-MP priced at (functional-unit time + n) clock periods"),
-        "vp200_startup_factor": (0.5, 2.0, "chosen"),
-        "fp_pipes": (1.0, 4.0, "chosen"),
         "vr_bytes": (32768.0, 131072.0, "published range of the VP series (netlib top500 report 1994)"),
-        "vregs": (4.0, 16.0, "chosen"),
-        "list_rate": (0.25, 1.0, "chosen"),
         "vdiv_factor": (1.0, 8.0, "chosen, around the Cray-1's published 3"),
         "i4_access_factor": (0.5, 2.0, "chosen: packed 4-byte access (0.5) to a bank conflict per pair (2)"),
-        "cp_fadd": (3.0, 14.0, "chosen"),
-        "cp_fmul": (3.0, 14.0, "chosen"),
-        "cp_mem": (2.0, 20.0, "chosen"),
-        "cp_branch": (1.0, 14.0, "chosen"),
-        "strip_cp": (5.0, 60.0, "chosen"),
+        **{k: (lo, hi, "chosen") for k, (lo, hi) in CHOSEN_BOUNDS.items()},
     }
 
 
