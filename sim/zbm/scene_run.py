@@ -17,8 +17,7 @@ from rasterhw.golden_model.zbm.words import doublez_words, words_to_doublez
 from rasterhw.sim.engines import run as run_engine
 from rasterhw.sim.testbench import find_testbench
 from rasterhw.sim.zbm.edge_check import check_edge_pairs
-from rasterhw.sim.zbm.testbench import deal
-from rasterhw.sim.zbm.unit_bench import unit_watchdog
+from rasterhw.sim.zbm.testbench import deal, unit_watchdog
 from tqdm import tqdm
 
 __all__ = ["CLOCK_HZ", "ENGINES", "PLAIN_BUILD", "SPEED_BUILD", "float_tolerance", "run_scene", "run_units_equal_clocks",
@@ -90,7 +89,7 @@ def run_scene(eps_per_unit: list, *, width: int, height: int, interleave: int, s
     Verilator build settings (default :data:`SPEED_BUILD`); ``stall``, ``seed``: back-pressure on
     every merge slot; ``gap_seed``: random idle gaps on the edge-pair input (None: none); ``clocks``:
     separate segment and merge clocks (``{"sync": Clock, "merge": Clock}``, e.g. the cocotb bench's at
-    a ratio: ``unit_bench.bench_clocks``; one build for every ratio; "cycles" and "line_cycles" stay
+    a ratio: ``testbench.bench_clocks``; one build for every ratio; "cycles" and "line_cycles" stay
     in segment clocks); None: one clock for both."""
     tb = find_testbench("zbm-unit")
     p = tb.params(interleave=interleave, width=width, height=height, capacity=capacity, schedule=schedule,
