@@ -14,8 +14,9 @@ from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.cycles import check_schedule
 from rasterhw.golden_model.zbm.words import doublez_words, words_to_doublez
+from rasterhw.sim import engines
 from rasterhw.sim.engines import run as run_engine
-from rasterhw.sim.testbench import find_testbench
+from rasterhw.sim.testbench import compare, find_testbench
 from rasterhw.sim.zbm.edge_check import check_edge_pairs
 from rasterhw.sim.zbm.testbench import deal, unit_watchdog
 from tqdm import tqdm
@@ -85,7 +86,9 @@ def run_scene(eps_per_unit: list, *, width: int, height: int, interleave: int, s
     ``eps_per_unit[k]``; a scene's: ``testbench.deal``) on the generic engine (the ``zbm-unit``
     testbench, :class:`rasterhw.sim.zbm.testbench.UnitBench`): ``{"s0", "s1": (H, W) uint64 frame,
     "cycles" (segment clocks until the last merge word), "proto_errors", "run_s" (the clock loop on
-    Verilator; the simulation on pysim), "build_s", "build", "frames_ok", "overflow", ["line_cycles"]}``. ``build``:
+    Verilator; the simulation on pysim), "build_s", "build", "words_compared" (merge words of the
+    frame), "mismatches" (those that differ from the testbench's golden words: ``testbench.compare``),
+    "frames_ok", "overflow", ["line_cycles"]}``. ``build``:
     Verilator build settings (default :data:`SPEED_BUILD`); ``stall``, ``seed``: back-pressure on
     every merge slot; ``gap_seed``: random idle gaps on the edge-pair input (None: none); ``clocks``:
     separate segment and merge clocks (``{"sync": Clock, "merge": Clock}``, e.g. the cocotb bench's at
@@ -103,8 +106,10 @@ def run_scene(eps_per_unit: list, *, width: int, height: int, interleave: int, s
                      build=(SPEED_BUILD if build is None else build) if engine == "verilator" else None,
                      clocks=clocks)
     s0, s1 = tb.frame(p, got.words)
+    cmp = compare(exp, got, cycle_exact=False)
     out = {"s0": s0, "s1": s1, "cycles": got.cycles, "proto_errors": got.protocol_errors, "run_s": got.run_s,
-           "build_s": got.build_s, "build": got.build, **got.status}
+           "build_s": got.build_s, "build": got.build, "words_compared": sum(want.values()),
+           "mismatches": cmp["mismatches"], **got.status}
     if line_log:
         out["line_cycles"] = tb.line_cycles(p, got)
     return out
@@ -112,16 +117,15 @@ def run_scene(eps_per_unit: list, *, width: int, height: int, interleave: int, s
 
 def run_units_equal_clocks(per_unit: list, *, width: int, height: int, interleave: int, engine: str,
                            schedule: str, line_log: bool = False) -> dict:
-    """A chain of units with equal, in-phase clocks (the Table 1, skew and chain runs): on
-    Verilator the generic engine (:func:`run_scene`, held word-, cycle- and line-log-exact with the
-    cocotb bench by ``tests/zbm/test_zbm_unit_fast.py``; it builds and runs several times faster),
-    on Icarus the same testbench under cocotb (the generic cocotb engine). g++ ``-O0``: these frames are small, the build is what costs."""
+    """A chain of units with equal, in-phase clocks (the Table 1, pixel-rate, skew and chain runs) on
+    the generic engine (:func:`run_scene`): pysim, Verilator (g++ ``-O0``: these frames are small, the
+    build is what costs; held word-, cycle- and line-log-exact with the cocotb bench by
+    ``tests/zbm/test_zbm_unit_engine.py``), or ``icarus`` (the same testbench under cocotb on Icarus)."""
     if engine == "verilator":
         return run_scene(per_unit, width=width, height=height, interleave=interleave, schedule=schedule,
                          line_log=line_log, build={"speed": True, "opt": "-O0"})
-    # Icarus: the same testbench under cocotb (the generic cocotb engine)
     return run_scene(per_unit, width=width, height=height, interleave=interleave, schedule=schedule,
-                     line_log=line_log, engine="cocotb-icarus")
+                     line_log=line_log, engine=engines.ALIASES.get(engine, engine))
 
 
 def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: int = 1,
