@@ -322,7 +322,7 @@ class ProcessorBench(VPBench):
         return Expected({"o": _words(g.tri_id[b::q, a::p], zq[b::q, a::p], params["z_bits"]) + [int(v) for v in tail]})
 
     def decode(self, params: dict, words: list[int]) -> dict:
-        """The engine's ``o`` words as ``hdl_run.run_processor``'s keys: ``tri``, ``zq`` (N x N, -1
+        """The engine's ``o`` words as ``tri``, ``zq`` (N x N, -1
         where empty), ``tests``, ``stalls``, ``writes``, ``cycles``."""
         n, zb = params["n"], params["z_bits"]
         N = 1 << n
