@@ -1,7 +1,7 @@
 """Play a :class:`PixelStream` into the SNU pixel-bus HDL and check it against the golden model.
 
 :func:`simulate_pixelbus` runs the block's testbench (``sim/snu/testbench.py: BusBench``, the
-frame memory streamed out by ``sim/snu/readout.py: ReadOut``) on the generic engines
+frame memory streamed out by the engines' ``ReadOut``, ``sim/engines/readout.py``) on the generic engines
 (``sim/engines/``: Amaranth pysim, plain Verilator) and compares the frame and the cycle count
 with ``golden_model/snu/pixelbus.py`` (every write's acceptance clock against the golden cycle
 model is a test's own pysim loop: ``tests/snu/snu_pixelbus_pysim.py``). ``rasterhw sim pixelbus --engine verilator`` runs the whole frame instead (clear, the
@@ -37,7 +37,7 @@ def simulate_pixelbus(stream: PixelStream, *, engine: str = "pysim", gaps: np.nd
     The block's testbench (``BusBench``) on ``engine`` (``sim/engines/``), ``gaps`` idle clocks
     before each write. Returns ``{"block": "pixelbus", "engine", "cycles", "clock_hz": 12.5e6,
     "pixels_compared", "mismatches", "wall_s", "cycles_per_s", "frame_rgb"}`` plus
-    ``"golden_cycles"``, ``"writes"`` and ``"build_s"`` (simulator build, 0 for pysim and for a
+    ``"cycles_golden"``, ``"cycle_mismatches"`` (0 or 1, also counted in ``mismatches``), ``"writes"`` and ``"build_s"`` (simulator build, 0 for pysim and for a
     build already made).  ``cycles``: the clock the read-out started in, the first clock after the
     last write's memory cycle (the golden model's cycle count).  ``wall_s`` is the whole call.
     ``mismatches`` counts read-out words (pixels) whose RGB or Z differs from the golden frame,
@@ -76,7 +76,8 @@ def simulate_pixelbus(stream: PixelStream, *, engine: str = "pysim", gaps: np.nd
         "block": "pixelbus",
         "engine": engine,
         "cycles": int(cycles),
-        "golden_cycles": g_cycles,
+        "cycles_golden": g_cycles,
+        "cycle_mismatches": cmp["cycle_mismatches"],
         "writes": len(stream),
         "clock_hz": golden.CLOCK_HZ,
         "pixels_compared": stream.width * stream.height,
@@ -103,7 +104,7 @@ def measure_rates(*, engine: str = "verilator", width: int = 1280, height: int =
             r = simulate_pixelbus(s, engine=engine)
             rows.append({
                 "pattern": pattern, "pipes": pipes, "writes": len(s), "cycles": r["cycles"],
-                "golden_cycles": r["golden_cycles"], "mismatches": r["mismatches"],
+                "golden_cycles": r["cycles_golden"], "mismatches": r["mismatches"],
                 "mpixel_s": golden.pixels_per_second(len(s), r["cycles"]) / 1e6,
             })
     return rows

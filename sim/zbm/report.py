@@ -65,7 +65,9 @@ def measure_steady_state(interleave: int, engine: str = "pysim", schedule: str =
 
 def _hdl_engine(engine: str) -> str:
     """The simulator the Table 1 rows run on: the one requested, if it is an HDL simulator."""
-    return engine if engine in ("pysim", "verilator", "icarus") else "pysim"
+    from rasterhw.sim.registry import ENGINES
+
+    return engine if engine in ENGINES else "pysim"
 
 
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: bool = False,

@@ -177,10 +177,10 @@ class UnitBench(Testbench):
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         i = params["interleave"]
-        g0, g1 = doublez_words(G.chain_frame(stim.source, params["width"], params["height"],
-                                             capacity=params["capacity"]))
+        frame = G.chain_frame(stim.source, params["width"], params["height"], capacity=params["capacity"])
+        g0, g1 = doublez_words(frame)
         outs = self.outputs_of(params)
-        return Expected({outs[c]: merge_words(g0[:, c::i], g1[:, c::i]) for c in range(i)})
+        return Expected({outs[c]: merge_words(g0[:, c::i], g1[:, c::i]) for c in range(i)}, golden=frame)
 
     def frame(self, params: dict, words: dict[str, list[int]]) -> tuple[np.ndarray, np.ndarray]:
         """The merge words of every slot as the frame's (s0, s1) (H, W) uint64 samples (all ones

@@ -68,7 +68,7 @@ def test_scene_stream_pysim(name, width, height):
     r = simulate_pixelbus(s, engine="pysim")
     assert r["pixels_compared"] == width * height > 0
     assert r["mismatches"] == 0
-    assert r["cycles"] == r["golden_cycles"] == g.pixelbus_cycles(s)
+    assert r["cycles"] == r["cycles_golden"] == g.pixelbus_cycles(s)
 
 
 @pytest.mark.parametrize("gaps_kind", ["none", "1110", "random-seed5"])

@@ -1,5 +1,5 @@
 """The pixel-bus Verilog on the Verilator engine (sim/engines/verilator.py: the block's testbench,
-``sim/snu/testbench.py: BusBench``, its frame memory streamed out by ``sim/snu/readout.py``).
+``sim/snu/testbench.py: BusBench``, its frame memory streamed out by the engines' read-out adapter, ``sim/engines/readout.py``).
 
 Moved from the cocotb bench (``cocotb_tests/snu/pixelbus/``, removed): the frame and the cycle
 count against the golden model, with idle gaps, one-bank back-pressure, the Verilog RAM model and
