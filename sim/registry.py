@@ -34,11 +34,16 @@ from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 
-__all__ = ["SIM_KEYS", "Arch", "Clock", "Flow", "FpgaSweep", "Machine", "Option", "SimBlock", "block_machine",
+__all__ = ["ENGINES", "SIM_KEYS", "Arch", "Clock", "Flow", "FpgaSweep", "Machine", "Option", "SimBlock", "block_machine",
            "entries", "flow", "load", "machines"]
 
-#: keys every ``rasterhw sim`` JSON result carries
-SIM_KEYS = ("engine", "cycles", "clock_hz", "pixels_compared", "mismatches", "wall_s", "cycles_per_s")
+#: the one list of the command line's simulator names (``--engine`` of ``sim``, ``report``, ``sweep``,
+#: ``demo``): Amaranth pysim, plain Verilator, cocotb on Icarus (``sim/engines/``: ``engines.ENGINES``
+#: runs them, ``icarus`` being its alias of ``cocotb-icarus``)
+ENGINES = ("pysim", "verilator", "icarus")
+#: keys every sim block's ``simulate`` returns (``rasterhw sim`` adds the common timing keys from the
+#: engine runs: ``sim/cli/jsonout.py: sim_json``)
+SIM_KEYS = ("engine", "cycles", "clock_hz", "pixels_compared", "mismatches")
 
 
 @dataclass(frozen=True)
@@ -78,6 +83,9 @@ class SimBlock:
     default_scene: str
     options: tuple[Option, ...] = ()
     bytes_per_pixel: int = 400         # peak memory per frame pixel (checked before a run starts)
+    #: keys the driver returns (for its other callers) that repeat a common key of the sim JSON
+    #: under another name (``sim/cli/jsonout.py: sim_json`` leaves them out of ``extra``)
+    aliases: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)

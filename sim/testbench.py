@@ -104,6 +104,7 @@ class Expected:
 
     words: dict[str, list[int]]
     cycles: int | None = None
+    golden: object = None                        # the golden model's result the words were made from (a frame)
 
 
 @dataclass(frozen=True)
@@ -116,6 +117,7 @@ class Run:
     wall_s: float = 0.0
     build_s: float = 0.0
     run_s: float = 0.0
+    cpu_s: float | None = None                   # CPU seconds (user + sys) of the simulation; None: not measured
     protocol_errors: int = 0                     # clocks that broke the stream rules, every port
     status: dict = field(default_factory=dict)   # the testbench's status values at the end (Testbench.status)
     build: dict = field(default_factory=dict)    # how the model was built (engine's words: opt, pgo, ...)

@@ -115,13 +115,29 @@ def _die_with_parent() -> None:  # runs in the child between fork and exec
         pass
 
 
+class _Popen(subprocess.Popen):
+    """:class:`subprocess.Popen` that keeps the child's resource usage (``os.wait4``) when it reaps it."""
+
+    rusage = None
+
+    def _try_wait(self, wait_flags):   # CPython's reaping step (Popen.wait), with wait4 for waitpid
+        try:
+            pid, sts, ru = os.wait4(self.pid, wait_flags)
+        except ChildProcessError:
+            return self.pid, 0
+        if pid == self.pid:
+            self.rusage = ru
+        return pid, sts
+
+
 def run_child(cmd: Sequence[str], *, timeout: float | None = None, **kw) -> subprocess.CompletedProcess:
     """:func:`subprocess.run` (same keywords) whose child, in its own process group, is
-    killed with that group if this process is interrupted, times out or dies."""
+    killed with that group if this process is interrupted, times out or dies; the result's
+    ``rusage`` is the child's resource usage (``os.wait4``; None where it was not reaped by us)."""
     linux = sys.platform.startswith("linux")
     if kw.pop("capture_output", False):
         kw["stdout"] = kw["stderr"] = subprocess.PIPE
-    with subprocess.Popen(cmd, preexec_fn=_die_with_parent if linux else None, process_group=0, **kw) as p:
+    with _Popen(cmd, preexec_fn=_die_with_parent if linux else None, process_group=0, **kw) as p:
         try:
             out, err = p.communicate(timeout=timeout)
         except BaseException:
@@ -133,4 +149,6 @@ def run_child(cmd: Sequence[str], *, timeout: float | None = None, **kw) -> subp
             # a child that left its own children behind (make -> compiler): end them too
             with contextlib.suppress(ProcessLookupError, PermissionError):
                 os.killpg(p.pid, signal.SIGKILL)
-    return subprocess.CompletedProcess(p.args, p.returncode, out, err)
+    done = subprocess.CompletedProcess(p.args, p.returncode, out, err)
+    done.rusage = p.rusage
+    return done

@@ -15,7 +15,7 @@ import time
 TIMED = (("rasterhw.sim.engines.runner", "_build_plain_in", "build"),
          ("rasterhw.sim.engines.verilog_cache", "convert_cached", "convert"),
          ("rasterhw.sim.engines.verilator", "convert_cached", "convert"),
-         ("rasterhw.sim.zbm.unit_verilog", "convert_cached", "convert"))
+         ("zbm_cocotb.unit_verilog", "convert_cached", "convert"))
 
 
 def install(path: str) -> None:

@@ -182,3 +182,49 @@ def test_render_json_has_pixels_covered_for_every_arch(tmp_path):
         r = run("render", "c50", "--size", "64x64", "--arch", arch, "--json", "-o", str(tmp_path / f"{arch}.png"))
         assert r.returncode == 0, (arch, r.stderr[-500:])
         assert json.loads(r.stdout)["pixels_covered"] == ref["pixels_covered"], arch
+
+
+def test_sim_block_help_lists_only_that_blocks_options():
+    """``rasterhw sim BLOCK --help`` shows BLOCK's options and no other block's (issue 46); an option
+    of another block is still refused by name, not as an unknown option."""
+    from rasterhw.sim import registry
+
+    blocks = registry.sim_blocks()
+    for name, (_machine, b) in blocks.items():
+        r = run("sim", name, "--help")
+        assert r.returncode == 0, r.stderr
+        own = {o.flag for o in b.options}
+        others = {o.flag for _, (_, x) in blocks.items() for o in x.options} - own
+        for flag in own:
+            assert f"  {flag} " in r.stdout, (name, flag)
+        for flag in others:
+            assert f"  {flag} " not in r.stdout and f"{flag}/" not in r.stdout, (name, flag)
+    r = run("sim", "pixelbus", "--interleave", "2", "--engine", "pysim")
+    assert r.returncode == 2 and r.stderr.strip() == "error: --interleave does not apply to sim pixelbus", r.stderr
+
+
+def test_engine_names_are_one_list():
+    """The command line's --engine choices are registry.ENGINES, every one an engine of sim/engines/."""
+    from rasterhw.sim import engines, registry
+    from rasterhw.sim.cli.main import cli
+
+    assert set(registry.ENGINES) <= {*engines.ENGINES, *engines.ALIASES}
+    for cmd in ("sim", "report", "demo"):
+        (opt,) = [p for p in cli.commands[cmd].params if p.name == "engine"]
+        assert tuple(opt.type.choices) == registry.ENGINES, cmd
+
+
+def test_readme_machine_table_is_the_registry():
+    """The README's machine table names every registered machine once, with its folder and seed number."""
+    import re
+    from pathlib import Path
+
+    from rasterhw.sim import registry
+
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    rows = [ln for ln in text.split("\n| machine (paper")[1].split("\n\n")[0].splitlines()[2:] if ln.startswith("|")]
+    folders = {}
+    for ln in rows:
+        cells = [c.strip() for c in ln.strip("|").split("|")]
+        folders[cells[1].strip("`")] = re.search(r"seed (\d{3})", cells[0]).group(1)
+    assert folders == {m.name: m.seed[:3] for m in registry.machines().values()}

@@ -69,7 +69,7 @@ def test_the_frame_bench_key_covers_its_adapter_and_read_out():
     """The SNU frame's bench top: its adapter and read-out modules (imported by the testbench
     module, not by the block) and the engine's own module are in the key's sources."""
     rel = {str(f.relative_to(PKG_ROOT)) for f in verilator.bench_sources(FrameBench()) if PKG_ROOT in f.parents}
-    assert {"sim/snu/frame_adapter.py", "sim/snu/readout.py", "sim/snu/testbench.py", "sim/testbench.py",
+    assert {"sim/snu/frame_adapter.py", "sim/engines/readout.py", "sim/snu/testbench.py", "sim/testbench.py",
             "sim/engines/verilator.py"} <= rel
     # another machine's modules do not rebuild it
     assert not any(r.startswith(("sim/zbm/", "hdl/zbm/", "sim/sparse/")) for r in rel)

@@ -105,11 +105,21 @@ def test_compare(tmp_path, capsys):
 ], ids=["pixelbus", "pxp", "experts", "zbm", "sparse"])
 def test_sim(argv, tmp_path, capsys):
     extra = [] if "sparse" in argv else ["-o", str(tmp_path / "a.png")]
+    from rasterhw.sim.cli.jsonout import SIM_JSON_KEYS
+
     res = _json_of([*argv, "--json", *extra], capsys)
     _check(res, dict)
-    assert "cycles" in res and "mismatches" in res and res["block"] == argv[1]
-    if argv[1] == "pixelbus":    # the older name of the golden cycle count is not in the output
-        assert "cycles_golden" in res and "golden_cycles" not in res
+    # one key set on every machine and engine (issue 46): the common keys in order, then the image
+    assert tuple(res)[:len(SIM_JSON_KEYS)] == SIM_JSON_KEYS and set(res) - set(SIM_JSON_KEYS) <= {"image"}
+    assert res["schema"] == "rasterhw.sim/1" and res["block"] == argv[1] and res["engine"] == "pysim"
+    assert isinstance(res["mismatches"], int) and res["mismatches"] == 0 and res["pixels_compared"] > 0
+    assert res["sim_cycles"] >= res["cycles"] > 0 and res["sim_cpu_s"] > 0
+    assert res["cycles_per_cpu_s"] == pytest.approx(res["sim_cycles"] / res["sim_cpu_s"])
+    # no value under two names: the older names are gone, top level and extra
+    for old in ("sim_s", "golden_cycles", "run_s", "build_s", "wall_s", "cycles_per_s", "sim_cycles"):
+        assert old not in res["extra"], old
+    if argv[1] == "pixelbus":    # a machine's own figures are in extra, golden values as K_golden
+        assert "cycles_golden" in res["extra"]
 
 
 def test_sweep(tmp_path, capsys):
@@ -127,11 +137,24 @@ def test_flow_commands_print_through_the_same_writer():
     assert flow.emit_json is jsonout.emit_json
 
 
-def test_renamed_keys():
-    from rasterhw.sim.cli.jsonout import normalise
+def test_sim_json_common_keys_and_extra():
+    """sim_json: the common keys from the driver and the engine runs, the driver's timings replaced
+    by the engine runs' (one name per value), everything else in extra; a driver without a common
+    key is a programming error."""
+    from rasterhw.sim.cli.jsonout import SIM_JSON_KEYS, sim_json
+    from rasterhw.sim.engines import Tally
+    from rasterhw.sim.testbench import Run
 
-    assert list(normalise({"block": "zbm", "sim_s": 1.5, "golden_cycles": 7})) == ["block", "run_s", "sim_s",
-                                                                                   "cycles_golden"]
+    runs = Tally([Run("verilator", {"o": [1]}, {"o": [99]}, run_s=0.5, build_s=2.0, cpu_s=0.25),
+                  Run("verilator", {"o": [1]}, {"o": [49]}, run_s=0.5, build_s=0.0, cpu_s=0.25)])
+    res = sim_json("zbm", "c50", {"engine": "verilator", "cycles": 100, "clock_hz": 25e6, "pixels_compared": 9,
+                                  "mismatches": 0, "sim_s": 7.0, "run_s": 7.0, "units": 2, "image": "a.png"},
+                   runs, 3.0)
+    assert tuple(res) == (*SIM_JSON_KEYS, "image") and res["extra"] == {"units": 2}
+    assert (res["sim_cycles"], res["sim_cpu_s"], res["run_s"], res["build_s"]) == (150, 0.5, 1.0, 2.0)
+    assert res["cycles_per_cpu_s"] == 300 and res["cycles_per_s"] == 150 and res["cycle_mismatches"] is None
+    with pytest.raises(RuntimeError, match="no 'mismatches'"):
+        sim_json("zbm", "c50", {"engine": "pysim", "cycles": 1, "clock_hz": None, "pixels_compared": 1}, runs, 1.0)
 
 
 @pytest.mark.slow

@@ -64,7 +64,9 @@ def test_a_report_run_through_the_runner_is_the_direct_call():
     merge-bound line), plus who ran it."""
     (got,) = run_tasks([call("rasterhw.sim.zbm.scaling:pixel_rate", interleave=2, width=16, height=12)])
     assert _same([got]) == [{"interleave": 2, "width": 16, "cycles_per_line": 10.0, "chip_pixels": 8,
-                             "pixels_per_cycle": 1.6, "pixels_per_s": 40e6, "engine": "pysim"}]
+                             "pixels_per_cycle": 1.6, "pixels_per_s": 40e6, "engine": "pysim",
+                             # every merge word of the 16 x 12 frame compared (issue 46)
+                             "words_compared": 16 * 12, "mismatches": 0}]
     assert got["worker"] == "in-process" and got["wall_s"] > 0
 
 

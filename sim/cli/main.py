@@ -15,14 +15,14 @@ import click
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
 from rasterhw.sim.cli.flow import add_commands
-from rasterhw.sim.cli.jsonout import emit_json, normalise
+from rasterhw.sim.cli.jsonout import emit_json, sim_json
 from rasterhw.sim.report.rows import systems as _report_systems
 
 #: the float reference rasteriser is shared by every machine; the rest come from the registry
 REFERENCE = "reference"
 ARCHS = (REFERENCE, *registry.archs())
 SIM_BLOCKS = tuple(registry.sim_blocks())
-ENGINES = ("pysim", "verilator", "icarus")
+ENGINES = registry.ENGINES   # the one list (sim/registry.py)
 
 
 def _union_options(decls) -> list[registry.Option]:
@@ -473,7 +473,26 @@ def sim_image_name(scene: str, block: str, engine: str, options: dict) -> Path:
     return Path("out") / f"{Path(scene).stem}-{block}-{engine}{given}.png"
 
 
-@cli.command("sim")
+class _SimCommand(click.Command):
+    """``rasterhw sim``: ``rasterhw sim BLOCK --help`` lists only BLOCK's own options (every block's
+    are still parsed, so one given to a block that does not take it is refused by name)."""
+
+    def parse_args(self, ctx, args):
+        ctx.meta["sim_block"] = next((a for a in args if a in SIM_BLOCKS), None)
+        return super().parse_args(ctx, args)
+
+    def format_options(self, ctx, formatter):
+        block = ctx.meta.get("sim_block")
+        own = None if block is None else {o.name for o in registry.sim_blocks()[block][1].options}
+        shared = {o.name for o in _SIM_OPTIONS}
+        rows = [rec for p in self.get_params(ctx)
+                if (own is None or p.name not in shared or p.name in own) and (rec := p.get_help_record(ctx))]
+        if rows:
+            with formatter.section(f"Options ({block}'s)" if block else "Options"):
+                formatter.write_dl(rows)
+
+
+@cli.command("sim", cls=_SimCommand)
 @click.argument("block", type=click.Choice(SIM_BLOCKS))
 @click.option("--scene", default=None, help="Built-in scene or .obj/.ply (default: the block's own, "
               + ", ".join(f"{n}: {b.default_scene}" for n, (_, b) in registry.sim_blocks().items()) + ").")
@@ -492,9 +511,12 @@ def sim_image_name(scene: str, block: str, engine: str, options: dict) -> Path:
 @click.option("--trace-end", type=int, default=None, metavar="N",
               help="With --waves: record up to edge N, not included (must be after --trace-start).")
 @click.option("--json", "as_json", is_flag=True,
-              help="Print the run's result as JSON on stdout (cycles, mismatches, pixels compared, timings).")
+              help="Print the run's result as JSON on stdout: one key set for every block (schema rasterhw.sim/1: "
+                   "cycles, sim_cycles, sim_cpu_s, mismatches, pixels compared, timings; the block's own figures in "
+                   "extra).")
 def sim_cmd(block, scene, size, engine, output, waves, trace_start, trace_end, as_json, **block_options) -> None:
-    """Run a scene through a block's HDL, compare with the golden model, write the frame."""
+    """Run a scene through a block's HDL, compare with the golden model, write the frame.
+    `rasterhw sim BLOCK --help` lists BLOCK's options only."""
     from rasterhw.sim.engines.waves import check_window, recording
     from rasterhw.sim.outfile import check_image_output, write_image
 
@@ -504,16 +526,22 @@ def sim_cmd(block, scene, size, engine, output, waves, trace_start, trace_end, a
     scene = scene or b.default_scene
     out = check_image_output(output) or sim_image_name(scene, block, engine, block_options)
     sc, (w, h) = load_scene_and_size(scene, size, bytes_per_pixel=b.bytes_per_pixel, what=f"sim {block}")
+    from rasterhw.sim.engines import tally
+
+    t0 = time.perf_counter()
     empty = _nothing_to_draw(sc, w, h)
     if empty is not None:
         _warn_if_empty(_geometry(sc, w, h), 0)
         write_image(out, empty)
-        res = {"block": block, "scene": sc.name, "engine": engine, "simulated": False, "pixels_compared": 0,
-               "mismatches": 0, "image": str(out)}
+        with tally() as nothing:
+            pass
+        res = sim_json(block, sc.name, {"engine": engine, "cycles": 0, "clock_hz": None, "pixels_compared": 0,
+                                        "mismatches": 0, "simulated": False, "image": str(out)},
+                       nothing, time.perf_counter() - t0)
         emit_json(res) if as_json else info(" ".join(f"{k}={v}" for k, v in res.items()))
         return
     try:
-        with recording(waves, engine, start=trace_start, end=trace_end) as traces:
+        with recording(waves, engine, start=trace_start, end=trace_end) as traces, tally() as runs:
             res = registry.load(b.simulate)(sc, w, h, engine=engine, progress=not as_json, **opts)
     except RasterhwError:
         raise                                  # already one line that names what is wrong
@@ -528,7 +556,7 @@ def sim_cmd(block, scene, size, engine, output, waves, trace_start, trace_end, a
         res["image"] = str(out)
     elif output is not None:
         raise RasterhwError(f"sim {block} gives no frame image; -o {output} cannot be written (leave -o out)")
-    res = normalise({"block": block, "scene": sc.name, **res})
+    res = sim_json(block, sc.name, res, runs, time.perf_counter() - t0, b.aliases)
     if as_json:
         emit_json(res)
     else:

@@ -16,7 +16,9 @@ Usage::
 
 from __future__ import annotations
 
-from dataclasses import replace
+import threading
+from contextlib import contextmanager
+from dataclasses import dataclass, field, replace
 from functools import partial
 
 import numpy as np
@@ -24,12 +26,55 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.engines import cocotb, pysim, verilator
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, clocks_of
 
-__all__ = ["ALIASES", "ENGINES", "run", "with_gaps"]
+__all__ = ["ALIASES", "ENGINES", "Tally", "run", "tally", "with_gaps"]
 
 ENGINES = {"pysim": pysim.run, "verilator": verilator.run,
            **{name: partial(cocotb.run, sim=sim) for name, sim in cocotb.SIMULATORS.items()}}
 #: the command line's simulator names for engines: ``icarus`` (cocotb benches' name) is cocotb on Icarus
 ALIASES = {"icarus": "cocotb-icarus"}
+
+
+@dataclass
+class Tally:
+    """Every engine run made inside :func:`tally` (any thread), summed: ``sim_cycles`` (each run's
+    ``cycles``), ``run_s``, ``build_s``, ``cpu_s`` (None if a run's CPU was not measured: the cocotb
+    engines)."""
+
+    runs: list = field(default_factory=list)
+
+    @property
+    def sim_cycles(self) -> int:
+        return int(sum(r.cycles for r in self.runs))
+
+    @property
+    def run_s(self) -> float:
+        return float(sum(r.run_s for r in self.runs))
+
+    @property
+    def build_s(self) -> float:
+        return float(sum(r.build_s for r in self.runs))
+
+    @property
+    def cpu_s(self) -> float | None:
+        cpu = [r.cpu_s for r in self.runs]
+        return None if not cpu or None in cpu else float(sum(cpu))
+
+
+_tallies: list[Tally] = []
+_tally_lock = threading.Lock()
+
+
+@contextmanager
+def tally():
+    """Collect every :func:`run` made inside the ``with`` (every thread of this process) in a :class:`Tally`."""
+    t = Tally()
+    with _tally_lock:
+        _tallies.append(t)
+    try:
+        yield t
+    finally:
+        with _tally_lock:
+            _tallies.remove(t)
 
 
 def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", idle: float = 0.0, stall: int = 0,
@@ -85,8 +130,12 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
         raise RasterhwError(f"build settings are for the verilator engine (cocotb's: depth, out_depth), not {engine}")
     if build:
         kw["build"] = build
-    return ENGINES[engine](tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
-                           max_cycles=max_cycles, **kw)
+    got = ENGINES[engine](tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
+                          max_cycles=max_cycles, **kw)
+    with _tally_lock:
+        for t in _tallies:
+            t.runs.append(got)
+    return got
 
 
 def with_gaps(stim: Stimulus, idle: float, seed: int, ports) -> Stimulus:

@@ -111,10 +111,11 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
         sim.add_testbench(_sinks(sinks, d, limit, finished, read_status))
     # with --waves: the GTKWave save file shows these ports, one group each (sim/engines/waves.py)
     declare_streams(sim, {name: port_of(dut, name) for name in (*tb.inputs_of(params), *tb.outputs_of(params))})
-    t1 = time.perf_counter()
+    t1, c1 = time.perf_counter(), time.process_time()
     sim.run()
+    cpu_s = time.process_time() - c1   # this process's CPU in the simulation (pysim runs in it)
     if errors:
         raise RasterhwError(f"pysim: {tb.block} broke the stream rules: {errors[0]}")
     return Run("pysim", words, stamps, wall_s=time.perf_counter() - t0, run_s=time.perf_counter() - t1,
-               status=status, clocks=dict(clocks or {}),
+               cpu_s=cpu_s, status=status, clocks=dict(clocks or {}),
                port_domains={n: tb.domain_of(n) for n in outs} if clocks else {})

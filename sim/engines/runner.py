@@ -518,7 +518,8 @@ def _cocotb_runtime_key(cmd: Sequence[str], env: Mapping[str, str]) -> tuple[Pat
 def run_plain_verilator(exe: Path, plusargs: Sequence[str], *, run_dir: Path, maxcyc: int,
                         profile: Path | None = None) -> dict:
     """Run a :func:`build_plain_verilator` binary in ``run_dir`` with ``plusargs`` and a
-    ``+maxcyc=`` watchdog; return its JSON line. A crash, no JSON or no ``done`` is a
+    ``+maxcyc=`` watchdog; return its JSON line, with ``cpu_s``: the child's user + system CPU
+    seconds (its resource usage when it was reaped, ``os.wait4``: file I/O included). A crash, no JSON or no ``done`` is a
     :class:`RasterhwError` naming the binary. ``profile``: the folder an instrumented binary
     (``pgo="generate"``) writes its profile into (``X.gcda`` per object, added to what is there)."""
     trace = waves.next_plain_trace() if "-trace-" in exe.parent.parent.name else None
@@ -539,6 +540,8 @@ def run_plain_verilator(exe: Path, plusargs: Sequence[str], *, run_dir: Path, ma
         raise RasterhwError(f"{exe.name} failed (exit {r.returncode}: {_first_error(r.stdout + r.stderr)})") from None
     if not meta["done"]:
         raise RasterhwError(f"{exe.name}: no `done` within {maxcyc} cycles")
+    ru = getattr(r, "rusage", None)   # the child's own (os.wait4): loading, clock loop and dumps
+    meta["cpu_s"] = ru.ru_utime + ru.ru_stime if ru is not None else None
     return meta
 
 

@@ -324,6 +324,7 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
                                       inputs=inputs, max_cycles=max_cycles, dut=dut, clocks=clocks)
     status = unpack_status(status_of(tb, dut, params), int(meta.get("status", 0)))
     return Run("verilator", words, stamps, wall_s=time.perf_counter() - t0, build_s=build_s, run_s=meta["run_s"],
+               cpu_s=meta["cpu_s"],
                protocol_errors=int(meta.get("errors", 0)), status=status,
                build={"speed": speed, "opt": opt, "pgo": prof is not None, "hier": bool(blocks)},
                clocks=dict(clocks or {}),

@@ -193,7 +193,7 @@ def run_frame_engine(stream: PixelStream, gaps: np.ndarray, sched: dict, *, engi
 def frame_run(scene, width: int, height: int, *, cpu: i860.I860 | None = None, progress: bool = False,
               bus_only_bound: bool = False) -> dict:
     """The whole frame (module docstring). Returns the ``simulate_pixelbus`` keys (``block``,
-    ``engine``, ``cycles``, ``golden_cycles``, ``writes``, ``pixels_compared``, ``mismatches``,
+    ``engine``, ``cycles``, ``cycles_golden``, ``writes``, ``pixels_compared``, ``mismatches``,
     ``wall_s``, ``build_s``, ``cycles_per_s``, ``frame_rgb``) plus ``frame``: the schedule, the
     frame time, each stage's busy time and share, and the limiting bound."""
     from rasterhw.golden_model.pipeline import run_geometry
@@ -243,7 +243,7 @@ def frame_run(scene, width: int, height: int, *, cpu: i860.I860 | None = None, p
     limit = max(bounds, key=bounds.get)
     bound_s = busy["clear (pixel bus)"] + bounds[limit]
     out = {
-        "block": "pixelbus", "engine": "verilator", "cycles": int(hdl["cycles"]), "golden_cycles": int(sched["cycles"]),
+        "block": "pixelbus", "engine": "verilator", "cycles": int(hdl["cycles"]), "cycles_golden": int(sched["cycles"]),
         "writes": len(stream), "clock_hz": CLOCK_HZ, "pixels_compared": width * height, "mismatches": bad,
         "wall_s": wall, "build_s": hdl["build_s"],
         "cycles_per_s": hdl["sim_cycles"] / hdl["loop_s"] if hdl["loop_s"] > 0 else float("inf"),

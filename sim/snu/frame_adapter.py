@@ -1,6 +1,6 @@
 # amaranth: UnusedElaboratable=no
 """Bench adapter of the SNU headline frame: the pixel bus drawing one whole frame as the machine
-does, on the generic engines (``sim/engines/``), beside :class:`~rasterhw.sim.snu.readout.ReadOut`.
+does, on the generic engines (``sim/engines/``), beside the engines' read-out :class:`~rasterhw.sim.engines.readout.ReadOut` (its :func:`sweep`).
 
 The schedule (the one the frame's dedicated Verilog bench played before this adapter replaced it):
 
@@ -21,7 +21,7 @@ from __future__ import annotations
 from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
-from rasterhw.sim.snu.readout import ReadOut, sweep
+from rasterhw.sim.engines.readout import sweep
 from rasterhw.sim.testbench import port_of
 
 __all__ = ["GAP_BITS", "FrameAdapter", "SCHEDULE"]
@@ -47,7 +47,9 @@ class FrameAdapter(wiring.Component):
         sig["o_sched"] = Out(stream.Signature(32))
         super().__init__(sig)
 
-    extra_verilog = ReadOut.extra_verilog   # the block's RAM model, for the Verilator bench
+    def extra_verilog(self) -> str:
+        """The block's hand-written Verilog (its RAM model), for the Verilator bench."""
+        return self.block.extra_verilog() if hasattr(self.block, "extra_verilog") else ""
 
     def elaborate(self, platform):
         m = Module()
@@ -99,5 +101,5 @@ class FrameAdapter(wiring.Component):
         with m.If(self.o_sched.valid & self.o_sched.ready):
             m.d.sync += k.eq(k + 1)
         m.d.comb += b.rd_buf.eq(1)
-        sweep(m, b, self.o, self._words, swapped)
+        sweep(m, b.rd_addr, Cat(b.rd_z, b.rd_rgb), self.o, self._words, swapped)
         return m

@@ -1,11 +1,10 @@
 """Play a :class:`PixelStream` into the SNU pixel-bus HDL and check it against the golden model.
 
 :func:`simulate_pixelbus` runs the block's testbench (``sim/snu/testbench.py: BusBench``, the
-frame memory streamed out by ``sim/snu/readout.py: ReadOut``) on the generic engines
+frame memory streamed out by the engines' ``ReadOut``, ``sim/engines/readout.py``) on the generic engines
 (``sim/engines/``: Amaranth pysim, plain Verilator) and compares the frame and the cycle count
-with ``golden_model/snu/pixelbus.py``. :func:`run_pysim` drives the bare block in pysim and
-reports every write's acceptance clock (the tests hold it to the golden cycle model write by
-write). ``rasterhw sim pixelbus --engine verilator`` runs the whole frame instead (clear, the
+with ``golden_model/snu/pixelbus.py`` (every write's acceptance clock against the golden cycle
+model is a test's own pysim loop: ``tests/snu/snu_pixelbus_pysim.py``). ``rasterhw sim pixelbus --engine verilator`` runs the whole frame instead (clear, the
 producers' timing, swap: ``sim/snu/frame.py``).
 """
 
@@ -22,87 +21,13 @@ from rasterhw.golden_model.snu.formats import Z_BITS
 from rasterhw.golden_model.snu.gouraud import scan_convert
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.sim import engines
-from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put
 from rasterhw.sim.snu.frame import frame_run
 from rasterhw.sim.snu.testbench import frame_of
 from rasterhw.sim.testbench import compare, find_testbench
 
-__all__ = ["ENGINES", "measure_rates", "run_pysim", "simulate_pixelbus", "simulate_scene"]
+__all__ = ["ENGINES", "measure_rates", "simulate_pixelbus", "simulate_scene"]
 
 ENGINES = (*engines.ENGINES, *engines.ALIASES)   # pysim, verilator, cocotb-verilator, cocotb-icarus, icarus
-
-
-def run_pysim(
-    stream: PixelStream,
-    *,
-    gaps: np.ndarray | None = None,
-    readback: bool = True,
-    mem_cycle: int = 5,
-    n_banks: int = 5,
-    checker_logs: list | None = None,
-) -> dict:
-    """Run ``stream`` through ``PixelBus`` in pysim.
-
-    Returns ``{"cycles", "accept": (N,) cycle of each write's transfer, "rgb", "z"}``
-    (``rgb``/``z`` (H, W) int64 read back through the read port, draw buffer, if
-    ``readback``).  ``checker_logs``, if a list, receives two lists of the payloads each
-    pipeline stream transferred, from :func:`stream_protocol_checker`.
-    """
-    from amaranth.sim import Simulator
-    from rasterhw.hdl.snu.pixelbus import PixelBus
-
-    dut = PixelBus(width=stream.width, height=stream.height, z_bits=stream.z_bits,
-                   n_banks=n_banks, mem_cycle=mem_cycle)
-    n = len(stream)
-    gap = np.zeros(n, dtype=np.int64) if gaps is None else np.asarray(gaps, dtype=np.int64)
-    accept = np.full(n, -1, dtype=np.int64)
-    ports = [dut.i_pipe0, dut.i_pipe1]
-    idx = [np.flatnonzero(stream.pipe == p) for p in range(2)]
-    addr, rgb, z = stream.addr.tolist(), stream.rgb.tolist(), stream.z.tolist()
-    done = [False, False]
-    out: dict = {}
-
-    def driver(p):
-        async def tb(ctx):
-            for k in idx[p].tolist():
-                await stream_put(ctx, ports[p], {"addr": addr[k], "rgb": rgb[k], "z": z[k]}, gap=int(gap[k]))
-                # stream_put returns one clock after the transfer
-                accept[k] = ctx.get(dut.cycle) - 1
-            done[p] = True
-
-        return tb
-
-    async def main(ctx):
-        while not all(done):
-            await ctx.tick()
-        while ctx.get(dut.busy):
-            await ctx.tick()
-        out["cycles"] = int(ctx.get(dut.cycle))
-        if readback:
-            size = stream.width * stream.height
-            rb_rgb = np.zeros(size, dtype=np.int64)
-            rb_z = np.zeros(size, dtype=np.int64)
-            ctx.set(dut.rd_buf, 0)
-            for a in range(size):
-                ctx.set(dut.rd_addr, a)
-                await ctx.tick()  # synchronous read: data for `a` in the next clock
-                rb_rgb[a] = ctx.get(dut.rd_rgb)
-                rb_z[a] = ctx.get(dut.rd_z)
-            out["rgb"] = rb_rgb.reshape(stream.height, stream.width)
-            out["z"] = rb_z.reshape(stream.height, stream.width)
-
-    sim = Simulator(dut)
-    sim.add_clock(80e-9)
-    for p in range(2):
-        sim.add_testbench(driver(p))
-        if checker_logs is not None:
-            log: list = []
-            checker_logs.append(log)
-            sim.add_testbench(stream_protocol_checker(ports[p], f"i_pipe{p}", log), background=True)
-    sim.add_testbench(main)
-    sim.run()
-    out["accept"] = accept
-    return out
 
 
 def simulate_pixelbus(stream: PixelStream, *, engine: str = "pysim", gaps: np.ndarray | None = None,
@@ -112,7 +37,7 @@ def simulate_pixelbus(stream: PixelStream, *, engine: str = "pysim", gaps: np.nd
     The block's testbench (``BusBench``) on ``engine`` (``sim/engines/``), ``gaps`` idle clocks
     before each write. Returns ``{"block": "pixelbus", "engine", "cycles", "clock_hz": 12.5e6,
     "pixels_compared", "mismatches", "wall_s", "cycles_per_s", "frame_rgb"}`` plus
-    ``"golden_cycles"``, ``"writes"`` and ``"build_s"`` (simulator build, 0 for pysim and for a
+    ``"cycles_golden"``, ``"cycle_mismatches"`` (0 or 1, also counted in ``mismatches``), ``"writes"`` and ``"build_s"`` (simulator build, 0 for pysim and for a
     build already made).  ``cycles``: the clock the read-out started in, the first clock after the
     last write's memory cycle (the golden model's cycle count).  ``wall_s`` is the whole call.
     ``mismatches`` counts read-out words (pixels) whose RGB or Z differs from the golden frame,
@@ -151,7 +76,8 @@ def simulate_pixelbus(stream: PixelStream, *, engine: str = "pysim", gaps: np.nd
         "block": "pixelbus",
         "engine": engine,
         "cycles": int(cycles),
-        "golden_cycles": g_cycles,
+        "cycles_golden": g_cycles,
+        "cycle_mismatches": cmp["cycle_mismatches"],
         "writes": len(stream),
         "clock_hz": golden.CLOCK_HZ,
         "pixels_compared": stream.width * stream.height,
@@ -178,7 +104,7 @@ def measure_rates(*, engine: str = "verilator", width: int = 1280, height: int =
             r = simulate_pixelbus(s, engine=engine)
             rows.append({
                 "pattern": pattern, "pipes": pipes, "writes": len(s), "cycles": r["cycles"],
-                "golden_cycles": r["golden_cycles"], "mismatches": r["mismatches"],
+                "golden_cycles": r["cycles_golden"], "mismatches": r["mismatches"],
                 "mpixel_s": golden.pixels_per_second(len(s), r["cycles"]) / 1e6,
             })
     return rows

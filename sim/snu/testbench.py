@@ -1,8 +1,8 @@
 # amaranth: UnusedElaboratable=no
 """Testbenches of the SNU blocks (``sim/testbench.py``): pixel writes in, the frame memory out.
 
-Both blocks keep what they make in their frame memory; the bench adapter :class:`ReadOut`
-(``sim/snu/readout.py``) ends every write stream with a token and then streams the memory out
+Both blocks keep what they make in their frame memory; the engines' read-out adapter
+(``sim/engines/readout.py: ReadOut``) ends every write stream with a token and then streams the memory out
 (``o``: ``{rgb, z}`` per word, address order, draw buffer), so the generic engines compare it with
 the golden frame (``golden_model/snu/pixelbus.py: pixelbus_frame``) word for word.
 """
@@ -10,13 +10,14 @@ the golden frame (``golden_model/snu/pixelbus.py: pixelbus_frame``) word for wor
 from __future__ import annotations
 
 import numpy as np
+from amaranth import Cat
 from rasterhw.golden_model.snu import pixelbus as golden
 from rasterhw.golden_model.snu.formats import RGB_BITS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.golden_model.snu.words import payload_fields
 from rasterhw.sim.engines.packed import pack_fields
+from rasterhw.sim.engines.readout import ReadOut
 from rasterhw.sim.snu.frame_adapter import GAP_BITS, SCHEDULE, FrameAdapter
-from rasterhw.sim.snu.readout import ReadOut
 from rasterhw.sim.testbench import Expected, Run, Stimulus, Testbench
 
 __all__ = ["BankBench", "BusBench", "FrameBench", "frame_of"]
@@ -69,6 +70,18 @@ def frame_of(run: Run, z_bits: int, shape: tuple[int, int]) -> tuple[np.ndarray,
     return (w >> z_bits).reshape(shape), (w & ((1 << z_bits) - 1)).reshape(shape)
 
 
+def _read_out(block, ports: tuple[str, ...], words: int) -> ReadOut:
+    """The frame-memory block behind the engines' read-out adapter: an end token on every write
+    stream, then the draw buffer (``rd_buf`` 0) streamed out as ``{rgb, z}`` (``z`` low); ``i_cmd``
+    idle (no clear, no swap: the memory starts at zero, as after a clear)."""
+
+    def address(m, b, addr):
+        m.d.comb += b.rd_addr.eq(addr)
+
+    return ReadOut(block, ports=ports, words=words, address=address, data=lambda b: Cat(b.rd_z, b.rd_rgb),
+                   fixed={"i_cmd.valid": 0, "rd_buf": 0})
+
+
 def _frame_words(rgb: np.ndarray, z: np.ndarray, z_bits: int) -> list[int]:
     return ((rgb.ravel() << z_bits) | z.ravel()).tolist()
 
@@ -83,7 +96,7 @@ class BankBench(Testbench):
     block = "pixelbus-bank"
 
     def dut(self, params: dict):
-        return ReadOut(super().dut(params), self.inputs, params["depth"])
+        return _read_out(super().dut(params), self.inputs, params["depth"])
 
     def stimulus(self, params: dict, seed: int) -> Stimulus:
         rng = np.random.default_rng(seed)
@@ -112,7 +125,7 @@ class BusBench(Testbench):
     inputs = ("i_pipe0", "i_pipe1")
 
     def dut(self, params: dict):
-        return ReadOut(super().dut(params), self.inputs, params["width"] * params["height"])
+        return _read_out(super().dut(params), self.inputs, params["width"] * params["height"])
 
     def stimulus(self, params: dict, seed: int) -> Stimulus:
         rng = np.random.default_rng(seed)

@@ -888,7 +888,7 @@ def _stack_matrix_hdl_rows(row, engine: str) -> list[str]:
     from rasterhw.golden_model.sparse.fixed import broadcast_records
     from rasterhw.golden_model.sparse.search import sparse_render
     from rasterhw.golden_model.sparse.stack import stack_processor
-    from rasterhw.sim.sparse.matrix_run import run_matrix, run_matrix_pysim
+    from rasterhw.sim.sparse.matrix_run import run_matrix
 
     if engine == "verilator":
         W, p, lab, depths = 512, 4, "c300 512x512, 4x4", (64, 1)
@@ -896,7 +896,7 @@ def _stack_matrix_hdl_rows(row, engine: str) -> list[str]:
         tris = run_geometry(build_scene("c300"), W, W)
     elif engine == "pysim":  # its input FIFOs built 8 deep
         W, p, lab, depths = 16, 2, "12 random triangles of 16 px, 16x16, 2x2", (8, 1)
-        run = run_matrix_pysim
+        run = lambda recs, **kw: run_matrix(tris, **kw, in_depth=8, engine="pysim")  # noqa: E731
         tris = random_triangles(W, W, 12, mean_area=16.0, seed=SEED)
     else:
         return []

@@ -29,20 +29,16 @@ HIER_FROM_CELLS = 16
 def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bool = False, idle: int = 0,
                   seed: int = 1, workers: int = 2) -> dict:
     """Run every processor on ``tris``; returns the ``rasterhw sim`` keys plus per-level tests.
-    ``idle``, ``seed`` (Verilator only): random idle clocks on every processor's input (see
+    ``idle``, ``seed``: random idle clocks on every processor's input (see
     :func:`rasterhw.sim.sparse.verilator_run.run_processor_verilator`; processor ``(a, b)`` uses
     seed ``seed + 64 * b + a``). ``workers``: Verilator processors run at once (at most the
     machine's cores)."""
     p, q = parse_matrix(matrix)
     n = sparse_geometry(tris.width, tris.height, p, q)
-    if engine == "pysim":
-        from rasterhw.sim.sparse.hdl_run import run_processor as run
-    elif engine == "verilator":
-        from rasterhw.sim.sparse.verilator_run import run_processor_verilator
-    else:
+    from rasterhw.sim.sparse.verilator_run import run_processor_verilator
+
+    if engine not in ("pysim", "verilator"):
         raise RasterhwError(f"sparse sim: engine must be 'pysim' or 'verilator', not {engine!r}")
-    if idle and engine != "verilator":
-        raise RasterhwError("sparse sim: idle input clocks are a Verilator bench setting")
     g = sparse_render(tris, (p, q), depth="fixed")
     gz = g.depth_words(tris.z_bits)
     recs = broadcast_records(tris)
@@ -54,14 +50,14 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
     run_s = 0.0
     sim_cycles = 0
     procs = [(a, b) for b in range(q) for a in range(p)]
+    def one(a, b):   # ProcessorBench on the generic engine
+        return run_processor_verilator(tris, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits, idle=idle,
+                                       seed=seed + 64 * b + a, engine=engine)
+
     if engine == "verilator":
         # the processors are independent simulator processes: the first alone (it builds the bench
         # once), then two at a time on this machine's cores; results are taken in processor order
         from concurrent.futures import ThreadPoolExecutor
-
-        def one(a, b):
-            return run_processor_verilator(tris, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits, idle=idle,
-                                           seed=seed + 64 * b + a)
 
         first = one(*procs[0])
         pool = ThreadPoolExecutor(max_workers=max(1, min(int(workers), os.cpu_count() or 1)))
@@ -69,7 +65,7 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
         results = itertools.chain([first], (f.result() for f in futures))
     else:
         pool = None
-        results = (run(recs, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits) for a, b in procs)
+        results = (one(a, b) for a, b in procs)
     try:
         for (a, b), r in zip(procs, results, strict=True):
             loc_t[b, a], loc_z[b, a] = r["tri"], r["zq"]
@@ -120,7 +116,7 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
     ``None`` (the default): hierarchical from :data:`HIER_FROM_CELLS` processors up (a flat 4x4 at
     1024² took 20-37 min to build, hierarchical 20 s), flat below."""
     from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
-    from rasterhw.sim.sparse.matrix_run import IN_DEPTH, run_matrix, run_matrix_pysim
+    from rasterhw.sim.sparse.matrix_run import IN_DEPTH, run_matrix
 
     p, q = parse_matrix(matrix)
     n = sparse_geometry(tris.width, tris.height, p, q)
@@ -146,8 +142,8 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
     recs = broadcast_records_rgb(tris) if colour else broadcast_records(tris)
     kw = dict(n=n, p=p, q=q, limit=fifo_depth, z_bits=tris.z_bits, fifo_depth=vp_fifo_depth, in_depth=in_depth, vp=vp,
               colour=colour, kp=kp, ke=KE_EDGES)
-    # Verilator: the generic engine's testbench (MatrixFrameBench); pysim: the direct bench (idle patterns, tests)
-    h = run_matrix(tris, **kw, hierarchical=hierarchical) if engine == "verilator" else run_matrix_pysim(recs, **kw)
+    # the generic engine's testbench (MatrixFrameBench) on either engine
+    h = run_matrix(tris, **kw, hierarchical=hierarchical, engine=engine)
     hdl_s = time.perf_counter() - t0
     t1 = time.perf_counter()
     g = sparse_render(tris, (p, q), depth="fixed", trace=True)

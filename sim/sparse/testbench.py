@@ -6,135 +6,21 @@ raster) streamed out after the input ends, against the golden search."""
 from __future__ import annotations
 
 import numpy as np
-from amaranth import Cat, Const, Module, Mux, Signal
-from amaranth.lib import stream, wiring
-from amaranth.lib.wiring import In, Out
+from amaranth import Cat
 from rasterhw.golden_model.reference import random_triangles
 from rasterhw.golden_model.sparse.fixed import broadcast_records
 from rasterhw.golden_model.sparse.formats import TRI_BITS
 from rasterhw.golden_model.sparse.search import sparse_render
 from rasterhw.sim import registry
+from rasterhw.sim.engines.readout import ReadOut
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 
-__all__ = ["MatrixFrameBench", "MatrixBench", "ProcessorBench", "ReadOut", "StackVPBench", "VPBench"]
+__all__ = ["MatrixFrameBench", "MatrixBench", "ProcessorBench", "StackVPBench", "VPBench"]
 
 
-class ReadOut(wiring.Component):
-    """Bench adapter for a memory-backed block: records in, memory words (and counters) out.
-
-    ``i`` carries ``{end, record}`` (``{config, end, record}`` with ``config``): records go to the
-    block's ``i``; a word with ``end`` set is taken at once and starts the read-out when the block
-    is no longer ``busy``: the read address sweeps ``0 .. words - 1`` (``address(m, addr)`` drives
-    the block's read port; one cycle of read latency, the next address presented on a transfer)
-    and ``o`` carries ``{rd_tri, rd_z}`` of each address, one word a clock while ``o.ready`` is
-    high (held while it is low). ``fixed``: constant inputs of the block (``{name: value}``).
-    ``config``: inputs of the block set at run time (``{name: value before any config word}``): a
-    word with ``config`` set is taken at once and loads them from its low bits, in order
-    (:meth:`config_word`), so one build serves every value. ``tail``: the block's counters (output
-    names) sent after the memory, one word each (zero-extended), in order. ``stats``: ``(cells,
-    sels)``: then counter ``stat`` for every ``stat_cell`` in ``0 .. cells - 1`` and, within it,
-    ``stat_sel`` in ``0 .. sels - 1``. ``count``: then the adapter's own count of the block's
-    cycles: every clock from the first record offered until the block is idle after the end word
-    (the clock that sees it idle included; the plain benches' count). ``extra``: Verilog the block
-    instantiates by name (the Verilator bench compiles it beside the block)."""
-
-    def __init__(self, block, *, words: int, address, fixed: dict, z_bits: int, tail: tuple[str, ...] = (),
-                 record_bits: int | None = None, rgb: bool = False, config: dict | None = None,
-                 stats: tuple[int, int] | None = None, count: bool = False, extra: str = ""):
-        from rasterhw.hdl.sparse.layouts import BROADCAST
-
-        self.block, self._words, self._address, self._fixed, self._tail = block, words, address, fixed, tuple(tail)
-        self._rec = BROADCAST.size if record_bits is None else record_bits
-        self._rgb, self._config, self._stats, self._extra = rgb, dict(config or {}), stats, extra
-        self._tail += ("$cycles",) if count else ()
-        super().__init__({"i": In(stream.Signature(self._rec + 1 + bool(self._config))),
-                          "o": Out(stream.Signature(TRI_BITS + z_bits + 1 + (24 if rgb else 0)))})
-
-    def extra_verilog(self) -> str:
-        return self._extra
-
-    @staticmethod
-    def config_word(record_bits: int, widths: dict, values: dict) -> int:
-        """The input word that loads ``values`` (``{name: value}``, the ``config`` inputs of widths
-        ``widths``, in order) into a :class:`ReadOut` whose records are ``record_bits`` wide."""
-        word, at = 0, 0
-        for name, w in widths.items():
-            v = int(values[name])
-            if not 0 <= v < 1 << w:
-                raise ValueError(f"config {name}={v} does not fit {w} bits")
-            word |= v << at
-            at += w
-        return word | 1 << (record_bits + 1)
-
-    def elaborate(self, platform):
-        m = Module()
-        m.submodules.block = b = self.block
-        for name, v in self._fixed.items():
-            m.d.comb += getattr(b, name).eq(v)
-        at = 0
-        cfg = self.i.payload[self._rec + 1] if self._config else Const(0, 1)
-        for name, v in self._config.items():
-            port = getattr(b, name)
-            reg = Signal(len(port), init=v, name=f"cfg_{name}")
-            m.d.comb += port.eq(reg)
-            with m.If(self.i.valid & cfg):
-                m.d.sync += reg.eq(self.i.payload[at:at + len(port)])
-            at += len(port)
-        end = self.i.payload[self._rec]
-        addr = Signal(range(self._words + 1))
-        run_cycles, started = Signal(32), Signal()
-        take = self.o.valid & self.o.ready
-        word = Cat(b.rd_z, b.rd_tri, b.rd_rgb) if self._rgb else Cat(b.rd_z, b.rd_tri)
-        m.d.comb += b.i.payload.eq(self.i.payload[:self._rec])
-        with m.FSM():
-            with m.State("FEED"):
-                m.d.comb += [b.i.valid.eq(self.i.valid & ~end & ~cfg), self.i.ready.eq(end | cfg | b.i.ready)]
-                self._address(m, b, addr)
-                with m.If(b.i.valid):
-                    m.d.sync += started.eq(1)
-                with m.If(b.i.valid | started):
-                    m.d.sync += run_cycles.eq(run_cycles + 1)
-                with m.If(self.i.valid & end & ~cfg):
-                    m.next = "WAIT"
-            with m.State("WAIT"):
-                self._address(m, b, addr)
-                m.d.sync += run_cycles.eq(run_cycles + 1)
-                with m.If(~b.busy):
-                    m.next = "READ"
-            with m.State("READ"):
-                # the word of addr is on the read port now; a transfer presents the next address
-                self._address(m, b, Mux(take, addr + 1, addr))
-                m.d.comb += [self.o.valid.eq(1), self.o.payload.eq(word)]
-                with m.If(take):
-                    m.d.sync += addr.eq(addr + 1)
-                    with m.If(addr == self._words - 1):
-                        m.next = "TAIL" if self._tail else ("STATS" if self._stats else "DONE")
-            if self._tail:
-                k = Signal(range(len(self._tail)))
-                with m.State("TAIL"):
-                    m.d.comb += self.o.valid.eq(1)
-                    with m.Switch(k):
-                        for j, name in enumerate(self._tail):
-                            with m.Case(j):
-                                m.d.comb += self.o.payload.eq(run_cycles if name == "$cycles" else getattr(b, name))
-                    with m.If(self.o.ready):
-                        m.d.sync += k.eq(k + 1)
-                        with m.If(k == len(self._tail) - 1):
-                            m.next = "STATS" if self._stats else "DONE"
-            if self._stats:
-                cells, sels = self._stats
-                c, s = Signal(range(cells)), Signal(range(sels))
-                with m.State("STATS"):
-                    m.d.comb += [self.o.valid.eq(1), b.stat_cell.eq(c), b.stat_sel.eq(s), self.o.payload.eq(b.stat)]
-                    with m.If(self.o.ready):
-                        m.d.sync += s.eq(s + 1)
-                        with m.If(s == sels - 1):
-                            m.d.sync += [s.eq(0), c.eq(c + 1)]
-                            with m.If(c == cells - 1):
-                                m.next = "DONE"
-            with m.State("DONE"):
-                pass
-        return m
+def _word(rgb: bool):
+    """The read-out word of a sparse memory: ``{rd_z, rd_tri}`` (and ``rd_rgb`` with colour)."""
+    return (lambda b: Cat(b.rd_z, b.rd_tri, b.rd_rgb)) if rgb else (lambda b: Cat(b.rd_z, b.rd_tri))
 
 
 def _words(tri: np.ndarray, zq: np.ndarray, z_bits: int) -> list[int]:
@@ -192,8 +78,9 @@ class VPBench(_SparseBench):
             m.d.comb += b.rd_addr.eq(addr[:2 * n])
 
         col = params.get("colour", False)
-        return ReadOut(vp, words=1 << (2 * n), address=address, fixed={"a": params["p"] - 1, "b": params["q"] - 1},
-                       z_bits=params["z_bits"], tail=self.tail(params), record_bits=layouts(col)[0].size, rgb=col)
+        return ReadOut(vp, words=1 << (2 * n), address=address, data=_word(col),
+                       fixed={"a": params["p"] - 1, "b": params["q"] - 1}, tail=self.tail(params),
+                       record_bits=layouts(col)[0].size)
 
     def stimulus(self, params: dict, seed: int) -> Stimulus:
         st = super().stimulus(params, seed)
@@ -245,7 +132,7 @@ class MatrixBench(_SparseBench):
         def address(m, b, addr):
             m.d.comb += [b.rd_x.eq(addr[:xb]), b.rd_y.eq(addr[xb:])]
 
-        return ReadOut(mx, words=w * h, address=address, fixed={"limit": params["in_depth"]}, z_bits=params["z_bits"])
+        return ReadOut(mx, words=w * h, address=address, data=_word(False), fixed={"limit": params["in_depth"]})
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         g, zq = self._golden(params, stim)
@@ -280,8 +167,8 @@ class ProcessorBench(VPBench):
         def address(m, b, addr):
             m.d.comb += b.rd_addr.eq(addr[:2 * n])
 
-        return ReadOut(vp, words=1 << (2 * n), address=address, fixed={},
-                       config={"a": params["p"] - 1, "b": params["q"] - 1}, z_bits=params["z_bits"],
+        return ReadOut(vp, words=1 << (2 * n), address=address, data=_word(False),
+                       config={"a": params["p"] - 1, "b": params["q"] - 1},
                        tail=self.tail(params), count=True, record_bits=self._lay(params).size)
 
     @staticmethod
@@ -322,7 +209,7 @@ class ProcessorBench(VPBench):
         return Expected({"o": _words(g.tri_id[b::q, a::p], zq[b::q, a::p], params["z_bits"]) + [int(v) for v in tail]})
 
     def decode(self, params: dict, words: list[int]) -> dict:
-        """The engine's ``o`` words as ``hdl_run.run_processor``'s keys: ``tri``, ``zq`` (N x N, -1
+        """The engine's ``o`` words as ``tri``, ``zq`` (N x N, -1
         where empty), ``tests``, ``stalls``, ``writes``, ``cycles``."""
         n, zb = params["n"], params["z_bits"]
         N = 1 << n
@@ -397,10 +284,10 @@ class MatrixFrameBench(MatrixBench):
         def address(m, b, addr):
             m.d.comb += [b.rd_x.eq(addr[:xb]), b.rd_y.eq(addr[xb:])]
 
-        return ReadOut(mx, words=w * h, address=address, fixed={}, config={"limit": params["in_depth"]},
-                       z_bits=params["z_bits"], tail=("cycles", "stall_cycles"),
+        return ReadOut(mx, words=w * h, address=address, data=_word(params["colour"]),
+                       config={"limit": params["in_depth"]}, tail=("cycles", "stall_cycles"),
                        stats=(params["p"] * params["q"], len(cell_stats(params["n"]))),
-                       record_bits=layouts(params["colour"])[0].size, rgb=params["colour"], extra=extra)
+                       record_bits=layouts(params["colour"])[0].size, extra=extra)
 
     def frame(self, tris, params: dict, limit: int, what: str = "") -> Stimulus:
         """The words of one frame: the limit, the records of ``tris``, the end word."""

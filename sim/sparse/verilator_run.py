@@ -27,8 +27,9 @@ MAXT = 16384
 
 def run_processor_verilator(tris, *, n: int, p: int, q: int, a: int, b: int, z_bits: int = 24, idle: int = 0,
                             seed: int = 1, engine: str = "verilator") -> dict:
-    """Processor ``(a, b)`` on ``tris`` on Verilator: the keys of
-    :func:`rasterhw.sim.sparse.hdl_run.run_processor` plus ``run_s`` (the C++ clock loop),
+    """Processor ``(a, b)`` on ``tris`` on ``engine`` (Verilator by default; pysim; the cocotb engines):
+    ``tri``, ``zq`` (N x N, -1 where empty), ``tests`` and ``stalls`` per level, ``writes``, ``cycles``
+    (the processor's own count: ``ProcessorBench.decode``) plus ``run_s`` (the simulation),
     ``build_s``, ``records`` (the broadcast records played) and ``sim_cycles`` (the bench's clocks, read-out included). ``idle`` (0..255): each
     clock before a record is idle with probability ``idle / 256`` (seeded by ``seed``); the frame
     and the per-level tests do not depend on it, the cycle count does."""
@@ -46,7 +47,7 @@ def run_processor_verilator(tris, *, n: int, p: int, q: int, a: int, b: int, z_b
     maxcyc = (200 * (ntri + 10) * (1 + n) + 64 * N * N + 10_000_000) * (1 + idle // 16)
     got = run_engine(tb, params, stim, engine=engine, idle=idle / 256, seed=seed,
                      expect_words={"o": N * N + 2 * n + 2}, max_cycles=maxcyc,
-                     build={"depth": MAXT + 2})   # one build per design, whatever the frame
+                     build={"depth": MAXT + 2} if engine != "pysim" else None)   # one build per design
     if got.protocol_errors:
         raise RasterhwError(f"sparse processor ({a}, {b}) on {engine}: {got.protocol_errors} clocks broke the "
                             "stream rules")

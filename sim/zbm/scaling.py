@@ -39,20 +39,24 @@ CHAIN_UNITS = (1, 2, 4, 8)
 def pixel_rate(interleave: int, *, width: int = 128, height: int = 12,
                schedule: str = "overlap") -> dict:
     """Output pixels per segment clock of one unit whose lines are bound by the merge bus
-    (pysim). One 5 x 5 edge pair on lines 0-4, lines 5.. empty: per line a chip sends its
-    ``ceil(width / interleave)`` pixels down the merge bus, one per clock, all chips at once."""
-    from rasterhw.sim.zbm.cycles_hdl import run_unit_cycles
+    (pysim: the ``zbm-unit`` testbench on the generic engine, every merge word compared). One 5 x 5
+    edge pair on lines 0-4, lines 5.. empty: per line a chip sends its ``ceil(width / interleave)``
+    pixels down the merge bus, one per clock, all chips at once."""
+    from rasterhw.sim.zbm.scene_run import run_units_equal_clocks
 
     eps = C.paper_workload(1, width=width)
-    r = run_unit_cycles(eps, height, width=width, interleave=interleave, schedule=schedule)
-    if r["overflow"] or r["lines"] != height:
-        raise RasterhwError(f"ZB/M unit did not finish: {r}")
+    r = run_units_equal_clocks([eps], width=width, height=height, interleave=interleave, engine="pysim",
+                               schedule=schedule, line_log=True)
+    if r["overflow"] or not r["frames_ok"] or r["mismatches"]:
+        raise RasterhwError(f"ZB/M unit did not finish the frame bit-exact: overflow {r['overflow']}, "
+                            f"{r['mismatches']} merge words differ")
     t = r["line_cycles"]
     a, b = 6, height - 1                       # steady, empty lines
     per_line = (t[b] - t[a]) / (b - a)
     return {"interleave": interleave, "width": width, "cycles_per_line": per_line,
             "chip_pixels": -(-width // interleave), "pixels_per_cycle": width / per_line,
-            "pixels_per_s": width / per_line * CLOCK_HZ, "engine": "pysim"}
+            "pixels_per_s": width / per_line * CLOCK_HZ, "engine": "pysim", "words_compared": r["words_compared"],
+            "mismatches": r["mismatches"]}
 
 
 def _offset_workload(n: int, width: int, offset: int) -> G.EdgePairs:

@@ -13,18 +13,18 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.cycles import check_schedule
-from rasterhw.golden_model.zbm.words import doublez_words, words_to_doublez
+from rasterhw.golden_model.zbm.words import words_to_doublez
+from rasterhw.sim import engines, registry
 from rasterhw.sim.engines import run as run_engine
-from rasterhw.sim.testbench import find_testbench
+from rasterhw.sim.testbench import compare, find_testbench
 from rasterhw.sim.zbm.edge_check import check_edge_pairs
-from rasterhw.sim.zbm.testbench import deal
-from rasterhw.sim.zbm.unit_bench import unit_watchdog
+from rasterhw.sim.zbm.testbench import deal, unit_watchdog
 from tqdm import tqdm
 
 __all__ = ["CLOCK_HZ", "ENGINES", "PLAIN_BUILD", "SPEED_BUILD", "float_tolerance", "run_scene", "run_units_equal_clocks",
            "simulate_zbm"]
 
-ENGINES = ("pysim", "verilator", "icarus")
+ENGINES = registry.ENGINES   # the command line's engines (sim/registry.py)
 CLOCK_HZ = 25e6          # the paper's segment clock (sec. 6.1)
 
 
@@ -86,11 +86,14 @@ def run_scene(eps_per_unit: list, *, width: int, height: int, interleave: int, s
     ``eps_per_unit[k]``; a scene's: ``testbench.deal``) on the generic engine (the ``zbm-unit``
     testbench, :class:`rasterhw.sim.zbm.testbench.UnitBench`): ``{"s0", "s1": (H, W) uint64 frame,
     "cycles" (segment clocks until the last merge word), "proto_errors", "run_s" (the clock loop on
-    Verilator; the simulation on pysim), "build_s", "build", "frames_ok", "overflow", ["line_cycles"]}``. ``build``:
+    Verilator; the simulation on pysim), "build_s", "build", "words_compared" (merge words of the
+    frame), "mismatches" (those that differ from the testbench's golden words: ``testbench.compare``),
+    "golden" (the golden double-Z frame they were made from, ``chain_frame``: the one golden route),
+    "frames_ok", "overflow", ["line_cycles"]}``. ``build``:
     Verilator build settings (default :data:`SPEED_BUILD`); ``stall``, ``seed``: back-pressure on
     every merge slot; ``gap_seed``: random idle gaps on the edge-pair input (None: none); ``clocks``:
     separate segment and merge clocks (``{"sync": Clock, "merge": Clock}``, e.g. the cocotb bench's at
-    a ratio: ``unit_bench.bench_clocks``; one build for every ratio; "cycles" and "line_cycles" stay
+    a ratio: ``testbench.bench_clocks``; one build for every ratio; "cycles" and "line_cycles" stay
     in segment clocks); None: one clock for both."""
     tb = find_testbench("zbm-unit")
     p = tb.params(interleave=interleave, width=width, height=height, capacity=capacity, schedule=schedule,
@@ -104,8 +107,10 @@ def run_scene(eps_per_unit: list, *, width: int, height: int, interleave: int, s
                      build=(SPEED_BUILD if build is None else build) if engine == "verilator" else None,
                      clocks=clocks)
     s0, s1 = tb.frame(p, got.words)
+    cmp = compare(exp, got, cycle_exact=False)
     out = {"s0": s0, "s1": s1, "cycles": got.cycles, "proto_errors": got.protocol_errors, "run_s": got.run_s,
-           "build_s": got.build_s, "build": got.build, **got.status}
+           "build_s": got.build_s, "build": got.build, "words_compared": sum(want.values()),
+           "mismatches": cmp["mismatches"], "golden": exp.golden, **got.status}
     if line_log:
         out["line_cycles"] = tb.line_cycles(p, got)
     return out
@@ -113,16 +118,15 @@ def run_scene(eps_per_unit: list, *, width: int, height: int, interleave: int, s
 
 def run_units_equal_clocks(per_unit: list, *, width: int, height: int, interleave: int, engine: str,
                            schedule: str, line_log: bool = False) -> dict:
-    """A chain of units with equal, in-phase clocks (the Table 1, skew and chain runs): on
-    Verilator the generic engine (:func:`run_scene`, held word-, cycle- and line-log-exact with the
-    cocotb bench by ``tests/zbm/test_zbm_unit_fast.py``; it builds and runs several times faster),
-    on Icarus the same testbench under cocotb (the generic cocotb engine). g++ ``-O0``: these frames are small, the build is what costs."""
+    """A chain of units with equal, in-phase clocks (the Table 1, pixel-rate, skew and chain runs) on
+    the generic engine (:func:`run_scene`): pysim, Verilator (g++ ``-O0``: these frames are small, the
+    build is what costs; held word-, cycle- and line-log-exact with the cocotb bench by
+    ``tests/zbm/test_zbm_unit_engine.py``), or ``icarus`` (the same testbench under cocotb on Icarus)."""
     if engine == "verilator":
         return run_scene(per_unit, width=width, height=height, interleave=interleave, schedule=schedule,
                          line_log=line_log, build={"speed": True, "opt": "-O0"})
-    # Icarus: the same testbench under cocotb (the generic cocotb engine)
     return run_scene(per_unit, width=width, height=height, interleave=interleave, schedule=schedule,
-                     line_log=line_log, engine="cocotb-icarus")
+                     line_log=line_log, engine=engines.ALIASES.get(engine, engine))
 
 
 def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: int = 1,
@@ -132,7 +136,8 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
     Pipeline: ``run_geometry`` -> ``edge_pairs`` -> checks (:func:`check_edge_pairs`: bad or
     over-capacity streams raise ``RasterhwError`` before any simulation) -> triangles dealt to
     units round-robin (triangle i -> unit i % units, as ``render_zbm``) -> HDL -> every line's
-    double-Z pixels compared with ``render_zbm(...).pixels`` bit for bit -> composite.
+    double-Z pixels compared with the ``zbm-unit`` testbench's golden frame (``chain_frame``, the
+    frame ``render_zbm`` draws) bit for bit -> composite.
 
     ``schedule``: ``"overlap"`` (ours) or ``"paper"`` (the paper's sec. 6.1 schedule; the image is
     the same, only the timing differs).
@@ -141,7 +146,7 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
     the last merge word left the chain), "clock_hz": 25e6, "pixels_compared", "mismatches"
     (pixels whose 128-bit double-Z word differs), "wall_s" (the whole call), "cycles_per_s"
     (simulated cycles per second of simulator run, build excluded), "edge_pairs", "triangles",
-    "polygons_per_s" (triangles x 25 MHz / cycles), "build_s", "sim_s", "frame_rgb" (H, W, 3)
+    "polygons_per_s" (triangles x 25 MHz / cycles), "build_s", "run_s", "frame_rgb" (H, W, 3)
     uint8, "float_tolerance": {...}}``.
     """
     t0 = time.perf_counter()
@@ -156,7 +161,7 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
             raise RasterhwError(f"ZB/M: {name} must be an integer in {lo}..512, not {v!r}")
     bar = None
     if progress:
-        bar = tqdm(total=5, desc=f"zbm {engine}", unit="step", file=sys.stderr)
+        bar = tqdm(total=4, desc=f"zbm {engine}", unit="step", file=sys.stderr)
 
     started = []
 
@@ -172,27 +177,19 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
     tris = run_geometry(scene, width, height)
     eps = G.edge_pairs(tris)
     peak = check_edge_pairs(eps, width, height, units=units)
-    step("golden model")
-    gold = G.render_zbm(tris, interleave=interleave, units=units)
-    g0, g1 = doublez_words(gold.pixels)
-    step("HDL build + simulation" if engine != "pysim" else "HDL simulation (pysim)")
-    t1 = time.perf_counter()
-    per_unit = deal(eps, units)
-    if engine == "icarus":
-        # the unit's testbench under cocotb on Icarus (the generic cocotb engine; Icarus has no plain engine)
-        r = run_scene(per_unit, width=width, height=height, interleave=interleave, schedule=schedule,
-                      engine="cocotb-icarus")
-        sim_s, build_s = r["run_s"], r["build_s"]
-    else:
-        r = run_scene(per_unit, width=width, height=height, interleave=interleave, schedule=schedule, engine=engine)
-        sim_s, build_s = (r["run_s"], r["build_s"]) if engine == "verilator" else (time.perf_counter() - t1, 0.0)
-    step("compare + composite")
-    bad = (r["s0"] != g0) | (r["s1"] != g1)
-    mismatches = int(np.count_nonzero(bad))
+    step("golden model + HDL build + simulation" if engine != "pysim" else "golden model + HDL simulation (pysim)")
+    # icarus: the unit's testbench under cocotb on Icarus (the generic cocotb engine)
+    r = run_scene(deal(eps, units), width=width, height=height, interleave=interleave, schedule=schedule,
+                  engine=engine)
+    sim_s, build_s = r["run_s"], r["build_s"]
+    step("composite")
+    # every merge word (one per pixel) compared with the testbench's golden frame (run_scene:
+    # testbench.compare); the same frame gives the nearest triangles the float check needs
+    mismatches = int(r["mismatches"])
     px = words_to_doublez(r["s0"], r["s1"])
     rgb8 = G.composite(px)
     step("float tolerance")
-    tol = float_tolerance(tris, px, rgb8, eps, gold.pixels.tag)
+    tol = float_tolerance(tris, px, rgb8, eps, r["golden"].tag)
     if bar is not None:
         bar.update(1)
         bar.close()
@@ -214,8 +211,9 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
         "protocol_errors": int(r.get("proto_errors", 0)),
         "wall_s": wall,
         "build_s": build_s,
-        "sim_s": sim_s,
+        "run_s": sim_s,
         "cycles_per_s": cycles / sim_s if sim_s > 0 else float("inf"),
+        "cycle_mismatches": None,   # a scene has no golden cycle count here (the Table 1 rows compare cycles)
         "edge_pairs": len(eps),
         "aep_peak": peak,
         "triangles": n_tri,

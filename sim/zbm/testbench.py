@@ -30,11 +30,50 @@ from rasterhw.golden_model.zbm.words import (
 from rasterhw.hdl.zbm.chain import ZbmChain
 from rasterhw.sim import registry
 from rasterhw.sim.engines.verilog import merge_identical_modules
-from rasterhw.sim.testbench import Expected, Run, Stimulus, Testbench
+from rasterhw.sim.testbench import Clock, Expected, Run, Stimulus, Testbench
 from rasterhw.sim.zbm.line_bench import LineBench
-from rasterhw.sim.zbm.stimfiles import random_gaps
 
-__all__ = ["ChipBench", "LoopBench", "MergerBench", "PixelBench", "SeggenBench", "UnitBench", "deal", "pixel_visits"]
+__all__ = ["RESET_EDGES", "ChipBench", "LoopBench", "MergerBench", "PixelBench", "SeggenBench", "UnitBench",
+           "bench_clocks", "deal", "pixel_visits", "random_gaps", "unit_watchdog"]
+
+
+def random_gaps(n: int, seed: int | None, *, p_idle: float = 0.3, max_gap: int = 4) -> np.ndarray:
+    """Idle clocks before each of ``n`` words: 0 with probability ``1 - p_idle``, else 1..max_gap.
+    ``seed=None`` gives no gaps. (The ZB/M cocotb cross-check in ``tests/zbm_cocotb/`` plays the same.)"""
+    if seed is None:
+        return np.zeros(n, np.int64)
+    rng = np.random.default_rng(seed)
+    return rng.integers(1, max_gap + 1, n) * (rng.random(n) < p_idle)
+
+
+#: rising edges of each clock the cocotb benches hold their reset for (``rasterhw_reset #(.CYCLES(6))``)
+RESET_EDGES = 6
+
+
+def bench_clocks(ratio: tuple[int, int], phase: int = 1) -> dict[str, Clock]:
+    """The generic engine's separate clocks (``engines.run(..., clocks=...)``, 1 ns units) of a unit
+    run at segment : merge half periods ``ratio`` (ns) with the merge clock ``phase`` (0 or 1) ns
+    behind, timed as the cocotb unit bench's Verilog-side clocks after its reset
+    (``tests/zbm_cocotb/``: ``rasterhw_two_clocks`` raises ``clk`` at 1 + (2k + 1) * segment half ns
+    and ``mclk`` ``phase`` ns later on its own half period; the engine has no reset, so edge 0 of
+    each domain is the bench's edge :data:`RESET_EDGES`)."""
+    sh, mh = ratio
+    if phase not in (0, 1):
+        raise RasterhwError(f"merge clock phase must be 0 or 1 ns, not {phase!r}")
+    if not (isinstance(sh, int) and isinstance(mh, int) and sh >= 1 and mh >= 1):
+        raise RasterhwError(f"clock ratio must be two positive integer half periods (ns), not {ratio!r}")
+    return {"sync": Clock(sh, 1 + (2 * RESET_EDGES + 1) * sh), "merge": Clock(mh, 1 + phase + (2 * RESET_EDGES + 1) * mh)}
+
+
+def unit_watchdog(total_words: int, *, width: int, height: int, stall: int = 0,
+                  ratio: tuple[int, int] = (5, 5)) -> int:
+    """A unit run's watchdog in segment clocks: generously above any frame this design can take
+    with ready always high and equal clocks, times the expected slow-down of the back-pressure
+    (ready high in ``256 - stall`` of 256 merge clocks) and of a merge clock slower than the
+    segment clock (``ratio`` = half periods, segment : merge)."""
+    base = 200 * (total_words + 64) + 40 * height * (width + 64)
+    slow = 256 / max(1, 256 - stall) * max(1.0, ratio[1] / ratio[0])
+    return min(int(base * max(1.0, slow)), 2**31 - 1)   # the cocotb bench's MAXCYC is a Verilog integer
 
 
 class SeggenBench(Testbench):
@@ -65,7 +104,7 @@ class UnitBench(Testbench):
     merge-bus words out (``o_merge[c]``, the last unit's in a chain; chip ``c`` owning columns
     ``c, c + I, ...``, line by line), the double-Z samples of ``golden_model/zbm/render.py:
     render_zbm``. The merge clock runs with the segment clock, or at any ratio and phase as a run's
-    separate clocks (``engines.run(..., clocks=...)``; ``unit_bench.bench_clocks``: the cocotb bench's). A random frame: 2..40 random screen triangles (seeded), the first ones that fit
+    separate clocks (``engines.run(..., clocks=...)``; :func:`bench_clocks`: the cocotb bench's). A random frame: 2..40 random screen triangles (seeded), the first ones that fit
     the active-edge-pair memory; a scene: :meth:`scene_stimulus` (``rasterhw sim zbm``, the soak).
 
     The back-pressure of slot ``c`` is the cocotb unit bench's (``cocotb_tests/zbm/tb_zbm_unit.v``:
@@ -124,7 +163,7 @@ class UnitBench(Testbench):
     def scene_stimulus(self, params: dict, eps_per_unit: list, *, gap_seed: int | None = None,
                        what: str = "") -> Stimulus:
         """Unit ``k``'s edge pairs (:func:`deal`: a scene's, as ``render_zbm`` deals them) as its
-        edge-pair words; ``gap_seed``: random idle gaps (``stimfiles.random_gaps`` over all units'
+        edge-pair words; ``gap_seed``: random idle gaps (:func:`random_gaps` over all units'
         words in order, as the cocotb bench plays them; None: none)."""
         ins = self.inputs_of(params)
         if len(eps_per_unit) != len(ins):
@@ -138,10 +177,10 @@ class UnitBench(Testbench):
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         i = params["interleave"]
-        g0, g1 = doublez_words(G.chain_frame(stim.source, params["width"], params["height"],
-                                             capacity=params["capacity"]))
+        frame = G.chain_frame(stim.source, params["width"], params["height"], capacity=params["capacity"])
+        g0, g1 = doublez_words(frame)
         outs = self.outputs_of(params)
-        return Expected({outs[c]: merge_words(g0[:, c::i], g1[:, c::i]) for c in range(i)})
+        return Expected({outs[c]: merge_words(g0[:, c::i], g1[:, c::i]) for c in range(i)}, golden=frame)
 
     def frame(self, params: dict, words: dict[str, list[int]]) -> tuple[np.ndarray, np.ndarray]:
         """The merge words of every slot as the frame's (s0, s1) (H, W) uint64 samples (all ones

@@ -23,9 +23,10 @@ from rasterhw.golden_model.snu import pixelbus as g
 from rasterhw.golden_model.snu.gouraud import scan_convert
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.sim.engines import run
-from rasterhw.sim.snu.pixelbus import run_pysim, simulate_pixelbus
+from rasterhw.sim.snu.pixelbus import simulate_pixelbus
 from rasterhw.sim.snu.testbench import frame_of
 from rasterhw.sim.testbench import compare, find_testbench
+from snu_pixelbus_pysim import run_pysim
 
 
 def scene_stream(name: str, width: int, height: int) -> PixelStream:
@@ -67,7 +68,7 @@ def test_scene_stream_pysim(name, width, height):
     r = simulate_pixelbus(s, engine="pysim")
     assert r["pixels_compared"] == width * height > 0
     assert r["mismatches"] == 0
-    assert r["cycles"] == r["golden_cycles"] == g.pixelbus_cycles(s)
+    assert r["cycles"] == r["cycles_golden"] == g.pixelbus_cycles(s)
 
 
 @pytest.mark.parametrize("gaps_kind", ["none", "1110", "random-seed5"])

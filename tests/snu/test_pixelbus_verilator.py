@@ -1,5 +1,5 @@
 """The pixel-bus Verilog on the Verilator engine (sim/engines/verilator.py: the block's testbench,
-``sim/snu/testbench.py: BusBench``, its frame memory streamed out by ``sim/snu/readout.py``).
+``sim/snu/testbench.py: BusBench``, its frame memory streamed out by the engines' read-out adapter, ``sim/engines/readout.py``).
 
 Moved from the cocotb bench (``cocotb_tests/snu/pixelbus/``, removed): the frame and the cycle
 count against the golden model, with idle gaps, one-bank back-pressure, the Verilog RAM model and
@@ -17,9 +17,10 @@ from amaranth.utils import ceil_log2
 from rasterhw.golden_model.snu import pixelbus as g
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.sim.engines import run
-from rasterhw.sim.snu.pixelbus import run_pysim, simulate_pixelbus
+from rasterhw.sim.snu.pixelbus import simulate_pixelbus
 from rasterhw.sim.snu.testbench import frame_of
 from rasterhw.sim.testbench import compare, find_testbench
+from snu_pixelbus_pysim import run_pysim
 
 pytestmark = pytest.mark.cocotb
 

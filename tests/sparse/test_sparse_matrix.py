@@ -12,13 +12,13 @@ from rasterhw.golden_model.sparse.search import sparse_render
 from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
 
 
-def run_matrix_pysim(tris, *, p, q, limit, gaps=None):
-    from rasterhw.golden_model.sparse.fixed import broadcast_records
+def run_matrix_pysim(tris, *, p, q, limit):
+    """The matrix's testbench (``MatrixFrameBench``) on the generic pysim engine, input FIFOs built 8 deep."""
     from rasterhw.golden_model.sparse.formats import sparse_geometry
-    from rasterhw.sim.sparse.matrix_run import run_matrix_pysim as run
+    from rasterhw.sim.sparse.matrix_run import run_matrix
 
     n = sparse_geometry(tris.width, tris.height, p, q)
-    return run(broadcast_records(tris), n=n, p=p, q=q, limit=limit, z_bits=tris.z_bits, gaps=gaps)
+    return run_matrix(tris, n=n, p=p, q=q, limit=limit, z_bits=tris.z_bits, in_depth=8, engine="pysim")
 
 
 @pytest.mark.parametrize(("size", "matrix", "limit", "ntri", "area"), [

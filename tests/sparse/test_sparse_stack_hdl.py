@@ -10,7 +10,7 @@ from rasterhw.golden_model.reference import random_triangles
 from rasterhw.golden_model.sparse.cycles import service_times
 from rasterhw.golden_model.sparse.search import sparse_render
 from rasterhw.golden_model.sparse.stack import stack_processor
-from rasterhw.sim.sparse.stack_run import compare_stack, run_stack_pysim
+from sparse_stack_run import compare_stack, run_stack_pysim
 
 
 @pytest.mark.parametrize(("matrix", "size", "count", "area", "procs"), [
@@ -71,13 +71,12 @@ def test_coupled_matrix_of_stack_processors_cycle_exact(limit):
     cycle for cycle cycles.coupled_matrix on the stack processors' service times (frame, broadcast
     stalls, FIFO peaks, busy cycles), the frame's end moved only by the last pixels' drain."""
     from rasterhw.golden_model.sparse.cycles import coupled_matrix
-    from rasterhw.golden_model.sparse.fixed import broadcast_records
-    from rasterhw.sim.sparse.matrix_run import run_matrix_pysim
+    from rasterhw.sim.sparse.matrix_run import run_matrix
 
     tris = random_triangles(16, 16, 12, mean_area=16.0, seed=12 + limit)
     f = sparse_render(tris, "2x2", depth="fixed", per_record=True)
     gz = f.depth_words(tris.z_bits)
-    h = run_matrix_pysim(broadcast_records(tris), n=f.n, p=2, q=2, limit=limit, z_bits=tris.z_bits, vp="stack")
+    h = run_matrix(tris, n=f.n, p=2, q=2, limit=limit, z_bits=tris.z_bits, in_depth=8, vp="stack", engine="pysim")
     assert np.array_equal(h["tri"], f.tri_id) and np.array_equal(h["zq"], gz)
     s = service_times(f.stats["windows_per_record"], vp="stack")
     g = coupled_matrix(s, limit)

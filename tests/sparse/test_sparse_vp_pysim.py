@@ -1,12 +1,34 @@
-"""The HDL video processor in Amaranth pysim, bit-exact against the bit-accurate golden model."""
+"""The HDL video processor in Amaranth pysim (its testbench ``ProcessorBench`` on the generic pysim
+engine), bit-exact against the bit-accurate golden model."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 from rasterhw.golden_model.reference import random_triangles
-from rasterhw.golden_model.sparse.search import sparse_render
-from rasterhw.sim.sparse.hdl_run import run_matrix
+from rasterhw.golden_model.sparse.formats import parse_matrix, sparse_geometry
+from rasterhw.golden_model.sparse.search import interleave, sparse_render
+from rasterhw.sim.sparse.verilator_run import run_processor_verilator
+
+
+def run_matrix(tris, matrix, *, processors=None) -> dict:
+    """Every processor (or the listed ``(a, b)``) of the matrix on ``tris``, each on the generic pysim
+    engine; the interleaved frame when all ran, the local memories and per-processor results."""
+    p, q = parse_matrix(matrix)
+    n = sparse_geometry(tris.width, tris.height, p, q)
+    procs = [(a, b) for b in range(q) for a in range(p)] if processors is None else list(processors)
+    N = 1 << n
+    loc_t = np.full((q, p, N, N), -1, dtype=np.int64)
+    loc_z = loc_t.copy()
+    per = {}
+    for a, b in procs:
+        r = run_processor_verilator(tris, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits, engine="pysim")
+        loc_t[b, a], loc_z[b, a] = r["tri"], r["zq"]
+        per[(a, b)] = r
+    out = {"per_processor": per, "local_tri": loc_t, "local_zq": loc_z}
+    if processors is None:
+        out["tri"], out["zq"] = interleave(loc_t), interleave(loc_z)
+    return out
 
 
 def _golden(tris, matrix):

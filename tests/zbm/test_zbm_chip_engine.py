@@ -16,7 +16,7 @@ from rasterhw.golden_model.zbm.stimulus import random_doublez, random_triangles
 from rasterhw.golden_model.zbm.words import merge_words
 from rasterhw.sim.engines import run
 from rasterhw.sim.testbench import Stimulus, find_testbench
-from rasterhw.sim.zbm.chip_bench import chip_stimulus, run_chip_bench
+from zbm_cocotb.chip_bench import chip_stimulus, run_chip_bench
 
 pytestmark = pytest.mark.cocotb
 

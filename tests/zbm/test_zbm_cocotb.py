@@ -20,8 +20,8 @@ from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm.stimulus import random_doublez, random_triangles
 from rasterhw.golden_model.zbm.words import doublez_words
-from rasterhw.sim.zbm.chip_bench import chip_stimulus, run_chip_bench
-from rasterhw.sim.zbm.unit_bench import plusargs, run_unit_bench
+from zbm_cocotb.chip_bench import chip_stimulus, run_chip_bench
+from zbm_cocotb.unit_bench import plusargs, run_unit_bench
 
 pytestmark = pytest.mark.cocotb
 

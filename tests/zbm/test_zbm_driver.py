@@ -9,10 +9,10 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.scenes import SCENES, build_scene
 from rasterhw.golden_model.zbm import words as W
 from rasterhw.golden_model.zbm.stimulus import random_triangles
-from rasterhw.sim.zbm.chip_bench import run_chip_bench
 from rasterhw.sim.zbm.edge_check import check_edge_pairs
 from rasterhw.sim.zbm.scene_run import simulate_zbm
-from rasterhw.sim.zbm.unit_bench import run_unit_bench
+from zbm_cocotb.chip_bench import run_chip_bench
+from zbm_cocotb.unit_bench import run_unit_bench
 
 
 def _scene():

@@ -50,16 +50,21 @@ def test_mapper_bad_maps():
 
 
 def test_mapping_driver_full_rate():
-    """sim/zbm/mapping_hdl.run_mapper_pysim: mapper -> compositor, one pixel per clock, latency
-    2 + 2, the same words as map_samples and the same pixels as composite."""
+    """sim/zbm/mapping_hdl.run_mapping (MappingBench on the generic pysim engine): mapper ->
+    compositor, one pixel per clock, latency 2 + 2, the same words as map_samples and the same
+    pixels as composite (testbench.compare on both output ports)."""
     from rasterhw.golden_model.zbm.composite import composite
-    from rasterhw.sim.zbm.mapping_hdl import run_mapper_pysim
+    from rasterhw.sim.zbm.mapping_hdl import run_mapping
 
     px = random_doublez(np.random.default_rng(2), 40)
     tex, il = default_maps(1)
     want, stats = map_samples(px, tex, il)
-    got, hw = run_mapper_pysim(pixel2_words(px), tex, il)
-    assert got == pixel2_words(want) and hw["texture_lookups"] == stats["texture_lookups"]
+    hw = run_mapping(px, want, composite(want), tex, il)
+    assert hw["mismatches"] == 0 and hw["words_compared"] == 80
+    assert hw["texture_lookups"] == stats["texture_lookups"] and hw["illum_lookups"] == stats["illum_lookups"]
     assert hw["cycles"] == 40 + 2 + 2
+    assert hw["run"].words["o_map"] == pixel2_words(want)
     img = composite(want).astype(np.int64)
-    assert hw["rgb"] == [int(v) for v in img[:, 0] | img[:, 1] << 8 | img[:, 2] << 16]
+    assert hw["run"].words["o"] == [int(v) for v in img[:, 0] | img[:, 1] << 8 | img[:, 2] << 16]
+    wrong = run_mapping(px, want, np.zeros_like(composite(want)), tex, il)   # the check can fail
+    assert wrong["ports"]["o"]["mismatches"] > 0 and wrong["ports"]["o_map"]["mismatches"] == 0

@@ -14,8 +14,9 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.golden_model.zbm.words import doublez_words
 from rasterhw.sim.zbm.scene_run import run_scene
-from rasterhw.sim.zbm.stimfiles import stimulus_depth
-from rasterhw.sim.zbm.unit_bench import run_unit_bench, unit_watchdog
+from rasterhw.sim.zbm.testbench import unit_watchdog
+from zbm_cocotb.stimfiles import stimulus_depth
+from zbm_cocotb.unit_bench import run_unit_bench
 
 pytestmark = pytest.mark.cocotb
 

@@ -16,7 +16,7 @@ from rasterhw.golden_model.zbm.words import edge_pair_words, pixel2_words
 from rasterhw.hdl.zbm.chain import ZbmChain
 from rasterhw.hdl.zbm.unit import ZbmUnit
 from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put
-from rasterhw.sim.zbm.cycles_hdl import measure_cycles_per_edge_pair, run_unit_cycles
+from zbm_unit_cycles import measure_cycles_per_edge_pair, run_unit_cycles
 
 pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 
@@ -163,6 +163,8 @@ def test_line_log_steady_state_equals_model():
     for sched, want in (("paper", 64), ("overlap", 62)):
         r = measure_table1(2, schedule=sched, n_edge_pairs=2)
         assert r["per_edge_pair"] == r["model_marginal"] == want
+        # every merge word of the frame compared on pysim too (issue 46): 20 lines x 8 pixels
+        assert r["words_compared"] == 20 * 8 and r["mismatches"] == 0
 
 
 @pytest.mark.parametrize("interleave,width", [(1, 32), (4, 32),

@@ -41,13 +41,13 @@ def test_interleave_is_checked_once_where_every_block_is_built():
     from rasterhw.golden_model.errors import RasterhwError
     from rasterhw.hdl.zbm.loop import ZbmLoop
     from rasterhw.hdl.zbm.unit import ZbmUnit
-    from rasterhw.sim.zbm.cycles_hdl import measure_cycles_per_edge_pair
+    from rasterhw.sim.zbm.cycles_hdl import measure_table1
 
     assert L.check_interleave is F.check_interleave
     for bad in (3, 0, 32, True, "8", 8.0):
         for build in (lambda i: ZbmUnit(interleave=i, width=64, height=16), lambda i: ZbmLoop(interleave=i),
                       lambda i: ZbmChip(interleave=i), lambda i: G.render_zbm(None, interleave=i),
-                      lambda i: measure_cycles_per_edge_pair(i)):
+                      lambda i: measure_table1(i)):
             with pytest.raises(RasterhwError, match=f"interleave must be 1, 2, 4, 8 or 16, not {bad!r}"):
                 build(bad)
     with pytest.raises(RasterhwError, match="chip must be in 0..3, not 4"):

@@ -1,5 +1,5 @@
 # amaranth: UnusedElaboratable=no
-"""``zbm_chain_flat``: the top the cocotb unit bench (``cocotb_tests/zbm/tb_zbm_unit.v``) puts
+"""``zbm_chain_flat``: the top the cocotb unit bench (``tests/zbm_cocotb/tb_zbm_unit.v``) puts
 around a chain of generated ``zbm-unit``\\s, written in Amaranth and converted like any block.
 
 Unit 0 is the generated head ``zbm_unit`` (no merge inputs); units 1.. are the generated

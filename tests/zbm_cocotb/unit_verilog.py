@@ -1,6 +1,6 @@
 """Generated Verilog of the ZB/M unit and chip benches, from the one cache of generated Verilog
 (``sim/engines/verilog_cache.py``): the chip, the head and tail units of a chain and the chain's
-top (``sim/zbm/chain_flat.py: ChainFlat``). The simulators read files: each text is written once
+top (``chain_flat.py: ChainFlat``). The simulators read files: each text is written once
 to ``build/zbm-verilog/<module>-<digest of the text>.v``."""
 
 from __future__ import annotations
@@ -14,8 +14,9 @@ from rasterhw.sim.engines.verilog import canonical_port_lists, generate_verilog
 from rasterhw.sim.engines.verilog_cache import convert_cached, generate_cached
 from rasterhw.sim.outfile import write_text
 from rasterhw.sim.paths import REPO_ROOT
-from rasterhw.sim.zbm import chain_flat
-from rasterhw.sim.zbm.chain_flat import ChainFlat
+
+from zbm_cocotb import chain_flat
+from zbm_cocotb.chain_flat import ChainFlat
 
 __all__ = ["chain_verilog", "chip_verilog"]
 

@@ -1,6 +1,6 @@
-"""The cocotb chip bench (``cocotb_tests/zbm/tb_zbm_chip.v``): one ``zbm-chip`` on the generated
+"""The cocotb chip bench (``tests/zbm_cocotb/tb_zbm_chip.v``): one ``zbm-chip`` on the generated
 Verilog, segment words and upstream merge words preloaded and played out (gaps, clock ratios,
-back-pressure as the unit bench), and the chip's speed on a scene."""
+back-pressure as the unit bench)."""
 
 from __future__ import annotations
 
@@ -11,8 +11,6 @@ import time
 
 import numpy as np
 from rasterhw.golden_model import zbm as G
-from rasterhw.golden_model.meshio import load_scene
-from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.words import doublez_words, merge_words, segment_words
 from rasterhw.sim.engines.runner import (
@@ -24,14 +22,10 @@ from rasterhw.sim.engines.runner import (
     verilator_make_flags,
 )
 from rasterhw.sim.workdirs import temp_run_folder
-from rasterhw.sim.zbm.stimfiles import (
-    GAP_BITS,
-    memory_depth,
-    random_gaps,
-    read_hex_words,
-    write_hex,
-)
-from rasterhw.sim.zbm.unit_bench import (
+from rasterhw.sim.zbm.testbench import random_gaps
+
+from zbm_cocotb.stimfiles import GAP_BITS, memory_depth, read_hex_words, write_hex
+from zbm_cocotb.unit_bench import (
     BENCH_DIR,
     SIM_ENV,
     TEST_MODULE,
@@ -39,9 +33,9 @@ from rasterhw.sim.zbm.unit_bench import (
     expect_env,
     plusargs,
 )
-from rasterhw.sim.zbm.unit_verilog import chip_verilog
+from zbm_cocotb.unit_verilog import chip_verilog
 
-__all__ = ["chip_speed", "chip_stimulus", "run_chip_bench"]
+__all__ = ["chip_stimulus", "run_chip_bench"]
 
 
 def chip_stimulus(segs: G.Segments, lines: int, upstream: G.DoubleZ, *, chip: int, interleave: int,
@@ -110,21 +104,3 @@ def run_chip_bench(seg_words: list[int], up_words: list[int], *, lines: int, chi
     if os.environ.get("ZBM_KEEP") != "1":
         shutil.rmtree(run_dir, ignore_errors=True)
     return res
-
-
-def chip_speed(*, interleave: int = 8, width: int = 512, height: int = 512, scene: str = "c300",
-               repeat: int = 8, sim: str = "verilator") -> dict:
-    """Segment-clock cycles per second of one chip (chip 0) on preloaded stimulus: the
-    segments of ``scene`` at ``width x height`` (golden segment generator), played ``repeat``
-    times with no gaps or back-pressure; the last repetition is checked bit for bit."""
-    tris = run_geometry(load_scene(scene), width, height)
-    segs = G.segment_generator(G.edge_pairs(tris), height, width=width)
-    npx = -(-width // interleave)
-    up = G.DoubleZ.empty((height, npx))
-    seg_w, up_w, exp = chip_stimulus(segs, height, up, chip=0, interleave=interleave, width=width)
-    r = run_chip_bench(seg_w, up_w, lines=height, chip=0, interleave=interleave, width=width, sim=sim,
-                       repeat=repeat, phase=0, speed_run=True)
-    bad = int(np.count_nonzero((r["s0"] != exp[0]) | (r["s1"] != exp[1])))
-    return {"block": "zbm-chip", "engine": sim, "interleave": interleave, "scene": scene, "repeat": repeat,
-            "cycles": r["cycles"], "run_s": r["run_s"], "build_s": r["build_s"],
-            "cycles_per_s": r["cycles"] / r["run_s"], "mismatches": bad, "proto_errors": r["proto_errors"]}

@@ -1,5 +1,6 @@
-"""The cocotb unit bench (``cocotb_tests/zbm/tb_zbm_unit.v``): a chain of ``zbm-unit``\\s on the
-generated Verilog (``sim/zbm/unit_verilog.py``), Verilog-side clocks with any ratio and phase,
+"""The cocotb unit bench (``tests/zbm_cocotb/tb_zbm_unit.v``), a cross-check of the generic engines
+(a test, not a user path: it is not in the package): a chain of ``zbm-unit``\\s on the
+generated Verilog (``unit_verilog.py``), Verilog-side clocks with any ratio and phase,
 edge pairs preloaded from a hex file and played out, merge words collected into a frame memory
 and dumped, run under cocotb (``sim/engines/runner.py``) on Verilator or Icarus. With the golden
 frame the cocotb test compares every line itself and can run the Python stream checkers
@@ -11,6 +12,7 @@ import json
 import os
 import shutil
 import time
+from pathlib import Path
 
 import numpy as np
 from rasterhw.golden_model import zbm as G
@@ -19,23 +21,23 @@ from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.words import edge_pair_words
 from rasterhw.sim.engines.runner import (
     HARNESS_V,
-    REPO_ROOT,
     build_dir_for,
     get_sim,
     run_cocotb,
     verilator_make_flags,
 )
-from rasterhw.sim.testbench import Clock
 from rasterhw.sim.workdirs import keep as keep_run_folder
 from rasterhw.sim.workdirs import temp_run_folder
-from rasterhw.sim.zbm.stimfiles import GAP_BITS, read_hex_words, stimulus_depth, write_unit_stimulus
-from rasterhw.sim.zbm.unit_verilog import chain_verilog
+from rasterhw.sim.zbm.testbench import bench_clocks, unit_watchdog
+
+from zbm_cocotb.stimfiles import GAP_BITS, read_hex_words, stimulus_depth, write_unit_stimulus
+from zbm_cocotb.unit_verilog import chain_verilog
 
 __all__ = ["BENCH_DIR", "SIM_ENV", "TEST_MODULE", "VERILATOR_ARGS", "bench_clocks", "expect_env", "plusargs",
            "run_unit_bench", "unit_watchdog"]
 
-BENCH_DIR = REPO_ROOT / "cocotb_tests" / "zbm"
-TEST_MODULE = "cocotb_tests.zbm.test_zbm"
+BENCH_DIR = Path(__file__).resolve().parent
+TEST_MODULE = "zbm_cocotb.cocotb_zbm"
 # Verilator: cocotb's runner passes --public-flat-rw, which makes every signal of the ~0.4 MB
 # (chip) / 3 MB (unit, I = 8) generated Verilog public: Verilator then keeps every alias wire
 # as a member, optimises nothing across them and writes megabytes of run-once constructor code
@@ -53,30 +55,12 @@ def plusargs(ratio: tuple[int, int], stall: int, seed: int, maxcyc: int, phase: 
     """Bench plusargs. ``phase`` (ns) delays the merge clock against the segment clock: 1 (the
     tests) puts every merge edge in its own simulator time slot; 0 (speed runs, equal clocks)
     lets both clocks tick in the same slots, half as many evaluations per cycle."""
+    bench_clocks(ratio, phase)   # the ratio and phase checks (the engine's clocks of this bench)
     sh, mh = ratio
-    if phase not in (0, 1):
-        raise RasterhwError(f"merge clock phase must be 0 or 1 ns, not {phase!r}")
-    if not (isinstance(sh, int) and isinstance(mh, int) and sh >= 1 and mh >= 1):
-        raise RasterhwError(f"clock ratio must be two positive integer half periods (ns), not {ratio!r}")
     if not 0 <= stall <= 255:
         raise RasterhwError(f"stall must be in 0..255, not {stall!r}")
     return [f"+sync_half={sh}", f"+merge_half={mh}", f"+merge_phase={phase}", f"+stall={stall}", f"+seed={seed}",
             f"+maxcyc={maxcyc}"]
-
-
-#: rising edges of each clock the benches hold their reset for (``rasterhw_reset #(.CYCLES(6))``)
-RESET_EDGES = 6
-
-
-def bench_clocks(ratio: tuple[int, int], phase: int = 1) -> dict[str, Clock]:
-    """The generic engine's separate clocks (``engines.run(..., clocks=...)``, 1 ns units) that time
-    a run as this bench with ``plusargs(ratio, ..., phase)`` does after its reset: each clock's
-    first edge is its first edge out of reset (``rasterhw_two_clocks`` raises ``clk`` at
-    1 + (2k + 1) * segment half ns and ``mclk`` ``phase`` ns later on its own half period; the
-    engine has no reset, so edge 0 of each domain is the bench's edge ``RESET_EDGES``)."""
-    plusargs(ratio, 0, 1, 1, phase)   # the same checks as the bench's
-    sh, mh = ratio
-    return {"sync": Clock(sh, 1 + (2 * RESET_EDGES + 1) * sh), "merge": Clock(mh, 1 + phase + (2 * RESET_EDGES + 1) * mh)}
 
 
 def expect_env(expect, speed_run: bool) -> dict:
@@ -85,17 +69,6 @@ def expect_env(expect, speed_run: bool) -> dict:
     if expect is None and not speed_run:
         raise RasterhwError("ZB/M bench: give the golden frame (expect=) or say speed_run=True")
     return {"ZBM_SPEED_RUN": "1"} if expect is None else {}
-
-
-def unit_watchdog(total_words: int, *, width: int, height: int, stall: int = 0,
-                  ratio: tuple[int, int] = (5, 5)) -> int:
-    """The unit benches' watchdog in segment clocks (cocotb and plain Verilator alike): generously
-    above any frame this design can take with ready always high and equal clocks, times the
-    expected slow-down of the back-pressure (ready high in ``256 - stall`` of 256 merge clocks) and
-    of a merge clock slower than the segment clock (``ratio`` = half periods, segment : merge)."""
-    base = 200 * (total_words + 64) + 40 * height * (width + 64)
-    slow = 256 / max(1, 256 - stall) * max(1.0, ratio[1] / ratio[0])
-    return min(int(base * max(1.0, slow)), 2**31 - 1)   # the bench's MAXCYC is a Verilog integer
 
 
 def run_unit_bench(eps_per_unit: list[G.EdgePairs], *, width: int, height: int, interleave: int,

@@ -1,4 +1,4 @@
-"""The ZB/M cocotb benches' stimulus and dump files (``cocotb_tests/zbm/``): words with idle
+"""The ZB/M cocotb benches' stimulus and dump files (``tests/zbm_cocotb/``): words with idle
 gaps in ``$readmemh`` hex files, the unit benches' index file, 128-bit frame dumps read back."""
 
 from __future__ import annotations
@@ -9,20 +9,12 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import formats as F
 from rasterhw.sim.engines.memh import memh_uint64, read_memh
+from rasterhw.sim.zbm.testbench import random_gaps
 
-__all__ = ["GAP_BITS", "memory_depth", "random_gaps", "read_hex_words", "stimulus_depth", "write_hex",
+__all__ = ["GAP_BITS", "memory_depth", "read_hex_words", "stimulus_depth", "write_hex",
            "write_unit_stimulus"]
 
 GAP_BITS = 8             # idle clocks before a stimulus word, in the bench's stimulus files
-
-
-def random_gaps(n: int, seed: int | None, *, p_idle: float = 0.3, max_gap: int = 4) -> np.ndarray:
-    """Idle clocks before each of ``n`` words: 0 with probability ``1 - p_idle``, else 1..max_gap.
-    ``seed=None`` gives no gaps."""
-    if seed is None:
-        return np.zeros(n, np.int64)
-    rng = np.random.default_rng(seed)
-    return rng.integers(1, max_gap + 1, n) * (rng.random(n) < p_idle)
 
 
 def write_hex(path: Path, words, gaps, pw: int) -> None:

@@ -1,6 +1,6 @@
 """cocotb benches: ZB/M units (tb_zbm_unit.v) and one ZB/M chip (tb_zbm_chip.v).
 
-Driven by ``rasterhw.sim.zbm.unit_bench.run_unit_bench`` / ``chip_bench.run_chip_bench``, which writes the
+Driven by ``unit_bench.run_unit_bench`` / ``chip_bench.run_chip_bench`` (this folder), which writes the
 stimulus, the golden result and the plusargs (clock ratio, back-pressure, seed); run them
 with ``pytest tests/zbm/test_zbm_cocotb.py``.  The designs run free on Verilog-side clocks;
 Python only waits for ``finished`` unless ZBM_CHECK_PROTOCOL=1, which adds the stream
