@@ -44,10 +44,10 @@ def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: b
           as_json: bool, scheduler: str, store: str | None, fresh: bool) -> None:
     """Synthesise BLOCK (or --all) with Yosys: gate equivalents, flip-flops, RAM bits."""
     from rasterhw.sim.flow.synth import summary_row, synth_all, synth_report, synthesise
-    from rasterhw.sim.flow.tasks import default_store, parse_scheduler
+    from rasterhw.sim.flow.tasks import check_scheduler, default_store
 
-    parse_scheduler(scheduler)
     if all_blocks:
+        check_scheduler(scheduler)
         if block or params:
             raise RasterhwError("--all takes no BLOCK or -p")
         rows = synth_all(small=small, memory=memory, progress=not as_json, scheduler=scheduler,
@@ -63,6 +63,12 @@ def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: b
         return
     if small:
         raise RasterhwError("--small applies only with --all (a named block takes its sizes from -p)")
+    ctx = click.get_current_context()
+    given = [f"--{n}" for n in ("scheduler", "store", "fresh")
+             if ctx.get_parameter_source(n) is not click.core.ParameterSource.DEFAULT]
+    if given:   # they would be accepted and change nothing
+        raise RasterhwError(f"{' and '.join(given)} appl{'ies' if len(given) == 1 else 'y'} only with --all "
+                            "(one named block is synthesised here, not as a task)")
     if block is None:
         raise RasterhwError("name a block (rasterhw verilog --list) or give --all")
     kw = _params(block, params)

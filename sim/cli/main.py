@@ -368,15 +368,16 @@ def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, re
 
     A report's independent runs (ZB/M Table 1, pixel rate, skew and chains; EXPERTS balance;
     fpga place and route; the sparse FIFO-depth sweep) run as tasks on --scheduler (docs/scale.md)."""
-    from rasterhw.sim.flow.tasks import default_store, parse_scheduler
+    from rasterhw.sim.flow.tasks import check_scheduler, default_store, parse_scheduler
     from rasterhw.sim.report.rows import run_report, systems
 
-    parse_scheduler(scheduler)   # a bad one is an error before anything runs
+    parse_scheduler(scheduler)
     names = systems() if system == "all" else [system]
     if rerun and "fpga" not in names:
         raise RasterhwError("--rerun applies to the fpga report only")
     if rerun and fast:
         raise RasterhwError("--rerun and --fast contradict each other")
+    check_scheduler(scheduler)   # what answers at its address too, before anything runs
     rows = []
     for name in names:
         extra = {}
@@ -574,13 +575,13 @@ def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], scheduler: str,
     import secrets
 
     from rasterhw.sim.flow.soak import run_soak
-    from rasterhw.sim.flow.tasks import default_store, parse_scheduler
+    from rasterhw.sim.flow.tasks import check_scheduler, default_store
 
     if seed is not None and not 0 <= seed < 1 << 32:
         raise RasterhwError(f"--seed must be between 0 and {(1 << 32) - 1}, not {seed}")
     if pixels < 1:
         raise RasterhwError(f"--pixels must be 1 or more, not {pixels}")
-    parse_scheduler(scheduler)   # a bad one is an error before anything starts
+    check_scheduler(scheduler)   # a bad one (or one that does not answer as Dask) is an error before anything starts
     seed = secrets.randbelow(1 << 31) if seed is None else seed
     info(f"soak: seed {seed} (rerun: rasterhw soak --seed {seed} --pixels {pixels})")
     rows = run_soak(pixels=pixels, seed=seed, blocks=list(blocks) or None, progress=not as_json,
@@ -619,13 +620,14 @@ def sweep(target: str, params: tuple[str, ...], scenes: tuple[str, ...], size: s
       rasterhw sweep render:experts --param sn=1,2,4,8 --param pn=1,2,4,8 --out out/sweep
     """
     from rasterhw.sim.flow.sweep import plan, run_sweep, write_outputs
-    from rasterhw.sim.flow.tasks import default_store, parse_scheduler
+    from rasterhw.sim.flow.tasks import check_scheduler, default_store, parse_scheduler
 
     wh = parse_size(size)
     parse_scheduler(scheduler)
     if not params:
         raise RasterhwError("say what to sweep: --param NAME=V1,V2,...")
     plan(target, list(params), scenes=list(scenes), size=wh, engine=engine)   # every check before a cluster starts
+    check_scheduler(scheduler)   # then what answers at its address, before any run
     res = run_sweep(target, list(params), scenes=list(scenes) or None, size=wh, engine=engine, scheduler=scheduler,
                     store=store or default_store(), fresh=fresh, progress=not as_json)
     if out_dir is not None:
@@ -653,10 +655,10 @@ def sweep(target: str, params: tuple[str, ...], scenes: tuple[str, ...], size: s
 def demo(out_dir: str, scene: str, engine: str, scheduler: str, store: str | None, fresh: bool) -> None:
     """Render a default scene through the golden model and the hardware; write images and a report.
     The HDL runs are tasks on --scheduler (docs/scale.md)."""
-    from rasterhw.sim.flow.tasks import default_store, parse_scheduler
+    from rasterhw.sim.flow.tasks import check_scheduler, default_store
     from rasterhw.sim.report.demo import run_demo
 
-    parse_scheduler(scheduler)
+    check_scheduler(scheduler)
     out = Path(out_dir)
     existed = out.exists()
     try:

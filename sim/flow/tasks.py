@@ -284,7 +284,9 @@ def _describe(reply: bytes) -> str:
     if reply.startswith(b"HTTP/"):
         first = reply.split(b"\r\n", 1)[0].decode("ascii", "replace")
         server = re.search(rb"\r\nServer: *([^\r\n]{1,60})", reply, re.I)
-        dash = b"bokeh" in reply.lower() or b"dask" in reply.lower() or b"/status" in reply
+        # the dashboard sends "/" to "status" (Tornado's 302), its pages name Bokeh and Dask
+        dash = (re.search(rb"\r\nLocation: *\S*status", reply, re.I) is not None
+                or b"bokeh" in reply.lower() or b"dask" in reply.lower())
         return (f"an HTTP server ({first}{'; ' + server.group(1).decode('ascii', 'replace') if server else ''})"
                 + (": a Dask dashboard? The scheduler's own port is usually 8786" if dash else ""))
     return f"a server that does not speak Dask's protocol (it sent {reply[:24]!r})"
@@ -301,7 +303,8 @@ def _dask_handshake(head: bytes) -> bool:
     return 16 <= total <= 1 << 24 and 1 <= nframes <= 64 and 8 + 8 * nframes <= total
 
 
-_CHECKED: dict[str, float] = {}
+#: addresses :func:`check_scheduler` found a Dask scheduler at (in this process)
+_CHECKED: set[str] = set()
 
 
 def check_scheduler(text: str, *, limit_s: float = SCHEDULER_CHECK_S) -> tuple[str, object]:
@@ -334,7 +337,7 @@ def check_scheduler(text: str, *, limit_s: float = SCHEDULER_CHECK_S) -> tuple[s
     reply = b""
     with sock:
         try:
-            sock.settimeout(min(left(), 5.0))
+            sock.settimeout(min(left(), 2.0))   # a Dask scheduler sends its handshake at once
             while len(reply) < 16:
                 got = sock.recv(4096)
                 if not got:
@@ -356,7 +359,7 @@ def check_scheduler(text: str, *, limit_s: float = SCHEDULER_CHECK_S) -> tuple[s
             except OSError:
                 pass
     if _dask_handshake(reply):
-        _CHECKED[arg] = deadline
+        _CHECKED.add(arg)
         return kind, arg
     what = _describe(reply) if reply else (f"a server that accepted the connection and sent nothing in "
                                            f"{limit_s - left():.0f} s (not a Dask scheduler)")
@@ -416,8 +419,9 @@ class Runner:
                                         dashboard_address=None, silence_logs=logging.ERROR)
             self.client = Client(self.cluster)
         else:
-            check_scheduler(self.scheduler)   # done at once (one time limit) unless the command did it first
-            left = max(1.0, _CHECKED.get(self.arg, time.monotonic() + SCHEDULER_CHECK_S) - time.monotonic())
+            t0 = time.monotonic()
+            check_scheduler(self.scheduler)   # (at once if the command did it first) and the client: one limit
+            left = max(1.0, SCHEDULER_CHECK_S - (time.monotonic() - t0))
             try:
                 self.client = Client(self.arg, timeout=f"{left:.0f}s")
             except (OSError, TimeoutError) as e:
