@@ -688,10 +688,15 @@ def main(argv: list[str] | None = None) -> None:
             signal.signal(sig, _terminate)
         except (ValueError, OSError):  # not the main thread
             pass
+    workdirs.become_subreaper()   # a tool whose parent is killed comes to us, not to PID 1
     try:
         _main(argv)
     finally:
         workdirs.cleanup()
+        # no external tool outlives its command (sim/workdirs.py): whatever is still below us
+        # (a tool a killed Dask worker left, solvers SymbiYosys left), then its work folders
+        workdirs.end_descendants()
+        workdirs.remove_dead_work_folders()
 
 
 def _close_progress_bars() -> None:

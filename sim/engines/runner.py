@@ -18,7 +18,6 @@ import os
 import shutil
 import subprocess
 import sys
-import tempfile
 import time
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
@@ -27,7 +26,7 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.cachefile import matches, sha256_file
 from rasterhw.sim.engines import vlruntime, waves
 from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT, SimulatorUnavailable, verilator_bin_dir
-from rasterhw.sim.workdirs import build_lock, run_child
+from rasterhw.sim.workdirs import build_lock, run_child, work_folder
 
 __all__ = [
     "HARNESS_V",
@@ -339,7 +338,7 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
         # precompiled headers) never leaves a folder the next build would trust; what an
         # interrupted build left (or a folder without its record) is removed here first
         _discard_unfinished(bdir)
-        work = Path(tempfile.mkdtemp(prefix=f".{bdir.name}.tmp-", dir=bdir.parent))
+        work = work_folder(bdir.parent, bdir.name)   # named by host and process: removed if we are killed outright
         try:
             _exe, build_s = _build_plain_in(work, name, top, sources, params=params, opt=opt, defines=defines,
                                             generated=generated, args=args, make=make, profile=profile,

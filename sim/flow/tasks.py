@@ -400,7 +400,7 @@ class Runner:
         self.store = Path(store) if store is not None else None
         self.fresh = fresh
         self.progress = progress
-        self.client = self.cluster = None
+        self.client = self.cluster = self._watch = None
         self.computed = 0           # tasks run (not found in the store)
         self.reused = 0             # tasks whose result came from the store
         self._lock = threading.Lock()
@@ -414,6 +414,10 @@ class Runner:
         from distributed import Client, LocalCluster
 
         if self.kind == "local":
+            from rasterhw.sim.workdirs import OrphanWatch
+
+            # a worker killed mid-build leaves its compiler to this process (a subreaper): ended here
+            self._watch = OrphanWatch().__enter__()
             n = self.arg or _cores()
             self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                         dashboard_address=None, silence_logs=logging.ERROR)
@@ -436,7 +440,9 @@ class Runner:
             self.client.close()
         if self.cluster is not None:
             self.cluster.close()
-        self.client = self.cluster = None
+        if self._watch is not None:
+            self._watch.__exit__()
+        self.client = self.cluster = self._watch = None
 
     @property
     def nworkers(self) -> int:
