@@ -303,6 +303,22 @@ def _dask_handshake(head: bytes) -> bool:
     return 16 <= total <= 1 << 24 and 1 <= nframes <= 64 and 8 + 8 * nframes <= total
 
 
+def _receive(sock, upto: int, timeout: float) -> bytes:
+    """What ``sock`` sends within ``timeout`` seconds, until ``upto`` bytes or it closes (a time-out
+    with nothing is ``b""``; another error is raised)."""
+    out = b""
+    sock.settimeout(timeout)
+    try:
+        while len(out) < upto:
+            got = sock.recv(4096)
+            if not got:
+                break
+            out += got
+    except TimeoutError:
+        pass
+    return out
+
+
 #: addresses :func:`check_scheduler` found a Dask scheduler at (in this process)
 _CHECKED: set[str] = set()
 
@@ -337,25 +353,14 @@ def check_scheduler(text: str, *, limit_s: float = SCHEDULER_CHECK_S) -> tuple[s
     reply = b""
     with sock:
         try:
-            sock.settimeout(min(left(), 2.0))   # a Dask scheduler sends its handshake at once
-            while len(reply) < 16:
-                got = sock.recv(4096)
-                if not got:
-                    break
-                reply += got
-        except TimeoutError:
-            pass
+            reply = _receive(sock, 16, min(left(), 2.0))   # a Dask scheduler sends its handshake at once
         except OSError as e:
             raise RasterhwError(f"the Dask scheduler at {arg} closed the connection ({e.strerror or e})") from None
         if not reply:   # silent: ask it as a web server would, to say what it is
             try:
                 sock.settimeout(min(left(), 3.0))
                 sock.sendall(f"GET / HTTP/1.0\r\nHost: {host}\r\n\r\n".encode())
-                while len(reply) < 512:
-                    got = sock.recv(4096)
-                    if not got:
-                        break
-                    reply += got
+                reply = _receive(sock, 512, min(left(), 3.0))
             except OSError:
                 pass
     if _dask_handshake(reply):
