@@ -425,7 +425,11 @@ class Runner:
             self._watch = OrphanWatch().__enter__()
             n = self.arg or _cores()
             self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                        dashboard_address=None, silence_logs=logging.ERROR)
+                                        dashboard_address=None, silence_logs=logging.ERROR,
+                                        # no dashboard; the scheduler's own small HTTP server (health
+                                        # routes) on a free loopback port, not 8787 ("Port 8787 is
+                                        # already in use" on stderr when another cluster has it)
+                                        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"})
             self.client = Client(self.cluster)
         else:
             t0 = time.monotonic()
