@@ -425,8 +425,11 @@ class Runner:
             self._watch = OrphanWatch().__enter__()
             n = self.arg or _cores()
             self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                        dashboard_address=None, silence_logs=logging.ERROR,
-                                        # no dashboard; the scheduler's own small HTTP server (health
+                                        dashboard_address=None, silence_logs=logging.CRITICAL,
+                                        # a task's error reaches the caller through its result (one
+                                        # line); the workers' own error logs (a failed task's traceback,
+                                        # a closed connection when the command is interrupted) are not
+                                        # printed. No dashboard; the scheduler's own small HTTP server (health
                                         # routes) on a free loopback port, not 8787 ("Port 8787 is
                                         # already in use" on stderr when another cluster has it)
                                         scheduler_kwargs={"dashboard_address": "127.0.0.1:0"})
