@@ -152,6 +152,22 @@ def test_a_truncated_verilator_binary_is_said_and_rebuilt(tmp_path, monkeypatch,
     _runs(exe2)
 
 
+def test_a_build_folder_planted_as_a_link_is_replaced_not_followed(tmp_path, monkeypatch):
+    monkeypatch.setattr(runner, "BUILD_ROOT", tmp_path / "build")
+    src = _counter(tmp_path)
+    kw = dict(params={}, defines={"RASTERHW_CYCLES": 1}, opt="-O0")
+    bdir = runner.plain_build_dir("rel-count", "tb_rel_count", [src], **kw)
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    (outside / "keep.txt").write_text("mine\n")
+    bdir.parent.mkdir(parents=True)
+    bdir.symlink_to(outside)
+    exe, secs = runner.build_plain_verilator("rel-count", "tb_rel_count", [src], **kw)
+    assert secs > 0 and not bdir.is_symlink() and exe.is_file()
+    assert [p.name for p in outside.iterdir()] == ["keep.txt"] and (outside / "keep.txt").read_text() == "mine\n"
+    _runs(exe)
+
+
 def test_a_model_that_crashes_names_its_build_folder(tmp_path):
     exe = tmp_path / "b" / "obj_dir" / "Vcrash"
     exe.parent.mkdir(parents=True)

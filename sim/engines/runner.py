@@ -374,6 +374,8 @@ def _built(bdir: Path, exe: Path, *, quiet: bool = False) -> bool:
 def _discard_unfinished(bdir: Path) -> None:
     """Remove ``bdir`` (it has no finished build) and the work folders of interrupted builds of it."""
     for d in [bdir, *bdir.parent.glob(f".{bdir.name}.tmp-*")]:
+        if d.is_symlink():   # a link planted in the cache: removed, never followed (issue 47)
+            d.unlink()
         shutil.rmtree(d, ignore_errors=True)
 
 
