@@ -1,7 +1,11 @@
 """Load OBJ / PLY meshes into a :class:`Scene`, and resolve a scene spec (built-in or file).
 
-Meshes are read with trimesh (``force="mesh"``, ``process=False``: vertices are neither merged
-nor reordered). Polygons with more than 3 corners are triangulated by trimesh. The camera is
+OBJ files pass the project's own normaliser (:func:`_normalise_obj`: any white space, line ends,
+comments, relative indices, polygons cut by :func:`triangulate_polygon`, every malformed face
+refused with its line number) and are then read by trimesh (``force="mesh"``, ``process=False``:
+vertices are neither merged nor reordered). PLY files are read by the project's own reader
+(:mod:`rasterhw.golden_model.plyread`: ASCII and binary of both byte orders, faces of any size
+mixed, as exporters write them). The camera is
 placed to frame the mesh's bounding box; one parallel light; colours are the file's vertex or
 face colours when it has them, grey otherwise.
 
@@ -19,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.plyread import PlyMesh, read_ply
 from rasterhw.golden_model.scene import Camera, Light, Material, Scene
 
 __all__ = ["MESH_EXTENSIONS", "decode_text", "load_mesh", "load_scene", "triangulate_polygon"]
@@ -68,20 +73,6 @@ def decode_text(raw: bytes) -> tuple[str, str]:
     if best is not None:
         return str(best), best.encoding.replace("_", "-")
     return raw.decode("latin-1"), "latin-1"
-
-
-def _ascii_ply_header(raw: bytes) -> bytes:
-    """A PLY header is ASCII keywords, but comments may hold any bytes (trimesh decodes the
-    header as UTF-8 and fails on a Latin-1 comment): non-ASCII header text becomes ``?``;
-    the body (binary or ASCII numbers) is left as it is."""
-    end = raw.find(b"end_header")
-    if end < 0:
-        return raw
-    head = raw[:end]
-    if head.isascii():
-        return raw
-    text, _enc = decode_text(head)
-    return text.encode("ascii", errors="replace") + raw[end:]
 
 
 def _read_bytes(path: Path) -> bytes:
@@ -149,15 +140,23 @@ def triangulate_polygon(points: np.ndarray) -> list[tuple[int, int, int]]:
     return out
 
 
-_SHORT_VERTEX = re.compile(r"^v(?:[ \t]+\S+){0,2}[ \t]*$", re.M)
+_SHORT_VERTEX = re.compile(r"^v(?: +\S+){0,2} *$", re.M)
+#: every white-space character OBJ allows between words (and Python's ``str.split`` splits on)
+#: but the line end, as a space: tabs, vertical tabs, form feeds
+_OBJ_BLANKS = str.maketrans({"\t": " ", "\v": " ", "\f": " "})
+#: a face of exactly three corners, each ``v``, ``v/vt``, ``v//vn`` or ``v/vt/vn`` with absolute
+#: (positive) indices: what trimesh reads exactly as written
+_CORNER = r"[1-9][0-9]*(?:/(?:[1-9][0-9]*)?(?:/[1-9][0-9]*)?)?"
+_PLAIN_FACE = re.compile(rf"^f +({_CORNER}) +({_CORNER}) +({_CORNER}) *$", re.M)
 
 
 def _obj_is_plain(text: str) -> bool:
-    """True if ``text`` has none of what only :func:`_normalise_obj` reads right (CR line ends,
-    indentation, continued lines, inline comments, vertices of fewer than 3 coordinates); faces
-    are looked at by :func:`_check_obj_faces`. Substring tests and one regular expression: a
-    million-face file is not walked line by line in Python twice."""
-    if "\r" in text or "\\" in text or text[:1] in (" ", "\t") or "\n " in text or "\n\t" in text:
+    """True if ``text`` (white space already spaces) has none of what only the full pass of
+    :func:`_normalise_obj` reads right (CR line ends, indentation, continued lines, inline
+    comments, vertices of fewer than 3 coordinates) and every face is a plain triangle
+    (:data:`_PLAIN_FACE`) whose indices the file's vertices cover. Substring tests and regular
+    expressions: a million-face file is not walked line by line in Python."""
+    if "\r" in text or "\\" in text or text[:1] == " " or "\n " in text:
         return False
     at = text.find("#")
     while at >= 0:
@@ -166,27 +165,18 @@ def _obj_is_plain(text: str) -> bool:
             return False   # something before the # on its line: an inline comment
         nl = text.find("\n", at)
         at = -1 if nl < 0 else text.find("#", nl)
-    return _SHORT_VERTEX.search(text) is None
-
-
-def _check_obj_faces(path: Path, text: str) -> bool:
-    """What trimesh gets wrong silently in an OBJ's faces, found in the raw text: a face with
-    fewer than 3 vertices (dropped) and vertex index 0 (OBJ counts from 1; NumPy would read
-    0 - 1 as the last vertex). An index that is not an integer is an error too. Returns True if a
-    face is a polygon of more than 3 corners or has a relative index (:func:`_normalise_obj`
-    rewrites those), False if every face is a plain triangle."""
-    rewrite = False
-    for lineno, line in enumerate(text.splitlines(), 1):
-        if not (line.startswith("f") and line[1:2].isspace()):
-            continue
-        corners = line.split("#", 1)[0].split()[1:]
-        if len(corners) > 3 or "-" in line:
-            rewrite = True
-        if len(corners) < 3:
-            raise RasterhwError(f"{path}: line {lineno}: face has {len(corners)} vertices (a face needs at least 3)")
-        for c in corners:
-            _face_index(c.split("/", 1)[0], c, path, lineno)
-    return rewrite
+    if _SHORT_VERTEX.search(text) is not None:
+        return False
+    faces = text.count("\nf ") + text.startswith("f ")
+    if re.search(r"^f(?: |$)", text, re.M) is None and not faces:
+        return True
+    if re.search(r"^f$", text, re.M) is not None:
+        return False
+    n, top = 0, 0
+    for m in _PLAIN_FACE.finditer(text):
+        n += 1
+        top = max(top, *(int(m.group(k).split("/", 1)[0]) for k in (1, 2, 3)))
+    return n == faces and top <= text.count("\nv ") + text.startswith("v ")
 
 
 def _face_index(part: str, corner: str, path, lineno: int) -> int:
@@ -202,14 +192,21 @@ def _face_index(part: str, corner: str, path, lineno: int) -> int:
 
 
 def _normalise_obj(path: Path, text: str) -> str:
-    """The OBJ ``text`` rewritten so that trimesh reads exactly what the file says: line ends
+    """The OBJ ``text`` rewritten so that trimesh reads exactly what the file says (every OBJ
+    passes here). White space between words may be any (tabs, vertical tabs, form feeds: made
+    spaces); a file that is then plain (:func:`_obj_is_plain`: every face a triangle of absolute
+    indices the file has) is what the full pass would write, and is returned as it is. Else: line ends
     (``\\r\\n``, ``\\r`` alone, ``\\n``) and backslash-continued lines joined, comments
     (whole-line and inline ``#``) and indentation removed, relative (negative) indices turned into
     absolute ones counted from the vertices read *so far* (the OBJ rule; trimesh counted from the
     end of the file), and polygons of more than 3 corners cut into triangles by
     :func:`triangulate_polygon`. Errors name the line: a vertex with fewer than 3 coordinates or
     a coordinate that is not a number, a face of fewer than 3 corners, index 0, an index that is
-    not an integer or refers to a vertex the file does not have."""
+    not an integer or refers to a vertex the file does not have, a corner of more than three
+    indices (``f 1/1/1/1 2 3``)."""
+    text = text.translate(_OBJ_BLANKS)
+    if _obj_is_plain(text):
+        return text
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
     out: list[str] = []
     faces: list[tuple[int, int, list[list[int | None]]]] = []   # (line number, out slot, corners)
@@ -284,88 +281,6 @@ def _is_float(w: str) -> bool:
     except ValueError:
         return False
     return True
-
-
-def _check_ply_faces(path: Path, mesh) -> None:
-    """trimesh drops short PLY faces too; its raw element data (kept in metadata) still has them."""
-    try:
-        face = mesh.metadata.get("_ply_raw", {}).get("face")
-        if face is None:
-            return
-        data = face["data"]
-        name = next(iter(face["properties"]))
-        col = data[name]
-        if isinstance(col, np.ndarray) and col.dtype == object:  # ASCII: ragged lists
-            counts = np.fromiter((len(f) for f in col), dtype=np.int64, count=len(col))
-        elif isinstance(col, np.ndarray) and col.dtype.names:  # binary: (count, list) records
-            counts = np.asarray(col[col.dtype.names[0]], dtype=np.int64)
-        else:
-            counts = np.full(len(col), np.asarray(col).shape[-1] if np.ndim(col) > 1 else 3)
-    except Exception:  # private trimesh layout changed: fall back to trusting trimesh
-        return
-    bad = np.flatnonzero(counts < 3)
-    if bad.size:
-        raise RasterhwError(
-            f"{path}: face {int(bad[0])} has {int(counts[bad[0]])} vertices (a face needs at least 3)"
-        )
-
-
-def _check_ascii_ply(path: Path, raw: bytes) -> None:
-    """An ASCII PLY's face lines say how many corners follow; trimesh reads ``5 0 1 2`` as a
-    triangle. With the face element's one property a list (the common layout), every face line
-    must hold exactly that many indices."""
-    end = raw.find(b"end_header")
-    if end < 0 or b"format ascii" not in raw[:end]:
-        return
-    elements: list[list] = []   # [name, count, [property kinds]]
-    for line in raw[:end].decode("ascii", errors="replace").splitlines():
-        w = line.split()
-        if len(w) >= 3 and w[0] == "element":
-            try:
-                elements.append([w[1], int(w[2]), []])
-            except ValueError:
-                return
-        elif w[:1] == ["property"] and elements:
-            elements[-1][2].append(w[1])
-    body = raw[end:].split(b"\n", 1)[1] if b"\n" in raw[end:] else b""
-    lines = [ln for ln in body.decode("ascii", errors="replace").splitlines() if ln.strip()]
-    row = 0
-    for name, count, props in elements:
-        if name == "face" and props == ["list"]:
-            for k, ln in enumerate(lines[row:row + count]):
-                w = ln.split()
-                try:
-                    n = int(float(w[0]))
-                except ValueError:
-                    raise RasterhwError(f"{path}: face {k}: corner count {w[0][:20]!r} is not a number") from None
-                if len(w) - 1 != n:
-                    raise RasterhwError(f"{path}: face {k} says {n} corners but lists {len(w) - 1}")
-            return
-        row += count
-
-
-def _retriangulate_ply(mesh, verts: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """PLY polygons of more than 3 corners cut by :func:`triangulate_polygon` (trimesh fans
-    them from the first corner, wrong for a concave one); ``faces`` unchanged if there are none
-    or the raw polygons are not where this trimesh keeps them."""
-    try:
-        face = mesh.metadata.get("_ply_raw", {}).get("face")
-        col = face["data"][next(iter(face["properties"]))]
-        if isinstance(col, np.ndarray) and col.dtype.names:   # binary: (count, list) records
-            polys = [list(r[col.dtype.names[1]][: r[col.dtype.names[0]]]) for r in col]
-        else:
-            polys = [list(np.asarray(f).ravel()) for f in col]
-    except Exception:  # noqa: BLE001 - private trimesh layout changed: keep its triangles
-        return faces
-    if all(len(q) <= 3 for q in polys) or sum(len(q) - 2 for q in polys) != len(faces):
-        return faces
-    out = []
-    for q in polys:
-        q = np.asarray(q, dtype=np.int64)
-        if q.min() < 0 or q.max() >= len(verts):
-            return faces
-        out += [(q[a], q[b], q[c]) for a, b, c in triangulate_polygon(verts[q])]
-    return np.asarray(out, dtype=np.int64)   # n - 2 per polygon, in order: face colours still line up
 
 
 #: peak bytes per face while a mesh loads (trimesh's parse, our scene's positions, normals and
@@ -449,12 +364,9 @@ def load_mesh(path: str | Path, *, name: str | None = None, smooth: bool = True)
         # UTF-16, Latin-1) and hand trimesh clean UTF-8, so it never guesses (its guesser
         # needs an optional package) and a BOM never hides the first line.
         text, _enc = decode_text(raw)
-        if not _obj_is_plain(text) or _check_obj_faces(path, text):
-            text = _normalise_obj(path, text)
-        raw = text.encode("utf-8")
-    elif ext == ".ply":
-        _check_ascii_ply(path, raw)
-        raw = _ascii_ply_header(raw)
+        raw = _normalise_obj(path, text).encode("utf-8")
+    else:   # PLY: the project's own reader (binary of either byte order, faces of any size mixed)
+        return _scene_of(path, *_ply_triangles(read_ply(path, raw)), name=name, smooth=smooth)
 
     import io
 
@@ -467,7 +379,12 @@ def load_mesh(path: str | Path, *, name: str | None = None, smooth: bool = True)
     try:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore")
-            resolver = trimesh.resolvers.FilePathResolver(str(path.resolve()))
+            where = str(path.resolve())
+            try:   # material files beside the mesh; a name that is not UTF-8 (bytes kept as surrogates) has none
+                where.encode("utf-8")
+                resolver = trimesh.resolvers.FilePathResolver(where)
+            except UnicodeEncodeError:
+                resolver = None
             mesh = trimesh.load(io.BytesIO(raw), file_type=ext[1:], force="mesh", process=False,
                                 resolver=resolver)
             faces = np.asarray(mesh.faces, dtype=np.int64)
@@ -481,9 +398,86 @@ def load_mesh(path: str | Path, *, name: str | None = None, smooth: bool = True)
     finally:
         log.setLevel(old_level)
 
-    if ext == ".ply":
-        _check_ply_faces(path, mesh)
-        faces = _retriangulate_ply(mesh, verts, faces)
+    return _scene_of(path, verts, faces, _colours(mesh, faces), name=name, smooth=smooth)
+
+
+def _ply_triangles(ply: PlyMesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(vertices, triangles, corner colours) of a PLY mesh: each polygon of more than 3 corners
+    cut by :func:`triangulate_polygon` (n - 2 triangles, in the file's order; a convex one fanned
+    from its first corner, as OBJ's), a face's colour on each of its triangles."""
+    verts, corners, starts = ply.vertices, ply.corners, ply.starts
+    sizes = np.diff(starts)
+    if sizes.size and np.all(sizes == 3):
+        faces, owner = corners.reshape(-1, 3), np.arange(len(sizes))
+    else:
+        faces, owner = _cut_polygons(verts, corners, starts)
+    if ply.vertex_colours is not None:
+        col = ply.vertex_colours[faces]
+    elif ply.face_colours is not None:
+        col = np.repeat(ply.face_colours[owner][:, None, :], 3, axis=1)
+    else:
+        col = np.broadcast_to(np.array(_GREY), (len(faces), 3, 3)).copy()
+    return verts, faces, col
+
+
+def _convex_mask(p: np.ndarray) -> np.ndarray:
+    """For polygons ``p`` (m, n, 3) of n corners each: which ones :func:`triangulate_polygon`
+    fans (convex in its projection, or with no normal), by the same arithmetic in the same order,
+    for all of them at once."""
+    m, n, _ = p.shape
+    nrm = np.zeros((m, 3))
+    for i in range(n):
+        a, b = p[:, i], p[:, (i + 1) % n]
+        nrm += np.stack([(a[:, 1] - b[:, 1]) * (a[:, 2] + b[:, 2]), (a[:, 2] - b[:, 2]) * (a[:, 0] + b[:, 0]),
+                         (a[:, 0] - b[:, 0]) * (a[:, 1] + b[:, 1])], axis=1)
+    drop = np.argmax(np.abs(nrm), axis=1)
+    lead = nrm[np.arange(m), drop]
+    uv = np.array([(1, 2), (2, 0), (0, 1)])[drop]
+    rows, cols = np.arange(m)[:, None], np.arange(n)[None, :]
+    xy = np.stack([p[rows, cols, uv[:, 0][:, None]], p[rows, cols, uv[:, 1][:, None]]], axis=2)
+    xy[:, :, 0] *= np.where(lead > 0, 1.0, -1.0)[:, None]
+    scale = np.abs(xy).max(axis=(1, 2))
+    scale = np.where(scale == 0, 1.0, scale)
+    eps = 1e-12 * scale * scale
+    ok = np.ones(m, dtype=bool)
+    for i in range(n):
+        o, a, b = xy[:, i], xy[:, (i + 1) % n], xy[:, (i + 2) % n]
+        c = (a[:, 0] - o[:, 0]) * (b[:, 1] - o[:, 1]) - (a[:, 1] - o[:, 1]) * (b[:, 0] - o[:, 0])
+        ok &= c >= -eps
+    return ok | (lead == 0)
+
+
+def _cut_polygons(verts: np.ndarray, corners: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(triangles, the polygon each comes from) of polygons ``corners[starts[k]:starts[k+1]]``:
+    :func:`triangulate_polygon` of each, in order; the polygons it fans (most: every triangle and
+    every convex quad) are cut for a whole size at once, the rest one by one."""
+    sizes = np.diff(starts)
+    tri_of = np.zeros(len(sizes) + 1, dtype=np.int64)
+    np.cumsum(sizes - 2, out=tri_of[1:])
+    faces = np.empty((int(tri_of[-1]), 3), dtype=np.int64)
+    owner = np.repeat(np.arange(len(sizes)), sizes - 2)
+    for n in np.unique(sizes).tolist():
+        ks = np.flatnonzero(sizes == n)
+        q = corners[starts[ks][:, None] + np.arange(n)]          # (m, n) vertex indices
+        fan = np.ones(len(ks), dtype=bool) if n == 3 else _convex_mask(verts[q])
+        for j in range(1, n - 1):                                # the fan (0, j, j + 1)
+            faces[tri_of[ks[fan]] + j - 1] = q[fan][:, [0, j, j + 1]]
+        for k, qk in zip(ks[~fan].tolist(), q[~fan], strict=True):
+            faces[tri_of[k]:tri_of[k + 1]] = [(qk[a], qk[b], qk[c]) for a, b, c in triangulate_polygon(verts[qk])]
+    return faces, owner
+
+
+def _scene_name(path: Path) -> str:
+    """The file's stem as text (a byte that is not UTF-8 shown as U+FFFD, never a surrogate that
+    cannot be written out)."""
+    import os
+
+    return os.fsencode(path.stem).decode("utf-8", errors="replace")
+
+
+def _scene_of(path: Path, verts: np.ndarray, faces: np.ndarray, col: np.ndarray, *, name: str | None,
+              smooth: bool) -> Scene:
+    """The checked :class:`Scene` of triangles ``faces`` over ``verts`` with corner colours ``col``."""
     if faces.ndim != 2 or faces.shape[0] == 0:
         raise RasterhwError(f"{path}: no faces (not a polygon mesh, or nothing trimesh could parse)")
     if faces.shape[1] != 3:
@@ -516,10 +510,8 @@ def load_mesh(path: str | Path, *, name: str | None = None, smooth: bool = True)
     length = np.linalg.norm(nrm, axis=-1, keepdims=True)
     # Degenerate triangles (and vertices only they touch) have no normal: use +z, stay finite.
     nrm = np.where(length > 0, nrm / np.where(length > 0, length, 1.0), np.array([0.0, 0.0, 1.0]))
-    col = _colours(mesh, faces)
-
     return Scene(
-        name=name if name is not None else path.stem,
+        name=name if name is not None else _scene_name(path),
         positions=pos, normals=nrm, colours=col, nverts=np.full(len(faces), 3, dtype=np.int64),
         camera=_frame_camera(lo, hi), lights=(Light(direction=(-0.4, -1.0, -0.6)),),
         ambient=(0.2, 0.2, 0.2), material=Material(ka=1.0, kd=0.8, ks=0.0),

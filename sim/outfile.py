@@ -137,6 +137,15 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         except FileNotFoundError:
             st = None
         if st is None:
+            # a link whose target has no name to resolve (``/dev/stdout`` -> ``/proc/self/fd/1`` ->
+            # ``pipe:[...]``): what it opens is what counts
+            try:
+                st = os.stat(text)
+            except OSError:
+                st = None
+            if st is not None and not stat.S_ISREG(st.st_mode) and not stat.S_ISDIR(st.st_mode):
+                target = Path(text)
+        if st is None:
             kind = "new"
         elif stat.S_ISDIR(st.st_mode):
             raise RasterhwError(f"{text!r} is a folder, not a file name")

@@ -10,8 +10,15 @@
   them for debugging; :func:`keep` keeps one a caller asked to keep (and the runner keeps the
   folder of a simulation whose checks failed: its error names the logs there);
 * :func:`run_child` — ``subprocess.run`` whose child is killed with the parent: by the kernel
-  if the parent dies (``PR_SET_PDEATHSIG``), and, with its whole process group (make,
-  the compiler), if the parent is interrupted or fails while waiting.
+  if the parent dies (``PR_SET_PDEATHSIG``), and, with its whole process tree (make, the
+  compiler, SymbiYosys's solvers in process groups of their own: :func:`end_tree`, psutil), if
+  the parent is interrupted or fails while waiting;
+* the one mechanism that no external tool outlives its command: the CLI makes itself a
+  subreaper (:func:`become_subreaper`: what a killed parent leaves comes to it, not to PID 1),
+  ends what it inherits while a local Dask cluster runs (:class:`OrphanWatch`: a worker killed
+  mid-build) and, last, everything below it (:func:`end_descendants`); builds work in
+  work folders (:func:`work_folder`) named by host and process, removed once their process is gone
+  (:func:`remove_dead_work_folders`).
 """
 
 from __future__ import annotations
@@ -20,17 +27,22 @@ import atexit
 import contextlib
 import ctypes
 import os
+import re
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import tempfile
-from collections.abc import Iterator, Sequence
+import threading
+import time
+from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 
 from filelock import FileLock, Timeout
 
-__all__ = ["build_lock", "cleanup", "keep", "run_child", "run_folder", "temp_run_folder"]
+__all__ = ["OrphanWatch", "become_subreaper", "build_lock", "cleanup", "end_descendants", "end_orphans", "end_tree",
+           "keep", "remove_dead_work_folders", "run_child", "run_folder", "temp_run_folder", "work_folder"]
 
 _live: set[Path] = set()
 _held: set[str] = set()
@@ -107,6 +119,182 @@ def cleanup() -> None:
 atexit.register(cleanup)
 
 
+# ---------------------------------------------------------------- process trees
+#: pids :func:`run_child` started in this process and has not reaped yet (not orphans)
+_started: set[int] = set()
+_PR_SET_CHILD_SUBREAPER = 36
+
+
+def _libc():
+    try:
+        return ctypes.CDLL(None, use_errno=True)
+    except OSError:   # pragma: no cover - not Linux
+        return None
+
+
+def become_subreaper() -> bool:
+    """Make this process the one that inherits every orphaned process below it (Linux
+    ``PR_SET_CHILD_SUBREAPER``) instead of PID 1: a tool whose parent died (a Dask worker killed
+    mid-build, SymbiYosys killed under its solvers) stays findable here, and :func:`end_orphans`
+    and :func:`end_descendants` end it. The CLI calls it first thing; False where not supported."""
+    lib = _libc() if sys.platform.startswith("linux") else None
+    try:
+        return bool(lib is not None and lib.prctl(_PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0) == 0)
+    except AttributeError:   # pragma: no cover
+        return False
+
+
+def _is_subreaper() -> bool:
+    lib = _libc() if sys.platform.startswith("linux") else None
+    if lib is None:
+        return False
+    flag = ctypes.c_int(0)
+    try:
+        return lib.prctl(37, ctypes.byref(flag), 0, 0, 0) == 0 and bool(flag.value)   # PR_GET_CHILD_SUBREAPER
+    except AttributeError:   # pragma: no cover
+        return False
+
+
+def end_tree(pids: Iterable[int], *, reap_roots: bool = False) -> int:
+    """End the processes ``pids`` and every process descended from them, whatever process group or
+    session they put themselves in (SymbiYosys starts each solver in a group of its own; make,
+    the compiler and ``cc1plus`` sit under Verilator's make): every one found is stopped first
+    (``SIGSTOP``: none can start another), the tree looked at again until nothing new appears, then
+    all are killed (``SIGKILL``) and those that became this process's children reaped. The roots
+    themselves are reaped only if ``reap_roots`` (a :class:`subprocess.Popen` reaps its own).
+    Returns how many processes were ended (psutil)."""
+    import psutil
+
+    me = os.getpid()
+    roots = set(pids) - {me}
+    found: dict[int, psutil.Process] = {}
+    frontier = []
+    for pid in roots:
+        with contextlib.suppress(psutil.Error):
+            frontier.append(psutil.Process(pid))
+    for _ in range(100):
+        new = []
+        for proc in frontier:
+            try:
+                family = [proc, *proc.children(recursive=True)]
+            except psutil.Error:
+                family = [proc]
+            for q in family:
+                if q.pid != me and q.pid not in found:
+                    found[q.pid] = q
+                    new.append(q)
+                    with contextlib.suppress(psutil.Error):
+                        q.suspend()
+        if not new:
+            break
+        frontier = new
+    for q in found.values():
+        with contextlib.suppress(psutil.Error):
+            q.kill()
+    deadline = time.monotonic() + 5.0
+    left = {pid for pid in found if pid not in roots or reap_roots}
+    while left and time.monotonic() < deadline:
+        for pid in list(left):
+            try:
+                done, _ = os.waitpid(pid, os.WNOHANG)   # ours (a subreaper's orphan): reap it
+                if done:
+                    left.discard(pid)
+                    continue
+            except ChildProcessError:
+                pass
+            try:
+                if found[pid].status() == psutil.STATUS_ZOMBIE:   # someone else's to reap: it is dead
+                    left.discard(pid)
+            except psutil.Error:
+                left.discard(pid)
+        if left:
+            time.sleep(0.02)
+    return len(found)
+
+
+def end_orphans() -> int:
+    """End every process this (subreaper) process inherited: a child it did not start itself
+    (:func:`run_child` or in its own process group, as ``subprocess`` and ``multiprocessing``
+    children are), with its whole tree. Returns how many processes were ended."""
+    import psutil
+
+    try:
+        kids = psutil.Process().children()
+        mine = os.getpgrp()
+        orphans = [k.pid for k in kids if k.pid not in _started and os.getpgid(k.pid) != mine]
+    except (psutil.Error, OSError):
+        return 0
+    return end_tree(orphans, reap_roots=True) if orphans else 0
+
+
+def end_descendants() -> int:
+    """End every process below this one (its whole tree: children, their children, the orphans
+    it inherited as a subreaper). The CLI calls it last, however a command ended."""
+    import psutil
+
+    try:
+        kids = [k.pid for k in psutil.Process().children()]
+    except psutil.Error:
+        return 0
+    return end_tree([k for k in kids if k not in _started], reap_roots=True) + end_tree(
+        [k for k in kids if k in _started])
+
+
+class OrphanWatch:
+    """``with OrphanWatch():`` ends, every ``period`` seconds, the processes a subreaper process
+    inherits while it waits on others (a Dask worker killed mid-build leaves its compiler to the
+    process that started the local cluster). Does nothing unless this process is a subreaper."""
+
+    def __init__(self, period: float = 1.0):
+        self.period = period
+        self._stop = threading.Event()
+        self._thread = None
+
+    def __enter__(self):
+        if _is_subreaper():
+            self._thread = threading.Thread(target=self._run, name="rasterhw-orphans", daemon=True)
+            self._thread.start()
+        return self
+
+    def _run(self) -> None:
+        while not self._stop.wait(self.period):
+            with contextlib.suppress(Exception):
+                end_orphans()
+                remove_dead_work_folders()
+
+    def __exit__(self, *exc) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(5)
+
+
+# ---------------------------------------------------------------- work folders of one process
+def work_folder(parent: str | Path, name: str) -> Path:
+    """A new folder ``parent/.NAME.tmp-HOST-PID-*`` for a build in progress: the host and the
+    process are in its name, so one left by a process that was killed outright (a Dask worker
+    ended mid-build) is removed by :func:`remove_dead_work_folders` (and by the next build of
+    the same model), never one still in use."""
+    return Path(tempfile.mkdtemp(prefix=f".{name}.tmp-{_HOST}-{os.getpid()}-", dir=parent))
+
+
+_HOST = re.sub(r"[^A-Za-z0-9]", "", socket.gethostname())[:32] or "host"
+
+
+def remove_dead_work_folders(parent: str | Path | None = None) -> int:
+    """Remove the work folders (:func:`work_folder`) under ``parent`` (default the build root) of
+    processes of this host that no longer run; returns how many."""
+    import psutil
+    from rasterhw.sim.paths import BUILD_ROOT
+
+    n = 0
+    for d in Path(parent or BUILD_ROOT).glob(f".*.tmp-{_HOST}-*-*"):
+        m = re.search(rf"\.tmp-{_HOST}-(\d+)-[^-]*$", d.name)
+        if m and d.is_dir() and not psutil.pid_exists(int(m.group(1))):
+            shutil.rmtree(d, ignore_errors=True)
+            n += 1
+    return n
+
+
 def _die_with_parent() -> None:  # runs in the child between fork and exec
     try:
         libc = ctypes.CDLL(None, use_errno=True)
@@ -138,17 +326,19 @@ def run_child(cmd: Sequence[str], *, timeout: float | None = None, **kw) -> subp
     if kw.pop("capture_output", False):
         kw["stdout"] = kw["stderr"] = subprocess.PIPE
     with _Popen(cmd, preexec_fn=_die_with_parent if linux else None, process_group=0, **kw) as p:
+        _started.add(p.pid)
         try:
             out, err = p.communicate(timeout=timeout)
         except BaseException:
-            with contextlib.suppress(ProcessLookupError, PermissionError):
-                os.killpg(p.pid, signal.SIGKILL)
+            # the whole tree, whatever groups it made (SymbiYosys's solvers), then the child itself
+            end_tree([p.pid])
             p.wait()
             raise
         finally:
             # a child that left its own children behind (make -> compiler): end them too
             with contextlib.suppress(ProcessLookupError, PermissionError):
                 os.killpg(p.pid, signal.SIGKILL)
+            _started.discard(p.pid)
     done = subprocess.CompletedProcess(p.args, p.returncode, out, err)
     done.rusage = p.rusage
     return done

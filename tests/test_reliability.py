@@ -45,7 +45,11 @@ def test_p_false_is_false_not_a_truthy_string():
     from rasterhw.sim.engines.verilog import parse_params
 
     assert parse_params(("head=false",), ZbmUnit) == {"head": False}
-    assert parse_params(("head=1", "interleave=0x2"), ZbmUnit) == {"head": True, "interleave": 2}
+    assert parse_params(("head=1", "interleave=2"), ZbmUnit) == {"head": True, "interleave": 2}
+    # issue 47: digits as --size reads them (0x2 was read as 2; now refused like --size 0x40)
+    for bad in ("0x2", "1_0", "\u0662", "\uff12"):
+        with pytest.raises(RasterhwError, match="integer in ASCII digits"):
+            parse_params((f"interleave={bad}",), ZbmUnit)
 
 
 # ------------------------------------------------------------------ row 3

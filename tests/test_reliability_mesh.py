@@ -1,7 +1,9 @@
 """Issue 33: OBJ relative indices (high 3), concave polygons, indented faces, inline comments,
 CR-only line ends, 2-D vertices; and a differential test of the OBJ loader against a tiny
 independent reader written here (hypothesis-generated files: absolute and relative indices,
-triangles and convex n-gons, comments, line ends, indentation, encodings, garbage lines)."""
+triangles and convex n-gons, comments, line ends, indentation, encodings, garbage lines; issue 47:
+tabs and other white space, malformed corners, and binary PLY of mixed face sizes in both byte
+orders against an independent PLY reader)."""
 
 from __future__ import annotations
 
@@ -149,6 +151,8 @@ def reference_read(data: bytes) -> np.ndarray:
         elif w[0] == "f":
             idx = []
             for c in w[1:]:
+                if c.count("/") > 2:
+                    raise ValueError("a corner of more than v/vt/vn")
                 i = int(c.split("/")[0])
                 if i == 0:
                     raise ValueError("index 0")
@@ -196,10 +200,14 @@ def obj_files(draw):
         lines.insert(draw(st.integers(0, len(lines))), e)
     if draw(st.booleans()):
         lines = [("  " if draw(st.booleans()) else "") + ln for ln in lines]
+    if draw(st.booleans()):   # tabs (and other white space OBJ allows) between the words (issue 47)
+        sep = draw(st.sampled_from(["\t", " \t", "\t\t", "\x0b", "\x0c"]))
+        lines = [ln.replace(" ", sep) if draw(st.booleans()) else ln for ln in lines]
     if draw(st.booleans()):
         lines = [ln + ("  # note é" if ln.strip() and draw(st.booleans()) else "") for ln in lines]
     if draw(st.booleans()):   # something both readers must refuse
-        bad = draw(st.sampled_from(["v 1 2", "f 1 2 0", "f 1 2", "v a b c", f"f 1 2 {count + 40}"]))
+        bad = draw(st.sampled_from(["v 1 2", "f 1 2 0", "f 1 2", "v a b c", f"f 1 2 {count + 40}",
+                                    "f 1/1/1/1 2 3", "f 1 2//1/1 3"]))   # corners of 4 indices
         lines.insert(draw(st.integers(len(lines) // 2, len(lines))), bad)
     end = draw(st.sampled_from(["\n", "\r\n", "\r"]))
     text = end.join(lines) + end
@@ -282,3 +290,141 @@ def test_mesh_too_big_for_memory_is_one_line_before_parsing(tmp_path, monkeypatc
         _load(tmp_path, ply, "m.ply")
     monkeypatch.setenv("RASTERHW_MEMORY_LIMIT", "1G")
     assert len(_load(tmp_path, "v 0 0 0\nv 1 0 0\nv 0 1 0\n" + faces).positions) == 5000
+
+
+# --------------------------------------------------------------- issue 47: meshes as exporters write them
+def _binary_ply(verts, faces, order: str, *, before=False, colours=None) -> bytes:
+    """A binary PLY (``order``: ``<`` or ``>``) of float32 vertices and faces of any sizes;
+    ``before``: a uchar property before the face's index list (as some exporters write)."""
+    import struct
+
+    name = {"<": "binary_little_endian", ">": "binary_big_endian"}[order]
+    vprops = "property float x\nproperty float y\nproperty float z\n"
+    if colours is not None:
+        vprops += "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+    head = (f"ply\nformat {name} 1.0\ncomment made by a test\nelement vertex {len(verts)}\n{vprops}"
+            f"element face {len(faces)}\n" + ("property uchar flags\n" if before else "")
+            + "property list uchar int vertex_indices\nend_header\n")
+    body = b"".join(struct.pack(f"{order}3f", *v) + (b"" if colours is None else bytes(colours[i]))
+                    for i, v in enumerate(verts))
+    body += b"".join((b"\x07" if before else b"") + struct.pack(f"{order}B{len(f)}i", len(f), *f) for f in faces)
+    return head.encode() + body
+
+
+def _obj_twin(verts, faces) -> str:
+    """The plain-triangle OBJ of the same polygons (each convex one fanned from its first corner)."""
+    tris = [(f[0], f[j], f[j + 1]) for f in faces for j in range(1, len(f) - 1)]
+    return "".join(f"v {x} {y} {z}\n" for x, y, z in verts) + "".join(
+        f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in tris)
+
+
+#: a little box of quads and triangles mixed (as Blender exports): convex faces, outward
+BOX_V = [(0, 0, 0), (2, 0, 0), (2, 2, 0), (0, 2, 0), (0, 0, 2), (2, 0, 2), (2, 2, 2), (0, 2, 2), (1, 3, 1)]
+BOX_F = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6], [1, 6, 5], [3, 0, 4, 7], [2, 3, 8], [3, 7, 8],
+         [7, 6, 8], [6, 2, 8]]
+
+
+def _render_file(tmp_path, name: str, data: bytes, arch: str) -> np.ndarray:
+    from PIL import Image
+
+    src, png = tmp_path / name, tmp_path / f"{name}-{arch}.png"
+    src.write_bytes(data)
+    r = subprocess.run([PY, "-m", "rasterhw.sim.cli.main", "render", str(src), "--arch", arch, "--size", "48x48",
+                        "-o", str(png)], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    return np.asarray(Image.open(png))
+
+
+@pytest.mark.parametrize("arch", ["reference", "zbm"])
+def test_tabbed_obj_and_mixed_binary_ply_render_like_their_plain_twins(tmp_path, arch):
+    """The issue's must-show: an OBJ separated by tabs (refused before: "no faces") and binary PLY
+    of quads and triangles mixed in both byte orders (before: "PLY is unexpected length!") give
+    the pixels of their plain-triangle twin, on the reference and on ZB/M."""
+    twin = _render_file(tmp_path, "twin.obj", _obj_twin(BOX_V, BOX_F).encode(), arch)
+    assert (twin != twin[0, 0]).any()   # something was drawn
+    tabbed = _obj_twin(BOX_V, BOX_F).replace(" ", "\t")
+    np.testing.assert_array_equal(_render_file(tmp_path, "tabs.obj", tabbed.encode(), arch), twin)
+    for order in "<>":
+        got = _render_file(tmp_path, f"mixed{order == '>'}.ply", _binary_ply(BOX_V, BOX_F, order), arch)
+        np.testing.assert_array_equal(got, twin)
+
+
+def test_malformed_corner_is_refused_naming_its_line(tmp_path):
+    """``f 1/1/1/1 2 3`` was read as a degenerate triangle (exit 0, nothing drawn)."""
+    from test_reliability import one_line_error
+
+    src = tmp_path / "bad.obj"
+    src.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n")
+    r = subprocess.run([PY, "-m", "rasterhw.sim.cli.main", "render", str(src), "--size", "16x16", "-o",
+                        str(tmp_path / "b.png")], capture_output=True, text=True, timeout=300)
+    one_line_error(r, contains="line 4: face vertex '1/1/1/1' is not v, v/vt, v//vn or v/vt/vn")
+    assert not (tmp_path / "b.png").exists()
+
+
+@pytest.mark.parametrize("fmt", ["ascii", "<", ">"])
+def test_two_corner_ply_face_after_another_property_is_refused_not_dropped(tmp_path, fmt):
+    faces = [[0, 1, 2], [0, 1]]
+    if fmt == "ascii":
+        data = (b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                b"element face 2\nproperty uchar flags\nproperty list uchar int vertex_indices\nend_header\n"
+                b"0 0 0\n1 0 0\n0 1 0\n7 3 0 1 2\n7 2 0 1\n")
+    else:
+        data = _binary_ply([(0, 0, 0), (1, 0, 0), (0, 1, 0)], faces, fmt, before=True)
+    with pytest.raises(RasterhwError, match="face 1 has 2 vertices"):
+        _load(tmp_path, data, "two.ply")
+
+
+def test_a_file_name_that_is_not_utf8_loads(tmp_path):
+    import os
+
+    name = os.fsdecode(b"m\xff\xfe.obj")
+    sc = _load(tmp_path, PLAIN, name)
+    assert len(sc.positions) == 2 and sc.name == "m\ufffd\ufffd"
+    r = subprocess.run([PY, "-m", "rasterhw.sim.cli.main", "render", os.fsencode(str(tmp_path / name)), "--size",
+                        "16x16", "-o", str(tmp_path / "u.png"), "--json"], capture_output=True, timeout=300)
+    assert r.returncode == 0 and b"Traceback" not in r.stderr, r.stderr
+
+
+def reference_ply(data: bytes) -> np.ndarray:
+    """An independent binary-PLY reader for the files :func:`ply_files` writes (float32 x y z, one
+    uchar-counted int list, optionally a uchar before it), polygons fanned from the first corner."""
+    import struct
+
+    head, body = data.split(b"end_header\n", 1)
+    order = "<" if b"binary_little_endian" in head else ">"
+    nv = int(re.search(rb"element vertex (\d+)", head).group(1))
+    nf = int(re.search(rb"element face (\d+)", head).group(1))
+    before = b"property uchar flags" in head
+    verts = [struct.unpack_from(f"{order}3f", body, 12 * i) for i in range(nv)]
+    at, tris = 12 * nv, []
+    for _ in range(nf):
+        at += before
+        (n,) = struct.unpack_from("B", body, at)
+        idx = struct.unpack_from(f"{order}{n}i", body, at + 1)
+        at += 1 + 4 * n
+        if n < 3:
+            raise ValueError("short face")
+        tris += [(idx[0], idx[k], idx[k + 1]) for k in range(1, n - 1)]
+    return np.array(verts, dtype=np.float64)[np.array(tris)]
+
+
+@st.composite
+def ply_files(draw):
+    """Binary PLY, either byte order, triangles and convex n-gons (regular, in planes of their own)
+    mixed in any order, sometimes a property before the index list."""
+    verts, faces = [], []
+    for _ in range(draw(st.integers(1, 8))):
+        k = draw(st.sampled_from([3, 3, 4, 4, 5, 6]))
+        z, r = draw(st.integers(-20, 20)), draw(st.integers(1, 9))
+        base = len(verts)
+        verts += [(round(np.cos(2 * np.pi * j / k) * r, 3), round(np.sin(2 * np.pi * j / k) * r, 3), z)
+                  for j in range(k)]
+        faces.append(list(range(base, base + k)))
+    order = draw(st.sampled_from("<>"))
+    return _binary_ply(verts, faces, order, before=draw(st.booleans()))
+
+
+@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(ply_files())
+def test_ply_loader_agrees_with_an_independent_reader(tmp_path, data):
+    np.testing.assert_array_equal(_load(tmp_path, data, "h.ply").positions, reference_ply(data))

@@ -313,7 +313,7 @@ BAD = {
     "junk.obj": ("hello\nthis is not a mesh\n", "no faces"),
     "lines.obj": ("v 0 0 0\nv 1 0 0\nl 1 2\n", "no faces"),
     "twovert.obj": ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", "2 vertices"),
-    "badindex.obj": ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "not a readable"),
+    "badindex.obj": ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "line 4: face refers to vertex 9; the file has 3"),
     "nan.obj": ("v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n", "NaN or infinite"),
     "inf.obj": ("v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n", "NaN or infinite"),
     "huge.obj": ("v 0 0 0\nv 1e30 0 0\nv 0 1 0\nf 1 2 3\n", "1e+30"),

@@ -74,7 +74,7 @@ def test_bad_scheduler_is_one_line_exit_2(capsys):
 def test_unreachable_scheduler_is_one_line_exit_2(capsys, monkeypatch):
     import rasterhw.sim.flow.tasks as T
 
-    monkeypatch.setattr(T, "CONNECT_TIMEOUT", "1s")
+    monkeypatch.setattr(T, "SCHEDULER_CHECK_S", 1.0)
     code, _, err = cli(capsys, "sweep", "render:experts", "--param", "sn=1", "--scene", "c50", "--scheduler",
                        NOWHERE)
     assert code == 2 and "cannot reach the Dask scheduler" in err and "Traceback" not in err, err

@@ -105,8 +105,8 @@ def _bands_from_load(load: np.ndarray, sn: int) -> np.ndarray:
     targets = cum[-1] * np.arange(1, sn) / sn
     cuts = np.searchsorted(cum, targets)
     b = np.concatenate([[0], cuts, [load.size]]).astype(np.int64)
-    for i in range(1, sn + 1):                      # strictly increasing
-        b[i] = max(b[i], b[i - 1] + 1)
+    for i in range(1, sn):                          # strictly increasing, the last bound kept at the
+        b[i] = max(b[i], b[i - 1] + 1)              # frame's end (it was pushed past it: issue 47)
     for i in range(sn - 1, 0, -1):
         b[i] = min(b[i], b[i + 1] - 1)
     return b

@@ -44,12 +44,13 @@ def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: b
           as_json: bool, scheduler: str, store: str | None, fresh: bool) -> None:
     """Synthesise BLOCK (or --all) with Yosys: gate equivalents, flip-flops, RAM bits."""
     from rasterhw.sim.flow.synth import summary_row, synth_all, synth_report, synthesise
-    from rasterhw.sim.flow.tasks import default_store, parse_scheduler
+    from rasterhw.sim.flow.tasks import check_scheduler, default_store
 
-    parse_scheduler(scheduler)
     if all_blocks:
+        check_scheduler(scheduler)
         if block or params:
             raise RasterhwError("--all takes no BLOCK or -p")
+        check_cache()
         rows = synth_all(small=small, memory=memory, progress=not as_json, scheduler=scheduler,
                          store=store or default_store(), fresh=fresh)
         if as_json:
@@ -63,9 +64,16 @@ def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: b
         return
     if small:
         raise RasterhwError("--small applies only with --all (a named block takes its sizes from -p)")
+    ctx = click.get_current_context()
+    given = [f"--{n}" for n in ("scheduler", "store", "fresh")
+             if ctx.get_parameter_source(n) is not click.core.ParameterSource.DEFAULT]
+    if given:   # they would be accepted and change nothing
+        raise RasterhwError(f"{' and '.join(given)} appl{'ies' if len(given) == 1 else 'y'} only with --all "
+                            "(one named block is synthesised here, not as a task)")
     if block is None:
         raise RasterhwError("name a block (rasterhw verilog --list) or give --all")
     kw = _params(block, params)
+    check_cache()
     if as_json:
         _emit(summary_row(synthesise(block, memory=memory, **kw)))
     else:
@@ -85,9 +93,13 @@ def fpga(block: str, params: tuple[str, ...], family: str, device: str | None, a
 
     Routes with router2, and again with router1 on the same netlist when router2 does not finish
     in the time limit; results are cached in build/pnr-* and docs/reproduction/fpga_runs.json."""
-    from rasterhw.sim.flow.fpga import fpga_summary, place_and_route
+    from rasterhw.sim.flow.fpga import DEVICES, fpga_summary, place_and_route
 
-    r = place_and_route(block, family=family, device=device, **_params(block, params))
+    if device is not None and device not in DEVICES[family]:   # '' too: never the default in its place
+        raise RasterhwError(f"--device for {family} must be one of {', '.join(DEVICES[family])}, not {device!r}")
+    kw = _params(block, params)
+    check_cache()
+    r = place_and_route(block, family=family, device=device, **kw)
     if as_json:
         _emit({k: v for k, v in r.items() if k != "build_dir"})
     else:
@@ -107,6 +119,9 @@ def prove(block: str, depth: int | None, fresh: bool, as_json: bool) -> None:
     in the output); --fresh runs SymbiYosys again."""
     from rasterhw.sim.flow.prove import prove as run
 
+    if depth is not None and not 1 <= depth <= MAX_DEPTH:
+        raise RasterhwError(f"--depth must be a whole number of steps from 1 to {MAX_DEPTH}, not {depth}")
+    check_cache()
     r = run(block, depth=depth, fresh=fresh)
     if as_json:
         _emit(r)
@@ -120,6 +135,18 @@ def prove(block: str, depth: int | None, fresh: bool, as_json: bool) -> None:
             click.echo(f"  counterexample: {r['trace']}")
     if r["status"] != "PASS":
         sys.exit(1)
+
+
+#: the longest proof ``prove --depth`` runs: SymbiYosys's unrolling grows with the depth (the ZB/M
+#: merger's proof at depth 400 keeps two solvers busy for minutes); a depth of 10^20 ran without end
+MAX_DEPTH = 10_000
+
+
+def check_cache() -> None:
+    """The build cache can be written: said before any work (sim/cachefile.py)."""
+    from rasterhw.sim.cachefile import check_writable
+
+    check_writable()
 
 
 def add_commands(group: click.Group) -> None:

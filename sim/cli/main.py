@@ -57,6 +57,7 @@ def _click_options(opts: list[registry.Option]):
 def _take_options(given: dict, declared: tuple[registry.Option, ...], who: str) -> dict:
     """The values for one arch / block: its declared options (defaults filled in); an option
     given on the command line that it does not take is an error, not silently ignored."""
+    _ascii_values(given)
     names = {o.name for o in declared}
     for k, v in given.items():
         if v is not None and k not in names:
@@ -92,6 +93,37 @@ def parse_size(text: str | None) -> tuple[int, int] | None:
 
 def info(msg: str) -> None:
     click.echo(msg, err=True)
+
+
+def check_engine(engine: str | None) -> None:
+    """An HDL engine that is not installed here is one line before any work (``--engine icarus``
+    without ``iverilog`` was refused after 32 s of golden-model work, and the demo printed three
+    Dask tracebacks first); ``pysim`` needs nothing."""
+    if engine in ("verilator", "icarus"):
+        from rasterhw.sim.engines.runner import get_sim
+        from rasterhw.sim.paths import SimulatorUnavailable
+
+        try:
+            get_sim(engine)
+        except SimulatorUnavailable as e:
+            raise RasterhwError(f"--engine {engine}: {e} (install it, or use --engine "
+                                f"{'verilator' if engine == 'icarus' else 'pysim'})") from None
+
+
+def check_cache() -> None:
+    """The build cache can be written: said before any work, not when the first entry is stored
+    (sim/cachefile.py)."""
+    from rasterhw.sim.cachefile import check_writable
+
+    check_writable()
+
+
+def _ascii_values(given: dict) -> None:
+    """Text option values whose digits are not ASCII (``--matrix ２x２``) are refused, as
+    ``--size`` refuses them (the number they mean is not what a reader sees)."""
+    for k, v in given.items():
+        if isinstance(v, str) and any(ch.isdigit() and not ch.isascii() for ch in v):
+            raise RasterhwError(f"--{k.replace('_', '-')} {v!r}: write its digits as ASCII 0-9")
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -368,15 +400,18 @@ def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, re
 
     A report's independent runs (ZB/M Table 1, pixel rate, skew and chains; EXPERTS balance;
     fpga place and route; the sparse FIFO-depth sweep) run as tasks on --scheduler (docs/scale.md)."""
-    from rasterhw.sim.flow.tasks import default_store, parse_scheduler
+    from rasterhw.sim.flow.tasks import check_scheduler, default_store, parse_scheduler
     from rasterhw.sim.report.rows import run_report, systems
 
-    parse_scheduler(scheduler)   # a bad one is an error before anything runs
+    parse_scheduler(scheduler)
     names = systems() if system == "all" else [system]
     if rerun and "fpga" not in names:
         raise RasterhwError("--rerun applies to the fpga report only")
     if rerun and fast:
         raise RasterhwError("--rerun and --fast contradict each other")
+    check_engine(engine)
+    check_cache()
+    check_scheduler(scheduler)   # what answers at its address too, before anything runs
     rows = []
     for name in names:
         extra = {}
@@ -431,10 +466,12 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
             raise RasterhwError(f"--interleave {interleave} contradicts -p interleave={kw['interleave']}")
         kw["interleave"] = interleave
     _limit_memory()   # explicit parameters can ask for any size: a MemoryError (one line), not an OOM kill
+    check_cache()
     if sys.stderr.isatty():  # progress for a person waiting; logs and pipes get only the result
         info(f"generating Verilog for {block} ...")
     try:
-        write_verilog(block, output, **kw)
+        with _memory_estimate(block):
+            write_verilog(block, output, **kw)
     except RasterhwError:
         raise
     except (TypeError, ValueError, OverflowError) as e:
@@ -442,6 +479,54 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
     except MemoryError:
         raise RasterhwError(f"{block}: these parameters need more memory than there is") from None
     info(f"wrote {'standard output' if output == '-' else output}")
+
+
+#: memory one word of an Amaranth ``Memory`` takes to elaborate and convert (measured: the SNU
+#: pixel bus with ``ram=memory``, 256x256 -> 512x512 frame, 150 -> 237 MB peak for 196,608 more
+#: words: ~450 B a word; rounded up)
+_ELAB_BYTES_PER_WORD = 500
+
+
+class _memory_estimate:
+    """``with _memory_estimate(block):`` every Amaranth memory the block makes is sized before its
+    contents are allocated (``MemoryData``: shape and depth are known first): one that would need
+    more memory than there is (:data:`_ELAB_BYTES_PER_WORD` a word) is one line at once, before
+    the elaboration grows to the memory cap (``verilog pixelbus -p width=100000 -p height=100000
+    -p ram=memory`` grew to 15.6 GB). Amaranth's ``MemoryData`` is wrapped only inside the block;
+    a different Amaranth without it leaves the cap (:func:`_limit_memory`) to say it."""
+
+    def __init__(self, block: str):
+        self.block = block
+        self.orig = None
+
+    def __enter__(self):
+        try:
+            from amaranth.hdl import _mem
+        except ImportError:   # pragma: no cover - another Amaranth
+            return self
+        cls, orig, block = _mem.MemoryData, _mem.MemoryData.__init__, self.block
+
+        words = [0]   # every memory of the block so far
+
+        def sized(obj, *args, shape=None, depth=None, **kw):
+            from rasterhw.golden_model.memcheck import HEADROOM, available_bytes, format_bytes
+
+            if isinstance(depth, int) and depth > 0:
+                words[0] += depth
+                need, avail = words[0] * _ELAB_BYTES_PER_WORD, available_bytes()
+                if need > HEADROOM * avail:
+                    raise RasterhwError(f"{block}: its memories hold {words[0]:,} words so far; elaborating them "
+                                        f"needs about {format_bytes(need)}, {format_bytes(avail)} is available "
+                                        "(use smaller -p sizes, or a RAM kind the block writes as Verilog)")
+            orig(obj, *args, shape=shape, depth=depth, **kw)
+
+        self.cls, self.orig = cls, orig
+        cls.__init__ = sized
+        return self
+
+    def __exit__(self, *exc):
+        if self.orig is not None:
+            self.cls.__init__ = self.orig
 
 
 def _limit_memory() -> None:
@@ -523,6 +608,9 @@ def sim_cmd(block, scene, size, engine, output, waves, trace_start, trace_end, a
     check_window(trace_start, trace_end, waves=waves)   # before any work
     _machine, b = registry.sim_blocks()[block]
     opts = _take_options(block_options, b.options, f"sim {block}")
+    check_engine(engine)
+    if engine != "pysim":
+        check_cache()
     scene = scene or b.default_scene
     out = check_image_output(output) or sim_image_name(scene, block, engine, block_options)
     sc, (w, h) = load_scene_and_size(scene, size, bytes_per_pixel=b.bytes_per_pixel, what=f"sim {block}")
@@ -602,13 +690,14 @@ def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], scheduler: str,
     import secrets
 
     from rasterhw.sim.flow.soak import run_soak
-    from rasterhw.sim.flow.tasks import default_store, parse_scheduler
+    from rasterhw.sim.flow.tasks import check_scheduler, default_store
 
     if seed is not None and not 0 <= seed < 1 << 32:
         raise RasterhwError(f"--seed must be between 0 and {(1 << 32) - 1}, not {seed}")
     if pixels < 1:
         raise RasterhwError(f"--pixels must be 1 or more, not {pixels}")
-    parse_scheduler(scheduler)   # a bad one is an error before anything starts
+    check_cache()
+    check_scheduler(scheduler)   # a bad one (or one that does not answer as Dask) is an error before anything starts
     seed = secrets.randbelow(1 << 31) if seed is None else seed
     info(f"soak: seed {seed} (rerun: rasterhw soak --seed {seed} --pixels {pixels})")
     rows = run_soak(pixels=pixels, seed=seed, blocks=list(blocks) or None, progress=not as_json,
@@ -646,14 +735,18 @@ def sweep(target: str, params: tuple[str, ...], scenes: tuple[str, ...], size: s
       rasterhw sweep zbm --param interleave=1,2,4 --scene c50 --size 64x64
       rasterhw sweep render:experts --param sn=1,2,4,8 --param pn=1,2,4,8 --out out/sweep
     """
+    from rasterhw.sim.cachefile import check_writable
     from rasterhw.sim.flow.sweep import plan, run_sweep, write_outputs
-    from rasterhw.sim.flow.tasks import default_store, parse_scheduler
+    from rasterhw.sim.flow.tasks import check_scheduler, default_store, parse_scheduler
 
     wh = parse_size(size)
     parse_scheduler(scheduler)
     if not params:
         raise RasterhwError("say what to sweep: --param NAME=V1,V2,...")
     plan(target, list(params), scenes=list(scenes), size=wh, engine=engine)   # every check before a cluster starts
+    check_engine(engine)
+    check_writable(store or default_store())   # where the results go, before any run
+    check_scheduler(scheduler)   # then what answers at its address, before any run
     res = run_sweep(target, list(params), scenes=list(scenes) or None, size=wh, engine=engine, scheduler=scheduler,
                     store=store or default_store(), fresh=fresh, progress=not as_json)
     if out_dir is not None:
@@ -681,10 +774,12 @@ def sweep(target: str, params: tuple[str, ...], scenes: tuple[str, ...], size: s
 def demo(out_dir: str, scene: str, engine: str, scheduler: str, store: str | None, fresh: bool) -> None:
     """Render a default scene through the golden model and the hardware; write images and a report.
     The HDL runs are tasks on --scheduler (docs/scale.md)."""
-    from rasterhw.sim.flow.tasks import default_store, parse_scheduler
+    from rasterhw.sim.flow.tasks import check_scheduler, default_store
     from rasterhw.sim.report.demo import run_demo
 
-    parse_scheduler(scheduler)
+    check_engine(engine)
+    check_cache()
+    check_scheduler(scheduler)
     out = Path(out_dir)
     existed = out.exists()
     try:
@@ -714,10 +809,15 @@ def main(argv: list[str] | None = None) -> None:
             signal.signal(sig, _terminate)
         except (ValueError, OSError):  # not the main thread
             pass
+    workdirs.become_subreaper()   # a tool whose parent is killed comes to us, not to PID 1
     try:
         _main(argv)
     finally:
         workdirs.cleanup()
+        # no external tool outlives its command (sim/workdirs.py): whatever is still below us
+        # (a tool a killed Dask worker left, solvers SymbiYosys left), then its work folders
+        workdirs.end_descendants()
+        workdirs.remove_dead_work_folders()
 
 
 def _close_progress_bars() -> None:

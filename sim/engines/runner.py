@@ -18,15 +18,15 @@ import os
 import shutil
 import subprocess
 import sys
-import tempfile
 import time
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim.cachefile import matches, sha256_file
 from rasterhw.sim.engines import vlruntime, waves
 from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT, SimulatorUnavailable, verilator_bin_dir
-from rasterhw.sim.workdirs import build_lock, run_child
+from rasterhw.sim.workdirs import build_lock, run_child, work_folder
 
 __all__ = [
     "HARNESS_V",
@@ -331,14 +331,14 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
     if _built(bdir, exe):
         return exe, 0.0
     with build_lock(bdir, what=name):
-        if _built(bdir, exe):  # another process built it while we waited
+        if _built(bdir, exe, quiet=True):  # another process built it while we waited
             return exe, 0.0
         # all or nothing: the build runs in a fresh folder beside bdir and is renamed to bdir once
         # it succeeded, so an interrupted build (Ctrl-C, kill mid-compile: half-written objects and
         # precompiled headers) never leaves a folder the next build would trust; what an
         # interrupted build left (or a folder without its record) is removed here first
         _discard_unfinished(bdir)
-        work = Path(tempfile.mkdtemp(prefix=f".{bdir.name}.tmp-", dir=bdir.parent))
+        work = work_folder(bdir.parent, bdir.name)   # named by host and process: removed if we are killed outright
         try:
             _exe, build_s = _build_plain_in(work, name, top, sources, params=params, opt=opt, defines=defines,
                                             generated=generated, args=args, make=make, profile=profile,
@@ -359,14 +359,23 @@ def _umask() -> int:
     return mask
 
 
-def _built(bdir: Path, exe: Path) -> bool:
-    """A finished plain build: its binary and its record (written last) are there."""
-    return exe.exists() and (bdir / "build.json").exists()
+def _built(bdir: Path, exe: Path, *, quiet: bool = False) -> bool:
+    """A finished plain build: its record (written last) is there and the binary has the SHA-256
+    the record holds (a binary truncated or replaced since is said in one line and rebuilt; a
+    record without the digest, from before digests were kept, is rebuilt silently)."""
+    try:
+        rec = json.loads((bdir / "build.json").read_text())
+    except (OSError, ValueError):
+        return False
+    digest = (rec.get("sha256") or {}).get(str(exe.relative_to(bdir))) if isinstance(rec, dict) else None
+    return matches(exe, digest, what=f"the Verilator model {exe.name} of {bdir.name}", quiet=quiet)
 
 
 def _discard_unfinished(bdir: Path) -> None:
     """Remove ``bdir`` (it has no finished build) and the work folders of interrupted builds of it."""
     for d in [bdir, *bdir.parent.glob(f".{bdir.name}.tmp-*")]:
+        if d.is_symlink():   # a link planted in the cache: removed, never followed (issue 47)
+            d.unlink()
         shutil.rmtree(d, ignore_errors=True)
 
 
@@ -414,7 +423,8 @@ def _build_plain_in(bdir: Path, name: str, top: str, sources: Sequence[Path], *,
     (bdir / "build.json").write_text(json.dumps({
         "model": name, "top": top, "params": params, "opt": opt, "hierarchical": hier, "build_s": round(build_s, 2),
         "verilate_s": round(t1 - t0, 2), "compile_s": round(build_s - (t1 - t0), 2),
-        "verilate_peak_mb": mb[0], "compile_peak_mb": mb[1], "built": time.strftime("%Y-%m-%d %H:%M:%S")},
+        "verilate_peak_mb": mb[0], "compile_peak_mb": mb[1], "built": time.strftime("%Y-%m-%d %H:%M:%S"),
+        "sha256": {str(exe.relative_to(bdir)): sha256_file(exe)}},   # checked at every use (_built)
         default=str) + "\n")
     return exe, build_s
 
@@ -537,7 +547,8 @@ def run_plain_verilator(exe: Path, plusargs: Sequence[str], *, run_dir: Path, ma
     try:
         meta = json.loads(r.stdout.strip().splitlines()[-1])
     except (IndexError, json.JSONDecodeError):
-        raise RasterhwError(f"{exe.name} failed (exit {r.returncode}: {_first_error(r.stdout + r.stderr)})") from None
+        hint = (f"; if its build is damaged, remove {exe.parent.parent} and run again" if r.returncode < 0 else "")
+        raise RasterhwError(f"{exe.name} failed (exit {r.returncode}: {_first_error(r.stdout + r.stderr)}){hint}") from None
     if not meta["done"]:
         raise RasterhwError(f"{exe.name}: no `done` within {maxcyc} cycles")
     ru = getattr(r, "rusage", None)   # the child's own (os.wait4): loading, clock loop and dumps

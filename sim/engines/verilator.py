@@ -31,6 +31,7 @@ from amaranth.hdl import (
     Signal,
 )
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim.cachefile import matches, sha256_file, warn_damaged
 from rasterhw.sim.engines.memh import memh_uint64, read_memh
 from rasterhw.sim.engines.packed import as_bytes, records
 from rasterhw.sim.engines.runner import (
@@ -278,7 +279,7 @@ def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outp
     name, generated, defines = design
     prof = BUILD_ROOT / "pgo" / plain_build_dir(name, "rasterhw_bench", [HARNESS_V], params={}, opt=opt,
                                                  defines=defines, generated=generated, pgo="generate").name
-    if (prof / "trained.json").exists():
+    if _trained(prof):
         return prof
     stim = tb.train_stimulus(params) if train else None
     if stim is None:
@@ -289,7 +290,7 @@ def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outp
         return None
     exe, _ = _build(design, opt, pgo="generate")
     with build_lock(prof, what=f"{tb.block} profile"):
-        if (prof / "trained.json").exists():
+        if _trained(prof, quiet=True):
             return prof
         shutil.rmtree(prof, ignore_errors=True)
         prof.mkdir(parents=True)
@@ -301,8 +302,24 @@ def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outp
             shutil.rmtree(prof, ignore_errors=True)
             raise RasterhwError(f"{tb.block} profile: the instrumented build's training run ({stim.what}) "
                                 f"gave {bad} words that are not golden")
-        (prof / "trained.json").write_text(json.dumps({"what": stim.what, "cycles": got[3]}) + "\n")
+        # written last, with the SHA-256 of every profile file: checked at every use (_trained)
+        sums = {f.name: sha256_file(f) for f in sorted(prof.glob("*.gcda"))}
+        (prof / "trained.json").write_text(json.dumps({"what": stim.what, "cycles": got[3], "sha256": sums}) + "\n")
     return prof
+
+
+def _trained(prof: Path, *, quiet: bool = False) -> bool:
+    """A finished profile: its record is there and every ``*.gcda`` it names has the SHA-256 it
+    recorded, and there are no others (a damaged profile is said in one line and trained again)."""
+    try:
+        sums = json.loads((prof / "trained.json").read_text()).get("sha256")
+    except (OSError, ValueError, AttributeError):
+        return False
+    if not isinstance(sums, dict) or not sums or set(sums) != {f.name for f in prof.glob("*.gcda")}:
+        if isinstance(sums, dict) and sums and not quiet:
+            warn_damaged(prof, "a gcc profile")
+        return False
+    return all(matches(prof / k, v, what="a gcc profile file", quiet=quiet) for k, v in sums.items())
 
 
 def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, expect_words: dict[str, int],

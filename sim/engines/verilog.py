@@ -236,11 +236,13 @@ def parse_params(params: tuple[str, ...], factory) -> dict:
                 raise RasterhwError(f"parameter {k!r} is true or false, not {v!r}")
             out[k] = low in ("true", "1", "yes")
         elif isinstance(default, int) or default is inspect.Parameter.empty:
-            try:
-                out[k] = int(v, 0)
-            except ValueError:
-                if isinstance(default, int):
-                    raise RasterhwError(f"parameter {k!r} is an integer, not {v!r}") from None
+            # ASCII digits with an optional sign, as --size reads them: no 0x40, no 1_000, no
+            # Arabic-Indic or full-width digits (int() takes them all; issue 47)
+            if re.fullmatch(r"[+-]?[0-9]+", v.strip(), re.ASCII):
+                out[k] = int(v)
+            elif isinstance(default, int):
+                raise RasterhwError(f"parameter {k!r} is an integer in ASCII digits (e.g. {k}=24), not {v!r}")
+            else:
                 out[k] = v
         elif isinstance(default, float):
             try:

@@ -7,7 +7,9 @@ parameters, the Amaranth version and the bytes of every Python file the design c
 (:func:`design_sources`: ``hdl/``, the generator and every module of ours they import, such as
 the formats modules the HDL takes its widths from), so any change to the design gives a fresh
 conversion and an unchanged design never converts twice.
-Files go to ``build/verilog/<name>-<digest>.v``, written atomically.
+Files go to ``build/verilog/<name>-<digest>.v``, written atomically, each with the SHA-256 of its
+text beside it (``sim/cachefile.py``): a truncated or edited entry is said in one line and converted
+again, never served.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from pathlib import Path
 
 import amaranth
 from amaranth.back import verilog
+from rasterhw.sim.cachefile import check_writable, read_entry, write_entry
 from rasterhw.sim.engines.verilog import canonical_port_lists, generate_verilog
 from rasterhw.sim.outfile import write_text
 from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT
@@ -153,13 +156,15 @@ def convert_cached(name: str, factory: Callable[[], object], *, params: Mapping[
     key = json.dumps({"name": name, "module": module, "params": dict(params)}, sort_keys=True, default=str)
     digest = hashlib.sha1((source_digest(name) + key).encode()).hexdigest()[:16]
     path = BUILD_ROOT / "verilog" / f"{name}-{digest}.v"
-    if path.exists():
-        return path.read_text()
+    got = read_entry(path, what=f"the generated Verilog of {name}")
+    if got is not None:
+        return got.decode()
+    check_writable(path.parent)   # an unwritable cache is said now, not after the elaboration
     if convert is None:
         def convert(design, mod):
             return canonical_port_lists(verilog.convert(design, name=mod))
     text = convert(factory(), module)
-    write_text(path, text)
+    write_entry(path, text.encode(), root=BUILD_ROOT)
     return text
 
 

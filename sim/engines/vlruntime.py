@@ -7,6 +7,7 @@ compiler flags, so after a successful plain build (``runner.build_plain_verilato
 every scene run) they are kept in ``build/verilator-runtime/<key>/`` and copied into the next
 build folder between Verilator's code generation and make; the copies are newer than the
 generated makefile (``$(VK_GLOBAL_OBJS): $(VM_PREFIX).mk`` in verilated.mk), so make keeps them.
+Each object is kept with its SHA-256 (``sim/cachefile.py``) and copied only when it still matches.
 cocotb builds do the same between the two commands of cocotb's runner (``verilator`` then
 ``make -f Vtop.mk``: ``runner._execute_cmds_as_children``), keyed by :func:`cocotb_flags`. The key
 digests the Verilator version, the kind of build and every flag that reaches the compiler (the
@@ -20,11 +21,10 @@ from __future__ import annotations
 import hashlib
 import os
 import re
-import shutil
 from collections.abc import Iterable
 from pathlib import Path
 
-from rasterhw.sim.outfile import atomic_path
+from rasterhw.sim.cachefile import RECORD_SUFFIX, read_entry, write_entry
 from rasterhw.sim.paths import BUILD_ROOT, verilator_bin_dir
 
 __all__ = ["RUNTIME_OBJECTS", "cache_dir", "cocotb_flags", "harvest", "seed"]
@@ -51,8 +51,11 @@ def cache_dir(kind: str, flags: Iterable[str]) -> Path:
         pass
     for f in flags:
         h.update(" ".join(re.sub(r"-DRASTERHW_\w+=\S+", "", str(f)).split()).encode() + b"\0")
-    root = Path(os.environ.get("RASTERHW_VL_RUNTIME_DIR", BUILD_ROOT / "verilator-runtime"))
-    return root / h.hexdigest()[:12]
+    return _root() / h.hexdigest()[:12]
+
+
+def _root() -> Path:
+    return Path(os.environ.get("RASTERHW_VL_RUNTIME_DIR", BUILD_ROOT / "verilator-runtime"))
 
 
 #: makefile variables of a cocotb build that do not reach the runtime's compile lines: the
@@ -107,9 +110,11 @@ def seed(obj_dir: Path, kind: str, flags: Iterable[str]) -> int:
     obj_dir.mkdir(parents=True, exist_ok=True)
     n = 0
     for name in RUNTIME_OBJECTS:
-        f = src / name
-        if f.exists() and not (obj_dir / name).exists():
-            shutil.copyfile(f, obj_dir / name)   # a fresh mtime: newer than the runtime sources
+        if (obj_dir / name).exists():
+            continue
+        data = read_entry(src / name, what=f"the Verilator runtime object {name}")   # checked against its SHA-256
+        if data is not None:
+            (obj_dir / name).write_bytes(data)   # a fresh mtime: newer than the runtime sources
             n += 1
     return n
 
@@ -122,8 +127,7 @@ def harvest(obj_dir: Path, kind: str, flags: Iterable[str]) -> int:
     n = 0
     for name in RUNTIME_OBJECTS:
         f = obj_dir / name
-        if f.exists() and not (dst / name).exists():
-            with atomic_path(dst / name) as tmp:
-                shutil.copyfile(f, tmp)
+        if f.exists() and not (dst / (name + RECORD_SUFFIX)).exists():
+            write_entry(dst / name, f.read_bytes(), root=_root())   # with its SHA-256, inside the cache
             n += 1
     return n

@@ -41,8 +41,8 @@ from amaranth.hdl import Assert, Assume, ClockDomain
 from amaranth.hdl._ast import AnySeq
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
+from rasterhw.sim.cachefile import read_entry, write_entry
 from rasterhw.sim.flow.tools import tool
-from rasterhw.sim.outfile import atomic_path
 from rasterhw.sim.paths import BUILD_ROOT
 from rasterhw.sim.workdirs import build_lock, run_child
 
@@ -168,9 +168,10 @@ def prove(block: str, *, dut_factory: Callable | None = None, depth: int | None 
 
 def _run_proof(p: Proof, block: str, bdir: Path, text: str, depth: int, timeout: float, fresh: bool) -> dict:
     done = bdir / "result.json"
-    if done.exists() and not fresh:
+    raw = None if fresh else read_entry(done, what=f"the proof record of {block}")   # checked against its SHA-256
+    if raw is not None:
         try:
-            r = json.loads(done.read_text())
+            r = json.loads(raw)
             trace = Path(r["trace"]) if r.get("trace") else None
             if trace is None or trace.exists():
                 return {**r, "params": p.params, "workdir": bdir, "trace": trace, "cached": True}
@@ -206,7 +207,7 @@ def _run_proof(p: Proof, block: str, bdir: Path, text: str, depth: int, timeout:
            "depth": depth, "params": p.params, "what": p.what,
            "wall_s": wall, "workdir": bdir, "trace": traces[0] if (status == "FAIL" and traces) else None,
            "failed": failed, "cached": False}
-    with atomic_path(done) as tmp:   # written last: a folder without it is an unfinished proof
-        tmp.write_text(json.dumps({k: v for k, v in out.items() if k not in ("params", "workdir")},
-                                  default=str) + "\n")
+    # written last (a folder without it is an unfinished proof), with its SHA-256, inside the cache
+    write_entry(done, (json.dumps({k: v for k, v in out.items() if k not in ("params", "workdir")},
+                                  default=str) + "\n").encode(), root=BUILD_ROOT)
     return out

@@ -50,14 +50,16 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
 from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT
 
-__all__ = ["VARYING", "Handle", "Runner", "Task", "call", "code_digest", "default_store", "parse_scheduler",
+__all__ = ["VARYING", "Handle", "Runner", "Task", "call", "check_scheduler", "code_digest", "default_store",
+           "parse_scheduler",
            "run_task", "run_tasks", "tool_versions"]
 
 #: result keys that may differ between two runs of one task (timings, who ran it)
 VARYING = ("wall_s", "build_s", "cycles_per_s", "worker", "pid", "scheduler")
 
-#: how long to wait for a Dask scheduler named by address before saying it cannot be reached
-CONNECT_TIMEOUT = "20s"
+#: the one time limit (seconds) of checking a scheduler named by address: reaching it, seeing that
+#: what answers speaks Dask's protocol (:func:`check_scheduler`), and the Dask client's connection
+SCHEDULER_CHECK_S = 20.0
 
 #: the folders whose files make up the design, the golden model and the benches
 _CODE_TREES = ("golden_model", "hdl", "sim", "cocotb_tests")
@@ -277,6 +279,98 @@ def parse_scheduler(text: str) -> tuple[str, object]:
                         f"tcp://127.0.0.1:8786, not {text!r}")
 
 
+def _describe(reply: bytes) -> str:
+    """What sent ``reply`` (the first bytes a server sent), in a few words for an error line."""
+    if reply.startswith(b"HTTP/"):
+        first = reply.split(b"\r\n", 1)[0].decode("ascii", "replace")
+        server = re.search(rb"\r\nServer: *([^\r\n]{1,60})", reply, re.I)
+        # the dashboard sends "/" to "status" (Tornado's 302), its pages name Bokeh and Dask
+        dash = (re.search(rb"\r\nLocation: *\S*status", reply, re.I) is not None
+                or b"bokeh" in reply.lower() or b"dask" in reply.lower())
+        return (f"an HTTP server ({first}{'; ' + server.group(1).decode('ascii', 'replace') if server else ''})"
+                + (": a Dask dashboard? The scheduler's own port is usually 8786" if dash else ""))
+    return f"a server that does not speak Dask's protocol (it sent {reply[:24]!r})"
+
+
+def _dask_handshake(head: bytes) -> bool:
+    """Do ``head`` (the first bytes a server sent) start a Dask TCP message (``distributed.comm.tcp``:
+    a 64-bit length of the frame header, then the number of frames and each frame's length)?"""
+    import struct
+
+    if len(head) < 16:
+        return False
+    total, nframes = struct.unpack_from("<QQ", head)
+    return 16 <= total <= 1 << 24 and 1 <= nframes <= 64 and 8 + 8 * nframes <= total
+
+
+def _receive(sock, upto: int, timeout: float) -> bytes:
+    """What ``sock`` sends within ``timeout`` seconds, until ``upto`` bytes or it closes (a time-out
+    with nothing is ``b""``; another error is raised)."""
+    out = b""
+    sock.settimeout(timeout)
+    try:
+        while len(out) < upto:
+            got = sock.recv(4096)
+            if not got:
+                break
+            out += got
+    except TimeoutError:
+        pass
+    return out
+
+
+#: addresses :func:`check_scheduler` found a Dask scheduler at (in this process)
+_CHECKED: set[str] = set()
+
+
+def check_scheduler(text: str, *, limit_s: float = SCHEDULER_CHECK_S) -> tuple[str, object]:
+    """:func:`parse_scheduler`, and for a ``tcp://HOST:PORT`` address, a look at what answers there
+    before any work: a TCP connection and the first bytes the server sends (a Dask scheduler sends its
+    handshake at once). Nothing listening, an HTTP server (the dashboard's port typed for the
+    scheduler's), a server that sends other bytes or nothing: one :class:`RasterhwError` line naming
+    the address and what answered, within ``limit_s`` seconds. Other schemes (``tls://``, ...) are
+    left to the Dask client (:class:`Runner`), under the same limit."""
+    import socket
+
+    kind, arg = parse_scheduler(text)
+    if kind != "address" or not str(arg).startswith("tcp://") or arg in _CHECKED:
+        return kind, arg
+    m = re.fullmatch(r"tcp://(\[[^\]]+\]|[^:/]+)(?::([0-9]{1,5}))?/?", str(arg))
+    if m is None or (m.group(2) is not None and not 0 < int(m.group(2)) < 65536):
+        raise RasterhwError(f"--scheduler {arg}: not a tcp://HOST:PORT address")
+    host, port = m.group(1).strip("[]"), int(m.group(2) or 8786)
+    deadline = time.monotonic() + limit_s
+
+    def left() -> float:
+        return max(0.1, deadline - time.monotonic())
+
+    try:
+        sock = socket.create_connection((host, port), timeout=min(left(), limit_s / 2))
+    except TimeoutError:
+        raise RasterhwError(f"cannot reach the Dask scheduler at {arg}: no answer in {limit_s / 2:.0f} s") from None
+    except OSError as e:
+        raise RasterhwError(f"cannot reach the Dask scheduler at {arg}: {e.strerror or e}") from None
+    reply = b""
+    with sock:
+        try:
+            reply = _receive(sock, 16, min(left(), 2.0))   # a Dask scheduler sends its handshake at once
+        except OSError as e:
+            raise RasterhwError(f"the Dask scheduler at {arg} closed the connection ({e.strerror or e})") from None
+        if not reply:   # silent: ask it as a web server would, to say what it is
+            try:
+                sock.settimeout(min(left(), 3.0))
+                sock.sendall(f"GET / HTTP/1.0\r\nHost: {host}\r\n\r\n".encode())
+                reply = _receive(sock, 512, min(left(), 3.0))
+            except OSError:
+                pass
+    if _dask_handshake(reply):
+        _CHECKED.add(arg)
+        return kind, arg
+    what = _describe(reply) if reply else (f"a server that accepted the connection and sent nothing in "
+                                           f"{limit_s - left():.0f} s (not a Dask scheduler)")
+    raise RasterhwError(f"--scheduler {arg} is not a Dask scheduler: {what}")
+
+
 def default_store() -> Path:
     """Where finished results are kept unless ``--store`` says otherwise."""
     return BUILD_ROOT / "tasks"
@@ -311,7 +405,7 @@ class Runner:
         self.store = Path(store) if store is not None else None
         self.fresh = fresh
         self.progress = progress
-        self.client = self.cluster = None
+        self.client = self.cluster = self._watch = None
         self.computed = 0           # tasks run (not found in the store)
         self.reused = 0             # tasks whose result came from the store
         self._lock = threading.Lock()
@@ -325,15 +419,32 @@ class Runner:
         from distributed import Client, LocalCluster
 
         if self.kind == "local":
+            from rasterhw.sim.workdirs import OrphanWatch
+
+            # a worker killed mid-build leaves its compiler to this process (a subreaper): ended here
+            self._watch = OrphanWatch().__enter__()
             n = self.arg or _cores()
             self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                        dashboard_address=None, silence_logs=logging.ERROR)
+                                        dashboard_address=None, silence_logs=logging.CRITICAL,
+                                        # a task's error reaches the caller through its result (one
+                                        # line); the workers' own error logs (a failed task's traceback,
+                                        # a closed connection when the command is interrupted) are not
+                                        # printed. No dashboard; the scheduler's own small HTTP server (health
+                                        # routes) on a free loopback port, not 8787 ("Port 8787 is
+                                        # already in use" on stderr when another cluster has it)
+                                        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"})
             self.client = Client(self.cluster)
         else:
+            t0 = time.monotonic()
+            check_scheduler(self.scheduler)   # (at once if the command did it first) and the client: one limit
+            left = max(1.0, SCHEDULER_CHECK_S - (time.monotonic() - t0))
             try:
-                self.client = Client(self.arg, timeout=CONNECT_TIMEOUT)
+                self.client = Client(self.arg, timeout=f"{left:.0f}s")
             except (OSError, TimeoutError) as e:
                 raise RasterhwError(f"cannot reach the Dask scheduler at {self.arg}: {e}") from None
+            except Exception as e:  # noqa: BLE001 - a reply that is not Dask's: one line, never a traceback
+                raise RasterhwError(f"--scheduler {self.arg} did not answer as a Dask scheduler "
+                                    f"({type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''})") from None
         return self
 
     def __exit__(self, *exc) -> None:
@@ -341,7 +452,9 @@ class Runner:
             self.client.close()
         if self.cluster is not None:
             self.cluster.close()
-        self.client = self.cluster = None
+        if self._watch is not None:
+            self._watch.__exit__()
+        self.client = self.cluster = self._watch = None
 
     @property
     def nworkers(self) -> int:
