@@ -9,6 +9,7 @@ import pytest
 from click.testing import CliRunner
 from rasterhw.sim.cli.main import cli, main
 from rasterhw.sim.flow import mutate as M
+from test_json_style import style_problems
 
 LINE = ("mutate -ctrl mutsel 6 4 -mode const1 -module rasterhw_bench -cell $flatten\\dut.$ternary$bench.v:455$13 "
         "-port A -portbit 62 -src bench.v:455.3-455.9 -src /x/t50-pkg/rasterhw/hdl/zbm/merger.py:35")
@@ -50,6 +51,7 @@ def test_campaign_json_adds_up(tmp_path):
     assert r["killed"] + r["equivalent"] + r["survived"] == 3
     assert r["score"] == pytest.approx(r["killed"] / (3 - r["equivalent"]), abs=1e-4)
     assert all(s["src"] and s["mutation"] for s in r["survivors"])
+    assert not style_problems(r)   # the JSON conventions (docs/architecture.md, JSON output)
     again = CliRunner().invoke(cli, ["mutate", "zbm-merger", "--mutants", "3", "--seed", "1", "--json",
                                      "--store", str(tmp_path)])
     assert json.loads(again.stdout.strip().splitlines()[-1])["reused"] == 4   # mutants 0..3 from the store

@@ -262,7 +262,7 @@ def campaign(block: str, params: dict | None = None, *, mutants: int = 40, seed:
             "baseline_passed": not base["killed"], "baseline_why": base["why"], "killed": killed,
             "equivalent": equivalent, "survived": n - killed - equivalent, "bounded_equivalent": 0,
             "score": None if score is None else round(score, 4), "survivors": survivors,
-            "killed_by": {str(r["mutant"]): r["why"] for r in rest if r["killed"]},
+            "killed_by": [{"mutant": r["mutant"], "why": r["why"]} for r in rest if r["killed"]],
             "scheduler": where, "computed": computed, "reused": reused,
             "yosys_s": m["yosys_s"], "build_s": round(build_s, 2), "runs_s": round(runs_s, 2),
             "wall_s": round(time.perf_counter() - t0, 2), "dir": str(m["dir"])}
