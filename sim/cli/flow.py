@@ -1,4 +1,4 @@
-"""``rasterhw synth``, ``rasterhw fpga`` and ``rasterhw prove``: the hardware flow's commands.
+"""``rasterhw synth``, ``rasterhw fpga``, ``rasterhw prove`` and ``rasterhw mutate``: the hardware flow's commands.
 
 Kept apart from ``sim/cli/main.py`` (which adds them with :func:`add_commands`); every tool comes
 from PyPI (``sim/flow/tools.py``). Errors are ``RasterhwError``: one line ``error: ...``, exit 2.
@@ -143,13 +143,58 @@ MAX_DEPTH = 10_000
 
 
 def check_cache() -> None:
-    """The build cache can be written: said before any work (sim/cachefile.py)."""
+    """The build cache can be written: said before any work, not when the first entry is stored
+    (sim/cachefile.py)."""
     from rasterhw.sim.cachefile import check_writable
 
     check_writable()
 
 
+@click.command()
+@click.argument("block")
+@click.option("-p", "--param", "params", multiple=True, metavar="NAME=VALUE",
+              help="Block parameter, e.g. -p depth=64 (repeatable; default: the testbench's defaults).")
+@click.option("--mutants", type=int, default=40, show_default=True, help="Mutations Yosys samples (mutate -list N).")
+@click.option("--seed", type=int, default=1, show_default=True,
+              help="Seed of Yosys's sampling and of the testbench's stimulus (same seed: same mutants, same runs).")
+@click.option("--scheduler", default="serial", show_default=True, metavar="serial|local[:N]|tcp://HOST:PORT",
+              help="Where the mutants' runs go (a task each: docs/scale.md).")
+@click.option("--store", type=click.Path(file_okay=False), default=None,
+              help="Folder keeping every finished mutant's result (default: build/tasks); a rerun reuses them.")
+@click.option("--fresh", is_flag=True, help="Run every mutant again, even those in the store.")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print the campaign as JSON (mutants, baseline_passed, killed, equivalent, survived, score, survivors).")
+def mutate(block: str, params: tuple[str, ...], mutants: int, seed: int, scheduler: str, store: str | None,
+           fresh: bool, as_json: bool) -> None:
+    """Mutation coverage of BLOCK: N faults planted by Yosys (mutate) behind one control input,
+    one Verilator build, the block's testbench run once per mutant; killed / survived, score.
+
+    Exit 1 if mutant 0 (no mutation) fails its testbench (the campaign is void). docs/mutation.md."""
+    from rasterhw.sim.flow.mutate import campaign, mutation_blocks
+    from rasterhw.sim.flow.tasks import check_scheduler, default_store
+
+    if block not in mutation_blocks():
+        raise RasterhwError(f"no testbench for block {block!r}; blocks: {', '.join(mutation_blocks())}")
+    check_cache()
+    check_scheduler(scheduler)   # what answers at its address too, before anything runs
+    r = campaign(block, _params(block, params), mutants=mutants, seed=seed, scheduler=scheduler,
+                 store=store or default_store(), fresh=fresh, progress=not as_json)
+    if as_json:
+        _emit(r)
+    else:
+        shown = ", ".join(f"{k}={v}" for k, v in r["params"].items())
+        score = "void (mutant 0 fails: " + r["baseline_why"] + ")" if r["score"] is None else f"{r['score']:.3f}"
+        click.echo(f"{block} ({shown}): {r['mutants']} mutants, {r['killed']} killed, {r['equivalent']} equivalent, "
+                   f"{r['survived']} survived; score {score}")
+        click.echo(f"  Yosys {r['yosys_s']:.1f} s, build {r['build_s']:.1f} s, runs {r['runs_s']:.1f} s "
+                   f"({r['computed']} run, {r['reused']} from the store); files in {r['dir']}")
+        for s in r["survivors"]:
+            click.echo(f"  survivor {s['mutant']}: {', '.join(s['src']) or '(no Amaranth src)'}: {s['mutation']}")
+    if not r["baseline_passed"]:
+        sys.exit(1)
+
+
 def add_commands(group: click.Group) -> None:
-    """Add ``synth``, ``fpga`` and ``prove`` to the ``rasterhw`` group."""
-    for cmd in (synth, fpga, prove):
+    """Add ``synth``, ``fpga``, ``prove`` and ``mutate`` to the ``rasterhw`` group."""
+    for cmd in (synth, fpga, prove, mutate):
         group.add_command(cmd)

@@ -14,7 +14,7 @@ from pathlib import Path
 import click
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
-from rasterhw.sim.cli.flow import add_commands
+from rasterhw.sim.cli.flow import add_commands, check_cache
 from rasterhw.sim.cli.jsonout import emit_json, sim_json
 from rasterhw.sim.report.rows import systems as _report_systems
 
@@ -108,14 +108,6 @@ def check_engine(engine: str | None) -> None:
         except SimulatorUnavailable as e:
             raise RasterhwError(f"--engine {engine}: {e} (install it, or use --engine "
                                 f"{'verilator' if engine == 'icarus' else 'pysim'})") from None
-
-
-def check_cache() -> None:
-    """The build cache can be written: said before any work, not when the first entry is stored
-    (sim/cachefile.py)."""
-    from rasterhw.sim.cachefile import check_writable
-
-    check_writable()
 
 
 def _ascii_values(given: dict) -> None:

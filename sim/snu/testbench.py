@@ -89,9 +89,9 @@ def _frame_words(rgb: np.ndarray, z: np.ndarray, z_bits: int) -> list[int]:
 class BankBench(Testbench):
     """``pixelbus-bank``: pixel writes (bank-local address, RGB, Z) in on ``i`` back to back, the
     bank's draw buffer and Z out (``o``, ``depth`` words). Golden: the writes applied in order with
-    the strict Z test (``pixelbus_frame``). The golden cycle model is the bus's (two pipelines'
-    slots), not one bank's: no cycle count here (the bank's memory-cycle timing is held by
-    ``tests/snu/test_pixelbus_pysim.py``)."""
+    the strict Z test (``pixelbus_frame``), and the cycle count of one bank (:func:`bank_cycles`:
+    one write per memory cycle, the block's documented throughput; the read-out once the last
+    memory cycle ended). The bus's golden cycle model (two pipelines' slots) is not one bank's."""
 
     block = "pixelbus-bank"
 
@@ -111,7 +111,24 @@ class BankBench(Testbench):
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         s = stim.source
         rgb, z = golden.pixelbus_frame(s, accept=np.arange(len(s)))
-        return Expected({"o": _frame_words(rgb, z, params["z_bits"])})
+        return Expected({"o": _frame_words(rgb, z, params["z_bits"])}, cycles=bank_cycles(params, stim))
+
+
+def bank_cycles(params: dict, stim: Stimulus) -> int:
+    """The edges of a bank run with ``o`` always ready (``ReadOut``'s timing): write ``k`` is
+    offered ``gap`` clocks after the edge following write ``k - 1``'s accept and accepted once the
+    bank is free, ``mem_cycle`` clocks after that accept (``PixelBusBank``: "one write per
+    ``mem_cycle`` clocks"); the end token is taken when offered; the sweep starts at the first
+    clock with the token seen and the last memory cycle over, and gives word ``j`` at the edge
+    after it plus ``j``: the cycles are that start + ``depth`` + 1 (added for mutation coverage,
+    docs/mutation.md: the bank's memory-cycle counter was unchecked)."""
+    m, g = params["mem_cycle"], stim.gaps_of("i")
+    n = len(stim.words["i"]) - 1           # the writes; the last word is the end token
+    if n == 0:
+        return int(g[0]) + 1 + params["depth"] + 1
+    accept = int(g[0]) + int(np.maximum(m, 1 + g[1:n]).sum())
+    start = max(accept + 1 + int(g[n]) + 1, accept + m)
+    return start + params["depth"] + 1
 
 
 class BusBench(Testbench):

