@@ -178,9 +178,12 @@ def schedule(lines: list[tuple[int, int, int]]) -> dict:
     return {"line_cycles": out, "last_pixel": de[-1] if de else -1}
 
 
-def line_job(segs: list[dict], bucket: list[int], lead: int, lo: int, hi: int, *, aj: str, width: int) -> dict:
-    """One PXP line: its words, resolve and drain cycles and visible positions of ``[lo, hi)``."""
+def line_job(segs: list[dict], bucket: list[int], lead: int, lo: int, hi: int, *, aj: str, width: int,
+             resolver=None) -> dict:
+    """One PXP line: its words, resolve and drain cycles and visible positions of ``[lo, hi)``.
+    ``resolver``: :func:`resolve` (default, the span PXP) or another PXP's resolve on the same
+    DMM/P words, schedule and drain (``coherent.resolve``: the coherent span PXP)."""
     glo, ghi = guarded(lo, hi, width, aj)
-    cyc, vis = resolve(segs, bucket, lead, glo, ghi)
+    cyc, vis = (resolver or resolve)(segs, bucket, lead, glo, ghi)
     return {"words": len(segs) + len(bucket) + 1, "resolve": sum(cyc.values()), "steps": cyc,
             "drain": drain_cycles(lo, hi, aj=aj, width=width), "visible": vis[lo - glo:lo - glo + (hi - lo)]}

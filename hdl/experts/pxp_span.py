@@ -55,7 +55,7 @@ from rasterhw.hdl.experts.drain import Drain, check_pxp_params, pxp_members
 from rasterhw.hdl.experts.pxp import asb_fields
 from rasterhw.hdl.params import params
 
-__all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "PTR_BITS", "NO_PTR"]
+__all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "dmm_p", "take_bank", "zrun_at", "PTR_BITS", "NO_PTR"]
 
 NONE = (1 << ADDR_BITS) - 1     # ASB address / polygon number of the background
 PTR_BITS = 9                    # ASL position in a DMM/P bank
@@ -75,6 +75,87 @@ def dmm_layout() -> data.StructLayout:
 def asb_layout() -> data.StructLayout:
     """The ASB fields of a DMM/P word (without ``last``, ``list``, ``ptr``)."""
     return data.StructLayout(asb_fields())
+
+
+def dmm_p(m: Module, comp, asb, D: int) -> dict:
+    """The DMM/P writer of a span PXP ``comp`` (two banks of ``D`` ASBs and bucket entries), added to
+    ``m``: the words of ``comp.i`` (module docstring) into the bank being written. Returns the
+    memory ``dmm``, the resolve side's read ports ``srd`` (ASBs) and ``brd`` (bucket list), the banks'
+    ``full`` flags and ``clr_full`` (the drain releases a bank), and per bank its ASB count ``bn``,
+    bucket count ``bnb``, leading pointer ``blead`` and range ``blo``/``bhi``."""
+    pw = (D - 1).bit_length()
+    cw = D.bit_length()
+    m.submodules.dmm = dmm = Memory(shape=asb, depth=2 << pw, init=[])
+    dwr = dmm.write_port()
+    srd = dmm.read_port(domain="comb")          # resolve side
+    m.submodules.bkt = bkt = Memory(shape=unsigned(PTR_BITS), depth=2 << pw, init=[])
+    bwr = bkt.write_port()
+    brd = bkt.read_port(domain="comb")
+    wbank = Signal()
+    wn = Signal(cw)
+    wnb = Signal(cw)
+    full = Signal(2)
+    bn = [Signal(cw, name=f"n{b}") for b in range(2)]
+    bnb = [Signal(cw, name=f"nb{b}") for b in range(2)]
+    blead = [Signal(PTR_BITS, name=f"lead{b}") for b in range(2)]
+    blo = [Signal(10, name=f"lo{b}") for b in range(2)]
+    bhi = [Signal(11, name=f"hi{b}") for b in range(2)]
+    set_full = Signal(2)
+    clr_full = Signal(2)
+    wfull = Signal()
+    m.d.comb += wfull.eq(full.bit_select(wbank, 1))
+    p = comp.i.payload
+    fits = Signal()
+    m.d.comb += fits.eq(p.last | Mux(p.list, wnb < D, wn < D))
+    m.d.comb += [comp.i.ready.eq(~wfull & ~comp.overflow & fits),
+                 dwr.en.eq(0), bwr.en.eq(0),
+                 dwr.addr.eq((wbank << pw) | wn[:pw]), bwr.addr.eq((wbank << pw) | wnb[:pw]),
+                 bwr.data.eq(p.ptr)]
+    for name in asb.members:
+        m.d.comb += getattr(dwr.data, name).eq(getattr(p, name))
+    with m.If(comp.i.valid & ~wfull & ~fits):
+        m.d.sync += comp.overflow.eq(1)
+    with m.If(comp.i.valid & comp.i.ready):
+        with m.If(p.last):
+            m.d.sync += [wn.eq(0), wnb.eq(0), wbank.eq(~wbank)]
+            for b in range(2):
+                with m.If(wbank == b):
+                    m.d.comb += set_full.eq(1 << b)
+                    m.d.sync += [bn[b].eq(wn), bnb[b].eq(wnb), blead[b].eq(p.ptr),
+                                 blo[b].eq(comp.lo), bhi[b].eq(comp.hi)]
+        with m.Elif(p.list):
+            m.d.comb += bwr.en.eq(1)
+            m.d.sync += wnb.eq(wnb + 1)
+        with m.Else():
+            m.d.comb += dwr.en.eq(1)
+            m.d.sync += wn.eq(wn + 1)
+    m.d.sync += full.eq((full | set_full) & ~clr_full)
+    return {"dmm": dmm, "srd": srd, "brd": brd, "full": full, "clr_full": clr_full, "bn": bn, "bnb": bnb,
+            "blead": blead, "blo": blo, "bhi": bhi}
+
+
+def take_bank(m: Module, dm: dict, rb, W: int, aj: bool) -> dict:
+    """Bank ``rb`` of :func:`dmm_p` as the resolve side takes it: its range ``lo``/``hi``, the
+    guarded range ``glo``/``ghi`` (one guard pixel each side with A.J., within the frame), the ASB
+    count ``n``, bucket count ``nb`` and leading pointer ``lead``."""
+    lo_b, hi_b = Signal(10), Signal(11)
+    glo_b, ghi_b = Signal(11), Signal(11)
+    m.d.comb += [lo_b.eq(Mux(rb, dm["blo"][1], dm["blo"][0])), hi_b.eq(Mux(rb, dm["bhi"][1], dm["bhi"][0]))]
+    if aj:
+        m.d.comb += [glo_b.eq(Mux(lo_b > 0, lo_b - 1, 0)), ghi_b.eq(Mux(hi_b < W, hi_b + 1, hi_b))]
+    else:
+        m.d.comb += [glo_b.eq(lo_b), ghi_b.eq(hi_b)]
+    return {"lo": lo_b, "hi": hi_b, "glo": glo_b, "ghi": ghi_b, "lead": Mux(rb, dm["blead"][1], dm["blead"][0]),
+            "n": Mux(rb, dm["bn"][1], dm["bn"][0]), "nb": Mux(rb, dm["bnb"][1], dm["bnb"][0])}
+
+
+def zrun_at(m: Module, seg, col):
+    """A multiplier: the running z (Q16.4) of ASB ``seg`` at pixel ``col`` (``span_cycles._zrun``)."""
+    d = Signal(signed(20), name="d_z")
+    z = Signal(signed(40), name="zrun")
+    m.d.comb += [d.eq((col << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl),
+                 z.eq((seg.zl << DZ_FRAC) + ((d * seg.dzdx) >> X_FRAC))]
+    return z
 
 
 class _R(enum.Enum, shape=3):
@@ -137,51 +218,8 @@ class ExpertsPxpSpan(wiring.Component):
         ab = (W - 1).bit_length()                   # DSLB bank bit position
 
         # ---------------------------------------------------------------- DMM/P (two banks)
-        m.submodules.dmm = dmm = Memory(shape=asb, depth=2 << pw, init=[])
-        dwr = dmm.write_port()
-        srd = dmm.read_port(domain="comb")          # resolve side
-        m.submodules.bkt = bkt = Memory(shape=unsigned(PTR_BITS), depth=2 << pw, init=[])
-        bwr = bkt.write_port()
-        brd = bkt.read_port(domain="comb")
-        wbank = Signal()
-        wn = Signal(cw)
-        wnb = Signal(cw)
-        full = Signal(2)
-        bn = [Signal(cw, name=f"n{b}") for b in range(2)]
-        bnb = [Signal(cw, name=f"nb{b}") for b in range(2)]
-        blead = [Signal(PTR_BITS, name=f"lead{b}") for b in range(2)]
-        blo = [Signal(10, name=f"lo{b}") for b in range(2)]
-        bhi = [Signal(11, name=f"hi{b}") for b in range(2)]
-        set_full = Signal(2)
-        clr_full = Signal(2)
-        wfull = Signal()
-        m.d.comb += wfull.eq(full.bit_select(wbank, 1))
-        p = self.i.payload
-        fits = Signal()
-        m.d.comb += fits.eq(p.last | Mux(p.list, wnb < D, wn < D))
-        m.d.comb += [self.i.ready.eq(~wfull & ~self.overflow & fits),
-                     dwr.en.eq(0), bwr.en.eq(0),
-                     dwr.addr.eq((wbank << pw) | wn[:pw]), bwr.addr.eq((wbank << pw) | wnb[:pw]),
-                     bwr.data.eq(p.ptr)]
-        for name in asb.members:
-            m.d.comb += getattr(dwr.data, name).eq(getattr(p, name))
-        with m.If(self.i.valid & ~wfull & ~fits):
-            m.d.sync += self.overflow.eq(1)
-        with m.If(self.i.valid & self.i.ready):
-            with m.If(p.last):
-                m.d.sync += [wn.eq(0), wnb.eq(0), wbank.eq(~wbank)]
-                for b in range(2):
-                    with m.If(wbank == b):
-                        m.d.comb += set_full.eq(1 << b)
-                        m.d.sync += [bn[b].eq(wn), bnb[b].eq(wnb), blead[b].eq(p.ptr),
-                                     blo[b].eq(self.lo), bhi[b].eq(self.hi)]
-            with m.Elif(p.list):
-                m.d.comb += bwr.en.eq(1)
-                m.d.sync += wnb.eq(wnb + 1)
-            with m.Else():
-                m.d.comb += dwr.en.eq(1)
-                m.d.sync += wn.eq(wn + 1)
-        m.d.sync += full.eq((full | set_full) & ~clr_full)
+        dm = dmm_p(m, self, asb, D)
+        dmm, srd, brd, full, clr_full = dm["dmm"], dm["srd"], dm["brd"], dm["full"], dm["clr_full"]
 
         # ---------------------------------------------------------------- DSLB (two banks)
         word = data.StructLayout({"addr": unsigned(ADDR_BITS), "pix": unsigned(pb), "slot": unsigned(pw)})
@@ -240,14 +278,8 @@ class ExpertsPxpSpan(wiring.Component):
                      a.eq(Mux(c0 > glo, c0, glo)), e.eq(Mux(c1 < ghi - 1, c1, ghi - 1))]
 
         # the two multipliers: running z (Q16.4) at pixels sl and sr
-        def zrun_at(col):
-            d = Signal(signed(20), name="d_z")
-            z = Signal(signed(40), name="zrun")
-            m.d.comb += [d.eq((col << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl),
-                         z.eq((seg.zl << DZ_FRAC) + ((d * seg.dzdx) >> X_FRAC))]
-            return z
-        zl_ = zrun_at(sl)
-        zr_ = zrun_at(sr)
+        zl_ = zrun_at(m, seg, sl)
+        zr_ = zrun_at(m, seg, sr)
         zk = Signal(signed(40))
         key = Signal(Z_BITS)
         m.d.comb += [zk.eq(zl_ >> DZ_FRAC),
@@ -307,18 +339,11 @@ class ExpertsPxpSpan(wiring.Component):
         with m.Switch(state):
             with m.Case(_R.IDLE):
                 m.d.sync += cyc.eq(1)
-                lo_b, hi_b = Signal(10), Signal(11)
-                glo_b, ghi_b = Signal(11), Signal(11)
-                m.d.comb += [lo_b.eq(Mux(rb, blo[1], blo[0])), hi_b.eq(Mux(rb, bhi[1], bhi[0]))]
-                if aj:
-                    m.d.comb += [glo_b.eq(Mux(lo_b > 0, lo_b - 1, 0)), ghi_b.eq(Mux(hi_b < W, hi_b + 1, hi_b))]
-                else:
-                    m.d.comb += [glo_b.eq(lo_b), ghi_b.eq(hi_b)]
+                tb = take_bank(m, dm, rb, W, aj)
+                lo_b, hi_b, glo_b, ghi_b, lead, n_b = tb["lo"], tb["hi"], tb["glo"], tb["ghi"], tb["lead"], tb["n"]
                 with m.If(full.bit_select(rb, 1)):
-                    lead = Mux(rb, blead[1], blead[0])
-                    n_b = Mux(rb, bn[1], bn[0])
                     m.d.sync += [lo.eq(lo_b), hi.eq(hi_b), glo.eq(glo_b), ghi.eq(ghi_b), x.eq(glo_b),
-                                 n.eq(n_b), nb.eq(Mux(rb, bnb[1], bnb[0])),
+                                 n.eq(n_b), nb.eq(tb["nb"]),
                                  pp.eq(Mux(lead == NO_PTR, n_b, lead)),
                                  i.eq(0), j.eq(0), k.eq(0), bi.eq(0), minend.eq(ghi_b),
                                  state.eq(Mux(ghi_b <= glo_b, _R.HAND, _R.ENTER))]
