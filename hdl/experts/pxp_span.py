@@ -55,7 +55,8 @@ from rasterhw.hdl.experts.drain import Drain, check_pxp_params, pxp_members
 from rasterhw.hdl.experts.pxp import asb_fields
 from rasterhw.hdl.params import params
 
-__all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "dmm_p", "take_bank", "zrun_at", "PTR_BITS", "NO_PTR"]
+__all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "dmm_p", "take_bank", "zrun_at", "z_key", "guarded_test",
+           "intensity_at", "PTR_BITS", "NO_PTR"]
 
 NONE = (1 << ADDR_BITS) - 1     # ASB address / polygon number of the background
 PTR_BITS = 9                    # ASL position in a DMM/P bank
@@ -156,6 +157,40 @@ def zrun_at(m: Module, seg, col):
     m.d.comb += [d.eq((col << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl),
                  z.eq((seg.zl << DZ_FRAC) + ((d * seg.dzdx) >> X_FRAC))]
     return z
+
+
+def z_key(m: Module, zrun) -> Signal:
+    """The 16-bit compare key of a running z: ``zrun >> DZ_FRAC`` clamped to ``0 .. 2**Z_BITS - 1``."""
+    zk = Signal(signed(40), name="zk")
+    key = Signal(Z_BITS, name="key")
+    m.d.comb += [zk.eq(zrun >> DZ_FRAC), key.eq(Mux(zk < 0, 0, Mux(zk > (1 << Z_BITS) - 1, (1 << Z_BITS) - 1, zk)))]
+    return key
+
+
+def guarded_test(m: Module, zsl, zsr, zbl, zbr, s_lower) -> Signal:
+    """The guarded end-depth test of ``golden_model/experts/span.py`` (``_stays_nearest``, bit
+    model): S (running z ``zsl``/``zsr`` at the two end pixels) nearer than B (``zbl``/``zbr``) at
+    every pixel between; ``s_lower``: S has the lower ASB address (ties go to S)."""
+    g = 1 << DZ_FRAC
+    zmax_run = ((1 << Z_BITS) - 1) << DZ_FRAC
+    lower, higher, good = Signal(name="lower"), Signal(name="higher"), Signal(name="good_t")
+    m.d.comb += [lower.eq((zsl <= zbl) & (zsr <= zbr)),
+                 higher.eq((zsl + g <= zbl) & (zsr + g <= zbr) & (zbl >= g) & (zbr >= g)
+                           & (zsl < zmax_run) & (zsr < zmax_run)),
+                 good.eq(Mux(s_lower, lower, higher))]
+    return good
+
+
+def intensity_at(m: Module, seg, col, fmt: Formats) -> Signal:
+    """S.S.: the intensity of ASB ``seg`` at pixel ``col`` by the multiplier, clamped (Q.i_frac)."""
+    di = Signal(signed(20), name="di")
+    irun = Signal(signed(40), name="irun")
+    m.d.comb += [di.eq((col << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl),
+                 irun.eq(seg.il + ((di * seg.didx) >> X_FRAC))]
+    imax = fmt.i_max << fmt.i_frac
+    ic = Signal(16, name="ic")
+    m.d.comb += ic.eq(Mux(irun < 0, 0, Mux(irun > imax, imax, irun)))
+    return ic
 
 
 class _R(enum.Enum, shape=3):
@@ -280,33 +315,17 @@ class ExpertsPxpSpan(wiring.Component):
         # the two multipliers: running z (Q16.4) at pixels sl and sr
         zl_ = zrun_at(m, seg, sl)
         zr_ = zrun_at(m, seg, sr)
-        zk = Signal(signed(40))
-        key = Signal(Z_BITS)
-        m.d.comb += [zk.eq(zl_ >> DZ_FRAC),
-                     key.eq(Mux(zk < 0, 0, Mux(zk > (1 << Z_BITS) - 1, (1 << Z_BITS) - 1, zk)))]
+        key = z_key(m, zl_)
         nearer = Signal()
         m.d.comb += nearer.eq((i == 0) | (key < skey) | ((key == skey) & (seg.addr < saddr)))
         # the guarded test (span.py): S nearer than this segment B at every pixel of [sl, sr]
-        g = 1 << DZ_FRAC
-        zmax_run = ((1 << Z_BITS) - 1) << DZ_FRAC
-        lower = Signal()
-        higher = Signal()
         good = Signal()
-        m.d.comb += [lower.eq((szl <= zl_) & (szr <= zr_)),
-                     higher.eq((szl + g <= zl_) & (szr + g <= zr_) & (zl_ >= g) & (zr_ >= g)
-                               & (szl < zmax_run) & (szr < zmax_run)),
-                     good.eq((raddr == S) | Mux(saddr < seg.addr, lower, higher))]
+        m.d.comb += good.eq((raddr == S) | guarded_test(m, szl, szr, zl_, zr_, saddr < seg.addr))
         mid = Signal(11)
         m.d.comb += mid.eq((sl + sr + 1) >> 1)
 
         # S.S. at pixel sl (the write cursor): intensity by the multiplier
-        di = Signal(signed(20))
-        irun = Signal(signed(40))
-        m.d.comb += [di.eq((sl << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl),
-                     irun.eq(seg.il + ((di * seg.didx) >> X_FRAC))]
-        imax = fmt.i_max << fmt.i_frac
-        ic = Signal(16)
-        m.d.comb += ic.eq(Mux(irun < 0, 0, Mux(irun > imax, imax, irun)))
+        ic = intensity_at(m, seg, sl, fmt)
 
         # the next entering candidate: the bucket list, then the walk from the leading pointer
         in_bkt = Signal()
