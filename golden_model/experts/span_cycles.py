@@ -27,7 +27,8 @@ cycle before it hands the DSLB bank over), every term:
 
 **Line schedule** (:func:`schedule`, the input back to back and the output always ready; cycle =
 the edge index, edge 0 takes the first word): line ``k`` has ``w_k`` words (ASL, bucket list,
-token), resolve cycles ``r_k`` and drain cycles ``d_k`` (:func:`pxp_cycles.drain_cycles`). The
+token), resolve cycles ``r_k`` and drain cycles ``d_k`` (:func:`span_drain_cycles`: with A.J. the
+entry is read at a segment's boundary pixels only). The
 writer starts ``WS_k = max(WE_{k-1} + 1, DE_{k-2} + 1)`` (the bank it writes is released when the
 drain has finished the line that used it), ends ``WE_k = WS_k + w_k - 1``; resolve starts
 ``RS_k = max(WE_k + 1, RH_{k-1} + 1)``, hands over at ``RH_k = max(RS_k + r_k, DE_{k-1} + 1)``;
@@ -44,7 +45,7 @@ from rasterhw.golden_model.experts.model import ExpertsFrame
 from rasterhw.golden_model.experts.pxp_cycles import asb_record, drain_cycles, guarded
 from rasterhw.golden_model.experts.slp_run import block_lists
 
-__all__ = ["DMM_DEPTH", "NO_PTR", "STEPS", "line_asl", "dmm_line", "resolve", "schedule"]
+__all__ = ["DMM_DEPTH", "NO_PTR", "STEPS", "line_asl", "dmm_line", "resolve", "schedule", "span_drain_cycles"]
 
 DMM_DEPTH = 256       # ASBs per DMM/P bank (the block's default)
 NO_PTR = 511          # leading pointer: none
@@ -186,4 +187,17 @@ def line_job(segs: list[dict], bucket: list[int], lead: int, lo: int, hi: int, *
     glo, ghi = guarded(lo, hi, width, aj)
     cyc, vis = (resolver or resolve)(segs, bucket, lead, glo, ghi)
     return {"words": len(segs) + len(bucket) + 1, "resolve": sum(cyc.values()), "steps": cyc,
-            "drain": drain_cycles(lo, hi, aj=aj, width=width), "visible": vis[lo - glo:lo - glo + (hi - lo)]}
+            "drain": span_drain_cycles(vis, lo, hi, aj=aj, width=width),
+            "visible": vis[lo - glo:lo - glo + (hi - lo)]}
+
+
+def span_drain_cycles(vis: list[int], lo: int, hi: int, *, aj: str, width: int) -> int:
+    """Drain cycles of one span-PXP line (``hdl/experts/drain.py``, ``boundary_only``): without
+    A.J. ``2 R``; with A.J. (c) 2 per guarded pixel, + 1 per pixel whose visible segment (``vis``,
+    the guarded range's ASL positions, -1 background) is not background and differs from the
+    pixel on its left (or is the walk's first), + 1 flush at the frame's right edge."""
+    if aj != "c":
+        return drain_cycles(lo, hi, aj=aj, width=width)
+    glo, ghi = guarded(lo, hi, width, aj)
+    reads = sum(1 for q, v in enumerate(vis) if v >= 0 and (q == 0 or vis[q - 1] != v))
+    return 2 * (ghi - glo) + reads + (1 if ghi == hi else 0)

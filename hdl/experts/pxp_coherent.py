@@ -178,7 +178,7 @@ class ExpertsPxpCoherent(wiring.Component):
 
         trd = dmm.read_port(transparent_for=()) if aj else None
         drain = Drain(m, o=self.o, drd=drd, word=word, bank_bit=ab, width=W, ib=ib, aj=aj,
-                      trd=trd, ent=asb, ent_bank_bit=pw,
+                      trd=trd, ent=asb, ent_bank_bit=pw, boundary_only=True,
                       done_comb=lambda d: [clr_full.eq(Mux(d.dbank, 0b10, 0b01))])
 
         def write(last):

@@ -1,4 +1,4 @@
-"""EXPERTS span PXP (the paper's): DMM/P bank in, span cull and depth search per span, S.S., A.J. (c), DSLB.
+"""EXPERTS span PXP (ours, after the paper's steps): DMM/P bank in, span cull and depth search per span, S.S., A.J. (c), DSLB.
 
 Paper (seed 000, section 4): the PXP's stages are "iv) スキャン・ラインをスパンに分割し、そのスパン内に
 現われる範囲のセグメントを抽出する《span cull》" and "v) iv)で抽出したセグメントに応じてデプス・サーチを
@@ -335,7 +335,7 @@ class ExpertsPxpSpan(wiring.Component):
         # ---------------------------------------------------------------- drain side (drain.py)
         trd = dmm.read_port(transparent_for=()) if aj else None    # the visible segment's edges
         drain = Drain(m, o=self.o, drd=drd, word=word, bank_bit=ab, width=W, ib=ib, aj=aj,
-                      trd=trd, ent=asb, ent_bank_bit=pw,
+                      trd=trd, ent=asb, ent_bank_bit=pw, boundary_only=True,
                       done_comb=lambda d: [clr_full.eq(Mux(d.dbank, 0b10, 0b01))])
         dbusy = drain.dbusy
 

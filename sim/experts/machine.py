@@ -6,8 +6,13 @@ _NO_CLOCK = Clock("sync", "EXPERTS: the paper names no clock (times in operation
 
 MACHINE = Machine(
     headline=("fig. 4.1 / text: balance Pn", "table 2.2: work with A.J.", "5: processor op rate for 30 frames/s",
-              "5: SLP clock for 30 frames/s, experts-1000", "5: PXP clock for 30 frames/s, experts-1000",
-              "5 / HDL: span PXP (the paper's)", "5 / HDL: SLP list work"),
+              "4 iv): coherent span PXP (ours: span cull once per segment, depth search where the visible segment "
+              "can change): span cull operations, Fr 2000 / Fr 1000",
+              "4 v): coherent span PXP (ours: span cull once per segment, depth search where the visible segment "
+              "can change): depth search operations, Fr 2000 / Fr 1000",
+              "5: SLP with set-up, operation count (model): SLP clock for 30 frames/s, experts-1000",
+              "5 / HDL: coherent span PXP (ours, experts-pxp-coherent), HDL cycles",
+              "5 / HDL: span PXP (ours, experts-pxp-span), HDL cycles", "5 / HDL: SLP list work"),
     name="experts",
     title="EXPERTS scan-line multiprocessor (Kyoto Univ.)",
     seed="000_5ac5e14b809e6e93.txt",
@@ -71,9 +76,9 @@ MACHINE = Machine(
                  "experts-group": "rasterhw.sim.experts.testbench:GroupBench",
                  "experts-pxp-unit": "rasterhw.sim.experts.testbench:PxpUnitBench",
                  "experts-dmm": "rasterhw.sim.experts.testbench:DmmBench"},
-    status="scan-line golden model split as SLP/PXP (float and 16-bit): the paper's span PXP (span cull, "
+    status="scan-line golden model split as SLP/PXP (float and 16-bit): span PXPs (the paper's span cull, "
            "depth search per span) and the SLP's sorts run and counted, Sn x Pn parallel model with "
            "load balancing at both levels, fig. 4.1 cost model (golden); in HDL, bit- and cycle-exact: the "
-           "span PXP (the paper's, default) and the line-Z-buffer PXP (ours), the SLP (Y-sort, ASL update, "
+           "span PXP (default), the coherent span PXP and the line-Z-buffer PXP (all ours), the SLP (Y-sort, ASL update, "
            "L-sort, X-merge, block lists; not its set-up); one SLP + Pn PXPs clocked together (pixel-exact)",
 )

@@ -153,7 +153,7 @@ class PxpBench(Testbench):
 
 
 class PxpSpanBench(PxpBench):
-    """``experts-pxp-span`` (the paper's PXP): the first line's range word, then per line the
+    """``experts-pxp-span`` (the span PXP): the first line's range word, then per line the
     DMM/P words the SLP writes -- the line's whole ASL, this PXP's block boundary bucket list, the
     ``last`` token with the block leading segment pointer (and the next line's range for the
     adapter) -- in (``i``), the range's pixel words out (``o``), as the golden bit model gives
