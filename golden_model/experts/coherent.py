@@ -49,7 +49,7 @@ lines, at every pixel up to ``vu``) or entered later and passed the test against
 from __future__ import annotations
 
 from rasterhw.golden_model.experts.formats import DZ_FRAC, Z_BITS
-from rasterhw.golden_model.experts.span_cycles import NO_PTR, _ends, _good, _zrun
+from rasterhw.golden_model.experts.span_cycles import Entering, _ends, _good, _zrun
 
 __all__ = ["STEPS", "TERMS", "resolve"]
 
@@ -87,38 +87,20 @@ def resolve_counts(segs: list[dict], bucket: list[int], lead: int, glo: int,
     vis: list[int] = []
     if ghi <= glo:
         return cyc, vis, cnt
-    n = len(segs)
     ends = [_ends(s, glo, ghi) for s in segs]
     act: list[int] = []
-    bi, pp = 0, (n if lead == NO_PTR else lead)
+    walk = Entering(bucket, lead, ends, ghi)
     x = glo
     V, vu = -1, glo - 1
     while x < ghi:
         cnt["spans"] += 1
-        fail = False
-        while True:
-            cyc["enter"] += 1
-            if bi < len(bucket):
-                pos, cand = bucket[bi], True
-            else:
-                pos = pp
-                cand = pp < n and ends[pp][0] < ghi
-            if cand:
-                _, a, e = ends[pos]
-                if e < a or a == x:
-                    if a <= e:
-                        act.append(pos)
-                        if V >= 0 and vu >= x:
-                            s, b, rb = segs[V], segs[pos], min(vu, e)
-                            fail |= not _good(_zrun(s, x), _zrun(s, rb), _zrun(b, x), _zrun(b, rb),
-                                              s["addr"] < b["addr"])
-                    if bi < len(bucket):
-                        bi += 1
-                    else:
-                        pp += 1
-                    continue
-            ns = ends[pos][1] if cand else ghi
-            break
+        entered: list[int] = []
+        ns = walk.take(x, cyc, entered.append)
+        act += entered
+        # each entering segment tested against the visible one up to vu (in its entering cycle)
+        fail = V >= 0 and vu >= x and not all(
+            _good(_zrun(segs[V], x), _zrun(segs[V], min(vu, ends[p][2])), _zrun(segs[p], x),
+                  _zrun(segs[p], min(vu, ends[p][2])), segs[V]["addr"] < segs[p]["addr"]) for p in entered)
         if fail or x > vu:
             cnt["searches_all"] += 1
             cyc["drop"] += sum(1 for p in act if ends[p][2] < x)

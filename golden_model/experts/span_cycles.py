@@ -45,7 +45,7 @@ from rasterhw.golden_model.experts.model import ExpertsFrame
 from rasterhw.golden_model.experts.pxp_cycles import asb_record, drain_cycles, guarded
 from rasterhw.golden_model.experts.slp_run import block_lists
 
-__all__ = ["DMM_DEPTH", "NO_PTR", "STEPS", "line_asl", "dmm_line", "resolve", "schedule", "span_drain_cycles"]
+__all__ = ["DMM_DEPTH", "Entering", "NO_PTR", "STEPS", "line_asl", "dmm_line", "resolve", "schedule", "span_drain_cycles"]
 
 DMM_DEPTH = 256       # ASBs per DMM/P bank (the block's default)
 NO_PTR = 511          # leading pointer: none
@@ -95,6 +95,39 @@ def _good(zs_l, zs_r, zb_l, zb_r, s_lower: bool) -> bool:
             and zs_l < _ZMAX_RUN and zs_r < _ZMAX_RUN)
 
 
+class Entering:
+    """The candidates entering a PXP's range, in the order the PXP reads them: its block boundary
+    bucket list, then the ASL from the block leading pointer while a segment's first pixel is
+    before ``ghi`` (``ends``: per ASL position ``(c0, a, e)`` of :func:`_ends`)."""
+
+    def __init__(self, bucket: list[int], lead: int, ends: list[tuple[int, int, int]], ghi: int):
+        self.bucket, self.ends, self.ghi = bucket, ends, ghi
+        self.bi, self.pp = 0, (len(ends) if lead == NO_PTR else lead)
+
+    def take(self, x: int, cyc: dict, enter) -> int:
+        """Take every candidate entering at pixel ``x``, one ``cyc["enter"]`` cycle each (one with no
+        pixel in the range is skipped in a cycle; ``enter(pos)`` for the others), plus one cycle that
+        finds the next start; returns it (``ghi``: none)."""
+        while True:
+            cyc["enter"] += 1
+            if self.bi < len(self.bucket):
+                pos, cand = self.bucket[self.bi], True
+            else:
+                pos = self.pp
+                cand = self.pp < len(self.ends) and self.ends[self.pp][0] < self.ghi
+            if not cand:
+                return self.ghi
+            _, a, e = self.ends[pos]
+            if not (e < a or a == x):
+                return a
+            if a <= e:
+                enter(pos)
+            if self.bi < len(self.bucket):
+                self.bi += 1
+            else:
+                self.pp += 1
+
+
 def resolve(segs: list[dict], bucket: list[int], lead: int, glo: int, ghi: int) -> tuple[dict, list[int]]:
     """One line of one range through the span PXP: cycles per step (:data:`STEPS`) and the visible
     ASL position of every pixel of ``[glo, ghi)`` (-1: background)."""
@@ -103,35 +136,18 @@ def resolve(segs: list[dict], bucket: list[int], lead: int, glo: int, ghi: int) 
     vis: list[int] = []
     if ghi <= glo:
         return cyc, vis
-    n = len(segs)
     ends = [_ends(s, glo, ghi) for s in segs]
     act: list[int] = []
-    bi, pp = 0, (n if lead == NO_PTR else lead)
+    walk = Entering(bucket, lead, ends, ghi)
     x = glo
     while x < ghi:
         cyc["cull"] += len(act)
         act = [p for p in act if ends[p][2] >= x]
         minend = min([ghi] + [ends[p][2] + 1 for p in act])
-        while True:
-            cyc["enter"] += 1
-            if bi < len(bucket):
-                pos, cand = bucket[bi], True
-            else:
-                pos = pp
-                cand = pp < n and ends[pp][0] < ghi
-            if cand:
-                _, a, e = ends[pos]
-                if e < a or a == x:
-                    if a <= e:
-                        act.append(pos)
-                        minend = min(minend, e + 1)
-                    if bi < len(bucket):
-                        bi += 1
-                    else:
-                        pp += 1
-                    continue
-            nxt = ends[pos][1] if cand and ends[pos][1] < minend else minend
-            break
+        entered = []
+        ns = walk.take(x, cyc, entered.append)
+        act += entered
+        nxt = min([ns, minend] + [ends[p][2] + 1 for p in entered])
         r = nxt - 1
         if len(act) < 2:
             cyc["write"] += r - x + 1

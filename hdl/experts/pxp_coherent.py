@@ -30,19 +30,18 @@ visible segment ``S`` (``vok``: one is visible) and the last pixel ``vu`` it has
 from __future__ import annotations
 
 from amaranth import Module, Mux, Signal, signed, unsigned
-from amaranth.lib import data, enum, wiring
+from amaranth.lib import enum
 from amaranth.lib.memory import Memory
-from amaranth.lib.wiring import Out
-from rasterhw.golden_model.experts.formats import ADDR_BITS, X_FRAC, Z_BITS, Formats
-from rasterhw.hdl.experts.drain import Drain, check_pxp_params, pxp_members
+from rasterhw.golden_model.experts.formats import ADDR_BITS, Z_BITS
 from rasterhw.hdl.experts.pxp_span import (
     NO_PTR,
+    NONE,
     PTR_BITS,
-    asb_layout,
-    dmm_layout,
-    dmm_p,
+    ExpertsPxpSpan,
+    candidate,
     guarded_test,
     intensity_at,
+    seg_ends,
     take_bank,
     z_key,
     zrun_at,
@@ -50,9 +49,6 @@ from rasterhw.hdl.experts.pxp_span import (
 from rasterhw.hdl.params import params
 
 __all__ = ["ExpertsPxpCoherent"]
-
-NONE = (1 << ADDR_BITS) - 1     # ASB address / polygon number of the background
-
 
 class _R(enum.Enum, shape=3):
     IDLE = 0      # wait for a full DMM/P bank; start the line
@@ -64,59 +60,19 @@ class _R(enum.Enum, shape=3):
 
 
 @params("width", "aj", "depth")
-class ExpertsPxpCoherent(wiring.Component):
+class ExpertsPxpCoherent(ExpertsPxpSpan):
     """One coherent span PXP with its DMM/P: DMM/P words in, the range's pixel words out, line by
-    line. Ports and parameters: :class:`hdl.experts.pxp_span.ExpertsPxpSpan`'s.
-
-    Parameters
-    ----------
-    width : int
-        Frame width (1..1024): depth of the DSLB.
-    intensity_bits : int
-        Intensity field width (1..7).
-    aj : str
-        ``"none"`` or ``"c"`` (anti-jagging, method (c)).
-    depth : int
-        ASBs per DMM/P bank (2..511).
-
-    Members
-    -------
-    i : In(stream.Signature(dmm_layout()))
-    o : Out(stream.Signature(unsigned(9 + intensity_bits)))
-    lo, hi : In(10), In(11)
-    line_cycles : Out(16)
-    lines : Out(16)
-    overflow : Out(1)
-    """
-
-    def __init__(self, *, width: int = 512, intensity_bits: int = 7, aj: str = "none", depth: int = 256):
-        check_pxp_params(width=width, aj=aj)
-        if isinstance(depth, bool) or not isinstance(depth, int) or not 2 <= depth <= NO_PTR:
-            raise ValueError(f"depth must be an integer in 2..{NO_PTR}, not {depth!r}")
-        self._fmt = Formats(intensity_bits)
-        self._width = width
-        self._aj = aj
-        self._depth = depth
-        super().__init__({**pxp_members(dmm_layout(), self._fmt.pixel_bits), "overflow": Out(1)})
+    line. Parameters (``width``, ``intensity_bits``, ``aj``, ``depth``), ports (``i``, ``o``, ``lo``,
+    ``hi``, ``line_cycles``, ``lines``, ``overflow``), DMM/P, DSLB and drain:
+    :class:`hdl.experts.pxp_span.ExpertsPxpSpan`'s (``frame``); the resolve side is this block's."""
 
     def elaborate(self, platform):
         m = Module()
-        fmt, W, D, aj = self._fmt, self._width, self._depth, self._aj == "c"
-        pb, ib = fmt.pixel_bits, fmt.intensity_bits
-        asb = asb_layout()
-        pw = (D - 1).bit_length()
-        cw = D.bit_length()
-        ab = (W - 1).bit_length()
-
-        dm = dmm_p(m, self, asb, D)
-        dmm, srd, brd, full, clr_full = dm["dmm"], dm["srd"], dm["brd"], dm["full"], dm["clr_full"]
-        vrd = dmm.read_port(domain="comb")          # the visible segment S
-
-        word = data.StructLayout({"addr": unsigned(ADDR_BITS), "pix": unsigned(pb), "slot": unsigned(pw)})
-        m.submodules.dslb = dslb = Memory(shape=word, depth=2 << ab, init=[])
-        wr = dslb.write_port()
-        drd = dslb.read_port(transparent_for=())
-        m.d.comb += wr.en.eq(0)
+        fr = self.frame(m)
+        fmt, W, D, aj, ib, asb = fr["fmt"], fr["W"], fr["D"], fr["aj"], fr["ib"], fr["asb"]
+        pw, cw, ab, word, wr, drain = fr["pw"], fr["cw"], fr["ab"], fr["word"], fr["wr"], fr["drain"]
+        srd, brd, full = fr["srd"], fr["brd"], fr["full"]
+        vrd = fr["dmm"].read_port(domain="comb")    # the visible segment S
 
         state = Signal(_R)
         rb = Signal()
@@ -150,10 +106,7 @@ class ExpertsPxpCoherent(wiring.Component):
         vseg = Signal(asb)
         m.d.comb += [srd.addr.eq((rb << pw) | raddr), seg.eq(srd.data),
                      vrd.addr.eq((rb << pw) | S), vseg.eq(vrd.data)]
-        c0, c1 = Signal(signed(12)), Signal(signed(12))
-        a, e = Signal(signed(12)), Signal(signed(12))
-        m.d.comb += [c0.eq((seg.xl + 31) >> X_FRAC), c1.eq(((seg.xr + 31) >> X_FRAC) - 1),
-                     a.eq(Mux(c0 > glo, c0, glo)), e.eq(Mux(c1 < ghi - 1, c1, ghi - 1))]
+        c0, a, e = seg_ends(m, seg, glo, ghi)
 
         # the test's right end: min(vu (ENTER) / sr (PASSB), the segment's last pixel)
         rt = Signal(12)
@@ -176,10 +129,6 @@ class ExpertsPxpCoherent(wiring.Component):
         cand = Signal()
         m.d.comb += [in_bkt.eq(bi < nb), brd.addr.eq((rb << pw) | bi[:pw])]
 
-        trd = dmm.read_port(transparent_for=()) if aj else None
-        drain = Drain(m, o=self.o, drd=drd, word=word, bank_bit=ab, width=W, ib=ib, aj=aj,
-                      trd=trd, ent=asb, ent_bank_bit=pw, boundary_only=True,
-                      done_comb=lambda d: [clr_full.eq(Mux(d.dbank, 0b10, 0b01))])
 
         def write(last):
             """Decided: write ``[sl, last]``."""
@@ -194,7 +143,7 @@ class ExpertsPxpCoherent(wiring.Component):
         with m.Switch(state):
             with m.Case(_R.IDLE):
                 m.d.sync += cyc.eq(1)
-                tb = take_bank(m, dm, rb, W, aj)
+                tb = take_bank(m, fr, rb, W, aj)
                 with m.If(full.bit_select(rb, 1)):
                     m.d.sync += [lo.eq(tb["lo"]), hi.eq(tb["hi"]), glo.eq(tb["glo"]), ghi.eq(tb["ghi"]),
                                  sl.eq(tb["glo"]), n.eq(tb["n"]), nb.eq(tb["nb"]),
@@ -202,21 +151,15 @@ class ExpertsPxpCoherent(wiring.Component):
                                  na.eq(0), bi.eq(0), vok.eq(0), fail.eq(0),
                                  state.eq(Mux(tb["ghi"] <= tb["glo"], _R.HAND, _R.ENTER))]
             with m.Case(_R.ENTER):
-                with m.If(in_bkt):
-                    m.d.comb += raddr.eq(brd.data)
-                with m.Else():
-                    m.d.comb += raddr.eq(pp)
-                m.d.comb += cand.eq(in_bkt | ((pp < n) & (c0 < ghi)))
+                take = candidate(m, raddr=raddr, cand=cand, in_bkt=in_bkt, brd=brd, bi=bi, pp=pp, n=n,
+                                 c0=c0, ghi=ghi)
                 with m.If(cand & ((e < a) | (a == sl))):
                     with m.If(a <= e):
                         m.d.comb += [awr.en.eq(1), awr.addr.eq(na), awr.data.eq(raddr)]
                         m.d.sync += na.eq(na + 1)
                         with m.If(vok & (vu >= sl) & ~good):
                             m.d.sync += fail.eq(1)
-                    with m.If(in_bkt):
-                        m.d.sync += bi.eq(bi + 1)
-                    with m.Else():
-                        m.d.sync += pp.eq(pp + 1)
+                    take()
                 with m.Else():
                     nxt = Signal(12)
                     m.d.comb += nxt.eq(Mux(cand, a, ghi))

@@ -55,7 +55,7 @@ from rasterhw.hdl.experts.drain import Drain, check_pxp_params, pxp_members
 from rasterhw.hdl.experts.pxp import asb_fields
 from rasterhw.hdl.params import params
 
-__all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "dmm_p", "take_bank", "zrun_at", "z_key", "guarded_test",
+__all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "candidate", "dmm_p", "seg_ends", "take_bank", "zrun_at", "z_key", "guarded_test",
            "intensity_at", "PTR_BITS", "NO_PTR"]
 
 NONE = (1 << ADDR_BITS) - 1     # ASB address / polygon number of the background
@@ -159,6 +159,34 @@ def zrun_at(m: Module, seg, col):
     return z
 
 
+def seg_ends(m: Module, seg, glo, ghi) -> tuple[Signal, Signal, Signal]:
+    """ASB ``seg``'s first pixel ``c0`` (``(xl + 31) >> 6``, the top-left rule) and its first and
+    last pixel ``a``, ``e`` in the guarded range ``[glo, ghi)`` (``e < a``: none there)."""
+    c0, c1 = Signal(signed(12), name="c0"), Signal(signed(12), name="c1")
+    a, e = Signal(signed(12), name="a"), Signal(signed(12), name="e")
+    m.d.comb += [c0.eq((seg.xl + 31) >> X_FRAC), c1.eq(((seg.xr + 31) >> X_FRAC) - 1),
+                 a.eq(Mux(c0 > glo, c0, glo)), e.eq(Mux(c1 < ghi - 1, c1, ghi - 1))]
+    return c0, a, e
+
+
+def candidate(m: Module, *, raddr, cand, in_bkt, brd, bi, pp, n, c0, ghi):
+    """The entering candidate read this cycle (``raddr``): the next bucket list entry, else the ASL
+    position ``pp`` of the walk from the leading pointer while its first pixel ``c0`` is before
+    ``ghi`` (``cand``: there is one). Returns ``take()``: the sync statements that move past it."""
+    with m.If(in_bkt):
+        m.d.comb += raddr.eq(brd.data)
+    with m.Else():
+        m.d.comb += raddr.eq(pp)
+    m.d.comb += cand.eq(in_bkt | ((pp < n) & (c0 < ghi)))
+
+    def take():
+        with m.If(in_bkt):
+            m.d.sync += bi.eq(bi + 1)
+        with m.Else():
+            m.d.sync += pp.eq(pp + 1)
+    return take
+
+
 def z_key(m: Module, zrun) -> Signal:
     """The 16-bit compare key of a running z: ``zrun >> DZ_FRAC`` clamped to ``0 .. 2**Z_BITS - 1``."""
     zk = Signal(signed(40), name="zk")
@@ -243,25 +271,38 @@ class ExpertsPxpSpan(wiring.Component):
         self._depth = depth
         super().__init__({**pxp_members(dmm_layout(), self._fmt.pixel_bits), "overflow": Out(1)})
 
-    def elaborate(self, platform):
-        m = Module()
+    def frame(self, m: Module) -> dict:
+        """What both span PXPs share, added to ``m``: the DMM/P (:func:`dmm_p`), the double-banked
+        DSLB (its write port ``wr``, words ``word``, bank bit ``ab``) and the drain (``drain``: the
+        A.J. (c) entry read at a segment's boundary pixels only), plus the widths ``pw`` (ASL
+        position), ``cw`` (counts) and the block's parameters."""
         fmt, W, D, aj = self._fmt, self._width, self._depth, self._aj == "c"
         pb, ib = fmt.pixel_bits, fmt.intensity_bits
         asb = asb_layout()
         pw = (D - 1).bit_length()                   # ASL position bits within a bank
         cw = D.bit_length()                         # counts 0..D
         ab = (W - 1).bit_length()                   # DSLB bank bit position
-
-        # ---------------------------------------------------------------- DMM/P (two banks)
         dm = dmm_p(m, self, asb, D)
-        dmm, srd, brd, full, clr_full = dm["dmm"], dm["srd"], dm["brd"], dm["full"], dm["clr_full"]
-
-        # ---------------------------------------------------------------- DSLB (two banks)
         word = data.StructLayout({"addr": unsigned(ADDR_BITS), "pix": unsigned(pb), "slot": unsigned(pw)})
         m.submodules.dslb = dslb = Memory(shape=word, depth=2 << ab, init=[])
         wr = dslb.write_port()
         drd = dslb.read_port(transparent_for=())
         m.d.comb += wr.en.eq(0)
+        trd = dm["dmm"].read_port(transparent_for=()) if aj else None    # the visible segment's edges
+        clr_full = dm["clr_full"]
+        drain = Drain(m, o=self.o, drd=drd, word=word, bank_bit=ab, width=W, ib=ib, aj=aj,
+                      trd=trd, ent=asb, ent_bank_bit=pw, boundary_only=True,
+                      done_comb=lambda d: [clr_full.eq(Mux(d.dbank, 0b10, 0b01))])
+        return {**dm, "fmt": fmt, "W": W, "D": D, "aj": aj, "ib": ib, "asb": asb, "pw": pw, "cw": cw, "ab": ab,
+                "word": word, "wr": wr, "drain": drain}
+
+    def elaborate(self, platform):
+        m = Module()
+        fr = self.frame(m)
+        fmt, W, D, aj, ib, asb = fr["fmt"], fr["W"], fr["D"], fr["aj"], fr["ib"], fr["asb"]
+        pw, cw, ab, word, wr = fr["pw"], fr["cw"], fr["ab"], fr["word"], fr["wr"]
+        dm = fr
+        srd, brd, full = dm["srd"], dm["brd"], dm["full"]
 
         # ---------------------------------------------------------------- resolve side
         state = Signal(_R)
@@ -305,12 +346,7 @@ class ExpertsPxpSpan(wiring.Component):
         raddr = Signal(pw)
         seg = Signal(asb)
         m.d.comb += [srd.addr.eq((rb << pw) | raddr), seg.eq(srd.data)]
-        c0 = Signal(signed(12))
-        c1 = Signal(signed(12))
-        a = Signal(signed(12))
-        e = Signal(signed(12))
-        m.d.comb += [c0.eq((seg.xl + 31) >> X_FRAC), c1.eq(((seg.xr + 31) >> X_FRAC) - 1),
-                     a.eq(Mux(c0 > glo, c0, glo)), e.eq(Mux(c1 < ghi - 1, c1, ghi - 1))]
+        c0, a, e = seg_ends(m, seg, glo, ghi)
 
         # the two multipliers: running z (Q16.4) at pixels sl and sr
         zl_ = zrun_at(m, seg, sl)
@@ -333,10 +369,7 @@ class ExpertsPxpSpan(wiring.Component):
         m.d.comb += [in_bkt.eq(bi < nb), brd.addr.eq((rb << pw) | bi[:pw])]
 
         # ---------------------------------------------------------------- drain side (drain.py)
-        trd = dmm.read_port(transparent_for=()) if aj else None    # the visible segment's edges
-        drain = Drain(m, o=self.o, drd=drd, word=word, bank_bit=ab, width=W, ib=ib, aj=aj,
-                      trd=trd, ent=asb, ent_bank_bit=pw, boundary_only=True,
-                      done_comb=lambda d: [clr_full.eq(Mux(d.dbank, 0b10, 0b01))])
+        drain = fr["drain"]
         dbusy = drain.dbusy
 
         def next_span(xn):
@@ -373,23 +406,13 @@ class ExpertsPxpSpan(wiring.Component):
                 with m.If(i + 1 >= k):
                     m.d.sync += state.eq(_R.ENTER)
             with m.Case(_R.ENTER):
-                with m.If(in_bkt):
-                    m.d.comb += raddr.eq(brd.data)
-                with m.Else():
-                    m.d.comb += raddr.eq(pp)
-                m.d.comb += cand.eq(in_bkt | ((pp < n) & (c0 < ghi)))
+                take = candidate(m, raddr=raddr, cand=cand, in_bkt=in_bkt, brd=brd, bi=bi, pp=pp, n=n,
+                                 c0=c0, ghi=ghi)
                 with m.If(cand & (e < a)):
-                    # no pixel in the range: skipped
-                    with m.If(in_bkt):
-                        m.d.sync += bi.eq(bi + 1)
-                    with m.Else():
-                        m.d.sync += pp.eq(pp + 1)
+                    take()              # no pixel in the range: skipped
                 with m.Elif(cand & (a == x)):
                     keep_active()
-                    with m.If(in_bkt):
-                        m.d.sync += bi.eq(bi + 1)
-                    with m.Else():
-                        m.d.sync += pp.eq(pp + 1)
+                    take()
                 with m.Else():
                     # the span's right end: the nearest end, the next start, the range's end
                     nxt = Signal(12)
