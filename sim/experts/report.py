@@ -118,36 +118,44 @@ def _fig41(out: list, sections: list, out_dir: Path, progress: bool) -> None:
                     "The term rows above say why they differ (docs/experts.md, cost model).\n")
 
 
+def hdl_frame_cycles(tris, pxp: str, aj: str, engine: str = "verilator") -> int:
+    """HDL cycles of a whole frame ``tris`` (bit model) through one ``pxp`` PXP over whole lines
+    (1 x 1) on ``engine``: its edges up to the frame's last pixel, the run checked pixel for pixel
+    and line for line against the golden model."""
+    from rasterhw.golden_model.experts.model import render_frame
+    from rasterhw.sim.experts.pxp_sim import check_jobs, jobs
+    jb = jobs(render_frame(tris, model="bit", aj=aj), 1, 1, pxp=pxp)
+    r = check_jobs(jb, width=tris.width, engine=engine)
+    if r["pixel_mismatches"] or r["line_mismatches"] or r["sim_cycles"] != jb["last_pixel"] + 1:
+        raise RuntimeError(f"experts: the {pxp} PXP HDL differs from its golden model (A.J. {aj})")
+    return int(r["sim_cycles"])
+
+
 def table21_hdl(engine: str = "verilator") -> dict:
-    """Table 2.1 from HDL cycles: each solid through the span PXP (the default) and the coherent span
-    PXP on ``engine``, one PXP over whole lines (1 x 1, 512 x 512), without and with A.J. (c) (the
-    entry read and blend at a segment's boundary pixels only, ``hdl/experts/drain.py``): the cycles
-    up to the frame's last pixel, each run pixel- and cycle-exact against its golden model."""
+    """Tables 2.1 and 2.2 from HDL cycles: each solid (and the 8 line segments, key ``"lines"``)
+    through the span PXP (the default) and the coherent span PXP on ``engine``, one PXP over whole
+    lines (1 x 1, 512 x 512), without and with A.J. (c) (the entry read and blend at a segment's
+    boundary pixels only, ``hdl/experts/drain.py``)."""
+    from rasterhw.golden_model.experts.cost import line_segments
+    from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.sim.experts.pxp_sim import simulate_scene
-    res = {}
-    for k in PAPER_T21:
-        sc = build_scene(f"experts-solid-{k}")
-        for v in ("span", "coherent"):
-            for aj in ("none", "c"):
-                r = simulate_scene(sc, 512, 512, engine=engine, sn=1, pn=1, aj=aj, pxp=v)
-                if r["mismatches"] or r["cycle_mismatches"] or r["last_pixel_mismatch"]:
-                    raise RuntimeError(f"experts-solid-{k}, {v} PXP, A.J. {aj}: the HDL differs from its golden model")
-                res[k, v, aj] = int(r["cycles"])
-    return res
+    frames = {k: run_geometry(build_scene(f"experts-solid-{k}"), 512, 512, z_bits=16) for k in PAPER_T21}
+    frames["lines"] = line_segments(8)
+    return {(k, v, aj): hdl_frame_cycles(t, v, aj, engine) for k, t in frames.items()
+            for v in ("span", "coherent") for aj in ("none", "c")}
 
 
 def _table21_hdl(out: list, engine: str, progress: bool) -> None:
     if progress and engine == "verilator":
-        print("experts: table 2.1 solids through the span PXPs' HDL on Verilator")
+        print("experts: table 2.1 / 2.2 frames through the span PXPs' HDL on Verilator")
     res = table21_hdl(engine) if engine == "verilator" else None
-    why = "the 512 x 512 solids run through the PXP HDL on Verilator only (rasterhw report experts --engine verilator)"
+    why = "the 512 x 512 frames run through the PXP HDL on Verilator only (rasterhw report experts --engine verilator)"
+    src = "hdl:verilator"
     for v, label in (("span", "span PXP (ours; the default)"), ("coherent", "coherent span PXP (ours)")):
         for k, paper in PAPER_T21.items():
             what = f"{label}, solid with {k} segments (experts-solid-{k}, 1 SLP x 1 PXP, 512x512)"
             base = None if res is None else res[k, v, "none"]
             aj = None if res is None else res[k, v, "c"]
-            src = "hdl:verilator"
             out.append(make_row(SYS, "table 2.1 (HDL)", f"HDL cycles without A.J., {what}", paper=None, formula=None,
                                 measured=base, unit="cycles", source=src, reason=None if res else why))
             out.append(make_row(SYS, "table 2.1 (HDL)", f"HDL cycles with A.J. (c) at a segment's boundary pixels, "
@@ -156,6 +164,10 @@ def _table21_hdl(out: list, engine: str, progress: bool) -> None:
             out.append(make_row(SYS, "table 2.1 (HDL)", f"A.J. (c) increase in HDL cycles, {what}", paper=paper,
                                 formula=None, measured=None if res is None else round(100.0 * (aj - base) / base, 2),
                                 unit="%", source=src, reason=None if res else why))
+        out.append(make_row(SYS, "table 2.2 (HDL)", f"work with A.J. (c) in HDL cycles, 8 line segments (no A.J. = 1), "
+                            f"{label}, 1 SLP x 1 PXP, 512x512", paper=PAPER_T22["c"], formula=None,
+                            measured=None if res is None else round(res["lines", v, "c"] / res["lines", v, "none"], 4),
+                            unit="x", source=src, reason=None if res else why))
 
 
 def _tables(out: list, sections: list, out_dir: Path, progress: bool, engine: str = "pysim") -> None:
