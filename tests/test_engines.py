@@ -18,6 +18,7 @@ SMALL = {
     "experts-dmm": {"depth": 16},
     "experts-pxp": {"width": 64, "aj": "c"},
     "experts-pxp-span": {"width": 64, "aj": "c"},
+    "experts-pxp-coherent": {"width": 64, "aj": "c"},
     "experts-pxp-unit": {"width": 64, "depth": 64},
     "pixelbus": {"width": 20, "height": 8},
     "pixelbus-bank": {"depth": 64},

@@ -105,7 +105,8 @@ def realtime(f: ExpertsFrame, sn: int, pn: int, fps: float = 30.0) -> dict:
     SLP: the busiest band's operations, one per cycle -- the sorts and block lists as they run
     (:mod:`slp_run`) plus the other SLP stages as counted in :func:`slp.slp_line_ops` (PL read,
     set-up, ASL update, DMM/P write). PXP: the busiest PXP's cycles over its band's lines by the
-    span PXP's cycle model (:func:`span.span_cycles`). The two overlap through DMM/P, so the
+    span PXP's operation-count model (:func:`span.span_cycles`; not the HDL's cycles, which
+    ``span_cycles.py`` counts). The two overlap through DMM/P, so the
     frame needs each processor at its own clock."""
     from rasterhw.golden_model.experts import slp_run, span
     bands = equal_bounds(f.height, sn)

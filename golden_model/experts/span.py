@@ -1,4 +1,4 @@
-"""The paper's PXP: span cull and depth search per span (Watkins), not a per-pixel Z-buffer.
+"""The span PXP (ours, after the paper's steps): span cull and depth search per span (Watkins), not a per-pixel Z-buffer.
 
 Seed 000, section 4: the PXP's stages are "iv) スキャン・ラインをスパンに分割し、そのスパン内に
 現われる範囲のセグメントを抽出する《span cull》" and "v) iv)で抽出したセグメントに応じてデプス・
@@ -40,8 +40,9 @@ Operations (one 16-bit operation each; :data:`SPAN_OPS`) counted as the spans ar
   start value each), ``k - 1`` compares for ``S`` at the left pixel, ``2(k - 1)`` guarded tests:
   ``5k - 3``; a one-pixel span ``2k - 1`` (z and compare, as the per-pixel search).
 
-**Cycle model** (for the span PXP HDL to be made cycle-exact against, :func:`span_cycles`): one
-operation per cycle on a 16-bit datapath with one multiplier and one comparator (the paper's PXP:
+**Operation-count model** (:func:`span_cycles` in this module; it is *not* what the span PXP HDL is
+cycle-exact against -- that is ``golden_model/experts/span_cycles.py``, which counts the HDL's own
+steps): one operation per cycle on a 16-bit datapath with one multiplier and one comparator (the paper's PXP:
 "乗算器を装備", a microprogrammed 16-bit processor), so the cycles of one range of one line are
 its counted operations of every PXP stage (range clip, start values, span cull, depth search,
 smooth shading, A.J., DSLB write; the last three from :func:`pxp.pixel_costs` of the same visible

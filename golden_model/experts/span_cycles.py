@@ -27,7 +27,8 @@ cycle before it hands the DSLB bank over), every term:
 
 **Line schedule** (:func:`schedule`, the input back to back and the output always ready; cycle =
 the edge index, edge 0 takes the first word): line ``k`` has ``w_k`` words (ASL, bucket list,
-token), resolve cycles ``r_k`` and drain cycles ``d_k`` (:func:`pxp_cycles.drain_cycles`). The
+token), resolve cycles ``r_k`` and drain cycles ``d_k`` (:func:`span_drain_cycles`: with A.J. the
+entry is read at a segment's boundary pixels only). The
 writer starts ``WS_k = max(WE_{k-1} + 1, DE_{k-2} + 1)`` (the bank it writes is released when the
 drain has finished the line that used it), ends ``WE_k = WS_k + w_k - 1``; resolve starts
 ``RS_k = max(WE_k + 1, RH_{k-1} + 1)``, hands over at ``RH_k = max(RS_k + r_k, DE_{k-1} + 1)``;
@@ -44,7 +45,7 @@ from rasterhw.golden_model.experts.model import ExpertsFrame
 from rasterhw.golden_model.experts.pxp_cycles import asb_record, drain_cycles, guarded
 from rasterhw.golden_model.experts.slp_run import block_lists
 
-__all__ = ["DMM_DEPTH", "NO_PTR", "STEPS", "line_asl", "dmm_line", "resolve", "schedule"]
+__all__ = ["DMM_DEPTH", "Entering", "NO_PTR", "STEPS", "line_asl", "dmm_line", "resolve", "schedule", "span_drain_cycles"]
 
 DMM_DEPTH = 256       # ASBs per DMM/P bank (the block's default)
 NO_PTR = 511          # leading pointer: none
@@ -94,6 +95,39 @@ def _good(zs_l, zs_r, zb_l, zb_r, s_lower: bool) -> bool:
             and zs_l < _ZMAX_RUN and zs_r < _ZMAX_RUN)
 
 
+class Entering:
+    """The candidates entering a PXP's range, in the order the PXP reads them: its block boundary
+    bucket list, then the ASL from the block leading pointer while a segment's first pixel is
+    before ``ghi`` (``ends``: per ASL position ``(c0, a, e)`` of :func:`_ends`)."""
+
+    def __init__(self, bucket: list[int], lead: int, ends: list[tuple[int, int, int]], ghi: int):
+        self.bucket, self.ends, self.ghi = bucket, ends, ghi
+        self.bi, self.pp = 0, (len(ends) if lead == NO_PTR else lead)
+
+    def take(self, x: int, cyc: dict, enter) -> int:
+        """Take every candidate entering at pixel ``x``, one ``cyc["enter"]`` cycle each (one with no
+        pixel in the range is skipped in a cycle; ``enter(pos)`` for the others), plus one cycle that
+        finds the next start; returns it (``ghi``: none)."""
+        while True:
+            cyc["enter"] += 1
+            if self.bi < len(self.bucket):
+                pos, cand = self.bucket[self.bi], True
+            else:
+                pos = self.pp
+                cand = self.pp < len(self.ends) and self.ends[self.pp][0] < self.ghi
+            if not cand:
+                return self.ghi
+            _, a, e = self.ends[pos]
+            if not (e < a or a == x):
+                return a
+            if a <= e:
+                enter(pos)
+            if self.bi < len(self.bucket):
+                self.bi += 1
+            else:
+                self.pp += 1
+
+
 def resolve(segs: list[dict], bucket: list[int], lead: int, glo: int, ghi: int) -> tuple[dict, list[int]]:
     """One line of one range through the span PXP: cycles per step (:data:`STEPS`) and the visible
     ASL position of every pixel of ``[glo, ghi)`` (-1: background)."""
@@ -102,35 +136,18 @@ def resolve(segs: list[dict], bucket: list[int], lead: int, glo: int, ghi: int) 
     vis: list[int] = []
     if ghi <= glo:
         return cyc, vis
-    n = len(segs)
     ends = [_ends(s, glo, ghi) for s in segs]
     act: list[int] = []
-    bi, pp = 0, (n if lead == NO_PTR else lead)
+    walk = Entering(bucket, lead, ends, ghi)
     x = glo
     while x < ghi:
         cyc["cull"] += len(act)
         act = [p for p in act if ends[p][2] >= x]
         minend = min([ghi] + [ends[p][2] + 1 for p in act])
-        while True:
-            cyc["enter"] += 1
-            if bi < len(bucket):
-                pos, cand = bucket[bi], True
-            else:
-                pos = pp
-                cand = pp < n and ends[pp][0] < ghi
-            if cand:
-                _, a, e = ends[pos]
-                if e < a or a == x:
-                    if a <= e:
-                        act.append(pos)
-                        minend = min(minend, e + 1)
-                    if bi < len(bucket):
-                        bi += 1
-                    else:
-                        pp += 1
-                    continue
-            nxt = ends[pos][1] if cand and ends[pos][1] < minend else minend
-            break
+        entered = []
+        ns = walk.take(x, cyc, entered.append)
+        act += entered
+        nxt = min([ns, minend] + [ends[p][2] + 1 for p in entered])
         r = nxt - 1
         if len(act) < 2:
             cyc["write"] += r - x + 1
@@ -178,9 +195,25 @@ def schedule(lines: list[tuple[int, int, int]]) -> dict:
     return {"line_cycles": out, "last_pixel": de[-1] if de else -1}
 
 
-def line_job(segs: list[dict], bucket: list[int], lead: int, lo: int, hi: int, *, aj: str, width: int) -> dict:
-    """One PXP line: its words, resolve and drain cycles and visible positions of ``[lo, hi)``."""
+def line_job(segs: list[dict], bucket: list[int], lead: int, lo: int, hi: int, *, aj: str, width: int,
+             resolver=None) -> dict:
+    """One PXP line: its words, resolve and drain cycles and visible positions of ``[lo, hi)``.
+    ``resolver``: :func:`resolve` (default, the span PXP) or another PXP's resolve on the same
+    DMM/P words, schedule and drain (``coherent.resolve``: the coherent span PXP)."""
     glo, ghi = guarded(lo, hi, width, aj)
-    cyc, vis = resolve(segs, bucket, lead, glo, ghi)
+    cyc, vis = (resolver or resolve)(segs, bucket, lead, glo, ghi)
     return {"words": len(segs) + len(bucket) + 1, "resolve": sum(cyc.values()), "steps": cyc,
-            "drain": drain_cycles(lo, hi, aj=aj, width=width), "visible": vis[lo - glo:lo - glo + (hi - lo)]}
+            "drain": span_drain_cycles(vis, lo, hi, aj=aj, width=width),
+            "visible": vis[lo - glo:lo - glo + (hi - lo)]}
+
+
+def span_drain_cycles(vis: list[int], lo: int, hi: int, *, aj: str, width: int) -> int:
+    """Drain cycles of one span-PXP line (``hdl/experts/drain.py``, ``boundary_only``): without
+    A.J. ``2 R``; with A.J. (c) 2 per guarded pixel, + 1 per pixel whose visible segment (``vis``,
+    the guarded range's ASL positions, -1 background) is not background and differs from the
+    pixel on its left (or is the walk's first), + 1 flush at the frame's right edge."""
+    if aj != "c":
+        return drain_cycles(lo, hi, aj=aj, width=width)
+    glo, ghi = guarded(lo, hi, width, aj)
+    reads = sum(1 for q, v in enumerate(vis) if v >= 0 and (q == 0 or vis[q - 1] != v))
+    return 2 * (ghi - glo) + reads + (1 if ghi == hi else 0)

@@ -1,5 +1,5 @@
 """A.J. (c) at a segment boundary in the PXP's drain, shared by both PXPs (``pxp.py``, the line
-Z-buffer; ``pxp_span.py``, the paper's span PXP): the paper's anti-jagging blends the two pixels at
+Z-buffer; ``pxp_span.py`` and ``pxp_coherent.py``, the span PXPs): the paper's anti-jagging blends the two pixels at
 a boundary between two polygons by the covered fraction alpha of the edge that crosses it
 (eq. (5), C = alpha C_L + (1 - alpha) C_R per R, G, B, I field, Q0.8, rounded), alpha from the
 edge's end x and slope (``golden_model/experts/alpha.py`` is the golden side)."""

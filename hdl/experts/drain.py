@@ -1,5 +1,5 @@
 """The DSLB drain of an EXPERTS PXP, its ports and parameter checks, shared by both PXPs
-(``pxp.py``, the line Z-buffer; ``pxp_span.py``, the paper's span PXP).
+(``pxp.py``, the line Z-buffer; ``pxp_span.py`` and ``pxp_coherent.py``, the span PXPs).
 
 Paper (seed 000, 3.2): "DSLBもDMM同様、2重系の構成とし、PXPによる書き込みと、FBへの転送のための読み出し
 とを並行して同時に行なう" -- the DSLB is double-banked; one bank is written by the resolve side while
@@ -8,7 +8,12 @@ A.J., over ``[lo, hi)``, one pixel per two cycles (read, offer); with A.J. (c), 
 range ``[lo-1, hi+1)`` within the frame, one pixel per three cycles (read the DSLB, read the
 visible segment's edges from the segment table or DMM/P bank, blend the boundary and offer the
 pixel on its left: ``aj.py``), offering only ``[lo, hi)``; where the range ends at the frame's
-right edge (no guard pixel), a flush cycle offers its last pixel. The resolve side hands a
+right edge (no guard pixel), a flush cycle offers its last pixel. ``boundary_only`` (the span
+PXPs): A.J. works at a segment's boundary pixels only (the paper: "多角形の境界線のところに発生する
+jagの抑制", blending "直線成分の通過する画素"): the entry is read only for a pixel whose visible segment
+differs from its left neighbour's (or the first of the walk), not background; every other pixel is
+offered (and a polygon-background boundary blended from the entry already held) in its second
+cycle: 2 cycles a pixel, 3 at a segment's first pixel. The resolve side hands a
 finished bank over with :meth:`Drain.hand` once :attr:`Drain.dbusy` is low. The paper does not
 give the drain's rate; these are ours, as the golden cycle models (``pxp_cycles``,
 ``span_cycles``) count them.
@@ -16,11 +21,11 @@ give the drain's rate; these are ours, as the golden cycle models (``pxp_cycles`
 
 from __future__ import annotations
 
-from amaranth import Signal, unsigned
+from amaranth import Mux, Signal, unsigned
 from amaranth.lib import enum, stream
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.experts.formats import ADDR_BITS
-from rasterhw.hdl.experts.aj import aj_boundary
+from rasterhw.hdl.experts.aj import NONE, aj_boundary
 
 __all__ = ["Drain", "check_pxp_params", "pxp_members"]
 
@@ -66,7 +71,7 @@ class Drain:
     """
 
     def __init__(self, m, *, o, drd, word, bank_bit: int, width: int, ib: int, aj: bool,
-                 trd=None, ent=None, ent_bank_bit: int = 0, done_comb=None):
+                 trd=None, ent=None, ent_bank_bit: int = 0, done_comb=None, boundary_only: bool = False):
         pb = len(o.payload)
         self.aj = aj
         self.dstate = dstate = Signal(_D)
@@ -86,10 +91,20 @@ class Drain:
             p_addr = Signal(ADDR_BITS)
             p_ent = Signal(ent)
             self.p_ok = p_ok = Signal()   # there is a pixel dx-1 in the walk
-            c_pix = Signal(pb)
-            c_addr = Signal(ADDR_BITS)
+            c_pix_r = Signal(pb)
+            c_addr_r = Signal(ADDR_BITS)
             c_ent = Signal(ent)
             m.d.comb += c_ent.eq(trd.data)
+            # boundary_only: in DSEG, a pixel whose segment is its left neighbour's (or background)
+            # needs no entry read: it is blended (or passed) in that cycle from the DSLB word itself
+            # (the sync read ports hold their data: trd still has the run's segment's entry)
+            seg_read = Signal()
+            skip = Signal()
+            m.d.comb += [seg_read.eq(~((dstored.addr == NONE) | (p_ok & (dstored.addr == p_addr)))),
+                         skip.eq((dstate == _D.DSEG) & ~seg_read if boundary_only else 0)]
+            c_pix = Signal(pb)
+            c_addr = Signal(ADDR_BITS)
+            m.d.comb += [c_pix.eq(Mux(skip, dstored.pix, c_pix_r)), c_addr.eq(Mux(skip, dstored.addr, c_addr_r))]
             o_prev, o_cur = aj_boundary(m, dx=dx, width=width, ib=ib, p_ok=p_ok, p_pix=p_pix, p_out=p_out,
                                         p_addr=p_addr, p_ent=p_ent, c_pix=c_pix, c_addr=c_addr, c_ent=c_ent)
             emit = Signal()
@@ -113,10 +128,7 @@ class Drain:
                     with m.Else():
                         m.d.sync += dstate.eq(_D.DRD)
             if aj:
-                with m.Case(_D.DSEG):
-                    m.d.comb += [trd.addr.eq((dbank << ent_bank_bit) | dstored.slot), trd.en.eq(1)]
-                    m.d.sync += [c_pix.eq(dstored.pix), c_addr.eq(dstored.addr), dstate.eq(_D.DAJ)]
-                with m.Case(_D.DAJ):
+                def blend_offer():
                     m.d.comb += [o.valid.eq(emit), o.payload.eq(o_prev)]
                     with m.If(~emit | o.ready):
                         m.d.sync += [p_pix.eq(c_pix), p_out.eq(o_cur), p_addr.eq(c_addr), p_ent.eq(c_ent),
@@ -128,6 +140,15 @@ class Drain:
                                 drain_done()
                         with m.Else():
                             m.d.sync += dstate.eq(_D.DRD)
+
+                with m.Case(_D.DSEG):
+                    with m.If(skip):
+                        blend_offer()
+                    with m.Else():
+                        m.d.comb += [trd.addr.eq((dbank << ent_bank_bit) | dstored.slot), trd.en.eq(1)]
+                        m.d.sync += [c_pix_r.eq(dstored.pix), c_addr_r.eq(dstored.addr), dstate.eq(_D.DAJ)]
+                with m.Case(_D.DAJ):
+                    blend_offer()
                 with m.Case(_D.FLUSH):
                     m.d.comb += [o.valid.eq(1), o.payload.eq(p_out)]
                     with m.If(o.ready):

@@ -1,4 +1,4 @@
-"""EXPERTS span PXP (the paper's): DMM/P bank in, span cull and depth search per span, S.S., A.J. (c), DSLB.
+"""EXPERTS span PXP (ours, after the paper's steps): DMM/P bank in, span cull and depth search per span, S.S., A.J. (c), DSLB.
 
 Paper (seed 000, section 4): the PXP's stages are "iv) スキャン・ラインをスパンに分割し、そのスパン内に
 現われる範囲のセグメントを抽出する《span cull》" and "v) iv)で抽出したセグメントに応じてデプス・サーチを
@@ -55,7 +55,8 @@ from rasterhw.hdl.experts.drain import Drain, check_pxp_params, pxp_members
 from rasterhw.hdl.experts.pxp import asb_fields
 from rasterhw.hdl.params import params
 
-__all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "PTR_BITS", "NO_PTR"]
+__all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "candidate", "dmm_p", "seg_ends", "take_bank", "zrun_at", "z_key", "guarded_test",
+           "intensity_at", "PTR_BITS", "NO_PTR"]
 
 NONE = (1 << ADDR_BITS) - 1     # ASB address / polygon number of the background
 PTR_BITS = 9                    # ASL position in a DMM/P bank
@@ -75,6 +76,149 @@ def dmm_layout() -> data.StructLayout:
 def asb_layout() -> data.StructLayout:
     """The ASB fields of a DMM/P word (without ``last``, ``list``, ``ptr``)."""
     return data.StructLayout(asb_fields())
+
+
+def dmm_p(m: Module, comp, asb, D: int) -> dict:
+    """The DMM/P writer of a span PXP ``comp`` (two banks of ``D`` ASBs and bucket entries), added to
+    ``m``: the words of ``comp.i`` (module docstring) into the bank being written. Returns the
+    memory ``dmm``, the resolve side's read ports ``srd`` (ASBs) and ``brd`` (bucket list), the banks'
+    ``full`` flags and ``clr_full`` (the drain releases a bank), and per bank its ASB count ``bn``,
+    bucket count ``bnb``, leading pointer ``blead`` and range ``blo``/``bhi``."""
+    pw = (D - 1).bit_length()
+    cw = D.bit_length()
+    m.submodules.dmm = dmm = Memory(shape=asb, depth=2 << pw, init=[])
+    dwr = dmm.write_port()
+    srd = dmm.read_port(domain="comb")          # resolve side
+    m.submodules.bkt = bkt = Memory(shape=unsigned(PTR_BITS), depth=2 << pw, init=[])
+    bwr = bkt.write_port()
+    brd = bkt.read_port(domain="comb")
+    wbank = Signal()
+    wn = Signal(cw)
+    wnb = Signal(cw)
+    full = Signal(2)
+    bn = [Signal(cw, name=f"n{b}") for b in range(2)]
+    bnb = [Signal(cw, name=f"nb{b}") for b in range(2)]
+    blead = [Signal(PTR_BITS, name=f"lead{b}") for b in range(2)]
+    blo = [Signal(10, name=f"lo{b}") for b in range(2)]
+    bhi = [Signal(11, name=f"hi{b}") for b in range(2)]
+    set_full = Signal(2)
+    clr_full = Signal(2)
+    wfull = Signal()
+    m.d.comb += wfull.eq(full.bit_select(wbank, 1))
+    p = comp.i.payload
+    fits = Signal()
+    m.d.comb += fits.eq(p.last | Mux(p.list, wnb < D, wn < D))
+    m.d.comb += [comp.i.ready.eq(~wfull & ~comp.overflow & fits),
+                 dwr.en.eq(0), bwr.en.eq(0),
+                 dwr.addr.eq((wbank << pw) | wn[:pw]), bwr.addr.eq((wbank << pw) | wnb[:pw]),
+                 bwr.data.eq(p.ptr)]
+    for name in asb.members:
+        m.d.comb += getattr(dwr.data, name).eq(getattr(p, name))
+    with m.If(comp.i.valid & ~wfull & ~fits):
+        m.d.sync += comp.overflow.eq(1)
+    with m.If(comp.i.valid & comp.i.ready):
+        with m.If(p.last):
+            m.d.sync += [wn.eq(0), wnb.eq(0), wbank.eq(~wbank)]
+            for b in range(2):
+                with m.If(wbank == b):
+                    m.d.comb += set_full.eq(1 << b)
+                    m.d.sync += [bn[b].eq(wn), bnb[b].eq(wnb), blead[b].eq(p.ptr),
+                                 blo[b].eq(comp.lo), bhi[b].eq(comp.hi)]
+        with m.Elif(p.list):
+            m.d.comb += bwr.en.eq(1)
+            m.d.sync += wnb.eq(wnb + 1)
+        with m.Else():
+            m.d.comb += dwr.en.eq(1)
+            m.d.sync += wn.eq(wn + 1)
+    m.d.sync += full.eq((full | set_full) & ~clr_full)
+    return {"dmm": dmm, "srd": srd, "brd": brd, "full": full, "clr_full": clr_full, "bn": bn, "bnb": bnb,
+            "blead": blead, "blo": blo, "bhi": bhi}
+
+
+def take_bank(m: Module, dm: dict, rb, W: int, aj: bool) -> dict:
+    """Bank ``rb`` of :func:`dmm_p` as the resolve side takes it: its range ``lo``/``hi``, the
+    guarded range ``glo``/``ghi`` (one guard pixel each side with A.J., within the frame), the ASB
+    count ``n``, bucket count ``nb`` and leading pointer ``lead``."""
+    lo_b, hi_b = Signal(10), Signal(11)
+    glo_b, ghi_b = Signal(11), Signal(11)
+    m.d.comb += [lo_b.eq(Mux(rb, dm["blo"][1], dm["blo"][0])), hi_b.eq(Mux(rb, dm["bhi"][1], dm["bhi"][0]))]
+    if aj:
+        m.d.comb += [glo_b.eq(Mux(lo_b > 0, lo_b - 1, 0)), ghi_b.eq(Mux(hi_b < W, hi_b + 1, hi_b))]
+    else:
+        m.d.comb += [glo_b.eq(lo_b), ghi_b.eq(hi_b)]
+    return {"lo": lo_b, "hi": hi_b, "glo": glo_b, "ghi": ghi_b, "lead": Mux(rb, dm["blead"][1], dm["blead"][0]),
+            "n": Mux(rb, dm["bn"][1], dm["bn"][0]), "nb": Mux(rb, dm["bnb"][1], dm["bnb"][0])}
+
+
+def zrun_at(m: Module, seg, col):
+    """A multiplier: the running z (Q16.4) of ASB ``seg`` at pixel ``col`` (``span_cycles._zrun``)."""
+    d = Signal(signed(20), name="d_z")
+    z = Signal(signed(40), name="zrun")
+    m.d.comb += [d.eq((col << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl),
+                 z.eq((seg.zl << DZ_FRAC) + ((d * seg.dzdx) >> X_FRAC))]
+    return z
+
+
+def seg_ends(m: Module, seg, glo, ghi) -> tuple[Signal, Signal, Signal]:
+    """ASB ``seg``'s first pixel ``c0`` (``(xl + 31) >> 6``, the top-left rule) and its first and
+    last pixel ``a``, ``e`` in the guarded range ``[glo, ghi)`` (``e < a``: none there)."""
+    c0, c1 = Signal(signed(12), name="c0"), Signal(signed(12), name="c1")
+    a, e = Signal(signed(12), name="a"), Signal(signed(12), name="e")
+    m.d.comb += [c0.eq((seg.xl + 31) >> X_FRAC), c1.eq(((seg.xr + 31) >> X_FRAC) - 1),
+                 a.eq(Mux(c0 > glo, c0, glo)), e.eq(Mux(c1 < ghi - 1, c1, ghi - 1))]
+    return c0, a, e
+
+
+def candidate(m: Module, *, raddr, cand, in_bkt, brd, bi, pp, n, c0, ghi):
+    """The entering candidate read this cycle (``raddr``): the next bucket list entry, else the ASL
+    position ``pp`` of the walk from the leading pointer while its first pixel ``c0`` is before
+    ``ghi`` (``cand``: there is one). Returns ``take()``: the sync statements that move past it."""
+    with m.If(in_bkt):
+        m.d.comb += raddr.eq(brd.data)
+    with m.Else():
+        m.d.comb += raddr.eq(pp)
+    m.d.comb += cand.eq(in_bkt | ((pp < n) & (c0 < ghi)))
+
+    def take():
+        with m.If(in_bkt):
+            m.d.sync += bi.eq(bi + 1)
+        with m.Else():
+            m.d.sync += pp.eq(pp + 1)
+    return take
+
+
+def z_key(m: Module, zrun) -> Signal:
+    """The 16-bit compare key of a running z: ``zrun >> DZ_FRAC`` clamped to ``0 .. 2**Z_BITS - 1``."""
+    zk = Signal(signed(40), name="zk")
+    key = Signal(Z_BITS, name="key")
+    m.d.comb += [zk.eq(zrun >> DZ_FRAC), key.eq(Mux(zk < 0, 0, Mux(zk > (1 << Z_BITS) - 1, (1 << Z_BITS) - 1, zk)))]
+    return key
+
+
+def guarded_test(m: Module, zsl, zsr, zbl, zbr, s_lower) -> Signal:
+    """The guarded end-depth test of ``golden_model/experts/span.py`` (``_stays_nearest``, bit
+    model): S (running z ``zsl``/``zsr`` at the two end pixels) nearer than B (``zbl``/``zbr``) at
+    every pixel between; ``s_lower``: S has the lower ASB address (ties go to S)."""
+    g = 1 << DZ_FRAC
+    zmax_run = ((1 << Z_BITS) - 1) << DZ_FRAC
+    lower, higher, good = Signal(name="lower"), Signal(name="higher"), Signal(name="good_t")
+    m.d.comb += [lower.eq((zsl <= zbl) & (zsr <= zbr)),
+                 higher.eq((zsl + g <= zbl) & (zsr + g <= zbr) & (zbl >= g) & (zbr >= g)
+                           & (zsl < zmax_run) & (zsr < zmax_run)),
+                 good.eq(Mux(s_lower, lower, higher))]
+    return good
+
+
+def intensity_at(m: Module, seg, col, fmt: Formats) -> Signal:
+    """S.S.: the intensity of ASB ``seg`` at pixel ``col`` by the multiplier, clamped (Q.i_frac)."""
+    di = Signal(signed(20), name="di")
+    irun = Signal(signed(40), name="irun")
+    m.d.comb += [di.eq((col << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl),
+                 irun.eq(seg.il + ((di * seg.didx) >> X_FRAC))]
+    imax = fmt.i_max << fmt.i_frac
+    ic = Signal(16, name="ic")
+    m.d.comb += ic.eq(Mux(irun < 0, 0, Mux(irun > imax, imax, irun)))
+    return ic
 
 
 class _R(enum.Enum, shape=3):
@@ -127,68 +271,38 @@ class ExpertsPxpSpan(wiring.Component):
         self._depth = depth
         super().__init__({**pxp_members(dmm_layout(), self._fmt.pixel_bits), "overflow": Out(1)})
 
-    def elaborate(self, platform):
-        m = Module()
+    def frame(self, m: Module) -> dict:
+        """What both span PXPs share, added to ``m``: the DMM/P (:func:`dmm_p`), the double-banked
+        DSLB (its write port ``wr``, words ``word``, bank bit ``ab``) and the drain (``drain``: the
+        A.J. (c) entry read at a segment's boundary pixels only), plus the widths ``pw`` (ASL
+        position), ``cw`` (counts) and the block's parameters."""
         fmt, W, D, aj = self._fmt, self._width, self._depth, self._aj == "c"
         pb, ib = fmt.pixel_bits, fmt.intensity_bits
         asb = asb_layout()
         pw = (D - 1).bit_length()                   # ASL position bits within a bank
         cw = D.bit_length()                         # counts 0..D
         ab = (W - 1).bit_length()                   # DSLB bank bit position
-
-        # ---------------------------------------------------------------- DMM/P (two banks)
-        m.submodules.dmm = dmm = Memory(shape=asb, depth=2 << pw, init=[])
-        dwr = dmm.write_port()
-        srd = dmm.read_port(domain="comb")          # resolve side
-        m.submodules.bkt = bkt = Memory(shape=unsigned(PTR_BITS), depth=2 << pw, init=[])
-        bwr = bkt.write_port()
-        brd = bkt.read_port(domain="comb")
-        wbank = Signal()
-        wn = Signal(cw)
-        wnb = Signal(cw)
-        full = Signal(2)
-        bn = [Signal(cw, name=f"n{b}") for b in range(2)]
-        bnb = [Signal(cw, name=f"nb{b}") for b in range(2)]
-        blead = [Signal(PTR_BITS, name=f"lead{b}") for b in range(2)]
-        blo = [Signal(10, name=f"lo{b}") for b in range(2)]
-        bhi = [Signal(11, name=f"hi{b}") for b in range(2)]
-        set_full = Signal(2)
-        clr_full = Signal(2)
-        wfull = Signal()
-        m.d.comb += wfull.eq(full.bit_select(wbank, 1))
-        p = self.i.payload
-        fits = Signal()
-        m.d.comb += fits.eq(p.last | Mux(p.list, wnb < D, wn < D))
-        m.d.comb += [self.i.ready.eq(~wfull & ~self.overflow & fits),
-                     dwr.en.eq(0), bwr.en.eq(0),
-                     dwr.addr.eq((wbank << pw) | wn[:pw]), bwr.addr.eq((wbank << pw) | wnb[:pw]),
-                     bwr.data.eq(p.ptr)]
-        for name in asb.members:
-            m.d.comb += getattr(dwr.data, name).eq(getattr(p, name))
-        with m.If(self.i.valid & ~wfull & ~fits):
-            m.d.sync += self.overflow.eq(1)
-        with m.If(self.i.valid & self.i.ready):
-            with m.If(p.last):
-                m.d.sync += [wn.eq(0), wnb.eq(0), wbank.eq(~wbank)]
-                for b in range(2):
-                    with m.If(wbank == b):
-                        m.d.comb += set_full.eq(1 << b)
-                        m.d.sync += [bn[b].eq(wn), bnb[b].eq(wnb), blead[b].eq(p.ptr),
-                                     blo[b].eq(self.lo), bhi[b].eq(self.hi)]
-            with m.Elif(p.list):
-                m.d.comb += bwr.en.eq(1)
-                m.d.sync += wnb.eq(wnb + 1)
-            with m.Else():
-                m.d.comb += dwr.en.eq(1)
-                m.d.sync += wn.eq(wn + 1)
-        m.d.sync += full.eq((full | set_full) & ~clr_full)
-
-        # ---------------------------------------------------------------- DSLB (two banks)
+        dm = dmm_p(m, self, asb, D)
         word = data.StructLayout({"addr": unsigned(ADDR_BITS), "pix": unsigned(pb), "slot": unsigned(pw)})
         m.submodules.dslb = dslb = Memory(shape=word, depth=2 << ab, init=[])
         wr = dslb.write_port()
         drd = dslb.read_port(transparent_for=())
         m.d.comb += wr.en.eq(0)
+        trd = dm["dmm"].read_port(transparent_for=()) if aj else None    # the visible segment's edges
+        clr_full = dm["clr_full"]
+        drain = Drain(m, o=self.o, drd=drd, word=word, bank_bit=ab, width=W, ib=ib, aj=aj,
+                      trd=trd, ent=asb, ent_bank_bit=pw, boundary_only=True,
+                      done_comb=lambda d: [clr_full.eq(Mux(d.dbank, 0b10, 0b01))])
+        return {**dm, "fmt": fmt, "W": W, "D": D, "aj": aj, "ib": ib, "asb": asb, "pw": pw, "cw": cw, "ab": ab,
+                "word": word, "wr": wr, "drain": drain}
+
+    def elaborate(self, platform):
+        m = Module()
+        fr = self.frame(m)
+        fmt, W, D, aj, ib, asb = fr["fmt"], fr["W"], fr["D"], fr["aj"], fr["ib"], fr["asb"]
+        pw, cw, ab, word, wr = fr["pw"], fr["cw"], fr["ab"], fr["word"], fr["wr"]
+        dm = fr
+        srd, brd, full = dm["srd"], dm["brd"], dm["full"]
 
         # ---------------------------------------------------------------- resolve side
         state = Signal(_R)
@@ -232,49 +346,22 @@ class ExpertsPxpSpan(wiring.Component):
         raddr = Signal(pw)
         seg = Signal(asb)
         m.d.comb += [srd.addr.eq((rb << pw) | raddr), seg.eq(srd.data)]
-        c0 = Signal(signed(12))
-        c1 = Signal(signed(12))
-        a = Signal(signed(12))
-        e = Signal(signed(12))
-        m.d.comb += [c0.eq((seg.xl + 31) >> X_FRAC), c1.eq(((seg.xr + 31) >> X_FRAC) - 1),
-                     a.eq(Mux(c0 > glo, c0, glo)), e.eq(Mux(c1 < ghi - 1, c1, ghi - 1))]
+        c0, a, e = seg_ends(m, seg, glo, ghi)
 
         # the two multipliers: running z (Q16.4) at pixels sl and sr
-        def zrun_at(col):
-            d = Signal(signed(20), name="d_z")
-            z = Signal(signed(40), name="zrun")
-            m.d.comb += [d.eq((col << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl),
-                         z.eq((seg.zl << DZ_FRAC) + ((d * seg.dzdx) >> X_FRAC))]
-            return z
-        zl_ = zrun_at(sl)
-        zr_ = zrun_at(sr)
-        zk = Signal(signed(40))
-        key = Signal(Z_BITS)
-        m.d.comb += [zk.eq(zl_ >> DZ_FRAC),
-                     key.eq(Mux(zk < 0, 0, Mux(zk > (1 << Z_BITS) - 1, (1 << Z_BITS) - 1, zk)))]
+        zl_ = zrun_at(m, seg, sl)
+        zr_ = zrun_at(m, seg, sr)
+        key = z_key(m, zl_)
         nearer = Signal()
         m.d.comb += nearer.eq((i == 0) | (key < skey) | ((key == skey) & (seg.addr < saddr)))
         # the guarded test (span.py): S nearer than this segment B at every pixel of [sl, sr]
-        g = 1 << DZ_FRAC
-        zmax_run = ((1 << Z_BITS) - 1) << DZ_FRAC
-        lower = Signal()
-        higher = Signal()
         good = Signal()
-        m.d.comb += [lower.eq((szl <= zl_) & (szr <= zr_)),
-                     higher.eq((szl + g <= zl_) & (szr + g <= zr_) & (zl_ >= g) & (zr_ >= g)
-                               & (szl < zmax_run) & (szr < zmax_run)),
-                     good.eq((raddr == S) | Mux(saddr < seg.addr, lower, higher))]
+        m.d.comb += good.eq((raddr == S) | guarded_test(m, szl, szr, zl_, zr_, saddr < seg.addr))
         mid = Signal(11)
         m.d.comb += mid.eq((sl + sr + 1) >> 1)
 
         # S.S. at pixel sl (the write cursor): intensity by the multiplier
-        di = Signal(signed(20))
-        irun = Signal(signed(40))
-        m.d.comb += [di.eq((sl << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl),
-                     irun.eq(seg.il + ((di * seg.didx) >> X_FRAC))]
-        imax = fmt.i_max << fmt.i_frac
-        ic = Signal(16)
-        m.d.comb += ic.eq(Mux(irun < 0, 0, Mux(irun > imax, imax, irun)))
+        ic = intensity_at(m, seg, sl, fmt)
 
         # the next entering candidate: the bucket list, then the walk from the leading pointer
         in_bkt = Signal()
@@ -282,10 +369,7 @@ class ExpertsPxpSpan(wiring.Component):
         m.d.comb += [in_bkt.eq(bi < nb), brd.addr.eq((rb << pw) | bi[:pw])]
 
         # ---------------------------------------------------------------- drain side (drain.py)
-        trd = dmm.read_port(transparent_for=()) if aj else None    # the visible segment's edges
-        drain = Drain(m, o=self.o, drd=drd, word=word, bank_bit=ab, width=W, ib=ib, aj=aj,
-                      trd=trd, ent=asb, ent_bank_bit=pw,
-                      done_comb=lambda d: [clr_full.eq(Mux(d.dbank, 0b10, 0b01))])
+        drain = fr["drain"]
         dbusy = drain.dbusy
 
         def next_span(xn):
@@ -307,18 +391,11 @@ class ExpertsPxpSpan(wiring.Component):
         with m.Switch(state):
             with m.Case(_R.IDLE):
                 m.d.sync += cyc.eq(1)
-                lo_b, hi_b = Signal(10), Signal(11)
-                glo_b, ghi_b = Signal(11), Signal(11)
-                m.d.comb += [lo_b.eq(Mux(rb, blo[1], blo[0])), hi_b.eq(Mux(rb, bhi[1], bhi[0]))]
-                if aj:
-                    m.d.comb += [glo_b.eq(Mux(lo_b > 0, lo_b - 1, 0)), ghi_b.eq(Mux(hi_b < W, hi_b + 1, hi_b))]
-                else:
-                    m.d.comb += [glo_b.eq(lo_b), ghi_b.eq(hi_b)]
+                tb = take_bank(m, dm, rb, W, aj)
+                lo_b, hi_b, glo_b, ghi_b, lead, n_b = tb["lo"], tb["hi"], tb["glo"], tb["ghi"], tb["lead"], tb["n"]
                 with m.If(full.bit_select(rb, 1)):
-                    lead = Mux(rb, blead[1], blead[0])
-                    n_b = Mux(rb, bn[1], bn[0])
                     m.d.sync += [lo.eq(lo_b), hi.eq(hi_b), glo.eq(glo_b), ghi.eq(ghi_b), x.eq(glo_b),
-                                 n.eq(n_b), nb.eq(Mux(rb, bnb[1], bnb[0])),
+                                 n.eq(n_b), nb.eq(tb["nb"]),
                                  pp.eq(Mux(lead == NO_PTR, n_b, lead)),
                                  i.eq(0), j.eq(0), k.eq(0), bi.eq(0), minend.eq(ghi_b),
                                  state.eq(Mux(ghi_b <= glo_b, _R.HAND, _R.ENTER))]
@@ -329,23 +406,13 @@ class ExpertsPxpSpan(wiring.Component):
                 with m.If(i + 1 >= k):
                     m.d.sync += state.eq(_R.ENTER)
             with m.Case(_R.ENTER):
-                with m.If(in_bkt):
-                    m.d.comb += raddr.eq(brd.data)
-                with m.Else():
-                    m.d.comb += raddr.eq(pp)
-                m.d.comb += cand.eq(in_bkt | ((pp < n) & (c0 < ghi)))
+                take = candidate(m, raddr=raddr, cand=cand, in_bkt=in_bkt, brd=brd, bi=bi, pp=pp, n=n,
+                                 c0=c0, ghi=ghi)
                 with m.If(cand & (e < a)):
-                    # no pixel in the range: skipped
-                    with m.If(in_bkt):
-                        m.d.sync += bi.eq(bi + 1)
-                    with m.Else():
-                        m.d.sync += pp.eq(pp + 1)
+                    take()              # no pixel in the range: skipped
                 with m.Elif(cand & (a == x)):
                     keep_active()
-                    with m.If(in_bkt):
-                        m.d.sync += bi.eq(bi + 1)
-                    with m.Else():
-                        m.d.sync += pp.eq(pp + 1)
+                    take()
                 with m.Else():
                     # the span's right end: the nearest end, the next start, the range's end
                     nxt = Signal(12)

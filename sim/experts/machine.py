@@ -6,8 +6,13 @@ _NO_CLOCK = Clock("sync", "EXPERTS: the paper names no clock (times in operation
 
 MACHINE = Machine(
     headline=("fig. 4.1 / text: balance Pn", "table 2.2: work with A.J.", "5: processor op rate for 30 frames/s",
-              "5: SLP clock for 30 frames/s, experts-1000", "5: PXP clock for 30 frames/s, experts-1000",
-              "5 / HDL: span PXP (the paper's)", "5 / HDL: SLP list work"),
+              "4 iv): coherent span PXP (ours: span cull once per segment, depth search where the visible segment "
+              "can change): span cull operations, Fr 2000 / Fr 1000",
+              "4 v): coherent span PXP (ours: span cull once per segment, depth search where the visible segment "
+              "can change): depth search operations, Fr 2000 / Fr 1000",
+              "5: SLP with set-up, operation count (model): SLP clock for 30 frames/s, experts-1000",
+              "5 / HDL: coherent span PXP (ours, experts-pxp-coherent), HDL cycles",
+              "5 / HDL: span PXP (ours, experts-pxp-span), HDL cycles", "5 / HDL: SLP list work"),
     name="experts",
     title="EXPERTS scan-line multiprocessor (Kyoto Univ.)",
     seed="000_5ac5e14b809e6e93.txt",
@@ -24,6 +29,7 @@ MACHINE = Machine(
                          Option("pn", "PXPs per SLP (ranges of each line) for the timing stats", 8, type=int))),),
     blocks={"experts-pxp": "rasterhw.hdl.experts.pxp:ExpertsPxp",
             "experts-pxp-span": "rasterhw.hdl.experts.pxp_span:ExpertsPxpSpan",
+            "experts-pxp-coherent": "rasterhw.hdl.experts.pxp_coherent:ExpertsPxpCoherent",
             "experts-slp": "rasterhw.hdl.experts.slp:ExpertsSlp",
             "experts-group": "rasterhw.hdl.experts.group:ExpertsGroup",
             "experts-dmm": "rasterhw.hdl.experts.dmm:ExpertsDmm",
@@ -35,9 +41,11 @@ MACHINE = Machine(
                             Option("aj", "anti-jagging in the PXP: none or c", "c", ("none", "a", "b", "c")),
                             Option("ranges", "PXP ranges: static, or set per line by method i / ii from the "
                                    "previous line's finish-time counters", "static", ("static", "i", "ii")),
-                            Option("pxp", "PXP datapath: span (the paper's: span cull + depth search, "
-                                   "experts-pxp-span) or zbuffer (ours: a one-line Z-buffer, experts-pxp)", "span",
-                                   ("span", "zbuffer")))),
+                            Option("pxp", "PXP: span (span cull at every segment end + depth search per span, "
+                                   "experts-pxp-span), coherent (span cull once per segment + depth search where "
+                                   "the visible segment can change, experts-pxp-coherent) or zbuffer (a one-line "
+                                   "Z-buffer, experts-pxp); all ours, the same pixels", "span",
+                                   ("span", "coherent", "zbuffer")))),
           SimBlock("experts", "the whole frame: every band through the SLP HDL (experts-slp), its ASL order and "
                    "block lists then into every span PXP's DMM/P (experts-pxp-span); words, pixels and cycles "
                    "against golden, SLP and PXP clocks for 30 frames/s", "rasterhw.sim.experts.frame_sim:simulate_frame",
@@ -55,6 +63,7 @@ MACHINE = Machine(
     flows={"experts-dmm": Flow(small={"depth": 16}, clocks=(_NO_CLOCK,)),
            "experts-pxp": Flow(small={"width": 64}, clocks=(_NO_CLOCK,)),
            "experts-pxp-span": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,)),
+           "experts-pxp-coherent": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,)),
            "experts-slp": Flow(small={"width": 64, "tris": 64, "lines": 16, "asl": 32}, clocks=(_NO_CLOCK,)),
            "experts-group": Flow(small={"width": 64, "pn": 2, "tris": 64, "lines": 16, "asl": 32, "depth": 32},
                                  clocks=(_NO_CLOCK,)),
@@ -62,13 +71,14 @@ MACHINE = Machine(
     fpga_note="EXPERTS names no clock (docs/experts.md: times in operation times).",
     testbenches={"experts-pxp": "rasterhw.sim.experts.testbench:PxpBench",
                  "experts-pxp-span": "rasterhw.sim.experts.testbench:PxpSpanBench",
+                 "experts-pxp-coherent": "rasterhw.sim.experts.testbench:PxpCoherentBench",
                  "experts-slp": "rasterhw.sim.experts.testbench:SlpBench",
                  "experts-group": "rasterhw.sim.experts.testbench:GroupBench",
                  "experts-pxp-unit": "rasterhw.sim.experts.testbench:PxpUnitBench",
                  "experts-dmm": "rasterhw.sim.experts.testbench:DmmBench"},
-    status="scan-line golden model split as SLP/PXP (float and 16-bit): the paper's span PXP (span cull, "
+    status="scan-line golden model split as SLP/PXP (float and 16-bit): span PXPs (the paper's span cull, "
            "depth search per span) and the SLP's sorts run and counted, Sn x Pn parallel model with "
            "load balancing at both levels, fig. 4.1 cost model (golden); in HDL, bit- and cycle-exact: the "
-           "span PXP (the paper's, default) and the line-Z-buffer PXP (ours), the SLP (Y-sort, ASL update, "
+           "span PXP (default), the coherent span PXP and the line-Z-buffer PXP (all ours), the SLP (Y-sort, ASL update, "
            "L-sort, X-merge, block lists; not its set-up); one SLP + Pn PXPs clocked together (pixel-exact)",
 )

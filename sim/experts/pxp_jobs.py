@@ -61,13 +61,17 @@ def job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
 
 
 
-def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict | None = None) -> dict:
+def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict | None = None, *,
+                  pxp: str = "span") -> dict:
     """:func:`job_list` for the span PXP (``experts-pxp-span``): per PXP line ``(y, lo, hi)`` the
     DMM/P words the SLP writes (the line's whole ASL, the range's bucket list, the ``last`` token
     with the leading pointer and the next job's range), the expected pixels and the cycles of
     ``golden_model/experts/span_cycles.py``; ``visible`` per job (ASL record ids, -1 background).
     ``slp``: ``{(y, lo, hi): (the ASBs in ASL order, leading pointer, bucket list)}`` as an SLP
-    (the ``experts-slp`` HDL) wrote them, instead of the golden SLP's."""
+    (the ``experts-slp`` HDL) wrote them, instead of the golden SLP's. ``pxp="coherent"``: the
+    coherent span PXP's cycles (``golden_model/experts/coherent.py``, ``experts-pxp-coherent``:
+    the same words and pixels)."""
+    from rasterhw.golden_model.experts.coherent import resolve as coherent_resolve
     from rasterhw.golden_model.experts.span_cycles import NO_PTR, dmm_line, line_asl, line_job
     from rasterhw.golden_model.experts.span_cycles import schedule as span_schedule
     from rasterhw.hdl.experts.pxp_span import dmm_layout
@@ -96,7 +100,8 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
         else:
             _, ld, bk = slp[(y, lo, hi)]
             lead, buckets = [NO_PTR if ld < 0 else ld], [bk]
-        job = line_job(segs, buckets[0], lead[0], lo, hi, aj=aj, width=W)
+        job = line_job(segs, buckets[0], lead[0], lo, hi, aj=aj, width=W,
+                       resolver=coherent_resolve if pxp == "coherent" else None)
         _, nlo, nhi = todo[k + 1] if k + 1 < len(todo) else todo[k]
         words += packed
         words += [pack(lay, {"list": 1, "ptr": b}) for b in buckets[0]]
@@ -109,4 +114,4 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
     return {"words": words, "pixels": np.concatenate(exp_pix).astype(np.int64) if exp_pix else np.zeros(0, np.int64),
             "cycles": np.array(sch["line_cycles"], np.int64), "last_pixel": sch["last_pixel"],
             "lo0": todo[0][1], "hi0": todo[0][2], "lines": len(todo), "aj": aj, "steps": steps,
-            "visible": visible, "timing": lines, "seg_bits": SPAN_BITS}
+            "visible": visible, "timing": lines, "seg_bits": SPAN_BITS, "pxp": pxp}

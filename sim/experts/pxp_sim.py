@@ -24,11 +24,17 @@ from rasterhw.golden_model.experts.pxp import to_rgb8
 from rasterhw.golden_model.experts.pxp_cycles import schedule
 from rasterhw.sim.experts.pxp_jobs import SEG_BITS, SPAN_BITS, job_list, span_job_list
 
-__all__ = ["ENGINES", "PXPS", "SEG_BITS", "SPAN_BITS", "check_jobs", "job_list", "jobs", "run_jobs", "simulate_scene",
+__all__ = ["ENGINES", "PXPS", "PXP_IS", "SEG_BITS", "SPAN_BITS", "check_jobs", "job_list", "jobs", "run_jobs", "simulate_scene",
            "span_job_list", "span_ranges"]
 
 ENGINES = ("pysim", "verilator", "cocotb-verilator", "cocotb-icarus", "icarus")   # icarus: cocotb on Icarus
-PXPS = ("span", "zbuffer")
+PXPS = ("span", "coherent", "zbuffer")
+#: what each PXP is: the paper's, or ours (with the paper's words it rests on)
+PXP_IS = {"span": "ours: span cull at every segment end, a depth search per span (the paper's words: "
+                  "span cull, depth search; Watkins' spans)",
+          "coherent": "ours: span cull once per segment, a depth search only where the visible segment can "
+                      "change (the paper's words: span cull, depth search, span coherence)",
+          "zbuffer": "ours: a one-line Z-buffer (the paper argues against the Z-B method)"}
 
 
 def hdl_image(fr: ExpertsFrame, got: np.ndarray) -> np.ndarray | None:
@@ -46,7 +52,7 @@ def hdl_image(fr: ExpertsFrame, got: np.ndarray) -> np.ndarray | None:
 
 def jobs(fr: ExpertsFrame, sn: int, pn: int, *, ranges: np.ndarray | None = None, pxp: str = "zbuffer",
          slp: dict | None = None) -> dict:
-    """:func:`job_list` (``pxp="span"``: :func:`span_job_list`) for every (line, PXP) of an Sn x Pn
+    """:func:`job_list` (``pxp="span"`` / ``"coherent"``: :func:`span_job_list`) for every (line, PXP) of an Sn x Pn
     split, in frame order, plus each PXP's
     own frame time by the cycle model (its band's lines back to back, as that PXP runs them):
     ``pxp_frame_cycles`` (Sn, Pn). ``ranges`` (H, Pn + 1): per-line boundaries (balancing);
@@ -56,14 +62,14 @@ def jobs(fr: ExpertsFrame, sn: int, pn: int, *, ranges: np.ndarray | None = None
     bands = equal_bounds(H, sn)
     rbs = np.broadcast_to(equal_bounds(fr.width, pn) if ranges is None else np.asarray(ranges), (H, pn + 1))
     todo = [(y, int(rbs[y, p]), int(rbs[y, p + 1])) for y in range(H) for p in range(pn)]
-    jb = span_job_list(fr, todo, slp) if pxp == "span" else job_list(fr, todo)
+    jb = span_job_list(fr, todo, slp, pxp=pxp) if pxp in ("span", "coherent") else job_list(fr, todo)
     jb["owner"] = [(int(np.searchsorted(bands, y, side="right") - 1), p) for y in range(H) for p in range(pn)]
     per = np.zeros((sn, pn), np.int64)
     for sidx in range(sn):
         for p in range(pn):
             # job k = y * pn + p (frame order): its segments were clipped once, in job_list
             ys = range(int(bands[sidx]), int(bands[sidx + 1]))
-            if pxp == "span":
+            if pxp in ("span", "coherent"):
                 per[sidx, p] = span_schedule([jb["timing"][y * pn + p] for y in ys])["last_pixel"] + 1
                 continue
             own = [(jb["segments"][y * pn + p], int(rbs[y, p]), int(rbs[y, p + 1])) for y in ys]
@@ -72,10 +78,12 @@ def jobs(fr: ExpertsFrame, sn: int, pn: int, *, ranges: np.ndarray | None = None
     return jb
 
 
-def span_ranges(fr: ExpertsFrame, sn: int, pn: int, method: str) -> np.ndarray:
+def span_ranges(fr: ExpertsFrame, sn: int, pn: int, method: str, *, pxp: str = "span") -> np.ndarray:
     """(H, Pn + 1) ranges for the span PXP set line by line by method i / ii
     (:func:`parallel.rebalance`) from the previous line's finish-time counters of every PXP of the
-    band, each PXP's own lines back to back (``span_cycles.schedule``)."""
+    band, each PXP's own lines back to back (``span_cycles.schedule``); ``pxp="coherent"``: the
+    coherent span PXP's counters (``coherent.resolve``)."""
+    from rasterhw.golden_model.experts.coherent import resolve as coherent_resolve
     from rasterhw.golden_model.experts.parallel import Balance, rebalance
     from rasterhw.golden_model.experts.span_cycles import dmm_line, line_job
     from rasterhw.golden_model.experts.span_cycles import schedule as span_schedule
@@ -91,7 +99,8 @@ def span_ranges(fr: ExpertsFrame, sn: int, pn: int, method: str) -> np.ndarray:
             segs, lead, buckets = dmm_line(fr, y, b)
             c = np.zeros(pn)
             for p in range(pn):
-                j = line_job(segs, buckets[p], lead[p], int(b[p]), int(b[p + 1]), aj=fr.aj, width=W)
+                j = line_job(segs, buckets[p], lead[p], int(b[p]), int(b[p + 1]), aj=fr.aj, width=W,
+                             resolver=coherent_resolve if pxp == "coherent" else None)
                 own[p].append((j["words"], j["resolve"], j["drain"]))
                 c[p] = span_schedule(own[p])["line_cycles"][-1]
             widths = rebalance(widths, c, method, Balance())
@@ -116,13 +125,21 @@ def run_jobs(jb: dict, *, width: int, engine: str = "pysim", idle: int = 0, stal
     testbench's line log), ``sim_cycles`` (= ``last_pixel``: the PXP's clock edges up to and
     including the frame's last pixel, counted from its first edge), ``run_s``, ``build_s``."""
     from rasterhw.sim.engines import run, with_gaps
-    from rasterhw.sim.experts.testbench import PxpBench, PxpSpanBench, job_stimulus
+    from rasterhw.sim.experts.testbench import (
+        PxpBench,
+        PxpCoherentBench,
+        PxpSpanBench,
+        job_stimulus,
+    )
     for what, v in (("idle", idle), ("stall", stall)):
         if not (isinstance(v, int) and 0 <= v <= 255):
             raise RasterhwError(f"experts PXP bench: {what} must be an integer in 0..255, not {v!r}")
     if engine not in ENGINES:
         raise RasterhwError(f"experts: PXP engine must be one of {', '.join(ENGINES)}, not {engine!r}")
-    tb = (PxpSpanBench if jb.get("seg_bits", SEG_BITS) == SPAN_BITS else PxpBench)(log=True)
+    if jb.get("seg_bits", SEG_BITS) == SPAN_BITS:
+        tb = (PxpCoherentBench if jb.get("pxp") == "coherent" else PxpSpanBench)(log=True)
+    else:
+        tb = PxpBench(log=True)
     p = tb.params(width=width, aj=jb["aj"])
     stim = job_stimulus(jb)
     if idle:
@@ -169,9 +186,11 @@ def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", pro
                    pxp: str | None = "span") -> dict:
     """Registry sim block ``pxp``: the whole frame through the PXP HDL, compared with the golden model.
 
-    ``pxp``: ``"span"`` (default, the paper's PXP: ``experts-pxp-span``, span cull and depth search
-    per span, the line's ASL and block lists through its DMM/P) or ``"zbuffer"`` (ours:
-    ``experts-pxp``, a one-line Z-buffer; the same pixels).
+    ``pxp`` (:data:`PXP_IS`): ``"span"`` (default: ``experts-pxp-span``, span cull at every segment
+    end and a depth search per span, the line's ASL and block lists through its DMM/P),
+    ``"coherent"`` (``experts-pxp-coherent``: the same DMM/P words, span cull once per segment and
+    a depth search only where the visible segment can change) or ``"zbuffer"`` (``experts-pxp``, a
+    one-line Z-buffer); the same pixels.
 
     ``idle`` / ``stall`` (Verilator only, 0..255): random input idle clocks / output back-pressure.
     Then the pixels are compared as always, and ``cycle_mismatches`` counts the lines that
@@ -195,8 +214,8 @@ def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", pro
         raise RasterhwError(f"experts: sim pxp --pxp must be one of {', '.join(PXPS)}, not {pxp!r}")
     fr = render_frame(run_geometry(scene, width, height, z_bits=16), model="bit", aj=aj)
     rb = None
-    if ranges != "static" and pxp == "span":
-        rb = span_ranges(fr, sn, pn, ranges)
+    if ranges != "static" and pxp != "zbuffer":
+        rb = span_ranges(fr, sn, pn, ranges, pxp=pxp)
     elif ranges != "static":
         # ranges set line by line from the previous line's finish-time counters (the PXP HDL's
         # resolve cycles, as the cycle model the HDL matches gives them)
@@ -214,7 +233,7 @@ def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", pro
     mism = int(np.count_nonzero(got[:n] != jb["pixels"][:n])) + abs(got.size - jb["pixels"].size)
     cyc = res["cycles"][:jb["lines"]]
     model = jb["cycles"][:cyc.size]
-    if not exact and pxp == "span":
+    if not exact and pxp != "zbuffer":
         # input idle delays a line's start and so may shorten its wait for the drain: the floor
         # of a stalled span line is its own resolve work (+ the hand-over cycle)
         model = np.array([t[1] + 1 for t in jb["timing"]], np.int64)[:cyc.size]
@@ -228,12 +247,12 @@ def simulate_scene(scene, width: int, height: int, *, engine: str = "pysim", pro
             "mismatches": mism, "wall_s": round(time.perf_counter() - t0, 3),
             "cycles_per_s": round(total / res["run_s"], 1) if res["run_s"] > 0 else None,
             "cycle_mismatches": cyc_mism, "frame_cycles_busiest_pxp": frame_cycles,
-            "last_pixel_mismatch": int(total != jb["last_pixel"] + (1 if pxp == "span" else 2)) if exact else 0,
+            "last_pixel_mismatch": int(total != jb["last_pixel"] + (1 if pxp != "zbuffer" else 2)) if exact else 0,
             "pxp_cycles_per_line_mean": round(float(cyc.mean()), 2) if cyc.size else 0.0,
             "pxp_clock_for_30fps_hz": frame_cycles * 30, "sn": sn, "pn": pn, "aj": aj, "ranges": ranges,
-            "pxp": pxp, "pxp_is": "the paper's (span cull + depth search)" if pxp == "span" else "ours (line Z-buffer)",
+            "pxp": pxp, "pxp_is": PXP_IS[pxp],
             **({"span_steps": {k: int(sum(st[k] for st in jb["steps"])) for k in jb["steps"][0]}}
-               if pxp == "span" and jb["steps"] else {}),
+               if pxp != "zbuffer" and jb["steps"] else {}),
             "run_s": round(res["run_s"], 3), "build_s": round(res.get("build_s", 0.0), 2),
             # the machine's frame on its Sn x Pn PXPs (all at once): the busiest PXP's
             "frame_cycles": frame_cycles, "frame_rgb": hdl_image(fr, got)}

@@ -23,7 +23,7 @@ from rasterhw.sim.experts.pxp_jobs import (
 )
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 
-__all__ = ["DmmBench", "GroupBench", "PxpBench", "PxpSpanBench", "PxpUnitBench", "RangeFromTokens", "SlpBench",
+__all__ = ["DmmBench", "GroupBench", "PxpBench", "PxpCoherentBench", "PxpSpanBench", "PxpUnitBench", "RangeFromTokens", "SlpBench",
            "job_stimulus", "slp_words"]
 
 
@@ -153,7 +153,7 @@ class PxpBench(Testbench):
 
 
 class PxpSpanBench(PxpBench):
-    """``experts-pxp-span`` (the paper's PXP): the first line's range word, then per line the
+    """``experts-pxp-span`` (the span PXP): the first line's range word, then per line the
     DMM/P words the SLP writes -- the line's whole ASL, this PXP's block boundary bucket list, the
     ``last`` token with the block leading segment pointer (and the next line's range for the
     adapter) -- in (``i``), the range's pixel words out (``o``), as the golden bit model gives
@@ -174,6 +174,20 @@ class PxpSpanBench(PxpBench):
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         jb = stim.source
         return Expected(self.words(jb), cycles=int(jb["last_pixel"]) + 2)
+
+
+class PxpCoherentBench(PxpSpanBench):
+    """``experts-pxp-coherent`` (ours: span cull once per segment, depth search only where the
+    visible segment can change): :class:`PxpSpanBench`'s words and pixels, cycles from
+    ``golden_model/experts/coherent.py`` through ``span_cycles.schedule``."""
+
+    block = "experts-pxp-coherent"
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        rng, name, fr = _frame(params, seed)
+        todo = _lines(rng, params["width"], int(rng.integers(2, 9)))
+        jb = span_job_list(fr, todo, pxp="coherent")
+        return job_stimulus(jb, f"{name} at {params['width']}, {jb['lines']} lines, seed {seed}")
 
 
 class PxpUnitBench(PxpBench):

@@ -12,7 +12,7 @@ from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.sim.engines import run
 from rasterhw.sim.experts.pxp_sim import IN_DEPTH, OUT_DEPTH, job_list, run_jobs, span_job_list
-from rasterhw.sim.experts.testbench import PxpBench, PxpSpanBench
+from rasterhw.sim.experts.testbench import PxpBench, PxpCoherentBench, PxpSpanBench
 from rasterhw.sim.testbench import compare
 
 SCENE_BUILD = {"depth": IN_DEPTH, "out_depth": OUT_DEPTH}
@@ -22,7 +22,7 @@ def _need(exp) -> dict[str, int]:
     return {k: len(v) for k, v in exp.words.items()}
 
 
-@pytest.mark.parametrize("cls", [PxpBench, PxpSpanBench], ids=["zbuffer", "span"])
+@pytest.mark.parametrize("cls", [PxpBench, PxpSpanBench, PxpCoherentBench], ids=["zbuffer", "span", "coherent"])
 def test_line_log_is_the_same_on_pysim_and_verilator(cls):
     tb = cls(log=True)
     p = tb.params(width=64, aj="c")
@@ -50,13 +50,13 @@ def test_line_log_is_the_same_on_pysim_and_verilator(cls):
     assert compare(plain.expect(p, stim), r)["cycle_mismatches"] == 0
 
 
-@pytest.mark.parametrize("pxp", ["zbuffer", "span"])
+@pytest.mark.parametrize("pxp", ["zbuffer", "span", "coherent"])
 def test_run_jobs_same_on_both_engines(pxp):
     """The scene runs' player: pixels, line cycles and the PXP's edges equal on pysim and
     Verilator (exact, and with idle gaps and back-pressure), exact equal to the cycle model."""
     fr = render_frame(run_geometry(build_scene("experts-tilt-1000"), 64, 64, z_bits=16), model="bit", aj="c")
     todo = [(y, lo, hi) for y in (5, 20, 21, 40) for lo, hi in ((0, 20), (20, 64))]
-    jb = span_job_list(fr, todo) if pxp == "span" else job_list(fr, todo)
+    jb = job_list(fr, todo) if pxp == "zbuffer" else span_job_list(fr, todo, pxp=pxp)
     for kw in ({}, {"idle": 40, "stall": 40, "seed": 3}):
         a = run_jobs(jb, width=64, engine="pysim", **kw)
         b = run_jobs(jb, width=64, engine="verilator", **kw)
@@ -66,7 +66,7 @@ def test_run_jobs_same_on_both_engines(pxp):
         assert a["pixels"].tolist() == jb["pixels"].tolist()
         if not kw:
             assert a["cycles"].tolist() == jb["cycles"].tolist()
-            assert a["sim_cycles"] == jb["last_pixel"] + (1 if pxp == "span" else 2)
+            assert a["sim_cycles"] == jb["last_pixel"] + (1 if pxp != "zbuffer" else 2)
         else:
             assert (a["cycles"] >= (jb["cycles"] if pxp == "zbuffer" else
                                     np.array([t[1] + 1 for t in jb["timing"]]))).all()

@@ -81,7 +81,7 @@ def test_small_frame_span_pxp_pysim_pixel_and_cycle_exact_same_pixels_as_zbuffer
     for q in (r, z):
         assert q["pixels_compared"] == 64 * 16 and q["mismatches"] == 0 and q["cycle_mismatches"] == 0
         assert q["last_pixel_mismatch"] == 0
-    assert r["pxp"] == "span" and z["pxp"] == "zbuffer" and "paper" in r["pxp_is"] and "ours" in z["pxp_is"]
+    assert r["pxp"] == "span" and z["pxp"] == "zbuffer" and "ours" in r["pxp_is"] and "Z-buffer" in z["pxp_is"]
     # every guarded pixel written once: with A.J. each inner range end adds a guard pixel
     assert r["span_steps"]["write"] == 16 * (64 + (2 * 3 if aj == "c" else 0))
     assert r["span_steps"]["pass_a"] > 0 and r["frame_cycles_busiest_pxp"] != z["frame_cycles_busiest_pxp"]
@@ -111,7 +111,7 @@ def test_block_lists_reach_the_pxp_as_data():
 
 
 def test_bad_pxp_is_one_line_error():
-    with pytest.raises(RasterhwError, match="--pxp must be one of span, zbuffer"):
+    with pytest.raises(RasterhwError, match="--pxp must be one of span, coherent, zbuffer"):
         simulate_scene(build_scene("experts-tilt-1000"), 64, 16, pxp="linez")
 
 

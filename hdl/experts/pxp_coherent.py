@@ -1,0 +1,216 @@
+"""EXPERTS coherent span PXP (ours): span cull once per segment, depth search only where the visible segment can change.
+
+Paper (seed 000, section 4): the PXP's work is "iv) ... 《span cull》" and "v) ... 《depth search》",
+priced at one span cull operation per segment per line and a number of depth searches per line that
+grows as sqrt(Fr); section 2.2: "一旦可視セグメントが決定されればその中では一様な計算で各画素の値を
+決めることができる (span coherence)" (Watkins [8]). The steps below are ours (the paper gives the terms,
+not the steps); every term is counted in ``golden_model/experts/coherent.py``, which this block is
+cycle-exact against.
+
+The DMM/P, the DSLB and its drain are the span PXP's (``pxp_span.py``: ``dmm_p``, ``take_bank``,
+``drain.Drain``); the same DMM/P words in, the same pixel words out. The resolve side keeps the
+visible segment ``S`` (``vok``: one is visible) and the last pixel ``vu`` it has been shown nearest to:
+
+* **ENTER** (per span, from ``x = sl``): one cycle per candidate entering at ``x`` (the bucket list
+  first, then the ASL from the leading pointer; one with no pixel in the range is skipped in a
+  cycle). An entering segment goes onto the active list and is tested against ``S`` over
+  ``[x, min(vu, its last pixel)]`` (the guarded end-depth test; four multiplies); a failed test
+  asks for a depth search. One more cycle sets the next start ``ns``; then a depth search if a test
+  failed, no segment is visible or ``x > vu``, else the write.
+* **PASSA** (depth search, one cycle per active entry): an entry that ended before ``x`` leaves
+  the list (compacted in place); for the others z at ``x`` and the nearest ``S`` at ``x`` (16-bit key,
+  ties to the lower ASB address). ``r = S``'s last pixel. None present: background up to ``ns - 1``.
+* **PASSB** (two or more present and ``r > x``), one cycle per test: ``S`` against the entry over
+  ``[x, min(r, its last pixel)]``; a pass moves to the next entry, a failure halves ``r`` to
+  ``((x + r + 1) >> 1) - 1`` and tests the same entry again (the entries before it passed over the
+  longer span, so over the shorter one too); ``r = x`` ends the search. Then ``vu = r``.
+* **WRITE**: S.S. and the DSLB word, one pixel per cycle over ``[x, min(vu, ns - 1)]``.
+"""
+
+from __future__ import annotations
+
+from amaranth import Module, Mux, Signal, signed, unsigned
+from amaranth.lib import enum
+from amaranth.lib.memory import Memory
+from rasterhw.golden_model.experts.formats import ADDR_BITS, Z_BITS
+from rasterhw.hdl.experts.pxp_span import (
+    NO_PTR,
+    NONE,
+    PTR_BITS,
+    ExpertsPxpSpan,
+    candidate,
+    guarded_test,
+    intensity_at,
+    seg_ends,
+    take_bank,
+    z_key,
+    zrun_at,
+)
+from rasterhw.hdl.params import params
+
+__all__ = ["ExpertsPxpCoherent"]
+
+class _R(enum.Enum, shape=3):
+    IDLE = 0      # wait for a full DMM/P bank; start the line
+    ENTER = 1     # span cull: one entering candidate per cycle (tested against S), then the next start
+    PASSA = 2     # depth search: drop ended entries, nearest at x
+    PASSB = 3     # depth search: guarded tests, halving on a failure
+    WRITE = 4     # S.S. and DSLB write, one pixel per cycle
+    HAND = 5      # hand the DSLB bank to the drain
+
+
+@params("width", "aj", "depth")
+class ExpertsPxpCoherent(ExpertsPxpSpan):
+    """One coherent span PXP with its DMM/P: DMM/P words in, the range's pixel words out, line by
+    line. Parameters (``width``, ``intensity_bits``, ``aj``, ``depth``), ports (``i``, ``o``, ``lo``,
+    ``hi``, ``line_cycles``, ``lines``, ``overflow``), DMM/P, DSLB and drain:
+    :class:`hdl.experts.pxp_span.ExpertsPxpSpan`'s (``frame``); the resolve side is this block's."""
+
+    def elaborate(self, platform):
+        m = Module()
+        fr = self.frame(m)
+        fmt, W, D, aj, ib, asb = fr["fmt"], fr["W"], fr["D"], fr["aj"], fr["ib"], fr["asb"]
+        pw, cw, ab, word, wr, drain = fr["pw"], fr["cw"], fr["ab"], fr["word"], fr["wr"], fr["drain"]
+        srd, brd, full = fr["srd"], fr["brd"], fr["full"]
+        vrd = fr["dmm"].read_port(domain="comb")    # the visible segment S
+
+        state = Signal(_R)
+        rb = Signal()
+        glo, ghi = Signal(11), Signal(11)
+        lo, hi = Signal(10), Signal(11)
+        n, nb = Signal(cw), Signal(cw)
+        i = Signal(cw)            # scan index (active list)
+        j = Signal(cw)            # active list write index
+        na = Signal(cw)           # entries on the active list
+        bi = Signal(cw)           # next bucket list entry
+        pp = Signal(PTR_BITS + 1)  # next ASL position of the walk from the leading pointer
+        sl = Signal(11)           # the span's left pixel x; in WRITE the write cursor
+        sr = Signal(11)           # PASSB: the span searched ends at sr; WRITE: the last pixel written
+        ns = Signal(12)           # the next start (or ghi)
+        vu = Signal(12)           # S is nearest up to pixel vu
+        vok = Signal()            # a segment is visible (S)
+        fail = Signal()           # an entering segment failed its test against S
+        S = Signal(pw)
+        skey = Signal(Z_BITS)
+        saddr = Signal(ADDR_BITS)
+        send = Signal(signed(12))  # S's last pixel in the guarded range
+        cyc = Signal(16)
+
+        m.submodules.act = act = Memory(shape=unsigned(pw), depth=D, init=[])
+        awr = act.write_port()
+        ard = act.read_port(domain="comb")
+        m.d.comb += [awr.en.eq(0), ard.addr.eq(i), awr.addr.eq(j)]
+
+        raddr = Signal(pw)
+        seg = Signal(asb)
+        vseg = Signal(asb)
+        m.d.comb += [srd.addr.eq((rb << pw) | raddr), seg.eq(srd.data),
+                     vrd.addr.eq((rb << pw) | S), vseg.eq(vrd.data)]
+        c0, a, e = seg_ends(m, seg, glo, ghi)
+
+        # the test's right end: min(vu (ENTER) / sr (PASSB), the segment's last pixel)
+        rt = Signal(12)
+        rbx = Signal(12)
+        m.d.comb += [rt.eq(Mux(state == _R.PASSB, sr, vu)), rbx.eq(Mux(e < rt, e, rt))]
+        zl_ = zrun_at(m, seg, sl)
+        zr_ = zrun_at(m, seg, rbx)
+        zsl = zrun_at(m, vseg, sl)
+        zsr = zrun_at(m, vseg, rbx)
+        good = Signal()
+        m.d.comb += good.eq(guarded_test(m, zsl, zsr, zl_, zr_, vseg.addr < seg.addr))
+        key = z_key(m, zl_)
+        nearer = Signal()
+        m.d.comb += nearer.eq((j == 0) | (key < skey) | ((key == skey) & (seg.addr < saddr)))
+        mid = Signal(11)
+        m.d.comb += mid.eq((sl + sr + 1) >> 1)
+        ic = intensity_at(m, vseg, sl, fmt)
+
+        in_bkt = Signal()
+        cand = Signal()
+        m.d.comb += [in_bkt.eq(bi < nb), brd.addr.eq((rb << pw) | bi[:pw])]
+
+
+        def write(last):
+            """Decided: write ``[sl, last]``."""
+            return [sr.eq(last), state.eq(_R.WRITE)]
+
+        def decided(r):
+            """S is nearest over ``[sl, r]``: write up to ``min(r, ns - 1)``."""
+            return [vok.eq(1), vu.eq(r), *write(Mux(r < ns - 1, r, ns - 1))]
+
+        m.d.sync += cyc.eq(cyc + 1)
+        m.d.comb += raddr.eq(ard.data)
+        with m.Switch(state):
+            with m.Case(_R.IDLE):
+                m.d.sync += cyc.eq(1)
+                tb = take_bank(m, fr, rb, W, aj)
+                with m.If(full.bit_select(rb, 1)):
+                    m.d.sync += [lo.eq(tb["lo"]), hi.eq(tb["hi"]), glo.eq(tb["glo"]), ghi.eq(tb["ghi"]),
+                                 sl.eq(tb["glo"]), n.eq(tb["n"]), nb.eq(tb["nb"]),
+                                 pp.eq(Mux(tb["lead"] == NO_PTR, tb["n"], tb["lead"])),
+                                 na.eq(0), bi.eq(0), vok.eq(0), fail.eq(0),
+                                 state.eq(Mux(tb["ghi"] <= tb["glo"], _R.HAND, _R.ENTER))]
+            with m.Case(_R.ENTER):
+                take = candidate(m, raddr=raddr, cand=cand, in_bkt=in_bkt, brd=brd, bi=bi, pp=pp, n=n,
+                                 c0=c0, ghi=ghi)
+                with m.If(cand & ((e < a) | (a == sl))):
+                    with m.If(a <= e):
+                        m.d.comb += [awr.en.eq(1), awr.addr.eq(na), awr.data.eq(raddr)]
+                        m.d.sync += na.eq(na + 1)
+                        with m.If(vok & (vu >= sl) & ~good):
+                            m.d.sync += fail.eq(1)
+                    take()
+                with m.Else():
+                    nxt = Signal(12)
+                    m.d.comb += nxt.eq(Mux(cand, a, ghi))
+                    m.d.sync += [ns.eq(nxt), i.eq(0), j.eq(0), fail.eq(0)]
+                    with m.If(fail | ~vok | (sl > vu)):
+                        with m.If(na == 0):
+                            m.d.sync += [vok.eq(0), vu.eq(nxt - 1), *write(nxt - 1)]
+                        with m.Else():
+                            m.d.sync += state.eq(_R.PASSA)
+                    with m.Else():
+                        m.d.sync += write(Mux(vu < nxt - 1, vu, nxt - 1))
+            with m.Case(_R.PASSA):
+                kept = Signal(cw)
+                se = Signal(signed(12))
+                m.d.comb += [kept.eq(j), se.eq(send)]
+                with m.If(e >= sl):
+                    m.d.comb += [awr.en.eq(1), awr.data.eq(raddr), kept.eq(j + 1)]
+                    m.d.sync += j.eq(j + 1)
+                    with m.If(nearer):
+                        m.d.comb += se.eq(e)
+                        m.d.sync += [S.eq(raddr), skey.eq(key), saddr.eq(seg.addr), send.eq(e)]
+                m.d.sync += i.eq(i + 1)
+                with m.If(i + 1 >= na):
+                    m.d.sync += [na.eq(kept), i.eq(0)]
+                    with m.If(kept == 0):
+                        m.d.sync += [vok.eq(0), vu.eq(ns - 1), *write(ns - 1)]
+                    with m.Elif((kept >= 2) & (se > sl)):
+                        m.d.sync += [sr.eq(se), state.eq(_R.PASSB)]
+                    with m.Else():
+                        m.d.sync += decided(se)
+            with m.Case(_R.PASSB):
+                with m.If(good | (raddr == S)):
+                    m.d.sync += i.eq(i + 1)
+                    with m.If(i + 1 >= na):
+                        m.d.sync += decided(sr)
+                with m.Else():
+                    m.d.sync += sr.eq(mid - 1)
+                    with m.If(mid - 1 == sl):
+                        m.d.sync += decided(sl)
+            with m.Case(_R.WRITE):
+                m.d.comb += [wr.addr.eq((rb << ab) | sl), wr.en.eq(1)]
+                with m.If(~vok):
+                    m.d.comb += wr.data.eq(word.const({"addr": NONE, "pix": 0, "slot": 0}))
+                with m.Else():
+                    m.d.comb += [wr.data.addr.eq(vseg.addr), wr.data.pix.eq((vseg.hue << ib) | (ic >> fmt.i_frac)),
+                                 wr.data.slot.eq(S)]
+                m.d.sync += sl.eq(sl + 1)
+                with m.If(sl == sr):
+                    m.d.sync += state.eq(Mux(sl + 1 >= ghi, _R.HAND, _R.ENTER))
+            with m.Case(_R.HAND):
+                with m.If(~drain.dbusy):
+                    m.d.sync += [*drain.hand(bank=rb, lo=lo, hi=hi, glo=glo, ghi=ghi), rb.eq(~rb), state.eq(_R.IDLE),
+                                 self.line_cycles.eq(cyc + 1), self.lines.eq(self.lines + 1)]
+        return m
