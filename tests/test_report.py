@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import pytest
 from rasterhw.golden_model.triangle_ops import ops_per_triangle
+from rasterhw.golden_model.zbm.paper import PAPER_CYCLES, PAPER_KPOLYS
 from rasterhw.sim.report.rows import ROW_KEYS, format_table, make_row, ratio, run_report
 from rasterhw.sim.snu.report import golden_rows
-from rasterhw.sim.zbm.report import PAPER_CYCLES, PAPER_KPOLYS, polygons_per_s
+from rasterhw.sim.zbm.report import polygons_per_s
 
 
 def test_make_row_checks_source():
