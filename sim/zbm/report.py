@@ -39,7 +39,6 @@ CLOCK_HZ = PAPER_CLOCK_HZ  # condition 3
 EDGE_PAIRS_PER_POLYGON = PAPER_EDGE_PAIRS_PER_POLYGON  # condition 1
 SKEW_FACTOR = round(1 / PAPER_SKEW_WAIT)  # condition 7: "half the time is waiting" -> x1/2
 UNITS_SECOND_LEVEL = PAPER_UNITS
-PAPER_64_UNITS = PAPER_UNITS_RATE
 #: our reading of sec. 7's "RAM 部 49Kbits": 49,152 = 48 x 1024 bits ("49 K" in decimal: 49.152 K), a
 #: ``formula`` value in the report (the ``paper`` cell holds 49 Kbits as printed; docs/zbm.md#area)
 RAM_BITS_READING = 48 * 1024
@@ -129,7 +128,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: 
                 reason=None if m is not None else FAST_TABLE1_SKIP))
     out.append(make_row("zbm", "6.1", f"{UNITS_SECOND_LEVEL} units, best interleave (not simulated: "
                         f"{UNITS_SECOND_LEVEL} x the paper's per-unit arithmetic)",
-                        paper=PAPER_64_UNITS, formula=UNITS_SECOND_LEVEL * polygons_per_s(min(PAPER_CYCLES.values())),
+                        paper=PAPER_UNITS_RATE, formula=UNITS_SECOND_LEVEL * polygons_per_s(min(PAPER_CYCLES.values())),
                         measured=None, unit="polygons/s", source="formula",
                         reason=f"{UNITS_SECOND_LEVEL} units are not simulated here: chains of 1-8 units of "
                                "interleave 1 are (rows 'chain'); an interleave-16 unit alone takes ~21 min "
@@ -350,7 +349,7 @@ def mapping_mode_rows() -> list[dict]:
                                 measured=polygons_per_s(cyc), unit="polygons/s", source="golden"))
     best = max(polygons_per_s(_unit_cycles_model(i, "paper", 1)) for i in (8, 16))
     out.append(make_row("zbm", "6.1 (mapping mode)", f"{UNITS_SECOND_LEVEL} units, mapping mode, paper schedule, best "
-                        "interleave (64 x the exact cycle model's unit rate; not simulated)", paper=PAPER_64_UNITS,
+                        "interleave (64 x the exact cycle model's unit rate; not simulated)", paper=PAPER_UNITS_RATE,
                         formula=None, measured=UNITS_SECOND_LEVEL * best, unit="polygons/s", source="golden"))
     return out
 

@@ -1,0 +1,69 @@
+"""Every ``paper`` cell of a committed report is a number the paper prints: helpers of the
+per-machine tests (tests/{sparse,zbm,snu}/test_*_paper.py).
+
+A cell is printed if one of its spellings occurs in the seed's text as a number on its own (no
+digit beside it): as is, with a decimal comma (Russian), with thousands separators, or scaled to
+the K / M the paper writes (115.8K, 7.4M, 12 Mpixel). A value the paper prints in words ("half",
+"five", "100 %") is listed by the test with the seed's words, which must occur.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from rasterhw.sim.report.rows import parse_table
+
+ROOT = Path(__file__).resolve().parents[1]
+SEEDS = Path("/work/shared/seeds") if Path("/work/shared/seeds").is_dir() else ROOT.parent / "shared" / "seeds"
+
+
+def seed_text(prefix: str) -> str:
+    (path,) = SEEDS.glob(f"{prefix}_*.txt")
+    return path.read_text()
+
+
+def committed_rows(system: str) -> list[dict]:
+    return parse_table((ROOT / "docs" / "reproduction" / f"{system}.md").read_text())
+
+
+def _spellings(v: float) -> set[str]:
+    out = set()
+    for scale in (1, 1e3, 1e6):
+        x = v / scale
+        if x < 0.01 and v != 0:
+            continue
+        for s in (f"{x:g}", f"{x:.1f}", f"{x:.2f}", f"{x:.3f}"):
+            out |= {s, s.replace(".", ",")}
+        if x == int(x):
+            out |= {f"{int(x):,}", str(int(x))}
+    return out
+
+
+def printed(v: float, text: str) -> bool:
+    """Whether ``v`` occurs in ``text`` as a number, in one of its spellings."""
+    return any(re.search(rf"(?<![\d.,]){re.escape(s)}(?![\d])", text) for s in _spellings(v))
+
+
+def unprinted_paper_cells(system: str, prefix: str, words: dict[float, str]) -> list[tuple[str, str]]:
+    """(quantity, paper cell) of every committed row whose paper value the seed does not print:
+    neither as a number (:func:`printed`) nor in the words ``words`` gives for it."""
+    text = seed_text(prefix)
+    bad = []
+    for r in committed_rows(system):
+        cell = r["paper"]
+        if cell in ("—", ""):
+            continue
+        v = float(cell.replace(",", ""))
+        if printed(v, text):
+            continue
+        w = words.get(v)
+        if w is not None and w in text:
+            continue
+        bad.append((r["quantity"], cell))
+    return bad
+
+
+def paper_cells(system: str, needle: str) -> list[str]:
+    """The paper cells of the committed rows whose quantity contains ``needle``."""
+    return [r["paper"] for r in committed_rows(system) if needle in r["quantity"]]
