@@ -67,3 +67,38 @@ def unprinted_paper_cells(system: str, prefix: str, words: dict[float, str]) -> 
 def paper_cells(system: str, needle: str) -> list[str]:
     """The paper cells of the committed rows whose quantity contains ``needle``."""
     return [r["paper"] for r in committed_rows(system) if needle in r["quantity"]]
+
+
+def derived_with_paper_cells(system: str, needles: tuple[str, ...]) -> list[tuple[str, list[str]]]:
+    """(needle, cells) for every derived-row needle that matches no committed row or whose rows hold a
+    paper cell (a derived value belongs in ``formula``)."""
+    out = []
+    for needle in needles:
+        cells = paper_cells(system, needle)
+        if not cells or set(cells) != {"—"}:
+            out.append((needle, cells))
+    return out
+
+
+def unprinted_module_values(module, prefix: str, words: dict, skip: tuple[str, ...] = ()) -> list[tuple[str, float]]:
+    """(name, value) of every number of a ``paper.py`` module's ``PAPER_*`` constants (nested dicts
+    and tuples opened) the seed does not print (nor ``words`` for it), and (name, None) for a
+    constant without a quote in the module's ``QUOTES``."""
+    text = seed_text(prefix)
+
+    def numbers(v):
+        if isinstance(v, dict):
+            return [x for t in v.values() for x in numbers(t)]
+        if isinstance(v, tuple):
+            return [x for t in v for x in numbers(t)]
+        return [v]
+
+    bad = []
+    for name in module.__all__:
+        if name == "QUOTES" or name in skip:
+            continue
+        bad += [(name, x) for x in numbers(getattr(module, name))
+                if not printed(x, text) and words.get(x, "\0") not in text]
+        if name not in module.QUOTES:
+            bad.append((name, None))
+    return bad
