@@ -149,6 +149,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: 
 def _i860_note() -> list[str]:
     """Where the table 2 rows come from, and every parameter of the i860 model with its source."""
     from rasterhw.golden_model.i860 import PARAMETERS
+    from rasterhw.golden_model.i860.cache import CACHE_PARAMETERS
 
     md = ["", "## The i860 model (table 2, i860s per unit)", "",
           "Rows `model:i860`: the first-level work our golden code does (transform, perspective, clipping, "
@@ -160,6 +161,9 @@ def _i860_note() -> list[str]:
           "cycle model at interleave 8, named in each label) by the model's per-processor rate.", "",
           "| parameter | value | source |", "|---|---|---|"]
     md += [f"| `{k}` | {v} | {src} |" for k, (v, src) in PARAMETERS.items()]
+    md += ["", "The data cache (`golden_model/i860/cache.py`, on the polygon records' layout: "
+           "`golden_model/zbm/i860.py: polygon_cache`):", "", "| parameter | value | source |", "|---|---|---|"]
+    md += [f"| `{k}` | {v} | {src} |" for k, (v, src) in CACHE_PARAMETERS.items()]
     return md + [""]
 
 
