@@ -42,3 +42,19 @@ def pytest_collection_modifyitems(config, items):
         return 0 if m is None else -(m.args[0] if m.args else 1)
 
     items.sort(key=rank)   # stable: the rest keep their order
+
+
+def _paper_values_module():
+    import importlib.util
+    from pathlib import Path
+
+    spec = importlib.util.spec_from_file_location("paper_values", Path(__file__).parent / "paper_values.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def pytest_generate_tests(metafunc):
+    """``pv``: tests/paper_values.py (the paper-cell checks of tests/*/test_*_paper.py)."""
+    if "pv" in metafunc.fixturenames:
+        metafunc.parametrize("pv", [_paper_values_module()], ids=["paper_values"])

@@ -22,6 +22,13 @@ from fractions import Fraction
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.snu.paper import (
+    PAPER_MFLOPS,
+    PAPER_TABLE1,
+    PAPER_TEXT_COUNTS,
+    PAPER_TOTAL_CLOCKS,
+    PAPER_TOTAL_OPS,
+)
 
 __all__ = [
     "CLOCK_HZ",
@@ -42,41 +49,7 @@ STAGES = ("vertex_transform", "normal_transform", "normalise", "light", "clip",
           "perspective_divide", "screen_map")
 OP_KINDS = ("mul", "add", "cmp", "div", "sqrt", "lookup", "cvt")
 
-#: Table 1 of the paper, per triangle: operations, i860 clocks, percent of clocks.
-PAPER_TABLE1: dict[str, dict[str, float]] = {
-    "vertex_transform": {"ops": 72, "clocks": 60, "percent": 19.4},
-    "normal_transform": {"ops": 45, "clocks": 39, "percent": 12.6},
-    "normalise": {"ops": 30, "clocks": 81, "percent": 26.2},
-    "light": {"ops": 72, "clocks": 60, "percent": 19.4},
-    "clip": {"ops": 24, "clocks": 24, "percent": 7.8},
-    "perspective_divide": {"ops": 12, "clocks": 18, "percent": 5.8},
-    "screen_map": {"ops": 15, "clocks": 27, "percent": 8.7},
-}
-PAPER_TOTAL_OPS = 270
-PAPER_TOTAL_CLOCKS = 309
-#: The paper's Mflops for 100,000 polygons/s (text 4.2.1-4.2.5); clip is 1.8 in the text
-#: (18 compares), although table 1 has 24 operations.
-PAPER_MFLOPS = {"vertex_transform": 7.2, "normal_transform": 4.5, "normalise": 3.0, "light": 7.2,
-                "clip": 1.8, "perspective_divide": 1.2, "screen_map": 1.5}
-
-#: Per-vertex operation mix the paper's text gives (x3 per triangle). ``div`` is a reciprocal.
-#: The paper counts 1/sqrt as "2 real operations" (sqrt + reciprocal).
-PAPER_TEXT_COUNTS: dict[str, dict[str, int]] = {
-    # 4x4 matrix with w fixed at 1.0: 12 mul + 12 add
-    "vertex_transform": {"mul": 12, "add": 12},
-    # 3x3 matrix: 9 mul + 6 add
-    "normal_transform": {"mul": 9, "add": 6},
-    # sum of squares 3 mul + 2 add; 1 sqrt + 1 reciprocal; scale 3 mul
-    "normalise": {"mul": 6, "add": 2, "sqrt": 1, "div": 1},
-    # 12 mul, 10 add, 3 compares, 1 memory reference (exponent lookup)
-    "light": {"mul": 12, "add": 10, "cmp": 3, "lookup": 1},
-    # 6 compares per vertex against the view volume
-    "clip": {"cmp": 6},
-    # reciprocal of w, 3 multiplies
-    "perspective_divide": {"div": 1, "mul": 3},
-    # 3 mul (x1280, y1024, z 2^24) + 2 add (z flip, y flip)
-    "screen_map": {"mul": 3, "add": 2},
-}
+# table 1, its totals and the text's Mflops: golden_model/snu/paper.py (quotes and locations there)
 
 #: i860 clock frequency assumed for polygons/s. The paper never states it (the i860 XR came
 #: at 25, 33 and 40 MHz); 40 MHz is consistent with its "8 ops per pixel, 80 MOPS for
@@ -224,23 +197,30 @@ def table1_rows(recipe_counts: dict, full_counts: dict | None = None, model: dic
                 PAPER_TABLE1[s]["clocks"], None, float(compiler[s]["clocks"]), "clocks", source=src)
         row(f"{s}: share of clocks (i860 model, assembler schedule)", PAPER_TABLE1[s]["percent"], None,
             100 * clk[s] / total, "%", source=src)
-    row("total i860 clocks per triangle (i860 model, assembler schedule, one triangle per stage)",
+    row("total i860 clocks per triangle (i860 model, assembler schedule, scheduling window 1 triangle: each stage "
+        "scheduled for one triangle, as table 1 reads 'the clocks one polygon takes on the i860'; the default)",
         PAPER_TOTAL_CLOCKS, None, total, "clocks", source=src)
+    diff = {s: clk[s] - PAPER_TABLE1[s]["clocks"] for s in STAGES}
+    row("per-stage absolute error, sum over the seven stages of |model - paper| (assembler schedule, scheduling "
+        "window 1 triangle)", None, None, float(sum(abs(v) for v in diff.values())), "clocks", source=src)
+    row("net total error, model total - paper total (assembler schedule, scheduling window 1 triangle; stage "
+        "errors of both signs cancel in it)", None, None, float(sum(diff.values())), "clocks", source=src)
     if compiler is not None:
         row("total i860 clocks per triangle (i860 model, compiler schedule, one triangle per stage)",
             PAPER_TOTAL_CLOCKS, None, float(sum(compiler[s]["clocks"] for s in STAGES)), "clocks", source=src)
     if model["total"].get("stream") is not None:
-        row("total i860 clocks per triangle (i860 model, assembler schedule, 8 triangles scheduled together)",
-            PAPER_TOTAL_CLOCKS, None, float(model["total"]["stream"]), "clocks", source=src)
+        row("total i860 clocks per triangle (i860 model, assembler schedule, scheduling window 8 triangles "
+            "scheduled together; the paper states no window)", PAPER_TOTAL_CLOCKS, None,
+            float(model["total"]["stream"]), "clocks", source=src)
     paper_bal = balance({s: PAPER_TABLE1[s]["clocks"] for s in STAGES}, clock_hz=clock_hz)
     m_bal = balance(clk, clock_hz=clock_hz)
     for g in GROUPS:
-        # The paper prints no group sums; "paper" is the sum of its own table 1 clocks.
-        row(f"{g}: clocks per triangle (paper = sum of table 1; assembler schedule)", paper_bal["groups"][g], None,
-            m_bal["groups"][g], "clocks", figure="text 4.5", source=src)
-    row(f"polygons/s per 3-processor pipeline at {clock_hz / 1e6:g} MHz (assumed clock; paper = its table; "
-        "assembler schedule)", paper_bal["polys_per_s_pipeline"], None, m_bal["polys_per_s_pipeline"],
-        "polygons/s", figure="text 4.5", source=src)
+        # The paper prints no group sums: the sum of its own table 1 clocks is a formula, derived
+        row(f"{g}: clocks per triangle (formula = sum of the paper's table 1 clocks, derived; assembler schedule)",
+            None, paper_bal["groups"][g], m_bal["groups"][g], "clocks", figure="text 4.5", source=src)
+    row(f"polygons/s per 3-processor pipeline at {clock_hz / 1e6:g} MHz (assumed clock; formula = the paper's "
+        "table 1 clocks, derived; assembler schedule)", None, paper_bal["polys_per_s_pipeline"],
+        m_bal["polys_per_s_pipeline"], "polygons/s", figure="text 4.5", source=src)
     row("geometry-bound polygons/s, 2 pipelines of 3 i860s (paper: 100 K target; assembler schedule)", 100_000,
         None, m_bal["polys_per_s_system"], "polygons/s", figure="abstract", source=src)
     return rows

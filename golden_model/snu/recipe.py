@@ -60,17 +60,18 @@ from rasterhw.golden_model.pipeline import (
 )
 from rasterhw.golden_model.scene import Scene
 from rasterhw.golden_model.screen import ScreenTriangles
+from rasterhw.golden_model.snu.paper import PAPER_TEXT_COUNTS
 
-__all__ = ["LUT_BITS", "PAPER_TEXT_PER_TRIANGLE", "TABLE1_STAGES", "npc_matrix", "ops_per_triangle",
+__all__ = ["LUT_BITS", "TEXT_PER_TRIANGLE", "TABLE1_STAGES", "npc_matrix", "ops_per_triangle",
            "run_geometry_paper", "light_paper", "compare_with_full"]
 
 #: Table 1's stages in its order.
 TABLE1_STAGES = ("vertex_transform", "normal_transform", "normalise", "light", "clip",
                  "perspective_divide", "screen_map")
-#: The per-triangle numbers the paper's *text* gives (4.2.1-4.2.5); table 1 prints 72 for
-#: lighting and 24 for clipping instead (same 270 total).
-PAPER_TEXT_PER_TRIANGLE = {"vertex_transform": 72, "normal_transform": 45, "normalise": 30, "light": 78,
-                           "clip": 18, "perspective_divide": 12, "screen_map": 15}
+#: The per-triangle numbers the paper's *text* gives (4.2.1-4.2.5): its per-vertex mix
+#: (``paper.PAPER_TEXT_COUNTS``) x 3; table 1 prints 72 for lighting and 24 for clipping instead
+#: (same 270 total).
+TEXT_PER_TRIANGLE = {s: 3 * sum(PAPER_TEXT_COUNTS[s].values()) for s in TABLE1_STAGES}
 #: The exponent table has 2**LUT_BITS entries per unit of (d + n_z) over [-2, 2].
 LUT_BITS = 9
 _LUT_OFFSET = 2.0  # (d + n_z) >= -2: the offset is folded into the magic constant

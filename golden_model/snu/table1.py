@@ -5,23 +5,17 @@ never reads it."""
 from __future__ import annotations
 
 from rasterhw.golden_model.opcount import CATEGORIES
+from rasterhw.golden_model.snu.paper import PAPER_TABLE1
 from rasterhw.golden_model.triangle_ops import ops_per_triangle
 
-__all__ = ["PAPER_PER_VERTEX_TEXT", "PAPER_TABLE1", "paper_comparison"]
+__all__ = ["PER_VERTEX_TEXT", "TABLE1", "paper_comparison"]
 
-#: The paper's table 1 (seed 004, "표 1"): stage -> (operations per triangle, i860 clocks).
-PAPER_TABLE1: dict[str, tuple[int, int]] = {
-    "vertex_transform": (72, 60),
-    "normal_transform": (45, 39),
-    "normalise": (30, 81),
-    "light": (72, 60),
-    "clip": (24, 24),
-    "perspective_divide": (12, 18),
-    "screen_map": (15, 27),
-}
+#: The paper's table 1 (seed 004, "표 1"): stage -> (operations per triangle, i860 clocks), from
+#: :data:`rasterhw.golden_model.snu.paper.PAPER_TABLE1`.
+TABLE1: dict[str, tuple[int, int]] = {s: (int(v["ops"]), int(v["clocks"])) for s, v in PAPER_TABLE1.items()}
 
 #: What the paper's text (section 4.2.1-4.2.5) says each stage does per vertex.
-PAPER_PER_VERTEX_TEXT: dict[str, str] = {
+PER_VERTEX_TEXT: dict[str, str] = {
     "vertex_transform": "4x4 matrix, w fixed at 1.0: 12 mul + 12 add",
     "normal_transform": "3x3 matrix: 9 mul + 6 add",
     "normalise": "3 mul + 2 add (sum of squares), 1 sqrt + 1 recip (counted as 2), 3 mul",
@@ -41,8 +35,8 @@ def paper_comparison(
     for stage, c in counts.items():
         if stage == "total":
             continue
-        paper = PAPER_TABLE1.get(stage, (None, None))[0]
+        paper = TABLE1.get(stage, (None, None))[0]
         parts = " + ".join(f"{c[k]} {k}" for k in CATEGORIES if c[k])
         rows.append((stage, paper, c["total"], parts or "0"))
-    rows.append(("total", sum(v[0] for v in PAPER_TABLE1.values()), counts["total"]["total"], ""))
+    rows.append(("total", sum(v[0] for v in TABLE1.values()), counts["total"]["total"], ""))
     return rows

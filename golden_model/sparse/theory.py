@@ -32,6 +32,9 @@ import math
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.golden_model.sparse.paper import (
+    PAPER_S_K,  # the crossing areas S_1..S_4, with the quote
+)
 
 __all__ = [
     "L_RECT_5_1",
@@ -51,8 +54,6 @@ __all__ = [
     "windows",
 ]
 
-#: the paper's crossing areas S_1..S_4 (text after formula (4))
-PAPER_S_K = (0.0, 1.8, 23.3, 157.0)
 
 
 def shape_coefficient(perimeter: float, area: float) -> float:

@@ -39,18 +39,23 @@ from rasterhw.golden_model.fastpath import FastPath
 from rasterhw.golden_model.sparse.cycles import KE_EDGES, _check_int
 from rasterhw.golden_model.sparse.stack import param_cycles
 
-__all__ = ["ENGINE_ENV", "HDL_FIFO_DEPTH", "PAPER_FIFO_DEPTH", "VPCycleModel", "choose_engine", "coupled_matrix_vp", "vp_standalone",
+__all__ = ["ENGINE_ENV", "HDL_FIFO_DEPTH", "SHALLOW_FIFO_DEPTH", "VPCycleModel", "choose_engine", "coupled_matrix_vp", "vp_standalone",
            "vp_streams"]
 
-#: ``VideoProcessor(fifo_depth=8)``, the default every driver builds (ours: eight-entry FIFOs between
-#: the levels, a queue of windows inside the processor)
+#: ``VideoProcessor(fifo_depth=8)``: eight-entry FIFOs between the levels (ours: a queue of windows
+#: inside the processor), the default every driver builds, the coupled matrix's too. The paper gives
+#: no buffer size: it asks only for a "sufficient" input FIFO ("при малой размерности матрицы и
+#: достаточном объеме FIFO") and refers the micro-pipeline to its reference [3] ("Такой микроконвейер
+#: подробно описан и исследован в [3]"). Eight is the depth at which the processor reproduces the
+#: paper's formulas (9) and (10): its frame comes within a few per cent of its busiest stage's time
+#: and its load equals (10) on its own window counts; with two-entry buffers the frame runs 17-44 %
+#: above the busiest stage (measured: ``rasterhw report sparse``, rows "(9) / (10), HDL frame
+#: time"; docs/sparse.md#the-inner-buffer-depth).
 HDL_FIFO_DEPTH = 8
 
-#: the coupled matrix's default, the paper's processor: "Память типа FIFO на входе хранит очередь
-#: описаний геометрических примитивов" / "Описания определяют очереди на входах растровых процессоров"
-#: -- the queue of primitives is the input FIFO; between the micro-pipeline's stages (set-up, levels)
-#: the smallest buffer Amaranth's buffered FIFO takes, two entries (the sizes are not in the paper)
-PAPER_FIFO_DEPTH = 2
+#: the shallowest inner buffer Amaranth's buffered FIFO takes, two entries (ours, a comparison
+#: point: ``rasterhw sim sparse --vp-fifo-depth 2``)
+SHALLOW_FIFO_DEPTH = 2
 
 #: Environment variable choosing the engine of :func:`coupled_matrix_vp` and :func:`vp_standalone`
 #: when a call does not: ``python`` (this module's code, the specification), ``numba`` (the compiled

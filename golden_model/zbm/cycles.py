@@ -50,16 +50,16 @@ from rasterhw.golden_model.zbm.formats import (
     check_interleave,
     paper_lead,
 )
+from rasterhw.golden_model.zbm.paper import PAPER_CLOCK_HZ, PAPER_LEN_CHIP
+
+# table 1 (K polygons/s per unit) and its "average segment length per ZB/M": the paper's, with quotes
+from rasterhw.golden_model.zbm.paper import PAPER_KPOLYS as PAPER_TABLE1_KPOLYS
 
 __all__ = ["PAPER_TABLE1_KPOLYS", "PAPER_LEN_CHIP", "len_chip", "formula_cycles_per_edge_pair",
            "formula_polygons_per_s", "paper_table1", "event_cycles", "paper_workload", "hdl_cycles",
            "FIFO_LATENCY", "SCHEDULES", "paper_lead", "check_schedule"]
 
-#: Table 1 of the paper, K polygons/s per unit, by interleave.
-PAPER_TABLE1_KPOLYS = {1: 84.5, 2: 97.7, 4: 105.9, 8: 115.8, 16: 115.8}
-#: The paper's "average segment length per ZB/M" by interleave.
-PAPER_LEN_CHIP = {1: 5, 2: 3, 4: 2, 8: 1, 16: 1}
-CLOCK_HZ = 25e6
+CLOCK_HZ = PAPER_CLOCK_HZ  # condition 3 (golden_model/zbm/paper.py)
 
 
 def len_chip(seg_len: int, interleave: int) -> int:

@@ -26,11 +26,13 @@ from __future__ import annotations
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.i860 import I860, Program, schedule
+from rasterhw.golden_model.i860.cache import DataCache
+from rasterhw.golden_model.zbm.paper import PAPER_I860_CLOCK_HZ
 
-__all__ = ["CLOCK_HZ", "STAGES", "polygon_clocks", "stage_clocks", "stage_program"]
+__all__ = ["CLOCK_HZ", "STAGES", "polygon_cache", "polygon_clocks", "record_bytes", "stage_clocks", "stage_program"]
 
 #: seed 003 §6.2: "i860XR 33.3MHz" (the commercial board the paper measured on)
-CLOCK_HZ = 33.3e6
+CLOCK_HZ = PAPER_I860_CLOCK_HZ
 STAGES = ("transform", "perspective", "clip", "setup_triangle", "setup_edge_pair")
 #: attribute channels per mode (``formats.CHANNELS``: colour z r g b a; mapping z um vm ui vi a)
 CHANNELS = {"colour": 5, "mapping": 6}
@@ -132,3 +134,42 @@ def polygon_clocks(*, vertices: float = 3.0, triangles: float = 1.0, edge_pairs:
     asm = sum(stages[s]["assembler" if s in ("transform", "perspective") else "compiler"] for s in stages)
     return {"C": c, "assembler": asm, "per_stage": stages, "clock_hz": cpu.clock_hz,
             "C_polygons_per_s": cpu.clock_hz / c, "assembler_polygons_per_s": cpu.clock_hz / asm}
+
+
+def record_bytes(channels: str = "colour") -> int:
+    """Bytes of one polygon's input record (our golden layout, float32): per vertex x, y, z in object
+    space and the mode's vertex attributes (colour r, g, b, a; mapping um, vm, ui, vi, a)."""
+    if channels not in CHANNELS:
+        raise RasterhwError(f"mode must be one of {tuple(CHANNELS)}, not {channels!r}")
+    return 3 * (3 + CHANNELS[channels] - 1) * 4
+
+
+def polygon_cache(polygons: int, *, channels: str = "colour", edge_pairs: int = 2,
+                  cache: DataCache | None = None) -> dict:
+    """The data cache over one run of ``polygons`` polygons processed one at a time (table 2's
+    5,760 / N): each polygon's input record read from a contiguous array (the records' layout,
+    :func:`record_bytes`), every stage's intermediate values stored to and loaded from one per-polygon
+    scratch area (transformed and projected vertices, gradients: the same addresses for every
+    polygon), the edge pairs' words stored to a contiguous output array. Returns the cache's counts
+    and ``stall_clocks`` (line fills and write-backs at the cache's miss cost) in all and per polygon."""
+    if isinstance(polygons, bool) or not isinstance(polygons, int) or polygons < 1:
+        raise RasterhwError(f"polygons must be a positive integer, not {polygons!r}")
+    c = cache or DataCache()
+    rec = record_bytes(channels)
+    nch = CHANNELS[channels]
+    scratch = 1 << 30   # far from the records and the output
+    out = 2 << 30
+    ep_bytes = (9 + (nch - 5)) * 4
+    s_words = 3 * 4 + 3 * 4 + 2 * nch + 4   # transformed (x y z w), projected, gradients, edge slopes
+    for k in range(polygons):
+        for b in range(0, rec, 4):
+            c.access(k * rec + b)
+        for w in range(s_words):              # stored by one stage ...
+            c.access(scratch + 4 * w, store=True)
+        for w in range(s_words):              # ... loaded by the next
+            c.access(scratch + 4 * w)
+        for b in range(0, edge_pairs * ep_bytes, 4):
+            c.access(out + (k * edge_pairs) * ep_bytes + b, store=True)
+    return {"polygons": polygons, "record_bytes": rec, "hits": c.hits, "misses": c.misses,
+            "writebacks": c.writebacks, "store_misses": c.store_misses, "stall_clocks": c.stall_clocks,
+            "stall_clocks_per_polygon": c.stall_clocks / polygons, "miss_clocks": c.miss_clocks}

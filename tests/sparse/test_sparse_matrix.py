@@ -107,15 +107,15 @@ def test_bad_depths_are_one_line_errors():
         Matrix(n=2, cells="flat")
 
 
-def test_the_default_matrix_is_the_papers_processor_and_its_input_fifo_depth_shows(monkeypatch):
-    """Unset, ``rasterhw sim sparse`` runs the paper's processor (the queue at the input, two-entry
-    buffers between the stages: ``PAPER_FIFO_DEPTH``; the label in the JSON is checked by the colour
-    test's pysim runs) and, on Verilator, a hierarchical build from 4x4 up; with the paper's processor
-    a one-entry input FIFO costs frame cycles on c300 (the golden coupled model, which the HDL equals
-    counter for counter), while ours (eight-entry inner FIFOs) absorbs most of the difference."""
+def test_the_default_matrix_has_eight_entry_inner_fifos_and_its_input_fifo_depth_shows(monkeypatch):
+    """Unset, ``rasterhw sim sparse`` builds eight-entry FIFOs between the levels (``HDL_FIFO_DEPTH``,
+    ours: the paper gives no size) and, on Verilator, a hierarchical build from 4x4 up; with two-entry
+    buffers (``SHALLOW_FIFO_DEPTH``, also ours) a one-entry input FIFO costs frame cycles on c300 (the
+    golden coupled model, which the HDL equals counter for counter), while eight-entry inner FIFOs
+    absorb most of the difference."""
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.sparse.vpcycles import HDL_FIFO_DEPTH, PAPER_FIFO_DEPTH
+    from rasterhw.golden_model.sparse.vpcycles import HDL_FIFO_DEPTH, SHALLOW_FIFO_DEPTH
     from rasterhw.sim.sparse import matrix_run, sim
     from rasterhw.sim.sparse.machine import MACHINE
 
@@ -127,10 +127,10 @@ def test_the_default_matrix_is_the_papers_processor_and_its_input_fifo_depth_sho
         with pytest.raises(ZeroDivisionError):
             sim.simulate("c50", 64, 64, engine="verilator", matrix=m, fifo_depth=64,
                          vp_fifo_depth=opts["vp_fifo_depth"], hierarchical=opts["hierarchical"])
-    assert [(kw["fifo_depth"], kw["hierarchical"]) for kw in seen] == [(PAPER_FIFO_DEPTH, False), (2, True)]
+    assert [(kw["fifo_depth"], kw["hierarchical"]) for kw in seen] == [(HDL_FIFO_DEPTH, False), (HDL_FIFO_DEPTH, True)]
     f = sparse_render(run_geometry(build_scene("c300"), 128, 128), "4x4", depth="fixed", trace=True)
     frame = {(vpd, D): coupled_matrix_vp(f, D, fifo_depth=vpd)["frame_cycles"]
-             for vpd in (PAPER_FIFO_DEPTH, HDL_FIFO_DEPTH) for D in (1, 64)}
+             for vpd in (SHALLOW_FIFO_DEPTH, HDL_FIFO_DEPTH) for D in (1, 64)}
     assert frame[(2, 1)] == 11074 and frame[(2, 64)] == 10721        # +3.3 %
     assert frame[(8, 1)] == 9982 and frame[(8, 64)] == 9894          # +0.9 %
     assert frame[(2, 1)] / frame[(2, 64)] > frame[(8, 1)] / frame[(8, 64)]

@@ -154,9 +154,10 @@ def test_gp_rate_rows(coupled):
 
 
 def test_coupled_hdl_rows_in_pysim():
-    """The report's whole-matrix HDL rows (pysim: a small frame, 2x2, FIFO depths 1 and 8): every
-    counter equal to the golden coupled cycle model, R_p and Q_p from the HDL's busy cycles beside
-    the formulas, sources hdl:pysim."""
+    """The report's whole-matrix HDL rows (pysim: a small frame, 2x2, FIFO depths 1 and 8, both inner
+    buffer depths): every counter equal to the golden coupled cycle model, R_p and Q_p from HDL frame
+    time and on the measured window counts beside the formulas, sources hdl:pysim; (9) holds more
+    closely with eight-entry inner FIFOs than with two-entry buffers."""
     from rasterhw.sim.sparse.report import _coupled_hdl_rows
 
     rows = []
@@ -168,16 +169,24 @@ def test_coupled_hdl_rows_in_pysim():
     assert sec and all(r["source"] == "hdl:pysim" for r in rows)
     diff = [r for r in rows if "HDL minus the golden" in r["quantity"] or "counters differing" in r["quantity"]
             or "pixels differing" in r["quantity"]]
-    assert len(diff) == 6 and all(r["measured"] == 0 for r in diff)
+    assert len(diff) == 12 and all(r["measured"] == 0 for r in diff)
     peaks = {r["quantity"].split("FIFO depth ")[1].split(" ")[0]: r["measured"] for r in rows
              if "largest FIFO peak" in r["quantity"]}
     assert peaks["1"] == 1 and 1 <= peaks["8"] <= 8
     stall1 = next(r for r in rows if "stall cycles, FIFO depth 1" in r["quantity"])
     assert stall1["measured"] > 0
-    rp = next(r for r in rows if r["quantity"].endswith("k_p/k_e = 0)") and r["figure"] == "(10) / HDL busy")
+    rp = next(r for r in rows if "R_p, (10) on measured window counts" in r["quantity"])
     assert 0 < rp["measured"] <= 1 and 0 < rp["formula"] <= 1
-    qp = next(r for r in rows if r["figure"] == "(12) / HDL busy")
+    qp = next(r for r in rows if r["figure"] == "(12) / HDL counts")
     assert 0 < qp["measured"] <= 1
+    rp_t = [r for r in rows if ": R_p from HDL frame time" in r["quantity"]]
+    qp_t = [r for r in rows if "Q_p from HDL frame time" in r["quantity"]]
+    assert len(rp_t) == 2 and len(qp_t) == 1
+    # time-based load below the count-based one: the frame is longer than the busiest stage's tests
+    assert all(0 < r["measured"] < rp["measured"] for r in rp_t[:1]) and 0 < qp_t[0]["measured"] < qp["measured"]
+    nine = {r["quantity"].split(", ")[3]: r["measured"] for r in rows if r["figure"] == "(9) / HDL frame time"
+            and "FIFO depth 8" in r["quantity"]}
+    assert 1 <= nine["eight-entry inner FIFOs (ours"] < nine["two-entry inner buffers (ours)"]
 
 
 def test_stack_against_pipeline_rows(report):
@@ -223,7 +232,9 @@ def test_stack_matrix_hdl_rows_on_pysim():
         rows.append({"figure": fig, "quantity": qty, **kw})
 
     sec = _stack_matrix_hdl_rows(row, "pysim")
-    assert len(rows) == 8 and all(r["source"] == "hdl:pysim" for r in rows)
+    assert len(rows) == 9 and all(r["source"] == "hdl:pysim" for r in rows)
+    qa = rows.pop()   # Q_a from HDL frame time (the stack matrix against the monoprocessor with a stack)
+    assert "Q_a from HDL frame time" in qa["quantity"] and 0 < qa["measured"] <= 1
     got = {r["quantity"].split(": ", 1)[1]: r["measured"] for r in rows}
     for D in (8, 1):
         pre = f"coupled matrix of HDL stack processors, input FIFO depth {D}: "

@@ -60,13 +60,13 @@ def test_ram_formula_and_paper_candidates():
 
 
 def test_paper_ram_value_is_one_number():
-    """The report's paper value for "49 Kbit" is 49,152 (docs/zbm.md#area), the 96-bit-sample
-    reading of the table above; nothing else in the report says otherwise."""
+    """The report's reading of "49Kbits" is 49,152 bits (docs/zbm.md#area), the 96-bit-sample
+    reading of the table above, a ``formula`` value; the ``paper`` cell keeps 49 Kbits as printed."""
     from rasterhw.sim.zbm import report
 
-    assert report.PAPER_RAM_BITS == 49_152 == 48 * 1024
+    assert report.RAM_BITS_READING == 49_152 == 48 * 1024
     assert {"width": 1024, "interleave": 8, "pixels_per_chip": 128, "sample_bits": 96} in \
-        paper_ram_candidates(report.PAPER_RAM_BITS)
+        paper_ram_candidates(report.RAM_BITS_READING)
 
 
 def test_register_flipflops_counts_named_registers(tmp_path):
