@@ -16,6 +16,7 @@ import json
 import os
 import re
 import shutil
+import threading
 import time
 from pathlib import Path
 
@@ -201,7 +202,7 @@ def _closure_cached(roots: list[Path]) -> list[Path]:
     known[key] = {"files": [str(f) for f in files], "stamps": stamps}
     try:
         _CLOSURES.parent.mkdir(parents=True, exist_ok=True)
-        tmp = _CLOSURES.with_name(f"{_CLOSURES.name}.{os.getpid()}.tmp")
+        tmp = _CLOSURES.with_name(f"{_CLOSURES.name}.{os.getpid()}.{threading.get_ident()}.tmp")
         tmp.write_text(json.dumps(known))
         os.replace(tmp, _CLOSURES)
     except OSError:
