@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import inspect
 from dataclasses import dataclass, field
+from operator import ne
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
@@ -245,7 +246,9 @@ def compare(exp: Expected, got: Run, *, cycle_exact: bool = True) -> dict:
     ports, total = {}, 0
     for p, want in exp.words.items():
         have = got.words.get(p, [])
-        bad = sum(a != b for a, b in zip(want, have, strict=False)) + abs(len(want) - len(have))
+        # equal lists (the usual run) compare in C at once; otherwise count the differing words
+        same = isinstance(want, list) and isinstance(have, list) and want == have
+        bad = 0 if same else sum(map(ne, want, have)) + abs(len(want) - len(have))
         ports[p] = {"words": len(want), "mismatches": bad}
         total += bad
     cyc = None

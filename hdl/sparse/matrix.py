@@ -1,9 +1,9 @@
 """The p x q matrix of video processors: the broadcast into every processor's input FIFO, held
-back by the fullest, and the interleaved read-out."""
+back by the fullest, the interleaved read-out, and the bench's parallel read-out."""
 
 from __future__ import annotations
 
-from amaranth.hdl import ClockSignal, Instance, Module, ResetSignal, Signal
+from amaranth.hdl import Cat, ClockSignal, Instance, Module, Mux, ResetSignal, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import TRI_BITS
@@ -46,6 +46,11 @@ class Matrix(wiring.Component):
     limit : In — run-time input FIFO depth (1..in_depth).
     rd_x, rd_y : In — full-raster pixel to read; rd_z, rd_tri : Out — its depth and triangle one
         cycle later (empty: ``z = 2**z_bits``, ``tri = 2**TRI_BITS - 1``).
+    rd_all, rd_addr : In; rd_words : Out — the bench's parallel read-out (not the paper's video
+        controller, which reads one pixel a clock through ``rd_x``, ``rd_y``): with ``rd_all`` high
+        every processor reads sparse address ``rd_addr`` and ``rd_words`` carries all ``p*q`` words
+        one cycle later, processor ``k = b * p + a`` in lane ``k`` (``{rd_rgb, rd_tri, rd_z}`` of
+        that processor, ``lane_bits`` wide, lane 0 the lowest).
     busy : Out(1) — a record in some FIFO or processor.
     cycles : Out(32) — cycles on which ``i.valid`` or ``busy`` was high (the frame, for a source
         that offers from its first cycle with no gaps).
@@ -76,6 +81,8 @@ class Matrix(wiring.Component):
                  "stat_cell": In(range(max(p * q, 2))), "stat_sel": In(range(len(cell_stats(n)))), "stat": Out(32)}
         if colour:
             ports["rd_rgb"] = Out(24)
+        self.lane_bits = z_bits + 1 + TRI_BITS + (24 if colour else 0)
+        ports.update({"rd_all": In(1), "rd_addr": In(2 * n), "rd_words": Out(p * q * self.lane_bits)})
         super().__init__(ports)
 
     def elaborate(self, platform):
@@ -85,7 +92,7 @@ class Matrix(wiring.Component):
         P = p * q
         push = Signal()
         addr = Signal(2 * n)
-        m.d.comb += addr.eq((self.rd_y[lq:] << n) | self.rd_x[lp:])
+        m.d.comb += addr.eq(Mux(self.rd_all, self.rd_addr, (self.rd_y[lq:] << n) | self.rd_x[lp:]))
         ports = []
         for k in range(P):
             c = {"room": Signal(name=f"room{k}"), "busy": Signal(name=f"busy{k}"),
@@ -124,6 +131,9 @@ class Matrix(wiring.Component):
                     m.d.comb += [self.rd_z.eq(c["rd_z"]), self.rd_tri.eq(c["rd_tri"])]
                     if self._colour:
                         m.d.comb += self.rd_rgb.eq(c["rd_rgb"])
+        # the parallel read-out: every processor's word of rd_addr, side by side
+        m.d.comb += self.rd_words.eq(Cat(*(Cat(c["rd_z"], c["rd_tri"], *([c["rd_rgb"]] if self._colour else []))
+                                           for c in ports)))
         with m.Switch(self.stat_cell):
             for k, c in enumerate(ports):
                 with m.Case(k):

@@ -5,8 +5,9 @@ with separate clocks, each domain by its own bit of a ``clocks`` port that the m
 domain's schedule: one build for every set of half periods and phases), built once
 per design and memory depth with the one C++ main (``cocotb_tests/plain_main.cpp``), the stimulus
 loaded at run time (``$fread`` of each port's packed ``{gap, word}`` records, :mod:`packed`: no
-Python int or text line per word) and the words and cycle stamps dumped at the end
-(``$writememh``)."""
+Python int or text line per word) and the words and cycle stamps dumped at the end in binary
+(``$fwrite`` ``"%u"`` with ``+dump_bin=1``, read with ``np.fromfile``; the cocotb engines, Icarus
+among them, keep the ``$writememh`` text)."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ import json
 import os
 import re
 import shutil
+import threading
 import time
 from pathlib import Path
 
@@ -167,7 +169,46 @@ def bench_sources(tb: Testbench) -> list[Path]:
     values and speed Verilog), each with every module of ours it imports, transitively
     (``verilog_cache.module_sources``: the same rule as the block's)."""
     roots = [Path(__file__)] + [f for c in type(tb).__mro__ if (f := _class_file(c)) is not None]
-    return module_sources(roots)
+    return _closure_cached(roots)
+
+
+#: the transitive sources of each set of roots, with every file's and folder's (mtime, size) when found
+_CLOSURES = BUILD_ROOT / "bench-sources.json"
+
+
+def _stamp(f: Path) -> list[int]:
+    st = f.stat()
+    return [st.st_mtime_ns, st.st_size]
+
+
+def _closure_cached(roots: list[Path]) -> list[Path]:
+    """:func:`module_sources` of ``roots``, kept in ``build/bench-sources.json`` (parsing ~50 modules
+    for their imports cost ~0.3 CPU-s a run): reused while no file of the closure and no folder
+    holding one has changed (a file edited, added or removed there changes its stamp), else found
+    again. The closure depends only on those files' text and on which modules exist."""
+    key = "|".join(str(Path(r).resolve()) for r in roots)
+    try:
+        known = json.loads(_CLOSURES.read_text())
+    except (OSError, ValueError):
+        known = {}
+    hit = known.get(key)
+    if hit is not None:
+        try:
+            if all(_stamp(Path(f)) == st for f, st in hit["stamps"].items()):
+                return [Path(f) for f in hit["files"]]
+        except OSError:
+            pass
+    files = module_sources(roots)
+    stamps = {str(f): _stamp(f) for f in files} | {str(d): _stamp(d) for d in {f.parent for f in files}}
+    known[key] = {"files": [str(f) for f in files], "stamps": stamps}
+    try:
+        _CLOSURES.parent.mkdir(parents=True, exist_ok=True)
+        tmp = _CLOSURES.with_name(f"{_CLOSURES.name}.{os.getpid()}.{threading.get_ident()}.tmp")
+        tmp.write_text(json.dumps(known))
+        os.replace(tmp, _CLOSURES)
+    except OSError:
+        pass   # a read-only cache: found again next time
+    return files
 
 
 def _class_file(cls) -> Path | None:
@@ -362,11 +403,15 @@ def _run_exe(exe: Path, tb: Testbench, params: dict, stim: Stimulus, *, stall: i
              dut=None, clocks: dict | None = None):
     """One run of a bench binary: (words, stamps, the main's JSON line, cycles)."""
     run_dir = temp_run_folder(exe.parent.parent)
+    dut = tb.dut(params) if dut is None else dut
     try:
         plus = stream_plusargs(run_dir, tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
                                inputs=inputs, dut=dut, clocks=clocks)
-        meta = run_plain_verilator(exe, plus, run_dir=run_dir, maxcyc=max_cycles, profile=profile)
-        words, stamps = collected(run_dir, tb.outputs_of(params), expect_words)
+        meta = run_plain_verilator(exe, plus + ["+dump_bin=1"], run_dir=run_dir, maxcyc=max_cycles,
+                                   profile=profile)
+        outs = tb.outputs_of(params)
+        words, stamps = collected(run_dir, outs, expect_words,
+                                  widths={n: len(_payload(port_of(dut, n))) for n in outs})
     finally:
         release(run_dir)
     return words, stamps, meta, max((s[-1] + 1 for s in stamps.values() if s), default=0)
@@ -399,14 +444,32 @@ def stream_plusargs(run_dir: Path, tb: Testbench, params: dict, stim: Stimulus, 
     return plus + [f"+clock_{k}={c.half},{after + c.first}" for k, c in enumerate((clocks or {}).values())]
 
 
-def collected(run_dir: Path, outs, expect_words: dict[str, int]) -> tuple[dict[str, list[int]], dict[str, list[int]]]:
-    """(words, stamps) per output port from the sinks' dumps in ``run_dir``."""
+def collected(run_dir: Path, outs, expect_words: dict[str, int], widths: dict[str, int] | None = None,
+              ) -> tuple[dict[str, list[int]], dict[str, list[int]]]:
+    """(words, stamps) per output port from the sinks' dumps in ``run_dir``: ``$writememh`` text, or
+    with ``widths`` (``{port: payload bits}``, a run with ``+dump_bin=1``) the binary dumps."""
     words, stamps = {}, {}
     for n in outs:
         t, k = _tag(n), expect_words[n]
-        words[n] = _ints(read_memh(run_dir / f"{t}.out", None))[:k] if k else []
-        stamps[n] = _ints(read_memh(run_dir / f"{t}.cyc", None))[:k] if k else []
+        if widths is not None:
+            words[n] = _binary(run_dir / f"{t}.out", widths[n])[:k] if k else []
+            stamps[n] = _binary(run_dir / f"{t}.cyc", 32)[:k] if k else []
+        else:
+            words[n] = _ints(read_memh(run_dir / f"{t}.out", None))[:k] if k else []
+            stamps[n] = _ints(read_memh(run_dir / f"{t}.cyc", None))[:k] if k else []
     return words, stamps
+
+
+def _binary(path: Path, bits: int) -> list[int]:
+    """A sink's binary dump (``$fwrite`` ``"%u"``: each word little-endian in ``4 * ceil(bits / 32)``
+    bytes) as Python ints; words of up to 64 bits in one NumPy pass."""
+    size = 4 * -(-bits // 32)
+    raw = np.fromfile(path, np.uint8)
+    if raw.size % size:
+        raise RasterhwError(f"{path}: {raw.size} bytes, not whole {size}-byte words")
+    if size <= 8:
+        return raw.view("<u4" if size == 4 else "<u8").tolist()
+    return [int.from_bytes(row.tobytes(), "little") for row in raw.reshape(-1, size)]
 
 
 def _extra(dut) -> str:

@@ -7,8 +7,9 @@ The engine runs the testbench
 generated once as the Verilog module ``sparse_cell`` and the matrix instantiates it ``p*q`` times
 by name, so the Verilog holds one processor module whatever the matrix size; the run's input FIFO
 limit rides in a config word before the records (one build serves every depth); the records are
-offered on every clock from the first; the full raster, the frame and stall counters and every
-cell's counters stream out. On pysim every cell is elaborated (``MatrixFrameBench("inline")``).
+offered on every clock from the first; the full raster (every processor's memory read in
+parallel: one word per processor per clock, ``MatrixFrameBench(readout="wide")``), the frame and
+stall counters and every cell's counters stream out. On pysim every cell is elaborated (``MatrixFrameBench("inline")``).
 """
 
 from __future__ import annotations
@@ -32,7 +33,8 @@ def run_matrix(tris, *, n: int, p: int, q: int, limit: int, z_bits: int = 24, fi
     limit in a config word, the raster and every counter streamed out): ``tri`` / ``zq`` (full
     raster, -1 where empty), ``rgb`` (``(H, W, 3)`` with ``colour``, else None), ``cycles`` (the
     matrix's frame counter), ``stall_cycles``, ``stats`` (counter name -> (p*q,) array),
-    ``run_s``, ``build_s``, ``sim_cycles`` (the bench's clocks, read-out included).
+    ``run_s``, ``build_s``, ``sim_cycles`` (the bench's clocks, read-out included: the frame, then
+    ``2**(2n)`` clocks of parallel read-out and one clock per counter).
     ``engine="verilator"`` instantiates one cell module by name; ``"pysim"`` elaborates every cell.
     ``hierarchical`` (Verilator): the cell verilated and compiled once (``build={"hier": True}``):
     the same model, a much shorter build, a slower clock loop (``docs/sparse.md``)."""
@@ -51,7 +53,7 @@ def run_matrix(tris, *, n: int, p: int, q: int, limit: int, z_bits: int = 24, fi
     if ntri > MAXT:
         raise RasterhwError(f"sparse matrix bench holds at most {MAXT} triangles, not {ntri}")
     W, H = p << n, q << n
-    want = W * H + 2 + p * q * len(cell_stats(n))
+    want = tb.pixel_words(params) + 2 + p * q * len(cell_stats(n))
     maxcyc = 400 * (ntri + 10) * (1 + n) * (1 + 64 // limit) + 4 * W * H + 10_000_000
     # the input memory sized for MAXT records whatever the frame: one build per design
     build = {"depth": MAXT + 2, **({"hier": True} if hierarchical else {})} if engine == "verilator" else None

@@ -242,10 +242,19 @@ class MatrixFrameBench(MatrixBench):
     counters hold for input offered back to back (the frame counts the cycles with a record
     offered or held). ``cells="instance"`` (Verilator only): the matrix instantiates one cell
     module by name, generated once (a 1024 x 1024 frame's cell is 4.6 MB of Verilog, mostly its
-    local memories' initial values); ``"inline"`` elaborates every cell (pysim too)."""
+    local memories' initial values); ``"inline"`` elaborates every cell (pysim too).
 
-    def __init__(self, cells: str = "instance"):
-        self.cells = cells
+    ``readout="wide"`` (default): the raster leaves through the matrix's parallel read-out, one
+    sparse address a clock with every processor's word side by side (``rd_words``: ``2**(2n)``
+    words of ``p*q`` lanes, lane ``k`` processor ``k``'s ``{tri, z}`` or ``{rgb, tri, z}``), so the
+    read-out costs ``1 / (p*q)`` of the raster's pixels in clocks; ``"port"``: through the paper's
+    interleaved read port, one pixel a clock, row-major (the counters follow either way, one a
+    word). :meth:`decode` gives the same full raster from either."""
+
+    def __init__(self, cells: str = "instance", readout: str = "wide"):
+        if readout not in ("wide", "port"):
+            raise ValueError(f"sparse frame bench: readout must be 'wide' or 'port', not {readout!r}")
+        self.cells, self.readout = cells, readout
         #: the Verilator engine's C++ level: a frame is one run of up to millions of clocks
         self.verilator_opt = "-O2"
 
@@ -278,16 +287,60 @@ class MatrixFrameBench(MatrixBench):
             key = {k: kw[k] for k in ("n", "p", "q", "z_bits", "fifo_depth", "in_depth")}
             key.update({k: kw[k] for k, v in _CELL_DEFAULTS.items() if kw[k] != v})
             extra = convert_cached("sparse-matrix", lambda: MatrixCell(**kw), params=key, module=CELL_MODULE)
-        w, h = self.raster(params)
-        xb = (w - 1).bit_length()
+        if self.readout == "wide":
+            nb = 2 * params["n"]
 
-        def address(m, b, addr):
-            m.d.comb += [b.rd_x.eq(addr[:xb]), b.rd_y.eq(addr[xb:])]
+            def address(m, b, addr):
+                m.d.comb += [b.rd_all.eq(1), b.rd_addr.eq(addr[:nb])]
 
-        return ReadOut(mx, words=w * h, address=address, data=_word(params["colour"]),
+            words, data = 1 << nb, (lambda b: b.rd_words)
+        else:
+            w, h = self.raster(params)
+            xb = (w - 1).bit_length()
+
+            def address(m, b, addr):
+                m.d.comb += [b.rd_x.eq(addr[:xb]), b.rd_y.eq(addr[xb:])]
+
+            words, data = w * h, _word(params["colour"])
+        return ReadOut(mx, words=words, address=address, data=data,
                        config={"limit": params["in_depth"]}, tail=("cycles", "stall_cycles"),
                        stats=(params["p"] * params["q"], len(cell_stats(params["n"]))),
                        record_bits=layouts(params["colour"])[0].size, extra=extra)
+
+    def pixel_words(self, params: dict) -> int:
+        """The raster's words on ``o`` (before the counters)."""
+        w, h = self.raster(params)
+        return 1 << (2 * params["n"]) if self.readout == "wide" else w * h
+
+    @staticmethod
+    def _lane_bits(params: dict) -> int:
+        return params["z_bits"] + 1 + TRI_BITS + (24 if params["colour"] else 0)
+
+    def _lanes(self, params: dict, words: list[int]) -> list[int]:
+        """Row-major full-raster words -> the parallel read-out's words: sparse address ``s = v *
+        2**n + u`` carries pixel ``(u p + a, v q + b)`` of every processor ``k = b p + a`` in lane ``k``."""
+        p, q, lb = params["p"], params["q"], self._lane_bits(params)
+        w, h = self.raster(params)
+        rows = [words[y * w:(y + 1) * w] for y in range(h)]
+        out = [0] * (1 << (2 * params["n"]))
+        for k in range(p * q):
+            a, b = k % p, k // p
+            lane = [v for row in rows[b::q] for v in row[a::p]]
+            out = [o | v << (k * lb) for o, v in zip(out, lane, strict=True)]
+        return out
+
+    def _unlanes(self, params: dict, wide: list[int]) -> list[int]:
+        """The inverse of :meth:`_lanes`: the row-major full-raster words."""
+        p, q, lb, n = params["p"], params["q"], self._lane_bits(params), params["n"]
+        w, h = self.raster(params)
+        N, mask = 1 << n, (1 << lb) - 1
+        out = [0] * (w * h)
+        for k in range(p * q):
+            a, b = k % p, k // p
+            sh = k * lb
+            for s, v in enumerate(wide):
+                out[((s >> n) * q + b) * w + (s & (N - 1)) * p + a] = (v >> sh) & mask
+        return out
 
     def frame(self, tris, params: dict, limit: int, what: str = "") -> Stimulus:
         """The words of one frame: the limit, the records of ``tris``, the end word."""
@@ -335,6 +388,8 @@ class MatrixFrameBench(MatrixBench):
         words = _words(g.tri_id, zq, params["z_bits"])
         if params["colour"]:
             words = VPBench.with_rgb(words, colour_rgb8(tris, g.tri_id, params["p"], params["q"]), params["z_bits"])
+        if self.readout == "wide":
+            words = self._lanes(params, words)
         cells = []
         for k in range(params["p"] * params["q"]):
             cells += list(gc["tests"][k]) + list(gc["stalls"][k]) + [gc["writes"][k], gc["busy"][k],
@@ -350,9 +405,10 @@ class MatrixFrameBench(MatrixBench):
         zb = params["z_bits"]
         names = cell_stats(params["n"])
         P = params["p"] * params["q"]
-        if len(words) != w * h + 2 + P * len(names):
-            raise ValueError(f"sparse frame bench: {len(words)} words, expected {w * h + 2 + P * len(names)}")
-        px = words[:w * h]
+        npx = self.pixel_words(params)
+        if len(words) != npx + 2 + P * len(names):
+            raise ValueError(f"sparse frame bench: {len(words)} words, expected {npx + 2 + P * len(names)}")
+        px = self._unlanes(params, words[:npx]) if self.readout == "wide" else words[:npx]
         if params["colour"]:
             sh = TRI_BITS + zb + 1
             rgb_w = np.array([v >> sh for v in px], dtype=np.int64)
@@ -364,9 +420,9 @@ class MatrixFrameBench(MatrixBench):
         zq = low & ((1 << (zb + 1)) - 1)
         empty = tri == (1 << TRI_BITS) - 1
         tri[empty], zq[empty] = -1, -1
-        st = np.array(words[w * h + 2:], dtype=np.int64).reshape(P, len(names))
-        return {"tri": tri.reshape(h, w), "zq": zq.reshape(h, w), "rgb": rgb, "cycles": int(words[w * h]),
-                "stall_cycles": int(words[w * h + 1]), "stats": {nm: st[:, j] for j, nm in enumerate(names)}}
+        st = np.array(words[npx + 2:], dtype=np.int64).reshape(P, len(names))
+        return {"tri": tri.reshape(h, w), "zq": zq.reshape(h, w), "rgb": rgb, "cycles": int(words[npx]),
+                "stall_cycles": int(words[npx + 1]), "stats": {nm: st[:, j] for j, nm in enumerate(names)}}
 
 
 class StackVPBench(VPBench):

@@ -14,9 +14,11 @@ from rasterhw.sim.sparse.testbench import MatrixFrameBench, ProcessorBench
 from rasterhw.sim.testbench import compare
 
 
-@pytest.mark.parametrize(("vp", "colour", "kp", "limit"), [("pipeline", False, 0, 1), ("stack", True, 4, 2)])
-def test_frame_bench_words_and_counters_equal_golden(vp, colour, kp, limit):
-    tb = MatrixFrameBench("inline")
+@pytest.mark.parametrize(("vp", "colour", "kp", "limit", "readout"),
+                         [("pipeline", False, 0, 1, "wide"), ("stack", True, 4, 2, "wide"),
+                          ("pipeline", False, 0, 1, "port"), ("stack", True, 4, 2, "port")])
+def test_frame_bench_words_and_counters_equal_golden(vp, colour, kp, limit, readout):
+    tb = MatrixFrameBench("inline", readout=readout)
     p = tb.params(n=2, p=2, q=2, in_depth=4, vp=vp, colour=colour, kp=kp)
     tris = random_triangles(8, 8, 10, mean_area=10.0, seed=4)
     stim = tb.frame(tris, p, limit)
@@ -24,13 +26,20 @@ def test_frame_bench_words_and_counters_equal_golden(vp, colour, kp, limit):
     want = {"o": len(exp.words["o"])}
     got = run(tb, p, stim, engine="pysim", expect_words=want)
     c = compare(exp, got)
-    assert c["mismatches"] == 0 and c["ports"]["o"]["words"] == 64 + 2 + 4 * 8
+    # the raster: 64 pixels through the port, or 16 sparse addresses of 4 processors each
+    assert c["mismatches"] == 0 and c["ports"]["o"]["words"] == (64 if readout == "port" else 16) + 2 + 4 * 8
     h = tb.decode(p, got.words["o"])
     assert h["stall_cycles"] > 0 and h["stats"]["fifo_peak"].max() == limit
     assert (h["rgb"] is not None) == colour and (h["tri"] >= 0).sum() > 10
     # the counters are compared: the golden model of another limit differs
     other = tb.expect(p, replace(stim, source={**stim.source, "limit": 4}))
     assert compare(other, got)["mismatches"] > 0
+    if readout == "wide":   # the same frame through the port: the same raster, 48 clocks more
+        tp = MatrixFrameBench("inline", readout="port")
+        gp = run(tp, p, stim, engine="pysim", expect_words={"o": 64 + 2 + 4 * 8})
+        hp = tp.decode(p, gp.words["o"])
+        assert (hp["tri"] == h["tri"]).all() and (hp["zq"] == h["zq"]).all() and hp["cycles"] == h["cycles"]
+        assert gp.cycles - got.cycles == 64 - 16
 
 
 def test_processor_bench_words_cycles_and_place_equal_golden():
