@@ -86,6 +86,9 @@ class SimBlock:
     #: keys the driver returns (for its other callers) that repeat a common key of the sim JSON
     #: under another name (``sim/cli/jsonout.py: sim_json`` leaves them out of ``extra``)
     aliases: tuple[str, ...] = ()
+    #: option values with which the run gives no frame image (e.g. ``{"coupled": False}``): ``-o`` is
+    #: refused with them before any work, not after the run
+    no_image: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -138,6 +138,28 @@ def test_sim_output_of_a_block_without_a_frame_is_refused_not_silently_skipped(m
     assert isinstance(r.exception, cli.RasterhwError) and "gives no frame image" in str(r.exception)
 
 
+def test_sim_output_refused_before_any_run_where_the_options_give_no_frame(monkeypatch, tmp_path):
+    """sim sparse --no-coupled gives no frame image: -o is refused before anything is simulated
+    (it simulated for 19 s, then exited 2, before)."""
+    from click.testing import CliRunner
+    from rasterhw.sim import registry
+    from rasterhw.sim.cli import main as cli
+
+    real = registry.load
+
+    def fake_load(ref):
+        if ref == registry.sim_blocks()["sparse"][1].simulate:
+            raise AssertionError("simulated before the -o check")
+        return real(ref)
+
+    monkeypatch.setattr(registry, "load", fake_load)
+    r = CliRunner().invoke(cli.cli, ["sim", "sparse", "--no-coupled", "-o", str(tmp_path / "no" / "x.png"),
+                                     "--json"])
+    assert isinstance(r.exception, cli.RasterhwError), r.exception
+    assert "--no-coupled gives no frame image" in str(r.exception)
+    assert not (tmp_path / "no").exists()
+
+
 def test_failed_demo_leaves_no_empty_folder(tmp_path):
     r = run("demo", "--out", "newout", "--scene", "no-such-scene", cwd=tmp_path)
     assert r.returncode == 2 and "Traceback" not in r.stderr

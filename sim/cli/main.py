@@ -600,6 +600,11 @@ def sim_cmd(block, scene, size, engine, output, waves, trace_start, trace_end, a
     check_window(trace_start, trace_end, waves=waves)   # before any work
     _machine, b = registry.sim_blocks()[block]
     opts = _take_options(block_options, b.options, f"sim {block}")
+    if output is not None and any(opts.get(k) == v for k, v in b.no_image.items()):
+        given = " ".join(f"--{'' if v else 'no-'}{k.replace('_', '-')}" if isinstance(v, bool)
+                         else f"--{k.replace('_', '-')} {v}" for k, v in b.no_image.items())
+        raise RasterhwError(f"sim {block} {given} gives no frame image; -o {output} cannot be written "
+                            "(leave -o out)")
     check_engine(engine)
     if engine != "pysim":
         check_cache()

@@ -56,6 +56,7 @@ MACHINE = Machine(
                    simulate="rasterhw.sim.sparse.sim:simulate", default_scene="c300",
                    options=(_MATRIX, _COUPLED, _FIFO_DEPTH, _VP_FIFO_DEPTH, _VP, _COLOUR, _KP, _HIERARCHICAL),
                    aliases=("frame_cycles",),   # = cycles (the report reads it under this name)
+                   no_image={"coupled": False},   # one processor's run alone: no frame to write
                    bytes_per_pixel=700),),
     report="rasterhw.sim.sparse.report:rows",
     bench="rasterhw.sim.sparse.bench:bench",
