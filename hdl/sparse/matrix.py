@@ -46,8 +46,9 @@ class Matrix(wiring.Component):
     limit : In — run-time input FIFO depth (1..in_depth).
     rd_x, rd_y : In — full-raster pixel to read; rd_z, rd_tri : Out — its depth and triangle one
         cycle later (empty: ``z = 2**z_bits``, ``tri = 2**TRI_BITS - 1``).
-    rd_all, rd_addr : In; rd_words : Out — the bench's parallel read-out (not the paper's video
-        controller, which reads one pixel a clock through ``rd_x``, ``rd_y``): with ``rd_all`` high
+    rd_all, rd_addr : In; rd_words : Out — only with ``wide_read=True``: the bench's parallel
+        read-out (not the paper's video controller, which reads one pixel a clock through ``rd_x``,
+        ``rd_y``; the block as the hardware flow takes it has no such port): with ``rd_all`` high
         every processor reads sparse address ``rd_addr`` and ``rd_words`` carries all ``p*q`` words
         one cycle later, processor ``k = b * p + a`` in lane ``k`` (``{rd_rgb, rd_tri, rd_z}`` of
         that processor, ``lane_bits`` wide, lane 0 the lowest).
@@ -61,7 +62,7 @@ class Matrix(wiring.Component):
 
     def __init__(self, *, n: int, p: int = 2, q: int = 2, alpha: int = 2, beta: int = 2, z_bits: int = 24,
                  fifo_depth: int = 8, in_depth: int = 64, cells: str = "inline", vp: str = "pipeline",
-                 colour: bool = False, kp: int = 0, ke: int = 3):
+                 colour: bool = False, kp: int = 0, ke: int = 3, wide_read: bool = False):
         if cells not in ("inline", "instance"):
             raise ValueError(f"cells must be 'inline' or 'instance', not {cells!r}")
         self._kw = dict(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth,
@@ -82,7 +83,9 @@ class Matrix(wiring.Component):
         if colour:
             ports["rd_rgb"] = Out(24)
         self.lane_bits = z_bits + 1 + TRI_BITS + (24 if colour else 0)
-        ports.update({"rd_all": In(1), "rd_addr": In(2 * n), "rd_words": Out(p * q * self.lane_bits)})
+        self._wide_read = wide_read
+        if wide_read:
+            ports.update({"rd_all": In(1), "rd_addr": In(2 * n), "rd_words": Out(p * q * self.lane_bits)})
         super().__init__(ports)
 
     def elaborate(self, platform):
@@ -92,7 +95,8 @@ class Matrix(wiring.Component):
         P = p * q
         push = Signal()
         addr = Signal(2 * n)
-        m.d.comb += addr.eq(Mux(self.rd_all, self.rd_addr, (self.rd_y[lq:] << n) | self.rd_x[lp:]))
+        port_addr = (self.rd_y[lq:] << n) | self.rd_x[lp:]
+        m.d.comb += addr.eq(Mux(self.rd_all, self.rd_addr, port_addr) if self._wide_read else port_addr)
         ports = []
         for k in range(P):
             c = {"room": Signal(name=f"room{k}"), "busy": Signal(name=f"busy{k}"),
@@ -131,9 +135,9 @@ class Matrix(wiring.Component):
                     m.d.comb += [self.rd_z.eq(c["rd_z"]), self.rd_tri.eq(c["rd_tri"])]
                     if self._colour:
                         m.d.comb += self.rd_rgb.eq(c["rd_rgb"])
-        # the parallel read-out: every processor's word of rd_addr, side by side
-        m.d.comb += self.rd_words.eq(Cat(*(Cat(c["rd_z"], c["rd_tri"], *([c["rd_rgb"]] if self._colour else []))
-                                           for c in ports)))
+        if self._wide_read:   # the bench's parallel read-out: every processor's word of rd_addr, side by side
+            m.d.comb += self.rd_words.eq(Cat(*(Cat(c["rd_z"], c["rd_tri"], *([c["rd_rgb"]] if self._colour else []))
+                                               for c in ports)))
         with m.Switch(self.stat_cell):
             for k, c in enumerate(ports):
                 with m.Case(k):

@@ -508,8 +508,9 @@ class _memory_estimate:
                 need, avail = words[0] * _ELAB_BYTES_PER_WORD, available_bytes()
                 if need > HEADROOM * avail:
                     raise RasterhwError(f"{block}: its memories hold {words[0]:,} words so far; elaborating them "
-                                        f"needs about {format_bytes(need)}, {format_bytes(avail)} is available "
-                                        "(use smaller -p sizes, or a RAM kind the block writes as Verilog)")
+                                        f"needs about {format_bytes(need)}, more memory than there is "
+                                        f"({format_bytes(avail)} available; use smaller -p sizes, or a RAM kind "
+                                        "the block writes as Verilog)")
             orig(obj, *args, shape=shape, depth=depth, **kw)
 
         self.cls, self.orig = cls, orig

@@ -94,7 +94,7 @@ def simulate_tris(tris, matrix="4x4", *, engine: str = "verilator", progress: bo
 
 
 def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_depth: int = 64,
-                     vp_fifo_depth: int = HDL_FIFO_DEPTH, progress: bool = False, vp: str = "pipeline",
+                     vp_fifo_depth: int | None = None, progress: bool = False, vp: str = "pipeline",
                      colour: bool = False, kp: int = 0, hierarchical: bool | None = None) -> dict:
     """The whole matrix in one simulation (``hdl/sparse/matrix.py``): the image against the golden
     model pixel by pixel, and the frame's cycles, broadcast stalls, FIFO peaks and every processor's
@@ -102,7 +102,7 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
     (``golden_model/sparse/vpcycles.py``, ``coupled_matrix_vp``): ``cycle_mismatches`` counts
     the counters that differ. ``fifo_depth``: the input FIFOs' run-time limit (built
     :data:`~rasterhw.sim.sparse.matrix_run.IN_DEPTH` deep); ``vp_fifo_depth``: the FIFOs between
-    the processor's levels (a build parameter): :data:`HDL_FIFO_DEPTH` (8, the default, as the one-processor runs
+    the processor's levels (a build parameter): ``None`` is :data:`HDL_FIFO_DEPTH` (8, as the one-processor runs
     build it: a queue of windows inside the processor) or down to 2 (the paper gives no size; both
     ours; ``"vp_buffers"`` in the JSON says which). ``vp="stack"``: every
     processor the stack-based one (``hdl/sparse/stack_vp.py``), against the golden coupled model on
@@ -122,6 +122,11 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
     n = sparse_geometry(tris.width, tris.height, p, q)
     if engine not in ("pysim", "verilator"):
         raise RasterhwError(f"sparse sim: engine must be 'pysim' or 'verilator', not {engine!r}")
+    if vp == "stack" and vp_fifo_depth is not None:
+        raise RasterhwError("sparse sim: --vp-fifo-depth is the pipeline processor's; the stack processor has no "
+                            "inner FIFOs")
+    if vp_fifo_depth is None:
+        vp_fifo_depth = HDL_FIFO_DEPTH
     if isinstance(vp_fifo_depth, bool) or not isinstance(vp_fifo_depth, int) or not 2 <= vp_fifo_depth <= 64:
         raise RasterhwError(f"sparse sim: --vp-fifo-depth must be an integer in 2..64, not {vp_fifo_depth!r}")
     if vp not in ("pipeline", "stack"):
@@ -134,9 +139,6 @@ def simulate_coupled(tris, matrix="4x4", *, engine: str = "verilator", fifo_dept
         hierarchical = engine == "verilator" and p * q >= HIER_FROM_CELLS
     if not isinstance(hierarchical, bool) or (hierarchical and engine != "verilator"):
         raise RasterhwError("sparse sim: --hierarchical is a flag of the Verilator build")
-    if vp == "stack" and vp_fifo_depth != HDL_FIFO_DEPTH:
-        raise RasterhwError("sparse sim: --vp-fifo-depth is the pipeline processor's; the stack processor has no "
-                            "inner FIFOs")
     in_depth = IN_DEPTH  # one build for every run-time depth
     t0 = time.perf_counter()
     recs = broadcast_records_rgb(tris) if colour else broadcast_records(tris)
@@ -226,8 +228,7 @@ def simulate(scene, width: int, height: int, *, engine: str = "verilator", progr
     sparse_geometry(width, height, p, q)
     tris = run_geometry(scene, width, height)
     if coupled:
-        vpd = HDL_FIFO_DEPTH if vp_fifo_depth is None else vp_fifo_depth
-        return simulate_coupled(tris, (p, q), engine=engine, fifo_depth=fifo_depth, vp_fifo_depth=vpd,
+        return simulate_coupled(tris, (p, q), engine=engine, fifo_depth=fifo_depth, vp_fifo_depth=vp_fifo_depth,
                                 progress=progress, vp=vp, colour=colour, kp=kp, hierarchical=hierarchical)
     if fifo_depth != 64 or vp_fifo_depth is not None or vp != "pipeline" or colour or kp or hierarchical:
         raise RasterhwError("sparse sim: --fifo-depth, --vp-fifo-depth, --vp, --colour, --kp and --hierarchical are "

@@ -280,7 +280,7 @@ class MatrixFrameBench(MatrixBench):
         from rasterhw.sim.engines.verilog_cache import convert_cached
 
         kw = dict(params)
-        mx = Matrix(**kw, cells=self.cells)
+        mx = Matrix(**kw, cells=self.cells, wide_read=self.readout == "wide")
         extra = ""
         if self.cells == "instance":
             # the cell's cache key as the plain bench had it: parameters at their defaults left out
