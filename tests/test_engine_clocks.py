@@ -18,7 +18,7 @@ from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.golden_model.zbm.words import doublez_words
 from rasterhw.sim.engines import run
 from rasterhw.sim.testbench import Clock, Run, clocks_of, compare, find_testbench
-from rasterhw.sim.zbm.scene_run import run_scene
+from rasterhw.sim.zbm.scene import run_scene
 from rasterhw.sim.zbm.testbench import bench_clocks
 from zbm_cocotb.unit_bench import run_unit_bench
 

@@ -12,7 +12,7 @@ from rasterhw.golden_model.scenes import build_scene
 from rasterhw.golden_model.zbm.words import doublez_words, edge_pair_words
 from rasterhw.sim.engines import run
 from rasterhw.sim.testbench import compare, find_testbench
-from rasterhw.sim.zbm.scene_run import PLAIN_BUILD, SPEED_BUILD, run_scene, simulate_zbm
+from rasterhw.sim.zbm.scene import PLAIN_BUILD, SPEED_BUILD, run_scene, simulate
 from rasterhw.sim.zbm.testbench import deal
 
 __all__ = ["bench", "chip_rate", "compare_builds"]
@@ -108,10 +108,10 @@ def bench(*, repeat: int = 11, hdl: bool = True, progress: bool = False) -> list
     # gcc profile trained on c50 here first if this design has none; sim zbm then uses it too)
     builds = compare_builds(run_geometry(build_scene("c300"), 512, 512), width=512, height=512, interleave=8,
                             rounds=5, base=run_geometry(build_scene("c50"), 512, 512))
-    res = simulate_zbm(build_scene("c300"), 512, 512, interleave=8, engine="verilator")
+    res = simulate(build_scene("c300"), 512, 512, interleave=8, engine="verilator")
     chip = chip_rate(interleave=8, engine="cocotb-verilator")
     fast = chip_rate(interleave=8)
-    small = simulate_zbm(build_scene("c50"), 64, 64, interleave=8, engine="pysim")
+    small = simulate(build_scene("c50"), 64, 64, interleave=8, engine="pysim")
     plain, speed = builds["plain"], builds["speed"]
     return [
         {"name": "ZB/M unit, c300 512x512, interleave 8, plain Verilator, build before issue 31 (one module per "

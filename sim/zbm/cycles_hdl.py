@@ -3,7 +3,7 @@ cycle model ``golden_model.zbm.cycles.hdl_cycles`` and the paper's Table 1 formu
 
 :func:`measure_table1` runs the paper's workload (sec. 6.1 cond. 1-2: edge pairs of 5 lines x 5
 pixels, one segment per line, ``zbm.cycles.paper_workload``) through one head unit on any engine
-(the ``zbm-unit`` testbench, ``sim/zbm/scene_run.py: run_scene``), every merge word compared with
+(the ``zbm-unit`` testbench, ``sim/zbm/scene.py: run_scene``), every merge word compared with
 the golden model. The frame is ``table1_width(interleave)`` pixels wide so each chip's merge-bus
 readout of a line (``chip_pixels + 2`` cycles) is shorter than its loop work and the count is the
 segment side's, as in the paper's estimate.
@@ -14,7 +14,7 @@ from __future__ import annotations
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm import cycles as C
 from rasterhw.golden_model.zbm.formats import check_interleave
-from rasterhw.sim.zbm.scene_run import run_units_equal_clocks
+from rasterhw.sim.zbm.scene import run_units_equal_clocks
 
 __all__ = ["measure_table1", "table1_width"]
 

@@ -29,7 +29,7 @@ MACHINE = Machine(
             "zbm-merger": "rasterhw.sim.zbm.blocks:merger",
             "zbm-pixel": "rasterhw.sim.zbm.blocks:pixel"},
     sims=(SimBlock("zbm", "the scene's edge pairs through a ZB/M unit (segment generator + chips) in HDL",
-                   "rasterhw.sim.zbm.scene_run:simulate_zbm", default_scene="c300", options=(_INTERLEAVE, _UNITS, _SCHEDULE)),),
+                   "rasterhw.sim.zbm.scene:simulate", default_scene="c300", options=(_INTERLEAVE, _UNITS, _SCHEDULE)),),
     report="rasterhw.sim.zbm.report:rows",
     bench="rasterhw.sim.zbm.bench:bench",
     soak={"zbm": "rasterhw.sim.zbm.soak:zbm_round"},

@@ -43,7 +43,7 @@ def pixel_rate(interleave: int, *, width: int = 128, height: int = 12,
     (pysim: the ``zbm-unit`` testbench on the generic engine, every merge word compared). One 5 x 5
     edge pair on lines 0-4, lines 5.. empty: per line a chip sends its ``ceil(width / interleave)``
     pixels down the merge bus, one per clock, all chips at once."""
-    from rasterhw.sim.zbm.scene_run import run_units_equal_clocks
+    from rasterhw.sim.zbm.scene import run_units_equal_clocks
 
     eps = C.paper_workload(1, width=width)
     r = run_units_equal_clocks([eps], width=width, height=height, interleave=interleave, engine="pysim",
@@ -76,7 +76,7 @@ def skew(*, interleave: int = 1, offset: int = 2, n_edge_pairs: int = 4, schedul
     where both units are busy: (t(line w0 + 5n - 1) - t(line w0 - 1)) / n, w0 = 5 (n // 2).
     """
     from rasterhw.sim.zbm.cycles_hdl import table1_width
-    from rasterhw.sim.zbm.scene_run import run_units_equal_clocks
+    from rasterhw.sim.zbm.scene import run_units_equal_clocks
 
     n = n_edge_pairs
     width = table1_width(interleave)
@@ -122,7 +122,7 @@ def chain(units: int, *, interleave: int = 1, width: int = 64, height: int = 48,
     ``render_zbm`` word for word. Returns cycles, polygons/s at 25 MHz, the merge-bus occupancy
     (merge words per clock on a slot's link: ``chip_pixels * height / cycles``) and the merge
     bound ``height * (chip_pixels + 2)`` (the bus alone, measured per line by ``pixel_rate``)."""
-    from rasterhw.sim.zbm.scene_run import run_units_equal_clocks
+    from rasterhw.sim.zbm.scene import run_units_equal_clocks
 
     if not (isinstance(units, int) and 1 <= units <= 16):
         raise RasterhwError(f"units must be 1..16, not {units!r}")

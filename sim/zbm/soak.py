@@ -18,7 +18,7 @@ from rasterhw.golden_model.scenes import build_scene
 from rasterhw.golden_model.zbm.stimulus import first_triangles, random_triangles
 from rasterhw.golden_model.zbm.words import doublez_words
 from rasterhw.sim.zbm.edge_check import check_edge_pairs
-from rasterhw.sim.zbm.scene_run import SPEED_BUILD, run_scene
+from rasterhw.sim.zbm.scene import SPEED_BUILD, run_scene
 from rasterhw.sim.zbm.testbench import bench_clocks
 
 __all__ = ["zbm_round"]

@@ -20,7 +20,7 @@ from rasterhw.golden_model.zbm.words import doublez_words
 from rasterhw.sim.engines import verilator
 from rasterhw.sim.engines.verilog_cache import generate_cached
 from rasterhw.sim.testbench import find_testbench
-from rasterhw.sim.zbm.scene_run import SPEED_BUILD, run_scene
+from rasterhw.sim.zbm.scene import SPEED_BUILD, run_scene
 from rasterhw.sim.zbm.testbench import TRAIN_SCENE
 
 pytestmark = pytest.mark.cocotb

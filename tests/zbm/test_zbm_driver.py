@@ -1,4 +1,4 @@
-"""simulate_zbm (sim/zbm/scene_run.py) on a tiny scene in Amaranth pysim, and its input checks."""
+"""ZbmScene (sim/zbm/scene.py) on a tiny scene in Amaranth pysim, and its input checks."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from rasterhw.golden_model.scenes import SCENES, build_scene
 from rasterhw.golden_model.zbm import words as W
 from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.sim.zbm.edge_check import check_edge_pairs
-from rasterhw.sim.zbm.scene_run import simulate_zbm
+from rasterhw.sim.zbm.scene import simulate
 from zbm_cocotb.chip_bench import run_chip_bench
 from zbm_cocotb.unit_bench import run_unit_bench
 
@@ -24,7 +24,7 @@ def _scene():
 
 def test_simulate_zbm_pysim_tiny_frame():
     # 32 x 8 (not 16): pysim runs ~1,000 clocks per line of c300 here; Verilator runs the bigger frames
-    r = simulate_zbm(_scene(), 32, 8, interleave=2, engine="pysim")
+    r = simulate(_scene(), 32, 8, interleave=2, engine="pysim")
     assert r["block"] == "zbm" and r["engine"] == "pysim" and r["units"] == 1
     assert r["pixels_compared"] == 32 * 8 and r["mismatches"] == 0
     assert r["edge_pairs"] > 0 and r["cycles"] > 0 and r["frame_rgb"].shape == (8, 32, 3)
@@ -35,13 +35,13 @@ def test_simulate_zbm_pysim_tiny_frame():
 def test_bad_arguments():
     sc = _scene()
     with pytest.raises(RasterhwError, match="engine"):
-        simulate_zbm(sc, 32, 16, engine="modelsim")
+        simulate(sc, 32, 16, engine="modelsim")
     with pytest.raises(RasterhwError, match="interleave"):
-        simulate_zbm(sc, 32, 16, interleave=3, engine="pysim")
+        simulate(sc, 32, 16, interleave=3, engine="pysim")
     with pytest.raises(RasterhwError, match="units"):
-        simulate_zbm(sc, 32, 16, units=0, engine="pysim")
+        simulate(sc, 32, 16, units=0, engine="pysim")
     with pytest.raises(RasterhwError, match="width"):
-        simulate_zbm(sc, 1024, 16, engine="pysim")
+        simulate(sc, 1024, 16, engine="pysim")
 
 
 def _eps():
@@ -81,7 +81,7 @@ def test_words_round_trip():
 def test_float_tolerance_when_last_triangles_cover_no_pixel():
     """Issue 14 row 1: the highest-numbered triangles of c50 at 16x16 cover no pixel; the
     float-tolerance check must still size its per-triangle table by every edge-pair tag."""
-    res = simulate_zbm(build_scene("c50"), 16, 16, interleave=1, engine="pysim")
+    res = simulate(build_scene("c50"), 16, 16, interleave=1, engine="pysim")
     assert res["mismatches"] == 0 and res["pixels_compared"] == 256
 
 

@@ -1,4 +1,4 @@
-"""The ``zbm-unit`` testbench on the generic Verilator engine (``rasterhw.sim.zbm.scene_run.run_scene``,
+"""The ``zbm-unit`` testbench on the generic Verilator engine (``rasterhw.sim.zbm.scene.run_scene``,
 what ``rasterhw sim zbm --engine verilator``, the bench and the soak run; its speed Verilog) against
 the cocotb unit bench (``run_unit_bench`` with equal, in-phase clocks) and the golden model: the same
 frame bit for bit, the same segment-clock cycle count and per-line log, under random idle gaps and
@@ -13,7 +13,7 @@ from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.golden_model.zbm.words import doublez_words
-from rasterhw.sim.zbm.scene_run import run_scene
+from rasterhw.sim.zbm.scene import run_scene
 from rasterhw.sim.zbm.testbench import unit_watchdog
 from zbm_cocotb.stimfiles import stimulus_depth
 from zbm_cocotb.unit_bench import run_unit_bench

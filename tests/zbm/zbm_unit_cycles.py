@@ -1,7 +1,7 @@
 """A test's own pysim loop of one ZB/M unit (not a user path): the unit's ``cycles`` counter read in
 the first clock with ``lines == height`` (every chip has swapped the last line), the moment the
 exact cycle model ``golden_model.zbm.cycles.hdl_cycles`` counts to; the scene runs and the report
-run the unit on the generic engines (``sim/zbm/scene_run.py``, ``sim/zbm/cycles_hdl.py``)."""
+run the unit on the generic engines (``sim/zbm/scene.py``, ``sim/zbm/cycles_hdl.py``)."""
 
 from __future__ import annotations
 
