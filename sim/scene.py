@@ -87,11 +87,13 @@ class SceneRun:
         return clocks[0].hz if clocks else None
 
     def simulate(self, scene, width: int, height: int, *, engine: str = "verilator", progress: bool = False,
-                 **options) -> dict:
+                 workers: int | None = None, **options) -> dict:
         """The registry's sim-block contract (``registry.SimBlock``): ``scene`` a Scene or a built-in
         name; the keys of ``registry.SIM_KEYS``, ``cycle_mismatches``, ``run_s``, ``build_s``,
         ``sim_cycles``, ``cycles_per_s``, ``wall_s`` (the simulations, for callers other than ``rasterhw sim``, whose
-        JSON measures them once for every machine) and the block's :meth:`result`."""
+        JSON measures them once for every machine), ``golden_wall_s`` (the golden model and the jobs'
+        stimulus), ``hdl_wall_s`` (the simulations, builds included) and the block's :meth:`result`.
+        ``workers``: jobs at once on Verilator (default :attr:`workers`)."""
         t0 = time.perf_counter()
         if engine not in self.engines:
             raise RasterhwError(f"sim {self.block}: engine must be one of {', '.join(self.engines)}, not {engine!r}")
@@ -103,6 +105,7 @@ class SceneRun:
         bar = _Steps(f"{self.block} {engine}", self.steps) if progress else None
         gold = self.golden(scene, width, height, engine=engine, **options)
         jobs = self.jobs(gold, engine=engine, **options)
+        t1 = time.perf_counter()
         if bar is not None:
             bar.next()
 
@@ -115,7 +118,8 @@ class SceneRun:
                 bar.note(f"{job.name}: {done.got.cycles} cycles, {done.cmp['mismatches']} mismatches")
             return done
 
-        done = self._run_all(one, jobs, engine)
+        done = self._run_all(one, jobs, engine, self.workers if workers is None else workers)
+        t2 = time.perf_counter()
         if bar is not None:
             bar.next()
         res = self.result(gold, done, engine=engine, **options)
@@ -131,12 +135,13 @@ class SceneRun:
                "sim_cycles": sum(r.cycles for r in runs)}
         out["mismatches"] = int(out["mismatches"])
         out["cycles_per_s"] = out["sim_cycles"] / out["run_s"] if out["run_s"] > 0 else None
-        out["wall_s"] = time.perf_counter() - t0
+        out.update(golden_wall_s=t1 - t0, hdl_wall_s=t2 - t1, wall_s=time.perf_counter() - t0)
         return out
 
-    def _run_all(self, one, jobs: list[Job], engine: str) -> list[Done]:
+    @staticmethod
+    def _run_all(one, jobs: list[Job], engine: str, workers: int) -> list[Done]:
         """Every job, in order; on Verilator ``workers`` at once after the first (which builds)."""
-        workers = max(1, min(int(self.workers), os.cpu_count() or 1))
+        workers = max(1, min(int(workers), os.cpu_count() or 1))
         if engine != "verilator" or workers == 1 or len(jobs) < 2:
             return [one(j) for j in jobs]
         first = one(jobs[0])

@@ -350,7 +350,7 @@ def test_pixelbus_bank_generates_with_defaults(tmp_path):
 # ------------------------------------------------------------------ row 13
 def test_pixelbus_progress_goes_to_stderr(capsys):
     from rasterhw.golden_model.snu.pixelstream import PixelStream
-    from rasterhw.sim.snu.pixelbus import simulate_pixelbus
+    from rasterhw.sim.snu.scene import simulate_pixelbus
 
     rng = np.random.default_rng(0)
     s = PixelStream(8, 4, rng.integers(0, 32, 20), rng.integers(0, 1 << 24, 20), rng.integers(0, 1 << 24, 20),
@@ -413,7 +413,7 @@ def test_pixelbus_frame_run_folder_is_removed_when_the_run_is_interrupted(monkey
     from rasterhw.golden_model.snu.gouraud import scan_convert
     from rasterhw.sim import workdirs
     from rasterhw.sim.engines import verilator
-    from rasterhw.sim.snu import frame
+    from rasterhw.sim.snu import scene as frame
 
     exe = tmp_path / "model" / "obj_dir" / "Vtb"
     exe.parent.mkdir(parents=True)

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 def bench(*, repeat: int = 11, hdl: bool = True, progress: bool = False) -> list[dict]:
     """Pixel-bus rows: the snu-100px frame as ``rasterhw sim pixelbus --engine verilator`` runs it
-    (plain Verilator, clear + both pipelines' streams + swap, ``sim/snu/frame.py``; only with ``hdl``)."""
+    (plain Verilator, clear + both pipelines' streams + swap, ``sim/snu/scene.py``; only with ``hdl``)."""
     if not hdl:
         return []
     from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.sim.snu.frame import frame_run
+    from rasterhw.sim.snu.scene import frame_run
 
     res = frame_run(build_scene("snu-100px"), 1280, 1024)
     return [

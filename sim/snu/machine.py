@@ -23,7 +23,7 @@ MACHINE = Machine(
     blocks={"pixelbus-bank": "rasterhw.hdl.snu.pixelbus_bank:PixelBusBank",
             "pixelbus": "rasterhw.hdl.snu.pixelbus:PixelBus"},
     sims=(SimBlock("pixelbus", "the scene's Gouraud pixel stream through the pixel-bus HDL (5 banks, 2 pipelines)",
-                   "rasterhw.sim.snu.pixelbus:simulate_scene", default_scene="snu-100px"),),
+                   "rasterhw.sim.snu.scene:simulate", default_scene="snu-100px"),),
     report="rasterhw.sim.snu.report:rows",
     bench="rasterhw.sim.snu.bench:bench",
     soak={"pixelbus": "rasterhw.sim.snu.soak:pixelbus_round"},

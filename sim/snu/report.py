@@ -6,7 +6,7 @@
 * Section 4.1 — traversal bytes and bandwidth from posting snu-100k's structure store.
 * Section 4.3 — Gouraud inner-loop operations per pixel, counted as the scan converter ran.
 * Section 3.2 — pixel-bus rate for scan-line, vertical and random patterns from HDL cycles.
-* Abstract — the snu-100k frame end to end (``sim/snu/frame.py``): pixel bus in HDL on plain
+* Abstract — the snu-100k frame end to end (``sim/snu/scene.py``): pixel bus in HDL on plain
   Verilator with clear and swap, producers' timing from the i860 model.
 """
 
@@ -43,7 +43,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path,
     ran it (the demo), else it is run here (plain Verilator)."""
     if frame is None:
         from rasterhw.golden_model.scenes import build_scene
-        from rasterhw.sim.snu.frame import frame_run
+        from rasterhw.sim.snu.scene import frame_run
 
         frame = frame_run(build_scene(HEADLINE), 1280, 1024, progress=progress, bus_only_bound=True)
     out = golden_rows(HEADLINE, frame=frame) + pixelbus_rows(engine=engine, progress=progress) + frame_rows(frame)
@@ -116,7 +116,7 @@ def golden_rows(scene_name: str = HEADLINE, *, frame: dict | None = None) -> lis
 def pixelbus_rows(*, engine: str, progress: bool) -> list[dict]:
     """Bus rates measured from HDL cycles on synthetic patterns."""
     from rasterhw.golden_model.snu.pixelbus import CLOCK_HZ, pattern_stream, pixels_per_second
-    from rasterhw.sim.snu.pixelbus import simulate_pixelbus
+    from rasterhw.sim.snu.scene import simulate_pixelbus
 
     src = f"hdl:{engine}"
     out = []
@@ -189,7 +189,7 @@ def _model_section() -> list[str]:
             "pipeline (`golden_model/pipeline.py`). i860 clocks: the shared i860 model `golden_model/i860/` "
             "scheduling the stage programs of `golden_model/snu/i860.py` two ways (compiler, assembler); no "
             "parameter is taken from table 1. "
-            "The snu-100k frame: `sim/snu/frame.py` (pixel bus in HDL on plain Verilator, producers' timing "
+            "The snu-100k frame: `sim/snu/scene.py` (pixel bus in HDL on plain Verilator, producers' timing "
             "from the i860 model). See `docs/snu_geometry.md` and `docs/snu.md` for every gap.", ""]
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from rasterhw.golden_model.snu.formats import N_BANKS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
-from rasterhw.sim.snu.pixelbus import simulate_pixelbus
+from rasterhw.sim.snu.scene import simulate_pixelbus
 
 __all__ = ["pixelbus_round"]
 

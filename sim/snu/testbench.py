@@ -171,7 +171,7 @@ class BusBench(Testbench):
 
 
 class FrameBench(BusBench):
-    """``pixelbus`` drawing one whole frame (``sim/snu/frame.py``): CLEAR, the two pipelines'
+    """``pixelbus`` drawing one whole frame (``sim/snu/scene.py``): CLEAR, the two pipelines'
     writes each after its 16-bit producer gap, SWAP, the display buffer out on ``o`` and the
     schedule on ``o_sched`` (:class:`~rasterhw.sim.snu.frame_adapter.FrameAdapter`). Not the
     block's registered testbench (that is :class:`BusBench`); the frame runs it on the engines.
@@ -188,7 +188,7 @@ class FrameBench(BusBench):
     def stimulus_of(self, params: dict, stream: PixelStream, gaps=None, what: str = "", *, schedule=None) -> Stimulus:
         """Each pipeline's writes as ``{end, gap, write}`` words (``gaps``: the producer gaps, the
         first write's counted from the pipelines' release), then the end token; ``schedule``:
-        ``sim/snu/frame.py: golden_schedule`` of the same stream and gaps."""
+        ``sim/snu/scene.py: golden_schedule`` of the same stream and gaps."""
         aw = _addr_bits(params["width"] * params["height"])
         g = np.zeros(len(stream), np.int64) if gaps is None else np.asarray(gaps, dtype=np.int64)
         words = {}

@@ -28,7 +28,7 @@ def bench(*, repeat: int = 5, hdl: bool = True, progress: bool = False) -> list[
                      "note": f"{int(f.tests.sum())} coverage tests, {f.tests.sum() / med / 1e6:.1f} M tests/s "
                              "(NumPy, all processors at once)"})
     if hdl:
-        from rasterhw.sim.sparse.sim import simulate_tris
+        from rasterhw.sim.sparse.scene import simulate_tris
 
         # one processor at a time: the rate of one simulator process, not of two sharing the cores
         r = simulate_tris(tris, "4x4", engine="verilator", progress=progress, workers=1)
@@ -40,7 +40,7 @@ def bench(*, repeat: int = 5, hdl: bool = True, progress: bool = False) -> list[
         rows.append({"name": "sparse-vp verilator c300 4x4: scene run, wall", "value": par["wall_s"], "unit": "s",
                      "note": f"two processors at a time (as rasterhw sim sparse); mismatches {par['mismatches']}"})
         # the whole matrix in one simulation at the paper's 1024 x 1024 (issue 28's target: < 60 s warm)
-        from rasterhw.sim.sparse.sim import simulate_coupled
+        from rasterhw.sim.sparse.scene import simulate_coupled
 
         big = run_geometry(build_scene("c300"), 1024, 1024)
         simulate_coupled(big, "4x4", fifo_depth=64, progress=progress)  # build (cold) or reuse

@@ -53,7 +53,7 @@ MACHINE = Machine(
             "sparse-stack-vp": "rasterhw.hdl.sparse.stack_vp:make_stack_vp"},
     sims=(SimBlock(name="sparse", help="every video processor of the matrix in HDL, interleaved local memories "
                                        "against the bit-accurate golden model",
-                   simulate="rasterhw.sim.sparse.sim:simulate", default_scene="c300",
+                   simulate="rasterhw.sim.sparse.scene:simulate", default_scene="c300",
                    options=(_MATRIX, _COUPLED, _FIFO_DEPTH, _VP_FIFO_DEPTH, _VP, _COLOUR, _KP, _HIERARCHICAL),
                    aliases=("frame_cycles",),   # = cycles (the report reads it under this name)
                    no_image={"coupled": False},   # one processor's run alone: no frame to write

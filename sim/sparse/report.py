@@ -321,7 +321,7 @@ def _hdl_rows(row, engine: str, progress: bool, hdl_scene=None) -> list[str]:
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.reference import random_triangles
     from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.sim.sparse.sim import simulate_tris
+    from rasterhw.sim.sparse.scene import simulate_tris
 
     if engine == "verilator":
         name = hdl_scene or "c300"
@@ -895,7 +895,7 @@ def _stack_matrix_hdl_rows(row, engine: str) -> list[str]:
     from rasterhw.golden_model.sparse.fixed import broadcast_records
     from rasterhw.golden_model.sparse.search import sparse_render
     from rasterhw.golden_model.sparse.stack import stack_processor
-    from rasterhw.sim.sparse.matrix_run import run_matrix
+    from rasterhw.sim.sparse.scene import run_matrix
 
     if engine == "verilator":
         W, p, lab, depths = 512, 4, "c300 512x512, 4x4", (64, 1)
@@ -981,7 +981,7 @@ def _paper_load_rows(row, engine: str, progress: bool) -> list[str]:
     from rasterhw.golden_model.reference import random_triangles
     from rasterhw.golden_model.sparse import cycles as cy
     from rasterhw.golden_model.sparse.search import sparse_render
-    from rasterhw.sim.sparse.sim import simulate_coupled
+    from rasterhw.sim.sparse.scene import simulate_coupled
 
     if engine not in LOAD_RUNS:
         return []
@@ -1088,7 +1088,7 @@ def _coupled_hdl_rows(row, engine: str, progress: bool) -> list[str]:
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.golden_model.sparse import cycles as cy
     from rasterhw.golden_model.sparse.search import sparse_render
-    from rasterhw.sim.sparse.sim import simulate_coupled
+    from rasterhw.sim.sparse.scene import simulate_coupled
 
     if engine == "verilator":
         W, m, depths = 1 << M_BITS, "4x4", (1, 8, 64)

@@ -25,8 +25,7 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.reference import random_triangles
 from rasterhw.golden_model.scenes import build_scene
-from rasterhw.sim.sparse.sim import simulate, simulate_tris
-from rasterhw.sim.sparse.verilator_run import check_processor
+from rasterhw.sim.sparse.scene import check_processor, simulate, simulate_tris
 
 __all__ = ["sparse_round", "sparse_round_ci"]
 

@@ -142,7 +142,7 @@ class MatrixBench(_SparseBench):
 class ProcessorBench(VPBench):
     """One pipeline video processor of the matrix on one frame, as ``rasterhw sim sparse
     --no-coupled`` runs every processor (not registered: the ``sparse-vp`` block on the generic
-    engines, :func:`rasterhw.sim.sparse.verilator_run.run_processor_verilator`).
+    engines, :func:`rasterhw.sim.sparse.scene.run_processor`).
 
     In (``i``): a config word setting the processor's place ``(a, b)`` (run-time inputs: one build
     serves every processor), the broadcast records, the end word. Out (``o``): its local memory
@@ -195,12 +195,14 @@ class ProcessorBench(VPBench):
         a, b = int(rng.integers(0, params["p"])), int(rng.integers(0, params["q"]))
         return self.frame(st.source, params, a, b, what=f"{st.what}, processor ({a}, {b})")
 
-    def expect(self, params: dict, stim: Stimulus) -> Expected:
+    def expect(self, params: dict, stim: Stimulus, g=None) -> Expected:
+        """``g``: the frame's golden search (``sparse_render(..., trace=True)``), made here if not given
+        (a scene's processors share one)."""
         from rasterhw.golden_model.sparse.vpcycles import vp_standalone, vp_streams
 
         tris, a, b = stim.source["tris"], stim.source["a"], stim.source["b"]
         p, q = params["p"], params["q"]
-        g = sparse_render(tris, (p, q), depth="fixed", trace=True)
+        g = sparse_render(tris, (p, q), depth="fixed", trace=True) if g is None else g
         zq = g.depth_words(tris.z_bits)
         k = b * p + a
         m = vp_standalone(*vp_streams(g, k), g.triangles, fifo_depth=params["fifo_depth"], kp=params["kp"],
@@ -231,7 +233,7 @@ _CELL_DEFAULTS = {"alpha": 2, "beta": 2, "vp": "pipeline", "colour": False, "kp"
 
 class MatrixFrameBench(MatrixBench):
     """The whole matrix on one frame as ``rasterhw sim sparse`` runs it (not registered: the
-    ``sparse-matrix`` block on the generic engines, :func:`rasterhw.sim.sparse.matrix_run.run_matrix`).
+    ``sparse-matrix`` block on the generic engines, :func:`rasterhw.sim.sparse.scene.run_matrix`).
 
     In (``i``): a config word setting the input FIFOs' run-time ``limit`` (1 .. ``in_depth``: one
     build serves every depth), the broadcast records, the end word. Out (``o``): the full raster
@@ -378,11 +380,12 @@ class MatrixFrameBench(MatrixBench):
                                    ke=params.get("ke", KE_EDGES))
         return {**gc, "writes": g.stats["writes_per_proc"].tolist(), "records": g.triangles, "frame": g}
 
-    def expect(self, params: dict, stim: Stimulus) -> Expected:
+    def expect(self, params: dict, stim: Stimulus, gc: dict | None = None) -> Expected:
+        """``gc``: :meth:`golden_counters` of ``stim``, made here if not given."""
         from rasterhw.golden_model.sparse.fixed import colour_rgb8
 
         tris = stim.source["tris"]
-        gc = self.golden_counters(params, stim)
+        gc = self.golden_counters(params, stim) if gc is None else gc
         g = gc["frame"]
         zq = g.depth_words(tris.z_bits)
         words = _words(g.tri_id, zq, params["z_bits"])

@@ -1,7 +1,7 @@
 """A test's own pysim loop of the SNU pixel bus (not a user path): every write's acceptance clock,
 which the tests hold to the golden cycle model write by write, and the Python stream checker's log
 of each pipeline port. The scene runs use the block's testbench on the generic engines
-(``sim/snu/pixelbus.py: simulate_pixelbus``)."""
+(``sim/snu/scene.py: simulate_pixelbus``)."""
 
 from __future__ import annotations
 

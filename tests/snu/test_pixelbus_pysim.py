@@ -13,7 +13,7 @@ from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.hdl.snu.pixelbus import PixelBus
 from rasterhw.hdl.snu.pixelbus_bank import Command, PixelBusBank
 from rasterhw.sim.engines.harness import stream_protocol_checker, stream_put
-from rasterhw.sim.snu.pixelbus import simulate_pixelbus
+from rasterhw.sim.snu.scene import simulate_pixelbus
 from snu_pixelbus_pysim import run_pysim
 
 # --- bank ------------------------------------------------------------------------------

@@ -17,7 +17,7 @@ from amaranth.utils import ceil_log2
 from rasterhw.golden_model.snu import pixelbus as g
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.sim.engines import run
-from rasterhw.sim.snu.pixelbus import simulate_pixelbus
+from rasterhw.sim.snu.scene import simulate_pixelbus
 from rasterhw.sim.snu.testbench import frame_of
 from rasterhw.sim.testbench import compare, find_testbench
 from snu_pixelbus_pysim import run_pysim

@@ -1,4 +1,4 @@
-"""The SNU frame end to end (sim/snu/frame.py): producer gaps from the i860 model, the golden
+"""The SNU frame end to end (sim/snu/scene.py): producer gaps from the i860 model, the golden
 schedule, and (marker cocotb: plain Verilator) the pixel-bus HDL drawing a whole frame with
 clear and swap, bit for bit and clock for clock against the golden model."""
 
@@ -16,7 +16,7 @@ from rasterhw.golden_model.scenes import build_scene
 from rasterhw.golden_model.snu import i860
 from rasterhw.golden_model.snu.gouraud import scan_convert, setup_spans
 from rasterhw.golden_model.snu.render import render
-from rasterhw.sim.snu import frame as F
+from rasterhw.sim.snu import scene as F
 
 
 def _tris(name="sp27", w=80, h=64):

@@ -118,7 +118,7 @@ def test_pipeline_vp_colour_bit_exact_and_cycles_as_the_model(matrix, proc, kp, 
 def test_coupled_matrix_with_colour_bit_and_cycle_exact(vp, limit, kp):
     """The whole matrix with surface parameters, either processor: image and colour against the
     golden model, frame, stalls, FIFO peaks, busy cycles and tests against its coupled cycle model."""
-    from rasterhw.sim.sparse.sim import simulate_coupled
+    from rasterhw.sim.sparse.scene import simulate_coupled
 
     tris = random_triangles(16, 16, 12, mean_area=16.0, seed=9)
     r = simulate_coupled(tris, "2x2", engine="pysim", fifo_depth=limit, vp=vp, colour=True, kp=kp)
@@ -140,7 +140,7 @@ def test_coupled_matrix_with_colour_bit_and_cycle_exact(vp, limit, kp):
 def test_colour_options_are_checked():
     from rasterhw.golden_model.errors import RasterhwError
     from rasterhw.hdl.sparse.vp import VideoProcessor
-    from rasterhw.sim.sparse.sim import simulate, simulate_coupled
+    from rasterhw.sim.sparse.scene import simulate, simulate_coupled
 
     tris = random_triangles(16, 16, 4, mean_area=10.0, seed=1)
     for kw in ({"kp": -1}, {"kp": 16}, {"kp": True}, {"colour": 1}):
@@ -156,7 +156,7 @@ def test_colour_options_are_checked():
 def test_verilator_coupled_matrix_colour_and_kp():
     """One small frame on Verilator: the 2x2 matrix of pipeline processors with colour and (5)'s
     k_p = 4: image, colour and every counter equal to the golden model's."""
-    from rasterhw.sim.sparse.sim import simulate_coupled
+    from rasterhw.sim.sparse.scene import simulate_coupled
 
     tris = random_triangles(32, 32, 30, mean_area=40.0, seed=11)
     r = simulate_coupled(tris, "2x2", fifo_depth=2, colour=True, kp=4)
@@ -172,7 +172,7 @@ def test_hierarchical_build_is_the_same_model():
     frame of the test above to the same image, colour, counters and cycles as the flat build
     (which that test builds); it is a build of its own (``tb-sparse-matrix-hier-*``)."""
     from rasterhw.golden_model.errors import RasterhwError
-    from rasterhw.sim.sparse.sim import simulate_coupled
+    from rasterhw.sim.sparse.scene import simulate_coupled
 
     tris = random_triangles(32, 32, 30, mean_area=40.0, seed=11)
     flat = simulate_coupled(tris, "2x2", fifo_depth=2, colour=True, kp=4)

@@ -15,7 +15,7 @@ from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
 def run_matrix_pysim(tris, *, p, q, limit):
     """The matrix's testbench (``MatrixFrameBench``) on the generic pysim engine, input FIFOs built 8 deep."""
     from rasterhw.golden_model.sparse.formats import sparse_geometry
-    from rasterhw.sim.sparse.matrix_run import run_matrix
+    from rasterhw.sim.sparse.scene import run_matrix
 
     n = sparse_geometry(tris.width, tris.height, p, q)
     return run_matrix(tris, n=n, p=p, q=q, limit=limit, z_bits=tris.z_bits, in_depth=8, engine="pysim")
@@ -75,7 +75,7 @@ def test_verilator_matrix_cycle_exact_and_depth_is_run_time():
     its FIFOs never hold more than one record. The design is the one the colour test
     (``test_sparse_colour_hdl.py``) and the soak's CI rounds build -- the matrix with colour and
     (5)'s k_p = 4 -- so the suite compiles it once; the colour is checked too."""
-    from rasterhw.sim.sparse.sim import simulate_coupled
+    from rasterhw.sim.sparse.scene import simulate_coupled
 
     tris = random_triangles(32, 32, 40, mean_area=40.0, seed=7)
     r1 = simulate_coupled(tris, "2x2", fifo_depth=1, colour=True, kp=4)
@@ -93,7 +93,7 @@ def test_verilator_matrix_cycle_exact_and_depth_is_run_time():
 
 def test_bad_depths_are_one_line_errors():
     from rasterhw.golden_model.errors import RasterhwError
-    from rasterhw.sim.sparse.sim import simulate, simulate_coupled
+    from rasterhw.sim.sparse.scene import simulate, simulate_coupled
 
     tris = random_triangles(16, 16, 4, mean_area=10.0, seed=1)
     for kw in ({"fifo_depth": 0}, {"fifo_depth": 65}, {"fifo_depth": 2.5}, {"vp_fifo_depth": 1}):
@@ -116,16 +116,16 @@ def test_the_default_matrix_has_eight_entry_inner_fifos_and_its_input_fifo_depth
     from rasterhw.golden_model.pipeline import run_geometry
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.golden_model.sparse.vpcycles import HDL_FIFO_DEPTH, SHALLOW_FIFO_DEPTH
-    from rasterhw.sim.sparse import matrix_run, sim
+    from rasterhw.sim.sparse import scene
     from rasterhw.sim.sparse.machine import MACHINE
 
     opts = {o.name: o.default for o in MACHINE.sims[0].options}   # what the CLI passes when nothing is given
     assert opts["vp_fifo_depth"] is None and opts["hierarchical"] is None
     seen = []
-    monkeypatch.setattr(matrix_run, "run_matrix", lambda tris, **kw: seen.append(kw) or 1 / 0)
+    monkeypatch.setattr(scene, "matrix_job", lambda tris, **kw: seen.append(kw) or 1 / 0)
     for m in ("2x2", "4x4"):
         with pytest.raises(ZeroDivisionError):
-            sim.simulate("c50", 64, 64, engine="verilator", matrix=m, fifo_depth=64,
+            scene.simulate("c50", 64, 64, engine="verilator", matrix=m, fifo_depth=64,
                          vp_fifo_depth=opts["vp_fifo_depth"], hierarchical=opts["hierarchical"])
     assert [(kw["fifo_depth"], kw["hierarchical"]) for kw in seen] == [(HDL_FIFO_DEPTH, False), (HDL_FIFO_DEPTH, True)]
     f = sparse_render(run_geometry(build_scene("c300"), 128, 128), "4x4", depth="fixed", trace=True)

@@ -71,7 +71,7 @@ def test_coupled_matrix_of_stack_processors_cycle_exact(limit):
     cycle for cycle cycles.coupled_matrix on the stack processors' service times (frame, broadcast
     stalls, FIFO peaks, busy cycles), the frame's end moved only by the last pixels' drain."""
     from rasterhw.golden_model.sparse.cycles import coupled_matrix
-    from rasterhw.sim.sparse.matrix_run import run_matrix
+    from rasterhw.sim.sparse.scene import run_matrix
 
     tris = random_triangles(16, 16, 12, mean_area=16.0, seed=12 + limit)
     f = sparse_render(tris, "2x2", depth="fixed", per_record=True)
@@ -95,7 +95,7 @@ def test_sim_sparse_vp_stack_pysim_and_bad_options():
     """``rasterhw sim sparse --vp stack``: the coupled matrix of stack processors against its golden
     coupled model (cycle_mismatches 0); --vp belongs to the coupled matrix."""
     from rasterhw.golden_model.errors import RasterhwError
-    from rasterhw.sim.sparse.sim import simulate, simulate_coupled
+    from rasterhw.sim.sparse.scene import simulate, simulate_coupled
 
     tris = random_triangles(16, 16, 10, mean_area=16.0, seed=9)
     r = simulate_coupled(tris, "2x2", engine="pysim", fifo_depth=1, vp="stack")

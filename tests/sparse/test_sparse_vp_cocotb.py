@@ -11,7 +11,7 @@ import shutil
 import numpy as np
 import pytest
 from rasterhw.golden_model.reference import random_triangles
-from rasterhw.sim.sparse.verilator_run import check_processor
+from rasterhw.sim.sparse.scene import check_processor
 
 pytestmark = pytest.mark.cocotb
 

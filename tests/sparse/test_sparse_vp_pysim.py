@@ -8,7 +8,7 @@ import pytest
 from rasterhw.golden_model.reference import random_triangles
 from rasterhw.golden_model.sparse.formats import parse_matrix, sparse_geometry
 from rasterhw.golden_model.sparse.search import interleave, sparse_render
-from rasterhw.sim.sparse.verilator_run import run_processor_verilator
+from rasterhw.sim.sparse.scene import run_processor
 
 
 def run_matrix(tris, matrix, *, processors=None) -> dict:
@@ -22,7 +22,7 @@ def run_matrix(tris, matrix, *, processors=None) -> dict:
     loc_z = loc_t.copy()
     per = {}
     for a, b in procs:
-        r = run_processor_verilator(tris, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits, engine="pysim")
+        r = run_processor(tris, n=n, p=p, q=q, a=a, b=b, z_bits=tris.z_bits, engine="pysim")
         loc_t[b, a], loc_z[b, a] = r["tri"], r["zq"]
         per[(a, b)] = r
     out = {"per_processor": per, "local_tri": loc_t, "local_zq": loc_z}

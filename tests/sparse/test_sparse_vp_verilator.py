@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from rasterhw.golden_model.reference import random_triangles
-from rasterhw.sim.sparse.sim import simulate_tris
+from rasterhw.sim.sparse.scene import simulate_tris
 
 
 def test_verilator_matrix_bit_exact():

@@ -112,14 +112,14 @@ def test_model_equals_the_verilator_bench_per_processor():
     """Every processor of the 4 x 4, n = 6 Verilog (the build tests/sparse/test_sparse_vp_verilator.py
     and the soak use: the generic engine's ProcessorBench, one build for every processor): the
     bench's cycle count equals the model's, processor by processor."""
-    from rasterhw.sim.sparse.verilator_run import run_processor_verilator
+    from rasterhw.sim.sparse.scene import run_processor
 
     tris = random_triangles(256, 256, 40, mean_area=1280.0, seed=8)
     f = sparse_render(tris, "4x4", depth="fixed", trace=True)
     got, want = [], []
     for b in range(4):
         for a in range(4):
-            r = run_processor_verilator(tris, n=6, p=4, q=4, a=a, b=b, z_bits=tris.z_bits)
+            r = run_processor(tris, n=6, p=4, q=4, a=a, b=b, z_bits=tris.z_bits)
             m = vp_standalone(*vp_streams(f, b * 4 + a), f.triangles)
             got.append((r["cycles"], list(r["tests"]), list(r["stalls"])))
             want.append((m["cycles"], m["tests"], m["stalls"]))
