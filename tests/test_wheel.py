@@ -32,7 +32,7 @@ def test_the_wheel_carries_benches_and_templates_and_nothing_of_the_checkout(whe
     names = zipfile.ZipFile(wheel).namelist()
     for need in ("rasterhw/cocotb_tests/harness.v", "rasterhw/cocotb_tests/plain_main.cpp",
                  "rasterhw/cocotb_tests/xorshift.vh", "rasterhw/sim/report/templates/index.html.j2",
-                 "rasterhw/sim/vzbuf/paper_tables.csv"):
+                 "rasterhw/golden_model/vzbuf/paper_tables.csv"):
         assert need in names, need
     # every scene run's bench top is generated (sim/engines/verilator.py): the ZB/M cocotb cross-check
     # of the engines is a test (tests/zbm_cocotb/), not in the wheel

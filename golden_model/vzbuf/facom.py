@@ -6,7 +6,7 @@ Every parameter is in :data:`PARAMS` with its source and its bounds (:func:`boun
 published fact where one was found, else chosen and marked); ``chosen=True`` marks the values no
 published fact fixes (each gets a sensitivity row in the report: the conclusions at half and at
 double the value). Nothing here is read from the paper's tables 2-7 (a test imports this module
-with ``rasterhw.sim.vzbuf.paper`` blocked).
+with ``rasterhw.golden_model.vzbuf.paper`` blocked).
 
 Scalar unit (the scalar column, and the scalar part of both VPs): every operation runs one at a
 time, its time the functional-unit time of an X-MP-class scalar unit in clock periods

@@ -15,10 +15,16 @@ import time
 import tracemalloc
 
 from rasterhw.golden_model.scenes import build_scene
+from rasterhw.golden_model.vzbuf.paper import (
+    COLS,
+    T1,
+    T5,
+    VP200_T5_C300_FRAGMENTS_PER_S,
+    VP200_T5_C300_MS,
+)
 from rasterhw.golden_model.vzbuf.render import render_frame
 from rasterhw.golden_model.vzbuf.wholearray import render_whole
 from rasterhw.golden_model.vzbuf.workload import table1_light
-from rasterhw.sim.vzbuf.paper import COLS, T1, T5, VP200_T5_C300_FRAGMENTS_PER_S, VP200_T5_C300_MS
 
 
 def _time(fn, repeat):

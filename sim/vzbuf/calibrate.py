@@ -18,6 +18,7 @@ import math
 
 import numpy as np
 from rasterhw.golden_model.vzbuf.facom import LINEAR, components
+from rasterhw.golden_model.vzbuf.paper import COLUMN
 from rasterhw.golden_model.vzbuf.render import table_stages
 from rasterhw.golden_model.vzbuf.trace import Trace
 
@@ -25,7 +26,6 @@ __all__ = ["FIT_TABLE", "error_factors", "fit", "predict", "stage_components", "
 
 FIT_TABLE = "table 2"
 MACHINES = ("scalar", "vp100", "vp200")
-PAPER_M = {"scalar": "scalar", "vp100": "VP100", "vp200": "VP200"}
 
 
 def stage_components(tr: Trace, alg: int, sh: str) -> dict:
@@ -58,8 +58,8 @@ def _entries(by_key: dict, tables: dict, table: str):
         if t != table:
             continue
         for m, entry in per_m.items():
-            if PAPER_M[m] in T:
-                yield n, entry, T[PAPER_M[m]]
+            if COLUMN[m] in T:
+                yield n, entry, T[COLUMN[m]]
 
 
 def _cells(comps: dict, tables: dict, table: str):

@@ -19,6 +19,18 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.reference import rasterise
 from rasterhw.golden_model.scenes import build_scene as _shared_scene
 from rasterhw.golden_model.vzbuf.facom import LINEAR, PARAMS, bounds, length10_ratio, price
+from rasterhw.golden_model.vzbuf.paper import (
+    COLS,
+    COLUMN,
+    CORRECTED,
+    RATES,
+    RUNS,
+    SLIST_SPEEDUP_AT_MOST,
+    SP8_EMPTY_LINE_FRACTION,
+    T1,
+    TABLES,
+    VTIME,
+)
 from rasterhw.golden_model.vzbuf.render import render_frame, table_stages
 from rasterhw.golden_model.vzbuf.shadows import ray_shadow
 from rasterhw.golden_model.vzbuf.stats import table1
@@ -33,7 +45,6 @@ from rasterhw.sim.vzbuf.calibrate import (
     stage_components,
     summary,
 )
-from rasterhw.sim.vzbuf.paper import COLS, CORRECTED, RATES, RUNS, T1, TABLES, VTIME
 
 SYS = "vzbuf"
 W = H = 512
@@ -83,7 +94,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
                             paper=T1["segments"][n] / T1["processed polygons"][n], formula=None,
                             measured=t1[n]["segments"] / t1[n]["processed polygons"], unit="ratio",
                             source="golden"))
-        out.append(make_row(SYS, "table 1 note", f"{n}: empty scan lines", paper=0.30 * H if n == "sp8" else None,
+        out.append(make_row(SYS, "table 1 note", f"{n}: empty scan lines", paper=SP8_EMPTY_LINE_FRACTION * H if n == "sp8" else None,
                             formula=None, measured=t1[n]["empty lines"], unit="lines", source="golden"))
         # the same shadow rows under the scene's own light: what the table-1 light changed (workload.py)
         own = table1(_shared_scene(n), W, H)
@@ -142,12 +153,12 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
             comps[(table, n)] = stage_components(tr, alg, sh)
             for stage in (*labels, "total"):
                 for m in MODELS:
-                    pm = PAPER_M[m]
+                    pm = COLUMN[m]
                     pv = T[pm][stage][n] if pm in T else None
                     out.append(make_row(SYS, table, f"{n}: {labels.get(stage, 'total')}", paper=pv, formula=None,
                                         measured=ms[m][stage], unit="ms", source=f"model:{m}"))
             for m in ("vp100", "vp200"):
-                pm = PAPER_M[m]
+                pm = COLUMN[m]
                 pg = (T["scalar"]["total"][n] / T[pm]["total"][n]
                       if pm in T and T[pm]["total"][n] and T["scalar"]["total"][n] else None)
                 out.append(make_row(SYS, table, f"{n}: vectorisation gain, scalar / {pm} total", paper=pg,
@@ -161,13 +172,13 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
                                         measured=ms["vp100"][stage] / ms["vp200"][stage], unit="ratio",
                                         source="model:facom"))
             for m in ("vp100", "vp200"):
-                out.append(make_row(SYS, table, f"{n}: vector time (vector unit in use), {PAPER_M[m]}",
-                                    paper=VTIME[table][PAPER_M[m]][n] if table in VTIME else None, formula=None,
+                out.append(make_row(SYS, table, f"{n}: vector time (vector unit in use), {COLUMN[m]}",
+                                    paper=VTIME[table][COLUMN[m]][n] if table in VTIME else None, formula=None,
                                     measured=ms[m]["vector"], unit="ms", source=f"model:{m}"))
             if table in RATES:
                 for m in ("vp100", "vp200"):
-                    out.append(make_row(SYS, table, f"{n}: vectorisation rate (4), {PAPER_M[m]}",
-                                        paper=RATES[table][PAPER_M[m]][n], formula=None, measured=ms[m]["rate"],
+                    out.append(make_row(SYS, table, f"{n}: vectorisation rate (4), {COLUMN[m]}",
+                                        paper=RATES[table][COLUMN[m]][n], formula=None, measured=ms[m]["rate"],
                                         unit="%", source=f"model:{m}"))
             if sh != "map":
                 vp = T["VP200"]["total"][n]
@@ -187,8 +198,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     for n in scenes:
         if tot("table 2", n) and tot("table 3", n):
             for m in ("vp100", "vp200"):
-                p2, p3 = TABLES["table 2"][PAPER_M[m]]["total"][n], TABLES["table 3"][PAPER_M[m]]["total"][n]
-                claim("text 3.3 1)", f"{n}: algorithm 1 total / algorithm 2 total, no shadows, {PAPER_M[m]}",
+                p2, p3 = TABLES["table 2"][COLUMN[m]]["total"][n], TABLES["table 3"][COLUMN[m]]["total"][n]
+                claim("text 3.3 1)", f"{n}: algorithm 1 total / algorithm 2 total, no shadows, {COLUMN[m]}",
                       p2 / p3 if p2 and p3 else None, tot("table 2", n, m) / tot("table 3", n, m), source=f"model:{m}")
     model_get = _getter_model(times)
     res = conclusions(model_get, scenes)
@@ -197,11 +208,11 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
         claim("conclusions", f"{_cname(key)} {what}: fraction of cases that hold (1 = holds)", pres[key][0], frac,
               unit="fraction", source=CONCLUSION_SOURCE[key])
     if tot("table 3", "c300"):
-        claim("conclusions", "(e) table 3, c300, VP200 total: model / paper", 1.0, tot("table 3", "c300") / 293.0,
+        claim("conclusions", "(e) table 3, c300, VP200 total: model / paper", 1.0, tot("table 3", "c300") / TABLES["table 3"]["VP200"]["total"]["c300"],
               source="model:vp200")
     # the published facts the parameters are bounded by (facom.bounds; not the paper's)
     for m in ("vp200", "vp100"):
-        claim("published bounds", f"{PAPER_M[m]} / X-MP time of V = S x V + V at vector length 10 (Lubeck, Moore, "
+        claim("published bounds", f"{COLUMN[m]} / X-MP time of V = S x V + V at vector length 10 (Lubeck, Moore, "
               "Mendez: the VP-200 and the X-MP 'performed equally on short vectors (vector length 10)'; "
               "bound for the VP-200 1/1.3-1.3)", None, length10_ratio(machine=m), source=f"model:{m}")
     # sensitivity: every chosen parameter at half and double, the conclusions recomputed
@@ -307,7 +318,6 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
 
 
 MODELS = ("scalar", "vp100", "vp200")
-PAPER_M = {"scalar": "scalar", "vp100": "VP100", "vp200": "VP200"}
 CUBES = ("c300", "c250", "c200", "c150", "c100", "c50")
 
 
@@ -350,7 +360,7 @@ def where_the_time_goes(times, t1, n: str = "c300") -> list[dict]:
     if ("table 6", n) in times:
         elems = 3 * W * H     # image memory, Z-buffer, shadow buffer ("画像記憶・Zバッファ・影バッファの初期化")
         for m in ("scalar", "vp200"):
-            pm = PAPER_M[m]
+            pm = COLUMN[m]
             row(f"buffer initialisation, ns per buffer element ({pm}; table 6 stage 4 / 3 x 512^2)",
                 T["table 6"][pm]["4"][n] * 1e6 / elems, ms("table 6", m, "4") * 1e6 / elems, "ns", f"model:{m}")
             row(f"eye->light transform / buffer initialisation ({pm}; table 6 stage 3 / stage 4)",
@@ -369,7 +379,7 @@ def where_the_time_goes(times, t1, n: str = "c300") -> list[dict]:
             ms("table 2", "scalar", "3") * 1e3 / t1[n]["segments"], "us", "model:scalar")
         # 4.1 1)(i): "ベクトル化による隠れ面消去処理の処理速度の向上率は約1.5~2倍"
         for m in ("vp100", "vp200"):
-            pm = PAPER_M[m]
+            pm = COLUMN[m]
             row(f"algorithm 1 hidden-surface removal, scalar / {pm} (text 4.1 1)(i): about 1.5-2)",
                 T["table 2"]["scalar"]["2"][n] / T["table 2"][pm]["2"][n],
                 ms("table 2", "scalar", "2") / ms("table 2", m, "2"), "ratio", f"model:{m}")
@@ -377,7 +387,7 @@ def where_the_time_goes(times, t1, n: str = "c300") -> list[dict]:
         if (table, n) not in times:
             continue
         for m in ("vp100", "vp200"):
-            pm = PAPER_M[m]
+            pm = COLUMN[m]
             row(f"{table}: time outside the vector unit, {pm} (total - vector time)",
                 T[table][pm]["total"][n] - VTIME[table][pm][n],
                 ms(table, m) - times[(table, n)][0][m]["vector"], "ms", f"model:{m}")
@@ -387,7 +397,7 @@ def where_the_time_goes(times, t1, n: str = "c300") -> list[dict]:
         sc = price(tr, "scalar", by="body")["phases"]
         for m in ("vp100", "vp200"):
             vp = price(tr, m, by="body")["phases"]
-            row(f"s-list shift slist(i+1) <- slist(i), scalar / {PAPER_M[m]} (text 4.1 2)(ii): at most 4)", 4.0,
+            row(f"s-list shift slist(i+1) <- slist(i), scalar / {COLUMN[m]} (text 4.1 2)(ii): at most 4)", SLIST_SPEEDUP_AT_MOST,
                 sc["a2 shift s-list"] / vp["a2 shift s-list"], "ratio", f"model:{m}")
     return out
 
@@ -401,7 +411,7 @@ def _getter_model(times):
 def _getter_paper():
     def get(table, n, m, stage="total"):
         T = TABLES[table]
-        pm = PAPER_M[m]
+        pm = COLUMN[m]
         return T[pm][stage][n] if pm in T else None
     return get
 
@@ -473,7 +483,7 @@ def _cname(key: str) -> str:
     if " " not in key:
         return f"({key})"
     k, rest = key.split(" ", 1)
-    return f"conclusion ({k}), {PAPER_M.get(rest, rest)}:"
+    return f"conclusion ({k}), {COLUMN.get(rest, rest)}:"
 
 
 def _sname(key: str) -> str:
@@ -494,7 +504,7 @@ def agreement_rows(times, scenes) -> list[dict]:
         T = TABLES[table]
         allf = []
         for m in MODELS:
-            pm = PAPER_M[m]
+            pm = COLUMN[m]
             if pm not in T:
                 continue
             r = []
@@ -548,7 +558,7 @@ def calibration_rows(comps, scenes) -> list[dict]:
             if (table, n) not in pred:
                 continue
             for m in MODELS:
-                pm = PAPER_M[m]
+                pm = COLUMN[m]
                 for stage in (*labels, "total"):
                     pv = T[pm][stage][n] if pm in T else None
                     out.append(make_row(SYS, table, f"{n}: {labels.get(stage, 'total')}, {pm} (calibrated on "
@@ -618,8 +628,8 @@ def _plot_tables(out_dir, times, scenes):
             return [times[(table, n)][0][m]["total"] if (table, n) in times else np.nan for n in scenes]
 
         for i, m in enumerate(MODELS):
-            ax.semilogy(x, get(PAPER_M[m]), "o--", color=f"C{i}", label=f"paper {PAPER_M[m]}")
-            ax.semilogy(x, mod(m), "s-", color=f"C{i}", label=f"model {PAPER_M[m]}")
+            ax.semilogy(x, get(COLUMN[m]), "o--", color=f"C{i}", label=f"paper {COLUMN[m]}")
+            ax.semilogy(x, mod(m), "s-", color=f"C{i}", label=f"model {COLUMN[m]}")
         ax.set_xticks(x, scenes, rotation=60, fontsize=7)
         ax.set_title(f"{table} ({'alg 1' if RUNS[table][0] == 1 else 'alg 2'}, {RUNS[table][1]})", fontsize=9)
         ax.set_ylabel("total ms")
@@ -658,7 +668,7 @@ def _sections(t1, times, scenes) -> list[str]:
                 for st in ms["scalar"]:            # the stages and the total
                     cells = []
                     for m in MODELS:
-                        pm = PAPER_M[m]
+                        pm = COLUMN[m]
                         cells += [_f(T[pm][st][n] if pm in T else None, 0), _f(ms[m][st], 1)]
                     rows_.append(f"| {n} | {st} | " + " | ".join(cells) + " |")
             s.append(f"## {table} ({'algorithm 1' if RUNS[table][0] == 1 else 'algorithm 2'}, shadows "

@@ -8,11 +8,11 @@ from pathlib import Path
 import pytest
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.golden_model.vzbuf.facom import LINEAR, PARAMS, price
+from rasterhw.golden_model.vzbuf.paper import RUNS
 from rasterhw.golden_model.vzbuf.render import render_frame, table_stages
 from rasterhw.golden_model.vzbuf.trace import Trace
 from rasterhw.sim.report.rows import parse_table
 from rasterhw.sim.vzbuf.calibrate import error_factors, fit, predict, stage_components, summary
-from rasterhw.sim.vzbuf.paper import RUNS
 
 W = H = 512
 SCENES = ("c50", "sp8")

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.golden_model.vzbuf.facom import PARAMS, price, scalar_cp, vector_element_ns
+from rasterhw.golden_model.vzbuf.paper import TABLES
 from rasterhw.golden_model.vzbuf.render import render_frame, table_stages
 from rasterhw.golden_model.vzbuf.trace import BODIES, Trace
-from rasterhw.sim.vzbuf.paper import TABLES
 from rasterhw.sim.vzbuf.report import _getter_paper, conclusions
 
 W = H = 512
@@ -175,7 +175,7 @@ def test_model_imports_without_the_paper_tables():
         "import sys, importlib.abc\n"
         "class B(importlib.abc.MetaPathFinder):\n"
         "    def find_spec(self, name, path, target=None):\n"
-        "        if name == 'rasterhw.sim.vzbuf.paper': raise ImportError('blocked: ' + name)\n"
+        "        if name == 'rasterhw.golden_model.vzbuf.paper': raise ImportError('blocked: ' + name)\n"
         "sys.meta_path.insert(0, B())\n"
         "import rasterhw.golden_model.vzbuf.facom, rasterhw.golden_model.vzbuf.trace\n"
         "import rasterhw.golden_model.vzbuf.render, rasterhw.golden_model.vzbuf.hsr\n"
@@ -188,9 +188,9 @@ def test_model_imports_without_the_paper_tables():
         "render_frame(build_scene('c50'), 128, 128, alg=2, trace=tr)\n"
         "assert all(sum(price(tr, m)['phases'].values()) > 0 for m in ('scalar', 'vp100', 'vp200'))\n"
         "assert out_of_bounds() == [] and bounds() and length10_ratio() > 0\n"
-        "assert 'rasterhw.sim.vzbuf.paper' not in sys.modules\n"
+        "assert 'rasterhw.golden_model.vzbuf.paper' not in sys.modules\n"
         "try:\n"
-        "    import rasterhw.sim.vzbuf.paper\n"
+        "    import rasterhw.golden_model.vzbuf.paper\n"
         "except ImportError:\n"
         "    print('blocked')\n"
     )

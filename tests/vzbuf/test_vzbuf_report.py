@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import pytest
+from rasterhw.golden_model.vzbuf.paper import COLS, T1, TABLES
 from rasterhw.sim.report.rows import ROW_KEYS, SOURCES
-from rasterhw.sim.vzbuf.paper import COLS, T1, TABLES
 
 
 def test_paper_tables_obey_their_identities():

@@ -37,7 +37,7 @@ def test_table1_orderings_like_the_paper():
 
 
 def _ratio(t, n, key):
-    from rasterhw.sim.vzbuf.paper import T1
+    from rasterhw.golden_model.vzbuf.paper import T1
     return t[key] / T1[key][n]
 
 

@@ -1,5 +1,6 @@
-"""The vector Z-buffer paper's tables 1-7 (seed 001), as data (``paper_tables.csv`` beside
-this module, loaded here).
+"""Every figure of the vector Z-buffer paper (seed 001) the reports and flows use, with its place in
+the seed: tables 1-7 as data (``paper_tables.csv`` beside this module, loaded here) and the
+figures of the text.
 
 Read from ``shared/vzbuf_tables.md`` (the cleaned reading) and checked cell by cell against the
 seed; a cell the OCR corrupted is corrected from the paper's own identities (totals = sums of
@@ -12,6 +13,8 @@ from __future__ import annotations
 import csv
 from importlib import resources
 
+#: the paper's name of each modelled machine (its tables' row labels)
+COLUMN = {"scalar": "scalar", "vp100": "VP100", "vp200": "VP200"}
 COLS = ("c300", "c250", "c200", "c150", "c100", "c50", "sp27", "sp5", "sp8")
 
 
@@ -61,3 +64,9 @@ CORRECTED = {
 #: the paper's throughput claim behind the benchmark: table 5, VP200, c300
 VP200_T5_C300_MS = 2059
 VP200_T5_C300_FRAGMENTS_PER_S = 843730
+#: 3.2 note on table 1: "sp8は表示図形のスクリーンに占める割合が小さく、全スクリーンラインの約30%ではデータがない"
+#: (sp8 covers little of the screen: about 30 % of all scan lines hold no data)
+SP8_EMPTY_LINE_FRACTION = 0.30
+#: 4.1 2)(ii): "slistの更新処理はベクトル化されるが…処理速度の向上は高々4倍にとどまる" (the s-list update
+#: vectorises, but its speed-up stays at most 4 times)
+SLIST_SPEEDUP_AT_MOST = 4.0
