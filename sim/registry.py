@@ -15,7 +15,8 @@ Contracts of the named callables:
   (:class:`rasterhw.golden_model.arch.Rendered`); ``options`` are the :class:`Option` values
   the arch declares, already converted;
 * verilog block: ``factory(**params) -> wiring.Component`` (ValueError/TypeError on a bad one);
-* sim block: ``simulate(scene, width, height, *, engine, progress, **options) -> dict`` with at
+* sim block: ``simulate(scene, width, height, *, engine, progress, **options) -> dict`` (a block
+  declares it as a ``sim/engines/scene.py: SceneRun`` and names its ``simulate``) with at
   least the keys of :data:`SIM_KEYS` and optionally ``frame_rgb``;
 * report: ``rows(*, engine, progress, out_dir, **known) -> (rows, markdown sections)``;
 * bench: ``bench(*, repeat, hdl, progress) -> list of {"name", "value", "unit", "note"}``;

@@ -1,4 +1,4 @@
-"""``rasterhw sim pixelbus``'s scene level (``sim/scene.py``): the scene's frame through the SNU
+"""``rasterhw sim pixelbus``'s scene level (``sim/engines/scene.py``): the scene's frame through the SNU
 pixel-bus HDL, checked against the golden model (``golden_model/snu/pixelbus.py``).
 
 On Verilator the whole frame as the machine draws it (the snu-100k headline frame end to end):
@@ -37,7 +37,7 @@ from rasterhw.golden_model.snu import pixelbus as golden
 from rasterhw.golden_model.snu.formats import CLOCK_HZ, MEM_CYCLE, N_BANKS, Z_BITS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.sim import engines
-from rasterhw.sim.scene import Done, Job, SceneRun, run_job
+from rasterhw.sim.engines.scene import Done, Job, SceneRun, run_job
 from rasterhw.sim.snu.frame_adapter import GAP_BITS, SCHEDULE
 from rasterhw.sim.snu.testbench import BusBench, FrameBench, frame_of
 

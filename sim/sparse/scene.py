@@ -1,4 +1,4 @@
-"""``rasterhw sim sparse``'s scene level (``sim/scene.py``): every video processor of the matrix in
+"""``rasterhw sim sparse``'s scene level (``sim/engines/scene.py``): every video processor of the matrix in
 HDL on the scene, its memories compared with the bit-accurate golden model pixel by pixel (triangle
 index and quantised depth), on the generic engines (pysim, Verilator).
 
@@ -26,7 +26,7 @@ from rasterhw.golden_model.sparse.cycles import KE_EDGES
 from rasterhw.golden_model.sparse.formats import parse_matrix, sparse_geometry
 from rasterhw.golden_model.sparse.search import interleave, sparse_render
 from rasterhw.golden_model.sparse.vpcycles import HDL_FIFO_DEPTH
-from rasterhw.sim.scene import Done, Job, SceneRun, run_job
+from rasterhw.sim.engines.scene import Done, Job, SceneRun, run_job
 from rasterhw.sim.testbench import Expected
 
 __all__ = ["HIER_FROM_CELLS", "IN_DEPTH", "MAXT", "SparseScene", "check_processor", "depth_image", "matrix_job",

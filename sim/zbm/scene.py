@@ -1,4 +1,4 @@
-"""``rasterhw sim zbm``'s scene level (``sim/scene.py``): a scene through ZB/M units in HDL (pysim,
+"""``rasterhw sim zbm``'s scene level (``sim/engines/scene.py``): a scene through ZB/M units in HDL (pysim,
 plain Verilator or the cocotb bench), every double-Z pixel compared with the golden model and the
 composited frame checked against the float model under docs/zbm.md's tolerance; :func:`run_scene`,
 a chain of units on edge pairs, for the soak, the bench and the reports."""
@@ -13,7 +13,7 @@ from rasterhw.golden_model.zbm import formats as F
 from rasterhw.golden_model.zbm.cycles import check_schedule
 from rasterhw.golden_model.zbm.words import words_to_doublez
 from rasterhw.sim import engines
-from rasterhw.sim.scene import Job, SceneRun, run_job
+from rasterhw.sim.engines.scene import Job, SceneRun, run_job
 from rasterhw.sim.testbench import find_testbench
 from rasterhw.sim.zbm.edge_check import check_edge_pairs
 from rasterhw.sim.zbm.testbench import deal, unit_watchdog

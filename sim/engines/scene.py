@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
+from rasterhw.sim.engines import run as run_engine
 from rasterhw.sim.testbench import Expected, Run, Stimulus, Testbench, compare
 
 __all__ = ["Done", "Job", "SceneRun", "run_job"]
@@ -158,8 +159,6 @@ class SceneRun:
 def run_job(job: Job, engine: str) -> Done:
     """``job`` on ``engine`` (``engines.run``, collecting every expected word), compared word for word
     (``testbench.compare``)."""
-    from rasterhw.sim.engines import run as run_engine
-
     got = run_engine(job.tb, job.params, job.stim, engine=engine,
                      expect_words={k: len(v) for k, v in job.expect.words.items()}, **job.run)
     return Done(job, got, compare(job.expect, got, cycle_exact=job.cycle_exact))
