@@ -29,6 +29,8 @@ Times are reported at the paper's clocks: 12.5 MHz bus (80 ns slot), i860 at
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.pipeline import run_geometry
@@ -198,10 +200,15 @@ def simulate_pixelbus(stream: PixelStream, *, engine: str = "pysim", gaps: np.nd
     """``stream`` through the pixel-bus HDL on ``engine`` (:func:`bus_job`), compared with the
     golden model: :func:`bus_result`'s keys and ``block``, ``engine``, ``clock_hz`` (12.5 MHz),
     ``build_s``, ``run_s``, ``cycles_per_s`` (simulated clocks, pixel phase + read-out, per second
-    of simulation)."""
+    of simulation); ``progress``: a line before and after the run on stderr."""
     if engine not in ENGINES:
         raise RasterhwError(f"engine must be one of {', '.join(ENGINES)}, not {engine!r}")
-    d = run_job(bus_job(stream, gaps), engine)
+    job = bus_job(stream, gaps)
+    if progress:
+        print(f"pixelbus: {len(stream)} writes, {stream.width}x{stream.height}; running {engine}", file=sys.stderr)
+    d = run_job(job, engine)
+    if progress:
+        print(f"pixelbus: {engine} {d.got.cycles} cycles, {d.cmp['mismatches']} mismatches", file=sys.stderr)
     return {"block": "pixelbus", "engine": engine, "clock_hz": golden.CLOCK_HZ, **bus_result(d),
             "build_s": d.got.build_s, "run_s": d.got.run_s,
             "cycles_per_s": d.got.cycles / d.got.run_s if d.got.run_s > 0 else float("inf")}
