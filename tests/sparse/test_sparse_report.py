@@ -267,3 +267,22 @@ def test_large_matrix_rows_stay_with_their_reason():
             make_row(r["system"], r["figure"], r["quantity"], paper=r["paper"], formula=r["formula"],
                      measured=None, unit=r["unit"], source=r["source"], reason=r["reason"])
     assert _large_matrix_hdl_rows("none", fast=False, progress=False) == ([], [])
+
+
+@pytest.mark.slow   # the 8x8 matrix at 1024² in Verilator: 2 min on a quiet machine, 12 min (473 s cold build) at load 20
+def test_large_matrix_rows_on_verilator(monkeypatch):
+    """The full report's row function on the 8x8 matrix (16x16 takes about 8 min more): every counter and
+    pixel equal to the golden models, (9) within 1 % with the default processor, R_p from HDL frame time
+    beside (10)."""
+    import rasterhw.sim.sparse.report as rep
+
+    monkeypatch.setattr(rep, "LARGE_MATRICES", ("8x8",))
+    rows, sec = rep._large_matrix_hdl_rows("verilator", fast=False, progress=False)
+    assert len(rows) == 7 and all(r["measured"] is not None and r["source"] == "hdl:verilator" for r in rows)
+    diff = [r for r in rows if r["formula"] == 0]
+    assert len(diff) == 3 and all(r["measured"] == 0 for r in diff)
+    (nine,) = [r for r in rows if r["figure"] == "(9) / HDL frame time"]
+    assert 1 <= nine["measured"] < 1.01
+    rp = [r for r in rows if "R_p from HDL frame time" in r["quantity"]]
+    assert 0 < rp[0]["measured"] < rp[1]["measured"] < 1 and abs(rp[0]["measured"] - rp[0]["formula"]) < 0.1
+    assert "| 8x8 |" in sec[-1]
