@@ -47,8 +47,10 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
          load_triangles: int = 3000, coupled_vp_matrices: tuple[str, ...] = ("2x2", "4x4", "8x8"),
          stack_size: int = 512, coupled_scene: str = "c300",
          stack_scenes: tuple[str, ...] = ("c300", "sp27"), stack_sizes: tuple[int, ...] = (512, 1 << M_BITS),
-         scheduler: str = "serial", store=None, fresh: bool = False, **known):
-    """Rows and markdown sections of the sparse-raster report (see the module docstring)."""
+         scheduler: str = "serial", store=None, fresh: bool = False, fast: bool = False, **known):
+    """Rows and markdown sections of the sparse-raster report (see the module docstring). ``fast``:
+    the 8x8 and 16x16 matrices at 1024² in HDL (:func:`_large_matrix_hdl_rows`, minutes of
+    Verilator) stay unmeasured with their reason."""
     M = int(samples)
     S_GRID = tuple(s_grid)  # noqa: N806 (the module default, narrowed by tests)
     out: list[dict] = []
@@ -250,6 +252,9 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     hdl_sec = _hdl_rows(row, engine, progress, hdl_scene=known.get("hdl_scene"))
     hdl_sec += _coupled_hdl_rows(row, engine, progress)
     hdl_sec += _paper_load_rows(row, engine, progress)
+    large, large_sec = _large_matrix_hdl_rows(engine, fast=fast, progress=progress)
+    out += large
+    hdl_sec += large_sec
 
     # ---------------------------------------------------------------- the coupled matrix (golden)
     coupled_sec = _coupled_rows(row, out_dir, size=coupled_size, matrices=coupled_matrices,
@@ -1019,6 +1024,89 @@ def _paper_load_rows(row, engine: str, progress: bool) -> list[str]:
             "окрестности S = Sk\") and the performance limit (\"максимальная производительность соответствует в "
             "среднем времени пяти тестов покрытия\"). Frame cycles end before the read-out.\n",
             "\n".join(tab) + "\n"]
+
+
+#: the whole matrix in HDL at the paper's 1024² beyond 4x4 (c300, default processor, input FIFO depth
+#: REF_DEPTH): Verilator's hierarchical build (the cell verilated once, ``docs/sparse.md``)
+LARGE_MATRICES = ("8x8", "16x16")
+LARGE_FAST_SKIP = ("slow row: not measured in a fast run (the whole matrix in Verilator at 1024², hierarchical "
+                   "build: 8x8 about 2 min, 16x16 about 8 min on a quiet machine); rasterhw report sparse without "
+                   "--fast measures it")
+LARGE_ENGINE_SKIP = ("needs --engine verilator: pysim runs a few thousand cycles a second, too slow for a 1024² "
+                     "frame of 64 or 256 processors")
+
+
+def _large_matrix_hdl_rows(engine: str, *, fast: bool, progress: bool) -> tuple[list[dict], list[str]]:
+    """The 8x8 and 16x16 matrices on c300 at 1024² in one Verilator simulation each: frame cycles
+    against the golden coupled cycle model, every counter and pixel against the golden models,
+    frame / busiest stage ((9)) and R_p from HDL frame time beside (10). Unmeasured (with the
+    reason) in a ``fast`` run or on pysim; the formula column is filled either way. No rows on an engine
+    that is no HDL simulator (as the other HDL rows)."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.sparse import cycles as cy
+    from rasterhw.golden_model.sparse.search import sparse_render
+
+    if engine not in ("pysim", "verilator"):
+        return [], []
+    W = 1 << M_BITS
+    D = REF_DEPTH
+    tris = run_geometry(build_scene("c300"), W, W)
+    why = LARGE_FAST_SKIP if fast else (None if engine == "verilator" else LARGE_ENGINE_SKIP)
+    src = "hdl:verilator"
+    out, tab = [], []
+    for m in LARGE_MATRICES:
+        p = int(m.split("x")[0])
+        P = p * p
+        n = M_BITS - (p.bit_length() - 1)
+        tf = th.stage_times(_formula_frame(np.asarray(tris.xy), n, p), kp_ke=0.0)
+        Rp_f = float(tf.sum() / (n * tf.max()))
+        r = None
+        if why is None:
+            from rasterhw.sim.sparse.sim import simulate_coupled
+
+            r = simulate_coupled(tris, m, engine="verilator", fifo_depth=D, progress=progress)
+            gfr = sparse_render(tris, (p, p), depth="fixed", per_record=True)
+            B_pi = cy.stage_cycles(gfr.stats["windows_per_record"]).sum(axis=1).astype(float)   # (P, n)
+            fr = r["frame_cycles"]
+            got = {"frame": fr, "diff": fr - r["frame_cycles_golden"], "counters": r["cycle_mismatches"],
+                   "pixels": r["mismatches"], "busiest": round(fr / float(B_pi.max()), 4),
+                   "Rp": round(float(np.sum(r["tests_per_level_hdl"]) / (n * P * fr)), 4),
+                   "Rp_h": round(float(B_pi.sum() / (n * P * fr)), 4)}
+            tab.append(f"| {m} | {fr} | {r['frame_cycles_golden']} | {r['stall_cycles']} | {r['cycle_mismatches']} "
+                       f"of {r['cycles_compared']} | {r['mismatches']} of {r['pixels_compared']} | {got['busiest']:.4f} | "
+                       f"{got['Rp']:.4f} ({got['Rp_h']:.4f}) | {Rp_f:.4f} | {r['build_s']:.1f} | {r['run_s']:.1f} |")
+        else:
+            got = dict.fromkeys(("frame", "diff", "counters", "pixels", "busiest", "Rp", "Rp_h"))
+        q = f"c300 {W}x{W}, {m}, eight-entry inner FIFOs (ours, the default), input FIFO depth {D}, whole matrix in HDL"
+        spec = [("FIFO sizing (coupled, HDL)", f"{q}: frame cycles", None, got["frame"], "cycles"),
+                ("FIFO sizing (coupled, HDL)", f"{q}: frame cycles, HDL minus the golden coupled cycle model "
+                 "(coupled_matrix_vp)", 0, got["diff"], "cycles"),
+                ("FIFO sizing (coupled, HDL)", f"{q}: counters differing from the golden coupled cycle model (frame, "
+                 "stalls, every FIFO peak, busy and per-level tests)", 0, got["counters"], "counters"),
+                ("FIFO sizing (coupled, HDL)", f"{q}: pixels differing from the bit-accurate golden model (of "
+                 f"{W * W})", 0, got["pixels"], "pixels"),
+                ("(9) / HDL frame time", f"{q}: frame cycles / the busiest stage's busy cycles (tests + header cycles "
+                 "of the busiest processor's busiest stage; (9): the pipeline runs at its slowest stage)", 1.0,
+                 got["busiest"], "ratio"),
+                ("(10) / HDL frame time", f"{q}: R_p from HDL frame time, sum_i B_i / (n P frame cycles), B_i the HDL "
+                 "stages' coverage tests (formula: (10) on (1)'s counts, k_p/k_e = 0)", round(Rp_f, 4), got["Rp"], ""),
+                ("(10) / HDL frame time", f"{q}: R_p from HDL frame time counting header cycles, sum_i (tests + "
+                 "headers)_i / (n P frame cycles) (formula: (10) on (1)'s counts, k_p/k_e = 0)", round(Rp_f, 4),
+                 got["Rp_h"], "")]
+        out += [make_row(SYSTEM, fig, qty, paper=None, formula=f, measured=v, unit=u, source=src,
+                         reason=None if v is not None else why) for fig, qty, f, v, u in spec]
+    sec = ["## The 8x8 and 16x16 matrices in HDL at 1024²\n"]
+    if tab:
+        sec += [f"c300 at {W}², the default processor, input FIFO depth {D}, each matrix one Verilator simulation "
+                "(hierarchical build: the cell verilated once; `rasterhw sim sparse --scene c300 --size 1024x1024 "
+                f"--matrix M --fifo-depth {D} --engine verilator --json`).\n",
+                "| matrix | frame cycles, HDL | golden | broadcast stalls, HDL | counters differing | pixels differing | "
+                "frame / busiest stage ((9): 1) | R_p from HDL frame time (with headers) | (10) | build s | run s |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|\n" + "\n".join(tab) + "\n"]
+    else:
+        sec += [f"Not simulated in this run: {why}.\n"]
+    return out, sec
 
 
 def _load_rows(row, W: int, ntri: int) -> list[str]:

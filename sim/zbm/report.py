@@ -293,6 +293,7 @@ def i860_rows(measured: dict[str, dict[int, float]], *, progress: bool = False) 
             make_row("zbm", "table 2", f"N = {n} processors: i860 data-cache stall clocks per polygon (8 KB, 2-way, "
                      f"32-byte lines, write-back; {dc['record_bytes']}-byte records read once; line fill 8 clocks)", paper=None, formula=None, measured=dc["stall_clocks_per_polygon"],
                      unit="clocks", source=src)]
+    out += cache_sensitivity_rows(pol["assembler"])
     out.append(make_row("zbm", "table 2 / 6.2", "C / assembler time ratio (paper: table 1.08-1.19 from its "
                         "seconds, text 'about 1.25'; paper column = the text)", paper=1.25, formula=None,
                         measured=pol["C"] / pol["assembler"], unit="x", source=src))
@@ -340,6 +341,41 @@ def i860_rows(measured: dict[str, dict[int, float]], *, progress: bool = False) 
                         paper=PAPER_I860S_PER_UNIT, formula=max(PAPER_KPOLYS.values()) / PAPER_TABLE2[8][2],
                         measured=None, unit="i860s", source="formula",
                         reason="the paper's arithmetic on its own figures, not a measurement"))
+    return out
+
+
+#: table 2's cell the cache-sensitivity rows price (the paper's 14.4 K: the balance rows' rate too)
+SENSITIVITY_N = 8
+#: the data cache's miss cost in the sensitivity rows: a line fill of 4 bus cycles of 2 (the bus's best,
+#: the default), 3, 4, 6 or 10 clocks, i.e. 0, 1, 2, 4 or 8 wait states a cycle (the board's are unknown)
+SENSITIVITY_MISS_CLOCKS = (8, 12, 16, 24, 40)
+
+
+def cache_sensitivity_rows(assembler_clocks: float) -> list[dict]:
+    """Table 2's polygons/s per processor (assembler column, N = :data:`SENSITIVITY_N`) with the data
+    cache's *chosen* parameters varied (``golden_model/i860/cache.py``: ``CACHE_PARAMETERS`` marks
+    them): the miss cost (:data:`SENSITIVITY_MISS_CLOCKS`) and fetching the line on a store miss.
+    ``assembler_clocks``: the model's clocks per polygon without stalls. Source ``model:i860``."""
+    from rasterhw.golden_model.i860.cache import DataCache
+    from rasterhw.golden_model.zbm import i860 as z
+
+    polys = PAPER_TEST_POLYGONS // SENSITIVITY_N
+    paper = PAPER_TABLE2[SENSITIVITY_N][2] * 1e3
+    cases = [(f"miss cost {m} clocks (4 bus cycles x {m // 4} clocks: {m // 4 - 2} wait state"
+              f"{'' if m // 4 - 2 == 1 else 's'})"
+              + (", the default: the bus's best" if m == DataCache.miss_clocks else ""), {"miss_clocks": m})
+             for m in SENSITIVITY_MISS_CLOCKS]
+    cases.append((f"a store miss fetches its line (write-allocate; miss cost {DataCache.miss_clocks} clocks)",
+                   {"write_allocate": True}))
+    out = []
+    for what, kw in cases:
+        dc = z.polygon_cache(polys, cache=DataCache(**kw))
+        t = (polys * assembler_clocks + dc["stall_clocks"]) / z.CLOCK_HZ
+        out.append(make_row(
+            "zbm", "table 2 (cache sensitivity)", f"N = {SENSITIVITY_N} processors: polygons/s per processor, "
+            f"assembler column, data cache {what}: {dc['stall_clocks_per_polygon']:.1f} stall clocks per polygon "
+            "(a chosen parameter varied; the manual gives no fill time)", paper=paper, formula=None,
+            measured=polys / t, unit="polygons/s", source="model:i860"))
     return out
 
 

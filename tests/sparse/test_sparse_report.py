@@ -242,3 +242,47 @@ def test_stack_matrix_hdl_rows_on_pysim():
         assert got[pre + "broadcast stall cycles HDL minus golden"] == 0
         assert got[pre + "pixels differing from the golden search (of 256)"] == 0
     assert "| yes |" in sec[-1] and "NO" not in sec[-1]
+
+
+def test_large_matrix_rows_stay_with_their_reason():
+    """The 8x8 and 16x16 matrices at 1024² in HDL: a fast run and pysim keep every row unmeasured with
+    its reason (the formula column filled); an engine that is no HDL simulator gives none."""
+    from rasterhw.sim.report.rows import make_row
+    from rasterhw.sim.sparse.report import (
+        LARGE_ENGINE_SKIP,
+        LARGE_FAST_SKIP,
+        _large_matrix_hdl_rows,
+    )
+
+    for engine, fast, why in (("verilator", True, LARGE_FAST_SKIP), ("pysim", False, LARGE_ENGINE_SKIP)):
+        rows, sec = _large_matrix_hdl_rows(engine, fast=fast, progress=False)
+        assert len(rows) == 14 and all(r["measured"] is None and r["reason"] == why and r["source"] == "hdl:verilator"
+                                       for r in rows)
+        assert sum("c300 1024x1024, 8x8," in r["quantity"] for r in rows) == 7
+        assert sum("c300 1024x1024, 16x16," in r["quantity"] for r in rows) == 7
+        rp = [r["formula"] for r in rows if "R_p from HDL frame time" in r["quantity"]]
+        assert len(rp) == 4 and all(0 < f < 1 for f in rp) and rp[0] == rp[1] and rp[2] == rp[3]
+        assert why in sec[-1]
+        for r in rows:   # the report's own check of a row accepts them
+            make_row(r["system"], r["figure"], r["quantity"], paper=r["paper"], formula=r["formula"],
+                     measured=None, unit=r["unit"], source=r["source"], reason=r["reason"])
+    assert _large_matrix_hdl_rows("none", fast=False, progress=False) == ([], [])
+
+
+@pytest.mark.slow   # the 8x8 matrix at 1024² in Verilator: 2 min on a quiet machine, 12 min (473 s cold build) at load 20
+def test_large_matrix_rows_on_verilator(monkeypatch):
+    """The full report's row function on the 8x8 matrix (16x16 takes about 8 min more): every counter and
+    pixel equal to the golden models, (9) within 1 % with the default processor, R_p from HDL frame time
+    beside (10)."""
+    import rasterhw.sim.sparse.report as rep
+
+    monkeypatch.setattr(rep, "LARGE_MATRICES", ("8x8",))
+    rows, sec = rep._large_matrix_hdl_rows("verilator", fast=False, progress=False)
+    assert len(rows) == 7 and all(r["measured"] is not None and r["source"] == "hdl:verilator" for r in rows)
+    diff = [r for r in rows if r["formula"] == 0]
+    assert len(diff) == 3 and all(r["measured"] == 0 for r in diff)
+    (nine,) = [r for r in rows if r["figure"] == "(9) / HDL frame time"]
+    assert 1 <= nine["measured"] < 1.01
+    rp = [r for r in rows if "R_p from HDL frame time" in r["quantity"]]
+    assert 0 < rp[0]["measured"] < rp[1]["measured"] < 1 and abs(rp[0]["measured"] - rp[0]["formula"]) < 0.1
+    assert "| 8x8 |" in sec[-1]
