@@ -172,10 +172,12 @@ def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator", sched
     fpga = _fpga_records()
     plots_out = out / "reproduction"
     summary["cross_chart"] = _cross_chart(summary["cross_machine"], out / "cross_machine.svg", scene)
+    snapshots = {(w["machine"], w["block"]): w for w in wave_snapshots(sims, out / "waves")}
     summary["about"] = about()
     for m in ms:
         entry = {"name": m.name, "title": m.title, "status": m.status, "no_hdl": m.no_hdl or None,
                  "reference": reference(m.name), "docs": _render_docs(m.name, out),
+                 "waves": [snapshots[(m.name, b.name)] for b in m.sims if (m.name, b.name) in snapshots],
                  "golden": [a for a in summary["archs"] if a["machine"] == m.name],
                  "hdl_runs": [s for s in results if s["machine"] == m.name],
                  "paper_rows": [], "report": None, "report_command": None, "plots": [],
@@ -264,22 +266,21 @@ def _fpga_records() -> list[dict]:
     """Every recorded ECP5 place-and-route run (``docs/reproduction/fpga_runs.json``, written by
     ``rasterhw report fpga``): the block, its parameters, LUT4s, flip-flops, block RAMs, Fmax per
     clock domain beside the clock the paper names, or why it was not measured."""
-    path = REPRO / "fpga_runs.json"
-    if not path.exists():
-        return []
+    from rasterhw.sim.flow.fpga import not_measured_reason, recorded_configs
+
     known = set(registry.blocks())
     out = []
-    for run in json.loads(path.read_text())["runs"]:
-        r = run["result"]
-        if run["block"] not in known or r.get("family", "ecp5") != "ecp5":
+    # one row per configuration (router1's run after router2's is the configuration's result)
+    for r in recorded_configs(REPRO / "fpga_runs.json"):
+        if r["block"] not in known or r.get("family", "ecp5") != "ecp5":
             continue
         clocks = {c["domain"]: c for c in r.get("paper_clocks", [])}
-        out.append({"block": run["block"], "params": ", ".join(f"{k} {v}" for k, v in run["params"].items()),
+        out.append({"block": r["block"], "params": ", ".join(f"{k} {v}" for k, v in r["params"].items()),
                     "finished": bool(r.get("finished")) and r.get("fits", True),
                     "luts": r.get("luts"), "ffs": r.get("ffs"), "brams": r.get("brams"),
                     "fmax": [{"domain": d, "mhz": f, "paper_mhz": clocks.get(d, {}).get("mhz"),
                               "paper_what": clocks.get(d, {}).get("what")} for d, f in sorted(r.get("fmax_mhz", {}).items())],
-                    "reason": r.get("reason"), "ran": r.get("ran"), "source": "hdl:nextpnr-ecp5"})
+                    "reason": not_measured_reason(r), "ran": r.get("ran"), "source": "hdl:nextpnr-ecp5"})
     return out
 
 
@@ -348,6 +349,45 @@ def _cross_chart(rows: list[dict], path: Path, scene: str) -> str | None:
     fig.savefig(path, metadata={"Date": None, "Creator": None})
     plt.close(fig)
     return path.name
+
+
+#: the wave snapshot of each HDL block: pysim on its default scene at this size, these clock edges
+SNAPSHOT_SIZE, SNAPSHOT_EDGES = (32, 32), (20, 60)
+
+
+def wave_snapshots(sims, folder: Path) -> list[dict]:
+    """One wave snapshot per HDL sim block (``sims``: (machine, block) pairs): a short pysim run
+    of the block on its default scene at :data:`SNAPSHOT_SIZE`, traced for clock edges
+    :data:`SNAPSHOT_EDGES` (``sim/engines/waves.py: recording``), drawn as SVG
+    (``sim/report/wavesvg.py``). A block whose snapshot cannot be made says why instead."""
+    import tempfile
+
+    from rasterhw.golden_model.errors import RasterhwError
+    from rasterhw.sim.engines.waves import recording
+    from rasterhw.sim.report.wavesvg import wave_svg
+
+    folder.mkdir(parents=True, exist_ok=True)
+    out = []
+    for m, b in sims:
+        start, end = SNAPSHOT_EDGES
+        what = (f"pysim, {b.default_scene} at {SNAPSHOT_SIZE[0]}x{SNAPSHOT_SIZE[1]}, clock edges {start}..{end - 1} "
+                f"(rasterhw sim {b.name} --engine pysim --scene {b.default_scene} --size "
+                f"{SNAPSHOT_SIZE[0]}x{SNAPSHOT_SIZE[1]} --waves run.vcd --trace-start {start} --trace-end {end})")
+        entry = {"machine": m.name, "block": b.name, "svg": None, "what": what, "why_not": None}
+        try:
+            with tempfile.TemporaryDirectory() as tmp:
+                vcd = Path(tmp) / "run.vcd"
+                with recording(vcd, "pysim", start=start, end=end) as traces:
+                    _run_sim(m.name, b.name, "pysim", None, SNAPSHOT_SIZE)
+                got = wave_svg(traces[0], folder / f"{b.name}.svg", title=f"{m.name} {b.name}: {what.split(' (')[0]}")
+                if got is None:
+                    entry["why_not"] = "the trace has no clock edges in the window"
+                else:
+                    entry["svg"] = f"{folder.name}/{got.name}"
+        except (RasterhwError, ValueError, OverflowError) as e:
+            entry["why_not"] = str(e).splitlines()[0] if str(e) else type(e).__name__
+        out.append(entry)
+    return out
 
 
 def about() -> dict:
