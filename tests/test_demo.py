@@ -131,3 +131,27 @@ def test_cross_machine_chart_has_a_bar_per_timed_row(tmp_path):
     svg = (tmp_path / name).read_text()
     assert "hdl:verilator" in svg and "model:vp200" in svg
     assert demo._cross_chart([], tmp_path / "none.svg", "c300") is None
+
+
+def test_wave_snapshot_draws_the_clock_counter_and_stream_ports(tmp_path):
+    """A short trace (as ``--waves`` with a window writes it) drawn as SVG: one row per signal,
+    a one-bit signal as a line, a vector as boxes with its value in hex."""
+    from rasterhw.sim.engines.waves import VcdWindow
+    from rasterhw.sim.report.wavesvg import wave_svg
+
+    head = ("$timescale 1 ns $end\n$scope module bench $end\n$scope module top $end\n$var wire 1 ! clk $end\n"
+            "$var wire 1 # o__valid $end\n$var wire 1 $ o__ready $end\n$var wire 8 % o__payload $end\n"
+            "$upscope $end\n$upscope $end\n$enddefinitions $end\n")
+    body = "#0\n$dumpvars\n0!\n0#\n1$\nb0 %\n$end\n" + "".join(
+        f"#{10 * k + 5}\n1!\n{k % 2}#\nb{k * 17 % 256:b} %\n#{10 * k + 10}\n0!\n" for k in range(30))
+    vcd = tmp_path / "run.vcd"
+    w = VcdWindow(open(vcd, "w"), 2, 20, counter=True)   # noqa: SIM115 - closed by w.close()
+    w.write(head + body)
+    w.close()
+    svg = wave_svg(vcd, tmp_path / "w.svg", title="t <1>")
+    text = svg.read_text()
+    assert text.startswith("<svg") and "t &lt;1&gt;" in text
+    for name in ("clk", "cycle", "o__valid", "o__ready", "o__payload"):
+        assert f">{name}" in text, name
+    assert ">22<" in text          # o__payload = 2 * 17 = 0x22 at edge 2, the window's first
+    assert text.count("<polygon") >= 17 and text.count("<line") > 30

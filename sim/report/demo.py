@@ -351,13 +351,14 @@ def _cross_chart(rows: list[dict], path: Path, scene: str) -> str | None:
     return path.name
 
 
-#: the wave snapshot of each HDL block: pysim on its default scene at this size, these clock edges
-SNAPSHOT_SIZE, SNAPSHOT_EDGES = (32, 32), (20, 60)
+#: the wave snapshot of each HDL block: pysim on this scene (5 solid polygons) at this size,
+#: these clock edges (a short run: elaboration and a small frame, not the demo's scene)
+SNAPSHOT_SCENE, SNAPSHOT_SIZE, SNAPSHOT_EDGES = "experts-solid-5", (16, 16), (20, 60)
 
 
 def wave_snapshots(sims, folder: Path) -> list[dict]:
     """One wave snapshot per HDL sim block (``sims``: (machine, block) pairs): a short pysim run
-    of the block on its default scene at :data:`SNAPSHOT_SIZE`, traced for clock edges
+    of the block on :data:`SNAPSHOT_SCENE` at :data:`SNAPSHOT_SIZE`, traced for clock edges
     :data:`SNAPSHOT_EDGES` (``sim/engines/waves.py: recording``), drawn as SVG
     (``sim/report/wavesvg.py``). A block whose snapshot cannot be made says why instead."""
     import tempfile
@@ -370,15 +371,15 @@ def wave_snapshots(sims, folder: Path) -> list[dict]:
     out = []
     for m, b in sims:
         start, end = SNAPSHOT_EDGES
-        what = (f"pysim, {b.default_scene} at {SNAPSHOT_SIZE[0]}x{SNAPSHOT_SIZE[1]}, clock edges {start}..{end - 1} "
-                f"(rasterhw sim {b.name} --engine pysim --scene {b.default_scene} --size "
+        what = (f"pysim, {SNAPSHOT_SCENE} at {SNAPSHOT_SIZE[0]}x{SNAPSHOT_SIZE[1]}, clock edges {start}..{end - 1} "
+                f"(rasterhw sim {b.name} --engine pysim --scene {SNAPSHOT_SCENE} --size "
                 f"{SNAPSHOT_SIZE[0]}x{SNAPSHOT_SIZE[1]} --waves run.vcd --trace-start {start} --trace-end {end})")
         entry = {"machine": m.name, "block": b.name, "svg": None, "what": what, "why_not": None}
         try:
             with tempfile.TemporaryDirectory() as tmp:
                 vcd = Path(tmp) / "run.vcd"
                 with recording(vcd, "pysim", start=start, end=end) as traces:
-                    _run_sim(m.name, b.name, "pysim", None, SNAPSHOT_SIZE)
+                    _run_sim(m.name, b.name, "pysim", SNAPSHOT_SCENE, SNAPSHOT_SIZE)
                 got = wave_svg(traces[0], folder / f"{b.name}.svg", title=f"{m.name} {b.name}: {what.split(' (')[0]}")
                 if got is None:
                     entry["why_not"] = "the trace has no clock edges in the window"
