@@ -193,8 +193,9 @@ def test_report_fpga_runs_place_and_route_only_when_asked(monkeypatch, tmp_path)
         r = CliRunner().invoke(cli.cli, ["report", *args, "--out", str(tmp_path)])
         assert r.exit_code == 0, r.output
     fpga = [kw for name, kw in calls if name == "fpga"]
-    assert [kw.get("cached_only") for kw in fpga] == [True, False, True]
-    assert all("cached_only" not in kw for name, kw in calls if name != "fpga")
+    # without --rerun the rows are the record's alone (issue 53: no Verilog, no tool runs)
+    assert [kw.get("records_only") for kw in fpga] == [True, False, True]
+    assert all("records_only" not in kw and "cached_only" not in kw for name, kw in calls if name != "fpga")
     r = CliRunner().invoke(cli.cli, ["report", "snu", "--rerun", "--out", str(tmp_path)])
     assert isinstance(r.exception, cli.RasterhwError)
 

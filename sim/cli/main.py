@@ -377,14 +377,18 @@ def _scheduler_options(f):
 @cli.command()
 @click.argument("system", type=click.Choice([*_report_systems(), "all"]))
 @click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON on stdout.")
-@click.option("--out", "out_dir", type=click.Path(file_okay=False), default="docs/reproduction", show_default=True,
-              help="Where SYSTEM.md and its plots are written.")
+@click.option("--out", "out_dir", type=click.Path(file_okay=False), default=None,
+              help="Where SYSTEM.md and its plots are written. Default: the checkout's docs/reproduction/ when "
+                   "rasterhw runs from a checkout (from any folder); for an installed package, reports/ in the "
+                   "cache folder ($RASTERHW_CACHE, else the user's cache folder), never the current folder.")
 @click.option("--engine", type=click.Choice(ENGINES), default="verilator",
               show_default=True, help="HDL simulator for rows measured from HDL cycles (full frames always "
               "run on a compiled simulator).")
 @click.option("--fast", is_flag=True, help="Keep slow rows (synthesis, place and route) unmeasured.")
-@click.option("--rerun", is_flag=True, help="fpga: run place and route again (minutes to an hour per block); "
-              "without it the fpga rows come from the recorded runs (docs/reproduction/fpga_runs.json, build/pnr-*).")
+@click.option("--rerun", is_flag=True, help="fpga: check every recorded run against the design as it is now "
+              "and run synthesis and place and route for what changed (minutes to an hour per block); without it "
+              "the fpga rows come from the recorded runs alone (fpga_runs.json in --out, else the checkout's "
+              "docs/reproduction/fpga_runs.json): no Verilog, no Yosys, no nextpnr.")
 @_scheduler_options
 def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, rerun: bool, scheduler: str,
            store: str | None, fresh: bool) -> None:
@@ -404,12 +408,16 @@ def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, re
     check_engine(engine)
     check_cache()
     check_scheduler(scheduler)   # what answers at its address too, before anything runs
+    from rasterhw.sim.report.rows import default_report_dir
+
+    out_dir = out_dir or str(default_report_dir())
     rows = []
     for name in names:
         extra = {}
         if name == "fpga" and not fast:
-            # place and route takes minutes to an hour per block: never started unasked
-            extra["cached_only"] = not rerun
+            # synthesis and place and route take minutes to an hour per block: never started
+            # unasked; without --rerun the rows are the record's
+            extra["records_only"] = not rerun
             if rerun:
                 info("fpga: running place and route for every configuration (minutes to an hour per block)")
         rows += run_report(name, out_dir=Path(out_dir), engine=engine, progress=not as_json, fast=fast,

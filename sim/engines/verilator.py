@@ -34,6 +34,7 @@ from amaranth.hdl import (
 )
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.cachefile import matches, sha256_file, warn_damaged
+from rasterhw.sim.engines import waves
 from rasterhw.sim.engines.memh import memh_uint64, read_memh
 from rasterhw.sim.engines.packed import as_bytes, records
 from rasterhw.sim.engines.runner import (
@@ -378,6 +379,7 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
     opt = opt or (PGO_OPT if prof is not None else tb.verilator_opt)
     exe, build_s = _build(top, opt, pgo=prof, hier=blocks)
     dut = tb.dut(params)   # for the port widths and the status values' names and widths (not simulated)
+    waves.declare_payloads({n: port_of(dut, n) for n in (*tb.inputs_of(params), *tb.outputs_of(params))})
     words, stamps, meta, _ = _run_exe(exe, tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
                                       inputs=inputs, max_cycles=max_cycles, dut=dut, clocks=clocks)
     status = unpack_status(status_of(tb, dut, params), int(meta.get("status", 0)))

@@ -82,7 +82,28 @@ def canonical_port_lists(text: str) -> str:
         ports = sorted(p.strip() for p in m.group(3).replace("\n", " ").split(",") if p.strip())
         return f"module {m.group(1)}{m.group(2)}(" + ", ".join(p + " " if p.startswith("\\") else p
                                                               for p in ports) + ");"
-    return _MODULE_HEADER.sub(fix, text)
+    return yosys_init_renamed(_MODULE_HEADER.sub(fix, text))
+
+
+# Yosys's Verilog backend gives every module with a combinational ``always`` a register that only
+# starts those blocks at time 0: ``reg \$auto$verilog_backend.cc:2355:dump_module$5 = 0;``. The
+# ``:`` in that name stops GTKWave's VCD reader ("$VAR parse error", issue 53), so every text
+# this module writes names it ``_yosys_init_2355_5``: a plain identifier, and one Verilator leaves
+# out of traces (it traces no name that starts with ``_`` unless asked, ``--trace-underscore``).
+_YOSYS_INIT = re.compile(r"\\\$auto\$verilog_backend\.cc:(\d+):dump_module\$(\d+)(?=\s)")
+_YOSYS_INIT_RENAMED = re.compile(r"\b_yosys_init_(\d+)_(\d+)\b")
+
+
+def yosys_init_renamed(text: str) -> str:
+    """``text`` with Yosys's time-0 trigger registers renamed (see above); a one-to-one renaming
+    of names local to their module, so the circuit is the same."""
+    return _YOSYS_INIT.sub(r"_yosys_init_\1_\2", text)
+
+
+def yosys_init_restored(text: str) -> str:
+    """The inverse of :func:`yosys_init_renamed`: the names Yosys wrote. Cache keys made before
+    the renaming (synthesis, place and route: ``sim/flow/synth.py: stable_text``) stay valid."""
+    return _YOSYS_INIT_RENAMED.sub(r"\\$auto$verilog_backend.cc:\1:dump_module$\2", text)
 
 
 _MODULE_START = re.compile(r"^module\s+(\\\S+|[A-Za-z_][\w$]*)")
@@ -90,7 +111,7 @@ _MODULE_START = re.compile(r"^module\s+(\\\S+|[A-Za-z_][\w$]*)")
 _INSTANCE = re.compile(r"^(\s+)(\\\S+|[A-Za-z_][\w$]*)(?=\s+(?:#|\\\S+\s+\(|[A-Za-z_][\w$]*\s*\())")
 # yosys-internal names (``\$auto$verilog_backend.cc:2355:dump_module$5``, ``\$12``): local to
 # their module, numbered by counters global to the file
-_INTERNAL = re.compile(r"\\\$\S+")
+_INTERNAL = re.compile(r"\\\$\S+|\b_yosys_init_\d+_\d+\b")
 
 
 def merge_identical_modules(text: str, *, no_inline: Callable[[str, int, int], bool] | None = None) -> str:

@@ -5,10 +5,9 @@ GTKWave save file ``out.gtkw`` beside it and an optional window of cycles
 :func:`recording` wraps one simulation run:
 
 * ``--engine pysim``: every Amaranth ``Simulator`` the run creates writes its trace with
-  ``Simulator.write_vcd`` (VCD; pysim writes no FST). A run with several simulators (one per
-  line or per chip) writes ``out.vcd``, ``out.1.vcd``, ...; a simulator whose testbench declared
-  its stream ports (:func:`declare_streams`, the generic pysim engine does) gets Amaranth's own
-  GTKWave save file (``write_vcd(gtkw_file=, traces=)``), one group per stream port;
+  ``Simulator.write_vcd`` (VCD; pysim writes no FST) through :class:`VcdWindow`, which adds a
+  cycle counter (``rasterhw.cycle``: the clock's rising edges from 0). A run with several
+  simulators (one per line or per chip) writes ``out.vcd``, ``out.1.vcd``, ...;
 * ``--engine verilator`` / ``icarus`` on a cocotb bench: ``WAVES=1`` for the run (cocotb's
   runner builds with tracing: VCD from Verilator's ``--trace``, the bench's own dump from
   Icarus), and the trace the run wrote is copied to the path given (its suffix must match);
@@ -27,12 +26,16 @@ which keeps the header, writes every value at the window's first time step and t
 changes inside the window (the edges are those of the trace's ``clk``). A cocotb bench's VCD is
 cut the same way after the run.
 
-Every VCD without Amaranth's save file gets one from :func:`write_gtkw`: the trace's header is
-read, and the stream ports of the block (Amaranth names a port's members ``PORT__valid``,
+Every trace gets a save file from :func:`write_gtkw`: its header is read with wellen
+(``pywellen``, the parser Surfer uses; VCD and FST), and the save file shows the clock, the reset
+and a cycle counter (the compiled bench's ``cycles``, or the one added to a pysim trace), then
+the stream ports of the block (Amaranth names a port's members ``PORT__valid``,
 ``PORT__ready``, ``PORT__payload``, in pysim and in the generated Verilog alike) in the
-shallowest scope that has any are listed, one GTKWave group per port. Shared code knows no machine:
-the names are the block's own. FST traces get no save file (reading FST needs a library we do
-not carry).
+shallowest scope that has any, one GTKWave group per port, a payload whose structure an engine
+declared (:func:`declare_payloads`) split into its fields; zoomed to the whole trace, with the
+dump path relative to the save file. Names GTKWave cannot read are said on stderr
+(:func:`gtkwave_unreadable`); the generated Verilog has none (``sim/engines/verilog.py:
+yosys_init_renamed``). Shared code knows no machine: the names are the block's own.
 
 Open the file with Surfer (``surfer out.vcd``, or drop it on https://app.surfer-project.org)
 or GTKWave (``gtkwave out.gtkw``, or ``gtkwave out.fst``); see ``docs/architecture.md#waves``.
@@ -113,6 +116,7 @@ def declare_streams(sim, streams: dict) -> None:
     """Say which stream ports (``{name: interface}``) simulator ``sim`` drives and collects: with
     ``--waves`` its GTKWave save file shows one group per port (Amaranth writes it)."""
     _streams[sim] = dict(streams)
+    declare_payloads(streams)
 
 
 def check_window(start: int | None, end: int | None, *, waves: object = True) -> tuple[int, int | None]:
@@ -140,8 +144,11 @@ class VcdWindow:
     ``end`` is written. ``name`` and :meth:`tell` are those of the file written (Amaranth's GTKWave
     writer reads them)."""
 
-    def __init__(self, out, start: int, end: int | None, clock: str = "clk"):
+    def __init__(self, out, start: int, end: int | None, clock: str = "clk", *, counter: bool = False):
         self.out, self.start, self.end, self.clock = out, start, end, clock
+        self.counter = counter    # add ``rasterhw.cycle``: the clock edges counted from 0
+        self._ids: set[str] = set()
+        self._cid: str | None = None
         self.name = getattr(out, "name", "")
         self._buf = ""
         self._header = True
@@ -186,12 +193,17 @@ class VcdWindow:
         self._written += len(text)
 
     def _line(self, ln: str) -> None:
+        if self._header and self.counter and "$enddefinitions" in ln.split():
+            self._cid = next(c for k in range(len(self._ids) + 1) if (c := f"rhw{k}") not in self._ids)
+            self._emit(f"$scope module rasterhw $end\n$var wire 32 {self._cid} cycle [31:0] $end\n$upscope $end\n")
         if self._header:
             self._emit(ln + "\n")
             tok = ln.split()
-            if tok[:1] == ["$var"] and len(tok) >= 5 and self._clk is None and tok[4].lstrip("\\") == self.clock:
-                self._clk = tok[3]
-            elif "$enddefinitions" in tok:
+            if tok[:1] == ["$var"] and len(tok) >= 5:
+                self._ids.add(tok[3])
+                if self._clk is None and tok[4].lstrip("\\") == self.clock:
+                    self._clk = tok[3]
+            if "$enddefinitions" in tok:
                 self._header = False
             return
         if not ln:
@@ -211,13 +223,19 @@ class VcdWindow:
     def _finish_block(self) -> None:
         if self._t is None:
             return
+        rose = False
         for ident, ln in self._block:
             self._last[ident] = ln
             if ident == self._clk:
                 v = ln[0]
                 if v == "1" and self._clk_val != "1":
                     self.edges += 1
+                    rose = True
                 self._clk_val = v
+        if self._cid is not None and rose:   # the edge's number, from 0 at the first
+            ln = f"b{self.edges - 1:b} {self._cid}"
+            self._last[self._cid] = ln
+            self._block.append((self._cid, ln))
         c = self.edges              # rising edges at or before this time step
         inside = c >= self.start + 1 and (self.end is None or c <= self.end)
         if inside:
@@ -247,28 +265,37 @@ def cut_vcd(src: Path, dst: Path, start: int, end: int | None) -> VcdWindow:
     return w
 
 
-_VAR = re.compile(r"\$var\s+\S+\s+(\d+)\s+(\S+)\s+(\S+)(?:\s+(\[[^\]]*\]))?\s+\$end")
-
-
 def vcd_header(path: Path) -> list[tuple[tuple[str, ...], str, int, str, str]]:
-    """Every variable a VCD declares: ``(scope path, name, width, bit range or "", id code)``."""
-    out, scope = [], []
-    with open(path) as f:
-        text = ""
-        for ln in f:
-            text += ln
-            if "$enddefinitions" in ln:
-                break
-    for tok in re.finditer(r"\$scope\s+\S+\s+(\S+)\s+\$end|\$upscope\s+\$end|(\$var\s.*?\$end)", text, re.S):
-        if tok.group(1) is not None:
-            scope.append(tok.group(1))
-        elif tok.group(2) is None:
-            scope.pop()
-        else:
-            m = _VAR.match(" ".join(tok.group(2).split()))
-            if m:
-                out.append((tuple(scope), m.group(3), int(m.group(1)), m.group(4) or "", m.group(2)))
+    """Every variable a trace (VCD or FST) declares: ``(scope path, name, width, bit range, signal)``,
+    read with wellen (``pywellen``, the parser Surfer uses) from the header alone. ``bit range`` is
+    ``[width-1:0]`` for a vector (what GTKWave appends to a vector's name; Amaranth's Verilog and
+    pysim number every vector from 0), ``""`` for one bit; ``signal`` is the same string for every
+    variable that names the same net (a module port and the bench wire it is connected to)."""
+    import pywellen
+
+    try:
+        w = pywellen.Waveform(str(path), multi_threaded=False, stream_only=True)
+    except Exception as e:   # pywellen raises its own exception types (and OSError) with one line
+        raise RasterhwError(f"{path}: not a trace wellen can read: {str(e).splitlines()[0] if str(e) else e!r}") from None
+    out = []
+
+    def walk(scopes, above):
+        for sc in scopes:
+            here = (*above, sc.name)
+            for v in sc.vars():
+                width = v.bitwidth or 1
+                out.append((here, v.name, width, f"[{width - 1}:0]" if width > 1 else "", str(v.signal_ref)))
+            walk(sc.scopes(), here)
+
+    walk(w.scopes(), ())
     return out
+
+
+def gtkwave_unreadable(vars_) -> list[str]:
+    """The variables of :func:`vcd_header` whose names GTKWave's VCD reader rejects ("$VAR parse
+    error"): a ``:`` in a name (GTKWave 3.3.118 reads it as the start of a bit range; Yosys's
+    ``$auto$verilog_backend.cc:N:dump_module$K`` registers had one, issue 53)."""
+    return [".".join((*s, n)) for s, n, *_ in vars_ if ":" in re.sub(r"\[\d+:\d+\]$", "", n)]
 
 
 _STREAM = re.compile(r"^\\?(?P<port>[A-Za-z_][A-Za-z0-9_]*?)__(?P<member>valid|ready|payload)(?P<rest>(\.[^$]*)?)$")
@@ -289,34 +316,161 @@ def stream_signals(vars_) -> tuple[tuple[str, ...], dict[str, list[str]]]:
     parent_ids = {i for s, *_, i in vars_ if s == top[:-1]}
     ports: dict[str, list[tuple[int, str, str]]] = {}
     wired: set[str] = set()
-    for s, n, w, r, i, m in hits:
+    for s, n, _w, r, i, m in hits:
         if s != top:
             continue
-        rng = r or (f"[{w - 1}:0]" if w > 1 else "")
-        ports.setdefault(m["port"], []).append((_ORDER[m["member"]], m["rest"], ".".join((*s, n)) + rng))
+        ports.setdefault(m["port"], []).append((_ORDER[m["member"]], m["rest"], ".".join((*s, n)) + r))
         if i in parent_ids:
             wired.add(m["port"])
+    # the ports an engine declared (:func:`declare_payloads`): pysim's trace has no bench scope
+    # above the block, so its sub-blocks' ports look like the block's own
+    declared = _declared & set(ports)
     return top, {p: [name for *_, name in sorted(sig, key=lambda t: (t[0], t[1]))]
-                 for p, sig in ports.items() if not wired or p in wired}
+                 for p, sig in ports.items() if (not wired or p in wired) and (not declared or p in declared)}
+
+
+def _shallowest(vars_, name: str, scope: tuple[str, ...] = ()) -> str | None:
+    """GTKWave name of the shallowest variable called ``name`` (inside ``scope`` if one is given
+    and has it), or None."""
+    got = [(len(s), k, ".".join((*s, n)) + r) for k, (s, n, w, r, i) in enumerate(vars_)
+           if n == name and s[:len(scope)] == scope]
+    if not got and scope:
+        return _shallowest(vars_, name)
+    return min(got)[2] if got else None
+
+
+#: payload fields of the stream ports the engines declared (:func:`declare_payloads`), by port
+#: name: ``[(field, lsb, width), ...]`` (nested structures as dotted names, leaves only)
+_payloads: dict[str, list[tuple[str, int, int]]] = {}
+#: the stream ports the engines declared, as the trace names them (``o_merge[0]`` -> ``o_merge__0``)
+_declared: set[str] = set()
+
+
+def payload_fields(shape) -> list[tuple[str, int, int]]:
+    """Leaf fields ``(dotted name, lsb, width)`` of a payload shape (a ``data.Layout`` /
+    ``data.Struct``; an array layout's elements named by index); ``[]`` for a plain value."""
+    from amaranth.hdl import Shape
+    from amaranth.lib import data
+
+    try:
+        lay = data.Layout.cast(shape)
+    except TypeError:
+        return []
+    out = []
+    for name, f in lay:
+        sub = payload_fields(f.shape)
+        if sub:
+            out += [(f"{name}.{n}", f.offset + lsb, w) for n, lsb, w in sub]
+        else:
+            out.append((str(name), f.offset, Shape.cast(f.shape).width))
+    return out
+
+
+def declare_payloads(ports: dict) -> None:
+    """Say what the payload of each stream port (``{name: interface}``) is made of: the GTKWave
+    save file splits a payload the trace holds as one vector (an input port's, on pysim and on
+    Verilator alike) into these fields."""
+    for name, port in ports.items():
+        traced = name.replace("[", "__").replace("]", "").replace(".", "__")
+        _declared.add(traced)
+        payload = getattr(port, "payload", None)
+        shape = getattr(payload, "shape", None)
+        fields = payload_fields(shape()) if callable(shape) else []
+        if fields:
+            _payloads[traced] = fields
+
+
+#: GTKWave's window on a trace: the save file asks for this size and fits the trace into the
+#: wave area (about the width less the signal list)
+GTKW_SIZE = (1400, 800)
+_WAVE_PX = 1100
+
+
+def fit_zoom(t0: int, t1: int, px: int = _WAVE_PX) -> float:
+    """GTKWave's zoom (``*Z`` line of a save file) that shows time ``t0 .. t1`` in ``px`` pixels:
+    one pixel is ``2**-Z`` time units of the trace."""
+    import math
+
+    return -math.ceil(math.log2(max(t1 - t0, 1) / px))
+
+
+def _time_span(path: Path) -> tuple[int, int] | None:
+    """First and last time step of a VCD (the first ``#T`` after the header, the last in the
+    file's tail); None for an FST or a trace with no time step."""
+    if path.suffix != ".vcd":
+        return None
+    first = last = None
+    with open(path, "rb") as f:
+        for ln in f:
+            if ln.startswith(b"#") and ln[1:].strip().isdigit():
+                first = int(ln[1:])
+                break
+        if first is None:
+            return None
+        f.seek(max(0, f.seek(0, 2) - (1 << 16)))
+        for ln in f.read().splitlines():
+            if ln.startswith(b"#") and ln[1:].strip().isdigit():
+                last = int(ln[1:])
+    return first, max(first, last or first)
 
 
 def write_gtkw(vcd: Path, gtkw: Path | None = None) -> Path:
     """A GTKWave save file beside ``vcd`` (``out.vcd`` -> ``out.gtkw``) that opens the trace with
-    the block's stream ports (:func:`stream_signals`), one group per port."""
+    its clock, reset and cycle counter, then the block's stream ports (:func:`stream_signals`),
+    one group per port, a payload held as one vector split into its fields
+    (:func:`declare_payloads`), zoomed to show the whole trace. The dump path is relative to the
+    save file (GTKWave takes it so when ``[savefile]`` is relative too): the pair can be moved."""
+    import os
+    import sys
+
     from vcd.gtkw import GTKWSave
 
     vcd, gtkw = Path(vcd), Path(gtkw) if gtkw else Path(vcd).with_suffix(".gtkw")
-    top, ports = stream_signals(vcd_header(vcd))
+    vars_ = vcd_header(vcd)
+    bad = gtkwave_unreadable(vars_)
+    if bad:
+        print(f"warning: {vcd}: {len(bad)} name(s) GTKWave cannot read (first: {bad[0]})", file=sys.stderr)
+    top, ports = stream_signals(vars_)
+    clk = _shallowest(vars_, "clk", top[:-1])
+    rst = _shallowest(vars_, "rst", top[:-1])
+    # the cycle counter: the one this module adds to a pysim trace (:class:`VcdWindow`), else
+    # the compiled bench's own ``cycles`` beside its clock
+    cycle = _shallowest(vars_, "cycle", ("rasterhw",)) if any(s == ("rasterhw",) for s, *_ in vars_) else None
+    if cycle is None and clk is not None:
+        cyc = [".".join((*s, n)) + r for s, n, w, r, i in vars_ if n == "cycles" and len(s) == 1
+               and ".".join(s) == clk.rsplit(".", 1)[0]]
+        cycle = cyc[0] if cyc else None
+    span = _time_span(vcd)
     with open(gtkw, "w") as f:
         g = GTKWSave(f)
-        g.comment(f"rasterhw: the stream ports of {'.'.join(top) or 'the trace'}")
-        g.dumpfile(str(vcd.resolve()))
+        g.comment(f"rasterhw: {'.'.join(top) or 'the trace'}: clock, reset, cycle counter and stream ports")
+        g.dumpfile(os.path.relpath(vcd.absolute(), gtkw.absolute().parent), abspath=False)
+        g.savefile(gtkw.name, abspath=False)
+        g.size(*GTKW_SIZE)
+        if span is not None:   # zoomed to fit the whole trace
+            g.timestart(span[0])
+            g.zoom_markers(fit_zoom(*span), span[0])
         for k in range(1, len(top) + 1):
             g.treeopen(".".join(top[:k]))
+        for name, fmt in ((clk, "bin"), (rst, "bin"), (cycle, "dec")):
+            if name is not None:
+                g.trace(name, datafmt=fmt)
         for port, names in ports.items():
+            fields = _payloads.get(port)
             with g.group(port):
                 for n in names:
+                    m = re.search(r"__payload\[(\d+):0\]$", n)
+                    if fields and not m and "__payload." in n:
+                        continue   # a field the trace holds itself: shown from the payload below
                     g.trace(n)
+                    if fields and m:
+                        # GTKWave's combined trace: bits of the one payload vector, (k) counted
+                        # from its MSB (GTKWave does not find Verilator's dotted field names)
+                        width = int(m.group(1)) + 1
+                        for field, lsb, w in fields:
+                            if lsb + w <= width:
+                                bits = " ".join(f"({width - 1 - b}){n}" for b in range(lsb + w - 1, lsb - 1, -1))
+                                f.write(f"#{{{n[:m.start()]}__payload.{field}[{w - 1}:0]}} {bits}\n")
     return gtkw
 
 
@@ -360,32 +514,28 @@ def _pysim(path: Path, window: tuple[int, int | None]) -> Iterator[list[Path]]:
         out = _nth(path, len(written))
         written.append(out)
         streams = _streams.get(self)
-        gtkw = str(out.with_suffix(".gtkw")) if streams else None
-        if window == (0, None):
-            vcd_file = str(out)
-        else:
-            vcd_file = VcdWindow(open(out, "w"), *window)   # noqa: SIM115 - closed below
-            vcd_file.name = str(out)
-            windows.append(vcd_file)
+        # every trace goes through the window filter (the whole run when no window was asked
+        # for), which adds the cycle counter; the save file is ours (:func:`write_gtkw`)
+        vcd_file = VcdWindow(open(out, "w"), *window, counter=True)   # noqa: SIM115 - closed below
+        vcd_file.name = str(out)
+        windows.append(vcd_file)
         try:
-            with self.write_vcd(vcd_file, gtkw, traces=streams or ()):
+            with self.write_vcd(vcd_file, traces=streams or ()):
                 return orig(self)
         finally:
-            if not isinstance(vcd_file, str):
-                vcd_file.close()
+            vcd_file.close()
 
     Simulator.run = run
     try:
         yield written
     finally:
         Simulator.run = orig
-    if windows and not any(w.opened for w in windows):
+    if window != (0, None) and windows and not any(w.opened for w in windows):
         # (a run of several simulators, one per line or chip: one that ended before the window
         # keeps a trace with its header only, as long as another reached it)
         raise RasterhwError(f"--trace-start {window[0]}: the run ended after {max(w.edges for w in windows)} cycles")
     for out in written:
-        if not out.with_suffix(".gtkw").exists():
-            write_gtkw(out)
+        write_gtkw(out)
 
 
 @contextlib.contextmanager
@@ -406,6 +556,8 @@ def recording(path: str | Path | None, engine: str, *, start: int | None = None,
         raise RasterhwError(f"--waves {path}: Verilator's FST writer needs lz4.h and zlib.h, not installed here "
                             "(Debian: liblz4-dev zlib1g-dev); name a .vcd file")
     path.parent.mkdir(parents=True, exist_ok=True)   # only once the name is good
+    _payloads.clear()
+    _declared.clear()
     if engine == "pysim":
         with _pysim(path, window) as written:
             yield written
@@ -439,8 +591,7 @@ def recording(path: str | Path | None, engine: str, *, start: int | None = None,
                                     f"(no trace written to {missing[0]})")
             raise RasterhwError(f"--waves: the run wrote no trace to {missing[0]}")
         for p in written:
-            if p.suffix == ".vcd":
-                write_gtkw(p)
+            write_gtkw(p)   # VCD or FST: wellen reads both, and so does GTKWave
         return
     # a cocotb bench (WAVES=1): the trace its runner wrote in the build folder
     traces = [p for ext in ("*.fst", "*.vcd") for p in BUILD_ROOT.rglob(ext)
@@ -459,6 +610,5 @@ def recording(path: str | Path | None, engine: str, *, start: int | None = None,
             raise RasterhwError(f"--trace-start {window[0]}: the run ended after {w.edges} cycles")
     else:
         shutil.copyfile(newest, path)
-    if path.suffix == ".vcd":
-        write_gtkw(path)
+    write_gtkw(path)
     written.append(path)

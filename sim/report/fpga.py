@@ -6,6 +6,8 @@ each machine's parameter sweeps. A report not tied to one machine (``EXTRA_REPOR
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from rasterhw.sim import registry
 from rasterhw.sim.flow.fpga import (
     DEVICE_NAMES,
@@ -17,6 +19,7 @@ from rasterhw.sim.flow.fpga import (
     not_measured_reason,
     paper_clock,
     place_and_route,
+    recorded_config,
     synth_demand,
     write_run_record,
 )
@@ -57,6 +60,35 @@ def _cfg(block: str, params: dict, kind: str) -> str:
 
 
 _NOT_RUN = "not run in the session that made this table (time): `rasterhw fpga {block}{args}`"
+_NOT_RECORDED = "no recorded run (`{record}`): `rasterhw report fpga --rerun` runs it, or `rasterhw fpga {block}{args}`"
+_NOT_RECORDED_DEMAND = ("no recorded synthesis demand (`{record}`): `rasterhw report fpga --rerun` runs it, or "
+                        "`rasterhw synth {block}`")
+
+
+def _recorded(block, params, *, family="ecp5", record=None):
+    """One configuration from the record alone (:func:`rasterhw.sim.flow.fpga.recorded_config`):
+    no Verilog, no Yosys, no nextpnr; unmeasured with why where nothing is recorded."""
+    from rasterhw.sim.paths import REPO_ROOT
+
+    rec = Path(record) if record is not None else RUN_RECORD
+    where = str(rec.relative_to(REPO_ROOT)) if rec.is_relative_to(REPO_ROOT) else str(rec)
+    args = "".join(f" -p {k}={v}" for k, v in params.items()) + ("" if family == "ecp5" else f" --family {family}")
+    if registry.flow(block).demand_from_synth and not params and family == "ecp5":
+        d = recorded_config(block, {}, demand=True, record=record)
+        if d is None:
+            return {"block": block, "params": params, "finished": False, "luts": None, "ffs": None, "brams": None,
+                    "fmax_mhz": {}, "reason": _NOT_RECORDED_DEMAND.format(record=where, block=block)}
+        if d.get("finished") is False:   # a demand recorded for an earlier design
+            return d
+        if not d["fits"]:
+            return {**d, "finished": True, "luts": None, "ffs": None, "brams": None, "fmax_mhz": {}}
+    r = recorded_config(block, params, family=family, record=record)
+    if r is None:
+        return {"block": block, "params": params, "finished": False, "luts": None, "ffs": None, "brams": None,
+                "fmax_mhz": {}, "reason": _NOT_RECORDED.format(record=where, block=block, args=args)}
+    if r.pop("fallback_pending", False):
+        r["display_reason"] = f"{_reason(r)}; {FALLBACK_ROUTER} " + _NOT_RUN.format(block=block, args=args)
+    return r
 
 
 def _measure(block, params, *, fast, progress, timeout, family="ecp5", cached_only=False):
@@ -69,6 +101,8 @@ def _measure(block, params, *, fast, progress, timeout, family="ecp5", cached_on
         print(f"fpga: {block} ({params or 'defaults'}) on {family} ...", file=sys.stderr, flush=True)
     if registry.flow(block).demand_from_synth and not params and family == "ecp5":
         d = synth_demand(block)
+        if d.get("finished") is False:   # a demand recorded for an earlier design
+            return d
         if not d["fits"]:
             return {**d, "finished": True, "luts": None, "ffs": None, "brams": None, "fmax_mhz": {}}
     r = place_and_route(block, family=family, timeout=timeout, cached_only=cached_only, **params)
@@ -92,12 +126,15 @@ def measure_task(block: str, *, family: str = "ecp5", timeout: float = REPORT_TI
 
 
 def _measure_all(configs: list[tuple[str, dict, str]], *, fast: bool, progress: bool, timeout: float,
-                 cached_only: bool, scheduler: str, store, fresh: bool) -> list[dict | None]:
-    """:func:`_measure` of every (block, params, family), as tasks on ``scheduler``, in order."""
+                 cached_only: bool, scheduler: str, store, fresh: bool, record=None) -> list[dict | None]:
+    """:func:`_measure` of every (block, params, family), as tasks on ``scheduler``, in order;
+    ``record`` (a run record's path): every configuration from that record alone, here."""
     from rasterhw.sim.flow.tasks import call, run_tasks
 
     if fast:
         return [None] * len(configs)
+    if record is not None:
+        return [_recorded(b, params, family=fam, record=record) for b, params, fam in configs]
     tasks = [call("rasterhw.sim.report.fpga:measure_task", block=b, family=fam, timeout=timeout,
                   cached_only=cached_only, **params) for b, params, fam in configs]
     got = run_tasks(tasks, scheduler=scheduler, store=store, fresh=fresh, progress=progress,
@@ -150,22 +187,29 @@ def _sweep_label(sw: FpgaSweep) -> str:
 
 
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool = False,
-         timeout: float = REPORT_TIMEOUT_S, cached_only: bool = False, scheduler: str = "serial", store=None,
-         fresh: bool = False):
+         timeout: float = REPORT_TIMEOUT_S, cached_only: bool = False, records_only: bool = False,
+         scheduler: str = "serial", store=None, fresh: bool = False):
     """Report rows: per configuration of :func:`fpga_configs`, ECP5 LUTs, flip-flops, block RAMs
     and Fmax per clock beside the paper's clock (``source`` ``hdl:nextpnr``; a full frame memory
     measured by synthesis: ``hdl:yosys``), and each sweep of :func:`fpga_sweeps` (the ZB/M chip's
     Fmax at each interleave) with a plot. ``fast``: the rows stay, unmeasured (place and route takes
     minutes to an hour per block). ``cached_only``: use the results cached in ``build/pnr-*`` and
-    run nothing (a configuration never run stays unmeasured, saying so). Every configuration is
+    the record whose digests match the design as it is now (its Verilog is generated, the tools
+    asked their versions; a demand measured by synthesis runs Yosys) and place nothing.
+    ``records_only`` (``rasterhw report fpga`` without ``--rerun``): every configuration from the
+    run record alone (``out_dir/fpga_runs.json`` if there is one, else the checkout's): no Verilog,
+    no tool runs; a configuration not recorded stays unmeasured, saying so. Every configuration is
     one task on ``scheduler`` (``rasterhw report fpga --scheduler``: the place-and-route queue on a
     Dask cluster; ``sim/flow/tasks.py``), results in this order."""
     from pathlib import Path
 
     configs = [(b, p, "ecp5") for b, p, _ in fpga_configs()] + [(b, p, "ice40") for b, p, _ in ICE40_CONFIGS]
     configs += [(sw.block, {sw.param: v, **sw.base}, "ecp5") for sw in fpga_sweeps() for v in sw.values]
+    record = None
+    if records_only and not fast:
+        record = Path(out_dir) / RUN_RECORD.name if (Path(out_dir) / RUN_RECORD.name).exists() else RUN_RECORD
     measured = _measure_all(configs, fast=fast, progress=progress, timeout=timeout, cached_only=cached_only,
-                            scheduler=scheduler, store=store, fresh=fresh)
+                            scheduler=scheduler, store=store, fresh=fresh, record=record)
     out = []
     dev = DEVICE_NAMES["ecp5"]["85k"]
     walls = []
@@ -252,7 +296,13 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
                 "cells against the device's (`nextpnr --pack-only`), or, for a frame memory that lies outside "
                 "the block (`Flow.demand_from_synth`), the RAM bits from synthesis. `paper` is the clock the paper "
                 "names: " + " ".join(m.fpga_note for m in registry.machines().values() if m.fpga_note)]
-    if cached_only:
+    if record is not None:
+        sections += ["", "This table was made from the recorded runs alone (`rasterhw report fpga`, no `--rerun`: "
+                     "`fpga_runs.json` beside it; no Verilog generated, no tool run): each row is the run of the "
+                     "design as it was on the date in the per-run table, named by its digest (the block's Verilog, "
+                     "the scripts and the tools' versions). `rasterhw report fpga --rerun` checks every digest "
+                     "against the design as it is now and places what changed."]
+    elif cached_only:
         sections += ["", "This table was made from the cached runs (`build/pnr-*`, `fpga_runs.json`) of a "
                      "place-and-route queue, one run at a time under `nice -n 10`, each with a time limit: "
                      "`python -c \"from rasterhw.sim.report.rows import run_report; run_report('fpga', cached_only=True)\"`; "
@@ -278,6 +328,10 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
             ss = "—" if r.get("synth_s") is None else f"{r['synth_s']:.0f}"
             ps = "—" if r.get("pnr_s") is None else f"{r['pnr_s']:.0f}"
             sections.append(f"| {block} | {_cfg(block, params, kind)} | {r.get('ran') or '—'} | {ss} | {ps} | {res} |")
-        write_run_record([r for *_, r in walls] + sweep,
-                         Path(out_dir) / RUN_RECORD.name)
+        if record is None:   # checked against the design by digest in this run: stamped with its sources
+            write_run_record([r for *_, r in walls] + sweep, Path(out_dir) / RUN_RECORD.name, stamp=True)
+        elif Path(record).resolve() != (Path(out_dir) / RUN_RECORD.name).resolve():
+            import shutil  # the record this table was read from goes beside it, as it is
+
+            shutil.copyfile(record, Path(out_dir) / RUN_RECORD.name)
     return out, sections

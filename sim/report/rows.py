@@ -173,6 +173,19 @@ def _load(system: str) -> Callable:
     return load(m.report)
 
 
+def default_report_dir() -> Path:
+    """Where ``rasterhw report`` writes unless ``--out`` says: the checkout's
+    ``docs/reproduction/`` when this package runs from a checkout (``pyproject.toml`` beside it),
+    wherever the command is started; otherwise (an installed wheel) ``reports/`` in the cache
+    folder (``$RASTERHW_CACHE``, else the user's cache folder: ``sim/paths.py``), never the
+    current folder."""
+    from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT
+
+    if (REPO_ROOT / "pyproject.toml").is_file() and (REPO_ROOT / "docs" / "reproduction").is_dir():
+        return REPO_ROOT / "docs" / "reproduction"
+    return BUILD_ROOT / "reports"
+
+
 def run_report(system: str, *, out_dir: Path = Path("docs/reproduction"), engine: str = "pysim",
                progress: bool = False, fast: bool = False, scheduler: str = "serial",
                store: str | Path | None = None, fresh: bool = False, **known) -> list[dict]:
