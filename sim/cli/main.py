@@ -14,6 +14,7 @@ from pathlib import Path
 import click
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
+from rasterhw.sim.cli.cache import cache as _cache_group
 from rasterhw.sim.cli.flow import add_commands, check_cache
 from rasterhw.sim.cli.jsonout import emit_json, sim_json
 from rasterhw.sim.report.rows import systems as _report_systems
@@ -118,8 +119,17 @@ def _ascii_values(given: dict) -> None:
             raise RasterhwError(f"--{k.replace('_', '-')} {v!r}: write its digits as ASCII 0-9")
 
 
+def _print_version(ctx, _param, value) -> None:
+    if value and not ctx.resilient_parsing:
+        from rasterhw.sim.version import version
+
+        click.echo(f"rasterhw, version {version()}")   # the commit too, in a checkout (sim/version.py)
+        ctx.exit()
+
+
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(package_name="rasterhw")
+@click.option("--version", is_flag=True, expose_value=False, is_eager=True, callback=_print_version,
+              help="Show the version (in a checkout: with the commit) and exit.")
 def cli() -> None:
     """RTL models (Amaranth) of parallel 3-D rendering machines of the 1980s-90s, checked
     against a NumPy golden model. Machines: see `rasterhw machines`.
@@ -131,6 +141,10 @@ def cli() -> None:
       rasterhw demo                        golden model + hardware, images and a report
       rasterhw report snu                  paper figures beside measured ones
     """
+    from rasterhw.sim.cacheinfo import apply_cap, cap_from_env
+
+    if cap_from_env() is not None:   # RASTERHW_CACHE_MAX: checked now, applied when the command ends
+        click.get_current_context().call_on_close(apply_cap)
 
 
 @cli.command()
@@ -789,6 +803,7 @@ def demo(out_dir: str, scene: str, engine: str, scheduler: str, store: str | Non
 
 
 add_commands(cli)   # synth, fpga, prove: the hardware flow (sim/cli/flow.py)
+cli.add_command(_cache_group)   # rasterhw cache info|clean (sim/cli/cache.py)
 
 
 def _terminate(signum, _frame):

@@ -32,6 +32,7 @@ mid-task has the task run again on another worker by the Dask scheduler (up to i
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import json
@@ -475,10 +476,14 @@ class Runner:
     def _load(self, digest: str) -> dict | None:
         if self.store is None or self.fresh:
             return None
+        path = self._path(digest)
         try:
-            return json.loads(self._path(digest).read_text())["result"]
+            got = json.loads(path.read_text())["result"]
         except (OSError, ValueError, KeyError):
             return None
+        with contextlib.suppress(OSError):
+            os.utime(path)   # its last use (rasterhw cache clean removes the least recently used first)
+        return got
 
     def _save(self, h: Handle, result: dict) -> None:
         if self.store is None:
