@@ -71,7 +71,7 @@ from rasterhw.sim import registry
 from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT
 
 __all__ = ["VARYING", "Handle", "Runner", "Task", "call", "check_scheduler", "close_clusters", "code_digest",
-           "batch_size", "default_store", "local_client", "one_cluster", "parse_scheduler", "run_batch", "scheduler_from_file",
+           "batch_size", "default_store", "local_client", "one_cluster", "parse_scheduler", "run_batch", "scheduler_from_file", "task_modules",
            "run_task", "run_tasks", "tool_versions"]
 
 #: result keys that may differ between two runs of one task (timings, who ran it)
@@ -280,6 +280,20 @@ def run_task(task: Task, code: str | None = None) -> dict:
     return res
 
 
+def task_modules(tasks: Iterable[Task]) -> list[str]:
+    """The modules ``tasks`` run (a sim block's driver, a golden arch's renderer, a call's own), for
+    a fork server to import once instead of every worker at its first task."""
+    refs = set()
+    for t in tasks:
+        if t.kind == "call":
+            refs.add(t.name)
+        elif t.kind == "sim" and t.name in registry.sim_blocks():
+            refs.add(registry.sim_blocks()[t.name][1].simulate)
+        elif t.kind == "render" and t.name in registry.archs():
+            refs.add(registry.archs()[t.name][1].render)
+    return sorted({r.split(":", 1)[0] for r in refs if isinstance(r, str) and ":" in r})
+
+
 def batch_size(n: int, workers: int) -> int:
     """Tasks per Dask task when ``n`` tasks go to ``workers`` workers: a quarter of each worker's
     share (at least 1), so that every worker gets several batches and a slow one does not leave
@@ -446,7 +460,7 @@ _QUIET = {"distributed.worker.profile.enabled": False,
           }
 
 
-def _forkserver() -> contextlib.AbstractContextManager:
+def _forkserver(extra: Iterable[str] = ()) -> contextlib.AbstractContextManager:
     """Dask's configuration under which a cluster's workers are forked from a fork server that
     imported :data:`_PRELOAD` (see the module docstring); unchanged where there is no fork server."""
     import multiprocessing
@@ -458,7 +472,8 @@ def _forkserver() -> contextlib.AbstractContextManager:
     cfg = dask.config.set({"distributed.worker.multiprocessing-method": "forkserver"})
     from distributed.utils import get_mp_context
 
-    get_mp_context().set_forkserver_preload(list(_PRELOAD))
+    # (takes effect when this process's fork server starts: its first cluster)
+    get_mp_context().set_forkserver_preload(list(dict.fromkeys([*_PRELOAD, *extra])))
     return cfg
 
 
@@ -490,14 +505,14 @@ def one_cluster():
             close_clusters()
 
 
-def _start_local(n: int, *, fork: bool):
+def _start_local(n: int, *, fork: bool, preload: Iterable[str] = ()):
     import logging
 
     import dask
     from distributed import Client, LocalCluster
 
     dash = "127.0.0.1:0" if _dashboard() else None
-    with _forkserver() if fork else contextlib.nullcontext(), dask.config.set(_QUIET):
+    with _forkserver(preload) if fork else contextlib.nullcontext(), dask.config.set(_QUIET):
         # a task's error reaches the caller through its result (one line); the workers' own error
         # logs (a failed task's traceback, a closed connection when the command is interrupted) are
         # not printed. The scheduler's HTTP server (health routes; the dashboard with bokeh) on a
@@ -511,13 +526,14 @@ def _start_local(n: int, *, fork: bool):
     return cluster, client
 
 
-def local_client(n: int):
+def local_client(n: int, preload: Iterable[str] = ()):
     """The client of the shared local cluster of ``n`` workers (:func:`one_cluster`), started if
-    there is none (or it stopped); the dashboard's address on stderr when there is one."""
+    there is none (or it stopped); the dashboard's address on stderr when there is one. ``preload``:
+    modules the fork server imports too (the tasks' own: :func:`task_modules`) when it starts."""
     got = _CLUSTERS.get(n)
     if got is not None and got[1].status == "running":
         return got[1]
-    _CLUSTERS[n] = _start_local(n, fork=True)
+    _CLUSTERS[n] = _start_local(n, fork=True, preload=preload)
     return _CLUSTERS[n][1]
 
 
@@ -560,12 +576,14 @@ class Runner:
     """Run tasks on one scheduler (``with Runner("local:2", store=...) as run: run.map(tasks)``)."""
 
     def __init__(self, scheduler: str = "local", *, store: str | Path | None = None, fresh: bool = False,
+                 preload: Iterable[str] = (),
                  progress: bool = False):
         self.kind, self.arg = parse_scheduler(scheduler)
         self.scheduler = scheduler
         self.store = Path(store) if store is not None else None
         self.fresh = fresh
         self.progress = progress
+        self.preload = tuple(preload)   # modules the workers' fork server imports once (task_modules)
         self.client = self.cluster = self._watch = None
         self._shared = False        # the client is this process's local cluster's (close_clusters)
         self.computed = 0           # tasks run (not found in the store)
@@ -585,7 +603,7 @@ class Runner:
             self._watch = OrphanWatch().__enter__()
             n = self.arg or _cores()
             if _SHARE:   # the command's one cluster of this size
-                self.client, self._shared = local_client(n), True
+                self.client, self._shared = local_client(n, self.preload), True
             else:
                 self.cluster, self.client = _start_local(n, fork=False)
         else:
@@ -796,7 +814,7 @@ def run_tasks(tasks: Sequence[Task], *, scheduler: str = "serial", store: str | 
     bar = tqdm(total=len(tasks), desc=desc, unit="run", disable=None if progress else True, leave=False,
                file=sys.stderr)
     try:
-        with Runner(scheduler, store=store, fresh=fresh) as run:
+        with Runner(scheduler, store=store, fresh=fresh, preload=task_modules(tasks)) as run:
             return run.map(tasks, progress=lambda _i, _h: bar.update(1))
     finally:
         bar.close()
