@@ -12,7 +12,11 @@ cache (``sim/paths.py: BUILD_ROOT``) keeps for reuse.
 * :func:`sha256_file` and :func:`matches` check the files a build folder's own record names (a
   Verilator binary: ``build.json``; a gcc profile: ``trained.json``);
 * :func:`check_writable` says, before any work, that the cache cannot be written (instead of after
-  minutes of elaboration, when the first entry is stored).
+  minutes of elaboration, when the first entry is stored);
+* :func:`mark_used` stamps the cache entry holding a file with the time it was used (its folder's
+  modification time; a file entry's record): :func:`read_entry` and :func:`matches` call it on
+  every hit, so ``rasterhw cache clean`` (``sim/cacheinfo.py``) removes the least recently *used*
+  entries first, not the oldest built; :func:`entry_of` says which entry a file belongs to.
 """
 
 from __future__ import annotations
@@ -26,11 +30,16 @@ from pathlib import Path
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.paths import BUILD_ROOT
 
-__all__ = ["RECORD_SUFFIX", "check_writable", "inside_cache", "matches", "read_entry", "sha256_file",
-           "warn_damaged", "write_entry"]
+__all__ = ["NESTED", "RECORD_SUFFIX", "check_writable", "entry_of", "inside_cache", "mark_used", "matches",
+           "read_entry", "sha256_file", "warn_damaged", "write_entry"]
 
 #: the record of an entry's SHA-256 is the entry's name with this added
 RECORD_SUFFIX = ".sha256"
+
+#: folders of the cache whose entries lie deeper than its top level: folder -> how many levels
+#: below it one entry is (``verilog/NAME-DIGEST.v``; ``tasks/AB/DIGEST.json``); every other
+#: top-level file or folder of the cache is one entry
+NESTED = {"verilog": 1, "zbm-verilog": 1, "verilator-runtime": 1, "pgo": 1, "tasks": 2}
 
 #: digests already computed in this process, by (path, inode, size, mtime): a soak's thousand
 #: runs of one binary hash it once
@@ -116,6 +125,7 @@ def read_entry(path: str | Path, *, what: str) -> bytes | None:
         for f in (path, _record(path)):
             f.unlink(missing_ok=True)
         return None
+    mark_used(path)
     return data
 
 
@@ -132,7 +142,38 @@ def matches(path: str | Path, digest: str | None, *, what: str, quiet: bool = Fa
         if not quiet:
             warn_damaged(path, what)
         return False
+    mark_used(path)
     return True
+
+
+def entry_of(path: str | Path, root: str | Path | None = None) -> Path | None:
+    """The cache entry (a file or folder :func:`mark_used` stamps, ``rasterhw cache`` lists and
+    removes) that ``path`` is in or is; None outside the cache folder ``root`` (default ``BUILD_ROOT``)."""
+    top = Path(root if root is not None else BUILD_ROOT)
+    try:
+        rel = Path(path).relative_to(top)
+    except ValueError:
+        return None
+    if not rel.parts:
+        return None
+    depth = 1 + NESTED.get(rel.parts[0], 0)
+    return top.joinpath(*rel.parts[:depth]) if len(rel.parts) >= depth else None
+
+
+def mark_used(path: str | Path) -> None:
+    """Stamp the cache entry holding ``path`` as used now: a folder entry's modification time; a
+    file entry's record (``NAME.sha256``) where it has one, so the entry's own bytes (and their
+    digest, cached by modification time) are untouched. Quietly nothing where the cache is not ours
+    to write (a shared read-only cache) or ``path`` lies outside it."""
+    entry = entry_of(path)
+    if entry is None:
+        return
+    if entry.is_file() and _record(entry).is_file():
+        entry = _record(entry)
+    try:
+        os.utime(entry)
+    except OSError:
+        pass
 
 
 def check_writable(folder: str | Path | None = None) -> Path:

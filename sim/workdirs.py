@@ -76,10 +76,12 @@ def build_lock(bdir: str | Path, *, what: str = "") -> Iterator[None]:
 
 
 def temp_run_folder(parent: str | Path, prefix: str = "run-") -> Path:
-    """A new folder under ``parent`` for one run, removed by :func:`cleanup` (or :func:`release`)."""
+    """A new folder ``parent/PREFIX-HOST-PID-*`` for one run, removed by :func:`cleanup` (or
+    :func:`release`); the host and process in its name tell ``rasterhw cache clean`` that the
+    build folder holding it is in use while that process runs (``sim/cacheinfo.py``)."""
     parent = Path(parent)
     parent.mkdir(parents=True, exist_ok=True)
-    d = Path(tempfile.mkdtemp(prefix=prefix, dir=parent))
+    d = Path(tempfile.mkdtemp(prefix=f"{prefix}{_HOST}-{os.getpid()}-", dir=parent))
     _live.add(d)
     return d
 

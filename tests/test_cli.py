@@ -43,7 +43,7 @@ def test_render_is_deterministic(tmp_path):
 def test_scenes_lists_counts():
     r = run("scenes", "--json")
     assert r.returncode == 0, r.stderr
-    rows = {row["name"]: row for row in json.loads(r.stdout)}
+    rows = {row["name"]: row for row in json.loads(r.stdout)["rows"]}
     for name in ("c50", "c100", "c150", "c200", "c250", "c300", "sp27", "sp5", "sp8", "zbm-5x5",
                  "snu-100px", "experts-1000", "experts-2000"):
         assert name in rows

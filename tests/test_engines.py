@@ -165,7 +165,7 @@ def test_machines_json_names_every_block_with_its_testbench():
 
     out = CliRunner().invoke(cli, ["machines", "--json"])
     assert out.exit_code == 0, out.output
-    ms = {m["name"]: m for m in json.loads(out.output)}
+    ms = {m["name"]: m for m in json.loads(out.output)["rows"]}
     assert set(ms) == set(registry.machines())
     blocks = {b: info for m in ms.values() for b, info in m["blocks"].items()}
     assert set(blocks) == set(registry.blocks())

@@ -15,7 +15,7 @@ SNAKE = re.compile(r"[a-z][a-z0-9_]*\Z")
 #: fields whose value is a map keyed by names of things (block names, stage labels, FPGA cells):
 #: those keys are the things' own names
 NAME_MAPS = {"blocks", "proofs", "soak", "stages_s", "busy_s", "share_of_frame", "available", "utilization",
-             "fmax_mhz", "ports", "sims"}
+             "fmax_mhz", "ports", "sims", "kinds"}
 #: unit spellings the style does not use (seconds are _s, milliseconds _ms, frequencies _hz / _mhz)
 BAD_UNITS = re.compile(r"_(sec|secs|seconds|msec|millis|khz|ghz|freq|frequency|time_s)\Z")
 
@@ -58,11 +58,47 @@ def _json_of(argv, capsys):
 
 
 def _check(obj, shape):
-    assert isinstance(obj, shape), type(obj)
-    if isinstance(obj, list):
-        assert obj and all(isinstance(r, dict) for r in obj)   # a list is rows: objects
+    """Every document is an object with its schema and version first (issue 53 item 5); a
+    command that lists things (``shape`` list) gives its rows under ``rows``."""
+    from rasterhw.sim.cli.jsonout import SCHEMAS
+    from rasterhw.sim.version import version
+
+    assert isinstance(obj, dict), type(obj)
+    assert list(obj)[:2] == ["schema", "version"], list(obj)[:3]
+    m = re.fullmatch(r"rasterhw\.([a-z-]+)/([0-9]+)", obj["schema"])
+    assert m and SCHEMAS[m.group(1)] == int(m.group(2)), obj["schema"]
+    assert obj["version"] == version()
+    if shape is list:
+        rows = obj["rows"]
+        assert set(obj) == {"schema", "version", "rows"}
+        assert rows and all(isinstance(r, dict) for r in rows)   # a list is rows: objects
+    else:
+        assert "rows" not in obj
     problems = style_problems(obj)
     assert not problems, problems
+
+
+def test_every_command_with_json_has_a_schema():
+    """Every command (and subcommand) that takes --json is in SCHEMAS, under the name its document
+    carries; every name in SCHEMAS is a command."""
+    import click
+    from rasterhw.sim.cli.jsonout import SCHEMAS, schema
+    from rasterhw.sim.cli.main import cli
+
+    found = set()
+
+    def walk(cmd, names):
+        if isinstance(cmd, click.Group):
+            for name, sub in cmd.commands.items():
+                walk(sub, [*names, name])
+        elif any("--json" in p.opts for p in cmd.params):
+            found.add("-".join(names))
+
+    walk(cli, [])
+    assert found == set(SCHEMAS)
+    assert schema("cache-info") == "rasterhw.cache-info/1"
+    with pytest.raises(RuntimeError, match="no schema"):
+        schema("nothing")
 
 
 def test_the_walker_finds_what_breaks_the_style():
@@ -120,6 +156,15 @@ def test_sim(argv, tmp_path, capsys):
         assert old not in res["extra"], old
     if argv[1] == "pixelbus":    # a machine's own figures are in extra, golden values as K_golden
         assert "cycles_golden" in res["extra"]
+
+
+def test_cache(tmp_path, capsys, monkeypatch):
+    from rasterhw.sim import paths
+
+    monkeypatch.setattr(paths, "BUILD_ROOT", tmp_path)
+    (tmp_path / "tb-x-0123456789").mkdir()
+    _check(_json_of(["cache", "info", "--json"], capsys), dict)
+    _check(_json_of(["cache", "clean", "--older-than", "1d", "--json"], capsys), dict)
 
 
 def test_sweep(tmp_path, capsys):

@@ -194,8 +194,10 @@ def test_a_dask_worker_killed_mid_tool_leaves_nothing_running(tmp_path):
                     assert time.monotonic() - t0 < 120
                     time.sleep(0.05)
                 tool = [int(x) for x in open({str(pids)!r}).read().split()]
-                worker = next(q for q in psutil.Process().children(recursive=True)
-                              if any(c.pid in tool for c in q.children(recursive=True)) and "-c" not in q.cmdline()[1:2])
+                # the worker: the process that started the tool (sh's parent) in its task; not any
+                # process above the tool (with a fork server, the server is above the worker)
+                sh = next(psutil.Process(p) for p in tool if psutil.Process(p).name() == "sh")
+                worker = sh.parent().parent()
                 os.kill(worker.pid, 9)
                 t0 = time.monotonic()
                 while any(psutil.pid_exists(p) and psutil.Process(p).status() != "zombie" for p in tool):

@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 from rasterhw.sim.engines.verilog_cache import source_digest, verilog_header
+from rasterhw.sim.version import version
 
 
 def _verilog(*args):
@@ -18,6 +19,7 @@ def test_verilog_to_stdout_starts_with_a_header_naming_block_parameters_and_stre
     assert r.returncode == 0, r.stderr
     head = r.stdout.splitlines()[:8]
     assert head[0].startswith("// rasterhw ") and "block zbm-merger" in head[0] and "-p fifo_depth=8" in head[0]
+    assert head[0].startswith(f"// rasterhw {version()}: ")   # the release and, in a checkout, the commit
     assert "fifo_depth=8" in head[1] and "z_bits=24" in head[1]          # given and default parameters
     assert source_digest("zbm-merger")[:16] in head[2]
     assert any("in  i_own: stream" in ln and "payload {s0: 64, s1: 64}" in ln for ln in head)

@@ -18,14 +18,66 @@ from rasterhw.sim.engines.vlruntime import cache_dir
 ROOT = Path(__file__).resolve().parents[1]
 
 
-@pytest.fixture(scope="module")
-def wheel(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("wheel")
-    r = subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(out), str(ROOT)],
+#: a module left in setuptools' old build folder of the checkout (as a moved module was): never shipped
+STALE = ROOT / "build" / "lib" / "rasterhw" / "sim" / "zz_stale_module.py"
+
+
+def _build_wheel(src: Path, out: Path) -> tuple[Path, str]:
+    r = subprocess.run([sys.executable, "-m", "pip", "wheel", "-v", "--no-deps", "-w", str(out), str(src)],
                        capture_output=True, text=True, timeout=900)
-    assert r.returncode == 0, r.stderr[-2000:]
+    assert r.returncode == 0, (r.stdout + r.stderr)[-2000:]
     (whl,) = out.glob("rasterhw-*.whl")
-    return whl
+    return whl, r.stdout + r.stderr
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory) -> tuple[Path, str]:
+    planted = not STALE.exists()
+    STALE.parent.mkdir(parents=True, exist_ok=True)
+    STALE.write_text("raise ImportError('a stale module of an old build folder')\n")
+    try:
+        return _build_wheel(ROOT, tmp_path_factory.mktemp("wheel"))
+    finally:
+        if planted:
+            STALE.unlink()
+
+
+@pytest.fixture(scope="module")
+def wheel(built) -> Path:
+    return built[0]
+
+
+def test_the_build_is_quiet_and_versioned_and_ships_nothing_stale(built):
+    """Every shipped folder is a declared package (no setuptools warning that one is absent from the
+    packages configuration); the build folder is not the checkout's build/ (the cache): a module
+    left there is not shipped; the wheel is named and stamped with sim/version.py's version."""
+    from rasterhw.sim.version import version
+
+    whl, log = built
+    assert "is absent from the `packages` configuration" not in log and "Package would be ignored" not in log
+    names = zipfile.ZipFile(whl).namelist()
+    assert not any("zz_stale_module" in n for n in names)
+    assert whl.name.startswith(f"rasterhw-{version()}-")
+    stamp = zipfile.ZipFile(whl).read("rasterhw/_version.py").decode()
+    assert f'VERSION = "{version()}"' in stamp
+
+
+@pytest.mark.heavy
+def test_a_wheel_from_a_tarball_without_git_has_the_release(tmp_path):
+    """A source tree without .git (git archive, as a release tarball): the wheel builds, its version
+    is the release alone."""
+    from rasterhw import __version__
+
+    if not (ROOT / ".git").exists():
+        pytest.skip("not a git checkout")
+    src = tmp_path / "src"
+    src.mkdir()
+    tar = subprocess.run(["git", "-C", str(ROOT), "archive", "--format=tar", "HEAD"], capture_output=True,
+                         check=True, timeout=120).stdout
+    subprocess.run(["tar", "-x", "-C", str(src)], input=tar, check=True, timeout=120)
+    whl, log = _build_wheel(src, tmp_path / "out")
+    assert whl.name.startswith(f"rasterhw-{__version__}-py3"), whl.name
+    assert f'VERSION = "{__version__}"' in zipfile.ZipFile(whl).read("rasterhw/_version.py").decode()
 
 
 def test_the_wheel_carries_benches_and_templates_and_nothing_of_the_checkout(wheel):
@@ -75,6 +127,11 @@ def test_the_installed_wheel_runs_a_verilator_scene_from_an_empty_folder(wheel, 
     where = subprocess.run([str(py), "-c", "import rasterhw, sys; print(rasterhw.__file__)"], cwd=work, env=env,
                            capture_output=True, text=True, check=True).stdout.strip()
     assert str(ROOT) not in where and str(site) in where
+    from rasterhw.sim.version import version
+
+    shown = subprocess.run([str(py), "-m", "rasterhw.sim.cli.main", "--version"], cwd=work, env=env,
+                           capture_output=True, text=True, check=True).stdout
+    assert shown == f"rasterhw, version {version()}\n"   # outside the checkout, the commit it was built from
     r = subprocess.run([str(py), "-m", "rasterhw.sim.cli.main", "sim", "pixelbus", "--scene", "snu-100px",
                         "--size", "64x64", "--engine", "verilator", "--json", "-o", "frame.png"],
                        cwd=work, env=env, capture_output=True, text=True, timeout=1800)

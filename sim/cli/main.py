@@ -14,6 +14,7 @@ from pathlib import Path
 import click
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
+from rasterhw.sim.cli.cache import cache as _cache_group
 from rasterhw.sim.cli.flow import add_commands, check_cache
 from rasterhw.sim.cli.jsonout import emit_json, sim_json
 from rasterhw.sim.report.rows import systems as _report_systems
@@ -118,8 +119,17 @@ def _ascii_values(given: dict) -> None:
             raise RasterhwError(f"--{k.replace('_', '-')} {v!r}: write its digits as ASCII 0-9")
 
 
+def _print_version(ctx, _param, value) -> None:
+    if value and not ctx.resilient_parsing:
+        from rasterhw.sim.version import version
+
+        click.echo(f"rasterhw, version {version()}")   # the commit too, in a checkout (sim/version.py)
+        ctx.exit()
+
+
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(package_name="rasterhw")
+@click.option("--version", is_flag=True, expose_value=False, is_eager=True, callback=_print_version,
+              help="Show the version (in a checkout: with the commit) and exit.")
 def cli() -> None:
     """RTL models (Amaranth) of parallel 3-D rendering machines of the 1980s-90s, checked
     against a NumPy golden model. Machines: see `rasterhw machines`.
@@ -131,6 +141,13 @@ def cli() -> None:
       rasterhw demo                        golden model + hardware, images and a report
       rasterhw report snu                  paper figures beside measured ones
     """
+    from rasterhw.sim.cacheinfo import apply_cap, cap_from_env
+    from rasterhw.sim.flow.tasks import one_cluster
+
+    ctx = click.get_current_context()
+    if cap_from_env() is not None:   # RASTERHW_CACHE_MAX: checked now, applied when the command ends
+        ctx.call_on_close(apply_cap)
+    ctx.with_resource(one_cluster())   # one local Dask cluster per command (sim/flow/tasks.py)
 
 
 @cli.command()
@@ -363,13 +380,35 @@ def compare(a: str, b: str, output: str | None, tolerance: int, as_json: bool) -
     sys.exit(0 if res["differing_pixels"] == 0 else 1)
 
 
+def _scheduler_file(ctx, _param, value):
+    if value is not None:
+        ctx.meta["rasterhw.scheduler_file"] = value
+    return value
+
+
+def _scheduler(ctx, _param, value):
+    """--scheduler, or the address in --scheduler-file (read when it is given; never both)."""
+    path = ctx.meta.get("rasterhw.scheduler_file")
+    if path is None:
+        return value
+    if ctx.get_parameter_source("scheduler") is not click.core.ParameterSource.DEFAULT:
+        raise RasterhwError("give --scheduler or --scheduler-file, not both")
+    from rasterhw.sim.flow.tasks import scheduler_from_file
+
+    return scheduler_from_file(path)
+
+
 def _scheduler_options(f):
-    """``--scheduler``, ``--store``, ``--fresh``: where a command's tasks run and where their
-    results are kept (sim/flow/tasks.py, docs/scale.md)."""
+    """``--scheduler`` (or ``--scheduler-file``), ``--store``, ``--fresh``: where a command's tasks
+    run and where their results are kept (sim/flow/tasks.py, docs/scale.md)."""
     f = click.option("--fresh", is_flag=True, help="Recompute every task, even those in the store.")(f)
     f = click.option("--store", type=click.Path(file_okay=False), default=None,
                      help="Folder keeping every finished task's result (default: build/tasks).")(f)
+    f = click.option("--scheduler-file", type=click.Path(dir_okay=False), default=None, expose_value=False,
+                     is_eager=True, callback=_scheduler_file,
+                     help="The Dask scheduler named in this file (dask scheduler --scheduler-file FILE).")(f)
     return click.option("--scheduler", default="local", show_default=True, metavar="serial|local[:N]|tcp://HOST:PORT",
+                        callback=_scheduler,
                         help="Where the tasks run: in this process, a local Dask cluster of N single-threaded "
                              "workers (default: one per core), or an existing Dask scheduler.")(f)
 
@@ -797,6 +836,7 @@ def demo(out_dir: str, scene: str, engine: str, scheduler: str, store: str | Non
 
 
 add_commands(cli)   # synth, fpga, prove: the hardware flow (sim/cli/flow.py)
+cli.add_command(_cache_group)   # rasterhw cache info|clean (sim/cli/cache.py)
 
 
 def _terminate(signum, _frame):

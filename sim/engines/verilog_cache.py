@@ -201,14 +201,10 @@ def verilog_header(name: str, **params) -> str:
     filled in), the design digest (:func:`source_digest`), the rasterhw and Amaranth versions, and
     each port of the block's signature — a stream as one line with its payload's fields, in the
     flattened names the Verilog uses (``<port>__payload`` ...)."""
-    from importlib.metadata import PackageNotFoundError, version
-
     from rasterhw.sim.engines.verilog import make_block
+    from rasterhw.sim.version import version
 
-    try:
-        ours = version("rasterhw")
-    except PackageNotFoundError:   # pragma: no cover - run from a bare checkout
-        ours = "unknown"
+    ours = version()   # the release and the commit (sim/version.py)
     eff = effective_params(name, params)
     given = " ".join(f"-p {k}={v}" for k, v in params.items())
     lines = [f"rasterhw {ours}: block {name} (rasterhw verilog {name}{' ' + given if given else ''})",

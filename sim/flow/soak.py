@@ -82,7 +82,8 @@ def run_soak(*, pixels: int, seed: int, blocks: list[str] | None = None, progres
     # lines go above it
     bar = tqdm(total=pixels * len(names), unit="px", unit_scale=True, desc="soak", disable=not progress,
                file=sys.stderr, dynamic_ncols=True)
-    with bar, Runner(scheduler, store=store, fresh=fresh) as run:
+    preload = ["rasterhw.sim.flow.soak", *sorted({table[b].split(":", 1)[0] for b in names})]
+    with bar, Runner(scheduler, store=store, fresh=fresh, preload=preload) as run:
         ahead = max(1, run.nworkers) if run.client is not None else 1
         t0 = time.perf_counter()
         st = {b: {"next": 0, "k": 0, "done": 0, "bad": 0, "failures": [], "queue": deque(), "wall": None}

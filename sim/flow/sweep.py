@@ -24,7 +24,7 @@ from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
-from rasterhw.sim.flow.tasks import Runner, Task
+from rasterhw.sim.flow.tasks import Runner, Task, task_modules
 
 __all__ = ["parse_param", "plan", "run_sweep", "write_outputs"]
 
@@ -131,7 +131,7 @@ def run_sweep(target: str, params: list[str], *, scenes: list[str] | None = None
     bar = tqdm(total=len(tasks), desc=f"sweep {target}", unit="point", disable=None if progress else True,
                file=sys.stderr)
     try:
-        with Runner(scheduler, store=store, fresh=fresh) as run:
+        with Runner(scheduler, store=store, fresh=fresh, preload=task_modules(tasks)) as run:
             def done(i, h):
                 bar.update(1)
                 if on_point is not None:

@@ -14,10 +14,29 @@ Dask worker's address, ``"in-process"`` for ``serial``) and ``pid`` added.
 
 * ``serial`` — in this process, one after another (debugging; nothing is started);
 * ``local`` / ``local:N`` — a ``dask.distributed.LocalCluster`` of ``N`` worker processes (default:
-  one per core), one thread each (the simulators are single-threaded and the models hold the GIL),
-  no dashboard; started on entry and stopped on exit;
+  one per core), one thread each (the simulators are single-threaded and the models hold the GIL);
+  see "What a local cluster costs" below;
 * ``tcp://HOST:PORT`` — an existing Dask scheduler (``dask scheduler`` + ``dask worker``, SLURM via
-  dask-jobqueue, SSH hosts: ``docs/scale.md``).
+  dask-jobqueue, SSH hosts: ``docs/scale.md``); ``--scheduler-file FILE`` names it by the file
+  ``dask scheduler --scheduler-file FILE`` writes (:func:`scheduler_from_file`).
+
+What a local cluster costs, and what is done about it (issue 51 item 5: ``sweep`` on ``local:2``
+was half the speed of ``serial`` on small sweeps). Measured under load (``sim/flow/tasks.py``'s
+note in ``docs/scale.md``): starting two worker processes by ``spawn`` (Dask's default) took 4.9-5.3 s
+of wall time and each worker imported Python, Dask, NumPy and rasterhw again (1.7 s CPU for two);
+closing the cluster 1.7-2.0 s; and a command that runs several lists of tasks (a report) started
+and stopped a cluster per list. Now:
+
+* one cluster per process and size: every :class:`Runner` of a command with ``local:N`` uses the
+  same cluster (its workers keep what they built and imported: generated Verilog, elaborated
+  designs, loaded models, numba's compiled code), closed at the command's end (:func:`close_clusters`);
+* workers are forked from a fork server that imported Dask, NumPy and this module once
+  (``forkserver`` with a preload list): starting two took 2.6-3.2 s and closing 0.1-0.2 s, same load;
+* :meth:`Runner.map` hands small tasks to the workers in batches (a few per worker, so that a
+  slow task still leaves the others busy), not one Dask task each;
+* the dashboard: with bokeh installed (``pip install rasterhw[dashboard]``) the cluster serves
+  Dask's dashboard on a free port and its address is said on stderr; without bokeh none. Every
+  port is a free one (never 8787: two commands at once do not clash).
 
 Results come back in task order (:meth:`Runner.map`; :meth:`Runner.submit` / :meth:`Runner.result`
 for callers that decide as they go, like the soak). Every finished result is written to the store
@@ -32,6 +51,7 @@ mid-task has the task run again on another worker by the Dask scheduler (up to i
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import json
@@ -50,8 +70,8 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
 from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT
 
-__all__ = ["VARYING", "Handle", "Runner", "Task", "call", "check_scheduler", "code_digest", "default_store",
-           "parse_scheduler",
+__all__ = ["VARYING", "Handle", "Runner", "Task", "call", "check_scheduler", "close_clusters", "code_digest",
+           "batch_size", "default_store", "local_client", "one_cluster", "parse_scheduler", "run_batch", "scheduler_from_file", "task_modules",
            "run_task", "run_tasks", "tool_versions"]
 
 #: result keys that may differ between two runs of one task (timings, who ran it)
@@ -260,6 +280,40 @@ def run_task(task: Task, code: str | None = None) -> dict:
     return res
 
 
+def task_modules(tasks: Iterable[Task]) -> list[str]:
+    """The modules ``tasks`` run (a sim block's driver, a golden arch's renderer, a call's own), for
+    a fork server to import once instead of every worker at its first task."""
+    refs = set()
+    for t in tasks:
+        if t.kind == "call":
+            refs.add(t.name)
+        elif t.kind == "sim" and t.name in registry.sim_blocks():
+            refs.add(registry.sim_blocks()[t.name][1].simulate)
+        elif t.kind == "render" and t.name in registry.archs():
+            refs.add(registry.archs()[t.name][1].render)
+    return sorted({r.split(":", 1)[0] for r in refs if isinstance(r, str) and ":" in r})
+
+
+def batch_size(n: int, workers: int) -> int:
+    """Tasks per Dask task when ``n`` tasks go to ``workers`` workers: a quarter of each worker's
+    share (at least 1), so that every worker gets several batches and a slow one does not leave
+    the others idle; up to ``4 * workers`` tasks, one each."""
+    return max(1, n // (4 * max(1, workers)))
+
+
+def run_batch(tasks: Sequence[Task], code: str | None = None) -> list[tuple[bool, object]]:
+    """Run ``tasks`` here one after another (a batch :meth:`Runner.map` gives one worker):
+    ``(True, result)`` per task, up to the first that fails, whose entry is ``(False, its error)``."""
+    out: list[tuple[bool, object]] = []
+    for t in tasks:
+        try:
+            out.append((True, run_task(t, code)))
+        except Exception as e:  # noqa: BLE001 - given back to the caller, raised there
+            out.append((False, e))
+            break
+    return out
+
+
 # ====================================================================== schedulers
 def parse_scheduler(text: str) -> tuple[str, object]:
     """``serial`` -> ("serial", None); ``local`` / ``local:N`` -> ("local", N or None);
@@ -371,6 +425,128 @@ def check_scheduler(text: str, *, limit_s: float = SCHEDULER_CHECK_S) -> tuple[s
     raise RasterhwError(f"--scheduler {arg} is not a Dask scheduler: {what}")
 
 
+def scheduler_from_file(path: str | Path) -> str:
+    """The address in a Dask scheduler file (``dask scheduler --scheduler-file FILE`` writes
+    ``{"address": "tcp://...", ...}``); a file that is missing or holds none is a one-line error."""
+    try:
+        info = json.loads(Path(path).read_text())
+    except OSError as e:
+        raise RasterhwError(f"--scheduler-file {path}: {e.strerror or e}") from None
+    except ValueError:
+        raise RasterhwError(f"--scheduler-file {path}: not a Dask scheduler file (not JSON)") from None
+    addr = info.get("address") if isinstance(info, dict) else None
+    if not isinstance(addr, str) or not addr:
+        raise RasterhwError(f"--scheduler-file {path}: no scheduler address in it (a Dask scheduler file has one)")
+    parse_scheduler(addr)
+    return addr
+
+
+# ---------------------------------------------------------------------- local clusters, one per size
+#: local clusters this process started, by worker count: (cluster, client); reused by every Runner
+_CLUSTERS: dict[int, tuple[object, object]] = {}
+#: what the fork server imports once, before it forks each worker
+_PRELOAD = ("distributed", "numpy", "rasterhw.sim.flow.tasks", "rasterhw.sim.registry")
+
+
+#: Dask's periodic work in a local cluster, made rarer: an idle cluster of two workers took 2.5
+#: CPU-seconds per 30 s here (0.84 in this process per 20 s, 0.3 per worker), taken from the
+#: simulations on a 2-core machine, and more the longer the command runs; and no statistical
+#: profiler (sampling a task's stack every 10 ms: the pysim points' deep Python stacks)
+_QUIET = {"distributed.worker.profile.enabled": False,
+          "distributed.admin.tick.interval": "1s",             # event-loop health checks (default 20 ms)
+          "distributed.admin.system-monitor.interval": "2s",   # the dashboard's CPU/memory graphs (500 ms)
+          "distributed.admin.system-monitor.disk": False,
+          "distributed.worker.memory.monitor-interval": "1s",  # memory limits (none set here; 100 ms)
+          }
+
+
+def _forkserver(extra: Iterable[str] = ()) -> contextlib.AbstractContextManager:
+    """Dask's configuration under which a cluster's workers are forked from a fork server that
+    imported :data:`_PRELOAD` (see the module docstring); unchanged where there is no fork server."""
+    import multiprocessing
+
+    import dask
+
+    if "forkserver" not in multiprocessing.get_all_start_methods():   # pragma: no cover - not Linux/macOS
+        return contextlib.nullcontext()
+    cfg = dask.config.set({"distributed.worker.multiprocessing-method": "forkserver"})
+    from distributed.utils import get_mp_context
+
+    # (takes effect when this process's fork server starts: its first cluster)
+    get_mp_context().set_forkserver_preload(list(dict.fromkeys([*_PRELOAD, *extra])))
+    return cfg
+
+
+def _dashboard() -> bool:
+    try:
+        import bokeh  # noqa: F401 - Dask's dashboard needs it (rasterhw[dashboard])
+    except ImportError:
+        return False
+    return True
+
+
+#: inside :func:`one_cluster` (a command of the CLI): Runners share one local cluster per size
+_SHARE = False
+
+
+@contextlib.contextmanager
+def one_cluster():
+    """``with one_cluster():`` every :class:`Runner` with ``local[:N]`` inside uses one cluster of
+    that size, its workers forked from a fork server that imported the models' code once, closed
+    at the end (the CLI wraps every command in it). Outside it a Runner starts and stops a cluster
+    of its own, its workers started by ``spawn`` with the environment of that moment."""
+    global _SHARE
+    outer, _SHARE = _SHARE, True
+    try:
+        yield
+    finally:
+        _SHARE = outer
+        if not outer:
+            close_clusters()
+
+
+def _start_local(n: int, *, fork: bool, preload: Iterable[str] = ()):
+    import logging
+
+    import dask
+    from distributed import Client, LocalCluster
+
+    dash = "127.0.0.1:0" if _dashboard() else None
+    with _forkserver(preload) if fork else contextlib.nullcontext(), dask.config.set(_QUIET):
+        # a task's error reaches the caller through its result (one line); the workers' own error
+        # logs (a failed task's traceback, a closed connection when the command is interrupted) are
+        # not printed. The scheduler's HTTP server (health routes; the dashboard with bokeh) on a
+        # free loopback port, never 8787 ("Port 8787 is already in use" when another has it)
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=dash,
+                               silence_logs=logging.CRITICAL,
+                               scheduler_kwargs={"dashboard_address": dash or "127.0.0.1:0"})
+    client = Client(cluster)
+    if dash is not None and cluster.dashboard_link:
+        print(f"dask dashboard: {cluster.dashboard_link}", file=sys.stderr, flush=True)
+    return cluster, client
+
+
+def local_client(n: int, preload: Iterable[str] = ()):
+    """The client of the shared local cluster of ``n`` workers (:func:`one_cluster`), started if
+    there is none (or it stopped); the dashboard's address on stderr when there is one. ``preload``:
+    modules the fork server imports too (the tasks' own: :func:`task_modules`) when it starts."""
+    got = _CLUSTERS.get(n)
+    if got is not None and got[1].status == "running":
+        return got[1]
+    _CLUSTERS[n] = _start_local(n, fork=True, preload=preload)
+    return _CLUSTERS[n][1]
+
+
+def close_clusters() -> None:
+    """Close every local cluster this process started (the CLI calls it when a command ends)."""
+    for n in list(_CLUSTERS):
+        cluster, client = _CLUSTERS.pop(n)
+        with contextlib.suppress(Exception):
+            client.close(timeout=5)
+        with contextlib.suppress(Exception):
+            cluster.close(timeout=5)
+
+
 def default_store() -> Path:
     """Where finished results are kept unless ``--store`` says otherwise."""
     return BUILD_ROOT / "tasks"
@@ -390,7 +566,8 @@ class Handle:
     task: Task
     digest: str
     result: dict | None = None          # known (from the store, or finished serially)
-    future: object = None               # a distributed.Future
+    future: object = None               # a distributed.Future (of this task, or of its batch)
+    index: int | None = None            # its place in the batch its future runs (None: a task of its own)
     stored: bool = False                # came from the store
     saved: bool = False                 # its fresh result is in the store (or there is no store)
 
@@ -399,13 +576,16 @@ class Runner:
     """Run tasks on one scheduler (``with Runner("local:2", store=...) as run: run.map(tasks)``)."""
 
     def __init__(self, scheduler: str = "local", *, store: str | Path | None = None, fresh: bool = False,
+                 preload: Iterable[str] = (),
                  progress: bool = False):
         self.kind, self.arg = parse_scheduler(scheduler)
         self.scheduler = scheduler
         self.store = Path(store) if store is not None else None
         self.fresh = fresh
         self.progress = progress
+        self.preload = tuple(preload)   # modules the workers' fork server imports once (task_modules)
         self.client = self.cluster = self._watch = None
+        self._shared = False        # the client is this process's local cluster's (close_clusters)
         self.computed = 0           # tasks run (not found in the store)
         self.reused = 0             # tasks whose result came from the store
         self._lock = threading.Lock()
@@ -414,9 +594,7 @@ class Runner:
     def __enter__(self) -> Runner:
         if self.kind == "serial":
             return self
-        import logging
-
-        from distributed import Client, LocalCluster
+        from distributed import Client
 
         if self.kind == "local":
             from rasterhw.sim.workdirs import OrphanWatch
@@ -424,16 +602,10 @@ class Runner:
             # a worker killed mid-build leaves its compiler to this process (a subreaper): ended here
             self._watch = OrphanWatch().__enter__()
             n = self.arg or _cores()
-            self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                        dashboard_address=None, silence_logs=logging.CRITICAL,
-                                        # a task's error reaches the caller through its result (one
-                                        # line); the workers' own error logs (a failed task's traceback,
-                                        # a closed connection when the command is interrupted) are not
-                                        # printed. No dashboard; the scheduler's own small HTTP server (health
-                                        # routes) on a free loopback port, not 8787 ("Port 8787 is
-                                        # already in use" on stderr when another cluster has it)
-                                        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"})
-            self.client = Client(self.cluster)
+            if _SHARE:   # the command's one cluster of this size
+                self.client, self._shared = local_client(n, self.preload), True
+            else:
+                self.cluster, self.client = _start_local(n, fork=False)
         else:
             t0 = time.monotonic()
             check_scheduler(self.scheduler)   # (at once if the command did it first) and the client: one limit
@@ -448,13 +620,18 @@ class Runner:
         return self
 
     def __exit__(self, *exc) -> None:
-        if self.client is not None:
+        if self.client is not None and not self._shared:
             self.client.close()
+        elif self.client is not None and exc and exc[0] is not None:
+            # a command that failed or was interrupted: its shared cluster goes now, with any task
+            # still running on it, not when the process ends
+            close_clusters()
         if self.cluster is not None:
             self.cluster.close()
         if self._watch is not None:
             self._watch.__exit__()
         self.client = self.cluster = self._watch = None
+        self._shared = False
 
     @property
     def nworkers(self) -> int:
@@ -475,10 +652,14 @@ class Runner:
     def _load(self, digest: str) -> dict | None:
         if self.store is None or self.fresh:
             return None
+        path = self._path(digest)
         try:
-            return json.loads(self._path(digest).read_text())["result"]
+            got = json.loads(path.read_text())["result"]
         except (OSError, ValueError, KeyError):
             return None
+        with contextlib.suppress(OSError):
+            os.utime(path)   # its last use (rasterhw cache clean removes the least recently used first)
+        return got
 
     def _save(self, h: Handle, result: dict) -> None:
         if self.store is None:
@@ -492,8 +673,9 @@ class Runner:
         os.replace(tmp, p)
 
     # ------------------------------------------------------------------ tasks
-    def submit(self, task: Task) -> Handle:
-        """Start ``task`` (serial: when its result is asked for); a stored result is used as it is."""
+    def submit(self, task: Task, *, start: bool = True) -> Handle:
+        """Start ``task`` (serial: when its result is asked for); a stored result is used as it is.
+        ``start=False``: only look in the store (:meth:`map` starts the rest in batches)."""
         h = Handle(task, task.digest())
         got = self._load(h.digest)
         if got is not None:
@@ -501,21 +683,52 @@ class Runner:
             with self._lock:
                 self.reused += 1
             return h
-        if self.client is not None:
+        if self.client is not None and start:
             h.future = self.client.submit(run_task, task, code_digest(), pure=False,
                                           key=f"{task.kind}-{h.digest[:16]}-{os.urandom(4).hex()}")
-            h.future.add_done_callback(functools.partial(self._finished, h))
+            h.future.add_done_callback(functools.partial(self._finished, [h]))
         return h
 
-    def _finished(self, h: Handle, fut) -> None:
-        """Store a result as soon as it arrives (a Dask callback thread)."""
+    def _start_batches(self, handles: list[Handle]) -> None:
+        """Start ``handles``' tasks on the cluster: one Dask task each when there are few, else in
+        batches of about a quarter of the tasks per worker each (scheduling a task costs the same
+        whatever it does: a point of a few milliseconds pays it once per batch)."""
+        size = batch_size(len(handles), self.nworkers)
+        for i in range(0, len(handles), size):
+            part = handles[i:i + size]
+            if size == 1:
+                fut = self.client.submit(run_task, part[0].task, code_digest(), pure=False,
+                                         key=f"{part[0].task.kind}-{part[0].digest[:16]}-{os.urandom(4).hex()}")
+            else:
+                fut = self.client.submit(run_batch, [h.task for h in part], code_digest(), pure=False,
+                                         key=f"batch-{part[0].digest[:16]}-{len(part)}-{os.urandom(4).hex()}")
+            for k, h in enumerate(part):
+                h.future, h.index = fut, (k if size > 1 else None)
+            fut.add_done_callback(functools.partial(self._finished, part))
+
+    def _finished(self, handles: list[Handle], fut) -> None:
+        """Store results as soon as they arrive (a Dask callback thread)."""
         if fut.status != "finished":
             return
-        try:
-            res = fut.result()
-        except Exception:  # noqa: BLE001 - the caller sees the error through result()
-            return
-        self._keep(h, res)
+        for h in handles:
+            try:
+                res = self._value(h)
+            except Exception:  # noqa: BLE001 - the caller sees the error through result()
+                continue
+            self._keep(h, res)
+
+    @staticmethod
+    def _value(h: Handle) -> dict:
+        """The result of ``h``'s future (its own, or its place in its batch's); its error raised."""
+        got = h.future.result()
+        if h.index is None:
+            return got
+        if h.index >= len(got):
+            raise RasterhwError(f"{h.task.label()}: not run (an earlier task of its batch failed)")
+        ok, val = got[h.index]
+        if not ok:
+            raise val
+        return val
 
     def _keep(self, h: Handle, res: dict) -> None:
         """Store a fresh result, once per handle, and count it."""
@@ -532,7 +745,7 @@ class Runner:
             if h.future is None:                       # serial
                 h.result = run_task(h.task)
             else:
-                h.result = h.future.result()
+                h.result = self._value(h)
             self._keep(h, h.result)
         return h.result
 
@@ -547,7 +760,7 @@ class Runner:
     def map(self, tasks: Iterable[Task], progress: Callable[[int, Handle], None] | None = None) -> list[dict]:
         """Every task's result, in task order; ``progress(i, handle)`` after each one finishes
         (in the order they finish)."""
-        handles = [self.submit(t) for t in tasks]
+        handles = [self.submit(t, start=False) for t in tasks]
         try:
             if self.client is None:
                 for i, h in enumerate(handles):
@@ -557,15 +770,21 @@ class Runner:
             else:
                 from distributed import as_completed
 
-                index = {h.future.key: i for i, h in enumerate(handles) if h.future is not None}
+                todo = [h for h in handles if h.result is None]
+                if todo:
+                    self._start_batches(todo)
+                index: dict[str, list[int]] = {}
                 for i, h in enumerate(handles):
-                    if h.future is None and progress:
+                    if h.future is not None:
+                        index.setdefault(h.future.key, []).append(i)
+                    elif progress:
                         progress(i, h)
-                for fut in as_completed([h.future for h in handles if h.future is not None]):
-                    i = index[fut.key]
-                    self.result(handles[i])
-                    if progress:
-                        progress(i, handles[i])
+                futures = list({h.future.key: h.future for h in todo}.values())
+                for fut in as_completed(futures):
+                    for i in index[fut.key]:
+                        self.result(handles[i])
+                        if progress:
+                            progress(i, handles[i])
             return [self.result(h) for h in handles]
         except BaseException:
             for h in handles:
@@ -595,7 +814,7 @@ def run_tasks(tasks: Sequence[Task], *, scheduler: str = "serial", store: str | 
     bar = tqdm(total=len(tasks), desc=desc, unit="run", disable=None if progress else True, leave=False,
                file=sys.stderr)
     try:
-        with Runner(scheduler, store=store, fresh=fresh) as run:
+        with Runner(scheduler, store=store, fresh=fresh, preload=task_modules(tasks)) as run:
             return run.map(tasks, progress=lambda _i, _h: bar.update(1))
     finally:
         bar.close()
