@@ -180,7 +180,7 @@ def simulate_zbm(scene, width: int, height: int, *, interleave: int = 8, units: 
     step("golden model + HDL build + simulation" if engine != "pysim" else "golden model + HDL simulation (pysim)")
     # icarus: the unit's testbench under cocotb on Icarus (the generic cocotb engine)
     r = run_scene(deal(eps, units), width=width, height=height, interleave=interleave, schedule=schedule,
-                  engine=engine)
+                  engine=engine, build={**SPEED_BUILD, "pgo": "train"} if engine == "verilator" else None)
     sim_s, build_s = r["run_s"], r["build_s"]
     step("composite")
     # every merge word (one per pixel) compared with the testbench's golden frame (run_scene:
