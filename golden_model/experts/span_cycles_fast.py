@@ -97,9 +97,11 @@ def dmm_line(fr: ExpertsFrame, y: int, bounds, *, engine: str | None = None) -> 
 
 
 def _arrays(segs: list[dict]) -> np.ndarray:
-    """(5, n) int64: xl, xr, zl, dzdx, addr of every segment (the last list's kept)."""
-    if _last_arr[0] is segs:
-        return _last_arr[1]
+    """(5, n) int64: xl, xr, zl, dzdx, addr of every segment (kept for the list :func:`line_asl`
+    last returned; any other list is read every call)."""
+    kept, a = _last_arr
+    if kept is segs and _last_asl[2] is not None and _last_asl[2][0] is segs:
+        return a
     a = np.array([[s["xl"], s["xr"], s["zl"], s["dzdx"], s["addr"]] for s in segs], np.int64).reshape(-1, 5).T.copy()
     _last_arr[:] = [segs, a]
     return a

@@ -59,6 +59,10 @@ def test_fast_resolve_edge_cases_equal_the_specification():
         assert fast.resolve(segs, bucket, lead, glo, ghi, engine="numba") == want
         assert fast.resolve(segs, bucket, lead, glo, ghi, engine="python") == want
     assert spec.resolve([s0, s1], [], 0, 0, 16)[0]["pass_a"] > 2        # the crossing was halved
+    segs = [dict(s0), dict(s1)]                  # a list changed between calls is read again
+    fast.resolve(segs, [], 0, 0, 16, engine="numba")
+    segs[1]["zl"] = 20
+    assert fast.resolve(segs, [], 0, 0, 16, engine="numba") == spec.resolve(segs, [], 0, 0, 16)
 
 
 def test_scene_job_list_is_the_same_on_either_engine(monkeypatch):
