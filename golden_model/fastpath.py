@@ -10,8 +10,9 @@ where numba cannot be loaded the specification runs, with one line on stderr say
 * the specification's name (``"numpy"`` for the reference rasteriser): the readable code;
 * ``None`` / ``"auto"``: the environment variable if set, else numba where it loads.
 
-Users: ``reference.py`` (``reference_fast.py``, ``RASTERHW_REFERENCE``) and the sparse machine's
-video-processor cycle model (``sparse/vpcycles.py``, ``vpcycles_fast.py``).
+Users: ``reference.py`` (``reference_fast.py``, ``RASTERHW_REFERENCE``), the sparse machine's
+video-processor cycle model (``sparse/vpcycles.py``, ``vpcycles_fast.py``) and the EXPERTS span
+PXP's cycle model (``experts/span_cycles_fast.py``, ``RASTERHW_SPANCYCLES``).
 """
 
 from __future__ import annotations

@@ -33,3 +33,17 @@ def test_pack_missing_fields_are_zero_and_negative_values_wrap():
     assert pack(lay, {"b": 5}) == 5 << 4
     assert pack(lay, {"a": -1, "c": [-1, 1]}) == 0xF | (0b0111 << 7)
     assert pack(lay, {"a": -1, "c": [-1, 1]}) == lay.const({"a": -1, "c": [-1, 1]}).as_bits()
+
+
+def test_pack_of_a_flat_struct_from_a_partial_dict_fills_zeros():
+    """The flat-struct path (one ``dict.get`` a field): missing fields are 0, as in the general walk
+    (a dict subclass takes the general walk) and in Amaranth's constant."""
+    from rasterhw.hdl.experts.pxp_span import dmm_layout
+    lay = dmm_layout()
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        full = _random_value(lay, rng)
+        part = {k: v for k, v in full.items() if rng.random() < 0.5}
+        want = lay.const(part).as_bits()
+        assert pack(lay, part) == want
+        assert pack(lay, type("D", (dict,), {})(part)) == want

@@ -190,7 +190,9 @@ def test_interrupted_cold_sim_then_the_same_command_passes(tmp_path):
     build folder holds only finished builds. Generated Verilog and the Verilator runtime come
     from the shared caches (the interruption is in the model's own compile)."""
     build = tmp_path / "build"
-    env = dict(os.environ, RASTERHW_BUILD=str(build),
+    # RASTERHW_PGO=0: the -O1 build alone, as before sim zbm trained a gcc profile with a design's
+    # first build (that path, and what it says: tests/zbm/test_zbm_build_speed.py)
+    env = dict(os.environ, RASTERHW_BUILD=str(build), RASTERHW_PGO="0",
                RASTERHW_VL_RUNTIME_DIR=str(cache_dir("plain", []).parent))
     # interleave 1: the smallest unit (its model compiles in ~3.5 s here, interleave 2's in ~10 s;
     # the signal comes 0.1-1.5 s into the compile)

@@ -140,3 +140,22 @@ def test_cli_image_to_stdout(tmp_path):
     write_image(a, np.zeros((4, 4, 3), np.uint8))
     r = _cli("compare", str(a), str(a), "-o", "-")
     assert r.returncode == 0 and r.stdout.startswith(b"\x89PNG")
+
+
+def test_common_image_formats_without_loading_every_pillow_plugin():
+    """``image_format`` answers .png (and the other formats Pillow's preinit registers) without
+    loading every plugin, with the format the full table (``image_formats``) gives; an extension
+    only a later plugin knows is still found, an unknown one is None."""
+    code = ("import sys\n"
+            "from PIL import Image\n"
+            "from rasterhw.sim.outfile import image_format, image_formats\n"
+            "assert image_format('.png') == 'PNG'\n"
+            "assert 'PIL.TiffImagePlugin' not in sys.modules\n"
+            "pre = {e: f for e, f in Image.EXTENSION.items() if f in Image.SAVE}\n"
+            "assert len(pre) >= 5\n"
+            "full = image_formats()\n"
+            "assert all(full[e] == f for e, f in pre.items()), pre\n"
+            "assert image_format('.tif') == full['.tif'] == 'TIFF' and image_format('.nope') is None\n"
+            "print('ok')\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr

@@ -16,6 +16,7 @@ import json
 import os
 import re
 import shutil
+import sys
 import threading
 import time
 from pathlib import Path
@@ -303,21 +304,22 @@ def _settings(build: dict | None, default_opt: str) -> tuple[bool, str | None, b
     depth, out_depth = b.get("depth", 0), b.get("out_depth", 0)
     pgo = b.get("pgo", False)
     env = os.environ.get("RASTERHW_PGO", "")
-    if pgo == "auto" and env in ("0", "1"):
+    if pgo in ("auto", "train") and env in ("0", "1"):
         pgo = env == "1"
-    if pgo not in (False, True, "auto"):
-        raise RasterhwError(f"build settings: pgo must be False, True or 'auto', not {pgo!r}")
+    if pgo not in (False, True, "auto", "train"):
+        raise RasterhwError(f"build settings: pgo must be False, True, 'auto' or 'train', not {pgo!r}")
     return bool(b.get("speed", False)), b.get("opt", default_opt if not build else None), pgo, depth, out_depth, bool(b.get("hier", False))
 
 
 def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outputs: dict[str, int],
-            opt: str = PGO_OPT, train: bool = True) -> Path | None:
+            opt: str = PGO_OPT, train: bool = True, say: bool = False) -> Path | None:
     """The gcc profile of ``design`` (the bench top with these memory depths): the instrumented build
     run once on the testbench's training stimulus (:meth:`Testbench.train_stimulus`), its output
     checked against the golden model (a wrong training run is an error, not a profile), kept in
     ``build/pgo/<the instrumented build's folder>/``. Paid once per design: a cached profile is
     returned as it is; ``train=False`` returns None instead of training, and so does a testbench
-    without a training stimulus or one that does not fit these memories."""
+    without a training stimulus or one that does not fit these memories. ``say``: a line on stderr
+    before training (a run that trains without being asked to: ``pgo="train"``)."""
     name, generated, defines = design
     prof = BUILD_ROOT / "pgo" / plain_build_dir(name, "rasterhw_bench", [HARNESS_V], params={}, opt=opt,
                                                  defines=defines, generated=generated, pgo="generate").name
@@ -330,6 +332,9 @@ def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outp
     want = {n: len(w) for n, w in exp.words.items()}
     if any(len(stim.words[n]) + 2 > inputs[n] for n in inputs) or any(want[n] + 2 > outputs[n] for n in outputs):
         return None
+    if say:
+        print(f"rasterhw: {tb.block}: first build of this design: training its gcc profile on {stim.what} "
+              "(once per design, kept in the build cache; RASTERHW_PGO=0 skips it)", file=sys.stderr, flush=True)
     exe, _ = _build(design, opt, pgo="generate")
     with build_lock(prof, what=f"{tb.block} profile"):
         if _trained(prof, quiet=True):
@@ -375,7 +380,7 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
     inputs, outputs = memory_depths(tb, params, stim, expect_words, depth=depth, out_depth=out_depth)
     top = bench_design(tb, params, inputs, outputs, speed, separate=bool(clocks))
     prof = profile(tb, params, top, inputs=inputs, outputs=outputs, opt=opt or PGO_OPT,
-                   train=pgo is True) if pgo else None
+                   train=pgo is True or pgo == "train", say=pgo == "train") if pgo else None
     opt = opt or (PGO_OPT if prof is not None else tb.verilator_opt)
     exe, build_s = _build(top, opt, pgo=prof, hier=blocks)
     dut = tb.dut(params)   # for the port widths and the status values' names and widths (not simulated)

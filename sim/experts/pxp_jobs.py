@@ -72,8 +72,8 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
     coherent span PXP's cycles (``golden_model/experts/coherent.py``, ``experts-pxp-coherent``:
     the same words and pixels)."""
     from rasterhw.golden_model.experts.coherent import resolve as coherent_resolve
-    from rasterhw.golden_model.experts.span_cycles import NO_PTR, dmm_line, line_asl, line_job
     from rasterhw.golden_model.experts.span_cycles import schedule as span_schedule
+    from rasterhw.golden_model.experts.span_cycles_fast import NO_PTR, dmm_line, line_asl, line_job
     from rasterhw.hdl.experts.pxp_span import dmm_layout
     from rasterhw.hdl.pack import pack
     lay = dmm_layout()

@@ -156,9 +156,12 @@ class ZbmScene(SceneRun):
                 "width": width, "height": height}
 
     def jobs(self, gold: dict, *, engine: str, interleave: int = 8, units: int = 1, schedule: str = "overlap"):
-        # icarus: the unit's testbench under cocotb on Icarus (the generic cocotb engine)
+        # icarus: the unit's testbench under cocotb on Icarus (the generic cocotb engine). On Verilator
+        # the profiled build, trained with the first build (said on stderr; RASTERHW_PGO=0 skips it)
+        engine = engines.ALIASES.get(engine, engine)
         return [unit_job(deal(gold["eps"], units), width=gold["width"], height=gold["height"], interleave=interleave,
-                         schedule=schedule, engine=engines.ALIASES.get(engine, engine))]
+                         schedule=schedule, engine=engine,
+                         build={**SPEED_BUILD, "pgo": "train"} if engine == "verilator" else None)]
 
     def result(self, gold: dict, done: list, *, engine: str, interleave: int = 8, units: int = 1,
                schedule: str = "overlap") -> dict:

@@ -30,7 +30,7 @@ W, H, IL = 48, 16, 2
 
 
 @pytest.mark.slow
-def test_speed_build_same_frame_same_cycles_as_the_plain_build():
+def test_speed_build_same_frame_same_cycles_as_the_plain_build(capfd):
     """Three builds (~1 min of CPU; 4 min at load 12): slow. The quick version in CI is
     ``test_zbm_unit_engine.py``, whose engine build is the merged one with the pixel
     processor out of line: the same words, cycles and line log as the cocotb bench (unmerged)."""
@@ -39,16 +39,24 @@ def test_speed_build_same_frame_same_cycles_as_the_plain_build():
     gold = doublez_words(G.render_zbm(tris, interleave=IL).pixels)
     plain = run_scene([eps], width=W, height=H, interleave=IL, build={"speed": False, "opt": "-O0", "pgo": False},
                       line_log=True)
-    speed = run_scene([eps], width=W, height=H, interleave=IL, build={**SPEED_BUILD, "pgo": True}, line_log=True)
-    assert speed["build"] == {"speed": True, "opt": "-O2", "pgo": True}
-    # the profile: trained on c50 (not the frame checked here), with gcc's files
     tb = find_testbench("zbm-unit")
     p = tb.params(interleave=IL, width=W, height=H)
     stim = tb.scene_stimulus(p, [eps])
     inputs = {"i": verilator._depth(len(stim.words["i"]))}
     outputs = {n: verilator._depth(len(w)) for n, w in tb.expect(p, stim).words.items()}
-    prof = verilator.profile(tb, p, verilator.bench_design(tb, p, inputs, outputs, True), inputs=inputs, outputs=outputs,
-                             train=False)
+
+    def cached():
+        return verilator.profile(tb, p, verilator.bench_design(tb, p, inputs, outputs, True), inputs=inputs,
+                                 outputs=outputs, train=False)
+
+    had = cached() is not None
+    # "train" (what sim zbm asks for): trains the design's profile with its first build, and says so
+    speed = run_scene([eps], width=W, height=H, interleave=IL, build={**SPEED_BUILD, "pgo": "train"}, line_log=True)
+    assert speed["build"] == {"speed": True, "opt": "-O2", "pgo": True}
+    said = "training its gcc profile on scene c50" in capfd.readouterr().err
+    assert said != had        # said exactly when it trained
+    # the profile: trained on c50 (not the frame checked here), with gcc's files
+    prof = cached()
     assert prof is not None
     assert json.loads((prof / "trained.json").read_text())["what"] == f"scene {TRAIN_SCENE}" != "scene sp8"
     assert TRAIN_SCENE != "sp8"
@@ -61,6 +69,33 @@ def test_speed_build_same_frame_same_cycles_as_the_plain_build():
     # "auto" finds the cached profile (and never trains one): the same binary as pgo=True
     auto = run_scene([eps], width=W, height=H, interleave=IL, build=SPEED_BUILD)
     assert auto["build"]["pgo"] and auto["build_s"] == 0.0 and auto["cycles"] == plain["cycles"]
+
+
+def test_sim_zbm_trains_the_profile_with_the_first_build_unless_told_not_to(monkeypatch):
+    """``rasterhw sim zbm`` on Verilator asks for ``pgo="train"`` (the profiled build without a
+    training step the user must know of; ``auto``, the soak's and the report's, never trains);
+    ``RASTERHW_PGO`` 0 / 1 overrides both."""
+    from rasterhw.golden_model.errors import RasterhwError
+    from rasterhw.sim.zbm import scene
+    seen = []
+
+    def fake(eps, **kw):
+        seen.append((kw["engine"], kw["build"]))
+        raise RasterhwError("stop")
+
+    monkeypatch.setattr(scene, "unit_job", fake)
+    for engine in ("verilator", "pysim"):
+        with pytest.raises(RasterhwError, match="stop"):
+            scene.simulate(build_scene("c50"), 32, 16, interleave=2, engine=engine)
+    assert seen == [("verilator", {**SPEED_BUILD, "pgo": "train"}), ("pysim", None)]
+    monkeypatch.delenv("RASTERHW_PGO", raising=False)
+    assert verilator._settings({**SPEED_BUILD, "pgo": "train"}, "-O1")[2] == "train"
+    assert verilator._settings(SPEED_BUILD, "-O1")[2] == "auto"
+    for env, want in (("0", False), ("1", True)):
+        monkeypatch.setenv("RASTERHW_PGO", env)
+        assert verilator._settings({**SPEED_BUILD, "pgo": "train"}, "-O1")[2] is want
+    with pytest.raises(RasterhwError, match="pgo must be False, True, 'auto' or 'train'"):
+        verilator._settings({"pgo": "yes"}, "-O1")
 
 
 def test_merged_unit_keeps_one_pixel_processor_out_of_line():

@@ -30,8 +30,12 @@ SIMS = ["verilator", pytest.param("icarus", marks=pytest.mark.skipif(
 W, H = 64, 16
 # (segment, merge) half periods in ns: 1:1, merge slower (3:2 periods), merge faster
 RATIOS = [(5, 5), (2, 3), (3, 2)]
-#: the first ratio builds the bench (heavy: handed out first, tests/conftest.py); the others reuse it
+#: the first ratio builds the bench (heavy: handed out first, tests/conftest.py); the others reuse it.
+#: The unit's two unequal ratios are slow: in the fast suite the engine runs the unit at ratios
+#: against the cocotb bench's recorded runs (test_engine_clocks.py, tests/zbm_cocotb/records.py)
 HEAVY_FIRST = [pytest.param(RATIOS[0], marks=pytest.mark.heavy), *RATIOS[1:]]
+UNIT_RATIOS = [pytest.param(RATIOS[0], marks=pytest.mark.heavy),
+               *(pytest.param(r, marks=pytest.mark.slow) for r in RATIOS[1:])]
 
 
 def _scene(seed: int, n: int = 30):
@@ -52,7 +56,7 @@ def _unit_run(sim, interleave, units, ratio, stall, seed):
     return r
 
 
-@pytest.mark.parametrize("ratio", HEAVY_FIRST)
+@pytest.mark.parametrize("ratio", UNIT_RATIOS)
 def test_unit_verilator_ratios(ratio):
     _unit_run("verilator", 2, 1, ratio, stall=80, seed=sum(ratio))
 

@@ -2,8 +2,8 @@
 what ``rasterhw sim zbm --engine verilator``, the bench and the soak run; its speed Verilog) against
 the cocotb unit bench (``run_unit_bench`` with equal, in-phase clocks) and the golden model: the same
 frame bit for bit, the same segment-clock cycle count and per-line log, under random idle gaps and
-back-pressure. Cold: one engine build (g++ -O1, ~30 s); the cocotb build is shared with
-test_zbm_cocotb.py. (Was test_zbm_unit_fast.py, on the plain bench ``sim/zbm/fast.py``.)"""
+back-pressure. Cold: one engine build (g++ -O1, ~30 s). One-unit cases compare with the cocotb
+bench's committed records (``tests/zbm_cocotb/records.py``); the two-unit chains (slow) run it. (Was test_zbm_unit_fast.py, on the plain bench ``sim/zbm/fast.py``.)"""
 
 from __future__ import annotations
 
@@ -15,6 +15,7 @@ from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.golden_model.zbm.words import doublez_words
 from rasterhw.sim.zbm.scene import run_scene
 from rasterhw.sim.zbm.testbench import unit_watchdog
+from zbm_cocotb import records as R
 from zbm_cocotb.stimfiles import stimulus_depth
 from zbm_cocotb.unit_bench import run_unit_bench
 
@@ -41,14 +42,17 @@ def _compare(units: int, stall: int, gap_seed, seed: int, schedule: str = "overl
     return fast
 
 
-@pytest.mark.parametrize(("stall", "gap_seed"), [(0, None), (90, 7)])
-def test_unit_engine_equals_cocotb_bench(stall, gap_seed):
-    _compare(1, stall, gap_seed, seed=11 + stall)
+@pytest.mark.parametrize("case", ["eq-s0-11", "eq-s90-g7-101"])
+def test_unit_engine_equals_the_cocotb_record(case):
+    """The golden frame, and the cocotb bench's cycle count, per-line log and frame as recorded
+    (``tests/zbm_cocotb/unit_records.json``; held equal to cocotb's runs by the slow
+    test_zbm_unit_records.py). Was a cocotb run beside each engine run."""
+    R.check_engine(case)
 
 
 def test_unit_engine_backpressure_costs_cycles():
-    free = _compare(1, 0, None, seed=3)
-    slow = _compare(1, 120, None, seed=3)
+    free = R.check_engine("eq-s0-3")
+    slow = R.check_engine("eq-s120-3")
     assert slow["cycles"] > free["cycles"]
 
 
