@@ -384,7 +384,8 @@ def _scheduler_options(f):
               "run on a compiled simulator).")
 @click.option("--fast", is_flag=True, help="Keep slow rows (synthesis, place and route) unmeasured.")
 @click.option("--rerun", is_flag=True, help="fpga: run place and route again (minutes to an hour per block); "
-              "without it the fpga rows come from the recorded runs (docs/reproduction/fpga_runs.json, build/pnr-*).")
+              "without it the fpga rows come from the recorded runs (docs/reproduction/fpga_runs.json, build/pnr-*). "
+              "mutation: run the campaign and the proofs again (docs/reproduction/mutation_runs.json).")
 @_scheduler_options
 def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, rerun: bool, scheduler: str,
            store: str | None, fresh: bool) -> None:
@@ -397,8 +398,8 @@ def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, re
 
     parse_scheduler(scheduler)
     names = systems() if system == "all" else [system]
-    if rerun and "fpga" not in names:
-        raise RasterhwError("--rerun applies to the fpga report only")
+    if rerun and not {"fpga", "mutation"} & set(names):
+        raise RasterhwError("--rerun applies to the fpga and mutation reports only")
     if rerun and fast:
         raise RasterhwError("--rerun and --fast contradict each other")
     check_engine(engine)
@@ -412,6 +413,8 @@ def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, re
             extra["cached_only"] = not rerun
             if rerun:
                 info("fpga: running place and route for every configuration (minutes to an hour per block)")
+        if name == "mutation":
+            extra["rerun"] = rerun
         rows += run_report(name, out_dir=Path(out_dir), engine=engine, progress=not as_json, fast=fast,
                            scheduler=scheduler, store=store or default_store(), fresh=fresh, **extra)
     if as_json:
