@@ -76,3 +76,17 @@ def test_bad_input_is_one_line_and_exit_2(capsys, args, msg):
 def test_help_says_what_it_does():
     out = CliRunner().invoke(cli, ["mutate", "--help"])
     assert out.exit_code == 0 and "--mutants" in out.output and "--scheduler" in out.output
+
+
+def test_all_takes_every_block_of_verilog_list_at_its_stated_small_configuration():
+    from rasterhw.sim import registry
+    from rasterhw.sim.engines.verilog import block_names
+
+    configs = M.all_configs()
+    assert sorted(configs) == sorted(block_names())
+    assert all(configs[b] == registry.flow(b).small for b in configs)
+
+
+def test_all_refuses_an_unknown_block_before_any_work():
+    with pytest.raises(M.RasterhwError, match="no testbench for block 'nope'"):
+        M.campaign_all(mutants=1, blocks=["nope"])

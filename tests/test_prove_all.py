@@ -52,3 +52,10 @@ def test_bad_input_is_one_line_and_exit_2(capsys, args, msg):
     lines = [ln for ln in out.err.splitlines() if ln.strip()]
     assert e.value.code == 2 and out.out == "" and len(lines) == 1 and lines[0].startswith("error: ")
     assert msg in lines[0]
+
+
+def test_a_configuration_that_does_not_fit_is_halved_down_to_sizes_of_2():
+    from rasterhw.sim.flow.stream_proof import halved
+
+    assert halved({"width": 64, "pn": 2, "aj": "c", "depth": 5}) == {"width": 32, "pn": 2, "aj": "c", "depth": 2}
+    assert halved({"n": 3, "colour": False}) is None
