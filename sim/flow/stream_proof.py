@@ -19,9 +19,9 @@ clock domain from ``port_domains``). Nothing in it knows a machine:
 Two SymbiYosys runs per block: ``mode cover`` on "some output stream is valid" gives the
 block's **input→output latency** (the fewest steps from the reset state to a first output word,
 inputs at their fastest) — measured by the solver, not typed; then ``mode prove`` with depth
-``latency + MARGIN``: its base case is BMC of every rule to that depth; its induction step, when
-it closes, makes the proof unbounded (``kind`` ``k-induction``), else the result is ``kind``
-``bmc`` to that depth. A run over its time limit leaves the block unproven with the reason.
+``latency + MARGIN``: its base case is BMC of every rule to that depth; its induction step, if it
+closes, makes the proof unbounded (``kind`` ``k-induction``), else ``kind`` ``bmc`` to that depth
+(``mode bmc`` alone if both time out). A run over its time limit leaves the block unproven.
 """
 
 from __future__ import annotations
@@ -188,14 +188,23 @@ def stream_proof(block: str, params: dict | None = None, *, depth: int | None = 
     pr = _sby(block, text, Proof(block, None, p, mode="prove", multiclock=multi), d, prove_timeout, tag, extra,
               fresh)
     walls.append(pr["wall_s"])
-    out.update(depth=d, wall_s=round(sum(walls), 2), trace=pr["trace"], failed=pr["failed"])
+    out.update(depth=d, wall_s=round(sum(walls), 2), trace=pr["trace"])
     if pr["status"] == "PASS":
         return {**out, "kind": "k-induction", "passed": True}
     if pr["basecase"] == "fail" or (pr["status"] == "FAIL" and pr["failed"] and pr["induction"] != "fail"):
-        return {**out, "kind": "bmc", "passed": False, "reason": "a stream rule fails"}
-    if pr["basecase"] == "pass":
-        return {**out, "kind": "bmc", "passed": True,
+        return {**out, "kind": "bmc", "passed": False, "reason": "a stream rule fails", "failed": pr["failed"]}
+    if pr["basecase"] == "pass":   # (the induction step's counterexample is not a failure: trace none)
+        return {**out, "kind": "bmc", "passed": True, "trace": None,
                 "reason": f"k-induction did not close at depth {d}: proved for every input up to {d} steps"}
+    if pr["timed_out"]:   # induction and base case together did not finish: the base case alone (BMC)
+        bmc = _sby(block, text, Proof(block, None, p, mode="bmc", multiclock=multi), d, prove_timeout, tag, extra,
+                   fresh)
+        out.update(wall_s=round(sum(walls) + bmc["wall_s"], 2), trace=bmc["trace"])
+        if bmc["status"] in ("PASS", "FAIL"):
+            ok = bmc["status"] == "PASS"
+            return {**out, "kind": "bmc", "passed": ok, "failed": [] if ok else bmc["failed"],
+                    "reason": (f"k-induction did not finish in {prove_timeout:.0f} s: proved for every input up to "
+                               f"{d} steps" if ok else "a stream rule fails")}
     why = (f"the solver did not finish in {prove_timeout:.0f} s at depth {d}" if pr["timed_out"] else
            f"SymbiYosys {pr['status']}: {' / '.join(pr['log_tail'])[:200]}")
     return {**out, "kind": None, "passed": None, "reason": why}
