@@ -211,10 +211,13 @@ def check_cache() -> None:
 @click.option("--store", type=click.Path(file_okay=False), default=None,
               help="Folder keeping every finished mutant's result (default: build/tasks); a rerun reuses them.")
 @click.option("--fresh", is_flag=True, help="Run every mutant again, even those in the store.")
+@click.option("--budget", "budget_s", type=float, default=None, metavar="SECONDS",
+              help="--all: wait for no block's build after this many seconds (those blocks are listed as not run; "
+                   "the mutants of the blocks built by then all run).")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the campaign as JSON (mutants, baseline_passed, killed, equivalent, survived, score, survivors).")
 def mutate(block: str | None, all_blocks: bool, params: tuple[str, ...], mutants: int, seed: int, scheduler: str,
-           store: str | None, fresh: bool, as_json: bool) -> None:
+           store: str | None, fresh: bool, budget_s: float | None, as_json: bool) -> None:
     """Mutation coverage of BLOCK: N faults planted by Yosys (mutate) behind one control input,
     one Verilator build, the block's testbench run once per mutant; killed / survived, score.
 
@@ -225,6 +228,8 @@ def mutate(block: str | None, all_blocks: bool, params: tuple[str, ...], mutants
 
     if all_blocks and (block or params):
         raise RasterhwError("--all runs every block at its stated small configuration: no BLOCK, no -p")
+    if budget_s is not None and not all_blocks:
+        raise RasterhwError("--budget applies to --all only")
     if not all_blocks and block not in mutation_blocks():
         what = f"no testbench for block {block!r}" if block else "name a block (or --all)"
         raise RasterhwError(f"{what}; blocks: {', '.join(mutation_blocks())}")
@@ -232,7 +237,7 @@ def mutate(block: str | None, all_blocks: bool, params: tuple[str, ...], mutants
     check_scheduler(scheduler)   # what answers at its address too, before anything runs
     if all_blocks:
         r = campaign_all(mutants=mutants, seed=seed, scheduler=scheduler, store=store or default_store(),
-                         fresh=fresh, progress=not as_json)
+                         fresh=fresh, progress=not as_json, budget_s=budget_s)
         if as_json:
             _emit(r)
         else:

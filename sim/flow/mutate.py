@@ -58,6 +58,9 @@ CTRL = "mutsel"
 SLOW_RUN = {"idle": 0.3, "stall": 90, "seed": 5}
 #: cells that may be mutated: Amaranth source (``.py``), not the bench (``sim/``)
 SELECTION = "a:src=*.py:* a:src=*/sim/* %d"
+#: ``mutate --all``: blocks whose Yosys run and build are under way at once (the rest of the
+#: workers run mutants)
+PREPARING = 2
 #: time limit of one Yosys run (the pixel-bus bank at its default size had not finished in 300 s)
 YOSYS_TIMEOUT_S = 600.0
 
@@ -326,12 +329,17 @@ def all_configs() -> dict[str, dict]:
 
 
 def campaign_all(*, mutants: int = 30, seed: int = 1, scheduler: str = "serial", store: str | Path | None = None,
-                 fresh: bool = False, progress: bool = False, blocks: list[str] | None = None) -> dict:
-    """``mutate --all``: every block's campaign (:func:`all_configs`) on one scheduler: first each
-    block's Yosys run and build (a task each, in parallel), then every mutant of every block (a task
-    each). A block that cannot be mutated (Yosys's time limit, a failed build) has ``error`` and no
-    score; the others go on. ``{"mutants", "seed", "blocks": [per-block result], "scheduler",
-    "computed", "reused", "wall_s"}``."""
+                 fresh: bool = False, progress: bool = False, blocks: list[str] | None = None,
+                 budget_s: float | None = None) -> dict:
+    """``mutate --all``: every block's campaign (:func:`all_configs`) on one scheduler. At most
+    :data:`PREPARING` blocks' Yosys runs and builds (a task each) at a time, in the order of
+    :func:`all_configs`; as soon as one is ready, every one of its mutants (a task each) is
+    submitted, so the mutants of one block run while the next blocks build. A block that cannot be mutated (Yosys's time limit, a failed
+    build) has ``error`` and no score; the others go on. ``budget_s``: after that many seconds
+    (from the scheduler's start) no build is waited for or started (those blocks get ``error``
+    saying so); the mutants of the blocks built by then all run.
+    ``{"mutants", "seed", "config", "blocks": [per-block result], "scheduler", "computed",
+    "reused", "wall_s"}``."""
     _check(mutants, seed)
     configs = all_configs()
     if blocks is not None:
@@ -339,23 +347,41 @@ def campaign_all(*, mutants: int = 30, seed: int = 1, scheduler: str = "serial",
         if unknown:
             raise RasterhwError(f"no testbench for block {unknown[0]!r}; blocks: {', '.join(configs)}")
         configs = {b: configs[b] for b in blocks}
+    if budget_s is not None and not budget_s > 0:
+        raise RasterhwError(f"--budget must be a number of seconds above 0, not {budget_s!r}")
     t0 = time.perf_counter()
     say = (lambda msg: print(msg, file=sys.stderr)) if progress else (lambda msg: None)
-    out = []
+    preps, handles = {}, {}
     with Runner(scheduler, store=store, fresh=fresh) as run:
-        preps = {b: run.submit(call("rasterhw.sim.flow.mutate:prepare", block=b,
-                                    params=json.dumps(p, sort_keys=True), mutants=mutants, seed=seed))
-                 for b, p in configs.items()}
-        handles = {}
-        for b, h in preps.items():
-            prep = run.result(h)
-            say(f"mutate --all: {b}: " + (f"error: {prep['error']}" if "error" in prep else
-                                          f"{len(prep['mutations'])} mutants built"))
-            if "error" not in prep:
-                handles[b] = [run.submit(t) for t in _mutant_tasks(b, json.dumps(prep["params"], sort_keys=True),
-                                                                   mutants, seed, len(prep["mutations"]))]
+        t_run = time.perf_counter()
+        queue, inflight = list(configs), {}
+        while queue or inflight:
+            if budget_s is not None and time.perf_counter() - t_run > budget_s:
+                for b in queue + list(inflight):
+                    preps[b] = {"block": b, "params": configs[b], "config": "small",
+                                "error": f"not built within the campaign's time budget ({budget_s:.0f} s)"}
+                for h in inflight.values():
+                    run.cancel(h)
+                queue, inflight = [], {}
+                break
+            while queue and len(inflight) < PREPARING:
+                b = queue.pop(0)
+                inflight[b] = run.submit(call("rasterhw.sim.flow.mutate:prepare", block=b, mutants=mutants, seed=seed,
+                                              params=json.dumps(configs[b], sort_keys=True)))
+            ready = [b for b, h in inflight.items() if run.client is None or run.done(h)]
+            if not ready:
+                time.sleep(0.5)
+                continue
+            for b in ready:
+                prep = preps[b] = run.result(inflight.pop(b))
+                say(f"mutate --all: {b}: " + (f"error: {prep['error']}" if "error" in prep else
+                                              f"{len(prep['mutations'])} mutants built"))
+                if "error" not in prep:
+                    handles[b] = [run.submit(t) for t in _mutant_tasks(b, json.dumps(prep["params"], sort_keys=True),
+                                                                       mutants, seed, len(prep["mutations"]))]
+        out = []
         for b in configs:
-            prep = run.result(preps[b])
+            prep = preps[b]
             full = find_testbench(b).params(**prep["params"])
             if "error" in prep:
                 out.append({"block": b, "params": full, "config": prep["config"], "seed": seed,
@@ -369,5 +395,5 @@ def campaign_all(*, mutants: int = 30, seed: int = 1, scheduler: str = "serial",
         where, computed, reused = run.address(), run.computed, run.reused
     return {"mutants": mutants, "seed": seed,
             "config": "each block's Flow.small (its machine's stated small sizes) unless its result says otherwise",
-            "blocks": out, "scheduler": where, "computed": computed, "reused": reused,
+            "budget_s": budget_s, "blocks": out, "scheduler": where, "computed": computed, "reused": reused,
             "wall_s": round(time.perf_counter() - t0, 2)}
