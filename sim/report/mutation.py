@@ -79,7 +79,7 @@ def sections(record: dict) -> list[str]:
             md.append(f"| `{b['block']}` | {_cfg(b['params'])} | — | — | — | — | not run: {b['error']} | "
                       f"{_proof_cell(pr)} | {_proof_cell(own)} |")
             continue
-        score = "void (mutant 0 fails)" if b["score"] is None else f"{b['score']:.3f}"
+        score = f"void (mutant 0 fails: {b['baseline_why']})" if b["score"] is None else f"{b['score']:.3f}"
         md.append(f"| `{b['block']}` | {_cfg(b['params'])} | {b['mutants']} | {b['killed']} | {b['equivalent']} | "
                   f"{b['survived']} | {score} | {_proof_cell(pr)} | {_proof_cell(own)} |")
     md += ["", "## Survivors", ""]
@@ -116,7 +116,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir=None, fast: b
         why = ("no record: rasterhw report mutation --rerun" if record is None else
                f"not in the record's campaign ({RECORD.name})" if b is None else
                f"not run: {b['error']}" if "error" in b else
-               "void: mutant 0 fails its testbench" if b["score"] is None else None)
+               f"void: mutant 0 (no mutation) fails its testbench here ({b['baseline_why']})" if b["score"] is None
+               else None)
         system = registry.block_machine(block).name
         fig = f"{block} mutation campaign ({_cfg(b['params'] if b else params)})"
         for q, key, unit in (("mutants", "mutants", "mutants"), ("killed", "killed", "mutants"),
