@@ -135,13 +135,8 @@ def prove(block: str | None, all_blocks: bool, scheduler: str, depth: int | None
         check_cache()
         check_scheduler(scheduler)
         r = prove_all(scheduler=scheduler)
-        if as_json:
-            _emit(r)
-        else:
-            for b in r["blocks"]:
-                click.echo(_prove_line(b))
-            click.echo(f"{r['proved']} proved (k-induction), {r['bounded']} to a bound (BMC), {r['failed']} failed, "
-                       f"{r['unproven']} unproven")
+        _emit_blocks(r, as_json, _prove_line, f"{r['proved']} proved (k-induction), {r['bounded']} to a bound (BMC), "
+                                              f"{r['failed']} failed, {r['unproven']} unproven")
         if r["failed"] or any(b["own"] and b["own"]["passed"] is False for b in r["blocks"]):
             sys.exit(1)
         return
@@ -161,6 +156,16 @@ def prove(block: str | None, all_blocks: bool, scheduler: str, depth: int | None
             click.echo(f"  counterexample: {r['trace']}")
     if r["status"] != "PASS":
         sys.exit(1)
+
+
+def _emit_blocks(r: dict, as_json: bool, line, total: str) -> None:
+    """An ``--all`` result: its JSON, or a line per block (``line(block)``) and the ``total`` line."""
+    if as_json:
+        _emit(r)
+        return
+    for b in r["blocks"]:
+        click.echo(line(b))
+    click.echo(total)
 
 
 def _prove_line(b: dict) -> str:
@@ -238,13 +243,8 @@ def mutate(block: str | None, all_blocks: bool, params: tuple[str, ...], mutants
     if all_blocks:
         r = campaign_all(mutants=mutants, seed=seed, scheduler=scheduler, store=store or default_store(),
                          fresh=fresh, progress=not as_json, budget_s=budget_s)
-        if as_json:
-            _emit(r)
-        else:
-            for b in r["blocks"]:
-                click.echo(_mutate_line(b))
-            click.echo(f"{len(r['blocks'])} blocks in {r['wall_s']:.0f} s ({r['computed']} tasks run, "
-                       f"{r['reused']} from the store)")
+        _emit_blocks(r, as_json, _mutate_line, f"{len(r['blocks'])} blocks in {r['wall_s']:.0f} s "
+                                               f"({r['computed']} tasks run, {r['reused']} from the store)")
         if not all(b.get("baseline_passed", True) for b in r["blocks"]):
             sys.exit(1)
         return
