@@ -76,3 +76,24 @@ def test_bad_input_is_one_line_and_exit_2(capsys, args, msg):
 def test_help_says_what_it_does():
     out = CliRunner().invoke(cli, ["mutate", "--help"])
     assert out.exit_code == 0 and "--mutants" in out.output and "--scheduler" in out.output
+
+
+def test_all_takes_every_block_of_verilog_list_at_its_stated_small_configuration():
+    from rasterhw.sim import registry
+    from rasterhw.sim.engines.verilog import block_names
+
+    configs = M.all_configs()
+    assert sorted(configs) == sorted(block_names())
+    assert all(configs[b] == registry.flow(b).small for b in configs)
+
+
+def test_all_refuses_an_unknown_block_before_any_work():
+    with pytest.raises(M.RasterhwError, match="no testbench for block 'nope'"):
+        M.campaign_all(mutants=1, blocks=["nope"])
+
+
+def test_a_block_not_built_within_the_budget_is_listed_with_why():
+    r = M.campaign_all(mutants=1, blocks=["zbm-merger", "experts-dmm"], budget_s=1e-9)
+    assert [b["block"] for b in r["blocks"]] == ["zbm-merger", "experts-dmm"]
+    assert all(b["score"] is None and "not built within the campaign's time budget" in b["error"] for b in r["blocks"])
+    assert r["computed"] == 0

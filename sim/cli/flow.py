@@ -107,20 +107,41 @@ def fpga(block: str, params: tuple[str, ...], family: str, device: str | None, a
 
 
 @click.command()
-@click.argument("block")
+@click.argument("block", required=False)
+@click.option("--all", "all_blocks", is_flag=True,
+              help="Every block of `rasterhw verilog --list`: its stream rules (sim/flow/stream_proof.py) and "
+                   "its own proof where it has one; kind, depth, passed per block.")
+@click.option("--scheduler", default="serial", show_default=True, metavar="serial|local[:N]|tcp://HOST:PORT",
+              help="--all: where the blocks' proofs run (a task each).")
 @click.option("--depth", type=int, default=None, help="Steps (BMC) or induction length (default: the proof's own).")
 @click.option("--fresh", is_flag=True, help="Prove again even if build/ holds this exact proof's result.")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the proof's result as JSON on stdout (block, kind, depth, passed, trace).")
-def prove(block: str, depth: int | None, fresh: bool, as_json: bool) -> None:
+def prove(block: str | None, all_blocks: bool, scheduler: str, depth: int | None, fresh: bool, as_json: bool) -> None:
     """Prove BLOCK's stream rules and pixel order formally (SymbiYosys); exit 1 with a VCD trace if one fails.
 
     A proof whose harness, script and tool versions are unchanged is read back from build/ (said
-    in the output); --fresh runs SymbiYosys again."""
+    in the output); --fresh runs SymbiYosys again. --all: every block (docs/mutation.md)."""
     from rasterhw.sim.flow.prove import prove as run
 
     if depth is not None and not 1 <= depth <= MAX_DEPTH:
         raise RasterhwError(f"--depth must be a whole number of steps from 1 to {MAX_DEPTH}, not {depth}")
+    if all_blocks:
+        if block or depth is not None or fresh:
+            raise RasterhwError("--all proves every block at its own depth: no BLOCK, --depth or --fresh")
+        from rasterhw.sim.flow.stream_proof import prove_all
+        from rasterhw.sim.flow.tasks import check_scheduler
+
+        check_cache()
+        check_scheduler(scheduler)
+        r = prove_all(scheduler=scheduler)
+        _emit_blocks(r, as_json, _prove_line, f"{r['proved']} proved (k-induction), {r['bounded']} to a bound (BMC), "
+                                              f"{r['failed']} failed, {r['unproven']} unproven")
+        if r["failed"] or any(b["own"] and b["own"]["passed"] is False for b in r["blocks"]):
+            sys.exit(1)
+        return
+    if block is None:
+        raise RasterhwError("name a block (or --all)")
     check_cache()
     r = run(block, depth=depth, fresh=fresh)
     if as_json:
@@ -137,6 +158,36 @@ def prove(block: str, depth: int | None, fresh: bool, as_json: bool) -> None:
         sys.exit(1)
 
 
+def _emit_blocks(r: dict, as_json: bool, line, total: str) -> None:
+    """An ``--all`` result: its JSON, or a line per block (``line(block)``) and the ``total`` line."""
+    if as_json:
+        _emit(r)
+        return
+    for b in r["blocks"]:
+        click.echo(line(b))
+    click.echo(total)
+
+
+def _prove_line(b: dict) -> str:
+    """One block of ``prove --all`` in one line."""
+    shown = ", ".join(f"{k}={v}" for k, v in b["params"].items())
+    if b["passed"] is None:
+        head = f"unproven: {b['reason']}"
+        f = b.get("fits_result")
+        head += (f"; fits at {', '.join(f'{k}={v}' for k, v in b['fits'].items())}: {f['kind']}, depth {f['depth']}, "
+                 f"{'passed' if f['passed'] else 'FAILED'}" if f else "; no configuration tried fits")
+    else:
+        head = f"{b['kind']}, depth {b['depth']} (latency {b['latency']}): {'passed' if b['passed'] else 'FAILED'}"
+        if b["reason"] and b["passed"]:
+            head += f" ({b['reason']})"
+    own = ""
+    if b["own"]:
+        o = b["own"]
+        own = (f"; own proof: {o['kind']}, depth {o['depth']}, {'passed' if o['passed'] else 'FAILED'}"
+               if o["passed"] is not None else f"; own proof unproven: {o['reason']}")
+    return f"{b['block']} ({shown}): stream rules {head}{own}"
+
+
 #: the longest proof ``prove --depth`` runs: SymbiYosys's unrolling grows with the depth (the ZB/M
 #: merger's proof at depth 400 keeps two solvers busy for minutes); a depth of 10^20 ran without end
 MAX_DEPTH = 10_000
@@ -151,7 +202,10 @@ def check_cache() -> None:
 
 
 @click.command()
-@click.argument("block")
+@click.argument("block", required=False)
+@click.option("--all", "all_blocks", is_flag=True,
+              help="Every block of `rasterhw verilog --list` in one campaign, each at its machine's small "
+                   "configuration (the hardware flow's Flow.small, named in each result).")
 @click.option("-p", "--param", "params", multiple=True, metavar="NAME=VALUE",
               help="Block parameter, e.g. -p depth=64 (repeatable; default: the testbench's defaults).")
 @click.option("--mutants", type=int, default=40, show_default=True, help="Mutations Yosys samples (mutate -list N).")
@@ -162,36 +216,60 @@ def check_cache() -> None:
 @click.option("--store", type=click.Path(file_okay=False), default=None,
               help="Folder keeping every finished mutant's result (default: build/tasks); a rerun reuses them.")
 @click.option("--fresh", is_flag=True, help="Run every mutant again, even those in the store.")
+@click.option("--budget", "budget_s", type=float, default=None, metavar="SECONDS",
+              help="--all: wait for no block's build after this many seconds (those blocks are listed as not run; "
+                   "the mutants of the blocks built by then all run).")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the campaign as JSON (mutants, baseline_passed, killed, equivalent, survived, score, survivors).")
-def mutate(block: str, params: tuple[str, ...], mutants: int, seed: int, scheduler: str, store: str | None,
-           fresh: bool, as_json: bool) -> None:
+def mutate(block: str | None, all_blocks: bool, params: tuple[str, ...], mutants: int, seed: int, scheduler: str,
+           store: str | None, fresh: bool, budget_s: float | None, as_json: bool) -> None:
     """Mutation coverage of BLOCK: N faults planted by Yosys (mutate) behind one control input,
     one Verilator build, the block's testbench run once per mutant; killed / survived, score.
 
-    Exit 1 if mutant 0 (no mutation) fails its testbench (the campaign is void). docs/mutation.md."""
-    from rasterhw.sim.flow.mutate import campaign, mutation_blocks
+    Exit 1 if mutant 0 (no mutation) fails its testbench (the campaign is void; with --all: any
+    block's). docs/mutation.md."""
+    from rasterhw.sim.flow.mutate import campaign, campaign_all, mutation_blocks
     from rasterhw.sim.flow.tasks import check_scheduler, default_store
 
-    if block not in mutation_blocks():
-        raise RasterhwError(f"no testbench for block {block!r}; blocks: {', '.join(mutation_blocks())}")
+    if all_blocks and (block or params):
+        raise RasterhwError("--all runs every block at its stated small configuration: no BLOCK, no -p")
+    if budget_s is not None and not all_blocks:
+        raise RasterhwError("--budget applies to --all only")
+    if not all_blocks and block not in mutation_blocks():
+        what = f"no testbench for block {block!r}" if block else "name a block (or --all)"
+        raise RasterhwError(f"{what}; blocks: {', '.join(mutation_blocks())}")
     check_cache()
     check_scheduler(scheduler)   # what answers at its address too, before anything runs
+    if all_blocks:
+        r = campaign_all(mutants=mutants, seed=seed, scheduler=scheduler, store=store or default_store(),
+                         fresh=fresh, progress=not as_json, budget_s=budget_s)
+        _emit_blocks(r, as_json, _mutate_line, f"{len(r['blocks'])} blocks in {r['wall_s']:.0f} s "
+                                               f"({r['computed']} tasks run, {r['reused']} from the store)")
+        if not all(b.get("baseline_passed", True) for b in r["blocks"]):
+            sys.exit(1)
+        return
     r = campaign(block, _params(block, params), mutants=mutants, seed=seed, scheduler=scheduler,
                  store=store or default_store(), fresh=fresh, progress=not as_json)
     if as_json:
         _emit(r)
     else:
-        shown = ", ".join(f"{k}={v}" for k, v in r["params"].items())
-        score = "void (mutant 0 fails: " + r["baseline_why"] + ")" if r["score"] is None else f"{r['score']:.3f}"
-        click.echo(f"{block} ({shown}): {r['mutants']} mutants, {r['killed']} killed, {r['equivalent']} equivalent, "
-                   f"{r['survived']} survived; score {score}")
+        click.echo(_mutate_line(r))
         click.echo(f"  Yosys {r['yosys_s']:.1f} s, build {r['build_s']:.1f} s, runs {r['runs_s']:.1f} s "
                    f"({r['computed']} run, {r['reused']} from the store); files in {r['dir']}")
         for s in r["survivors"]:
             click.echo(f"  survivor {s['mutant']}: {', '.join(s['src']) or '(no Amaranth src)'}: {s['mutation']}")
     if not r["baseline_passed"]:
         sys.exit(1)
+
+
+def _mutate_line(r: dict) -> str:
+    """One block's campaign in one line."""
+    shown = ", ".join(f"{k}={v}" for k, v in r["params"].items())
+    if "error" in r:
+        return f"{r['block']} ({shown}): not run: {r['error']}"
+    score = "void (mutant 0 fails: " + r["baseline_why"] + ")" if r["score"] is None else f"{r['score']:.3f}"
+    return (f"{r['block']} ({shown}): {r['mutants']} mutants, {r['killed']} killed, {r['equivalent']} equivalent, "
+            f"{r['survived']} survived; score {score}")
 
 
 def add_commands(group: click.Group) -> None:

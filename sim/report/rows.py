@@ -17,7 +17,7 @@ A row is a dict with the keys of :data:`ROW_KEYS`:
 
 Each machine names a function ``rows(engine, progress, out_dir, **known) -> (rows, sections)``
 in its registry entry (``Machine.report``); reports not tied to one machine are named in
-:data:`EXTRA_REPORTS` (``fpga``: place and route of every machine's blocks). :func:`run_report`
+:data:`EXTRA_REPORTS` (``fpga``: place and route of every machine's blocks; ``mutation``: mutation coverage and proofs). :func:`run_report`
 runs it, writes ``docs/reproduction/SYSTEM.md`` with the table (plus a ratio column) and
 whatever plots the system drew.
 
@@ -47,7 +47,8 @@ SOURCES = ("golden", "model", "formula", "hdl:pysim", "hdl:verilator", "hdl:icar
            "hdl:nextpnr")
 
 #: reports not tied to one machine: name -> "module:rows"
-EXTRA_REPORTS: dict[str, str] = {"fpga": "rasterhw.sim.report.fpga:rows"}
+EXTRA_REPORTS: dict[str, str] = {"fpga": "rasterhw.sim.report.fpga:rows",
+                                 "mutation": "rasterhw.sim.report.mutation:rows"}
 
 #: ``reason`` of a row a fast run leaves unmeasured
 FAST_SKIP = "slow row: not measured in a fast run (rasterhw report without --fast measures it)"

@@ -1,0 +1,128 @@
+"""``rasterhw report mutation``: ``docs/reproduction/mutation.md`` from the records of the mutation
+campaign (``rasterhw mutate --all``) and of the proofs (``rasterhw prove --all``).
+
+The record :data:`RECORD` (``docs/reproduction/mutation_runs.json``) holds the two commands' JSON
+as they printed it (``{"commands", "campaign", "proofs"}``); the report is made from it and runs
+nothing, unless ``--rerun``: then both commands run again (:data:`MUTANTS` mutants a block, seed
+:data:`SEED`, on ``--scheduler``) and the record is rewritten. Per block: mutants, killed,
+equivalent, survived, score (rows, ``source`` ``hdl:verilator``: the mutants' runs), and in the
+page the proofs (kind, depth, passed) and every survivor's location and mutation. A report not
+tied to one machine (``EXTRA_REPORTS`` in :mod:`rasterhw.sim.report.rows`).
+"""
+
+from __future__ import annotations
+
+import json
+
+from rasterhw.sim import registry
+from rasterhw.sim.paths import REPO_ROOT
+from rasterhw.sim.report.rows import make_row
+
+__all__ = ["MUTANTS", "RECORD", "SEED", "rows", "sections", "write_record"]
+
+#: where the campaign's and the proofs' results are kept
+RECORD = REPO_ROOT / "docs" / "reproduction" / "mutation_runs.json"
+#: the campaign of the record: mutants a block, seed
+MUTANTS, SEED = 30, 1
+
+
+def write_record(campaign: dict, proofs: dict, commands: list[str], path=None) -> None:
+    """Keep ``mutate --all`` 's and ``prove --all`` 's JSON (as printed) in the record."""
+    (path or RECORD).write_text(json.dumps({"commands": commands, "campaign": campaign, "proofs": proofs},
+                                           indent=1, sort_keys=True) + "\n")
+
+
+def _read(path=None) -> dict | None:
+    try:
+        return json.loads((path or RECORD).read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def _cfg(params: dict) -> str:
+    return ", ".join(f"{k} {v}" for k, v in params.items())
+
+
+def _proof_cell(p: dict | None) -> str:
+    if p is None:
+        return "—"
+    if p.get("passed") is None:
+        f = p.get("fits_result")
+        fits = (f"; fits at {_cfg(p['fits'])}: {f['kind']}, depth {f['depth']}, "
+                f"{'passed' if f['passed'] else '**failed**'}" if f else
+                "; no configuration tried fits" if "fits" in p else "")
+        return f"unproven: {p.get('reason')}{fits}"
+    s = f"{p['kind']}, depth {p['depth']}, {'passed' if p['passed'] else '**failed**'}"
+    if p.get("latency") is not None:
+        s += f" (latency {p['latency']})"
+    return s
+
+
+def sections(record: dict) -> list[str]:
+    """The page below the table: per block the counts, the proofs and the survivors."""
+    camp, proofs = record["campaign"], {b["block"]: b for b in record["proofs"]["blocks"]}
+    md = ["## Per block", "",
+          "From the record `docs/reproduction/mutation_runs.json`, made by: "
+          + "; ".join(f"`{c}`" for c in record["commands"]) + ". "
+          f"{camp['mutants']} mutants a block (seed {camp['seed']}), every block at {camp['config']}; "
+          f"campaign wall time {camp['wall_s']:.0f} s on `{camp['scheduler'].split(':')[0]}` "
+          f"({camp['computed']} tasks run, {camp['reused']} from the store). A mutant is killed when its "
+          "testbench (words against the golden model, cycles, stream rules, watchdog) fails; "
+          "`equivalent` is 0 until survivors are proved equivalent (docs/mutation.md). Stream proof: "
+          "`rasterhw prove --all` (sim/flow/stream_proof.py); own proof: the block's registered proof.", "",
+          "| block | configuration | mutants | killed | equivalent | survived | score | stream proof | own proof |",
+          "|---|---|---|---|---|---|---|---|---|"]
+    for b in camp["blocks"]:
+        pr = proofs.get(b["block"])
+        own = pr.get("own") if pr else None
+        if "error" in b:
+            md.append(f"| `{b['block']}` | {_cfg(b['params'])} | — | — | — | — | not run: {b['error']} | "
+                      f"{_proof_cell(pr)} | {_proof_cell(own)} |")
+            continue
+        score = f"void (mutant 0 fails: {b['baseline_why']})" if b["score"] is None else f"{b['score']:.3f}"
+        md.append(f"| `{b['block']}` | {_cfg(b['params'])} | {b['mutants']} | {b['killed']} | {b['equivalent']} | "
+                  f"{b['survived']} | {score} | {_proof_cell(pr)} | {_proof_cell(own)} |")
+    md += ["", "## Survivors", ""]
+    for b in camp["blocks"]:
+        if not b.get("survivors"):
+            continue
+        md += [f"### `{b['block']}` ({b['survived']} of {b['mutants']})", ""]
+        md += [f"- mutant {s['mutant']}: {', '.join(f'`{x}`' for x in s['src']) or '(no Amaranth source)'}: "
+               f"{s['mutation'].replace('|', '/')}" for s in b["survivors"]]
+        md.append("")
+    return md
+
+
+def rows(*, engine: str = "pysim", progress: bool = False, out_dir=None, fast: bool = False, rerun: bool = False,
+         scheduler: str = "serial", store=None, fresh: bool = False):
+    """Rows per block (mutants, killed, survived, score) and the page's sections, from the record;
+    ``rerun``: run the campaign and the proofs again first (``fast`` never reruns)."""
+    if rerun and not fast:
+        from rasterhw.sim.flow.mutate import campaign_all
+        from rasterhw.sim.flow.stream_proof import prove_all
+
+        camp = campaign_all(mutants=MUTANTS, seed=SEED, scheduler=scheduler, store=store, fresh=fresh,
+                            progress=progress)
+        write_record(camp, prove_all(scheduler=scheduler),
+                     [f"rasterhw mutate --all --mutants {MUTANTS} --seed {SEED} --scheduler {scheduler} --json",
+                      f"rasterhw prove --all --scheduler {scheduler} --json"])
+    record = _read()
+    from rasterhw.sim.flow.mutate import all_configs
+
+    blocks = {b["block"]: b for b in record["campaign"]["blocks"]} if record else {}
+    out = []
+    for block, params in all_configs().items():
+        b = blocks.get(block)
+        why = ("no record: rasterhw report mutation --rerun" if record is None else
+               f"not in the record's campaign ({RECORD.name})" if b is None else
+               f"not run: {b['error']}" if "error" in b else
+               f"void: mutant 0 (no mutation) fails its testbench here ({b['baseline_why']})" if b["score"] is None
+               else None)
+        system = registry.block_machine(block).name
+        fig = f"{block} mutation campaign ({_cfg(b['params'] if b else params)})"
+        for q, key, unit in (("mutants", "mutants", "mutants"), ("killed", "killed", "mutants"),
+                             ("survived", "survived", "mutants"), ("mutation score", "score", "")):
+            v = None if why else b[key]
+            out.append(make_row(system, fig, q, paper=None, formula=None, measured=v, unit=unit,
+                                source="hdl:verilator", reason=why))
+    return out, (sections(record) if record else [])
