@@ -84,6 +84,8 @@ class Setup:
     poly: np.ndarray       # (K,) poly_id
     sat_dzdx: int = 0
     sat_didx: int = 0
+    order: np.ndarray | None = None  # (K, 3): sorted vertex r (top, middle, bottom) is PL vertex order[k, r]
+
 
     @property
     def n(self) -> int:
@@ -160,7 +162,8 @@ def set_up(tris: ScreenTriangles, *, bit: bool, fmt: Formats | None = None) -> S
         hq = hue[keep]
     return Setup(bit=bit, fmt=fmt, grid=g, keep=keep, X=X, Y=Y, Z=Z, Iv=Iv, long_left=cr > 0,
                  r0=r0c[keep], r1=r1c[keep], rmid=rmid[keep], dzdx=dzdx, didx=didx, hue=hq,
-                 poly=np.asarray(tris.poly_id, dtype=np.int64)[keep], sat_dzdx=sdz, sat_didx=sdi)
+                 poly=np.asarray(tris.poly_id, dtype=np.int64)[keep], sat_dzdx=sdz, sat_didx=sdi,
+                 order=order[keep])
 
 
 def y_sort(st: Setup, band: tuple[int, int]) -> tuple[np.ndarray, np.ndarray, dict]:
