@@ -1,16 +1,22 @@
 """``rasterhw sim experts``: a whole frame through the SLP HDL and then the span PXP HDL.
 
-Every band's SLP work runs in ``experts-slp`` (the bands back to back through one instance: the
+Every band's set-up runs in ``experts-slp-setup`` (the bands back to back through one instance: the
+band word, then every PL triangle, ``golden_model/experts/slp_setup.py: pl_words``): the triangle
+words for the list work (sorted vertices, edge increments, eq. (3), the A.J. slopes, with the
+multiplier and the reciprocal ROM) compared word for word with ``slp_setup.band_setup`` (which equals
+``slp_cycles.tri_words`` in the band) and cycle for cycle (stamps). Those words -- the HDL's -- are
+the PL triangles every band's list work takes. Every band's SLP list work runs in ``experts-slp`` (the bands back to back through one instance: the
 SLPs are identical and independent, "ホスト計算機はすべての SLP に同一の PL を送出するだけ"): band,
 range bounds and the PL in; per line its ASL order, block leading pointers and bucket lists out,
 compared word for word and end-of-line by end-of-line (cycle stamps) with
 ``golden_model/experts/slp_cycles.py``. Those words -- the HDL's, not the golden SLP's -- then make
 every PXP's DMM/P words (the line's ASL in the SLP's order, that PXP's bucket list and leading
-pointer; each ASB's fields from the golden records: the SLP's z / i update and set-up are not in
-HDL), which run through ``experts-pxp-span`` as ``rasterhw sim pxp`` runs them: pixels against the
+pointer; each ASB's fields from the golden records), which run through ``experts-pxp-span`` as ``rasterhw sim pxp`` runs them: pixels against the
 golden bit model, every line's finish-time counter against ``span_cycles``.
 
-Frame times: an SLP's is its band's cycles (band start + its lines), a PXP's its own lines back to
+Frame times: an SLP's is its band's set-up cycles plus its list-work cycles (band start + its
+lines), both as the HDL took them (the two units are one processor's two phases, run one after
+the other; the sum is of two HDL counts, each checked against its cycle model), a PXP's its own lines back to
 back (``span_cycles.schedule``); the clock for 30 frames/s is the busiest one's cycles x 30, for
 SLPs and PXPs side by side. The SLP and PXP runs are chained, not clocked together: the DMM/P
 between them would overlap them in the machine.
@@ -18,6 +24,7 @@ between them would overlap them in the machine.
 
 from __future__ import annotations
 
+import sys
 import time
 
 import numpy as np
@@ -76,8 +83,38 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
     guard = 1 if aj == "c" else 0
     bands = equal_bounds(height, sn)
     bounds = equal_bounds(width, pn)
-    # ---- the SLPs: every band back to back through one experts-slp
+    # ---- the SLPs' set-up: every band back to back through one experts-slp-setup (band word, the PL)
+    from rasterhw.golden_model.experts.slp_setup import pl_words
+    from rasterhw.sim.experts.testbench import SlpSetupBench, setup_words
+    pls = pl_words(fr.setup)
+    sus = [setup_words(pls, (int(bands[s]), int(bands[s + 1])), height) for s in range(sn)]
+    stb = SlpSetupBench()
+    su_in = [w for su in sus for w in su["in"]]
+    su_want = [w for su in sus for w in su["out"]]
+    su_stamps, t = [], 0
+    for su in sus:
+        su_stamps += [t + st for st in su["stamps"]]
+        t += 1 + su["cycles"]
+    if progress:
+        print(f"experts: {sn} SLP set-ups, {len(su_in)} words in, {t:,} set-up cycles expected", file=sys.stderr)
+    sgot = run(stb, stb.params(height=height), Stimulus({"i": su_in}), engine=engine,
+               expect_words={"o": len(su_want)}, max_cycles=2 * t + 10000)
+    su_have = sgot.words["o"]
+    su_mism = sum(a != b for a, b in zip(su_want, su_have, strict=False)) + abs(len(su_want) - len(su_have))
+    su_cyc_mism = (sum(a != b for a, b in zip(su_stamps, sgot.stamps["o"], strict=False))
+                   + abs(len(su_stamps) - len(sgot.stamps["o"])))
+    # each band's set-up cycles as the HDL took them: from the stamp of its last word to the next's
+    n_pl = len(pls)
+    last = [int(sgot.stamps["o"][(s + 1) * n_pl - 1]) if len(sgot.stamps["o"]) >= (s + 1) * n_pl else 0
+            for s in range(sn)]
+    setup_band = [last[0] + 1] + [last[s] - last[s - 1] for s in range(1, sn)]
+    # ---- the SLPs' list work: every band back to back through one experts-slp, on the set-up HDL's words
     sws = [slp_words(fr, (int(bands[s]), int(bands[s + 1])), bounds, guard=guard) for s in range(sn)]
+    nb = 1 + len(bounds)
+    for s, sw in enumerate(sws):
+        hw = su_have[s * n_pl:(s + 1) * n_pl]
+        if len(hw) == n_pl:
+            sw["in"] = sw["in"][:nb] + list(hw) + sw["in"][nb + n_pl:]
     tb = SlpBench()
     p = tb.params(width=width, tris=max(2, min(4095, max(sw["tris"] for sw in sws))),
                   lines=max(1, int(np.diff(bands).max())), asl=256, guard=guard)
@@ -85,7 +122,6 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
     want = [w for sw in sws for w in sw["out"]]
     total = sum(sw["cycles"] for sw in sws)
     if progress:
-        import sys
         print(f"experts: {sn} SLP bands, {len(words_in)} words in, {len(want)} out, {total:,} SLP cycles expected",
               file=sys.stderr)
     got = run(tb, p, Stimulus({"i": words_in}), engine=engine, expect_words={"o": len(want)},
@@ -94,14 +130,19 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
     slp_mism = sum(a != b for a, b in zip(want, have, strict=False)) + abs(len(want) - len(have))
     # every end-of-line word on the golden cycle: band start, then its lines, band after band
     eol_want, t = [], 0
+    band_end = []
     for sw in sws:
         t += sw["start_cycles"]
         for c in sw["line_cycles"]:
             t += c
             eol_want.append(t - 1)
+        band_end.append(len(eol_want) - 1)
     dec = decode_slp(have)
     eol_got = [st for st, w in zip(got.stamps["o"], dec, strict=False) if w[0] == 3]
     slp_cyc_mism = sum(a != b for a, b in zip(eol_want, eol_got, strict=False)) + abs(len(eol_want) - len(eol_got))
+    # each band's list-work cycles as the HDL took them: from one band's last end-of-line word to the next's
+    ends = [int(eol_got[k]) if k < len(eol_got) else 0 for k in band_end]
+    list_band = [ends[0] + 1] + [ends[s] - ends[s - 1] for s in range(1, sn)]
     # ---- the HDL SLP's lists -> every PXP's DMM/P words
     lists: dict = {}
     line: dict = {"asl": [], "lead": {}, "bk": {}}
@@ -126,20 +167,29 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
     mism = int(np.count_nonzero(px[:n] != jb["pixels"][:n])) + abs(px.size - jb["pixels"].size)
     cyc = res["cycles"][:jb["lines"]]
     pxp_cyc_mism = int(np.count_nonzero(cyc != jb["cycles"][:cyc.size])) + (jb["lines"] - cyc.size)
-    slp_frame = max(sw["cycles"] for sw in sws)
-    cycles = int(got.cycles) + int(res["sim_cycles"])
-    run_s = got.run_s + res["run_s"]
+    # one SLP does its band's set-up, then its list work: its frame is the two, the busiest band's
+    slp_band = [a + b for a, b in zip(setup_band, list_band, strict=True)]
+    busiest = int(np.argmax(slp_band))
+    slp_frame = slp_band[busiest]
+    cycles = int(sgot.cycles) + int(got.cycles) + int(res["sim_cycles"])
+    run_s = sgot.run_s + got.run_s + res["run_s"]
     pxp_frame = int(jb["pxp_frame_cycles"].max())
     return {"engine": engine, "cycles": cycles, "clock_hz": None,
-            "cycles_per_s": round(cycles / run_s, 1) if run_s > 0 else None, "pixels_compared": int(n), "mismatches": mism + slp_mism,
+            "cycles_per_s": round(cycles / run_s, 1) if run_s > 0 else None, "pixels_compared": int(n), "mismatches": mism + slp_mism + su_mism,
             "pixel_mismatches": mism, "slp_word_mismatches": slp_mism, "slp_words": len(want),
-            "cycle_mismatches": slp_cyc_mism + pxp_cyc_mism,
+            "slp_setup_word_mismatches": su_mism, "slp_setup_words": len(su_want),
+            "cycle_mismatches": slp_cyc_mism + pxp_cyc_mism + su_cyc_mism,
             "slp_cycle_mismatches": slp_cyc_mism, "pxp_cycle_mismatches": pxp_cyc_mism,
-            "slp_cycles": slp_frame, "pxp_cycles": pxp_frame,
+            "slp_setup_cycle_mismatches": su_cyc_mism,
+            # the busiest SLP's band: set-up (experts-slp-setup) + list work (experts-slp), HDL cycles
+            "slp_cycles": slp_frame, "slp_setup_cycles": int(setup_band[busiest]),
+            "slp_list_cycles": int(list_band[busiest]), "slp_busiest_band": busiest,
+            "slp_setup_cycles_per_band": [int(v) for v in setup_band],
+            "slp_list_cycles_per_band": [int(v) for v in list_band], "pxp_cycles": pxp_frame,
             "slp_clock_for_30fps_hz": slp_frame * 30, "pxp_clock_for_30fps_hz": pxp_frame * 30,
             "bottleneck": "SLP" if slp_frame > pxp_frame else "PXP",
             "sn": sn, "pn": pn, "aj": aj, "pxp": "span", "wall_s": round(time.perf_counter() - t0, 3),
-            "slp_run_s": round(got.run_s, 3), "pxp_run_s": round(res["run_s"], 3),
+            "slp_run_s": round(got.run_s, 3), "slp_setup_run_s": round(sgot.run_s, 3), "pxp_run_s": round(res["run_s"], 3),
             # SLPs and PXPs work side by side: the machine's frame is the slower of the two
             "frame_cycles": max(slp_frame, pxp_frame), "frame_rgb": hdl_image(fr, px)}
 

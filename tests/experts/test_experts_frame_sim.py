@@ -21,6 +21,13 @@ def test_small_frame_slp_and_pxp_hdl_exact():
     assert r["slp_cycle_mismatches"] == 0 and r["pxp_cycle_mismatches"] == 0 and r["cycle_mismatches"] == 0
     assert r["slp_clock_for_30fps_hz"] == 30 * r["slp_cycles"] and r["pxp_clock_for_30fps_hz"] == 30 * r["pxp_cycles"]
     assert r["bottleneck"] in ("SLP", "PXP") and r["slp_cycles"] > 0 and r["pxp_cycles"] > 0
+    # the SLP's set-up in HDL (experts-slp-setup), its words fed to the list work, and one SLP clock with it
+    assert r["slp_setup_word_mismatches"] == 0 and r["slp_setup_cycle_mismatches"] == 0
+    assert r["slp_setup_words"] > 0
+    b = r["slp_busiest_band"]
+    assert r["slp_setup_cycles"] == r["slp_setup_cycles_per_band"][b] > 0
+    assert r["slp_cycles"] == r["slp_setup_cycles"] + r["slp_list_cycles"] == max(
+        a + c for a, c in zip(r["slp_setup_cycles_per_band"], r["slp_list_cycles_per_band"], strict=True))
 
 
 def test_the_pxp_needs_the_slps_bucket_list():
