@@ -11,7 +11,13 @@ import pytest
 from rasterhw.golden_model.experts.formats import recip_rom
 from rasterhw.golden_model.experts.model import render_frame
 from rasterhw.golden_model.experts.slp_cycles import tri_words
-from rasterhw.golden_model.experts.slp_setup import band_setup, pl_words, recip, rom_table, set_up_triangle
+from rasterhw.golden_model.experts.slp_setup import (
+    band_setup,
+    pl_words,
+    recip,
+    rom_table,
+    set_up_triangle,
+)
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.sim.engines import run
