@@ -12,7 +12,8 @@ MACHINE = Machine(
               "can change): depth search operations, Fr 2000 / Fr 1000",
               "5: SLP with set-up, operation count (model): SLP clock for 30 frames/s, experts-1000",
               "5 / HDL: coherent span PXP (ours, experts-pxp-coherent), HDL cycles",
-              "5 / HDL: span PXP (ours, experts-pxp-span), HDL cycles", "5 / HDL: SLP list work"),
+              "5 / HDL: span PXP (ours, experts-pxp-span), HDL cycles", "5 / HDL: SLP list work",
+              "5 / HDL: SLP with set-up (experts-slp-setup, then experts-slp), HDL cycles: SLP clock"),
     name="experts",
     title="EXPERTS scan-line multiprocessor (Kyoto Univ.)",
     seed="000_5ac5e14b809e6e93.txt",
@@ -47,7 +48,8 @@ MACHINE = Machine(
                                    "the visible segment can change, experts-pxp-coherent) or zbuffer (a one-line "
                                    "Z-buffer, experts-pxp); all ours, the same pixels", "span",
                                    ("span", "coherent", "zbuffer")))),
-          SimBlock("experts", "the whole frame: every band through the SLP HDL (experts-slp), its ASL order and "
+          SimBlock("experts", "the whole frame: every band through the SLP's set-up HDL (experts-slp-setup) and "
+                   "list-work HDL (experts-slp), its ASL order and "
                    "block lists then into every span PXP's DMM/P (experts-pxp-span); words, pixels and cycles "
                    "against golden, SLP and PXP clocks for 30 frames/s", "rasterhw.sim.experts.frame_sim:simulate_frame",
                    default_scene="experts-1000",
@@ -82,6 +84,7 @@ MACHINE = Machine(
     status="scan-line golden model split as SLP/PXP (float and 16-bit): span PXPs (the paper's span cull, "
            "depth search per span) and the SLP's sorts run and counted, Sn x Pn parallel model with "
            "load balancing at both levels, fig. 4.1 cost model (golden); in HDL, bit- and cycle-exact: the "
-           "span PXP (default), the coherent span PXP and the line-Z-buffer PXP (all ours), the SLP (Y-sort, ASL update, "
-           "L-sort, X-merge, block lists; not its set-up); one SLP + Pn PXPs clocked together (pixel-exact)",
+           "span PXP (default), the coherent span PXP and the line-Z-buffer PXP (all ours), the SLP (Y-sort, ASL "
+           "update, L-sort, X-merge, block lists) and its set-up (multiplier, reciprocal ROM); one SLP + Pn PXPs "
+           "clocked together (pixel-exact)",
 )
