@@ -227,7 +227,7 @@ def _tables(out: list, sections: list, out_dir: Path, progress: bool, engine: st
                             source="golden"))
         out.append(make_row(SYS, "table 2.2", f"work with A.J. ({m}), 8 line segments (no A.J. = 1)",
                             paper=PAPER_T22[m], formula=None, measured=round(rat[m], 4), unit="x", source="golden"))
-    out.append(make_row(SYS, "table 2.2", "(b) / (c) work ratio, 8 line segments (formula: the paper's 1.15 / 3.35)",
+    out.append(make_row(SYS, "table 2.2", "(b) / (c) work ratio, 8 line segments",
                         paper=None, formula=round(PAPER_T22["b"] / PAPER_T22["c"], 4), measured=round(rat["b"] / rat["c"], 4), unit="x", source="golden"))
     e = cost.alpha_error()
     for m in ("b", "c"):
