@@ -32,3 +32,8 @@ def test_no_other_experts_module_defines_a_paper_constant():
         m = importlib.import_module(f"rasterhw.{mod}")
         own = [k for k, v in vars(m).items() if k.startswith("PAPER_") and getattr(paper, k, None) is not v]
         assert own == [], (mod, own)
+
+
+def test_derived_rows_hold_no_paper_value(pv):
+    # (b) / (c) = 1.15 / 3.35 is arithmetic on the paper: a formula
+    assert pv.derived_with_paper_cells("experts", ("(b) / (c) work ratio",)) == []
