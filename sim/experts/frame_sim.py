@@ -20,6 +20,12 @@ the other; the sum is of two HDL counts, each checked against its cycle model), 
 back (``span_cycles.schedule``); the clock for 30 frames/s is the busiest one's cycles x 30, for
 SLPs and PXPs side by side. The SLP and PXP runs are chained, not clocked together: the DMM/P
 between them would overlap them in the machine.
+
+``datapath``: ``ours`` (today's HDL, the default) or ``paper`` (16-bit words, one multiplier a
+processor: ``formats.DATAPATHS``). Both report the golden bit model's error against the float model
+at their widths (``accuracy.float_error``, source ``golden``). The HDL is not yet parametrised by the
+datapath: ``paper`` runs no HDL and says so (``source`` ``golden``, ``simulated`` false,
+``pixels_compared`` 0, no cycles).
 """
 
 from __future__ import annotations
@@ -54,7 +60,8 @@ def decode_slp(words: list[int]) -> list[tuple]:
 
 
 def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator", progress: bool = False,
-                   sn: int | None = 8, pn: int | None = 8, aj: str | None = "c", path: str | None = "chained") -> dict:
+                   sn: int | None = 8, pn: int | None = 8, aj: str | None = "c", path: str | None = "chained",
+                   datapath: str | None = "ours") -> dict:
     """Registry sim block ``experts``: the frame's SLP bands and PXP lines in HDL, against golden.
 
     ``path="group"``: every band instead through ``experts-group`` (the SLP, its DMM/P writers and
@@ -76,10 +83,24 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
     path = "chained" if path is None else path
     if path not in ("chained", "group"):
         raise RasterhwError(f"experts: sim experts path must be chained or group, not {path!r}")
+    from rasterhw.golden_model.experts.formats import DATAPATHS
+    datapath = "ours" if datapath is None else datapath
+    if datapath not in DATAPATHS:
+        raise RasterhwError(f"experts: sim experts datapath must be one of {', '.join(DATAPATHS)}, not {datapath!r}")
+    if datapath == "paper" and path != "chained":
+        raise RasterhwError("experts: sim experts --datapath paper runs no HDL yet; --path group needs it")
     t0 = time.perf_counter()
-    fr = render_frame(run_geometry(scene, width, height, z_bits=16), model="bit", aj=aj)
+    tris = run_geometry(scene, width, height, z_bits=16)
+    acc = _accuracy(tris, datapath, aj)
+    if datapath == "paper":
+        return {"engine": "golden", "engine_requested": engine, "source": "golden", "simulated": False,
+                "cycles": None, "clock_hz": None, "pixels_compared": 0, "mismatches": 0,
+                "hdl": "none: the HDL is ours' widths (40 bits, 3 multipliers in the span PXP); "
+                       "issue 48 item 2 (c) not built", **acc, "sn": sn, "pn": pn, "aj": aj,
+                "wall_s": round(time.perf_counter() - t0, 3)}
+    fr = render_frame(tris, model="bit", aj=aj)
     if path == "group":
-        return _group_frame(fr, engine, sn, pn, aj, t0, progress)
+        return {**_group_frame(fr, engine, sn, pn, aj, t0, progress), **acc}
     guard = 1 if aj == "c" else 0
     bands = equal_bounds(height, sn)
     bounds = equal_bounds(width, pn)
@@ -197,7 +218,18 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
             "sn": sn, "pn": pn, "aj": aj, "pxp": "span", "wall_s": round(time.perf_counter() - t0, 3),
             "slp_run_s": round(got.run_s, 3), "slp_setup_run_s": round(su_run_s, 3), "pxp_run_s": round(res["run_s"], 3),
             # SLPs and PXPs work side by side: the machine's frame is the slower of the two
-            "frame_cycles": max(slp_frame, pxp_frame), "frame_rgb": hdl_image(fr, px)}
+            "frame_cycles": max(slp_frame, pxp_frame), **acc, "frame_rgb": hdl_image(fr, px)}
+
+
+def _accuracy(tris, datapath: str, aj: str) -> dict:
+    """The datapath's contract and its golden bit model's error against float (source golden)."""
+    from rasterhw.golden_model.experts.accuracy import float_error
+    e = float_error(tris, datapath, aj=aj)
+    return {"datapath": e["datapath"], "datapath_label": e["label"], "datapath_bits": e["datapath_bits"],
+            "multipliers": e["multipliers"], "max_abs_error": e["max_abs_error"],
+            "pixels_differing_from_float": e["pixels_differing_from_float"], "psnr_db": round(e["psnr_db"], 3),
+            "visible_differing_from_float": e["visible_differing"],
+            "pixels_differing_from_ours": e["pixels_differing_from_ours"], "accuracy_source": "golden"}
 
 
 def _group_frame(fr, engine: str, sn: int, pn: int, aj: str, t0: float, progress: bool) -> dict:

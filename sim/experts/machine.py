@@ -59,7 +59,11 @@ MACHINE = Machine(
                             Option("path", "chained (the SLP HDL, then the PXP HDL on its words, each against its "
                                    "cycle model) or group (one SLP + Pn PXPs clocked together per band, "
                                    "experts-group; pixels against golden, cycles measured)", "chained",
-                                   ("chained", "group")))),),
+                                   ("chained", "group")),
+                            Option("datapath", "ours (today's HDL: 40-bit registers, three multipliers in the span "
+                                   "PXP) or paper (the paper's 16-bit words, one multiplier a processor: golden bit "
+                                   "model only, no HDL yet); both report the bit model's error against float",
+                                   "ours", ("ours", "paper")))),),
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",
     soak={"pxp": "rasterhw.sim.experts.soak:pxp_round"},

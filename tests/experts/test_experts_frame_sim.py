@@ -28,6 +28,23 @@ def test_small_frame_slp_and_pxp_hdl_exact():
     assert r["slp_setup_cycles"] == r["slp_setup_cycles_per_band"][b] > 0
     assert r["slp_cycles"] == r["slp_setup_cycles"] + r["slp_list_cycles"] == max(
         a + c for a, c in zip(r["slp_setup_cycles_per_band"], r["slp_list_cycles_per_band"], strict=True))
+    # today's datapath, and its golden bit model's error against float
+    assert (r["datapath"], r["datapath_bits"], r["multipliers"], r["accuracy_source"]) == ("ours", 40, 3, "golden")
+    assert r["pixels_differing_from_ours"] == 0 and r["max_abs_error"] >= 0
+
+
+def test_paper_datapath_is_golden_only_and_says_so():
+    """--datapath paper: no HDL at 16 bits yet (issue 48 item 2 (c)); the figures are the golden bit
+    model's and the result says so: engine golden, nothing compared, no cycles."""
+    r = simulate_frame(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c", datapath="paper")
+    assert (r["engine"], r["source"], r["simulated"], r["pixels_compared"], r["cycles"]) == ("golden", "golden", False, 0, None)
+    assert (r["datapath_bits"], r["multipliers"], r["engine_requested"]) == (16, 1, "verilator")
+    assert (r["max_abs_error"], r["pixels_differing_from_float"], r["pixels_differing_from_ours"]) == (203, 222974, 19504)
+    assert "frame_rgb" not in r
+    with pytest.raises(RasterhwError, match="datapath must be"):
+        simulate_frame(build_scene("experts-1000"), 64, 16, engine="pysim", datapath="wide")
+    with pytest.raises(RasterhwError, match="path group"):
+        simulate_frame(build_scene("experts-1000"), 64, 16, engine="pysim", datapath="paper", path="group")
 
 
 def test_the_pxp_needs_the_slps_bucket_list():
