@@ -103,7 +103,7 @@ def pl_words(st) -> list[dict]:
     return out
 
 
-def set_up_triangle(pl: dict, band: tuple[int, int], height: int) -> tuple[dict, int]:
+def set_up_triangle(pl: dict, band: tuple[int, int], height: int, extra: int = ACC_EXTRA) -> tuple[dict, int]:
     """One PL triangle through the set-up: its triangle word (``slp_cycles.tri_words``' fields;
     out of the band only ``t``, ``r0``, ``r1``) and its cycles (:data:`__doc__`)."""
     v = sorted(range(3), key=lambda j: pl[f"y{j}"])      # stable: equal y keep PL order
@@ -123,14 +123,15 @@ def set_up_triangle(pl: dict, band: tuple[int, int], height: int) -> tuple[dict,
         return (Y[1] - Y[2]) * (A[0] - A[1]) - (Y[0] - Y[1]) * (A[1] - A[2])
     den, nz, ni = plane(X), plane(Z), plane(Iv)
     cyc = 1 + 6
-    sh = X_FRAC + ACC_EXTRA
+    sh = X_FRAC + extra           # the paper's datapath (extra 0): each increment one saturated 16-bit word
+    inc = _sat16 if extra == 0 else (lambda v: v)
     for e, i, j in EDGES:
         dX, dY = X[j] - X[i], Y[j] - Y[i]
         r, s, c = recip(dY)
         cyc += 2 + c + 4
-        w[f"inc_{e}"] = _md(dX, r, s, dY < 0, sh)
-        w[f"zinc_{e}"] = _md(Z[j] - Z[i], r, s, dY < 0, sh)
-        w[f"iinc_{e}"] = _md(Iv[j] - Iv[i], r, s, dY < 0, sh)
+        w[f"inc_{e}"] = inc(_md(dX, r, s, dY < 0, sh))
+        w[f"zinc_{e}"] = inc(_md(Z[j] - Z[i], r, s, dY < 0, sh))
+        w[f"iinc_{e}"] = inc(_md(Iv[j] - Iv[i], r, s, dY < 0, sh))
         w[f"s_{e}"] = _sat16(_md(dX, r, s, dY < 0, SLOPE_FRAC))
         r, s, c = recip(dX)
         cyc += 2 + c + 1
@@ -143,12 +144,12 @@ def set_up_triangle(pl: dict, band: tuple[int, int], height: int) -> tuple[dict,
     return w, cyc
 
 
-def band_setup(pls: list[dict], band: tuple[int, int], height: int) -> dict:
+def band_setup(pls: list[dict], band: tuple[int, int], height: int, extra: int = ACC_EXTRA) -> dict:
     """Every PL triangle of the frame through one SLP's set-up for its band: the triangle words in
     PL order, the cycles of each and in all (``cycles``), and how many were in the band."""
     words, cyc = [], []
     for pl in pls:
-        w, c = set_up_triangle(pl, band, height)
+        w, c = set_up_triangle(pl, band, height, extra)
         words.append(w)
         cyc.append(c)
     return {"words": words, "tri_cycles": cyc, "cycles": int(sum(cyc)),

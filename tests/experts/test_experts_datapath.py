@@ -65,3 +65,25 @@ def test_error_against_float_beside_ours(aj):
     got = (ours["max_abs_error"], ours["pixels_differing_from_float"], round(ours["psnr_db"], 3),
            paper["max_abs_error"], paper["pixels_differing_from_float"], round(paper["psnr_db"], 3))
     assert got == want
+
+
+@pytest.mark.parametrize("name", ["experts-tilt-1000", "c100"])
+def test_slp_cycle_model_and_set_up_at_the_papers_widths(name):
+    """The golden side the SLP HDL runs against, at the paper's widths (acc_extra 0): the set-up's
+    triangle words are the paper bit model's, and every ASB (x, z, i by 16-bit accumulators) is the
+    paper bit model's record; at ours' widths the same words give different ASBs (the test can fail)."""
+    from rasterhw.golden_model.experts.slp_cycles import asb, tri_words
+    from rasterhw.golden_model.experts.slp_setup import band_setup, pl_words
+    from rasterhw.golden_model.experts.span_cycles import line_asl
+    fr = render_frame(run_geometry(build_scene(name), 128, 96, z_bits=16), model="bit", aj="c", fmt=PAPER)
+    tws, pls = tri_words(fr.setup), pl_words(fr.setup)
+    assert band_setup(pls, (0, 96), 96, extra=0)["words"] == tws
+    assert band_setup(pls, (0, 96), 96)["words"] != tws
+    n = wide = 0
+    for y in range(96):
+        segs, _ = line_asl(fr, y)
+        for s in segs:
+            assert asb(tws[s["addr"]], y, extra=0) == s
+            wide += asb(tws[s["addr"]], y) != s
+            n += 1
+    assert n > 300 and wide > 0
