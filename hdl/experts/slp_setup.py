@@ -47,6 +47,9 @@ class ExpertsSlpSetup(wiring.Component):
     ----------
     height : int
         Frame height (the last line a triangle may reach), 1..1024.
+    acc_extra : int
+        Fraction bits of the edge increments beyond the 16-bit word (``formats.Datapath.acc_extra``):
+        16 (ours, the default) or 0 (the paper's 16-bit datapath: each increment saturated to 16 bits).
 
     Members
     -------
@@ -54,10 +57,12 @@ class ExpertsSlpSetup(wiring.Component):
     o : Out(stream.Signature(slp_in_layout()))
     """
 
-    def __init__(self, *, height: int = 512):
+    def __init__(self, *, height: int = 512, acc_extra: int = ACC_EXTRA):
         if isinstance(height, bool) or not isinstance(height, int) or not 1 <= height <= 1024:
             raise ValueError(f"height must be an integer in 1..1024, not {height!r}")
-        self._h = height
+        if acc_extra not in (0, ACC_EXTRA) or isinstance(acc_extra, bool):
+            raise ValueError(f"acc_extra must be 0 or {ACC_EXTRA}, not {acc_extra!r}")
+        self._h, self._ex = height, acc_extra
         from rasterhw.hdl.experts.slp import slp_in_layout
         super().__init__({"i": In(stream.Signature(pl_layout())), "o": Out(stream.Signature(slp_in_layout()))})
 
@@ -110,11 +115,12 @@ class ExpertsSlpSetup(wiring.Component):
         prog = [("mul", df(Y, 2, 1), df(X, 1, 0), den, True), ("mul", df(Y, 1, 0), df(X, 2, 1), den, False),
                 ("mul", df(Y, 2, 1), df(Z, 1, 0), nz, True), ("mul", df(Y, 1, 0), df(Z, 2, 1), nz, False),
                 ("mul", df(Y, 2, 1), df(Iv, 1, 0), ni, True), ("mul", df(Y, 1, 0), df(Iv, 2, 1), ni, False)]
-        sh = X_FRAC + ACC_EXTRA
+        sh = X_FRAC + self._ex
+        ik = "sat" if self._ex == 0 else "int"     # the paper's datapath: one saturated 16-bit word
         for e_, i, j in EDGES:
             dX, dY = df(X, i, j), df(Y, i, j)
-            prog += [("recip", dY), ("md", dX, sh, f"inc_{e_}", "int"), ("md", df(Z, i, j), sh, f"zinc_{e_}", "int"),
-                     ("md", df(Iv, i, j), sh, f"iinc_{e_}", "int"), ("md", dX, SLOPE_FRAC, f"s_{e_}", "sat"),
+            prog += [("recip", dY), ("md", dX, sh, f"inc_{e_}", ik), ("md", df(Z, i, j), sh, f"zinc_{e_}", ik),
+                     ("md", df(Iv, i, j), sh, f"iinc_{e_}", ik), ("md", dX, SLOPE_FRAC, f"s_{e_}", "sat"),
                      ("recip", dX), ("md", dY, SLOPE_FRAC, f"q_{e_}", "satq")]
         prog += [("recip", den), ("md", nz, 6 + 4, "dzdx", "sat"), ("md", ni, 6, "didx", "sat")]
 

@@ -8,6 +8,7 @@ import numpy as np
 from amaranth import EnableInserter, Module, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
+from rasterhw.golden_model.experts.formats import ACC_EXTRA
 from rasterhw.golden_model.experts.model import render_frame
 from rasterhw.golden_model.experts.pxp_cycles import line_segments
 from rasterhw.golden_model.pipeline import run_geometry
@@ -242,7 +243,7 @@ def slp_words(fr, band: tuple[int, int], bounds, *, guard: int) -> dict:
     from rasterhw.hdl.pack import pack
     li, lo = slp_in_layout(), slp_out_layout()
     tws = tri_words(fr.setup)
-    br = band_run(tws, band, bounds, width=fr.width, guard=guard)
+    br = band_run(tws, band, bounds, width=fr.width, guard=guard, extra=fr.setup.fmt.datapath.acc_extra)
     words = [pack(li, {"kind": IN_KIND["band"], "r0": band[0], "r1": band[1]})]
     words += [pack(li, {"kind": IN_KIND["bound"], "xa": int(v)}) for v in bounds]
     words += [pack(li, {"kind": IN_KIND["tri"], **tw}) for tw in tws] + [pack(li, {"kind": IN_KIND["go"]})]
@@ -251,7 +252,7 @@ def slp_words(fr, band: tuple[int, int], bounds, *, guard: int) -> dict:
     return {"in": words, "out": out, **br, "tris": len(tws)}
 
 
-def setup_words(pls: list[dict], band: tuple[int, int], height: int) -> dict:
+def setup_words(pls: list[dict], band: tuple[int, int], height: int, extra: int = ACC_EXTRA) -> dict:
     """``experts-slp-setup`` stimulus and expectation for one band: the band word and every PL
     triangle (``golden_model/experts/slp_setup.py: pl_words``) in, the triangle words the list work
     takes out, each on the edge ``band_setup``'s cycles put it (``stamps``: the band word's cycle,
@@ -261,7 +262,7 @@ def setup_words(pls: list[dict], band: tuple[int, int], height: int) -> dict:
     from rasterhw.hdl.experts.slp_setup import PL_KIND, pl_layout
     from rasterhw.hdl.pack import pack
     li, lo = pl_layout(), slp_in_layout()
-    bs = band_setup(pls, band, height)
+    bs = band_setup(pls, band, height, extra)
     words = [pack(li, {"kind": PL_KIND["band"], "r0": band[0], "r1": band[1]})]
     words += [pack(li, {"kind": PL_KIND["tri"], **pl}) for pl in pls]
     stamps, t = [], 1

@@ -87,3 +87,28 @@ def test_slp_cycle_model_and_set_up_at_the_papers_widths(name):
             wide += asb(tws[s["addr"]], y) != s
             n += 1
     assert n > 300 and wide > 0
+
+
+def test_slp_hdl_at_the_papers_widths_pysim():
+    """experts-slp-setup and experts-slp with acc_extra 0 (the paper's 16-bit increments and edge
+    accumulators), pysim, on one band of the paper bit model's frame: words and cycle stamps equal
+    the golden side's at the same widths; the same words at ours' widths differ (the test can fail)."""
+    from rasterhw.golden_model.experts.model import equal_bounds
+    from rasterhw.golden_model.experts.slp_setup import pl_words
+    from rasterhw.sim.engines import run
+    from rasterhw.sim.experts.testbench import SlpBench, SlpSetupBench, setup_words, slp_words
+    from rasterhw.sim.testbench import Stimulus
+    fr = render_frame(run_geometry(build_scene("experts-tilt-1000"), 64, 32, z_bits=16), model="bit", aj="c",
+                      fmt=PAPER)
+    su = setup_words(pl_words(fr.setup), (8, 16), 32, extra=0)
+    assert su["out"] != setup_words(pl_words(fr.setup), (8, 16), 32)["out"]
+    tb = SlpSetupBench()
+    got = run(tb, tb.params(height=32, acc_extra=0), Stimulus({"i": su["in"]}), engine="pysim",
+              expect_words={"o": len(su["out"])}, max_cycles=40000)
+    assert got.words["o"] == su["out"] and list(got.stamps["o"]) == su["stamps"]
+    sw = slp_words(fr, (8, 16), equal_bounds(64, 3), guard=1)
+    tb = SlpBench()
+    got = run(tb, tb.params(width=64, tris=1024, lines=32, asl=256, guard=1, acc_extra=0), Stimulus({"i": sw["in"]}),
+              engine="pysim", expect_words={"o": len(sw["out"])}, max_cycles=40000)
+    assert got.words["o"] == sw["out"] and int(got.stamps["o"][-1]) + 1 == sw["cycles"]
+    assert len(sw["out"]) > 8 * 10
