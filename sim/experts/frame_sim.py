@@ -23,9 +23,10 @@ between them would overlap them in the machine.
 
 ``datapath``: ``ours`` (today's HDL, the default) or ``paper`` (16-bit words, one multiplier a
 processor: ``formats.DATAPATHS``). Both report the golden bit model's error against the float model
-at their widths (``accuracy.float_error``, source ``golden``). The HDL is not yet parametrised by the
-datapath: ``paper`` runs no HDL and says so (``source`` ``golden``, ``simulated`` false,
-``pixels_compared`` 0, no cycles).
+at their widths (``accuracy.float_error``, ``accuracy_source`` golden). ``paper`` runs the frame's
+golden bit model at the paper's widths and the SLP HDL with 16-bit edge increments and accumulators
+(``acc_extra`` 0); the rest of the HDL is ours' (``HDL_WIDEST_BITS``, ``HDL_MULTIPLIERS``: what the
+result's ``datapath_bits`` and ``multipliers`` say; the contract's are ``contract_*``).
 """
 
 from __future__ import annotations
@@ -88,17 +89,14 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
     if datapath not in DATAPATHS:
         raise RasterhwError(f"experts: sim experts datapath must be one of {', '.join(DATAPATHS)}, not {datapath!r}")
     if datapath == "paper" and path != "chained":
-        raise RasterhwError("experts: sim experts --datapath paper runs no HDL yet; --path group needs it")
+        raise RasterhwError("experts: sim experts --datapath paper: experts-group has no 16-bit configuration; "
+                            "leave --path at chained")
     t0 = time.perf_counter()
     tris = run_geometry(scene, width, height, z_bits=16)
     acc = _accuracy(tris, datapath, aj)
-    if datapath == "paper":
-        return {"engine": "golden", "engine_requested": engine, "source": "golden", "simulated": False,
-                "cycles": None, "clock_hz": None, "pixels_compared": 0, "mismatches": 0,
-                "hdl": "none: the HDL is ours' widths (40 bits, 3 multipliers in the span PXP); "
-                       "issue 48 item 2 (c) not built", **acc, "sn": sn, "pn": pn, "aj": aj,
-                "wall_s": round(time.perf_counter() - t0, 3)}
-    fr = render_frame(tris, model="bit", aj=aj)
+    from rasterhw.golden_model.experts.formats import Formats
+    ex = DATAPATHS[datapath].acc_extra
+    fr = render_frame(tris, model="bit", aj=aj, fmt=Formats(datapath=DATAPATHS[datapath]))
     if path == "group":
         return {**_group_frame(fr, engine, sn, pn, aj, t0, progress), **acc}
     guard = 1 if aj == "c" else 0
@@ -110,7 +108,7 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
     from rasterhw.golden_model.experts.slp_setup import pl_words
     from rasterhw.sim.experts.testbench import SlpSetupBench, setup_words
     pls = pl_words(fr.setup)
-    sus = [setup_words(pls, (int(bands[s]), int(bands[s + 1])), height) for s in range(sn)]
+    sus = [setup_words(pls, (int(bands[s]), int(bands[s + 1])), height, ex) for s in range(sn)]
     stb = SlpSetupBench()
     su_in = [w for su in sus for w in su["in"]]
     su_want = [w for su in sus for w in su["out"]]
@@ -122,7 +120,7 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
     if n_pl:
         if progress:
             print(f"experts: {sn} SLP set-ups, {len(su_in)} words in, {t:,} set-up cycles expected", file=sys.stderr)
-        sgot = run(stb, stb.params(height=height), Stimulus({"i": su_in}), engine=engine,
+        sgot = run(stb, stb.params(height=height, acc_extra=ex), Stimulus({"i": su_in}), engine=engine,
                    expect_words={"o": len(su_want)}, max_cycles=2 * t + 10000)
         su_have, su_got_stamps, su_run_s, su_sim = sgot.words["o"], list(sgot.stamps["o"]), sgot.run_s, int(sgot.cycles)
     else:       # an empty PL: no set-up work, nothing to run (each band word alone, 1 cycle)
@@ -144,7 +142,7 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
             sw["in"] = sw["in"][:nb] + list(hw) + sw["in"][nb + n_pl:]
     tb = SlpBench()
     p = tb.params(width=width, tris=max(2, min(4095, max(sw["tris"] for sw in sws))),
-                  lines=max(1, int(np.diff(bands).max())), asl=256, guard=guard)
+                  lines=max(1, int(np.diff(bands).max())), asl=256, guard=guard, acc_extra=ex)
     words_in = [w for sw in sws for w in sw["in"]]
     want = [w for sw in sws for w in sw["out"]]
     total = sum(sw["cycles"] for sw in sws)
@@ -221,12 +219,25 @@ def simulate_frame(scene, width: int, height: int, *, engine: str = "verilator",
             "frame_cycles": max(slp_frame, pxp_frame), **acc, "frame_rgb": hdl_image(fr, px)}
 
 
+#: what the HDL of the chained frame has, at either datapath: its widest register (the set-up's 40 x 20
+#: multiplier, the PXPs' running z and i) and its multipliers (set-up 1; list work 3, x of a triangle's
+#: three edges at its entry; span PXP 3, z at a span's two ends and i at its start). ``paper`` makes the
+#: SLP's edge increments and accumulators 16 bits (acc_extra 0); the rest is not yet at 16 bits.
+HDL_WIDEST_BITS = 40
+HDL_MULTIPLIERS = {"slp_setup": 1, "slp_list": 3, "pxp_span": 3}
+
+
 def _accuracy(tris, datapath: str, aj: str) -> dict:
-    """The datapath's contract and its golden bit model's error against float (source golden)."""
+    """The datapath's contract, what the HDL has, and the golden bit model's error against float
+    (``accuracy_source`` golden). ``datapath_bits`` and ``multipliers`` are the HDL's (the widest
+    register, the most multipliers in one processor); ``contract_*`` the golden contract's."""
     from rasterhw.golden_model.experts.accuracy import float_error
     e = float_error(tris, datapath, aj=aj)
-    return {"datapath": e["datapath"], "datapath_label": e["label"], "datapath_bits": e["datapath_bits"],
-            "multipliers": e["multipliers"], "max_abs_error": e["max_abs_error"],
+    return {"datapath": e["datapath"], "datapath_label": e["label"], "datapath_bits": HDL_WIDEST_BITS,
+            "multipliers": max(HDL_MULTIPLIERS.values()), "hdl_multipliers": HDL_MULTIPLIERS,
+            "contract_datapath_bits": e["datapath_bits"], "contract_multipliers": e["multipliers"],
+            "hdl_16_bit": "SLP edge increments and accumulators" if datapath == "paper" else "none",
+            "max_abs_error": e["max_abs_error"],
             "pixels_differing_from_float": e["pixels_differing_from_float"], "psnr_db": round(e["psnr_db"], 3),
             "visible_differing_from_float": e["visible_differing"],
             "pixels_differing_from_ours": e["pixels_differing_from_ours"], "accuracy_source": "golden"}

@@ -61,8 +61,9 @@ MACHINE = Machine(
                                    "experts-group; pixels against golden, cycles measured)", "chained",
                                    ("chained", "group")),
                             Option("datapath", "ours (today's HDL: 40-bit registers, three multipliers in the span "
-                                   "PXP) or paper (the paper's 16-bit words, one multiplier a processor: golden bit "
-                                   "model only, no HDL yet); both report the bit model's error against float",
+                                   "PXP) or paper (the paper's 16-bit words, one multiplier a processor: the golden "
+                                   "bit model at those widths; in HDL so far the SLP's 16-bit edge increments and "
+                                   "accumulators); both report the bit model's error against float",
                                    "ours", ("ours", "paper")))),),
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",

@@ -33,17 +33,19 @@ def test_small_frame_slp_and_pxp_hdl_exact():
     assert r["pixels_differing_from_ours"] == 0 and r["max_abs_error"] >= 0
 
 
-def test_paper_datapath_is_golden_only_and_says_so():
-    """--datapath paper: no HDL at 16 bits yet (issue 48 item 2 (c)); the figures are the golden bit
-    model's and the result says so: engine golden, nothing compared, no cycles."""
-    r = simulate_frame(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c", datapath="paper")
-    assert (r["engine"], r["source"], r["simulated"], r["pixels_compared"], r["cycles"]) == ("golden", "golden", False, 0, None)
-    assert (r["datapath_bits"], r["multipliers"], r["engine_requested"]) == (16, 1, "verilator")
-    assert (r["max_abs_error"], r["pixels_differing_from_float"], r["pixels_differing_from_ours"]) == (203, 222974, 19504)
-    assert "frame_rgb" not in r
+def test_paper_datapath_hdl_against_the_golden_model_at_its_widths():
+    """--datapath paper: the SLP HDL with 16-bit increments and accumulators, against the golden bit
+    model at the paper's widths; the result says what the HDL has (40-bit registers, 3 multipliers)
+    beside the contract (16, 1)."""
+    r = simulate_frame(build_scene("experts-tilt-1000"), 48, 16, engine="pysim", sn=2, pn=3, aj="c", datapath="paper")
+    assert r["pixels_compared"] == 48 * 16 and r["mismatches"] == 0 and r["cycle_mismatches"] == 0
+    assert r["slp_setup_word_mismatches"] == 0 and r["slp_word_mismatches"] == 0 and r["slp_words"] > 300
+    assert (r["datapath"], r["datapath_bits"], r["multipliers"]) == ("paper", 40, 3)
+    assert (r["contract_datapath_bits"], r["contract_multipliers"]) == (16, 1)
+    assert r["hdl_16_bit"] == "SLP edge increments and accumulators"
     with pytest.raises(RasterhwError, match="datapath must be"):
         simulate_frame(build_scene("experts-1000"), 64, 16, engine="pysim", datapath="wide")
-    with pytest.raises(RasterhwError, match="path group"):
+    with pytest.raises(RasterhwError, match="path at chained"):
         simulate_frame(build_scene("experts-1000"), 64, 16, engine="pysim", datapath="paper", path="group")
 
 
