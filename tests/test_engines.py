@@ -23,6 +23,7 @@ SMALL = {
     "pixelbus": {"width": 20, "height": 8},
     "pixelbus-bank": {"depth": 64},
     "experts-slp": {"width": 64, "tris": 256, "lines": 16, "asl": 64},
+    "experts-slp-setup": {"height": 64},
     "experts-group": {"width": 64, "pn": 2, "tris": 256, "lines": 8, "asl": 64, "depth": 256},
     "zbm-chip": {"interleave": 2, "chip": 1, "width": 32},
     "zbm-loop": {"interleave": 2, "width": 32},

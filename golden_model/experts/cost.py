@@ -9,7 +9,7 @@ consistent: 893 + 31607 = 32500)::
     Q_par = max(Q_s, Q_p)
 
 Measured: the same stage sets counted by the instrumented golden model
-(:data:`model.PAPER_SLP`, :data:`model.PAPER_PXP`), Q_par as the busiest SLP or PXP of an equal
+(:data:`paper.PAPER_SLP`, :data:`paper.PAPER_PXP`), Q_par as the busiest SLP or PXP of an equal
 static Sn x Pn partition (the paper's division by Sn and Sn Pn assumes a perfect split).
 """
 
@@ -20,13 +20,12 @@ import math
 import numpy as np
 from rasterhw.golden_model.experts.alpha import ALPHA, alpha_area
 from rasterhw.golden_model.experts.model import (
-    PAPER_PXP,
-    PAPER_SLP,
     ExpertsFrame,
     equal_bounds,
     pxp_range_ops,
     slp_band_ops,
 )
+from rasterhw.golden_model.experts.paper import PAPER_COST, PAPER_PXP, PAPER_SLP
 from rasterhw.golden_model.screen import ScreenTriangles
 
 __all__ = ["q_seq", "q_s", "q_p", "q_par", "balance_pn", "measured_q", "measured_q_run", "realtime", "alpha_error",
@@ -34,18 +33,21 @@ __all__ = ["q_seq", "q_s", "q_p", "q_par", "balance_pn", "measured_q", "measured
            "total_ops"]
 
 
+_C = PAPER_COST
+
+
 def q_seq(fr: float) -> float:
     r = math.sqrt(fr)
-    return 4 * fr + 3.46 * fr * r + 32500 * r
+    return _C["fr"] * fr + _C["fr_sqrt_fr"] * fr * r + _C["seq_sqrt_fr"] * r
 
 
 def q_s(fr: float, sn: int) -> float:
     r = math.sqrt(fr)
-    return (4 * fr + 3.46 * fr * r + 893 * r) / sn
+    return (_C["fr"] * fr + _C["fr_sqrt_fr"] * fr * r + _C["slp_sqrt_fr"] * r) / sn
 
 
 def q_p(fr: float, sn: int, pn: int) -> float:
-    return 31607 * math.sqrt(fr) / (sn * pn)
+    return _C["pxp_sqrt_fr"] * math.sqrt(fr) / (sn * pn)
 
 
 def q_par(fr: float, sn: int, pn: int) -> float:
@@ -55,7 +57,7 @@ def q_par(fr: float, sn: int, pn: int) -> float:
 def balance_pn(fr: float) -> float:
     """Pn where Q_s = Q_p (independent of Sn)."""
     r = math.sqrt(fr)
-    return 31607 * r / (4 * fr + 3.46 * fr * r + 893 * r)
+    return _C["pxp_sqrt_fr"] * r / (_C["fr"] * fr + _C["fr_sqrt_fr"] * fr * r + _C["slp_sqrt_fr"] * r)
 
 
 def measured_q(f: ExpertsFrame, sn: int, pn: int) -> dict:

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 
-__all__ = ["ADDR_BITS", "SLOT_BITS", "WORD", "FRAME", "HUE_BITS", "X_FRAC", "Z_BITS", "DZ_FRAC", "SLOPE_FRAC", "ACC_EXTRA",
+__all__ = ["DATAPATHS", "Datapath", "ADDR_BITS", "SLOT_BITS", "WORD", "FRAME", "HUE_BITS", "X_FRAC", "Z_BITS", "DZ_FRAC", "SLOPE_FRAC", "ACC_EXTRA",
            "ALPHA_BITS", "ASB_WORDS", "Formats", "recip_rom", "rom_div", "sat", "wrap"]
 
 WORD = 16
@@ -59,16 +59,44 @@ ASB_WORDS = 2 + 1 + 2 + 3 + 2 + 3 + 2 + 2
 
 
 @dataclass(frozen=True)
+class Datapath:
+    """The width contract of one EXPERTS datapath: what the golden bit model and the HDL share.
+
+    ``word_bits``: the widest register the datapath has; ``acc_extra``: fraction bits the SLP's edge
+    accumulators and increments keep beyond the 16-bit ASB word; ``multipliers``: multipliers in the
+    processor that has the most (the span PXP's, in ours); ``label``: the paper's or ours.
+    """
+
+    name: str
+    word_bits: int
+    acc_extra: int
+    multipliers: int
+    label: str
+
+
+#: ``ours``: today's HDL (40-bit running z and i registers in the PXPs, 32-bit SLP edge accumulators
+#: with Q.22 increments of up to 40 bits; the span PXP has three multipliers: z at a span's two ends,
+#: i at its start). ``paper``: seed 000, 3.2, "SLP、PXPの基本演算データ幅は16ビットである" and a
+#: multiplier a processor ("乗算器 ... を装備"): every SLP edge accumulator and increment is one 16-bit
+#: word (the ASB word itself, no extra fraction bits: truncated, see docs/experts.md).
+DATAPATHS = {"ours": Datapath("ours", word_bits=40, acc_extra=ACC_EXTRA, multipliers=3, label="ours"),
+             "paper": Datapath("paper", word_bits=WORD, acc_extra=0, multipliers=1, label="the paper's")}
+
+
+@dataclass(frozen=True)
 class Formats:
     """The parameters a machine instance may change (everything else above is fixed)."""
 
     intensity_bits: int = 7
+    datapath: Datapath = DATAPATHS["ours"]
 
     def __post_init__(self) -> None:
         if isinstance(self.intensity_bits, bool) or not isinstance(self.intensity_bits, (int, np.integer)) \
                 or not 1 <= self.intensity_bits <= 7:
             raise RasterhwError(f"intensity_bits must be an integer in 1..7 (9 hue bits + I <= 16), "
                                 f"not {self.intensity_bits!r}")
+        if self.datapath not in DATAPATHS.values():
+            raise RasterhwError(f"experts: datapath must be one of {', '.join(DATAPATHS)}, not {self.datapath!r}")
 
     @property
     def i_frac(self) -> int:

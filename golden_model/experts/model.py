@@ -18,15 +18,12 @@ from rasterhw.golden_model.experts.formats import Formats
 from rasterhw.golden_model.screen import ScreenTriangles
 
 __all__ = ["ExpertsFrame", "render_frame", "equal_bounds", "slp_band_ops", "pxp_range_ops",
-           "SLP_STAGES", "PXP_STAGES", "PAPER_SLP", "PAPER_PXP", "AJ_METHODS", "MODELS"]
+           "SLP_STAGES", "PXP_STAGES", "AJ_METHODS", "MODELS"]
 
 SLP_STAGES = ("pl_read", "y_sort", "asl_build", "aj_setup", "asl_update", "l_sort", "x_merge",
               "block_lists", "dmm_p_write")
 PXP_STAGES = ("range_clip", "start_values", "span_cull", "depth_search", "shadows", "smooth_shading",
               "anti_jagging", "dslb")
-#: the stages the paper's cost model counts (section 4: i)-iii) on the SLP, iv)-v) on the PXP)
-PAPER_SLP = ("y_sort", "x_merge", "l_sort")
-PAPER_PXP = ("span_cull", "depth_search")
 AJ_METHODS = ("none", "a", "b", "c")
 MODELS = ("float", "bit")
 

@@ -84,6 +84,8 @@ class Setup:
     poly: np.ndarray       # (K,) poly_id
     sat_dzdx: int = 0
     sat_didx: int = 0
+    order: np.ndarray | None = None  # (K, 3): sorted vertex r (top, middle, bottom) is PL vertex order[k, r]
+
 
     @property
     def n(self) -> int:
@@ -160,7 +162,8 @@ def set_up(tris: ScreenTriangles, *, bit: bool, fmt: Formats | None = None) -> S
         hq = hue[keep]
     return Setup(bit=bit, fmt=fmt, grid=g, keep=keep, X=X, Y=Y, Z=Z, Iv=Iv, long_left=cr > 0,
                  r0=r0c[keep], r1=r1c[keep], rmid=rmid[keep], dzdx=dzdx, didx=didx, hue=hq,
-                 poly=np.asarray(tris.poly_id, dtype=np.int64)[keep], sat_dzdx=sdz, sat_didx=sdi)
+                 poly=np.asarray(tris.poly_id, dtype=np.int64)[keep], sat_dzdx=sdz, sat_didx=sdi,
+                 order=order[keep])
 
 
 def y_sort(st: Setup, band: tuple[int, int]) -> tuple[np.ndarray, np.ndarray, dict]:
@@ -201,22 +204,33 @@ class Records:
     first: np.ndarray      # index of each kept triangle's first record (records are triangle-major)
 
 
-def _edge_at(X0, Y0, X1, Y1, Yc, g, bit):
+def _accumulate(A0, dA, Y0, dY, Yc, extra: int):
+    """The SLP's edge accumulator at line centre Yc: the start value plus the increment per line.
+
+    ``extra``: fraction bits kept beyond the 16-bit word (``Datapath.acc_extra``). Ours keeps 16
+    (a Q.22 increment, up to 40 bits); the paper's 16-bit datapath keeps none: the increment is
+    one 16-bit word (saturated) and the accumulator is the ASB word itself.
+    """
+    inc = rom_div(dA, dY, X_FRAC + extra)                  # per line (one line = 64 units)
+    if extra == 0:
+        inc = sat(inc, 16)
+    return ((A0 << extra) + (((Yc - Y0) * inc) >> X_FRAC)) >> extra
+
+
+def _edge_at(X0, Y0, X1, Y1, Yc, g, bit, extra: int = ACC_EXTRA):
     """x of the edge (X0, Y0)->(X1, Y1) at line centre Yc: exact rational parts or the SLP accumulator."""
     dX, dY = X1 - X0, Y1 - Y0
     if bit:
-        inc = rom_div(dX, dY, X_FRAC + ACC_EXTRA)          # Q.22 per line (one line = 64 units)
-        acc = (X0 << ACC_EXTRA) + (((Yc - Y0) * inc) >> X_FRAC)
-        return acc >> ACC_EXTRA, None                      # ASB word, Q10.6 (floor)
+        return _accumulate(X0, dX, Y0, dY, Yc, extra), None   # ASB word, Q10.6 (floor)
     num = (Yc - Y0) * dX + X0 * dY                          # x = num / dY (grid units), exact
     return num, dY
 
 
-def _attr_at(A0, A1, Y0, Y1, Yc, g, bit):
-    """z or i of the edge at line centre Yc (eq. (1'))."""
+def _attr_at(A0, A1, Y0, Y1, Yc, g, bit, extra: int = ACC_EXTRA):
+    """z or i of the edge at line centre Yc (eq. (1')); a 16-bit accumulator saturates to 0..65535."""
     if bit:
-        inc = rom_div(A1 - A0, Y1 - Y0, X_FRAC + ACC_EXTRA)
-        return ((A0 << ACC_EXTRA) + (((Yc - Y0) * inc) >> X_FRAC)) >> ACC_EXTRA
+        a = _accumulate(A0, A1 - A0, Y0, Y1 - Y0, Yc, extra)
+        return sat(a, 16, signed=False) if extra == 0 else a
     return A0 + (Yc - Y0) * ((A1 - A0) / (Y1 - Y0))
 
 
@@ -240,8 +254,9 @@ def asl_update(st: Setup, W: int) -> Records:
     sb = sa + 1
     ar = np.arange(tri.size)
     Xs0, Ys0, Xs1, Ys1 = X[sa, ar], Y[sa, ar], X[sb, ar], Y[sb, ar]
-    longv = _edge_at(X[0], Y[0], X[2], Y[2], Yc, g, bit)
-    shortv = _edge_at(Xs0, Ys0, Xs1, Ys1, Yc, g, bit)
+    ex = st.fmt.datapath.acc_extra
+    longv = _edge_at(X[0], Y[0], X[2], Y[2], Yc, g, bit, ex)
+    shortv = _edge_at(Xs0, Ys0, Xs1, Ys1, Yc, g, bit, ex)
     ll = st.long_left[tri]
     half = g // 2
     if bit:
@@ -267,8 +282,8 @@ def asl_update(st: Setup, W: int) -> Records:
     li1 = np.where(ll, Iv[2], Iv[sb, ar])
     ly0 = np.where(ll, Y[0], Ys0)
     ly1 = np.where(ll, Y[2], Ys1)
-    zl = _attr_at(lz0, lz1, ly0, ly1, Yc, g, bit)
-    il = _attr_at(li0, li1, ly0, ly1, Yc, g, bit)
+    zl = _attr_at(lz0, lz1, ly0, ly1, Yc, g, bit, ex)
+    il = _attr_at(li0, li1, ly0, ly1, Yc, g, bit, ex)
     # slopes for A.J.
     dXl = np.where(ll, X[2] - X[0], Xs1 - Xs0)
     dYl = np.where(ll, Y[2] - Y[0], Ys1 - Ys0)

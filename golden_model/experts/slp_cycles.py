@@ -55,17 +55,17 @@ def tri_words(st) -> list[dict]:
     if st.n >= (1 << ADDR_BITS) - 1:
         raise RasterhwError(f"experts: {st.n} triangles do not fit the {ADDR_BITS}-bit PL order")
     X, Y = st.X.astype(np.int64), st.Y.astype(np.int64)
-    sh = X_FRAC + ACC_EXTRA
+    ex = st.fmt.datapath.acc_extra
+    sh = X_FRAC + ex
+
+    def ainc(A, i, j):       # the paper's datapath (no extra fraction bits): one saturated 16-bit word
+        d = Y[j] - Y[i]
+        safe = np.where(d == 0, 1, d)
+        v = np.where(d == 0, 0, rom_div(A[j] - A[i], safe, sh))
+        return sat(v, 16) if ex == 0 else v
 
     def inc(i, j):
-        d = Y[j] - Y[i]
-        safe = np.where(d == 0, 1, d)
-        return np.where(d == 0, 0, rom_div(X[j] - X[i], safe, sh))
-
-    def ainc(A, i, j):
-        d = Y[j] - Y[i]
-        safe = np.where(d == 0, 1, d)
-        return np.where(d == 0, 0, rom_div(A[j] - A[i], safe, sh))
+        return ainc(X, i, j)
 
     ac, ab, bc = inc(0, 2), inc(0, 1), inc(1, 2)
     Z, Iv = st.Z.astype(np.int64), st.Iv.astype(np.int64)
@@ -92,19 +92,25 @@ def tri_words(st) -> list[dict]:
     return out
 
 
-def _x(tw: dict, y: int) -> tuple[int, int]:
+def _acc(a0: int, y0: int, inc: int, yc: int, extra: int) -> int:
+    """An SLP edge accumulator at line centre ``yc`` (:func:`slp._accumulate`): ``extra`` fraction
+    bits beyond the word (``Datapath.acc_extra``)."""
+    return ((a0 << extra) + (((yc - y0) * inc) >> X_FRAC)) >> extra
+
+
+def _x(tw: dict, y: int, extra: int = ACC_EXTRA) -> tuple[int, int]:
     """x_L, x_R (Q10.6) of triangle word ``tw`` on line ``y``: :func:`slp._edge_at`, bit model."""
     yc = (y << X_FRAC) + (1 << (X_FRAC - 1))
 
     def edge(x0, y0, inc):
-        return ((x0 << ACC_EXTRA) + (((yc - y0) * inc) >> X_FRAC)) >> ACC_EXTRA
+        return _acc(x0, y0, inc, yc, extra)
 
     lng = edge(tw["xa"], tw["ya"], tw["inc_ac"])
     sht = edge(tw["xa"], tw["ya"], tw["inc_ab"]) if yc < tw["yb"] else edge(tw["xb"], tw["yb"], tw["inc_bc"])
     return (lng, sht) if tw["ll"] else (sht, lng)
 
 
-def asb(tw: dict, y: int) -> dict:
+def asb(tw: dict, y: int, extra: int = ACC_EXTRA) -> dict:
     """The ASB of triangle word ``tw`` on line ``y`` as the SLP writes it into the DMM/P: x_L, x_R,
     and z_L, i_L, the A.J. slopes of the left and right edges (the edge of each chosen as for x),
     with the triangle's dz/dx, di/dx, hue, PL index and polygon number."""
@@ -112,7 +118,7 @@ def asb(tw: dict, y: int) -> dict:
     upper = yc < tw["yb"]
 
     def edge(a0, y0, inc):
-        return ((a0 << ACC_EXTRA) + (((yc - y0) * inc) >> X_FRAC)) >> ACC_EXTRA
+        return _acc(a0, y0, inc, yc, extra)
 
     def left_right(pre, a, b):
         lng = edge(tw[a], tw["ya"], tw[f"{pre}inc_ac"])
@@ -121,6 +127,8 @@ def asb(tw: dict, y: int) -> dict:
     xl, xr = left_right("", "xa", "xb")
     zl, _ = left_right("z", "za", "zb")
     il, _ = left_right("i", "ia", "ib")
+    if extra == 0:                    # a 16-bit accumulator saturates (slp._attr_at)
+        zl, il = min(max(zl, 0), 0xFFFF), min(max(il, 0), 0xFFFF)
     es = "ab" if upper else "bc"
     le, re = ("ac", es) if tw["ll"] else (es, "ac")
     return {"xl": xl, "xr": xr, "zl": zl, "il": il, "dzdx": tw["dzdx"], "didx": tw["didx"], "hue": tw["hue"],
@@ -128,7 +136,8 @@ def asb(tw: dict, y: int) -> dict:
             "qr": tw[f"q_{re}"]}
 
 
-def band_run(tws: list[dict], band: tuple[int, int], bounds, *, width: int, guard: int = 0) -> dict:
+def band_run(tws: list[dict], band: tuple[int, int], bounds, *, width: int, guard: int = 0,
+             extra: int = ACC_EXTRA) -> dict:
     """One band through the SLP: per line the ASL (PL indices in ASL order), the output words
     ``(kind, p, pos, t, y, ASB or None)`` in order, and cycles (:data:`__doc__`); ``start_cycles`` before line 0."""
     y0, y1 = band
@@ -149,7 +158,7 @@ def band_run(tws: list[dict], band: tuple[int, int], bounds, *, width: int, guar
         cyc = 1 + len(prev)
         surv = [t for t in prev if r1[t] >= y]
         for t in surv:
-            xs[t] = _x(tws[t], y)
+            xs[t] = _x(tws[t], y, extra)
 
         def key(t, xs=xs):
             return (xs[t][0], t)
@@ -158,7 +167,7 @@ def band_run(tws: list[dict], band: tuple[int, int], bounds, *, width: int, guar
             cyc += passes * (len(surv) + 1)
         ent = list(buckets[y - y0])
         for t in ent:
-            xs[t] = _x(tws[t], y)
+            xs[t] = _x(tws[t], y, extra)
         cyc += 1 + len(ent)
         ne = len(ent)
         ent, _, _ = merge_sort(ent, key)
@@ -172,7 +181,7 @@ def band_run(tws: list[dict], band: tuple[int, int], bounds, *, width: int, guar
         words = []
         q = 0
         for pos, t in enumerate(cur):
-            words.append((KIND["asl"], 0, pos, t, y, asb(tws[t], y)))
+            words.append((KIND["asl"], 0, pos, t, y, asb(tws[t], y, extra)))
             cyc += 1
             a, e = int(c0[pos]), int(c1[pos])
             if e < a:

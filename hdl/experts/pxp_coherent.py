@@ -29,20 +29,17 @@ visible segment ``S`` (``vok``: one is visible) and the last pixel ``vu`` it has
 
 from __future__ import annotations
 
-from amaranth import Module, Mux, Signal, signed, unsigned
+from amaranth import Module, Mux, Signal, signed
 from amaranth.lib import enum
-from amaranth.lib.memory import Memory
-from rasterhw.golden_model.experts.formats import ADDR_BITS, Z_BITS
 from rasterhw.hdl.experts.pxp_span import (
     NO_PTR,
-    NONE,
-    PTR_BITS,
     ExpertsPxpSpan,
     candidate,
     guarded_test,
     intensity_at,
-    seg_ends,
+    resolve_regs,
     take_bank,
+    write_pixel,
     z_key,
     zrun_at,
 )
@@ -69,44 +66,24 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
     def elaborate(self, platform):
         m = Module()
         fr = self.frame(m)
-        fmt, W, D, aj, ib, asb = fr["fmt"], fr["W"], fr["D"], fr["aj"], fr["ib"], fr["asb"]
-        pw, cw, ab, word, wr, drain = fr["pw"], fr["cw"], fr["ab"], fr["word"], fr["wr"], fr["drain"]
-        srd, brd, full = fr["srd"], fr["brd"], fr["full"]
+        fmt, W, aj, asb, pw, cw, drain = fr["fmt"], fr["W"], fr["aj"], fr["asb"], fr["pw"], fr["cw"], fr["drain"]
+        brd, full = fr["brd"], fr["full"]
         vrd = fr["dmm"].read_port(domain="comb")    # the visible segment S
 
         state = Signal(_R)
-        rb = Signal()
-        glo, ghi = Signal(11), Signal(11)
-        lo, hi = Signal(10), Signal(11)
-        n, nb = Signal(cw), Signal(cw)
-        i = Signal(cw)            # scan index (active list)
-        j = Signal(cw)            # active list write index
+        (rb, glo, ghi, lo, hi, n, nb, i, j, bi, pp, S, skey, saddr, cyc, raddr, seg, c0, a, e, awr, ard, in_bkt,
+         cand) = resolve_regs(m, fr)
         na = Signal(cw)           # entries on the active list
-        bi = Signal(cw)           # next bucket list entry
-        pp = Signal(PTR_BITS + 1)  # next ASL position of the walk from the leading pointer
         sl = Signal(11)           # the span's left pixel x; in WRITE the write cursor
         sr = Signal(11)           # PASSB: the span searched ends at sr; WRITE: the last pixel written
         ns = Signal(12)           # the next start (or ghi)
         vu = Signal(12)           # S is nearest up to pixel vu
         vok = Signal()            # a segment is visible (S)
         fail = Signal()           # an entering segment failed its test against S
-        S = Signal(pw)
-        skey = Signal(Z_BITS)
-        saddr = Signal(ADDR_BITS)
         send = Signal(signed(12))  # S's last pixel in the guarded range
-        cyc = Signal(16)
 
-        m.submodules.act = act = Memory(shape=unsigned(pw), depth=D, init=[])
-        awr = act.write_port()
-        ard = act.read_port(domain="comb")
-        m.d.comb += [awr.en.eq(0), ard.addr.eq(i), awr.addr.eq(j)]
-
-        raddr = Signal(pw)
-        seg = Signal(asb)
         vseg = Signal(asb)
-        m.d.comb += [srd.addr.eq((rb << pw) | raddr), seg.eq(srd.data),
-                     vrd.addr.eq((rb << pw) | S), vseg.eq(vrd.data)]
-        c0, a, e = seg_ends(m, seg, glo, ghi)
+        m.d.comb += [vrd.addr.eq((rb << pw) | S), vseg.eq(vrd.data)]
 
         # the test's right end: min(vu (ENTER) / sr (PASSB), the segment's last pixel)
         rt = Signal(12)
@@ -125,10 +102,6 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
         m.d.comb += mid.eq((sl + sr + 1) >> 1)
         ic = intensity_at(m, vseg, sl, fmt)
 
-        in_bkt = Signal()
-        cand = Signal()
-        m.d.comb += [in_bkt.eq(bi < nb), brd.addr.eq((rb << pw) | bi[:pw])]
-
 
         def write(last):
             """Decided: write ``[sl, last]``."""
@@ -138,8 +111,6 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
             """S is nearest over ``[sl, r]``: write up to ``min(r, ns - 1)``."""
             return [vok.eq(1), vu.eq(r), *write(Mux(r < ns - 1, r, ns - 1))]
 
-        m.d.sync += cyc.eq(cyc + 1)
-        m.d.comb += raddr.eq(ard.data)
         with m.Switch(state):
             with m.Case(_R.IDLE):
                 m.d.sync += cyc.eq(1)
@@ -200,12 +171,7 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
                     with m.If(mid - 1 == sl):
                         m.d.sync += decided(sl)
             with m.Case(_R.WRITE):
-                m.d.comb += [wr.addr.eq((rb << ab) | sl), wr.en.eq(1)]
-                with m.If(~vok):
-                    m.d.comb += wr.data.eq(word.const({"addr": NONE, "pix": 0, "slot": 0}))
-                with m.Else():
-                    m.d.comb += [wr.data.addr.eq(vseg.addr), wr.data.pix.eq((vseg.hue << ib) | (ic >> fmt.i_frac)),
-                                 wr.data.slot.eq(S)]
+                write_pixel(m, fr, rb, sl, ~vok, vseg, ic, S)
                 m.d.sync += sl.eq(sl + 1)
                 with m.If(sl == sr):
                     m.d.sync += state.eq(Mux(sl + 1 >= ghi, _R.HAND, _R.ENTER))

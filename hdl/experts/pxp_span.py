@@ -55,7 +55,7 @@ from rasterhw.hdl.experts.drain import Drain, check_pxp_params, pxp_members
 from rasterhw.hdl.experts.pxp import asb_fields
 from rasterhw.hdl.params import params
 
-__all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "candidate", "dmm_p", "seg_ends", "take_bank", "zrun_at", "z_key", "guarded_test",
+__all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "candidate", "dmm_p", "resolve_regs", "seg_ends", "write_pixel", "take_bank", "zrun_at", "z_key", "guarded_test",
            "intensity_at", "PTR_BITS", "NO_PTR"]
 
 NONE = (1 << ADDR_BITS) - 1     # ASB address / polygon number of the background
@@ -221,6 +221,54 @@ def intensity_at(m: Module, seg, col, fmt: Formats) -> Signal:
     return ic
 
 
+def write_pixel(m: Module, fr: dict, rb, col, bg, seg, ic, slot) -> None:
+    """DSLB write of pixel ``col`` in bank ``rb`` this cycle: background where ``bg``, else ASB
+    ``seg``'s hue with the intensity ``ic`` (Q.i_frac) and the segment's ``slot`` (for A.J.)."""
+    wr, word, fmt = fr["wr"], fr["word"], fr["fmt"]
+    m.d.comb += [wr.addr.eq((rb << fr["ab"]) | col), wr.en.eq(1)]
+    with m.If(bg):
+        m.d.comb += wr.data.eq(word.const({"addr": NONE, "pix": 0, "slot": 0}))
+    with m.Else():
+        m.d.comb += [wr.data.addr.eq(seg.addr), wr.data.pix.eq((seg.hue << fmt.intensity_bits) | (ic >> fmt.i_frac)),
+                     wr.data.slot.eq(slot)]
+
+
+#: what :func:`resolve_regs` returns, in its order
+RESOLVE_REGS = ("rb", "glo", "ghi", "lo", "hi", "n", "nb", "i", "j", "bi", "pp", "S", "skey", "saddr", "cyc", "raddr",
+                "seg", "c0", "a", "e", "awr", "ard", "in_bkt", "cand")
+
+
+def resolve_regs(m: Module, fr: dict) -> tuple:
+    """The resolve side's registers and reads both span PXPs declare alike, added to ``m``
+    (returned in the order of :data:`RESOLVE_REGS`): the
+    bank being resolved ``rb``, the guarded range ``glo``/``ghi`` and range ``lo``/``hi``, the
+    bank's ASB and bucket counts ``n``/``nb``, the active list (memory ``act``: write port ``awr``
+    at ``j``, read port ``ard`` at ``i``), the next bucket entry ``bi`` and walk position ``pp``, the
+    nearest segment ``S`` with its key ``skey`` and address ``saddr``, the finish-time counter
+    ``cyc``; the segment read this cycle (``raddr`` -> ``seg``, one DMM/P access) with its ends
+    ``c0``/``a``/``e`` (:func:`seg_ends`; ``raddr`` is ``ard``'s entry unless a later statement
+    says otherwise; ``cyc`` counts every cycle unless one says otherwise), and the bucket read (``in_bkt``, ``brd`` at ``bi``)
+    with the candidate flag ``cand``."""
+    cw, pw, D = fr["cw"], fr["pw"], fr["D"]
+    r = {"rb": Signal(name="rb"), "glo": Signal(11, name="glo"), "ghi": Signal(11, name="ghi"),
+         "lo": Signal(10, name="lo"), "hi": Signal(11, name="hi"), "n": Signal(cw, name="n"),
+         "nb": Signal(cw, name="nb"), "i": Signal(cw, name="i"), "j": Signal(cw, name="j"),
+         "bi": Signal(cw, name="bi"), "pp": Signal(PTR_BITS + 1, name="pp"), "S": Signal(pw, name="S"),
+         "skey": Signal(Z_BITS, name="skey"), "saddr": Signal(ADDR_BITS, name="saddr"),
+         "cyc": Signal(16, name="cyc"), "raddr": Signal(pw, name="raddr"), "seg": Signal(fr["asb"], name="seg"),
+         "in_bkt": Signal(name="in_bkt"), "cand": Signal(name="cand")}
+    m.submodules.act = act = Memory(shape=unsigned(pw), depth=D, init=[])
+    r["awr"], r["ard"] = act.write_port(), act.read_port(domain="comb")
+    m.d.comb += [r["awr"].en.eq(0), r["ard"].addr.eq(r["i"]), r["awr"].addr.eq(r["j"]),
+                 fr["srd"].addr.eq((r["rb"] << pw) | r["raddr"]), r["seg"].eq(fr["srd"].data),
+                 r["in_bkt"].eq(r["bi"] < r["nb"]), fr["brd"].addr.eq((r["rb"] << pw) | r["bi"][:pw])]
+    r["c0"], r["a"], r["e"] = seg_ends(m, r["seg"], r["glo"], r["ghi"])
+    # every cycle counts; the segment read is the active list's entry unless a state reads another
+    m.d.sync += r["cyc"].eq(r["cyc"] + 1)
+    m.d.comb += r["raddr"].eq(r["ard"].data)
+    return tuple(r[k] for k in RESOLVE_REGS)
+
+
 class _R(enum.Enum, shape=3):
     IDLE = 0      # wait for a full DMM/P bank; start the line
     CULL = 1      # span cull: one active segment per cycle
@@ -299,54 +347,30 @@ class ExpertsPxpSpan(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         fr = self.frame(m)
-        fmt, W, D, aj, ib, asb = fr["fmt"], fr["W"], fr["D"], fr["aj"], fr["ib"], fr["asb"]
-        pw, cw, ab, word, wr = fr["pw"], fr["cw"], fr["ab"], fr["word"], fr["wr"]
+        fmt, W, aj, pw, cw = fr["fmt"], fr["W"], fr["aj"], fr["pw"], fr["cw"]
         dm = fr
-        srd, brd, full = dm["srd"], dm["brd"], dm["full"]
+        brd, full = dm["brd"], dm["full"]
 
         # ---------------------------------------------------------------- resolve side
         state = Signal(_R)
-        rb = Signal()
-        glo = Signal(11)
-        ghi = Signal(11)
-        lo = Signal(10)
-        hi = Signal(11)
-        n = Signal(cw)
-        nb = Signal(cw)
+        (rb, glo, ghi, lo, hi, n, nb, i, j, bi, pp, S, skey, saddr, cyc, raddr, seg, c0, a, e, awr, ard, in_bkt,
+         cand) = resolve_regs(m, fr)
         x = Signal(11)            # the current span's left pixel
-        i = Signal(cw)            # scan index (active list)
-        j = Signal(cw)            # active list write index
         k = Signal(cw)            # segments present in the span
-        bi = Signal(cw)           # next bucket list entry
-        pp = Signal(PTR_BITS + 1)  # next ASL position of the walk from the leading pointer
         minend = Signal(12)       # nearest end + 1 of the segments present
         one = Signal(pw)          # the first active entry (k = 1: the visible segment)
         sl = Signal(11)           # (sub)span searched / written
         sr = Signal(11)
-        S = Signal(pw)            # nearest segment (ASL position)
-        skey = Signal(Z_BITS)
-        saddr = Signal(ADDR_BITS)
         szl = Signal(signed(40))
         szr = Signal(signed(40))
         bad = Signal()
         wbg = Signal()            # the span written is background
         sp = Signal(5)            # stack pointer
-        cyc = Signal(16)
 
-        m.submodules.act = act = Memory(shape=unsigned(pw), depth=D, init=[])
-        awr = act.write_port()
-        ard = act.read_port(domain="comb")
         m.submodules.stk = stk = Memory(shape=unsigned(11), depth=16, init=[])
         kwr = stk.write_port()
         krd = stk.read_port(domain="comb")
-        m.d.comb += [awr.en.eq(0), kwr.en.eq(0), ard.addr.eq(i), awr.addr.eq(j), krd.addr.eq(sp - 1),
-                     kwr.addr.eq(sp)]
-
-        # the segment read this cycle (one DMM/P access): its first / last pixel in the guarded range
-        raddr = Signal(pw)
-        seg = Signal(asb)
-        m.d.comb += [srd.addr.eq((rb << pw) | raddr), seg.eq(srd.data)]
-        c0, a, e = seg_ends(m, seg, glo, ghi)
+        m.d.comb += [kwr.en.eq(0), krd.addr.eq(sp - 1), kwr.addr.eq(sp)]
 
         # the two multipliers: running z (Q16.4) at pixels sl and sr
         zl_ = zrun_at(m, seg, sl)
@@ -362,11 +386,6 @@ class ExpertsPxpSpan(wiring.Component):
 
         # S.S. at pixel sl (the write cursor): intensity by the multiplier
         ic = intensity_at(m, seg, sl, fmt)
-
-        # the next entering candidate: the bucket list, then the walk from the leading pointer
-        in_bkt = Signal()
-        cand = Signal()
-        m.d.comb += [in_bkt.eq(bi < nb), brd.addr.eq((rb << pw) | bi[:pw])]
 
         # ---------------------------------------------------------------- drain side (drain.py)
         drain = fr["drain"]
@@ -386,8 +405,6 @@ class ExpertsPxpSpan(wiring.Component):
             with m.If(e + 1 < minend):
                 m.d.sync += minend.eq(e + 1)
 
-        m.d.sync += cyc.eq(cyc + 1)
-        m.d.comb += raddr.eq(ard.data)
         with m.Switch(state):
             with m.Case(_R.IDLE):
                 m.d.sync += cyc.eq(1)
@@ -444,12 +461,7 @@ class ExpertsPxpSpan(wiring.Component):
                         m.d.sync += [wbg.eq(0), state.eq(_R.WRITE)]
             with m.Case(_R.WRITE):
                 m.d.comb += raddr.eq(S)
-                m.d.comb += [wr.addr.eq((rb << ab) | sl), wr.en.eq(1)]
-                with m.If(wbg):
-                    m.d.comb += wr.data.eq(word.const({"addr": NONE, "pix": 0, "slot": 0}))
-                with m.Else():
-                    m.d.comb += [wr.data.addr.eq(seg.addr), wr.data.pix.eq((seg.hue << ib) | (ic >> fmt.i_frac)),
-                                 wr.data.slot.eq(S)]
+                write_pixel(m, fr, rb, sl, wbg, seg, ic, S)
                 m.d.sync += sl.eq(sl + 1)
                 with m.If(sl == sr):
                     with m.If(sp != 0):

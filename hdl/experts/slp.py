@@ -130,6 +130,9 @@ class ExpertsSlp(wiring.Component):
         Segments an ASL may hold (2..511).
     guard : int
         Pixels each side of a range its block lists cover (1 with A.J. (c)).
+    acc_extra : int
+        Fraction bits of the edge accumulators beyond the 16-bit word (``formats.Datapath.acc_extra``):
+        16 (ours, the default) or 0 (the paper's 16-bit datapath).
 
     Members
     -------
@@ -140,12 +143,16 @@ class ExpertsSlp(wiring.Component):
                             golden side refuses such a band, so a run that sets it is a failed run)
     """
 
-    def __init__(self, *, width: int = 512, tris: int = 4095, lines: int = 512, asl: int = 256, guard: int = 1):
+    def __init__(self, *, width: int = 512, tris: int = 4095, lines: int = 512, asl: int = 256, guard: int = 1,
+                 acc_extra: int = ACC_EXTRA):
         for name, v, lo, hi in (("width", width, 1, 1024), ("tris", tris, 2, 4095), ("lines", lines, 1, 1024),
                                 ("asl", asl, 2, 511), ("guard", guard, 0, 1)):
             if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
                 raise ValueError(f"{name} must be an integer in {lo}..{hi}, not {v!r}")
+        if acc_extra not in (0, ACC_EXTRA) or isinstance(acc_extra, bool):
+            raise ValueError(f"acc_extra must be 0 or {ACC_EXTRA}, not {acc_extra!r}")
         self._w, self._tris, self._lines, self._asl, self._guard = width, tris, lines, asl, guard
+        self._ex = acc_extra
         super().__init__({
             "i": In(stream.Signature(slp_in_layout())),
             "o": Out(stream.Signature(slp_out_layout())),
@@ -219,7 +226,7 @@ class ExpertsSlp(wiring.Component):
 
         def edge(x0, yy0, inc, name):
             v = Signal(signed(80), name=name)
-            m.d.comb += v.eq(((x0 << ACC_EXTRA) + (((yc - yy0) * inc) >> X_FRAC)) >> ACC_EXTRA)
+            m.d.comb += v.eq(((x0 << self._ex) + (((yc - yy0) * inc) >> X_FRAC)) >> self._ex)
             return v
         lng = edge(tv.xa, tv.ya, tv.inc_ac, "x_long")
         sht = Signal(signed(80))

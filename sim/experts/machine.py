@@ -12,7 +12,8 @@ MACHINE = Machine(
               "can change): depth search operations, Fr 2000 / Fr 1000",
               "5: SLP with set-up, operation count (model): SLP clock for 30 frames/s, experts-1000",
               "5 / HDL: coherent span PXP (ours, experts-pxp-coherent), HDL cycles",
-              "5 / HDL: span PXP (ours, experts-pxp-span), HDL cycles", "5 / HDL: SLP list work"),
+              "5 / HDL: span PXP (ours, experts-pxp-span), HDL cycles", "5 / HDL: SLP list work",
+              "5 / HDL: SLP with set-up (experts-slp-setup, then experts-slp), HDL cycles: SLP clock"),
     name="experts",
     title="EXPERTS scan-line multiprocessor (Kyoto Univ.)",
     seed="000_5ac5e14b809e6e93.txt",
@@ -31,6 +32,7 @@ MACHINE = Machine(
             "experts-pxp-span": "rasterhw.hdl.experts.pxp_span:ExpertsPxpSpan",
             "experts-pxp-coherent": "rasterhw.hdl.experts.pxp_coherent:ExpertsPxpCoherent",
             "experts-slp": "rasterhw.hdl.experts.slp:ExpertsSlp",
+            "experts-slp-setup": "rasterhw.hdl.experts.slp_setup:ExpertsSlpSetup",
             "experts-group": "rasterhw.hdl.experts.group:ExpertsGroup",
             "experts-dmm": "rasterhw.hdl.experts.dmm:ExpertsDmm",
             "experts-pxp-unit": "rasterhw.hdl.experts.unit:ExpertsPxpUnit"},
@@ -46,7 +48,8 @@ MACHINE = Machine(
                                    "the visible segment can change, experts-pxp-coherent) or zbuffer (a one-line "
                                    "Z-buffer, experts-pxp); all ours, the same pixels", "span",
                                    ("span", "coherent", "zbuffer")))),
-          SimBlock("experts", "the whole frame: every band through the SLP HDL (experts-slp), its ASL order and "
+          SimBlock("experts", "the whole frame: every band through the SLP's set-up HDL (experts-slp-setup) and "
+                   "list-work HDL (experts-slp), its ASL order and "
                    "block lists then into every span PXP's DMM/P (experts-pxp-span); words, pixels and cycles "
                    "against golden, SLP and PXP clocks for 30 frames/s", "rasterhw.sim.experts.frame_sim:simulate_frame",
                    default_scene="experts-1000",
@@ -56,7 +59,12 @@ MACHINE = Machine(
                             Option("path", "chained (the SLP HDL, then the PXP HDL on its words, each against its "
                                    "cycle model) or group (one SLP + Pn PXPs clocked together per band, "
                                    "experts-group; pixels against golden, cycles measured)", "chained",
-                                   ("chained", "group")))),),
+                                   ("chained", "group")),
+                            Option("datapath", "ours (today's HDL: 40-bit registers, three multipliers in the span "
+                                   "PXP) or paper (the paper's 16-bit words, one multiplier a processor: the golden "
+                                   "bit model at those widths; in HDL so far the SLP's 16-bit edge increments and "
+                                   "accumulators); both report the bit model's error against float",
+                                   "ours", ("ours", "paper")))),),
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",
     soak={"pxp": "rasterhw.sim.experts.soak:pxp_round"},
@@ -65,6 +73,7 @@ MACHINE = Machine(
            "experts-pxp-span": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,)),
            "experts-pxp-coherent": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,)),
            "experts-slp": Flow(small={"width": 64, "tris": 64, "lines": 16, "asl": 32}, clocks=(_NO_CLOCK,)),
+           "experts-slp-setup": Flow(small={"height": 64}, clocks=(_NO_CLOCK,)),
            "experts-group": Flow(small={"width": 64, "pn": 2, "tris": 64, "lines": 16, "asl": 32, "depth": 32},
                                  clocks=(_NO_CLOCK,)),
            "experts-pxp-unit": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,))},
@@ -73,12 +82,14 @@ MACHINE = Machine(
                  "experts-pxp-span": "rasterhw.sim.experts.testbench:PxpSpanBench",
                  "experts-pxp-coherent": "rasterhw.sim.experts.testbench:PxpCoherentBench",
                  "experts-slp": "rasterhw.sim.experts.testbench:SlpBench",
+                 "experts-slp-setup": "rasterhw.sim.experts.testbench:SlpSetupBench",
                  "experts-group": "rasterhw.sim.experts.testbench:GroupBench",
                  "experts-pxp-unit": "rasterhw.sim.experts.testbench:PxpUnitBench",
                  "experts-dmm": "rasterhw.sim.experts.testbench:DmmBench"},
     status="scan-line golden model split as SLP/PXP (float and 16-bit): span PXPs (the paper's span cull, "
            "depth search per span) and the SLP's sorts run and counted, Sn x Pn parallel model with "
            "load balancing at both levels, fig. 4.1 cost model (golden); in HDL, bit- and cycle-exact: the "
-           "span PXP (default), the coherent span PXP and the line-Z-buffer PXP (all ours), the SLP (Y-sort, ASL update, "
-           "L-sort, X-merge, block lists; not its set-up); one SLP + Pn PXPs clocked together (pixel-exact)",
+           "span PXP (default), the coherent span PXP and the line-Z-buffer PXP (all ours), the SLP (Y-sort, ASL "
+           "update, L-sort, X-merge, block lists) and its set-up (multiplier, reciprocal ROM); one SLP + Pn PXPs "
+           "clocked together (pixel-exact)",
 )

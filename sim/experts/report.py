@@ -11,14 +11,17 @@ import math
 from pathlib import Path
 
 import numpy as np
+from rasterhw.golden_model.experts.paper import (
+    PAPER_COST,
+    PAPER_PXPS_PER_SLP_BALANCED,
+    PAPER_T21,
+    PAPER_T22,
+)
 from rasterhw.sim.report.rows import make_row
 
 SYS = "experts"
 PNS = (1, 2, 4, 8, 16)
 SNS = (1, 2, 4, 8)
-#: table 2.1: solid -> (paper's % increase with A.J. (c), line segments)
-PAPER_T21 = {"5": 4.4, "9": 5.0, "15": 6.4, "20": 12.4}
-PAPER_T22 = {"b": 1.15, "c": 3.35}
 
 
 def _frame(name: str, model: str = "float", aj: str = "none"):
@@ -74,7 +77,7 @@ def _fig41(out: list, sections: list, out_dir: Path, progress: bool) -> None:
                                 "search as run)", paper=None, formula=round(cost.q_p(fr, sn, pn)),
                                 measured=int(q["q_p"]), unit="ops", source="golden"))
         # balance Pn: formula closed form; measured where the counted Q_s and Q_p meet
-        out.append(make_row(SYS, "fig. 4.1 / text", f"balance Pn (Q_s = Q_p), Fr={fr}", paper="4-8",
+        out.append(make_row(SYS, "fig. 4.1 / text", f"balance Pn (Q_s = Q_p), Fr={fr}", paper="-".join(map(str, PAPER_PXPS_PER_SLP_BALANCED)),
                             formula=round(cost.balance_pn(fr), 3), measured=round(q1["q_p"] / q1["q_s"], 3),
                             unit="PXPs per SLP", source="model"))
         st = stage_totals(f)
@@ -86,12 +89,12 @@ def _fig41(out: list, sections: list, out_dir: Path, progress: bool) -> None:
             make_row(SYS, "4 i)", f"Y-sort, Fr={fr}", paper=None, formula=4 * fr, measured=run.ops["y_sort"],
                      unit="ops", source="golden"),
             make_row(SYS, "4 ii)+iii)", f"X-merge + L-sort, Fr={fr}", paper=None,
-                     formula=round(3.46 * fr * r + 893 * r), measured=run.ops["x_merge"] + run.ops["l_sort"],
+                     formula=round(PAPER_COST["fr_sqrt_fr"] * fr * r + PAPER_COST["slp_sqrt_fr"] * r), measured=run.ops["x_merge"] + run.ops["l_sort"],
                      unit="ops", source="golden"),
             make_row(SYS, "4 ii)+iii) (comparison)", f"X-merge + L-sort priced from the sorts' inputs "
                      f"(slp.l_sort_x_merge, not the sorts run), Fr={fr}", paper=None, formula=None,
                      measured=st["x_merge"] + st["l_sort"], unit="ops", source="golden"),
-            make_row(SYS, "4 iv)+v)", f"span cull + depth search, Fr={fr}", paper=None, formula=round(31607 * r),
+            make_row(SYS, "4 iv)+v)", f"span cull + depth search, Fr={fr}", paper=None, formula=round(PAPER_COST["pxp_sqrt_fr"] * r),
                      measured=sp.total(("span_cull", "depth_search")), unit="ops", source="golden"),
             make_row(SYS, "4 iv)+v) (ours: line Z-buffer)", f"per-pixel depth search of our line Z-buffer PXP "
                      f"(span entry/exit + 2k - 1 per pixel covered k times), Fr={fr}", paper=None, formula=None,
@@ -224,8 +227,8 @@ def _tables(out: list, sections: list, out_dir: Path, progress: bool, engine: st
                             source="golden"))
         out.append(make_row(SYS, "table 2.2", f"work with A.J. ({m}), 8 line segments (no A.J. = 1)",
                             paper=PAPER_T22[m], formula=None, measured=round(rat[m], 4), unit="x", source="golden"))
-    out.append(make_row(SYS, "table 2.2", "(b) / (c) work ratio, 8 line segments", paper=round(1.15 / 3.35, 4),
-                        formula=None, measured=round(rat["b"] / rat["c"], 4), unit="x", source="golden"))
+    out.append(make_row(SYS, "table 2.2", "(b) / (c) work ratio, 8 line segments",
+                        paper=None, formula=round(PAPER_T22["b"] / PAPER_T22["c"], 4), measured=round(rat["b"] / rat["c"], 4), unit="x", source="golden"))
     e = cost.alpha_error()
     for m in ("b", "c"):
         out.append(make_row(SYS, "fig. 2.7 (ours)", f"alpha ({m}) max |error| against the area (a), all slopes",
@@ -623,6 +626,7 @@ def _hdl_span_slp(out: list, engine: str, progress: bool) -> None:
     cycle models the HDL blocks match (``span_cycles``, ``coherent``, ``slp_cycles``; the
     line-Z-buffer PXP's beside them), one clock row per block, named "HDL cycles"."""
     from rasterhw.golden_model.experts.model import equal_bounds
+    from rasterhw.golden_model.experts.slp_setup import band_setup, pl_words
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.sim.experts.frame_sim import simulate_frame
     from rasterhw.sim.experts.pxp_sim import jobs, simulate_scene
@@ -634,6 +638,10 @@ def _hdl_span_slp(out: list, engine: str, progress: bool) -> None:
     out.append(make_row(SYS, "HDL", "SLP end-of-line stamps + span PXP lines off the golden cycle models, "
                         "experts-tilt-1000 at 48x16, 2x3 (pysim)", paper=None, formula=None,
                         measured=small["cycle_mismatches"], unit="lines", source="hdl:pysim"))
+    out.append(make_row(SYS, "HDL", "SLP set-up (experts-slp-setup: multiplier, reciprocal ROM) word + cycle-stamp "
+                        "mismatches, experts-tilt-1000 at 48x16, 2 bands (pysim)", paper=None, formula=None,
+                        measured=small["slp_setup_word_mismatches"] + small["slp_setup_cycle_mismatches"],
+                        unit="words + stamps", source="hdl:pysim"))
     co = simulate_scene(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=2, pn=4, aj="c", pxp="coherent")
     out.append(make_row(SYS, "HDL", "coherent span PXP (experts-pxp-coherent) pixel + line-cycle mismatches, "
                         "experts-tilt-1000 at 64x16, 2x4 (pysim)", paper=None, formula=None,
@@ -644,8 +652,12 @@ def _hdl_span_slp(out: list, engine: str, progress: bool) -> None:
         for v in ("span", "coherent", "zbuffer"):
             busy[name, v] = int(jobs(fr, 8, 8, pxp=v)["pxp_frame_cycles"].max())
         bands = equal_bounds(512, 8)
-        busy[name, "slp"] = max(slp_words(fr, (int(bands[s]), int(bands[s + 1])), equal_bounds(512, 8),
-                                          guard=1)["cycles"] for s in range(8))
+        lw = [slp_words(fr, (int(bands[s]), int(bands[s + 1])), equal_bounds(512, 8), guard=1)["cycles"]
+              for s in range(8)]
+        pls = pl_words(fr.setup)
+        su = [1 + band_setup(pls, (int(bands[s]), int(bands[s + 1])), 512)["cycles"] for s in range(8)]
+        busy[name, "slp"] = max(lw)
+        busy[name, "slp+setup"] = max(a + b for a, b in zip(su, lw, strict=True))
     what = "cycle model, matched by the HDL line for line"
     for name in ("experts-1000", "experts-tilt-1000"):
         for v, label in (("span", "span PXP (ours, experts-pxp-span)"),
@@ -662,6 +674,13 @@ def _hdl_span_slp(out: list, engine: str, progress: bool) -> None:
         out.append(make_row(SYS, "5 / HDL", f"SLP list work, HDL cycles: SLP clock for 30 frames/s, {name}, 8x8 ({what})",
                             paper=None, formula=None, measured=round(busy[name, "slp"] * 30 / 1e6, 3), unit="MHz",
                             source="model"))
+        out.append(make_row(SYS, "5 / HDL", f"SLP with set-up (experts-slp-setup, then experts-slp: one processor), HDL "
+                            f"cycles: busiest band's set-up + list-work cycles, {name}, 8x8 (cycle models, matched by "
+                            "the HDL word for word and stamp for stamp)", paper=None, formula=None,
+                            measured=busy[name, "slp+setup"], unit="cycles", source="model"))
+        out.append(make_row(SYS, "5 / HDL", f"SLP with set-up, HDL cycles: SLP clock for 30 frames/s, {name}, 8x8 (cycle "
+                            "models, matched by the HDL)", paper=None, formula=None,
+                            measured=round(busy[name, "slp+setup"] * 30 / 1e6, 3), unit="MHz", source="model"))
     for v, label in (("span", "span PXP (ours)"), ("coherent", "coherent span PXP (ours)"),
                      ("zbuffer", "line Z-buffer PXP (ours)")):
         out.append(make_row(SYS, "4 / HDL", f"{label} busiest frame, experts-tilt-1000 / experts-1000 (depth order "
@@ -680,6 +699,18 @@ def _hdl_span_slp(out: list, engine: str, progress: bool) -> None:
                             unit="lines", source="hdl:verilator"))
         out.append(make_row(SYS, "5 / HDL", "SLP list work, HDL cycles: SLP clock for 30 frames/s, experts-1000, 8x8, "
                             "from the HDL run", paper=None, formula=None,
+                            measured=round(max(r["slp_list_cycles_per_band"]) * 30 / 1e6, 3), unit="MHz",
+                            source="hdl:verilator"))
+        out.append(make_row(SYS, "HDL", "SLP set-up (experts-slp-setup) word + cycle-stamp mismatches, experts-1000, 8 "
+                            f"bands ({r['slp_setup_words']:,} words)", paper=None, formula=None,
+                            measured=r["slp_setup_word_mismatches"] + r["slp_setup_cycle_mismatches"],
+                            unit="words + stamps", source="hdl:verilator"))
+        out.append(make_row(SYS, "5 / HDL", "SLP with set-up (experts-slp-setup, then experts-slp), HDL cycles: busiest "
+                            "band's set-up cycles, experts-1000, 8x8, from the HDL run", paper=None, formula=None,
+                            measured=r["slp_setup_cycles"], unit="cycles", source="hdl:verilator"))
+        out.append(make_row(SYS, "5 / HDL", "SLP with set-up (experts-slp-setup, then experts-slp), HDL cycles: SLP clock "
+                            "for 30 frames/s, experts-1000, 8x8, from the HDL run (the busiest band's set-up + list "
+                            "work)", paper=None, formula=None,
                             measured=round(r["slp_clock_for_30fps_hz"] / 1e6, 3), unit="MHz", source="hdl:verilator"))
         out.append(make_row(SYS, "5 / HDL", "span PXP (ours, experts-pxp-span), HDL cycles: PXP clock for 30 frames/s, "
                             "experts-1000, 8x8, from the HDL run", paper=None, formula=None,

@@ -8,6 +8,7 @@ import numpy as np
 from amaranth import EnableInserter, Module, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
+from rasterhw.golden_model.experts.formats import ACC_EXTRA
 from rasterhw.golden_model.experts.model import render_frame
 from rasterhw.golden_model.experts.pxp_cycles import line_segments
 from rasterhw.golden_model.pipeline import run_geometry
@@ -24,7 +25,7 @@ from rasterhw.sim.experts.pxp_jobs import (
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 
 __all__ = ["DmmBench", "GroupBench", "PxpBench", "PxpCoherentBench", "PxpSpanBench", "PxpUnitBench", "RangeFromTokens", "SlpBench",
-           "job_stimulus", "slp_words"]
+           "SlpSetupBench", "job_stimulus", "setup_words", "slp_words"]
 
 
 class RangeFromTokens(wiring.Component):
@@ -242,13 +243,56 @@ def slp_words(fr, band: tuple[int, int], bounds, *, guard: int) -> dict:
     from rasterhw.hdl.pack import pack
     li, lo = slp_in_layout(), slp_out_layout()
     tws = tri_words(fr.setup)
-    br = band_run(tws, band, bounds, width=fr.width, guard=guard)
+    br = band_run(tws, band, bounds, width=fr.width, guard=guard, extra=fr.setup.fmt.datapath.acc_extra)
     words = [pack(li, {"kind": IN_KIND["band"], "r0": band[0], "r1": band[1]})]
     words += [pack(li, {"kind": IN_KIND["bound"], "xa": int(v)}) for v in bounds]
     words += [pack(li, {"kind": IN_KIND["tri"], **tw}) for tw in tws] + [pack(li, {"kind": IN_KIND["go"]})]
     out = [pack(lo, {"kind": k, "p": p, "pos": pos, "t": t, "y": y, "asb": a or {}})
            for k, p, pos, t, y, a in br["words"]]
     return {"in": words, "out": out, **br, "tris": len(tws)}
+
+
+def setup_words(pls: list[dict], band: tuple[int, int], height: int, extra: int = ACC_EXTRA) -> dict:
+    """``experts-slp-setup`` stimulus and expectation for one band: the band word and every PL
+    triangle (``golden_model/experts/slp_setup.py: pl_words``) in, the triangle words the list work
+    takes out, each on the edge ``band_setup``'s cycles put it (``stamps``: the band word's cycle,
+    then each triangle's cycles)."""
+    from rasterhw.golden_model.experts.slp_setup import band_setup
+    from rasterhw.hdl.experts.slp import IN_KIND, slp_in_layout
+    from rasterhw.hdl.experts.slp_setup import PL_KIND, pl_layout
+    from rasterhw.hdl.pack import pack
+    li, lo = pl_layout(), slp_in_layout()
+    bs = band_setup(pls, band, height, extra)
+    words = [pack(li, {"kind": PL_KIND["band"], "r0": band[0], "r1": band[1]})]
+    words += [pack(li, {"kind": PL_KIND["tri"], **pl}) for pl in pls]
+    stamps, t = [], 1
+    for c in bs["tri_cycles"]:
+        t += c
+        stamps.append(t - 1)
+    return {"in": words, "out": [pack(lo, {"kind": IN_KIND["tri"], **w}) for w in bs["words"]],
+            "stamps": stamps, **bs}
+
+
+class SlpSetupBench(Testbench):
+    """``experts-slp-setup`` (the SLP's set-up: multiplier and reciprocal ROM): one band of a random
+    frame -- the band word, then every PL triangle -- in (``i``); every triangle's word for the list
+    work out (``o``), as ``golden_model/experts/slp_setup.py`` gives them (equal to
+    ``slp_cycles.tri_words`` in the band); cycles: the last word's edge + 1 = the band word's cycle
+    and every triangle's."""
+
+    block = "experts-slp-setup"
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        from rasterhw.golden_model.experts.slp_setup import pl_words
+        H = params["height"]
+        rng, name, fr = _frame({"width": H, "tris": 999}, seed)
+        n = int(rng.integers(1, H + 1))
+        y0 = int(rng.integers(0, H - n + 1))
+        sw = setup_words(pl_words(fr.setup), (y0, y0 + n), H)
+        return Stimulus({"i": sw["in"]}, what=f"{name} at {H}, band {y0}..{y0 + n}, seed {seed}", source=sw)
+
+    def expect(self, params: dict, stim: Stimulus) -> Expected:
+        return Expected({"o": stim.source["out"]}, cycles=1 + int(stim.source["cycles"]))
 
 
 class SlpBench(Testbench):

@@ -21,6 +21,32 @@ def test_small_frame_slp_and_pxp_hdl_exact():
     assert r["slp_cycle_mismatches"] == 0 and r["pxp_cycle_mismatches"] == 0 and r["cycle_mismatches"] == 0
     assert r["slp_clock_for_30fps_hz"] == 30 * r["slp_cycles"] and r["pxp_clock_for_30fps_hz"] == 30 * r["pxp_cycles"]
     assert r["bottleneck"] in ("SLP", "PXP") and r["slp_cycles"] > 0 and r["pxp_cycles"] > 0
+    # the SLP's set-up in HDL (experts-slp-setup), its words fed to the list work, and one SLP clock with it
+    assert r["slp_setup_word_mismatches"] == 0 and r["slp_setup_cycle_mismatches"] == 0
+    assert r["slp_setup_words"] > 0
+    b = r["slp_busiest_band"]
+    assert r["slp_setup_cycles"] == r["slp_setup_cycles_per_band"][b] > 0
+    assert r["slp_cycles"] == r["slp_setup_cycles"] + r["slp_list_cycles"] == max(
+        a + c for a, c in zip(r["slp_setup_cycles_per_band"], r["slp_list_cycles_per_band"], strict=True))
+    # today's datapath, and its golden bit model's error against float
+    assert (r["datapath"], r["datapath_bits"], r["multipliers"], r["accuracy_source"]) == ("ours", 40, 3, "golden")
+    assert r["pixels_differing_from_ours"] == 0 and r["max_abs_error"] >= 0
+
+
+def test_paper_datapath_hdl_against_the_golden_model_at_its_widths():
+    """--datapath paper: the SLP HDL with 16-bit increments and accumulators, against the golden bit
+    model at the paper's widths; the result says what the HDL has (40-bit registers, 3 multipliers)
+    beside the contract (16, 1)."""
+    r = simulate_frame(build_scene("experts-tilt-1000"), 48, 16, engine="pysim", sn=2, pn=3, aj="c", datapath="paper")
+    assert r["pixels_compared"] == 48 * 16 and r["mismatches"] == 0 and r["cycle_mismatches"] == 0
+    assert r["slp_setup_word_mismatches"] == 0 and r["slp_word_mismatches"] == 0 and r["slp_words"] > 300
+    assert (r["datapath"], r["datapath_bits"], r["multipliers"]) == ("paper", 40, 3)
+    assert (r["contract_datapath_bits"], r["contract_multipliers"]) == (16, 1)
+    assert r["hdl_16_bit"] == "SLP edge increments and accumulators"
+    with pytest.raises(RasterhwError, match="datapath must be"):
+        simulate_frame(build_scene("experts-1000"), 64, 16, engine="pysim", datapath="wide")
+    with pytest.raises(RasterhwError, match="path at chained"):
+        simulate_frame(build_scene("experts-1000"), 64, 16, engine="pysim", datapath="paper", path="group")
 
 
 def test_the_pxp_needs_the_slps_bucket_list():

@@ -1,0 +1,224 @@
+"""EXPERTS SLP set-up (ASL creation): PL triangles in, the triangle words of the SLP's list work out.
+
+Paper (seed 000, 3.2): "SLPにおけるASL作成の処理は、以後のインクリメンタルな計算のための各種の増分値の
+計算を含んだりするため、乗除算の高速化を行なう必要がある。そこでSLPには ... ALU ... の他に、乗算器、
+および逆数表(ROMによる)を装備した". One multiplier (one product a cycle) and a reciprocal ROM of
+``2**15`` 16-bit words (the size is ours; ``golden_model/experts/slp_setup.py`` says why), run as
+``golden_model/experts/slp_setup.py`` runs them (every step and every cycle is named there):
+
+* a ``BAND`` word sets the band (``r0`` .. ``r1``, exclusive);
+* a PL triangle (``TRI``): vertices sorted on y (stable), first and last line, band test in the
+  cycle it is taken; out of the band, the word with ``t``, ``r0``, ``r1`` only; in the band, six
+  multiplies for eq. (3)'s denominator and the z and i numerators, then seven reciprocals (each
+  edge's ``dY`` and ``dX``, the denominator: ROM word + 1, one multiply for the remainder, one ALU
+  cycle per correction, one to finish) each followed by its multiply-and-rounds (``formats.rom_div``:
+  ``(|num| R << shift + 2**(S-1)) >> S`` with the sign), then the word out.
+
+Output: ``hdl/experts/slp.py``'s input word (:func:`~rasterhw.hdl.experts.slp.slp_in_layout`,
+kind ``TRI``), as ``slp_cycles.tri_words`` gives it.
+"""
+
+from __future__ import annotations
+
+from amaranth import Const, Module, Mux, Signal, signed, unsigned
+from amaranth.lib import data, stream, wiring
+from amaranth.lib.memory import Memory
+from amaranth.lib.wiring import In, Out
+from rasterhw.golden_model.experts.formats import ACC_EXTRA, ADDR_BITS, SLOPE_FRAC, X_FRAC
+from rasterhw.golden_model.experts.slp_setup import EDGES, ROM_INDEX_BITS, rom_table
+
+__all__ = ["ExpertsSlpSetup", "pl_layout", "PL_KIND"]
+
+PL_KIND = {"band": 0, "tri": 1}
+
+
+def pl_layout() -> data.StructLayout:
+    f = {"kind": unsigned(1), "t": unsigned(ADDR_BITS), "r0": unsigned(10), "r1": unsigned(10)}
+    for j in range(3):
+        f.update({f"x{j}": signed(17), f"y{j}": signed(17), f"z{j}": unsigned(16), f"i{j}": unsigned(16)})
+    f.update({"hue": unsigned(9), "poly": unsigned(ADDR_BITS)})
+    return data.StructLayout(f)
+
+
+class ExpertsSlpSetup(wiring.Component):
+    """The SLP's set-up unit: one multiplier, the reciprocal ROM, a sequencer.
+
+    Parameters
+    ----------
+    height : int
+        Frame height (the last line a triangle may reach), 1..1024.
+    acc_extra : int
+        Fraction bits of the edge increments beyond the 16-bit word (``formats.Datapath.acc_extra``):
+        16 (ours, the default) or 0 (the paper's 16-bit datapath: each increment saturated to 16 bits).
+
+    Members
+    -------
+    i : In(stream.Signature(pl_layout()))
+    o : Out(stream.Signature(slp_in_layout()))
+    """
+
+    def __init__(self, *, height: int = 512, acc_extra: int = ACC_EXTRA):
+        if isinstance(height, bool) or not isinstance(height, int) or not 1 <= height <= 1024:
+            raise ValueError(f"height must be an integer in 1..1024, not {height!r}")
+        if acc_extra not in (0, ACC_EXTRA) or isinstance(acc_extra, bool):
+            raise ValueError(f"acc_extra must be 0 or {ACC_EXTRA}, not {acc_extra!r}")
+        self._h, self._ex = height, acc_extra
+        from rasterhw.hdl.experts.slp import slp_in_layout
+        super().__init__({"i": In(stream.Signature(pl_layout())), "o": Out(stream.Signature(slp_in_layout()))})
+
+    def elaborate(self, platform):
+        from rasterhw.hdl.experts.slp import IN_KIND
+        m = Module()
+        p = self.i.payload
+        res = Signal(self.o.payload.shape())
+        m.d.comb += [self.o.payload.eq(res), self.i.ready.eq(0), self.o.valid.eq(0)]
+        rom = Memory(shape=16, depth=1 << ROM_INDEX_BITS, init=[int(v) for v in rom_table()])
+        m.submodules.rom = rom
+        rp = rom.read_port(domain="comb")
+
+        # ---- the vertices, sorted on y in the cycle the word is taken (stable: ties keep PL order)
+        X = [Signal(signed(17), name=f"X{k}") for k in range(3)]
+        Y = [Signal(signed(17), name=f"Y{k}") for k in range(3)]
+        Z = [Signal(unsigned(16), name=f"Z{k}") for k in range(3)]
+        Iv = [Signal(unsigned(16), name=f"I{k}") for k in range(3)]
+        py = [p.y0, p.y1, p.y2]
+        before = {(a, b): (py[a] <= py[b]) if a < b else (py[a] < py[b]) for a in range(3) for b in range(3) if a != b}
+        rank = [sum((before[(b, a)] for b in range(3) if b != a), Const(0, 2)) for a in range(3)]
+        y0, y1 = Signal(10), Signal(10)
+        half = 1 << (X_FRAC - 1)
+
+        # ---- the datapath: one multiplier, an accumulator, the reciprocal (R, S, sign, remainder)
+        ma, mb = Signal(signed(40)), Signal(signed(20))
+        prod = Signal(signed(60))
+        m.d.comb += prod.eq(ma * mb)
+        acc = Signal(signed(40))
+        den, nz, ni = (Signal(signed(40), name=n) for n in ("den", "nz", "ni"))
+        R = Signal(unsigned(18))
+        S = Signal(unsigned(6))
+        dneg = Signal()
+        dz = Signal()                         # the divisor is 0
+        dabs = Signal(unsigned(40))
+        e = Signal(signed(72))
+        corr = Signal()                       # in a reciprocal's correction cycles
+        s1 = Signal(unsigned(6))              # S - 1: the rounding bit
+        m.d.comb += s1.eq(S - 1)
+
+        pc = Signal(range(64))
+        busy = Signal()
+        out = Signal()
+
+        # the program: ("mul", a, b, dst, first) | ("recip", d) | ("md", num, shift, field, kind)
+        def df(A, i, j):
+            v = Signal(signed(18), name=f"d_{A[0].name}_{i}{j}")
+            m.d.comb += v.eq(A[j] - A[i])
+            return v
+        prog = [("mul", df(Y, 2, 1), df(X, 1, 0), den, True), ("mul", df(Y, 1, 0), df(X, 2, 1), den, False),
+                ("mul", df(Y, 2, 1), df(Z, 1, 0), nz, True), ("mul", df(Y, 1, 0), df(Z, 2, 1), nz, False),
+                ("mul", df(Y, 2, 1), df(Iv, 1, 0), ni, True), ("mul", df(Y, 1, 0), df(Iv, 2, 1), ni, False)]
+        sh = X_FRAC + self._ex
+        ik = "sat" if self._ex == 0 else "int"     # the paper's datapath: one saturated 16-bit word
+        for e_, i, j in EDGES:
+            dX, dY = df(X, i, j), df(Y, i, j)
+            prog += [("recip", dY), ("md", dX, sh, f"inc_{e_}", ik), ("md", df(Z, i, j), sh, f"zinc_{e_}", ik),
+                     ("md", df(Iv, i, j), sh, f"iinc_{e_}", ik), ("md", dX, SLOPE_FRAC, f"s_{e_}", "sat"),
+                     ("recip", dX), ("md", dY, SLOPE_FRAC, f"q_{e_}", "satq")]
+        prog += [("recip", den), ("md", nz, 6 + 4, "dzdx", "sat"), ("md", ni, 6, "didx", "sat")]
+
+        def sat16(v):
+            return Mux(v > (1 << 15) - 1, (1 << 15) - 1, Mux(v < -(1 << 15), -(1 << 15), v))
+
+        # ---- take a PL word
+        with m.If(~busy & ~out):
+            m.d.comb += self.i.ready.eq(1)
+            with m.If(self.i.valid):
+                with m.If(p.kind == PL_KIND["band"]):
+                    m.d.sync += [y0.eq(p.r0), y1.eq(p.r1)]
+                with m.Else():
+                    for a in range(3):
+                        with m.Switch(rank[a]):
+                            for r in range(3):
+                                with m.Case(r):
+                                    m.d.sync += [X[r].eq(getattr(p, f"x{a}")), Y[r].eq(getattr(p, f"y{a}")),
+                                                 Z[r].eq(getattr(p, f"z{a}")), Iv[r].eq(getattr(p, f"i{a}"))]
+                    ytop = Mux(rank[0] == 0, p.y0, Mux(rank[1] == 0, p.y1, p.y2))
+                    ybot = Mux(rank[0] == 2, p.y0, Mux(rank[1] == 2, p.y1, p.y2))
+                    r0v, r1v = Signal(signed(12)), Signal(signed(12))
+                    m.d.comb += [r0v.eq((ytop + half - 1) >> X_FRAC), r1v.eq(((ybot + half - 1) >> X_FRAC) - 1)]
+                    r0c = Mux(r0v < 0, 0, r0v)
+                    r1c = Mux(r1v > self._h - 1, self._h - 1, r1v)
+                    m.d.sync += [res.eq(0), res.kind.eq(IN_KIND["tri"]), res.t.eq(p.t), res.r0.eq(r0c),
+                                 res.r1.eq(r1c), res.hue.eq(p.hue), res.poly.eq(p.poly), pc.eq(0)]
+                    inb = (r1c >= y0) & (r0c < y1)
+                    m.d.sync += [busy.eq(inb), out.eq(~inb)]
+                    with m.If(~inb):
+                        m.d.sync += [res.hue.eq(0), res.poly.eq(0)]
+
+        # ---- the program, one step a cycle (a reciprocal's corrections stay on its step)
+        with m.If(busy):
+            with m.Switch(pc):
+                for k, st in enumerate(prog):
+                    with m.Case(k):
+                        nxt = [pc.eq(k + 1)] if k + 1 < len(prog) else [busy.eq(0), out.eq(1)]
+                        if st[0] == "mul":
+                            _, a, b, dst, first = st
+                            m.d.comb += [ma.eq(a), mb.eq(b)]
+                            if first:
+                                m.d.sync += acc.eq(prod)
+                            else:
+                                m.d.sync += dst.eq(acc - prod)
+                            m.d.sync += nxt
+                        elif st[0] == "recip":
+                            d = st[1]
+                            ad = Signal(unsigned(40), name=f"abs_{k}")
+                            m.d.comb += ad.eq(Mux(d < 0, -d, d))
+                            with m.If(~corr):
+                                # normalise |d| to its 16-bit mantissa, ROM word + 1, remainder (one multiply)
+                                bl = Signal(range(41), name=f"bl_{k}")
+                                for b_ in range(40):
+                                    with m.If(ad[b_]):
+                                        m.d.comb += bl.eq(b_ + 1)
+                                mant = Signal(unsigned(16), name=f"mant_{k}")
+                                shr, shl = Signal(6, name=f"shr_{k}"), Signal(6, name=f"shl_{k}")
+                                m.d.comb += [shr.eq(bl - 16), shl.eq(16 - bl),
+                                             mant.eq(Mux(bl > 16, ad >> shr, ad << shl))]
+                                rc = Signal(unsigned(18), name=f"rc_{k}")
+                                m.d.comb += [rp.addr.eq(mant[:ROM_INDEX_BITS]), rc.eq(rp.data + 1),
+                                             ma.eq(ad), mb.eq(rc)]
+                                sv = Signal(unsigned(6), name=f"s_{k}")
+                                m.d.comb += sv.eq(15 + bl)
+                                m.d.sync += [S.eq(sv), dneg.eq(d < 0), dabs.eq(ad), dz.eq(ad == 0), corr.eq(1)]
+                                with m.If(ad == 0):
+                                    m.d.sync += [R.eq(0), e.eq(0)]
+                                with m.Else():
+                                    m.d.sync += [R.eq(rc), e.eq((Const(1, 72) << sv) + (ad >> 1) - prod)]
+                            with m.Else():
+                                with m.If(e < 0):
+                                    m.d.sync += [R.eq(R - 1), e.eq(e + dabs)]
+                                with m.Else():
+                                    m.d.sync += [R.eq(Mux(R > 0xFFFF, 0xFFFF, R)), corr.eq(0), *nxt]
+                        else:
+                            _, num, shift, field, kind = st
+                            an = Signal(unsigned(40), name=f"an_{k}")
+                            m.d.comb += [an.eq(Mux(num < 0, -num, num)), ma.eq(an), mb.eq(R)]
+                            q = Signal(unsigned(72), name=f"q_{k}")
+                            m.d.comb += q.eq(((prod.as_unsigned() << shift) + (Const(1, 72) << s1)) >> S)
+                            v = Signal(signed(73), name=f"v_{k}")
+                            m.d.comb += v.eq(Mux((num < 0) ^ dneg, -q, q))
+                            tgt = getattr(res, field)
+                            if kind == "int":
+                                m.d.sync += tgt.eq(v)
+                            elif kind == "sat":
+                                m.d.sync += tgt.eq(sat16(v))
+                            else:
+                                m.d.sync += tgt.eq(Mux(dz, (1 << 15) - 1, sat16(v)))
+                            m.d.sync += nxt
+            # the sorted vertices and the left-edge flag into the word (they hold from the take on)
+            m.d.sync += [res.ll.eq(den > 0), res.xa.eq(X[0]), res.ya.eq(Y[0]), res.xb.eq(X[1]), res.yb.eq(Y[1]),
+                         res.za.eq(Z[0]), res.zb.eq(Z[1]), res.ia.eq(Iv[0]), res.ib.eq(Iv[1])]
+
+        # ---- the word out
+        with m.If(out):
+            m.d.comb += self.o.valid.eq(1)
+            with m.If(self.o.ready):
+                m.d.sync += out.eq(0)
+        return m
