@@ -85,9 +85,13 @@ def _frame(params: dict, seed: int):
     """A random EXPERTS frame at the block's width (square), bit-accurate model, A.J. as built."""
     rng = np.random.default_rng(seed)
     w = params["width"]
-    # the paper's scenes; a block built for fewer triangles (a quick test) gets scenes that fit it
-    small = params.get("tris", 1000) < 1000
-    name = str(rng.choice(["c50", "experts-solids"] if small else ["experts-1000", "experts-tilt-1000", "c100"]))
+    # the paper's scenes; a block built for fewer triangles or a smaller DMM/P bank (a quick test)
+    # gets scenes that fit it (at 64 px c50 is up to about 240 triangles and 16 segments a line,
+    # experts-solids 37 triangles)
+    tris, depth = params.get("tris", 1000), params.get("depth", 256)
+    names = (["experts-1000", "experts-tilt-1000", "c100"] if tris >= 1000 and depth >= 64 else
+             ["c50", "experts-solids"] if tris >= 256 else ["experts-solids"])
+    name = str(rng.choice(names))
     sc = build_scene(name, seed=int(rng.integers(0, 1 << 30)))
     return rng, name, render_frame(run_geometry(sc, w, w, z_bits=16), model="bit", aj=params.get("aj", "none"))
 
@@ -131,13 +135,26 @@ class PxpBench(Testbench):
         """Segments a line may hold (None: any)."""
         return None
 
-    def stimulus(self, params: dict, seed: int) -> Stimulus:
-        rng, name, fr = _frame(params, seed)
+    def segments(self, fr, line: tuple[int, int, int]) -> int:
+        """Segments line ``(y, lo, hi)`` puts in the block's bank."""
+        return len(line_segments(fr, *line, aj=fr.aj))
+
+    def lines(self, params: dict, rng, fr, name: str, seed: int) -> list[tuple[int, int, int]]:
+        """The random PXP lines of a stimulus, those the block can hold: a line with more segments
+        than ``max_segments`` would stall the block for good (its ``overflow``, by design), so it is
+        left out; none left is refused in one line, not run."""
         todo = _lines(rng, params["width"], int(rng.integers(2, 9)), whole=self.whole_lines)
         cap = self.max_segments(params)
-        if cap is not None:   # lines the block can hold (more would stall it for good, by design)
-            todo = [t for t in todo if len(line_segments(fr, *t, aj=fr.aj)) <= cap] or todo[:0]
-        jb = job_list(fr, todo)
+        if cap is not None:
+            todo = [t for t in todo if self.segments(fr, t) <= cap]
+            if not todo:
+                raise ValueError(f"{self.block}: no line of {name} at {params['width']} (seed {seed}) "
+                                 f"fits {cap} segments; take a larger depth")
+        return todo
+
+    def stimulus(self, params: dict, seed: int) -> Stimulus:
+        rng, name, fr = _frame(params, seed)
+        jb = job_list(fr, self.lines(params, rng, fr, name, seed))
         return job_stimulus(jb, f"{name} at {params['width']}, {jb['lines']} lines, seed {seed}")
 
     def words(self, jb: dict) -> dict[str, list[int]]:
@@ -166,10 +183,18 @@ class PxpSpanBench(PxpBench):
     def dut(self, params: dict):
         return RangeFromTokens(registry.load(registry.blocks()[self.block])(**params), params["width"], SPAN_BITS)
 
+    pxp = "span"
+
+    def max_segments(self, params: dict) -> int | None:
+        return params["depth"]          # ASBs (and bucket entries, never more) per DMM/P bank
+
+    def segments(self, fr, line: tuple[int, int, int]) -> int:
+        from rasterhw.golden_model.experts.span_cycles import line_asl
+        return len(line_asl(fr, line[0])[0])   # the line's whole ASL goes to the bank
+
     def stimulus(self, params: dict, seed: int) -> Stimulus:
         rng, name, fr = _frame(params, seed)
-        todo = _lines(rng, params["width"], int(rng.integers(2, 9)))
-        jb = span_job_list(fr, todo)
+        jb = span_job_list(fr, self.lines(params, rng, fr, name, seed), pxp=self.pxp)
         return job_stimulus(jb, f"{name} at {params['width']}, {jb['lines']} lines, seed {seed}")
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
@@ -183,12 +208,7 @@ class PxpCoherentBench(PxpSpanBench):
     ``golden_model/experts/coherent.py`` through ``span_cycles.schedule``."""
 
     block = "experts-pxp-coherent"
-
-    def stimulus(self, params: dict, seed: int) -> Stimulus:
-        rng, name, fr = _frame(params, seed)
-        todo = _lines(rng, params["width"], int(rng.integers(2, 9)))
-        jb = span_job_list(fr, todo, pxp="coherent")
-        return job_stimulus(jb, f"{name} at {params['width']}, {jb['lines']} lines, seed {seed}")
+    pxp = "coherent"
 
 
 class PxpUnitBench(PxpBench):
@@ -341,6 +361,14 @@ class GroupBench(Testbench):
         y0 = int(rng.integers(0, H - n + 1))
         b = equal_bounds(params["width"], params["pn"])
         sw = slp_words(fr, (y0, y0 + n), b, guard=1 if params["aj"] == "c" else 0)
+        # what the group cannot hold sets its overflow and gives wrong pixels: refused, not run
+        if sw["tris"] > params["tris"]:
+            raise ValueError(f"{name}: {sw['tris']} triangles, the SLP holds {params['tris']}")
+        from rasterhw.golden_model.experts.span_cycles import line_asl
+        most = max(len(line_asl(fr, y)[0]) for y in range(y0, y0 + n))
+        if most > min(params["asl"], params["depth"]):
+            raise ValueError(f"{name}: a line of {most} segments, the SLP's ASL holds {params['asl']} and a "
+                             f"DMM/P bank {params['depth']}")
         from rasterhw.golden_model.experts.pxp import pixel_words
         pix = pixel_words(fr.setup, fr.fields).reshape(H, fr.width)
         out = {f"o[{k}]": [int(v) for y in range(y0, y0 + n) for v in pix[y, int(b[k]):int(b[k + 1])]]
