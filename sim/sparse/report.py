@@ -1030,8 +1030,8 @@ def _paper_load_rows(row, engine: str, progress: bool) -> list[str]:
 #: REF_DEPTH): Verilator's hierarchical build (the cell verilated once, ``docs/sparse.md``)
 LARGE_MATRICES = ("8x8", "16x16")
 LARGE_FAST_SKIP = ("slow row: not measured in a fast run (the whole matrix in Verilator at 1024², hierarchical "
-                   "build: 8x8 about 2 min, 16x16 about 8 min on a quiet machine); rasterhw report sparse without "
-                   "--fast measures it")
+                   "build: measured 8x8 12 min, 16x16 26 min, cold, at load 10-30, of them the Verilator build "
+                   "473 s and 1,014 s); rasterhw report sparse without --fast measures it")
 LARGE_ENGINE_SKIP = ("needs --engine verilator: pysim runs a few thousand cycles a second, too slow for a 1024² "
                      "frame of 64 or 256 processors")
 
