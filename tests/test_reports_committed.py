@@ -6,15 +6,23 @@ decimal numbers masked), with the same ``paper`` value and ``source``; rows from
 model or a formula also keep their ``formula`` value. Measured HDL numbers, timings and ratios
 are not compared (they are the report's to change); slow rows (synthesis, place and route)
 come back unmeasured with their reason.
+
+That check needs no simulation: it runs rows-only (``run_report(..., rows_only=True)``: the
+golden, model and formula rows computed, every HDL and synthesis row kept unmeasured with its
+reason) for the systems whose rows function takes ``rows_only``, records-only (``fast``) for the
+others. That the HDL rows are measured is checked apart: ZB/M's in
+``test_zbm_report_measures_its_hdl_rows`` (fast) and in the whole fast report (``slow``).
 """
 
 from __future__ import annotations
 
+import inspect
 from pathlib import Path
 
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.report.rows import (
+    ROWS_ONLY,
     _fmt,
     make_row,
     missing_rows,
@@ -30,10 +38,10 @@ DOCS = Path(__file__).resolve().parents[1] / "docs" / "reproduction"
 SLOW_SYSTEMS = {"experts", "sparse", "vzbuf", "snu"}
 
 
-def _compare(system: str, tmp_path: Path) -> list[dict]:
+def _compare(system: str, tmp_path: Path, *, rows_only: bool = False) -> list[dict]:
     committed = parse_table((DOCS / f"{system}.md").read_text())
     assert committed, f"no table in docs/reproduction/{system}.md"
-    rows = run_report(system, out_dir=tmp_path, engine="pysim", fast=True)
+    rows = run_report(system, out_dir=tmp_path, engine="pysim", fast=True, rows_only=rows_only)
     lost = missing_rows(committed, rows)
     assert not lost, f"{system}: {len(lost)} committed rows not produced, first {lost[0]}"
     by_key = {}
@@ -54,45 +62,63 @@ def _compare(system: str, tmp_path: Path) -> list[dict]:
     return rows
 
 
-#: the test run's reduced configuration of a fast report (``"module.NAME": value`` set for the run):
-#: the same rows come back (a row left unmeasured keeps its name, with its reason), from fewer
-#: HDL runs. ZB/M, each left out run checked in every test run elsewhere:
-#: - the 2-unit chain is not built (cold, its Verilog conversion, -O0 build and run took 45 s of the
-#:   159 s of CPU this test took: docs/speed.md); the skew pair still runs two chained units on
-#:   Verilator word for word against the golden model (``skew`` raises on a mismatch);
-#: - Table 1 in pysim at interleave 2 (both schedules): tests/zbm/test_zbm_unit_pysim.py::
-#:   test_line_log_steady_state_equals_model runs the same measurement against the same model;
-#: - the pixel rate at interleave 2 and 4 (pysim, 128-px lines): test_pixel_rate_scales_with_interleave
-#:   runs interleave 1 and 4 against the same formula.
-#: Warm, those runs were most of this test's 37 s of CPU (pysim elaboration and simulation). The
-#: whole fast report: the ``slow`` test below.
-REDUCED = {"zbm": {"rasterhw.sim.zbm.scaling.FAST_SKIP_CHAIN": (2, 4, 8),
-                   "rasterhw.sim.zbm.report.FAST_SKIP_INTERLEAVES": (2, 8, 16),
-                   "rasterhw.sim.zbm.scaling.FAST_SKIP_PIXEL_RATE": (2, 4, 8, 16)}}
+def _takes_rows_only(system: str) -> bool:
+    from rasterhw.sim.report.rows import _load
+
+    return "rows_only" in inspect.signature(_load(system)).parameters
 
 
-@pytest.mark.parametrize("system", [s for s in systems() if s not in SLOW_SYSTEMS])
-@pytest.mark.heavy(3)
-def test_fast_report_keeps_every_committed_row(system, tmp_path, monkeypatch):
-    for name, value in REDUCED.get(system, {}).items():
-        monkeypatch.setattr(name, value)
-    rows = _compare(system, tmp_path)
-    if system == "zbm":   # the reduced run still measures the skew pair and the 1-unit chain on Verilator
-        skew = [r for r in rows if r["figure"] == "6.1 cond. 7"]
-        chain = {r["quantity"].split(",")[0]: r["measured"] for r in rows
-                 if r["figure"] == "6.1 (chain)" and r["quantity"].endswith("speed-up over 1 unit")}
-        assert len(skew) == 2 and all(r["measured"] is not None and r["source"] == "hdl:verilator" for r in skew)
-        assert chain["1 chained unit"] == 1 and chain["2 chained units"] is None
-        t1 = {(r["quantity"].split(", ")[1], r["quantity"].split(", ")[2]): r["measured"] for r in rows
-              if r["figure"] == "table 1 / 6.1"}
-        assert all(t1[(f"interleave {i}", s)] for i in (1, 4) for s in ("paper schedule", "overlapped schedule (ours)"))
-        assert t1[("interleave 2", "paper schedule")] is None
+@pytest.mark.parametrize("system", [s for s in systems() if s not in SLOW_SYSTEMS or _takes_rows_only(s)])
+def test_rows_only_report_keeps_every_committed_row(system, tmp_path):
+    """Row names, paper values, sources and formulas of the committed table, without simulating."""
+    rows = _compare(system, tmp_path, rows_only=True)
+    if _takes_rows_only(system):   # nothing simulated or synthesised: every HDL row says so
+        hdl = [r for r in rows if str(r["source"]).startswith("hdl:")]
+        assert hdl and all(r["measured"] is None and r["reason"] == ROWS_ONLY for r in hdl)
+
+
+@pytest.mark.heavy(2)
+def test_zbm_report_measures_its_hdl_rows(monkeypatch):
+    """The ZB/M report's HDL rows come back measured, word for word against the golden model: the
+    skew pair (two chained units, twice) and the 1-unit chain on Verilator through the report's
+    own rows (``skew`` and ``chain`` raise on a differing word), Table 1's steady state on pysim
+    at interleave 1, both schedules, each run comparing every merge word. The other runs of a
+    fast report, each checked in every test run elsewhere: Table 1 in pysim at interleave 2,
+    tests/zbm/test_zbm_unit_pysim.py::test_line_log_steady_state_equals_model (and at 1 and 8 on
+    Verilator, tests/zbm/test_zbm_cocotb.py::test_table1_paper_schedule_verilator); the pixel rate
+    at interleave 1 and 4, test_pixel_rate_scales_with_interleave; all of them through the
+    report: the ``slow`` test below."""
+    from rasterhw.sim.zbm import report, scaling
+
+    monkeypatch.setattr(scaling, "FAST_SKIP_PIXEL_RATE", (1, 2, 4, 8, 16))
+    monkeypatch.setattr(scaling, "FAST_SKIP_CHAIN", (2, 4, 8))
+    rows = scaling.report_rows(engine="verilator", fast=True)
+    skew = [r for r in rows if r["figure"] == "6.1 cond. 7"]
+    chain = {r["quantity"].split(",")[0]: r["measured"] for r in rows
+             if r["figure"] == "6.1 (chain)" and r["quantity"].endswith("speed-up over 1 unit")}
+    assert len(skew) == 2 and all(r["measured"] is not None and r["source"] == "hdl:verilator" for r in skew)
+    assert chain["1 chained unit"] == 1 and chain["2 chained units"] is None
+    assert all(r["measured"] is None for r in rows if r["figure"] == "5.3")
+    for sched in ("paper", "overlap"):
+        r = report.measure_steady_state(1, "pysim", sched)
+        assert r["words_compared"] > 0 and r["mismatches"] == 0
+        assert r["per_edge_pair"] == {"paper": 74, "overlap": 70}[sched]
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("system", sorted(REDUCED))
+@pytest.mark.parametrize("system", ["zbm"])
 def test_whole_fast_report_keeps_every_committed_row(system, tmp_path):
-    _compare(system, tmp_path)
+    """The whole fast report with its HDL runs: the committed rows, and every HDL row a fast run
+    measures measured (Table 1 on pysim at interleave 1, 2, 4, each carrying its compared words)."""
+    rows = _compare(system, tmp_path)
+    t1 = {(r["quantity"].split(", ")[1], r["quantity"].split(", ")[2]): r for r in rows
+          if r["figure"] == "table 1 / 6.1"}
+    for i in (1, 2, 4):
+        for s in ("paper schedule", "overlapped schedule (ours)"):
+            r = t1[(f"interleave {i}", s)]
+            assert r["measured"] and r["words_compared"] > 0 and r["mismatches"] == 0, r
+    assert all(r["measured"] is not None for r in rows if r["figure"] in ("6.1 cond. 7", "6.1 (chain)")
+               and not r["quantity"].startswith(("4 chained", "8 chained")))
 
 
 def test_every_report_has_a_committed_table():

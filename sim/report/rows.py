@@ -52,6 +52,9 @@ EXTRA_REPORTS: dict[str, str] = {"fpga": "rasterhw.sim.report.fpga:rows",
 
 #: ``reason`` of a row a fast run leaves unmeasured
 FAST_SKIP = "slow row: not measured in a fast run (rasterhw report without --fast measures it)"
+#: ``reason`` of a row a rows-only run leaves unmeasured (:func:`run_report`'s ``rows_only``)
+ROWS_ONLY = ("rows-only run: nothing simulated or synthesised (a check of the row names, paper values and "
+             "formulas; rasterhw report measures it)")
 
 
 def make_row(system: str, figure: str, quantity: str, *, paper, formula, measured, unit: str,
@@ -189,10 +192,15 @@ def default_report_dir() -> Path:
 
 def run_report(system: str, *, out_dir: Path = Path("docs/reproduction"), engine: str = "pysim",
                progress: bool = False, fast: bool = False, scheduler: str = "serial",
-               store: str | Path | None = None, fresh: bool = False, **known) -> list[dict]:
+               store: str | Path | None = None, fresh: bool = False, rows_only: bool = False,
+               **known) -> list[dict]:
     """Measure every row of SYSTEM, write ``out_dir/SYSTEM.md`` and its plots, return the rows.
 
     ``fast``: slow rows are kept unmeasured (for systems whose rows function takes ``fast``).
+    ``rows_only``: no HDL is simulated or synthesised, every such row is kept unmeasured with
+    :data:`ROWS_ONLY` (the golden, model and formula rows are computed as always), for systems
+    whose rows function takes ``rows_only``; it implies ``fast``. The committed-report tests
+    check row names, paper values and formulas this way.
     ``scheduler``, ``store``, ``fresh``: where a rows function that runs a list of independent
     simulations (it takes ``scheduler``) runs them, and where their results are kept
     (``sim/flow/tasks.py: run_tasks``; ``serial`` and no store unless the caller says:
@@ -205,8 +213,10 @@ def run_report(system: str, *, out_dir: Path = Path("docs/reproduction"), engine
     out_dir.mkdir(parents=True, exist_ok=True)
     fn = _load(system)
     takes = inspect.signature(fn).parameters
-    if fast and "fast" in takes:
+    if (fast or rows_only) and "fast" in takes:
         known["fast"] = True
+    if rows_only and "rows_only" in takes:
+        known["rows_only"] = True
     if "scheduler" in takes:
         known.update(scheduler=scheduler, store=store, fresh=fresh)
     # ``known``: results the caller already measured in this run (e.g. the demo's snu-100px

