@@ -42,6 +42,7 @@ from rasterhw.golden_model.reference import rasterise
 from rasterhw.golden_model.scenes import SCENES, build_scene
 from rasterhw.sim import registry
 from rasterhw.sim.paths import REPO_ROOT
+from rasterhw.sim.report.plots import saved_figure
 from rasterhw.sim.report.rows import parse_table
 from tqdm import tqdm
 
@@ -330,24 +331,17 @@ def _cross_chart(rows: list[dict], path: Path, scene: str) -> str | None:
     got = [r for r in rows if r.get("frame_ms")]
     if not got:
         return None
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(7, 0.6 + 0.45 * len(got)))
     labels = [f"{r['machine']} ({r['block'] or '—'})" for r in got]
-    ax.barh(labels, [r["frame_ms"] for r in got], color=["#4a7" if str(r["source"]).startswith("hdl:") else "#b84"
-                                                          for r in got])
-    for k, r in enumerate(got):
-        ax.annotate(f" {r['frame_ms']:.3g} ms, {r['source']}", (r["frame_ms"], k), va="center", fontsize=8)
-    ax.set_xscale("log")
-    ax.set_xlabel(f"frame time of {scene} at the paper's clock (ms, log scale)")
-    ax.invert_yaxis()
-    ax.set_xlim(right=max(r["frame_ms"] for r in got) * 40)
-    fig.tight_layout()
-    fig.savefig(path, metadata={"Date": None, "Creator": None})
-    plt.close(fig)
+    colours = ["#4a7" if str(r["source"]).startswith("hdl:") else "#b84" for r in got]
+    with saved_figure(path, figsize=(7, 0.6 + 0.45 * len(got)), dpi=None,
+                      metadata={"Date": None, "Creator": None}) as ax:
+        ax.barh(labels, [r["frame_ms"] for r in got], color=colours)
+        for k, r in enumerate(got):
+            ax.annotate(f" {r['frame_ms']:.3g} ms, {r['source']}", (r["frame_ms"], k), va="center", fontsize=8)
+        ax.set_xscale("log")
+        ax.set_xlabel(f"frame time of {scene} at the paper's clock (ms, log scale)")
+        ax.invert_yaxis()
+        ax.set_xlim(right=max(r["frame_ms"] for r in got) * 40)
     return path.name
 
 

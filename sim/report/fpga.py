@@ -24,6 +24,7 @@ from rasterhw.sim.flow.fpga import (
     write_run_record,
 )
 from rasterhw.sim.registry import FpgaSweep
+from rasterhw.sim.report.plots import saved_figure
 from rasterhw.sim.report.rows import FAST_SKIP, make_row
 
 __all__ = ["ICE40_CONFIGS", "REPORT_TIMEOUT_S", "rows", "sweep_plot"]
@@ -150,35 +151,28 @@ def _reason(r) -> str | None:
 def sweep_plot(sw: FpgaSweep, points: list[tuple[object, dict]], path, missing: dict | None = None) -> None:
     """Fmax of every clock of ``sw.block`` against ``sw.param``, with the clocks the paper names;
     ``missing``: value -> why it has no point (written at the bottom of the plot)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     clocks = registry.flow(sw.block).clocks
-    fig, ax = plt.subplots(figsize=(6, 3.6))
-    for c, mark in zip(clocks, ("o-", "s--", "^-.", "v:"), strict=False):
-        got = [(v, r["fmax_mhz"][c.domain]) for v, r in points if r.get("fmax_mhz", {}).get(c.domain) is not None]
-        if got:
-            ax.plot([v for v, _ in got], [f for _, f in got], mark, label=f"{c.name} (nextpnr)")
-    for c in clocks:
-        if c.hz is not None:
-            ax.axhline(c.hz / 1e6, color="grey", lw=1, ls=":", label=f"paper: {c.name} {c.hz / 1e6:g} MHz")
-    if all(isinstance(v, int) and v > 0 and v & (v - 1) == 0 for v in sw.values):
-        ax.set_xscale("log", base=2)
-        ax.set_xlim(min(sw.values) * 0.8, max(sw.values) * 1.25)
-    ax.set_xticks(list(sw.values), [str(v) for v in sw.values])
-    ax.set_xlabel(sw.xlabel)
-    ax.set_ylabel("Fmax (MHz)")
-    ax.set_ylim(bottom=0)
-    for v, why in (missing or {}).items():
-        ax.annotate(why, (v, 0), xytext=(0, 4), textcoords="offset points", rotation=90, fontsize=7,
-                    ha="center", va="bottom", color="firebrick")
-    ax.set_title(sw.title, fontsize=9)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110, metadata={"Software": None})
-    plt.close(fig)
+    with saved_figure(path, figsize=(6, 3.6), metadata={"Software": None}) as ax:
+        for c, mark in zip(clocks, ("o-", "s--", "^-.", "v:"), strict=False):
+            got = [(v, r["fmax_mhz"][c.domain]) for v, r in points
+                   if r.get("fmax_mhz", {}).get(c.domain) is not None]
+            if got:
+                ax.plot([v for v, _ in got], [f for _, f in got], mark, label=f"{c.name} (nextpnr)")
+        for c in clocks:
+            if c.hz is not None:
+                ax.axhline(c.hz / 1e6, color="grey", lw=1, ls=":", label=f"paper: {c.name} {c.hz / 1e6:g} MHz")
+        if all(isinstance(v, int) and v > 0 and v & (v - 1) == 0 for v in sw.values):
+            ax.set_xscale("log", base=2)
+            ax.set_xlim(min(sw.values) * 0.8, max(sw.values) * 1.25)
+        ax.set_xticks(list(sw.values), [str(v) for v in sw.values])
+        ax.set_xlabel(sw.xlabel)
+        ax.set_ylabel("Fmax (MHz)")
+        ax.set_ylim(bottom=0)
+        for v, why in (missing or {}).items():
+            ax.annotate(why, (v, 0), xytext=(0, 4), textcoords="offset points", rotation=90, fontsize=7,
+                        ha="center", va="bottom", color="firebrick")
+        ax.set_title(sw.title, fontsize=9)
+        ax.legend(fontsize=8)
 
 
 def _sweep_label(sw: FpgaSweep) -> str:

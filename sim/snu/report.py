@@ -29,7 +29,6 @@ from rasterhw.sim.report.rows import make_row
 
 # every paper value with its quote and place in the seed: golden_model/snu/paper.py
 FORMULA_BUS_RATE = 5 / 400e-9  # 400 ns memory cycle / 5 banks = 80 ns per pixel = 12.5 Mpixel/s
-CLOCK = 12.5e6  # bus clock, one 80 ns slot
 PATTERN_PIXELS = 2000  # writes per access pattern; enough for a steady state
 PATTERN_SIZE = (40, 25)  # a small frame whose width is a multiple of 5, as the paper's 1280
 

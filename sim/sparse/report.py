@@ -16,10 +16,24 @@ import math
 from pathlib import Path
 
 import numpy as np
+from rasterhw.golden_model.pipeline import run_geometry
+from rasterhw.golden_model.reference import random_triangles
+from rasterhw.golden_model.scenes import build_scene
+from rasterhw.golden_model.sparse import cycles as cy
 from rasterhw.golden_model.sparse import montecarlo as mc
 from rasterhw.golden_model.sparse import theory as th
+from rasterhw.golden_model.sparse.fixed import broadcast_records
 from rasterhw.golden_model.sparse.paper import PAPER_LOAD_MAX, PAPER_S_K, PAPER_TESTS_PER_PRIMITIVE
-from rasterhw.golden_model.sparse.vpcycles import HDL_FIFO_DEPTH, SHALLOW_FIFO_DEPTH
+from rasterhw.golden_model.sparse.search import sparse_render
+from rasterhw.golden_model.sparse.stack import stack_processor
+from rasterhw.golden_model.sparse.vpcycles import (
+    HDL_FIFO_DEPTH,
+    SHALLOW_FIFO_DEPTH,
+    coupled_matrix_vp,
+    vp_standalone,
+    vp_streams,
+)
+from rasterhw.sim.report.plots import saved_figure
 from rasterhw.sim.report.rows import make_row
 
 SYSTEM = "sparse"
@@ -135,18 +149,13 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     real_tab = ["| scene | matrix | level i | formula (1), mean over triangles | MC measured (95 %) | "
                 "golden search on the frame, per triangle and processor | gap MC |", "|---|---|---|---|---|---|---|"]
     for name in scenes:
-        from rasterhw.golden_model.pipeline import run_geometry
-        from rasterhw.golden_model.scenes import build_scene
-        from rasterhw.golden_model.sparse.search import sparse_render
 
         tris = run_geometry(build_scene(name), 512, 512)
         xy = np.asarray(tris.xy)
         n, p = 7, 4  # 512 = 4 * 2**7
         poly, off = mc.triangles_from_scene(xy, M, seed=SEED)
         r = mc.level_counts(poly, off, n, p, test="exact")
-        e1, e2 = poly[:, 1] - poly[:, 0], poly[:, 2] - poly[:, 0]
-        S_t = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
-        U_t = np.linalg.norm(poly - np.roll(poly, -1, 1), axis=2).sum(1)
+        S_t, U_t = _area_perimeter(poly)
         L_t = U_t / (2 * np.sqrt(math.pi * S_t))
         fm = np.zeros(n + 1)
         for s, ell in zip(S_t, L_t, strict=True):
@@ -157,15 +166,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
         T = fr.triangles
         gs = fr.windows / (T * p * p)
         gs_ap = fr.windows_aperture_n / (T * p * p)
-        xs = xy  # formula on the frame's own triangles
-        e1, e2 = xs[:, 1] - xs[:, 0], xs[:, 2] - xs[:, 0]
-        Sf = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
-        good = Sf > 1e-6
-        Uf = np.linalg.norm(xs - np.roll(xs, -1, 1), axis=2).sum(1)
-        ff = np.zeros(n + 1)
-        for s, u in zip(Sf[good], Uf[good], strict=True):
-            ff += th.windows(float(s), n, p, L=float(u / (2 * math.sqrt(math.pi * s))))
-        ff /= good.sum()
+        # the formula on the frame's own triangles, per (non-degenerate) triangle
+        ff = _formula_frame(xy, n, p) / np.count_nonzero(_area_perimeter(xy)[0] > 1e-6)
         for i in range(1, n + 1):
             g = gs_ap if i == n else gs[i]
             real_tab.append(f"| {name} | 4x4 | {i} | {fm[i]:.4g} | {_fmt_ci(r, i)} | {g:.4g} (formula {ff[i]:.4g}) | "
@@ -309,11 +311,16 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path = Path(
     return out, sec
 
 
-def _formula_frame(xy: np.ndarray, n: int, p: int) -> np.ndarray:
-    """Formula (1) summed over a frame's triangles (each with its own S and L): (n + 1,)."""
+def _area_perimeter(xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Area S and perimeter U of each triangle of ``xy`` (T, 3, 2)."""
     e1, e2 = xy[:, 1] - xy[:, 0], xy[:, 2] - xy[:, 0]
     S = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
-    U = np.linalg.norm(xy - np.roll(xy, -1, 1), axis=2).sum(1)
+    return S, np.linalg.norm(xy - np.roll(xy, -1, 1), axis=2).sum(1)
+
+
+def _formula_frame(xy: np.ndarray, n: int, p: int) -> np.ndarray:
+    """Formula (1) summed over a frame's triangles (each with its own S and L): (n + 1,)."""
+    S, U = _area_perimeter(xy)
     good = S > 1e-6
     tot = np.zeros(n + 1)
     for s, u in zip(S[good], U[good], strict=True):
@@ -323,9 +330,6 @@ def _formula_frame(xy: np.ndarray, n: int, p: int) -> np.ndarray:
 
 def _hdl_rows(row, engine: str, progress: bool, hdl_scene=None) -> list[str]:
     """Busy cycles per stage of the HDL video processors (τ = one cycle per coverage test)."""
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.reference import random_triangles
-    from rasterhw.golden_model.scenes import build_scene
     from rasterhw.sim.sparse.scene import simulate_tris
 
     if engine == "verilator":
@@ -363,8 +367,6 @@ def _hdl_rows(row, engine: str, progress: bool, hdl_scene=None) -> list[str]:
         measured=round(Rh, 4), unit="", source=src)
     row("(9) / HDL", f"{label}, 4x4: frame cycles (slowest processor) / busiest stage's tests", paper=None,
         formula=1.0, measured=round(r["cycles"] / r["max_stage_tests_per_processor"], 4), unit="ratio", source=src)
-    from rasterhw.golden_model.sparse.search import sparse_render
-    from rasterhw.golden_model.sparse.vpcycles import vp_standalone, vp_streams
 
     gf = sparse_render(tris, (p, p), depth="fixed", trace=True)
     model_cycles = max(vp_standalone(*vp_streams(gf, k), gf.triangles)["cycles"] for k in range(p * p))
@@ -382,75 +384,57 @@ def _hdl_rows(row, engine: str, progress: bool, hdl_scene=None) -> list[str]:
 
 
 def _plots(out_dir: Path, spr, mono, Sg, S_GRID):  # noqa: N803
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    files = []
     Sm = np.array(S_GRID)
     # fig. 3: w_i(S) per k
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8))
-    for ax, k in zip(axes.ravel(), KS, strict=True):
-        n, p = M_BITS - k, 1 << k
-        w = th.windows(Sg, n, p)
-        for i in range(1, n + 1):
-            (ln,) = ax.loglog(Sg, w[i], lw=1, label=f"i={i}")
-            mm = np.array([spr[k][S].mean[i] for S in S_GRID])
-            ax.plot(Sm, mm, "o", ms=3, color=ln.get_color())
-        ax.axvline(th.s_k(k) if k > 1 else 0.1, color="k", ls=":", lw=0.8)
-        ax.set_title(f"fig. 3: w_i(S), {p}x{p} (lines formula (1), dots Monte-Carlo)")
-        ax.set_xlabel("S, px")
-        ax.legend(fontsize=6, ncol=2)
-    fig.tight_layout()
-    fig.savefig(out_dir / "sparse_fig3.png", dpi=90)
-    plt.close(fig)
-    files.append(("fig. 3", "sparse_fig3.png"))
+    with saved_figure(out_dir / "sparse_fig3.png", figsize=(11, 8), dpi=90, nrows=2, ncols=2) as axes:
+        for ax, k in zip(axes.ravel(), KS, strict=True):
+            n, p = M_BITS - k, 1 << k
+            w = th.windows(Sg, n, p)
+            for i in range(1, n + 1):
+                (ln,) = ax.loglog(Sg, w[i], lw=1, label=f"i={i}")
+                mm = np.array([spr[k][S].mean[i] for S in S_GRID])
+                ax.plot(Sm, mm, "o", ms=3, color=ln.get_color())
+            ax.axvline(th.s_k(k) if k > 1 else 0.1, color="k", ls=":", lw=0.8)
+            ax.set_title(f"fig. 3: w_i(S), {p}x{p} (lines formula (1), dots Monte-Carlo)")
+            ax.set_xlabel("S, px")
+            ax.legend(fontsize=6, ncol=2)
     # fig. 4: alpha_i
-    fig, ax = plt.subplots(figsize=(6, 4))
-    for k in KS:
-        n = M_BITS - k
-        i = np.arange(1, n + 1)
-        ax.plot(i, th.alpha_i(i, n, 1 << k), "o-", label=f"{1 << k}x{1 << k}")
-    ax.set_xlabel("level i")
-    ax.set_ylabel("alpha_i")
-    ax.set_title("fig. 4: relative window size (2), alpha = 2")
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(out_dir / "sparse_fig4.png", dpi=90)
-    plt.close(fig)
-    files.append(("fig. 4", "sparse_fig4.png"))
+    with saved_figure(out_dir / "sparse_fig4.png", figsize=(6, 4), dpi=90) as ax:
+        for k in KS:
+            n = M_BITS - k
+            i = np.arange(1, n + 1)
+            ax.plot(i, th.alpha_i(i, n, 1 << k), "o-", label=f"{1 << k}x{1 << k}")
+        ax.set_xlabel("level i")
+        ax.set_ylabel("alpha_i")
+        ax.set_title("fig. 4: relative window size (2), alpha = 2")
+        ax.legend()
     # figs. 5, 6
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8))
-    for k in KS:
-        n, p = M_BITS - k, 1 << k
-        w = th.windows(Sg, n, p)
-        c = f"C{k - 1}"
-        wm = [spr[k][S].mean for S in S_GRID]
-        wmo = [mono[S].mean for S in S_GRID]
-        axes[0, 0].loglog(Sg, th.perf_stack(w), c, label=f"{p}x{p}")
-        axes[0, 0].plot(Sm, [float(th.perf_stack(x)) for x in wm], "o", ms=3, color=c)
-        axes[0, 1].semilogx(Sg, th.q_algorithm(Sg, M_BITS, k), c, label=f"{p}x{p}")
-        axes[0, 1].plot(Sm, [float(th.total_time(b) / (p * p * th.total_time(a))) for a, b in zip(wm, wmo, strict=True)],
-                        "o", ms=3, color=c)
-        axes[1, 0].loglog(Sg, th.perf_pipeline(w), c, label=f"{p}x{p}")
-        axes[1, 0].plot(Sm, [float(th.perf_pipeline(x)) for x in wm], "o", ms=3, color=c)
-        axes[1, 1].semilogx(Sg, th.load_pipeline(w), c, label=f"R_p {p}x{p}")
-        axes[1, 1].semilogx(Sg, th.efficiency_pipeline(Sg, M_BITS, k), c, ls="--")
-        axes[1, 1].plot(Sm, [float(th.load_pipeline(x)) for x in wm], "o", ms=3, color=c)
-    for ax, t in zip(axes.ravel(), ("fig. 5a: p_s = P_s / P_max", "fig. 5b: Q_a", "fig. 6a: p_p = P_p / P_max",
-                                    "fig. 6b: R_p (solid), Q_p (dashed)"), strict=True):
-        ax.set_title(t, fontsize=9)
-        ax.set_xlabel("S, px")
-        ax.legend(fontsize=7)
-    fig.suptitle("lines: formulas (1)-(12); dots: the same formulas on Monte-Carlo window counts")
-    fig.tight_layout()
-    fig.savefig(out_dir / "sparse_fig5_6.png", dpi=90)
-    plt.close(fig)
-    files.append(("figs. 5-6", "sparse_fig5_6.png"))
-    return files
+    with saved_figure(out_dir / "sparse_fig5_6.png", figsize=(11, 8), dpi=90, nrows=2, ncols=2) as axes:
+        for k in KS:
+            n, p = M_BITS - k, 1 << k
+            w = th.windows(Sg, n, p)
+            c = f"C{k - 1}"
+            wm = [spr[k][S].mean for S in S_GRID]
+            wmo = [mono[S].mean for S in S_GRID]
+            axes[0, 0].loglog(Sg, th.perf_stack(w), c, label=f"{p}x{p}")
+            axes[0, 0].plot(Sm, [float(th.perf_stack(x)) for x in wm], "o", ms=3, color=c)
+            axes[0, 1].semilogx(Sg, th.q_algorithm(Sg, M_BITS, k), c, label=f"{p}x{p}")
+            axes[0, 1].plot(Sm, [float(th.total_time(b) / (p * p * th.total_time(a)))
+                                 for a, b in zip(wm, wmo, strict=True)], "o", ms=3, color=c)
+            axes[1, 0].loglog(Sg, th.perf_pipeline(w), c, label=f"{p}x{p}")
+            axes[1, 0].plot(Sm, [float(th.perf_pipeline(x)) for x in wm], "o", ms=3, color=c)
+            axes[1, 1].semilogx(Sg, th.load_pipeline(w), c, label=f"R_p {p}x{p}")
+            axes[1, 1].semilogx(Sg, th.efficiency_pipeline(Sg, M_BITS, k), c, ls="--")
+            axes[1, 1].plot(Sm, [float(th.load_pipeline(x)) for x in wm], "o", ms=3, color=c)
+        for ax, t in zip(axes.ravel(), ("fig. 5a: p_s = P_s / P_max", "fig. 5b: Q_a", "fig. 6a: p_p = P_p / P_max",
+                                        "fig. 6b: R_p (solid), Q_p (dashed)"), strict=True):
+            ax.set_title(t, fontsize=9)
+            ax.set_xlabel("S, px")
+            ax.legend(fontsize=7)
+        axes[0, 0].figure.suptitle("lines: formulas (1)-(12); dots: the same formulas on Monte-Carlo window counts")
+    return [("fig. 3", "sparse_fig3.png"), ("fig. 4", "sparse_fig4.png"), ("figs. 5-6", "sparse_fig5_6.png")]
 
 
 # ---------------------------------------------------------------- the coupled matrix (golden cycle model)
@@ -466,9 +450,6 @@ def _coupled_rows(row, out_dir: Path, *, size: int, matrices: tuple[str, ...], l
     """Frame cycles against FIFO depth, R_p and Q_p from busy cycles, the stack processor and the
     k_p/k_e cost: :mod:`rasterhw.golden_model.sparse.cycles` on the golden search's per-record
     window counts of ``scene`` at ``size`` x ``size`` (the paper's 1024 x 1024 in the report)."""
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.sparse import cycles as cy
     from rasterhw.sim.flow.tasks import call, run_tasks
 
     W = size
@@ -627,9 +608,6 @@ def _vp_depths(matrix: str) -> tuple[int, ...]:
 
 def mono_tests(scene: str, size: int) -> dict:
     """Coverage tests of the monoprocessor (1x1 on the full raster) on ``scene`` at ``size``^2 (a task)."""
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.sparse.search import sparse_render
 
     tris = run_geometry(build_scene(scene), size, size)
     return {"tests": int(sparse_render(tris, "1x1", depth="fixed").tests.sum())}
@@ -639,10 +617,6 @@ def coupled_point(scene: str, size: int, matrix: str) -> dict:
     """One matrix of the coupled FIFO sweep (a task): the golden cycle model of pipeline video
     processors at every FIFO depth, the busy cycles per stage, the stack-based processors' frame,
     and on 4x4 the frames with surface parameters priced as (5)."""
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.sparse import cycles as cy
-    from rasterhw.golden_model.sparse.search import sparse_render
 
     tris = run_geometry(build_scene(scene), size, size)
     f = sparse_render(tris, matrix, depth="fixed", per_record=True)
@@ -671,10 +645,6 @@ def coupled_vp_point(scene: str, size: int, matrix: str) -> dict:
     """One matrix of the coupled sweep whose processors are the HDL video processor's cycle model
     (a task): frame cycles, stalls, largest FIFO peak and least busy processor per FIFO depth, for
     both processors of :data:`_VP_CONFIGS` (eight-entry inner FIFOs, ``"eight"``; two-entry, ``"two"``)."""
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.sparse.search import sparse_render
-    from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
 
     tris = run_geometry(build_scene(scene), size, size)
     f = sparse_render(tris, matrix, depth="fixed", trace=True)
@@ -717,21 +687,16 @@ def _coupled_vp_rows(row, lab: str, matrices: tuple[str, ...], points: list[dict
 def _gp_rate_rows(row, scene: str, size: int) -> list[str]:
     """Frame cycles against FIFO depth with the GP issuing at the matrix's mean rate (4x4), for the
     pipeline-as-server model and for the HDL video processors' cycle model."""
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.sparse.cycles import matrix_cycles
-    from rasterhw.golden_model.sparse.search import sparse_render
-    from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
 
     tris = run_geometry(build_scene(scene), size, size)
     f = sparse_render(tris, "4x4", depth="fixed", trace=True, per_record=True)
-    alone = matrix_cycles(f, f.triangles)["slowest_alone"]
+    alone = cy.matrix_cycles(f, f.triangles)["slowest_alone"]
     g = -(-alone // f.triangles)
     lab = f"{scene} {size}x{size}, 4x4, GP issue interval {g} (= ceil({alone} / {f.triangles}), ours)"
     tab = [f"{lab}; the GP alone needs {g * f.triangles} cycles.\n", "| FIFO depth D | frame, pipeline as server | "
            "stall cycles | frame, HDL video processors | stall cycles |", "|---|---|---|---|---|"]
     for D in (1, 4, 16, 64):
-        sv = matrix_cycles(f, D, issue_interval=g)
+        sv = cy.matrix_cycles(f, D, issue_interval=g)
         hv = coupled_matrix_vp(f, D, issue_interval=g)
         tab.append(f"| {D} | {sv['frame_cycles']} | {sv['stall_cycles']} | {hv['frame_cycles']} | "
                    f"{hv['stall_cycles']} |")
@@ -745,17 +710,12 @@ def _stack_rows(row, scene: str, size: int) -> str:
     """Every processor of a 4x4 matrix as a stack processor (depth first) on ``scene`` at ``size``:
     image against the breadth-first golden search, its stack depth, its cycles against the stack
     cycle model."""
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.sparse.cycles import service_times
-    from rasterhw.golden_model.sparse.search import sparse_render
-    from rasterhw.golden_model.sparse.stack import stack_processor
 
     tris = run_geometry(build_scene(scene), size, size)
     p = 4
     f = sparse_render(tris, (p, p), depth="fixed", per_record=True)
     gz = f.depth_words(tris.z_bits)
-    s = service_times(f.stats["windows_per_record"], vp="stack")
+    s = cy.service_times(f.stats["windows_per_record"], vp="stack")
     diff, same_cycles, deepest, n = 0, True, 0, f.n
     for b in range(p):
         for a in range(p):
@@ -787,11 +747,6 @@ def _stack_vs_pipeline_rows(row, *, scenes: tuple[str, ...], sizes: tuple[int, .
     HDL ``StackProcessor`` is cycle-exact with it). Pipeline: the golden cycle model of the HDL video
     processor as built (``vpcycles.coupled_matrix_vp``, cycle-exact with ``hdl/sparse/vp.py``) and the
     pipeline as a server of (9)."""
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.sparse import cycles as cy
-    from rasterhw.golden_model.sparse.search import sparse_render
-    from rasterhw.golden_model.sparse.vpcycles import coupled_matrix_vp
 
     D = STACK_CMP_DEPTH
     fig = "(8) / (9) stack vs pipeline"
@@ -840,9 +795,6 @@ def _stack_hdl_rows(row, engine: str, *, scenes: tuple[str, ...]) -> list[str]:
     testbench: processor (3, 3) of a 4x4 matrix on each scene at 512² (Verilator), or a small random
     frame (pysim): pixels and counters (busy cycles, records, stack depth, writes, tests per level)
     against the golden stack processor."""
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.reference import random_triangles
-    from rasterhw.golden_model.scenes import build_scene
     from rasterhw.sim.engines import run
     from rasterhw.sim.sparse.testbench import StackVPBench
 
@@ -874,15 +826,15 @@ def _stack_hdl_rows(row, engine: str, *, scenes: tuple[str, ...]) -> list[str]:
             tab.append(f"| {lab} | {proc} | {conf} | {pix} | {cnt} of {len(names)} | {hb} | {gb} | "
                        f"{g[words + names.index('max_stack')]} |")
             what = "triangle and depth" + (" and colour" if kw else "")
-            row("(8) / stack HDL", f"{lab}, processor {proc}, {conf}: local-memory words ({what}) of the HDL stack "
-                f"processor differing from the golden stack processor (of {words})", paper=None, formula=None,
-                measured=pix, unit="pixels", source=src)
-            row("(8) / stack HDL", f"{lab}, processor {proc}, {conf}: counters of the HDL stack processor differing "
-                f"from the golden model (busy cycles, records, stack depth, writes, tests per level: {len(names)})",
-                paper=None, formula=None, measured=cnt, unit="counters", source=src)
-            row("(8) / stack HDL", f"{lab}, processor {proc}, {conf}: busy cycles of the HDL stack processor (golden: "
-                "3 + tests + parameter cycles per record)", paper=None, formula=None, measured=hb, unit="cycles",
-                source=src)
+            for qty, v, unit in ((f"local-memory words ({what}) of the HDL stack processor differing from the "
+                                  f"golden stack processor (of {words})", pix, "pixels"),
+                                 ("counters of the HDL stack processor differing from the golden model (busy "
+                                  f"cycles, records, stack depth, writes, tests per level: {len(names)})", cnt,
+                                  "counters"),
+                                 ("busy cycles of the HDL stack processor (golden: 3 + tests + parameter cycles per "
+                                  "record)", hb, "cycles")):
+                row("(8) / stack HDL", f"{lab}, processor {proc}, {conf}: {qty}", paper=None, formula=None,
+                    measured=v, unit=unit, source=src)
     return ["## The stack-based processor in HDL\n",
             "`hdl/sparse/stack_vp.py` (`StackProcessor`, block `sparse-stack-vp`) on the engines' testbench "
             "(`sim/sparse/testbench.py` `StackVPBench`): the broadcast records back to back, then its local memory and "
@@ -893,13 +845,6 @@ def _stack_matrix_hdl_rows(row, engine: str) -> list[str]:
     """The coupled matrix of HDL stack processors (``hdl/sparse/matrix.py``, ``vp="stack"``, one
     simulation) at input FIFO depths 64 and 1: frame cycles, broadcast stalls and FIFO peaks against
     the golden coupled model on the stack service times (plus the last pixels' drain)."""
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.reference import random_triangles
-    from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.sparse.cycles import coupled_matrix, service_times
-    from rasterhw.golden_model.sparse.fixed import broadcast_records
-    from rasterhw.golden_model.sparse.search import sparse_render
-    from rasterhw.golden_model.sparse.stack import stack_processor
     from rasterhw.sim.sparse.scene import run_matrix
 
     if engine == "verilator":
@@ -915,14 +860,14 @@ def _stack_matrix_hdl_rows(row, engine: str) -> list[str]:
     src = f"hdl:{engine}"
     f = sparse_render(tris, (p, p), depth="fixed", per_record=True)
     gz = f.depth_words(tris.z_bits)
-    s = service_times(f.stats["windows_per_record"], vp="stack")
+    s = cy.service_times(f.stats["windows_per_record"], vp="stack")
     tail = np.stack([stack_processor(tris, (p, p), k % p, k // p)["tail"] for k in range(p * p)])
     tab = ["| input FIFO depth | frame cycles, HDL | golden | stall cycles, HDL | golden | FIFO peak, HDL = golden | "
            "pixels differing | busy and tests equal |", "|---|---|---|---|---|---|---|---|"]
     frames = {}
     for D in depths:
         h = run(broadcast_records(tris), n=f.n, p=p, q=p, limit=D, z_bits=tris.z_bits, vp="stack")
-        g = coupled_matrix(s, D)
+        g = cy.coupled_matrix(s, D)
         gf = int((g.pop + s + tail).max())
         pix = int(np.count_nonzero((h["tri"] != f.tri_id) | (h["zq"] != gz)))
         peak_ok = h["stats"]["fifo_peak"].tolist() == g.fifo_peak.tolist()
@@ -930,17 +875,13 @@ def _stack_matrix_hdl_rows(row, engine: str) -> list[str]:
         same = h["stats"]["busy_cycles"].tolist() == g.busy.tolist() and np.array_equal(tests, f.tests_per_proc[:, 1:])
         tab.append(f"| {D} | {h['cycles']} | {gf} | {h['stall_cycles']} | {g.stall_cycles} | "
                    f"{int(h['stats']['fifo_peak'].max())} ({'=' if peak_ok else '≠'}) | {pix} | {'yes' if same else 'NO'} |")
-        row("(8) / stack HDL matrix", f"{lab}: coupled matrix of HDL stack processors, input FIFO depth {D}: frame "
-            "cycles (golden: coupled model on the stack service times plus the last pixels' drain)", paper=None,
-            formula=None, measured=h["cycles"], unit="cycles", source=src)
-        row("(8) / stack HDL matrix", f"{lab}: coupled matrix of HDL stack processors, input FIFO depth {D}: frame "
-            "cycles HDL minus golden", paper=None, formula=None, measured=h["cycles"] - gf, unit="cycles", source=src)
-        row("(8) / stack HDL matrix", f"{lab}: coupled matrix of HDL stack processors, input FIFO depth {D}: broadcast "
-            "stall cycles HDL minus golden", paper=None, formula=None, measured=h["stall_cycles"] - g.stall_cycles,
-            unit="cycles", source=src)
-        row("(8) / stack HDL matrix", f"{lab}: coupled matrix of HDL stack processors, input FIFO depth {D}: pixels "
-            f"differing from the golden search (of {f.tri_id.size})", paper=None, formula=None, measured=pix,
-            unit="pixels", source=src)
+        for qty, v, unit in (("frame cycles (golden: coupled model on the stack service times plus the last "
+                              "pixels' drain)", h["cycles"], "cycles"),
+                             ("frame cycles HDL minus golden", h["cycles"] - gf, "cycles"),
+                             ("broadcast stall cycles HDL minus golden", h["stall_cycles"] - g.stall_cycles, "cycles"),
+                             (f"pixels differing from the golden search (of {f.tri_id.size})", pix, "pixels")):
+            row("(8) / stack HDL matrix", f"{lab}: coupled matrix of HDL stack processors, input FIFO depth {D}: "
+                f"{qty}", paper=None, formula=None, measured=v, unit=unit, source=src)
         frames[D] = h["cycles"]
     # Q_a (7) from HDL frame time: the monoprocessor with a stack on the full raster against p q
     # processors with stacks, Q_a = T_so / (pq T_s), T_s the HDL frame at the deepest input FIFO
@@ -964,8 +905,6 @@ def _mono_stack_cycles(tris) -> float:
     """T_so: cycles of the monoprocessor with a stack on the full raster (1x1), the golden stack cycle
     model (``cycles.service_times(vp="stack")``: set-up + every coverage test, per record; the HDL
     stack processor is cycle-exact with it), summed over the frame's records."""
-    from rasterhw.golden_model.sparse import cycles as cy
-    from rasterhw.golden_model.sparse.search import sparse_render
 
     f = sparse_render(tris, "1x1", depth="fixed", per_record=True)
     return float(cy.service_times(f.stats["windows_per_record"], vp="stack").sum())
@@ -983,9 +922,6 @@ def _paper_load_rows(row, engine: str, progress: bool) -> list[str]:
     input FIFO depth 64) of random triangles of mean area S_k: load = sum of the stages' busy cycles
     (HDL tests per level + header cycles counted from the golden search) / (n P frame cycles); time per
     primitive = HDL frame cycles (before read-out) / primitives, in coverage-test times (tau = 1 cycle)."""
-    from rasterhw.golden_model.reference import random_triangles
-    from rasterhw.golden_model.sparse import cycles as cy
-    from rasterhw.golden_model.sparse.search import sparse_render
     from rasterhw.sim.sparse.scene import simulate_coupled
 
     if engine not in LOAD_RUNS:
@@ -1042,10 +978,6 @@ def _large_matrix_hdl_rows(engine: str, *, fast: bool, progress: bool) -> tuple[
     frame / busiest stage ((9)) and R_p from HDL frame time beside (10). Unmeasured (with the
     reason) in a ``fast`` run or on pysim; the formula column is filled either way. No rows on an engine
     that is no HDL simulator (as the other HDL rows)."""
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.sparse import cycles as cy
-    from rasterhw.golden_model.sparse.search import sparse_render
 
     if engine not in ("pysim", "verilator"):
         return [], []
@@ -1063,7 +995,7 @@ def _large_matrix_hdl_rows(engine: str, *, fast: bool, progress: bool) -> tuple[
         Rp_f = float(tf.sum() / (n * tf.max()))
         r = None
         if why is None:
-            from rasterhw.sim.sparse.sim import simulate_coupled
+            from rasterhw.sim.sparse.scene import simulate_coupled
 
             r = simulate_coupled(tris, m, engine="verilator", fifo_depth=D, progress=progress)
             gfr = sparse_render(tris, (p, p), depth="fixed", per_record=True)
@@ -1112,9 +1044,6 @@ def _large_matrix_hdl_rows(engine: str, *, fast: bool, progress: bool) -> tuple[
 def _load_rows(row, W: int, ntri: int) -> list[str]:
     """R_p of frames of equal-area random triangles near S_k and at 1000 px (the paper's claim of a
     load maximum "практически до 100 %" in the neighbourhood of S = S_k)."""
-    from rasterhw.golden_model.reference import random_triangles
-    from rasterhw.golden_model.sparse import cycles as cy
-    from rasterhw.golden_model.sparse.search import sparse_render
 
     tab = ["| matrix | mean area S | R_p measured (model: (5), (10) on golden counts) | R_p formula (10) | "
            "R_p golden, our pipeline (headers, k_p = 0) |", "|---|---|---|---|---|"]
@@ -1134,8 +1063,7 @@ def _load_rows(row, W: int, ntri: int) -> list[str]:
             Rg = float(Bg.sum() / (n * Bg.max()))
             tf = th.stage_times(_formula_frame(xy, n, p), kp_ke=1.0)
             Rf = float(tf.sum() / (n * tf.max()))
-            e1, e2 = xy[:, 1] - xy[:, 0], xy[:, 2] - xy[:, 0]
-            Sm = float(np.mean(0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])))
+            Sm = float(np.mean(_area_perimeter(xy)[0]))
             near = S < 999
             row("fig. 6b text", f"R_p of a frame of {ntri} random triangles of mean area {Sm:.3g} px "
                 f"({'S_k' if near else 'S = 1000'}), {p}x{p}, {W}x{W} (paper: load maximum "
@@ -1146,24 +1074,16 @@ def _load_rows(row, W: int, ntri: int) -> list[str]:
 
 
 def _fifo_plot(out_dir: Path, curves: dict, lab: str) -> str:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    fig, ax = plt.subplots(figsize=(6, 4))
-    for m, c in curves.items():
-        ax.semilogx(FIFO_DEPTHS, c, "o-", base=2, label=m)
-    ax.axhline(1.0, color="k", lw=0.8, ls=":")
-    ax.set_xlabel("FIFO depth D (records)")
-    ax.set_ylabel("frame cycles / unbounded FIFO")
-    ax.set_title(f"coupled matrix, {lab} (golden cycle model)", fontsize=9)
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(out_dir / "sparse_fifo.png", dpi=90)
-    plt.close(fig)
+    with saved_figure(out_dir / "sparse_fifo.png", figsize=(6, 4), dpi=90) as ax:
+        for m, c in curves.items():
+            ax.semilogx(FIFO_DEPTHS, c, "o-", base=2, label=m)
+        ax.axhline(1.0, color="k", lw=0.8, ls=":")
+        ax.set_xlabel("FIFO depth D (records)")
+        ax.set_ylabel("frame cycles / unbounded FIFO")
+        ax.set_title(f"coupled matrix, {lab} (golden cycle model)", fontsize=9)
+        ax.legend()
     return "sparse_fifo.png"
 
 
@@ -1171,11 +1091,6 @@ def _coupled_hdl_rows(row, engine: str, progress: bool) -> list[str]:
     """The whole matrix in HDL (``hdl/sparse/matrix.py``, one simulation) at a few FIFO depths: frame
     cycles, stalls and FIFO peaks beside the golden coupled cycle model (``coupled_matrix_vp``), and
     R_p, Q_a, Q_p from the HDL's busy-cycle counters beside formulas (10), (7), (12)."""
-    from rasterhw.golden_model.pipeline import run_geometry
-    from rasterhw.golden_model.reference import random_triangles
-    from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.golden_model.sparse import cycles as cy
-    from rasterhw.golden_model.sparse.search import sparse_render
     from rasterhw.sim.sparse.scene import simulate_coupled
 
     if engine == "verilator":
@@ -1207,22 +1122,21 @@ def _coupled_hdl_rows(row, engine: str, progress: bool) -> list[str]:
             tab.append(f"| {who} | {D} | {fr} | {r['frame_cycles_golden']} | {r['stall_cycles']} | "
                        f"{r['stall_cycles_golden']} | {r['fifo_peak_max']} | {r['fifo_peak_max_golden']} | "
                        f"{r['cycle_mismatches']} of {r['cycles_compared']} | {util.min():.3f} … {util.max():.3f} |")
-            q = f"{lab}, {m}, {who}"
-            row(fig, f"{q}: frame cycles of the whole matrix in one simulation, FIFO depth {D}", paper=None,
-                formula=None, measured=fr, unit="cycles", source=src)
-            row(fig, f"{q}: frame cycles, HDL minus the golden coupled cycle model (coupled_matrix_vp: "
-                f"{r['frame_cycles_golden']}), FIFO depth {D}", paper=None, formula=0,
-                measured=fr - r["frame_cycles_golden"], unit="cycles", source=src)
-            row(fig, f"{q}: broadcast stall cycles, FIFO depth {D} (golden cycle model: "
-                f"{r['stall_cycles_golden']})", paper=None, formula=None, measured=r["stall_cycles"], unit="cycles",
-                source=src)
-            row(fig, f"{q}: largest FIFO peak, FIFO depth {D} (golden cycle model: {r['fifo_peak_max_golden']})",
-                paper=None, formula=None, measured=r["fifo_peak_max"], unit="entries", source=src)
-            row(fig, f"{q}: counters differing from the golden coupled cycle model (frame, stalls, every FIFO "
-                f"peak, busy and per-level tests; of {r['cycles_compared']}), FIFO depth {D}", paper=None, formula=0,
-                measured=r["cycle_mismatches"], unit="counters", source=src)
-            row(fig, f"{q}: pixels differing from the bit-accurate golden model (of {r['pixels_compared']}), "
-                f"FIFO depth {D}", paper=None, formula=0, measured=r["mismatches"], unit="pixels", source=src)
+            g = r["frame_cycles_golden"]
+            for qty, formula, v, unit in (
+                    (f"frame cycles of the whole matrix in one simulation, FIFO depth {D}", None, fr, "cycles"),
+                    (f"frame cycles, HDL minus the golden coupled cycle model (coupled_matrix_vp: {g}), FIFO depth "
+                     f"{D}", 0, fr - g, "cycles"),
+                    (f"broadcast stall cycles, FIFO depth {D} (golden cycle model: {r['stall_cycles_golden']})",
+                     None, r["stall_cycles"], "cycles"),
+                    (f"largest FIFO peak, FIFO depth {D} (golden cycle model: {r['fifo_peak_max_golden']})", None,
+                     r["fifo_peak_max"], "entries"),
+                    ("counters differing from the golden coupled cycle model (frame, stalls, every FIFO peak, busy "
+                     f"and per-level tests; of {r['cycles_compared']}), FIFO depth {D}", 0, r["cycle_mismatches"],
+                     "counters"),
+                    (f"pixels differing from the bit-accurate golden model (of {r['pixels_compared']}), FIFO depth "
+                     f"{D}", 0, r["mismatches"], "pixels")):
+                row(fig, f"{lab}, {m}, {who}: {qty}", paper=None, formula=formula, measured=v, unit=unit, source=src)
         row(fig, f"{lab}, {m}, {who}: frame with FIFO depth {dd[0]} / with depth {dd[-1]} (whole matrix in HDL)",
             paper=None, formula=None, measured=round(runs[dd[0]]["frame_cycles"] / runs[dd[-1]]["frame_cycles"], 5),
             unit="ratio", source=src)

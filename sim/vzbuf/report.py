@@ -36,6 +36,7 @@ from rasterhw.golden_model.vzbuf.shadows import ray_shadow
 from rasterhw.golden_model.vzbuf.stats import table1
 from rasterhw.golden_model.vzbuf.trace import Trace
 from rasterhw.golden_model.vzbuf.workload import table1_light
+from rasterhw.sim.report.plots import saved_figure
 from rasterhw.sim.report.rows import make_row
 from rasterhw.sim.vzbuf.calibrate import (
     FIT_TABLE,
@@ -588,55 +589,39 @@ def _parts(tr: Trace, machine: str = "vp200") -> dict:
 
 
 def _fig3(out_dir, s1, s2):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     parts = ("Z-test", "update 1", "update 2")
     names = ("Z-test", "update 1 (edges)", "update 2 (enter/exit)")
     v1 = [1e3 * s1[p] for p in parts]
     v2 = [1e3 * s2[p] for p in parts]
-    fig, ax = plt.subplots(figsize=(6, 3.2))
-    x = np.arange(3)
-    ax.bar(x - 0.2, v1, 0.4, label="algorithm 1")
-    ax.bar(x + 0.2, v2, 0.4, label="algorithm 2")
-    ax.set_xticks(x, names)
-    ax.set_ylabel("ms (timing model, VP200)")
-    ax.set_title("c300 with shadow polygons: hidden-surface step by part")
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(Path(out_dir) / "vzbuf_fig3.png", dpi=110)
-    plt.close(fig)
+    with saved_figure(Path(out_dir) / "vzbuf_fig3.png", figsize=(6, 3.2)) as ax:
+        x = np.arange(3)
+        ax.bar(x - 0.2, v1, 0.4, label="algorithm 1")
+        ax.bar(x + 0.2, v2, 0.4, label="algorithm 2")
+        ax.set_xticks(x, names)
+        ax.set_ylabel("ms (timing model, VP200)")
+        ax.set_title("c300 with shadow polygons: hidden-surface step by part")
+        ax.legend()
 
 
 def _plot_tables(out_dir, times, scenes):
-    import matplotlib
+    with saved_figure(Path(out_dir) / "vzbuf_tables.png", figsize=(12, 6.5), dpi=100, nrows=2, ncols=3) as axes:
+        for ax, table in zip(axes.ravel(), TABLES, strict=True):
+            T = TABLES[table]
+            x = np.arange(len(scenes))
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+            def get(m, T=T):
+                return [T[m]["total"][n] if m in T and T[m]["total"][n] is not None else np.nan for n in scenes]
 
-    fig, axes = plt.subplots(2, 3, figsize=(12, 6.5), sharey=False)
-    for ax, table in zip(axes.ravel(), TABLES, strict=True):
-        T = TABLES[table]
-        x = np.arange(len(scenes))
+            def mod(m, table=table):
+                return [times[(table, n)][0][m]["total"] if (table, n) in times else np.nan for n in scenes]
 
-        def get(m, T=T):
-            return [T[m]["total"][n] if m in T and T[m]["total"][n] is not None else np.nan for n in scenes]
-
-        def mod(m, table=table):
-            return [times[(table, n)][0][m]["total"] if (table, n) in times else np.nan for n in scenes]
-
-        for i, m in enumerate(MODELS):
-            ax.semilogy(x, get(COLUMN[m]), "o--", color=f"C{i}", label=f"paper {COLUMN[m]}")
-            ax.semilogy(x, mod(m), "s-", color=f"C{i}", label=f"model {COLUMN[m]}")
-        ax.set_xticks(x, scenes, rotation=60, fontsize=7)
-        ax.set_title(f"{table} ({'alg 1' if RUNS[table][0] == 1 else 'alg 2'}, {RUNS[table][1]})", fontsize=9)
-        ax.set_ylabel("total ms")
-    axes[0, 0].legend(fontsize=6)
-    fig.tight_layout()
-    fig.savefig(Path(out_dir) / "vzbuf_tables.png", dpi=100)
-    plt.close(fig)
+            for i, m in enumerate(MODELS):
+                ax.semilogy(x, get(COLUMN[m]), "o--", color=f"C{i}", label=f"paper {COLUMN[m]}")
+                ax.semilogy(x, mod(m), "s-", color=f"C{i}", label=f"model {COLUMN[m]}")
+            ax.set_xticks(x, scenes, rotation=60, fontsize=7)
+            ax.set_title(f"{table} ({'alg 1' if RUNS[table][0] == 1 else 'alg 2'}, {RUNS[table][1]})", fontsize=9)
+            ax.set_ylabel("total ms")
+        axes[0, 0].legend(fontsize=6)
 
 
 def _sections(t1, times, scenes) -> list[str]:
