@@ -4,7 +4,7 @@ A job is one PXP line ``(y, lo, hi)``: its words (the line PXP: the range's segm
 the DMM/P words the SLP writes), then the ``last`` token carrying the next job's range above the
 payload (``{next_hi[10:0], next_lo[9:0], payload}``, the bench adapter
 ``sim/experts/testbench.py: RangeFromTokens`` puts it on ``lo``/``hi``). Used by the testbenches
-(``sim/experts/testbench.py``) and the scene runs (``sim/experts/pxp_sim.py``).
+(``sim/experts/testbench.py``) and the scene runs (``sim/experts/scene.py``).
 """
 
 from __future__ import annotations
