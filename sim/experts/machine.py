@@ -66,7 +66,8 @@ MACHINE = Machine(
                                    "accumulators); paper also reports the golden bit model's error against float",
                                    "ours", ("ours", "paper")),
                             Option("accuracy", "also the golden bit model's error against the float model (renders "
-                                   "the float model; always on with --datapath paper)", False, type=bool))),),
+                                   "the float model; always on with --datapath paper)", False, type=bool)),
+                   no_image={"path": "group"}),),   # the group's bands: pixels compared, no frame written
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",
     soak={"pxp": "rasterhw.sim.experts.soak:pxp_round"},
