@@ -77,3 +77,15 @@ def test_registered_and_bad_arguments():
         simulate_frame(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=0)
     with pytest.raises(RasterhwError, match="aj must be"):
         simulate_frame(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", aj="b")
+
+
+def test_the_float_model_only_when_its_error_is_asked_for():
+    """``sim experts`` renders the float model for the error keys only with ``accuracy`` (or
+    ``--datapath paper``); the HDL's and the contract's widths are there either way."""
+    from rasterhw.sim.experts.scene import _accuracy
+    tris = run_geometry(build_scene("experts-tilt-1000"), 48, 16, z_bits=16)
+    without, with_ = _accuracy(tris, "ours", "c", False), _accuracy(tris, "ours", "c", True)
+    errors = {"max_abs_error", "pixels_differing_from_float", "psnr_db", "visible_differing_from_float",
+              "pixels_differing_from_ours", "accuracy_source"}
+    assert errors.isdisjoint(without) and errors <= set(with_) and set(without) <= set(with_)
+    assert with_["pixels_differing_from_ours"] == 0 and without["datapath_bits"] == with_["datapath_bits"]
