@@ -102,3 +102,29 @@ def unprinted_module_values(module, prefix: str, words: dict, skip: tuple[str, .
         if name not in module.QUOTES:
             bad.append((name, None))
     return bad
+
+
+#: the seed of each machine's ``golden_model/NAME/paper.py``
+SEED_OF = {"experts": "000", "vzbuf": "001", "sparse": "002", "zbm": "003", "snu": "004"}
+
+
+def _squash(s: str) -> str:
+    """``s`` without white space and the quote marks 《》 the quotes keep or drop."""
+    return "".join(s.split()).replace("《", "").replace("》", "")
+
+
+def unquoted(module, prefix: str) -> list[tuple[str, str]]:
+    """(name, piece) of every quote of a ``paper.py`` module's ``QUOTES`` that does not stand in seed
+    ``prefix``: each piece between the ellipses (``...``, and `` / `` between table rows) must occur
+    in the seed, spaces aside; (name, "") for a quote with no location or words, or whose name the
+    module does not export."""
+    text = _squash(seed_text(prefix))
+    bad = []
+    for name, (loc, quote) in module.QUOTES.items():
+        if not (loc and quote and name in module.__all__):
+            bad.append((name, ""))
+            continue
+        for piece in quote.replace(" / ", "...").split("..."):
+            if _squash(piece) and _squash(piece) not in text:
+                bad.append((name, piece))
+    return bad

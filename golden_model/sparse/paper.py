@@ -36,18 +36,21 @@ PAPER_LOAD_MAX = 1.0
 #: performance at large S grows "practically in proportion to the number of video processors 4^k"
 PAPER_GROWTH_BASE = 4
 
+#: the quotes are the seed's text as it stands, its OCR errors kept (Л = k, Si = S_1, 5з = S_3, 54 = S_4,
+#: /и = m, а X /3 = 2̂ = alpha x beta = 2^2, Ртях = 0,2<7\ = P_max = 0.2/tau, 4*" = 4^k); our reading is
+#: the comment above each constant
 QUOTES: dict[str, tuple[str, str]] = {
-    "PAPER_S_K": ("text after formula (4)", "Решив квадратное уравнение (4) для k = 1, 2, 3, 4, а = 2 и L = 1,514, "
-                  "получим S1 = 0; S2 = 1,8; S3 = 23,3; S4 = 157."),
-    "PAPER_M": ("text before fig. 3", "Разрешение полного растра фиксировано и составляет ... = 4^m, где m = 10."),
-    "PAPER_ALPHA": ("text before fig. 3", "Квадратная апертура фильтра a x b = 2^2"),
+    "PAPER_S_K": ("text after formula (4)", "Решив квадратное уравнение (4) для Л = 1, 2, 3, 4, а = 2 и L = 1,514, "
+                  "получим Si = 0; S2 = 1,8; 5з = 23,3; 54 = 157."),
+    "PAPER_M": ("text before fig. 3", "Разрешение полного растра фиксировано и составляет ... где /и = 10."),
+    "PAPER_ALPHA": ("text before fig. 3", "Квадратная апертура фильтра а X /3 = 2\u0302"),
     "PAPER_L": ("text before fig. 3", "коэффициент формы многоугольника L= 1,514"),
-    "PAPER_KP_KE": ("text of fig. 5", "m = 10, а = 2, L = 1,514 и кр/ке = 1"),
-    "PAPER_PMAX_TAU": ("text of fig. 5", "Ртах = 0,2/т"),
+    "PAPER_KP_KE": ("text of fig. 5", "m = 10, а = 2, L= 1,514 и кр/ке = 1"),
+    "PAPER_PMAX_TAU": ("text of fig. 5", "Ртях = 0,2<7\\"),
     "PAPER_TESTS_PER_PRIMITIVE": ("conclusion", "При этом максимальная производительность соответствует в "
                                   "среднем времени пяти тестов покрытия"),
-    "PAPER_LOAD_MAX": ("fig. 6b text", "характерно наличие максимумов загрузки (практически до 100 %) в "
+    "PAPER_LOAD_MAX": ("fig. 6b text", "характерно наличие максиму- ... MOB загрузки (практически до 100 %) в "
                        "окрестности S = Sk"),
-    "PAPER_GROWTH_BASE": ("fig. 6a text", "производительность растет практически пропорционально количеству "
-                          "видеопроцессоров 4^k"),
+    "PAPER_GROWTH_BASE": ("fig. 6a text", "производитель- ность растет практически пропорцио- нально количеству "
+                          "видеопроцессоров 4*\"."),
 }

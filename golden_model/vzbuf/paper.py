@@ -13,6 +13,10 @@ from __future__ import annotations
 import csv
 from importlib import resources
 
+__all__ = ["COLS", "COLUMN", "CORRECTED", "QUOTES", "RATES", "RUNS", "SLIST_SPEEDUP_AT_MOST", "SP8_EMPTY_LINE_FRACTION",
+           "T1", "T2", "T2_RATE", "T3", "T3_RATE", "T4", "T4_RATE", "T5", "T5_RATE", "T6", "T7", "TABLES", "VP200_T5_C300_FRAGMENTS_PER_S",
+           "VP200_T5_C300_MS", "VTIME"]
+
 #: the paper's name of each modelled machine (its tables' row labels)
 COLUMN = {"scalar": "scalar", "vp100": "VP100", "vp200": "VP200"}
 COLS = ("c300", "c250", "c200", "c150", "c100", "c50", "sp27", "sp5", "sp8")
@@ -70,3 +74,21 @@ SP8_EMPTY_LINE_FRACTION = 0.30
 #: 4.1 2)(ii): "slistの更新処理はベクトル化されるが…処理速度の向上は高々4倍にとどまる" (the s-list update
 #: vectorises, but its speed-up stays at most 4 times)
 SLIST_SPEEDUP_AT_MOST = 4.0
+
+#: name -> (location, the seed's words): each table by its title, each figure of the text by its sentence
+QUOTES: dict[str, tuple[str, str]] = {
+    "T1": ("3.2, table 1", "表1. 使用データの属性"),
+    "T2": ("3.3, table 2", "表2. アルゴリズム1 (付影処理なし)"),
+    "T3": ("3.3, table 3", "表3. アルゴリズム2 (付影処理なし)"),
+    "T4": ("3.3, table 4", "表4. アルゴリズム1 (影多角形法)"),
+    "T5": ("3.3, table 5", "表5. アルゴリズム2 (影多角形法)"),
+    "T6": ("3.3, table 6", "表6. アルゴリズム1 (レイキャスティング法)"),
+    "T7": ("3.3, table 7", "表7. アルゴリズム2 (レイキャスティング法)"),
+    "VP200_T5_C300_MS": ("3.3, table 5, VP200, first column (c300: see CORRECTED)",
+                         "VP200 c250 c200 ... 合計 2059 1774 1433"),
+    "VP200_T5_C300_FRAGMENTS_PER_S": ("3.3, table 5, VP200, first column", "処理面素数(実・影)/秒 843730 831707"),
+    "SP8_EMPTY_LINE_FRACTION": ("3.2, note on table 1", "sp8は表示図形のスクリーンに占める割合が小さく、"
+                                "全スクリーンラインの約30%ではデータがない"),
+    "SLIST_SPEEDUP_AT_MOST": ("4.1 2)(ii)", "slistの更新処理はベクトル化されるが演算器を余り用いないため処理速度の向上は"
+                              "高々4倍にとどまる"),
+}

@@ -51,14 +51,17 @@ QUOTES: dict[str, tuple[str, str]] = {
     "PAPER_CLOCK_HZ": ("6.1 condition 3", "ZB/M の入力クロックは 25MHz"),
     "PAPER_EDGE_PAIRS_PER_POLYGON": ("6.1 condition 1", "前処理で各ポリゴンは 2 エッジペアに展開される"),
     "PAPER_SKEW_WAIT": ("6.1 condition 7", "隣の ZB/M とのタイミングずれにより半分の時間は待ち状態と考える"),
-    "PAPER_CYCLES": ("6.1", "9 + 9 x 5 = 54 Cycles ... 9 + 10 x 5 = 59 ... 9 + 11 x 5 = 64 ... 9+13x5 = 74 "
-                     "(8 インタリーブ以上では ... 54)"),
+    "PAPER_CYCLES": ("6.1", r"1 エッジペアの処理サイクル数は $9 + 9 \times 5 = 54$ Cycles となる ... "
+                     r"$9 + 10 \times 5 = 59$ サイクル ... $9 + 11 \times 5 = 64$ サイクル ... "
+                     r"$9+13\times 5 = 74$ サイクル ... 8 インタリープ以上では"),
     "PAPER_LEN_CHIP": ("6.1", "1 個の ZB/M 当たりの平均セグメント長が 1 / は 2 / は 3 / は 5 となり"),
-    "PAPER_KPOLYS": ("table 1", "処理能力 84.5 97.7 105.9 115.8 115.8 (K Polygons/sec)"),
+    "PAPER_KPOLYS": ("table 1", r"処理能力 84.5 97.7 105.9 115.8 115.8 / 単位: $K \text{Polygons/sec}$"),
     "PAPER_UNITS": ("abstract, 7", "このユニットを 64 ユニット程度並列動作させることにより"),
-    "PAPER_UNITS_RATE": ("abstract, 7", "テクスチャ付ポリゴン処理能力 7.4M Polygons/sec"),
-    "PAPER_TABLE2": ("table 2", "4 プロセッサ 0.107sec 0.090sec 16.0K / 8 0.054 0.050 14.4K / 12 0.037 0.033 "
-                     "14.5K / 16 0.029 0.025 14.4K"),
+    "PAPER_UNITS_RATE": ("abstract, 7", r"テクスチャ付ポリゴン処理能力 $7.4M \text{Polygons/sec}$"),
+    "PAPER_TABLE2": ("table 2", r"4 プロセッサ 0.107sec 0.090sec $16.0K \text{Polys/sec}$ / "
+                     r"8 プロセッサ 0.054sec 0.050sec $14.4K \text{Polys/sec}$ / "
+                     r"12 プロセッサ 0.037sec 0.033sec $14.5K \text{Polys/sec}$ / "
+                     r"16 プロセッサ 0.029sec 0.025sec $14.4K \text{Polys/sec}$"),
     "PAPER_TEST_POLYGONS": ("6.2", "テストデータとしては 5,760 Polygon のデータを 4,8,12,16 分割して用い"),
     "PAPER_I860_CLOCK_HZ": ("6.2", "i860 プロセッサを用いた市販のボード (i860XR 33.3MHz) を利用し"),
     "PAPER_C_OVER_ASM": ("6.2", "アセンブラー化した場合のポリゴンの生成速度は約 1.25 倍程度高速化されており"),

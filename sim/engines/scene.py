@@ -4,8 +4,9 @@ A block that ``rasterhw sim`` runs declares its scene level once, beside its tes
 :class:`SceneRun` (in its machine's ``sim/NAME/scene.py``): :meth:`SceneRun.check` (option checks
 beyond the registry's types and choices), :meth:`SceneRun.golden` (the golden result, computed
 once, from which every expected word derives), :meth:`SceneRun.jobs` (the engine runs: testbench,
-block parameters, stimulus and expected words, each a :class:`Job`) and :meth:`SceneRun.result`
-(the frame from the words, the machine's own figures). :meth:`SceneRun.simulate` runs it for every
+block parameters, stimulus and expected words, each a :class:`Job`; a block whose later runs take an
+earlier run's words, as EXPERTS' SLP then PXP, gives them from :meth:`SceneRun.more`) and
+:meth:`SceneRun.result` (the frame from the words, the machine's own figures). :meth:`SceneRun.simulate` runs it for every
 machine the same way: engine names from the registry, one progress bar, ``engines.run``,
 ``testbench.compare``, the clock from the block's flow, the registry's sim keys
 (``registry.SIM_KEYS``; ``rasterhw sim --json`` puts them in one key set: ``sim/cli/jsonout.py``).
@@ -32,7 +33,8 @@ __all__ = ["Done", "Job", "SceneRun", "run_job"]
 class Job:
     """One engine run of a scene: the testbench with its block parameters, the stimulus, the
     expected words, ``engines.run``'s other keywords (``build``, ``max_cycles``, ``stall``, ``idle``,
-    ``seed``, ``clocks``) and whether the golden cycle count must be met exactly."""
+    ``seed``, ``clocks``), whether the golden cycle count must be met exactly and ``collect``: other
+    output ports to collect, not compared (port -> words; e.g. a line log the block checks itself)."""
 
     tb: Testbench
     params: dict
@@ -41,6 +43,7 @@ class Job:
     run: dict = field(default_factory=dict)
     cycle_exact: bool = True
     name: str = ""                        # for the progress line (e.g. "processor (1, 0)")
+    collect: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -74,6 +77,10 @@ class SceneRun:
 
     def jobs(self, gold, *, engine: str, **options) -> list[Job]:   # pragma: no cover - abstract
         raise NotImplementedError
+
+    def more(self, gold, done: list[Done], *, engine: str, **options) -> list[Job]:
+        """Jobs that take the words of those ``done`` so far (run after them); default none."""
+        return []
 
     def result(self, gold, done: list[Done], *, engine: str, **options) -> dict:
         """The machine's own keys: at least ``pixels_compared``; ``cycles``, ``mismatches`` and
@@ -119,7 +126,10 @@ class SceneRun:
                 bar.note(f"{job.name}: {done.got.cycles} cycles, {done.cmp['mismatches']} mismatches")
             return done
 
-        done = self._run_all(one, jobs, engine, self.workers if workers is None else workers)
+        workers = self.workers if workers is None else workers
+        done = self._run_all(one, jobs, engine, workers)
+        while nxt := self.more(gold, done, engine=engine, **options):
+            done += self._run_all(one, nxt, engine, workers)
         t2 = time.perf_counter()
         if bar is not None:
             bar.next()
@@ -160,7 +170,7 @@ def run_job(job: Job, engine: str) -> Done:
     """``job`` on ``engine`` (``engines.run``, collecting every expected word), compared word for word
     (``testbench.compare``)."""
     got = run_engine(job.tb, job.params, job.stim, engine=engine,
-                     expect_words={k: len(v) for k, v in job.expect.words.items()}, **job.run)
+                     expect_words={**{k: len(v) for k, v in job.expect.words.items()}, **job.collect}, **job.run)
     return Done(job, got, compare(job.expect, got, cycle_exact=job.cycle_exact))
 
 

@@ -23,7 +23,7 @@ def bench(*, repeat: int = 3, hdl: bool = False, progress: bool = False) -> list
         out.append({"name": f"experts golden {model} model, experts-tilt-1000 frame (A.J. c)", "value": round(best, 4),
                     "unit": "s", "note": f"best of {max(repeat, 1)}; whole 512x512 frame, every SLP/PXP stage"})
     if hdl:
-        from rasterhw.sim.experts.pxp_sim import simulate_scene
+        from rasterhw.sim.experts.scene import simulate_scene
         r = simulate_scene(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c")
         note = (f"{r['pixels_compared']} pixels, {r['mismatches']} mismatches, {r['cycle_mismatches']} cycle "
                 f"mismatches; {r['pxp_cycles_per_line_mean']} PXP cycles per scan line (8 x 8)")
@@ -33,7 +33,7 @@ def bench(*, repeat: int = 3, hdl: bool = False, progress: bool = False) -> list
                  "note": f"{r['cycles']} cycles in {r['run_s']} s (clock loop only)"},
                 {"name": "PXP cycles per scan line, experts-1000, 8 x 8", "value": r["pxp_cycles_per_line_mean"],
                  "unit": "cycles", "note": f"mean over the 4096 PXP lines ({r['pxp']} PXP)"}]
-        from rasterhw.sim.experts.frame_sim import simulate_frame
+        from rasterhw.sim.experts.scene import simulate_frame
         f = simulate_frame(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c")
         out.append({"name": "experts-1000 whole frame through SLP + span PXP HDL (Verilator), wall",
                     "value": f["wall_s"], "unit": "s",

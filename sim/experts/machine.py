@@ -37,7 +37,7 @@ MACHINE = Machine(
             "experts-dmm": "rasterhw.hdl.experts.dmm:ExpertsDmm",
             "experts-pxp-unit": "rasterhw.hdl.experts.unit:ExpertsPxpUnit"},
     sims=(SimBlock("pxp", "every PXP line of the frame through the PXP HDL, against the bit-accurate golden PXP "
-                   "(pixels and cycles)", "rasterhw.sim.experts.pxp_sim:simulate_scene", default_scene="experts-1000",
+                   "(pixels and cycles)", "rasterhw.sim.experts.scene:simulate_scene", default_scene="experts-1000",
                    options=(Option("sn", "SLPs (bands)", 8, type=int),
                             Option("pn", "PXPs per SLP (ranges)", 8, type=int),
                             Option("aj", "anti-jagging in the PXP: none or c", "c", ("none", "a", "b", "c")),
@@ -51,7 +51,7 @@ MACHINE = Machine(
           SimBlock("experts", "the whole frame: every band through the SLP's set-up HDL (experts-slp-setup) and "
                    "list-work HDL (experts-slp), its ASL order and "
                    "block lists then into every span PXP's DMM/P (experts-pxp-span); words, pixels and cycles "
-                   "against golden, SLP and PXP clocks for 30 frames/s", "rasterhw.sim.experts.frame_sim:simulate_frame",
+                   "against golden, SLP and PXP clocks for 30 frames/s", "rasterhw.sim.experts.scene:simulate_frame",
                    default_scene="experts-1000",
                    options=(Option("sn", "SLPs (bands)", 8, type=int),
                             Option("pn", "PXPs per SLP (ranges)", 8, type=int),
@@ -63,8 +63,11 @@ MACHINE = Machine(
                             Option("datapath", "ours (today's HDL: 40-bit registers, three multipliers in the span "
                                    "PXP) or paper (the paper's 16-bit words, one multiplier a processor: the golden "
                                    "bit model at those widths; in HDL so far the SLP's 16-bit edge increments and "
-                                   "accumulators); both report the bit model's error against float",
-                                   "ours", ("ours", "paper")))),),
+                                   "accumulators); paper also reports the golden bit model's error against float",
+                                   "ours", ("ours", "paper")),
+                            Option("accuracy", "also the golden bit model's error against the float model (renders "
+                                   "the float model; always on with --datapath paper)", False, type=bool)),
+                   no_image={"path": "group"}),),   # the group's bands: pixels compared, no frame written
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",
     soak={"pxp": "rasterhw.sim.experts.soak:pxp_round"},

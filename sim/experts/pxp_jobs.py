@@ -4,10 +4,12 @@ A job is one PXP line ``(y, lo, hi)``: its words (the line PXP: the range's segm
 the DMM/P words the SLP writes), then the ``last`` token carrying the next job's range above the
 payload (``{next_hi[10:0], next_lo[9:0], payload}``, the bench adapter
 ``sim/experts/testbench.py: RangeFromTokens`` puts it on ``lo``/``hi``). Used by the testbenches
-(``sim/experts/testbench.py``) and the scene runs (``sim/experts/pxp_sim.py``).
+(``sim/experts/testbench.py``) and the scene runs (``sim/experts/scene.py``).
 """
 
 from __future__ import annotations
+
+from operator import itemgetter
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
@@ -32,6 +34,28 @@ def range_word(lo: int, hi: int, seg_bits: int) -> int:
 def _pack(seg: dict, layout) -> int:
     from rasterhw.hdl.pack import pack
     return pack(layout, seg)
+
+
+def pack_rows(layout, rows: list[dict]) -> list[int]:
+    """``[pack(layout, r) for r in rows]`` (``hdl/pack.py``: missing fields 0, each wrapped to its
+    width) for a flat struct layout of fields up to 63 bits, a field at a time in NumPy: the words go
+    into 64-bit limbs, then one ``int.from_bytes`` per row (a frame's ~45,000 ASBs: 5x faster)."""
+    from amaranth import Shape
+    plan = [(n, f.offset, Shape.cast(f.shape).width) for n, f in layout]
+    if not rows or max(w for *_, w in plan) > 63:
+        return [_pack(r, layout) for r in rows]
+    plan = [p for p in plan if p[0] in rows[0]]     # the rest are 0 (the rows of one list share their keys)
+    if not plan:
+        return [0] * len(rows)
+    cols = np.array(list(map(itemgetter(*(n for n, *_ in plan)), rows)), np.int64).reshape(len(rows), len(plan))
+    limbs = np.zeros((len(rows), (layout.size + 63) // 64 + 1), np.uint64)
+    for j, (_, off, width) in enumerate(plan):
+        v = (cols[:, j] & ((1 << width) - 1)).astype(np.uint64)
+        k, sh = divmod(off, 64)
+        limbs[:, k] |= v << np.uint64(sh)
+        if sh + width > 64:
+            limbs[:, k + 1] |= v >> np.uint64(64 - sh)
+    return [int.from_bytes(r.tobytes(), "little") for r in limbs.astype("<u8")]
 
 
 def job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]]) -> dict:
@@ -82,7 +106,13 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
     W = fr.width
     aj = fr.aj
     pix = pixel_words(fr.setup, fr.fields).reshape(fr.height, W)
+    # the DMM/P words of a line's jobs at once: its ASL packed once, the block lists of all its ranges
+    # in one walk (dmm_line per range is the same walk, once per range), bucket and token words by value
+    ranges: dict[int, list[tuple[int, int]]] = {}
+    for y, lo, hi in todo:
+        ranges.setdefault(y, []).append((lo, hi))
     cache: dict[int, tuple] = {}
+    bucket_word: dict[int, int] = {}
     words, exp_pix, lines, steps, visible = [], [], [], [], []
     for k, (y, lo, hi) in enumerate(todo):
         if y not in cache:
@@ -93,22 +123,32 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
                 if sorted(s["addr"] for s in segs) != sorted(rid):
                     raise RasterhwError(f"experts: the SLP's ASL of line {y} is not the line's segments")
                 ids = np.array([rid[s["addr"]] for s in segs], np.int64)
-            cache = {y: (segs, ids, [pack(lay, {"last": 0, "list": 0, "ptr": 0, **s}) for s in segs])}
-        segs, ids, packed = cache[y]
-        if slp is None:
-            _, lead, buckets = dmm_line(fr, y, [lo, hi])
-        else:
+            rs = ranges[y]
+            tiled = slp is None and all(a[1] == b[0] for a, b in zip(rs, rs[1:], strict=False))
+            lists = dict(zip(rs, zip(*dmm_line(fr, y, [rs[0][0], *(h for _, h in rs)])[1:], strict=True),
+                             strict=False)) if tiled else {}
+            cache = {y: (segs, ids, pack_rows(lay, segs), lists)}
+        segs, ids, packed, lists = cache[y]
+        if slp is not None:
             _, ld, bk = slp[(y, lo, hi)]
-            lead, buckets = [NO_PTR if ld < 0 else ld], [bk]
-        job = line_job(segs, buckets[0], lead[0], lo, hi, aj=aj, width=W,
+            lead, bucket = NO_PTR if ld < 0 else ld, bk
+        elif (lo, hi) in lists:
+            lead, bucket = lists[(lo, hi)]
+        else:
+            _, (lead,), (bucket,) = dmm_line(fr, y, [lo, hi])
+        job = line_job(segs, bucket, lead, lo, hi, aj=aj, width=W,
                        resolver=coherent_resolve if pxp == "coherent" else None)
         _, nlo, nhi = todo[k + 1] if k + 1 < len(todo) else todo[k]
         words += packed
-        words += [pack(lay, {"list": 1, "ptr": b}) for b in buckets[0]]
-        words.append((nhi << (SPAN_BITS + 10)) | (nlo << SPAN_BITS) | pack(lay, {"last": 1, "ptr": lead[0]}))
+        for b in bucket:
+            if b not in bucket_word:
+                bucket_word[b] = pack(lay, {"list": 1, "ptr": b})
+            words.append(bucket_word[b])
+        words.append((nhi << (SPAN_BITS + 10)) | (nlo << SPAN_BITS) | pack(lay, {"last": 1, "ptr": lead}))
         lines.append((job["words"], job["resolve"], job["drain"]))
         steps.append(job["steps"])
-        visible.append(np.array([int(ids[v]) if v >= 0 else -1 for v in job["visible"]], np.int64))
+        vis = np.asarray(job["visible"], np.int64)
+        visible.append(np.where(vis >= 0, ids[np.maximum(vis, 0)], -1) if len(ids) else np.full(vis.size, -1, np.int64))
         exp_pix.append(pix[y, lo:hi])
     sch = span_schedule(lines)
     return {"words": words, "pixels": np.concatenate(exp_pix).astype(np.int64) if exp_pix else np.zeros(0, np.int64),

@@ -126,7 +126,7 @@ def hdl_frame_cycles(tris, pxp: str, aj: str, engine: str = "verilator") -> int:
     (1 x 1) on ``engine``: its edges up to the frame's last pixel, the run checked pixel for pixel
     and line for line against the golden model."""
     from rasterhw.golden_model.experts.model import render_frame
-    from rasterhw.sim.experts.pxp_sim import check_jobs, jobs
+    from rasterhw.sim.experts.scene import check_jobs, jobs
     jb = jobs(render_frame(tris, model="bit", aj=aj), 1, 1, pxp=pxp)
     r = check_jobs(jb, width=tris.width, engine=engine)
     if r["pixel_mismatches"] or r["line_mismatches"] or r["sim_cycles"] != jb["last_pixel"] + 1:
@@ -560,7 +560,7 @@ def _hdl_frame(out: list, scene: str, pxp: str, prefix: str, progress: bool) -> 
     """``scene`` (512 x 512, 8 x 8, A.J. (c)) through the ``pxp`` PXP HDL on Verilator: its pixel and
     line-cycle mismatch rows (``prefix`` names the PXP); the run's result."""
     from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.sim.experts.pxp_sim import simulate_scene
+    from rasterhw.sim.experts.scene import simulate_scene
     if progress:
         print(f"experts: {scene} through the {pxp} PXP HDL on Verilator")
     r = simulate_scene(build_scene(scene), 512, 512, engine="verilator", sn=8, pn=8, aj="c", pxp=pxp)
@@ -577,7 +577,7 @@ def _hdl(out: list, engine: str, progress: bool) -> None:
     "verilator"``; the 30 frames/s PXP clock from the cycle model the HDL matched."""
     from rasterhw.golden_model.experts.parallel import run_parallel
     from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.sim.experts.pxp_sim import jobs, simulate_scene
+    from rasterhw.sim.experts.scene import jobs, simulate_scene
     small = simulate_scene(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=2, pn=4, aj="c",
                            pxp="zbuffer")
     out.append(make_row(SYS, "HDL", "PXP pixel mismatches with A.J. (c), experts-tilt-1000 at 64x16, 2x4 (pysim)", paper=None,
@@ -628,8 +628,7 @@ def _hdl_span_slp(out: list, engine: str, progress: bool) -> None:
     from rasterhw.golden_model.experts.model import equal_bounds
     from rasterhw.golden_model.experts.slp_setup import band_setup, pl_words
     from rasterhw.golden_model.scenes import build_scene
-    from rasterhw.sim.experts.frame_sim import simulate_frame
-    from rasterhw.sim.experts.pxp_sim import jobs, simulate_scene
+    from rasterhw.sim.experts.scene import jobs, simulate_frame, simulate_scene
     from rasterhw.sim.experts.testbench import slp_words
     small = simulate_frame(build_scene("experts-tilt-1000"), 48, 16, engine="pysim", sn=2, pn=3, aj="c")
     out.append(make_row(SYS, "HDL", "SLP (experts-slp) + span PXP (experts-pxp-span) word and pixel mismatches, "

@@ -5,9 +5,9 @@ A round (512 x 512, anti-jagging (c)) renders a random EXPERTS / cube scene (see
 Sn x Pn and range method (static, i, ii); every PXP pixel is compared, and every line's cycle
 count: equal to the model's in half the rounds (input back to back, output always ready), no
 faster than the model's in the other half (random idle clocks on the input, random back-pressure
-on the pixel output: the Verilator engine's, ``pxp_sim.run_jobs``). Round 0 instead runs random
+on the pixel output: the Verilator engine's, ``scene.pxp_job``). Round 0 instead runs random
 lines of the (line) PXP under cocotb (the generic cocotb engine on Verilator) with the same kinds of
-timing (stream checkers on both ports; ``pxp_sim.check_jobs``).
+timing (stream checkers on both ports; ``scene.check_jobs``).
 """
 
 from __future__ import annotations
@@ -17,7 +17,8 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.experts.model import render_frame
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
-from rasterhw.sim.experts.pxp_sim import check_jobs, job_list, simulate_scene
+from rasterhw.sim.experts.pxp_jobs import job_list
+from rasterhw.sim.experts.scene import check_jobs, simulate_scene
 
 __all__ = ["pxp_round"]
 

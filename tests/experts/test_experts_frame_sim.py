@@ -10,12 +10,12 @@ from rasterhw.golden_model.experts.model import equal_bounds, render_frame
 from rasterhw.golden_model.experts.span_cycles import dmm_line, line_job
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
-from rasterhw.sim.experts.frame_sim import simulate_frame
+from rasterhw.sim.experts.scene import simulate_frame
 from rasterhw.sim.registry import SIM_KEYS, sim_blocks
 
 
 def test_small_frame_slp_and_pxp_hdl_exact():
-    r = simulate_frame(build_scene("experts-tilt-1000"), 48, 16, engine="pysim", sn=2, pn=3, aj="c")
+    r = simulate_frame(build_scene("experts-tilt-1000"), 48, 16, engine="pysim", sn=2, pn=3, aj="c", accuracy=True)
     assert set(SIM_KEYS) <= set(r)
     assert r["pixels_compared"] == 48 * 16 and r["mismatches"] == 0 and r["slp_words"] > 300
     assert r["slp_cycle_mismatches"] == 0 and r["pxp_cycle_mismatches"] == 0 and r["cycle_mismatches"] == 0
@@ -28,7 +28,9 @@ def test_small_frame_slp_and_pxp_hdl_exact():
     assert r["slp_setup_cycles"] == r["slp_setup_cycles_per_band"][b] > 0
     assert r["slp_cycles"] == r["slp_setup_cycles"] + r["slp_list_cycles"] == max(
         a + c for a, c in zip(r["slp_setup_cycles_per_band"], r["slp_list_cycles_per_band"], strict=True))
-    # today's datapath, and its golden bit model's error against float
+    # the machine's frame: the slower of the busiest SLP and the busiest PXP
+    assert r["cycles"] == max(r["slp_cycles"], r["pxp_cycles"]) < r["sim_cycles"]
+    # today's datapath, and (accuracy=True) its golden bit model's error against float
     assert (r["datapath"], r["datapath_bits"], r["multipliers"], r["accuracy_source"]) == ("ours", 40, 3, "golden")
     assert r["pixels_differing_from_ours"] == 0 and r["max_abs_error"] >= 0
 
@@ -75,3 +77,15 @@ def test_registered_and_bad_arguments():
         simulate_frame(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", sn=0)
     with pytest.raises(RasterhwError, match="aj must be"):
         simulate_frame(build_scene("experts-tilt-1000"), 64, 16, engine="pysim", aj="b")
+
+
+def test_the_float_model_only_when_its_error_is_asked_for():
+    """``sim experts`` renders the float model for the error keys only with ``accuracy`` (or
+    ``--datapath paper``); the HDL's and the contract's widths are there either way."""
+    from rasterhw.sim.experts.scene import _accuracy
+    tris = run_geometry(build_scene("experts-tilt-1000"), 48, 16, z_bits=16)
+    without, with_ = _accuracy(tris, "ours", "c", False), _accuracy(tris, "ours", "c", True)
+    errors = {"max_abs_error", "pixels_differing_from_float", "psnr_db", "visible_differing_from_float",
+              "pixels_differing_from_ours", "accuracy_source"}
+    assert errors.isdisjoint(without) and errors <= set(with_) and set(without) <= set(with_)
+    assert with_["pixels_differing_from_ours"] == 0 and without["datapath_bits"] == with_["datapath_bits"]

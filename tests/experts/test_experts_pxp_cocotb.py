@@ -1,6 +1,6 @@
 """The PXP under cocotb (the generic cocotb engine, ``sim/engines/cocotb.py``, on Verilator; on
 Icarus when installed): the PXP's testbench (``PxpBench``) with idle input clocks, output
-back-pressure and stream checkers on both ports, against the golden PXP (``pxp_sim.check_jobs``:
+back-pressure and stream checkers on both ports, against the golden PXP (``scene.check_jobs``:
 every pixel in order, every line's finish-time counter). These tests checked the PXP's own
 cocotb bench before it was retired for the generic engine; their assertions are the same."""
 
@@ -13,7 +13,8 @@ import pytest
 from rasterhw.golden_model.experts.model import render_frame
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
-from rasterhw.sim.experts.pxp_sim import check_jobs, job_list
+from rasterhw.sim.experts.pxp_jobs import job_list
+from rasterhw.sim.experts.scene import check_jobs
 
 pytestmark = pytest.mark.cocotb
 

@@ -15,7 +15,7 @@ from rasterhw.golden_model.experts.span_cycles import resolve as span_resolve
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.sim import registry
-from rasterhw.sim.experts.pxp_sim import jobs, simulate_scene
+from rasterhw.sim.experts.scene import jobs, simulate_scene
 
 
 def _frame(name, w, h, aj="c", seed=0):

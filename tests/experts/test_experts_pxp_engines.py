@@ -1,7 +1,7 @@
 """The PXP testbenches' line log (``RangeFromTokens.log``: every line's finish-time counter, the
 per-line log the scene runs read) on both engines: the same words and stamps on pysim and
 Verilator, with and without idle gaps and back-pressure, equal to the cycle model when exact; and
-the scene runs' job player (``pxp_sim.run_jobs``) giving the same on both engines."""
+the scene runs' job player (``scene.run_jobs``) giving the same on both engines."""
 
 from __future__ import annotations
 
@@ -11,7 +11,8 @@ from rasterhw.golden_model.experts.model import render_frame
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.sim.engines import run
-from rasterhw.sim.experts.pxp_sim import IN_DEPTH, OUT_DEPTH, job_list, run_jobs, span_job_list
+from rasterhw.sim.experts.pxp_jobs import job_list, span_job_list
+from rasterhw.sim.experts.scene import IN_DEPTH, OUT_DEPTH, run_jobs
 from rasterhw.sim.experts.testbench import PxpBench, PxpCoherentBench, PxpSpanBench
 from rasterhw.sim.testbench import compare
 
@@ -32,7 +33,7 @@ def test_line_log_is_the_same_on_pysim_and_verilator(cls):
     assert tb.outputs_of(p) == ("o", "log") and len(exp.words["log"]) == jb["lines"] >= 2
     for kw in ({}, {"idle": 0.25, "stall": 120, "seed": 9}):
         a = run(tb, p, stim, engine="pysim", expect_words=_need(exp), **kw)
-        # the scene runs' memories (pxp_sim.run_jobs): the build test_run_jobs_same_on_both_engines uses
+        # the scene runs' memories (scene.run_jobs): the build test_run_jobs_same_on_both_engines uses
         b = run(tb, p, stim, engine="verilator", expect_words=_need(exp), build=SCENE_BUILD, **kw)
         assert (a.words, a.stamps) == (b.words, b.stamps), kw
         assert b.protocol_errors == 0

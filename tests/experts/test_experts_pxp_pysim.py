@@ -214,7 +214,8 @@ def test_per_pixel_reference_equals_the_golden_model_on_scene_lines():
 def test_ranges_at_every_alignment(aj):
     """One PXP, many lines, the range moving line to line: every start modulo 8, widths 1..65,
     the frame's edges -- pixels and cycles exact (the range is sampled when each line starts)."""
-    from rasterhw.sim.experts.pxp_sim import job_list, run_jobs
+    from rasterhw.sim.experts.pxp_jobs import job_list
+    from rasterhw.sim.experts.scene import run_jobs
     fr = _frame("experts-tilt-1000", aj)
     todo = [(120 + k, lo, min(lo + w, 512)) for k, (lo, w) in
             enumerate([(a, w) for a in (0, 1, 2, 3, 4, 5, 6, 7, 255, 448, 505, 511) for w in (1, 2, 9, 65)])]

@@ -66,7 +66,7 @@ def test_fast_resolve_edge_cases_equal_the_specification():
 
 
 def test_scene_job_list_is_the_same_on_either_engine(monkeypatch):
-    from rasterhw.sim.experts.pxp_sim import jobs
+    from rasterhw.sim.experts.scene import jobs
     fr = _frame("experts-1000", 96, 48, "c")
     monkeypatch.setenv(fast.ENGINE_ENV, "python")
     want = jobs(fr, 1, 4, pxp="span")
