@@ -428,12 +428,6 @@ _FAST = FastPath("rasterhw.golden_model.reference_fast", env=ENGINE_ENV, spec="n
                  fallback="the reference rasteriser runs its NumPy specification (same pixels, slower)")
 
 
-def _fast_module():
-    """:mod:`reference_fast` (imported on first use), or None where it cannot be loaded; the
-    first failure prints one line on stderr."""
-    return _FAST.module()
-
-
 def choose_engine(engine: str | None = None) -> str:
     """``"numba"`` or ``"numpy"``: the engine that draws for ``engine`` (``None`` = the
     environment variable :data:`ENGINE_ENV`, default ``auto``)."""
@@ -454,7 +448,7 @@ def _fast_draw(xy, z, vcol, pid, bg, W: int, H: int, y0: int, y1: int, *, depth=
     exactly those rows (``None`` = not wanted; without ``depth`` a per-thread Z-buffer is used),
     as :func:`_bands` row bands in threads (the kernel releases the GIL). Returns
     ``(fragments, pixels_written, pixels_covered)``."""
-    fast = _fast_module()
+    fast = _FAST.module()
     n = len(_bands(W, y1 - y0, xy.shape[0]))
     X, Y, cuts = fast.prepare(xy, W, H, y0, y1, n * FAST_BANDS_PER_THREAD if n > 1 else 1)
     z = np.ascontiguousarray(z, dtype=np.float64)

@@ -10,7 +10,7 @@ from pathlib import Path
 from platformdirs import user_cache_dir
 from rasterhw.golden_model.errors import RasterhwError
 
-__all__ = ["BUILD_ROOT", "REPO_ROOT", "build_root", "SimulatorUnavailable", "verilator_bin_dir"]
+__all__ = ["BUILD_ROOT", "REPO_ROOT", "build_root", "SimulatorUnavailable", "umask", "verilator_bin_dir"]
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 
@@ -47,3 +47,10 @@ def verilator_bin_dir() -> Path:
     if not (d / "verilator").exists():
         raise SimulatorUnavailable(f"no verilator binary under {d}")
     return d
+
+
+def umask() -> int:
+    """This process's umask (read by setting it, then put back)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask

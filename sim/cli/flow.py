@@ -22,10 +22,6 @@ def _params(block: str, params: tuple[str, ...]) -> dict:
     return parse_params(params, registry.load(registry.blocks()[block]))
 
 
-def _emit(obj) -> None:
-    emit_json(obj)   # the one JSON style (sim/cli/jsonout.py)
-
-
 @click.command()
 @click.argument("block", required=False)
 @click.option("-p", "--param", "params", multiple=True, metavar="NAME=VALUE",
@@ -54,7 +50,7 @@ def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: b
         rows = synth_all(small=small, memory=memory, progress=not as_json, scheduler=scheduler,
                          store=store or default_store(), fresh=fresh)
         if as_json:
-            _emit([summary_row(r) for r in rows])
+            emit_json([summary_row(r) for r in rows])
             return
         click.echo(f"{'block':<18} {'gate eq.':>10} {'flip-flops':>10} {'RAM bits':>10} {'s':>7}  params")
         for r in rows:
@@ -75,7 +71,7 @@ def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: b
     kw = _params(block, params)
     check_cache()
     if as_json:
-        _emit(summary_row(synthesise(block, memory=memory, **kw)))
+        emit_json(summary_row(synthesise(block, memory=memory, **kw)))
     else:
         click.echo(synth_report(block, memory=memory, **kw))
 
@@ -101,7 +97,7 @@ def fpga(block: str, params: tuple[str, ...], family: str, device: str | None, a
     check_cache()
     r = place_and_route(block, family=family, device=device, **kw)
     if as_json:
-        _emit({k: v for k, v in r.items() if k != "build_dir"})
+        emit_json({k: v for k, v in r.items() if k != "build_dir"})
     else:
         click.echo(fpga_summary(r))
 
@@ -145,7 +141,7 @@ def prove(block: str | None, all_blocks: bool, scheduler: str, depth: int | None
     check_cache()
     r = run(block, depth=depth, fresh=fresh)
     if as_json:
-        _emit(r)
+        emit_json(r)
     else:
         bound = f"k-induction, {r['depth']} steps" if r["mode"] == "prove" else f"all inputs up to {r['depth']} steps"
         when = f"cached, proved in {r['wall_s']:.1f} s" if r["cached"] else f"{r['wall_s']:.1f} s"
@@ -161,7 +157,7 @@ def prove(block: str | None, all_blocks: bool, scheduler: str, depth: int | None
 def _emit_blocks(r: dict, as_json: bool, line, total: str) -> None:
     """An ``--all`` result: its JSON, or a line per block (``line(block)``) and the ``total`` line."""
     if as_json:
-        _emit(r)
+        emit_json(r)
         return
     for b in r["blocks"]:
         click.echo(line(b))
@@ -251,7 +247,7 @@ def mutate(block: str | None, all_blocks: bool, params: tuple[str, ...], mutants
     r = campaign(block, _params(block, params), mutants=mutants, seed=seed, scheduler=scheduler,
                  store=store or default_store(), fresh=fresh, progress=not as_json)
     if as_json:
-        _emit(r)
+        emit_json(r)
     else:
         click.echo(_mutate_line(r))
         click.echo(f"  Yosys {r['yosys_s']:.1f} s, build {r['build_s']:.1f} s, runs {r['runs_s']:.1f} s "

@@ -163,11 +163,6 @@ def stable_text(verilog: str) -> str:
                              for ln in yosys_init_restored(canonical_port_lists(verilog)).splitlines()))
 
 
-def _stable_text_v1(verilog: str) -> str:
-    """:func:`stable_text` before module headers were made canonical (to re-key old caches)."""
-    return "\n".join(sorted(" ".join(sorted(re.split(r"[\s,()]+", ln))) for ln in verilog.splitlines()))
-
-
 def _param_int(v) -> int:
     if isinstance(v, int):
         return v
