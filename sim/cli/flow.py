@@ -22,6 +22,48 @@ def _params(block: str, params: tuple[str, ...]) -> dict:
     return parse_params(params, registry.load(registry.blocks()[block]))
 
 
+def _scheduler_file(ctx, _param, value):
+    if value is not None:
+        ctx.meta["rasterhw.scheduler_file"] = value
+    return value
+
+
+def _scheduler(ctx, _param, value):
+    """--scheduler, or the address in --scheduler-file (read when it is given; never both)."""
+    path = ctx.meta.get("rasterhw.scheduler_file")
+    if path is None:
+        return value
+    if ctx.get_parameter_source("scheduler") is not click.core.ParameterSource.DEFAULT:
+        raise RasterhwError("give --scheduler or --scheduler-file, not both")
+    from rasterhw.sim.flow.tasks import scheduler_from_file
+
+    return scheduler_from_file(path)
+
+
+def _store(_ctx, _param, value):
+    from rasterhw.sim.flow.tasks import default_store
+
+    return default_store() if value is None else value
+
+
+def scheduler_options(default: str = "local", scope: str = ""):
+    """``--scheduler`` (or ``--scheduler-file``), ``--store``, ``--fresh``: where a command's tasks
+    run and where their results are kept (sim/flow/tasks.py, docs/scale.md); ``scope`` ends each
+    help (`` (with --all)``). The command gets ``store`` as a folder, never None."""
+    def deco(f):
+        f = click.option("--fresh", is_flag=True, help=f"Recompute every task, even those in the store{scope}.")(f)
+        f = click.option("--store", type=click.Path(file_okay=False), default=None, callback=_store,
+                         help=f"Folder keeping every finished task's result (default: build/tasks){scope}.")(f)
+        f = click.option("--scheduler-file", type=click.Path(dir_okay=False), default=None, expose_value=False,
+                         is_eager=True, callback=_scheduler_file,
+                         help=f"The Dask scheduler named in this file (dask scheduler --scheduler-file FILE){scope}.")(f)
+        return click.option("--scheduler", default=default, show_default=True, callback=_scheduler,
+                            metavar="serial|local[:N]|tcp://HOST:PORT",
+                            help="Where the tasks run: in this process, a local Dask cluster of N single-threaded "
+                                 f"workers (default: one per core), or an existing Dask scheduler{scope}.")(f)
+    return deco
+
+
 @click.command()
 @click.argument("block", required=False)
 @click.option("-p", "--param", "params", multiple=True, metavar="NAME=VALUE",
@@ -31,16 +73,12 @@ def _params(block: str, params: tuple[str, ...]) -> dict:
 @click.option("--all", "all_blocks", is_flag=True, help="Every registered block, one after the other.")
 @click.option("--small", is_flag=True, help="With --all: the small test sizes (each block's Flow.small in its machine.py).")
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")
-@click.option("--scheduler", default="local", show_default=True, metavar="serial|local[:N]|tcp://HOST:PORT",
-              help="With --all: where the blocks' syntheses run (a task each: docs/scale.md).")
-@click.option("--store", type=click.Path(file_okay=False), default=None,
-              help="With --all: folder keeping every finished task's result (default: build/tasks).")
-@click.option("--fresh", is_flag=True, help="With --all: recompute every task, even those in the store.")
+@scheduler_options(scope=" (with --all)")
 def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: bool, small: bool,
-          as_json: bool, scheduler: str, store: str | None, fresh: bool) -> None:
+          as_json: bool, scheduler: str, store: str, fresh: bool) -> None:
     """Synthesise BLOCK (or --all) with Yosys: gate equivalents, flip-flops, RAM bits."""
     from rasterhw.sim.flow.synth import summary_row, synth_all, synth_report, synthesise
-    from rasterhw.sim.flow.tasks import check_scheduler, default_store
+    from rasterhw.sim.flow.tasks import check_scheduler
 
     if all_blocks:
         check_scheduler(scheduler)
@@ -48,7 +86,7 @@ def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: b
             raise RasterhwError("--all takes no BLOCK or -p")
         check_cache()
         rows = synth_all(small=small, memory=memory, progress=not as_json, scheduler=scheduler,
-                         store=store or default_store(), fresh=fresh)
+                         store=store, fresh=fresh)
         if as_json:
             emit_json([summary_row(r) for r in rows])
             return
@@ -63,6 +101,7 @@ def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: b
     ctx = click.get_current_context()
     given = [f"--{n}" for n in ("scheduler", "store", "fresh")
              if ctx.get_parameter_source(n) is not click.core.ParameterSource.DEFAULT]
+    given += ["--scheduler-file"] * ("rasterhw.scheduler_file" in ctx.meta)
     if given:   # they would be accepted and change nothing
         raise RasterhwError(f"{' and '.join(given)} appl{'ies' if len(given) == 1 else 'y'} only with --all "
                             "(one named block is synthesised here, not as a task)")
@@ -207,25 +246,21 @@ def check_cache() -> None:
 @click.option("--mutants", type=int, default=40, show_default=True, help="Mutations Yosys samples (mutate -list N).")
 @click.option("--seed", type=int, default=1, show_default=True,
               help="Seed of Yosys's sampling and of the testbench's stimulus (same seed: same mutants, same runs).")
-@click.option("--scheduler", default="serial", show_default=True, metavar="serial|local[:N]|tcp://HOST:PORT",
-              help="Where the mutants' runs go (a task each: docs/scale.md).")
-@click.option("--store", type=click.Path(file_okay=False), default=None,
-              help="Folder keeping every finished mutant's result (default: build/tasks); a rerun reuses them.")
-@click.option("--fresh", is_flag=True, help="Run every mutant again, even those in the store.")
+@scheduler_options("serial")
 @click.option("--budget", "budget_s", type=float, default=None, metavar="SECONDS",
               help="--all: wait for no block's build after this many seconds (those blocks are listed as not run; "
                    "the mutants of the blocks built by then all run).")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the campaign as JSON (mutants, baseline_passed, killed, equivalent, survived, score, survivors).")
 def mutate(block: str | None, all_blocks: bool, params: tuple[str, ...], mutants: int, seed: int, scheduler: str,
-           store: str | None, fresh: bool, budget_s: float | None, as_json: bool) -> None:
+           store: str, fresh: bool, budget_s: float | None, as_json: bool) -> None:
     """Mutation coverage of BLOCK: N faults planted by Yosys (mutate) behind one control input,
     one Verilator build, the block's testbench run once per mutant; killed / survived, score.
 
     Exit 1 if mutant 0 (no mutation) fails its testbench (the campaign is void; with --all: any
     block's). docs/mutation.md."""
     from rasterhw.sim.flow.mutate import campaign, campaign_all, mutation_blocks
-    from rasterhw.sim.flow.tasks import check_scheduler, default_store
+    from rasterhw.sim.flow.tasks import check_scheduler
 
     if all_blocks and (block or params):
         raise RasterhwError("--all runs every block at its stated small configuration: no BLOCK, no -p")
@@ -237,7 +272,7 @@ def mutate(block: str | None, all_blocks: bool, params: tuple[str, ...], mutants
     check_cache()
     check_scheduler(scheduler)   # what answers at its address too, before anything runs
     if all_blocks:
-        r = campaign_all(mutants=mutants, seed=seed, scheduler=scheduler, store=store or default_store(),
+        r = campaign_all(mutants=mutants, seed=seed, scheduler=scheduler, store=store,
                          fresh=fresh, progress=not as_json, budget_s=budget_s)
         _emit_blocks(r, as_json, _mutate_line, f"{len(r['blocks'])} blocks in {r['wall_s']:.0f} s "
                                                f"({r['computed']} tasks run, {r['reused']} from the store)")
@@ -245,7 +280,7 @@ def mutate(block: str | None, all_blocks: bool, params: tuple[str, ...], mutants
             sys.exit(1)
         return
     r = campaign(block, _params(block, params), mutants=mutants, seed=seed, scheduler=scheduler,
-                 store=store or default_store(), fresh=fresh, progress=not as_json)
+                 store=store, fresh=fresh, progress=not as_json)
     if as_json:
         emit_json(r)
     else:
