@@ -204,6 +204,15 @@ def _script(top: str, files: list[Path], stubs: Path | None, memory: str, flatte
     return "\n".join(lines) + "\n"
 
 
+def block_verilog(block: str, params: dict) -> tuple[str, str]:
+    """``block``'s Verilog at ``params`` (generated once: the Verilog cache) and the block's
+    ``extra_verilog()``, which that Verilog ends with ("" for none)."""
+    if block not in block_names():
+        raise RasterhwError(f"unknown block {block!r}; known: {', '.join(block_names())}")
+    comp = make_block(block, **params)
+    return generate_cached(block, **params), comp.extra_verilog() if hasattr(comp, "extra_verilog") else ""
+
+
 def _stat_json(path: Path, top: str) -> dict:
     data = json.loads(path.read_text())
     mods = data["modules"]
@@ -266,15 +275,10 @@ def synthesise(
     """
     if memory not in MEMORY_MODES:
         raise RasterhwError(f"memory must be one of {', '.join(MEMORY_MODES)}, not {memory!r}")
-    if block not in block_names():
-        raise RasterhwError(f"unknown block {block!r}; known: {', '.join(block_names())}")
     yosys = yosys_path()
     params = {**registry.flow(block).synth, **params}
-    comp = make_block(block, **params)
+    text, extra = block_verilog(block, params)
     top = top or block.replace("-", "_")
-
-    text = generate_cached(block, **params)
-    extra = comp.extra_verilog() if hasattr(comp, "extra_verilog") else ""
     if extra:
         if not text.endswith("\n" + extra):
             raise RasterhwError(f"block {block!r}: generated Verilog does not end with its extra_verilog()")
