@@ -14,12 +14,21 @@ from rasterhw.sim import registry
 from rasterhw.sim.cli.jsonout import emit_json
 
 
-def _params(block: str, params: tuple[str, ...]) -> dict:
+def block_params(block: str | None, params: tuple[str, ...]) -> dict:
+    """The ``-p NAME=VALUE`` parameters of Verilog block ``block``, typed; an unknown block or a
+    bad value is one line."""
     from rasterhw.sim.engines.verilog import block_names, parse_params
 
     if block not in block_names():
-        raise RasterhwError(f"unknown block {block!r}; blocks: {', '.join(block_names())}")
-    return parse_params(params, registry.load(registry.blocks()[block]))
+        what = f"unknown block {block!r}" if block else "name a block"
+        near = [b for b in block_names() if block and b.endswith(f"-{block}")]
+        if near:  # e.g. `rasterhw verilog pxp`: the sim block's name, not the Verilog block's
+            what += f" (did you mean {' or '.join(near)}?)"
+        raise RasterhwError(f"{what}; blocks: {', '.join(block_names())}")
+    try:
+        return parse_params(params, registry.load(registry.blocks()[block]))
+    except (OverflowError, ValueError) as e:
+        raise RasterhwError(f"{block}: {e}") from None
 
 
 def _scheduler_file(ctx, _param, value):
@@ -107,7 +116,7 @@ def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: b
                             "(one named block is synthesised here, not as a task)")
     if block is None:
         raise RasterhwError("name a block (rasterhw verilog --list) or give --all")
-    kw = _params(block, params)
+    kw = block_params(block, params)
     check_cache()
     if as_json:
         emit_json(summary_row(synthesise(block, memory=memory, **kw)))
@@ -132,7 +141,7 @@ def fpga(block: str, params: tuple[str, ...], family: str, device: str | None, a
 
     if device is not None and device not in DEVICES[family]:   # '' too: never the default in its place
         raise RasterhwError(f"--device for {family} must be one of {', '.join(DEVICES[family])}, not {device!r}")
-    kw = _params(block, params)
+    kw = block_params(block, params)
     check_cache()
     r = place_and_route(block, family=family, device=device, **kw)
     if as_json:
@@ -279,7 +288,7 @@ def mutate(block: str | None, all_blocks: bool, params: tuple[str, ...], mutants
         if not all(b.get("baseline_passed", True) for b in r["blocks"]):
             sys.exit(1)
         return
-    r = campaign(block, _params(block, params), mutants=mutants, seed=seed, scheduler=scheduler,
+    r = campaign(block, block_params(block, params), mutants=mutants, seed=seed, scheduler=scheduler,
                  store=store, fresh=fresh, progress=not as_json)
     if as_json:
         emit_json(r)

@@ -7,6 +7,7 @@ traceback. ``--json`` puts a machine-readable result on stdout; progress goes to
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import time
 from pathlib import Path
@@ -15,7 +16,7 @@ import click
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
 from rasterhw.sim.cli.cache import cache as _cache_group
-from rasterhw.sim.cli.flow import add_commands, check_cache, scheduler_options
+from rasterhw.sim.cli.flow import add_commands, block_params, check_cache, scheduler_options
 from rasterhw.sim.cli.jsonout import emit_json, sim_json
 from rasterhw.sim.report.rows import systems as _report_systems
 
@@ -450,26 +451,17 @@ def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, re
 def verilog(block: str | None, list_blocks: bool, output: str | None, params: tuple[str, ...],
             interleave: int | None) -> None:
     """Generate Verilog for BLOCK (see `rasterhw verilog --list`)."""
-    from rasterhw.sim.engines.verilog import block_names, parse_params
+    from rasterhw.sim.engines.verilog import block_names
     from rasterhw.sim.engines.verilog_cache import write_verilog
     from rasterhw.sim.outfile import check_output
 
     if list_blocks:
         click.echo("\n".join(block_names()))
         return
-    if block not in block_names():
-        what = f"unknown block {block!r}" if block else "name a block"
-        near = [b for b in block_names() if block and b.endswith(f"-{block}")]
-        if near:  # e.g. `rasterhw verilog pxp`: the sim block's name, not the Verilog block's
-            what += f" (did you mean {' or '.join(near)}?)"
-        raise RasterhwError(f"{what}; blocks: {', '.join(block_names())}")
+    kw = block_params(block, params)
     if output is None:
         raise RasterhwError("say where to write the Verilog: -o FILE")
     check_output(output)   # a folder name is refused before the (slow) generation
-    try:
-        kw = parse_params(params, registry.load(registry.blocks()[block]))
-    except (OverflowError, ValueError) as e:
-        raise RasterhwError(f"{block}: {e}") from None
     if interleave is not None:
         if "interleave" in kw and kw["interleave"] != interleave:
             raise RasterhwError(f"--interleave {interleave} contradicts -p interleave={kw['interleave']}")
@@ -496,47 +488,40 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
 _ELAB_BYTES_PER_WORD = 500
 
 
-class _memory_estimate:
+@contextlib.contextmanager
+def _memory_estimate(block: str):
     """``with _memory_estimate(block):`` every Amaranth memory the block makes is sized before its
     contents are allocated (``MemoryData``: shape and depth are known first): one that would need
     more memory than there is (:data:`_ELAB_BYTES_PER_WORD` a word) is one line at once, before
     the elaboration grows to the memory cap (``verilog pixelbus -p width=100000 -p height=100000
     -p ram=memory`` grew to 15.6 GB). Amaranth's ``MemoryData`` is wrapped only inside the block;
     a different Amaranth without it leaves the cap (:func:`_limit_memory`) to say it."""
+    try:
+        from amaranth.hdl import _mem
+    except ImportError:   # pragma: no cover - another Amaranth
+        yield
+        return
+    cls, orig = _mem.MemoryData, _mem.MemoryData.__init__
+    words = [0]   # every memory of the block so far
 
-    def __init__(self, block: str):
-        self.block = block
-        self.orig = None
+    def sized(obj, *args, shape=None, depth=None, **kw):
+        from rasterhw.golden_model.memcheck import HEADROOM, available_bytes, format_bytes
 
-    def __enter__(self):
-        try:
-            from amaranth.hdl import _mem
-        except ImportError:   # pragma: no cover - another Amaranth
-            return self
-        cls, orig, block = _mem.MemoryData, _mem.MemoryData.__init__, self.block
+        if isinstance(depth, int) and depth > 0:
+            words[0] += depth
+            need, avail = words[0] * _ELAB_BYTES_PER_WORD, available_bytes()
+            if need > HEADROOM * avail:
+                raise RasterhwError(f"{block}: its memories hold {words[0]:,} words so far; elaborating them "
+                                    f"needs about {format_bytes(need)}, more memory than there is "
+                                    f"({format_bytes(avail)} available; use smaller -p sizes, or a RAM kind "
+                                    "the block writes as Verilog)")
+        orig(obj, *args, shape=shape, depth=depth, **kw)
 
-        words = [0]   # every memory of the block so far
-
-        def sized(obj, *args, shape=None, depth=None, **kw):
-            from rasterhw.golden_model.memcheck import HEADROOM, available_bytes, format_bytes
-
-            if isinstance(depth, int) and depth > 0:
-                words[0] += depth
-                need, avail = words[0] * _ELAB_BYTES_PER_WORD, available_bytes()
-                if need > HEADROOM * avail:
-                    raise RasterhwError(f"{block}: its memories hold {words[0]:,} words so far; elaborating them "
-                                        f"needs about {format_bytes(need)}, more memory than there is "
-                                        f"({format_bytes(avail)} available; use smaller -p sizes, or a RAM kind "
-                                        "the block writes as Verilog)")
-            orig(obj, *args, shape=shape, depth=depth, **kw)
-
-        self.cls, self.orig = cls, orig
-        cls.__init__ = sized
-        return self
-
-    def __exit__(self, *exc):
-        if self.orig is not None:
-            self.cls.__init__ = self.orig
+    cls.__init__ = sized
+    try:
+        yield
+    finally:
+        cls.__init__ = orig
 
 
 def _limit_memory() -> None:
