@@ -28,12 +28,11 @@ from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
-from rasterhw.sim.engines.runner import REPO_ROOT
 from rasterhw.sim.engines.verilog import block_names
 from rasterhw.sim.engines.verilog_cache import source_digest
 from rasterhw.sim.flow.synth import _split_extra, block_verilog, stable_text
 from rasterhw.sim.flow.tools import tool, tool_version
-from rasterhw.sim.paths import BUILD_ROOT
+from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT
 from rasterhw.sim.registry import FpgaSweep
 
 __all__ = ["DEVICES", "FAMILIES", "fpga_configs", "fpga_sweeps", "paper_clock", "place_and_route", "recorded_config", "recorded_configs",
