@@ -215,7 +215,7 @@ def plain_build_dir(name: str, top: str, sources: Sequence[Path], *, params: Map
 
 def _plain_plan(name, top, sources, *, params, opt, defines, generated, pgo, hierarchical=False):
     """(name, build folder, make variables, Verilator arguments, defines, generated files,
-    profile files) of a plain build: the folder's name digests everything else."""
+    profile files, optimisation level) of a plain build: the folder's name digests everything else."""
     generated = dict(generated or {})
     if hierarchical and pgo is not None:
         raise RasterhwError(f"{name}: a hierarchical build is not a profile-guided one")
@@ -260,7 +260,7 @@ def _plain_plan(name, top, sources, *, params, opt, defines, generated, pgo, hie
     for k in sorted(profile):
         h.update(k.encode() + profile[k])
     bdir = BUILD_ROOT / f"{name}-{h.hexdigest()[:10]}"
-    return name, bdir, make, args, defines, generated, profile
+    return name, bdir, make, args, defines, generated, profile, opt
 
 
 def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, params: Mapping[str, object],
@@ -287,9 +287,7 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
     instances of one large module, slower clock loop (the measured figures: ``docs/sparse.md``).
     Returns ``(binary, build seconds, 0.0 if it was already built)``.
     """
-    if pgo is None:
-        opt = effective_opt(opt)
-    name, bdir, make, args, defines, generated, profile = _plain_plan(
+    name, bdir, make, args, defines, generated, profile, opt = _plain_plan(
         name, top, sources, params=params, opt=opt, defines=defines, generated=generated, pgo=pgo,
         hierarchical=hierarchical)
     exe = bdir / "obj_dir" / f"V{top}"
@@ -306,8 +304,7 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
         work = work_folder(bdir.parent, bdir.name)   # named by host and process: removed if we are killed outright
         try:
             _exe, build_s = _build_plain_in(work, name, top, sources, params=params, opt=opt, defines=defines,
-                                            generated=generated, args=args, make=make, profile=profile,
-                                            rt_make=verilator_make_vars(opt))
+                                            generated=generated, args=args, make=make, profile=profile)
             os.chmod(work, 0o777 & ~paths.umask())
             os.rename(work, bdir)
         except RasterhwError as e:
@@ -340,7 +337,7 @@ def _discard_unfinished(bdir: Path) -> None:
 
 def _build_plain_in(bdir: Path, name: str, top: str, sources: Sequence[Path], *, params: Mapping[str, object],
                     opt: str, defines: Mapping[str, object], generated: Mapping[str, str], args: list[str],
-                    make: str, profile: Mapping[str, bytes], rt_make: str) -> tuple[Path, float]:
+                    make: str, profile: Mapping[str, bytes]) -> tuple[Path, float]:
     """The steps of :func:`build_plain_verilator` in folder ``bdir``."""
     exe = bdir / "obj_dir" / f"V{top}"
     bdir.mkdir(parents=True, exist_ok=True)
@@ -356,7 +353,7 @@ def _build_plain_in(bdir: Path, name: str, top: str, sources: Sequence[Path], *,
     # generate, put the shared runtime objects in (newer than the generated makefile, so make
     # keeps them: sim/engines/vlruntime.py), then compile; both steps' memory peaks are recorded
     # (the PGO flags reach only the model's per-cycle code and the link, not the runtime objects)
-    rt_flags = ["plain", rt_make, cflags, *args]
+    rt_flags = ["plain", verilator_make_vars(opt), cflags, *args]
     peak = [bdir / "verilate.peak", bdir / "compile.peak"]
     hier = "--hierarchical" in args
     if hier:   # Verilator builds the blocks and the top itself (one make per block, in order)
