@@ -397,7 +397,6 @@ def write_gtkw(vcd: Path, gtkw: Path | None = None) -> Path:
     one group per port, a payload held as one vector split into its fields
     (:func:`declare_payloads`), zoomed to show the whole trace. The dump path is relative to the
     save file (GTKWave takes it so when ``[savefile]`` is relative too): the pair can be moved."""
-    import os
     import sys
 
     from vcd.gtkw import GTKWSave
