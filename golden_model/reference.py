@@ -391,11 +391,9 @@ def rasterise(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0), engine: str 
     xy, z, vcol, pid, bg = _check(tris, background)
     W, H = int(tris.width), int(tris.height)
     if choose_engine(engine) == "numba":
-        depth, tri_id, poly, colour = _outputs(W * H)
-        fr, wr, cov = _fast_draw(xy, z, vcol, pid, bg, W, H, 0, H, depth=depth, colour=colour.reshape(-1),
-                                 tri=tri_id, poly=poly)
-        return Frame(colour=colour.reshape(H, W, 3), depth=depth.reshape(H, W), tri_id=tri_id.reshape(H, W),
-                     poly_id=poly.reshape(H, W), fragments=fr, pixels_written=wr, pixels_covered=cov)
+        out = depth, tri_id, poly, colour = _outputs(W * H)
+        return _frame(out, W, H, *_fast_draw(xy, z, vcol, pid, bg, W, H, 0, H, depth=depth,
+                                             colour=colour.reshape(-1), tri=tri_id, poly=poly))
     bands = _bands(W, H, xy.shape[0])
     if len(bands) == 1:
         return _guarded(_rasterise, tris, xy, z, vcol, pid, bg)
@@ -408,16 +406,16 @@ def rasterise(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0), engine: str 
     parts = list(_executor().map(
         lambda rows: _guarded(_rasterise, tris, xy, z, vcol, pid, bg, st=st, rows=rows,
                               into=tuple(a[rows[0] * W:rows[1] * W] for a in out)), bands))
+    return _frame(out, W, H, *(sum(getattr(f, k) for f in parts)
+                               for k in ("fragments", "pixels_written", "pixels_covered")))
+
+
+def _frame(out: tuple, W: int, H: int, fragments: int, written: int, covered: int) -> Frame:
+    """The :class:`Frame` of the flat ``(depth, tri_id, poly_id, colour)`` arrays ``out`` and its counts."""
     depth, tri_id, poly, colour = out
-    return Frame(
-        colour=colour.reshape(H, W, 3),
-        depth=depth.reshape(H, W),
-        tri_id=tri_id.reshape(H, W),
-        poly_id=poly.reshape(H, W),
-        fragments=sum(f.fragments for f in parts),
-        pixels_written=sum(f.pixels_written for f in parts),
-        pixels_covered=sum(f.pixels_covered for f in parts),
-    )
+    return Frame(colour=colour.reshape(H, W, 3), depth=depth.reshape(H, W), tri_id=tri_id.reshape(H, W),
+                 poly_id=poly.reshape(H, W), fragments=int(fragments), pixels_written=int(written),
+                 pixels_covered=int(covered))
 
 
 #: Environment variable choosing the engine when a call does not: ``numpy`` (the specification),
@@ -426,12 +424,6 @@ def rasterise(tris: ScreenTriangles, *, background=(0.0, 0.0, 0.0), engine: str 
 ENGINE_ENV = "RASTERHW_REFERENCE"
 _FAST = FastPath("rasterhw.golden_model.reference_fast", env=ENGINE_ENV, spec="numpy",
                  fallback="the reference rasteriser runs its NumPy specification (same pixels, slower)")
-
-
-def _fast_module():
-    """:mod:`reference_fast` (imported on first use), or None where it cannot be loaded; the
-    first failure prints one line on stderr."""
-    return _FAST.module()
 
 
 def choose_engine(engine: str | None = None) -> str:
@@ -454,7 +446,7 @@ def _fast_draw(xy, z, vcol, pid, bg, W: int, H: int, y0: int, y1: int, *, depth=
     exactly those rows (``None`` = not wanted; without ``depth`` a per-thread Z-buffer is used),
     as :func:`_bands` row bands in threads (the kernel releases the GIL). Returns
     ``(fragments, pixels_written, pixels_covered)``."""
-    fast = _fast_module()
+    fast = _FAST.module()
     n = len(_bands(W, y1 - y0, xy.shape[0]))
     X, Y, cuts = fast.prepare(xy, W, H, y0, y1, n * FAST_BANDS_PER_THREAD if n > 1 else 1)
     z = np.ascontiguousarray(z, dtype=np.float64)
@@ -696,15 +688,7 @@ def _rasterise(tris, xy, z, vcol, pid, bg, st: dict | None = None, rows: tuple[i
                 np.add(v, w2 * np.take(ctab[6 + ch], wt), out=rgb[:, ch])
             # One scatter of whole RGB triples (24-byte items).
             colour.view(_RGB)[wp, 0] = rgb.view(_RGB)[:, 0]
-    return Frame(
-        colour=colour.reshape(H, W, 3),
-        depth=depth.reshape(H, W),
-        tri_id=tri_id.reshape(H, W),
-        poly_id=poly.reshape(H, W),
-        fragments=int(fragments),
-        pixels_written=int(written),
-        pixels_covered=int(np.count_nonzero(tri_id >= 0)),
-    )
+    return _frame((depth, tri_id, poly, colour), W, H, fragments, written, np.count_nonzero(tri_id >= 0))
 
 
 def _restrict(st: dict, y0: int, y1: int) -> dict:

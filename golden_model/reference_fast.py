@@ -41,7 +41,7 @@ import numba
 import numpy as np
 from rasterhw.golden_model.numba_jit import njit_cached as _jit
 
-__all__ = ["band", "prepare", "compile_all"]
+__all__ = ["band", "prepare"]
 
 
 def _inline(fn):
@@ -286,17 +286,3 @@ def band(X, Y, z, col, pid, W: int, H: int, y0: int, y1: int, bg: np.ndarray, *,
                  depth,
                  tri is not None, _EMPTY[np.dtype(np.int64)] if tri is None else tri,
                  poly is not None, _EMPTY[np.dtype(np.int64)] if poly is None else poly)
-
-
-def compile_all() -> None:
-    """Compile (or load from numba's cache) the variants the package uses: the Frame's outputs
-    and the output contract's RGB8 with 32- or 64-bit ids."""
-    X, Y, _ = prepare(np.array([[[0.5, 0.5], [5.0, 0.5], [0.5, 5.0]]]), 8, 8, 0, 8, 2)
-    z = np.zeros((1, 3))
-    col = np.zeros((1, 3, 3))
-    pid = np.zeros(1, np.int64)
-    bg = np.zeros(3)
-    n = 8 * 8
-    for ids in (np.int32, np.int64):
-        band(X, Y, z, col, pid, 8, 8, 0, 8, bg, depth=np.empty(n), rgb8=np.empty(3 * n, np.uint8),
-             colour=np.empty(3 * n), tri=np.empty(n, ids), poly=np.empty(n, ids))

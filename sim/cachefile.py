@@ -28,7 +28,7 @@ import tempfile
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.paths import BUILD_ROOT
+from rasterhw.sim.paths import BUILD_ROOT, umask
 
 __all__ = ["NESTED", "RECORD_SUFFIX", "check_writable", "entry_of", "inside_cache", "mark_used", "matches",
            "read_entry", "sha256_file", "warn_damaged", "write_entry"]
@@ -76,19 +76,13 @@ def inside_cache(path: str | Path, root: str | Path | None = None) -> Path:
     return path
 
 
-def _umask() -> int:
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
 def _replace(path: Path, data: bytes) -> None:
     """Put ``data`` at ``path`` atomically; a link at ``path`` is replaced, not followed."""
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
         with os.fdopen(fd, "wb") as f:
             f.write(data)
-        os.chmod(tmp, 0o666 & ~_umask())
+        os.chmod(tmp, 0o666 & ~umask())
         os.replace(tmp, path)
     finally:
         Path(tmp).unlink(missing_ok=True)

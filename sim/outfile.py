@@ -32,18 +32,13 @@ from pathlib import Path
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim.paths import umask
 
 __all__ = ["STDOUT", "atomic_path", "check_image_output", "check_output", "image_format", "image_formats", "write_bytes",
            "write_image", "write_text"]
 
 #: the output name that means standard output
 STDOUT = "-"
-
-
-def _umask() -> int:
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
 
 
 def check_output(path: str | Path | None, *, flag: str = "-o", inputs: Iterable[str | Path] = ()) -> Path | None:
@@ -185,7 +180,7 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
             with open(tmp_path, "rb") as src, open(target, "wb") as dst:
                 shutil.copyfileobj(src, dst)
         else:
-            mode = stat.S_IMODE(st.st_mode) if st is not None else 0o666 & ~_umask()
+            mode = stat.S_IMODE(st.st_mode) if st is not None else 0o666 & ~umask()
             os.chmod(tmp_path, mode)
             os.replace(tmp_path, target)
     finally:

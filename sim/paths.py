@@ -4,13 +4,16 @@ error type, so every engine, cache and flow module can import it at the top."""
 
 from __future__ import annotations
 
+import contextlib
 import os
+from collections.abc import Iterator
 from pathlib import Path
 
 from platformdirs import user_cache_dir
 from rasterhw.golden_model.errors import RasterhwError
 
-__all__ = ["BUILD_ROOT", "REPO_ROOT", "build_root", "SimulatorUnavailable", "verilator_bin_dir"]
+__all__ = ["BUILD_ROOT", "REPO_ROOT", "build_root", "SimulatorUnavailable", "env_set", "umask",
+           "verilator_bin_dir"]
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 
@@ -47,3 +50,24 @@ def verilator_bin_dir() -> Path:
     if not (d / "verilator").exists():
         raise SimulatorUnavailable(f"no verilator binary under {d}")
     return d
+
+
+def umask() -> int:
+    """This process's umask (read by setting it, then put back)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+@contextlib.contextmanager
+def env_set(name: str, value: str) -> Iterator[None]:
+    """``os.environ[name] = value`` inside the ``with``; the old value (or its absence) put back after."""
+    old = os.environ.get(name)
+    os.environ[name] = value
+    try:
+        yield
+    finally:
+        if old is None:
+            os.environ.pop(name, None)
+        else:
+            os.environ[name] = old

@@ -185,15 +185,21 @@ def machines() -> dict[str, Machine]:
     return found
 
 
-def archs() -> dict[str, tuple[Machine, Arch]]:
-    """Every arch name -> (its machine, the arch)."""
-    out: dict[str, tuple[Machine, Arch]] = {}
+def _by_name(kind: str, what: str) -> dict[str, tuple[Machine, Arch | SimBlock]]:
+    """Every machine's ``Machine.<kind>`` (``archs``, ``sims``) by name -> (its machine, the entry);
+    a name two machines register is an error."""
+    out: dict[str, tuple[Machine, Arch | SimBlock]] = {}
     for m in machines().values():
-        for a in m.archs:
+        for a in getattr(m, kind):
             if a.name in out:
-                raise RuntimeError(f"arch {a.name!r} registered by {out[a.name][0].name} and {m.name}")
+                raise RuntimeError(f"{what} {a.name!r} registered by {out[a.name][0].name} and {m.name}")
             out[a.name] = (m, a)
     return out
+
+
+def archs() -> dict[str, tuple[Machine, Arch]]:
+    """Every arch name -> (its machine, the arch)."""
+    return _by_name("archs", "arch")
 
 
 def entries(kind: str) -> dict[str, str]:
@@ -215,13 +221,7 @@ def blocks() -> dict[str, str]:
 
 def sim_blocks() -> dict[str, tuple[Machine, SimBlock]]:
     """Every ``rasterhw sim`` block name -> (its machine, the block)."""
-    out: dict[str, tuple[Machine, SimBlock]] = {}
-    for m in machines().values():
-        for s in m.sims:
-            if s.name in out:
-                raise RuntimeError(f"sim block {s.name!r} registered twice")
-            out[s.name] = (m, s)
-    return out
+    return _by_name("sims", "sim block")
 
 
 def machine(name: str) -> Machine:

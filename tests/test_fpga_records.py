@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 import subprocess
 
-from rasterhw.sim.flow import fpga
+from rasterhw.sim.flow import fpga, synth
 from rasterhw.sim.report.rows import default_report_dir
 from wave_helpers import run_cli
 
@@ -30,7 +30,7 @@ def test_report_fpga_prints_the_recorded_rows_with_yosys_unrunnable(tmp_path, mo
     monkeypatch.setattr(tools, "tool_version", unrunnable)
     monkeypatch.setattr(fpga, "tool", unrunnable)
     monkeypatch.setattr(fpga, "tool_version", unrunnable)
-    monkeypatch.setattr(fpga, "generate_cached", unrunnable)    # no Verilog either
+    monkeypatch.setattr(synth, "generate_cached", unrunnable)   # no Verilog either (fpga gets it from synth)
     monkeypatch.setattr(verilog_cache, "generate_cached", unrunnable)
     monkeypatch.setattr(subprocess, "run", no_tools)
     out = tmp_path / "out"

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from brute import brute_coverage, brute_visible
 from rasterhw.golden_model import reference
-from rasterhw.golden_model.brute import brute_coverage, brute_visible
 from rasterhw.golden_model.compare import compare_images, diff_image, write_diff_png
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.reference import Frame, benchmark, random_triangles, rasterise

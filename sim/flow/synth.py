@@ -163,11 +163,6 @@ def stable_text(verilog: str) -> str:
                              for ln in yosys_init_restored(canonical_port_lists(verilog)).splitlines()))
 
 
-def _stable_text_v1(verilog: str) -> str:
-    """:func:`stable_text` before module headers were made canonical (to re-key old caches)."""
-    return "\n".join(sorted(" ".join(sorted(re.split(r"[\s,()]+", ln))) for ln in verilog.splitlines()))
-
-
 def _param_int(v) -> int:
     if isinstance(v, int):
         return v
@@ -207,6 +202,15 @@ def _script(top: str, files: list[Path], stubs: Path | None, memory: str, flatte
     if lut4:  # 4-input LUT estimate of the same gate netlist (flip-flops stay as they are)
         lines += ["abc -lut 4", "opt_clean", "tee -q -o stat_lut.json stat -json"]
     return "\n".join(lines) + "\n"
+
+
+def block_verilog(block: str, params: dict) -> tuple[str, str]:
+    """``block``'s Verilog at ``params`` (generated once: the Verilog cache) and the block's
+    ``extra_verilog()``, which that Verilog ends with ("" for none)."""
+    if block not in block_names():
+        raise RasterhwError(f"unknown block {block!r}; known: {', '.join(block_names())}")
+    comp = make_block(block, **params)
+    return generate_cached(block, **params), comp.extra_verilog() if hasattr(comp, "extra_verilog") else ""
 
 
 def _stat_json(path: Path, top: str) -> dict:
@@ -271,15 +275,10 @@ def synthesise(
     """
     if memory not in MEMORY_MODES:
         raise RasterhwError(f"memory must be one of {', '.join(MEMORY_MODES)}, not {memory!r}")
-    if block not in block_names():
-        raise RasterhwError(f"unknown block {block!r}; known: {', '.join(block_names())}")
     yosys = yosys_path()
     params = {**registry.flow(block).synth, **params}
-    comp = make_block(block, **params)
+    text, extra = block_verilog(block, params)
     top = top or block.replace("-", "_")
-
-    text = generate_cached(block, **params)
-    extra = comp.extra_verilog() if hasattr(comp, "extra_verilog") else ""
     if extra:
         if not text.endswith("\n" + extra):
             raise RasterhwError(f"block {block!r}: generated Verilog does not end with its extra_verilog()")
