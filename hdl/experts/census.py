@@ -9,7 +9,8 @@ widest operand of any multiplier: what a "16-bit basic operation width" means fo
 
 :func:`frame_census` counts the processors ``rasterhw sim experts`` chains at either datapath
 (``formats.DATAPATHS``): the SLP's set-up (``experts-slp-setup``), the SLP's list work
-(``experts-slp``), and the span PXP (``experts-pxp-span``, which has no 16-bit configuration yet).
+(``experts-slp``), and the span PXP (``experts-pxp-span``, ``datapath="paper"``: one multiplier in its
+resolve side; the A.J. blend's are not shared yet).
 Its ``datapath_bits`` is the widest multiplier operand over them, ``multipliers`` the most
 multipliers in one processor.
 """
@@ -42,10 +43,12 @@ def census(component) -> dict:
     return {"multipliers": len(ms), "bits": max((max(a, b) for a, b in ms), default=0), "widths": ms}
 
 
-def frame_census(datapath: str = "ours", *, width: int = 512, height: int = 512) -> dict:
-    """The chained frame's processors at ``datapath``, each elaborated and counted (:func:`census`):
-    ``per_block`` (block -> census), ``datapath_bits`` (widest multiplier operand of them all),
-    ``multipliers`` (most in one processor), ``source`` ``"hdl:elaborated"``."""
+def frame_census(datapath: str, *, pxp_datapath: str, width: int = 512, height: int = 512, aj: str = "c") -> dict:
+    """The chained frame's processors, each elaborated and counted (:func:`census`): the SLP's
+    set-up and list work at ``datapath``, the span PXP at ``pxp_datapath`` (what the driver builds:
+    ``"ours"`` until it passes ``datapath`` to the block). Returns ``per_block`` (block -> census),
+    ``datapath_bits`` (widest multiplier operand of them all), ``multipliers`` (most in one
+    processor), ``source`` ``"hdl:elaborated"``."""
     from rasterhw.golden_model.experts.formats import DATAPATHS
     from rasterhw.hdl.experts.pxp_span import ExpertsPxpSpan
     from rasterhw.hdl.experts.slp import ExpertsSlp
@@ -53,6 +56,6 @@ def frame_census(datapath: str = "ours", *, width: int = 512, height: int = 512)
     ex = DATAPATHS[datapath].acc_extra
     per = {"experts-slp-setup": census(ExpertsSlpSetup(height=height, acc_extra=ex)),
            "experts-slp": census(ExpertsSlp(width=width, lines=height, acc_extra=ex)),
-           "experts-pxp-span": census(ExpertsPxpSpan(width=width, aj="c"))}
+           "experts-pxp-span": census(ExpertsPxpSpan(width=width, aj=aj, datapath=pxp_datapath))}
     return {"datapath": datapath, "per_block": per, "datapath_bits": max(c["bits"] for c in per.values()),
             "multipliers": max(c["multipliers"] for c in per.values()), "source": "hdl:elaborated"}

@@ -63,6 +63,8 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
     ``hi``, ``line_cycles``, ``lines``, ``overflow``), DMM/P, DSLB and drain:
     :class:`hdl.experts.pxp_span.ExpertsPxpSpan`'s (``frame``); the resolve side is this block's."""
 
+    PAPER_DATAPATH = False     # ours only: its resolve side has no one-multiplier configuration yet
+
     def elaborate(self, platform):
         m = Module()
         fr = self.frame(m)

@@ -42,6 +42,7 @@ from amaranth.lib import data, enum, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.experts.formats import ACC_EXTRA, ADDR_BITS, X_FRAC
+from rasterhw.hdl.experts.mul16 import sm_mul
 
 __all__ = ["ExpertsSlp", "slp_in_layout", "slp_out_layout", "IN_KIND", "MUL_OPS"]
 
@@ -215,7 +216,7 @@ class ExpertsSlp(wiring.Component):
         (:data:`MUL_OPS`), ``res = a0 + ((yc - y0) * inc >> 6)`` in the cycle it is chosen (the
         edge accumulator's start value, :func:`slp_cycles._acc` with no extra bits). ``yc - y0`` is
         0..65504 (``y0`` is the edge's upper vertex, at or above the line's centre) and the
-        increment a saturated 16-bit word, multiplied as sign and magnitude (|inc| <= 32768). The
+        increment a saturated 16-bit word (:func:`mul16.sm_mul`, sign and magnitude). The
         FSM keeps x of the long edge in ``xlong`` (first cycle) and z_L in ``zreg``."""
         msel = Signal(2)
         upper = Signal()
@@ -236,12 +237,9 @@ class ExpertsSlp(wiring.Component):
                 pick(tv.za, tv.zb, tv.zinc_ac, tv.zinc_ab, tv.zinc_bc, tv.ll)
             with m.Case(MUL_OPS["i_left"]):
                 pick(tv.ia, tv.ib, tv.iinc_ac, tv.iinc_ab, tv.iinc_bc, tv.ll)
-        dy, mag, neg = Signal(16), Signal(16), Signal()
-        pu = Signal(32)
-        ps = Signal(signed(34))
+        dy = Signal(16)
         res = Signal(signed(36))
-        m.d.comb += [dy.eq(yc - y0_), neg.eq(inc < 0), mag.eq(Mux(neg, -inc, inc)),
-                     pu.eq(dy * mag), ps.eq(Mux(neg, -pu, pu)), res.eq(a0 + (ps >> X_FRAC))]
+        m.d.comb += [dy.eq(yc - y0_), res.eq(a0 + (sm_mul(m, dy, inc, "slp_mul") >> X_FRAC))]
         xlong = Signal(signed(18))
         zreg = Signal(16)
         newx = Signal(xs)
