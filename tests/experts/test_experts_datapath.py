@@ -168,10 +168,13 @@ def test_multipliers_are_counted_from_the_elaborated_hdl():
             m.d.comb += self.y.eq(self.a * self.b + 3 * k + k * self.a)
             return m
     assert sorted(multipliers(Two())) == [(8, 8), (8, 12)]
-    # the chained frame at the paper's datapath without A.J.: one multiplier a processor; the set-up's
-    # is still 40 x 20 (eq. (3) is not multi-word yet), so the frame's datapath is 40 bits
+    # the chained frame at the paper's datapath without A.J.: one 16 x 16 multiplier a processor (the
+    # set-up's products wider than that multi-word); with A.J. (c) the blend's 9 are not shared yet
     from rasterhw.hdl.experts.census import frame_census
     f = frame_census("paper", pxp_datapath="paper", width=64, height=32, aj="none")
     assert {b: (c["multipliers"], c["bits"]) for b, c in f["per_block"].items()} == {
-        "experts-slp-setup": (1, 40), "experts-slp": (1, 16), "experts-pxp-span": (1, 16)}
-    assert (f["multipliers"], f["datapath_bits"]) == (1, 40)
+        "experts-slp-setup": (1, 16), "experts-slp": (1, 16), "experts-pxp-span": (1, 16)}
+    assert (f["multipliers"], f["datapath_bits"]) == (1, 16)
+    f = frame_census("ours", pxp_datapath="ours", width=64, height=32, aj="none")
+    assert {b: (c["multipliers"], c["bits"]) for b, c in f["per_block"].items()} == {
+        "experts-slp-setup": (1, 40), "experts-slp": (9, 48), "experts-pxp-span": (3, 20)}
