@@ -78,7 +78,8 @@ class Datapath:
 #: with Q.22 increments of up to 40 bits; the span PXP has three multipliers: z at a span's two ends,
 #: i at its start). ``paper``: seed 000, 3.2, "SLP、PXPの基本演算データ幅は16ビットである" and a
 #: multiplier a processor ("乗算器 ... を装備"): every SLP edge accumulator and increment is one 16-bit
-#: word (the ASB word itself, no extra fraction bits: truncated, see docs/experts.md).
+#: word (the ASB word itself, no extra fraction bits: truncated, see docs/experts.md). These are the
+#: contracts; what the HDL has is counted from its elaborated design (``hdl/experts/census.py``).
 DATAPATHS = {"ours": Datapath("ours", word_bits=40, acc_extra=ACC_EXTRA, multipliers=3, label="ours"),
              "paper": Datapath("paper", word_bits=WORD, acc_extra=0, multipliers=1, label="the paper's")}
 

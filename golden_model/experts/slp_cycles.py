@@ -22,6 +22,13 @@ Cycles (every term; ``N`` PL triangles, ``L`` band lines, ``P`` ranges):
   ``+ 1 + n_s + n_e`` (the final merge) ``+ walk + 1`` (end-of-line word), where the walk takes per
   segment 1 cycle (its ASL word), and if it has a pixel ``q + 1`` (range starts it passes, then the
   stop) ``+ k + 1`` (later ranges it reaches, then the stop).
+
+The paper's datapath (``extra`` 0, ``Datapath.multipliers`` 1: "乗算器 ... を装備" per processor, seed
+000 3.2) has **one** 16 x 16 multiplier, where ours has one per edge and attribute: each multiply
+takes the multiplier for one cycle, so a segment's ASL update (x of its long edge, then of its short
+edge) takes ``2`` cycles instead of 1 for every survivor and every entering segment (a leaving one
+still takes 1: no multiply), and its ASL word ``2`` (z_L, then i_L as the word goes out): per line
+``+ n_s + n_e + m`` cycles (:data:`MUL_CYCLES`).
 """
 
 from __future__ import annotations
@@ -38,13 +45,16 @@ from rasterhw.golden_model.experts.slp_run import (
     merge_sort,
 )
 
-__all__ = ["TRI_FIELDS", "KIND", "tri_words", "asb", "band_run"]
+__all__ = ["TRI_FIELDS", "KIND", "MUL_CYCLES", "tri_words", "asb", "band_run"]
 
 TRI_FIELDS = ("t", "r0", "r1", "ll", "xa", "ya", "xb", "yb", "inc_ac", "inc_ab", "inc_bc",
               "za", "zb", "zinc_ac", "zinc_ab", "zinc_bc", "ia", "ib", "iinc_ac", "iinc_ab", "iinc_bc",
               "dzdx", "didx", "hue", "poly", "s_ac", "s_ab", "s_bc", "q_ac", "q_ab", "q_bc")
 KIND = {"asl": 0, "lead": 1, "bucket": 2, "eol": 3}
 _INC_MASK = (1 << 48) - 1
+#: the paper's one multiplier: the extra cycle of each survivor's and entering segment's ASL update and
+#: of each ASL word (``extra`` 0); ours: none
+MUL_CYCLES = {0: 1, ACC_EXTRA: 0}
 
 
 def tri_words(st) -> list[dict]:
@@ -153,10 +163,12 @@ def band_run(tws: list[dict], band: tuple[int, int], bounds, *, width: int, guar
     out = {"start_cycles": 1 + (y1 - y0) + (P + 1) + len(tws) + 1, "lines": [], "words": [], "line_cycles": [],
            "asl": []}
     prev: list[int] = []
+    one = MUL_CYCLES[extra]
     for y in range(y0, y1):
         xs = {}
         cyc = 1 + len(prev)
         surv = [t for t in prev if r1[t] >= y]
+        cyc += one * len(surv)
         for t in surv:
             xs[t] = _x(tws[t], y, extra)
 
@@ -168,7 +180,7 @@ def band_run(tws: list[dict], band: tuple[int, int], bounds, *, width: int, guar
         ent = list(buckets[y - y0])
         for t in ent:
             xs[t] = _x(tws[t], y, extra)
-        cyc += 1 + len(ent)
+        cyc += 1 + len(ent) + one * len(ent)
         ne = len(ent)
         ent, _, _ = merge_sort(ent, key)
         levels = int(np.ceil(np.log2(ne))) if ne >= 2 else 0
@@ -182,7 +194,7 @@ def band_run(tws: list[dict], band: tuple[int, int], bounds, *, width: int, guar
         q = 0
         for pos, t in enumerate(cur):
             words.append((KIND["asl"], 0, pos, t, y, asb(tws[t], y, extra)))
-            cyc += 1
+            cyc += 1 + one
             a, e = int(c0[pos]), int(c1[pos])
             if e < a:
                 continue

@@ -28,6 +28,13 @@ Cycles of one PL triangle (every term; one multiplier, one multiply a cycle):
   ``+ 7 reciprocals`` (``dY`` and ``dX`` of each edge, the denominator), each ``2 + c`` (``c``
   corrections) ``+ 17`` multiply-and-rounds (per edge x, z, i increments, dx/dy and dy/dx; dz/dx,
   di/dx) ``+ 1`` (the word out).
+
+The paper's datapath (``extra`` 0): the one multiplier is 16 x 16 (seed 000 3.2: "SLP、PXPの基本演算
+データ幅は16ビットである"), so a product wider than 16 x 16 is a multi-word product, one 16 x 16
+partial product a cycle (``hdl/experts/slp_setup.py: LIMBS``): eq. (3)'s six products and every
+edge's multiply-and-round are 16 x 16 (one cycle, as ours); each edge's reciprocal remainder
+``|d| (ROM + 1)`` is 1 x 2 limbs (``+1``), the denominator's 3 x 2 (``+5``), dz/dx and di/dx 3 x 1
+(``+2`` each): ``+ 15`` cycles a triangle in the band (:data:`MULTIWORD`).
 """
 
 from __future__ import annotations
@@ -35,14 +42,18 @@ from __future__ import annotations
 from functools import cache
 
 import numpy as np
+from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.experts.formats import ACC_EXTRA, SLOPE_FRAC, X_FRAC
 
-__all__ = ["ROM_INDEX_BITS", "rom_table", "recip", "pl_words", "set_up_triangle", "band_setup", "EDGES"]
+__all__ = ["ROM_INDEX_BITS", "MULTIWORD", "rom_table", "recip", "pl_words", "set_up_triangle", "band_setup", "EDGES"]
 
 ROM_INDEX_BITS = 15
 #: the three edges: (name, from vertex, to vertex), vertices sorted top (0), middle (1), bottom (2)
 EDGES = (("ac", 0, 2), ("ab", 0, 1), ("bc", 1, 2))
 _MAX16 = (1 << 16) - 1
+#: the paper's datapath: the extra cycles of the multi-word products of one triangle in the band
+#: (six edge reciprocals 1 each, the denominator's 5, dz/dx and di/dx 2 each)
+MULTIWORD = 6 * 1 + 5 + 2 * 2
 _S7 = (1 << 15) - 1
 
 
@@ -116,6 +127,9 @@ def set_up_triangle(pl: dict, band: tuple[int, int], height: int, extra: int = A
     r1 = min(((Y[2] + half - 1) >> X_FRAC) - 1, height - 1)
     assert g == 64
     w = {"t": pl["t"], "r0": r0, "r1": r1}
+    if extra == 0 and not all(0 <= a <= _MAX16 for a in X + Y):
+        raise RasterhwError(f"experts: the paper's datapath holds a vertex x, y in one 16-bit word (Q10.6, "
+                            f"0..{_MAX16}); PL triangle {pl['t']} has x {X}, y {Y}")
     if not (r1 >= band[0] and r0 < band[1]):
         return w, 2
 
@@ -137,7 +151,7 @@ def set_up_triangle(pl: dict, band: tuple[int, int], height: int, extra: int = A
         cyc += 2 + c + 1
         w[f"q_{e}"] = _S7 if dX == 0 else _sat16(_md(dY, r, s, dX < 0, SLOPE_FRAC))
     r, s, c = recip(den)
-    cyc += 2 + c + 2 + 1
+    cyc += 2 + c + 2 + 1 + (MULTIWORD if extra == 0 else 0)
     w.update({"ll": int(den > 0), "xa": X[0], "ya": Y[0], "xb": X[1], "yb": Y[1], "za": Z[0], "zb": Z[1],
               "ia": Iv[0], "ib": Iv[1], "dzdx": _sat16(_md(nz, r, s, den < 0, 6 + 4)),
               "didx": _sat16(_md(ni, r, s, den < 0, 6)), "hue": pl["hue"], "poly": pl["poly"]})

@@ -45,7 +45,8 @@ from rasterhw.golden_model.experts.model import ExpertsFrame
 from rasterhw.golden_model.experts.pxp_cycles import asb_record, drain_cycles, guarded
 from rasterhw.golden_model.experts.slp_run import block_lists
 
-__all__ = ["DMM_DEPTH", "Entering", "NO_PTR", "STEPS", "line_asl", "dmm_line", "resolve", "schedule", "span_drain_cycles"]
+__all__ = ["DMM_DEPTH", "Entering", "NO_PTR", "STEPS", "line_asl", "dmm_line", "resolve", "schedule", "span_drain_cycles",
+           "one_multiplier", "paper_jobs"]
 
 DMM_DEPTH = 256       # ASBs per DMM/P bank (the block's default)
 NO_PTR = 511          # leading pointer: none
@@ -193,6 +194,37 @@ def schedule(lines: list[tuple[int, int, int]]) -> dict:
         de.append(rh + d)
         out.append(rh - rs + 1)
     return {"line_cycles": out, "last_pixel": de[-1] if de else -1}
+
+
+def one_multiplier(steps: dict) -> int:
+    """The extra resolve cycles of one line on the paper's datapath (``experts-pxp-span`` with
+    ``datapath="paper"``: one 16 x 16 multiplier, "PXPにおいても ... SLP同様、乗算器を装備している",
+    seed 000 3.2): every pass A and pass B cycle needs z at the (sub)span's two end pixels, two
+    multiplies, so each takes two cycles (z at the left end kept, then the right); the write's one
+    multiply a pixel (the intensity) fits its cycle. ``steps``: :func:`resolve`'s counts."""
+    return steps["pass_a"] + steps["pass_b"]
+
+
+def paper_jobs(jb: dict) -> dict:
+    """A span PXP job list (``sim/experts/pxp_jobs.py: span_job_list``, ours' cycles) at the paper's
+    datapath: every line's resolve cycles + :func:`one_multiplier`, scheduled again (:func:`schedule`),
+    and a frame's ``pxp_frame_cycles`` (``pxp_sim.jobs``: per ``owner``, its lines back to back);
+    words and pixels unchanged. Adds ``datapath`` ``"paper"``."""
+    if jb.get("pxp", "span") != "span":
+        raise RasterhwError(f"experts: the {jb['pxp']} PXP has no paper datapath (one multiplier) yet")
+    lines = [(w, r + one_multiplier(st), d) for (w, r, d), st in zip(jb["timing"], jb["steps"], strict=True)]
+    sch = schedule(lines)
+    out = {**jb, "timing": lines, "cycles": np.array(sch["line_cycles"], np.int64),
+           "last_pixel": sch["last_pixel"], "datapath": "paper"}
+    if "pxp_frame_cycles" in jb:      # a frame's jobs (pxp_sim.jobs): each PXP's own lines back to back
+        own: dict = {}
+        for k, o in enumerate(jb["owner"]):
+            own.setdefault(o, []).append(lines[k])
+        per = np.zeros_like(jb["pxp_frame_cycles"])
+        for (s_, p), ls in own.items():
+            per[s_, p] = schedule(ls)["last_pixel"] + 1
+        out["pxp_frame_cycles"] = per
+    return out
 
 
 def line_job(segs: list[dict], bucket: list[int], lead: int, lo: int, hi: int, *, aj: str, width: int,

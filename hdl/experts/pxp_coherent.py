@@ -63,6 +63,11 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
     ``hi``, ``line_cycles``, ``lines``, ``overflow``), DMM/P, DSLB and drain:
     :class:`hdl.experts.pxp_span.ExpertsPxpSpan`'s (``frame``); the resolve side is this block's."""
 
+    PAPER_DATAPATH = False     # ours only: its resolve side has no one-multiplier configuration yet
+
+    def __init__(self, *, width: int = 512, intensity_bits: int = 7, aj: str = "none", depth: int = 256):
+        super().__init__(width=width, intensity_bits=intensity_bits, aj=aj, depth=depth)
+
     def elaborate(self, platform):
         m = Module()
         fr = self.frame(m)

@@ -52,6 +52,7 @@ from rasterhw.golden_model.experts.formats import (
     Formats,
 )
 from rasterhw.hdl.experts.drain import Drain, check_pxp_params, pxp_members
+from rasterhw.hdl.experts.mul16 import sm_mul
 from rasterhw.hdl.experts.pxp import asb_fields
 from rasterhw.hdl.params import params
 
@@ -212,13 +213,47 @@ def guarded_test(m: Module, zsl, zsr, zbl, zbr, s_lower) -> Signal:
 def intensity_at(m: Module, seg, col, fmt: Formats) -> Signal:
     """S.S.: the intensity of ASB ``seg`` at pixel ``col`` by the multiplier, clamped (Q.i_frac)."""
     di = Signal(signed(20), name="di")
+    m.d.comb += di.eq((col << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl)
+    return clamp_i(m, seg.il + ((di * seg.didx) >> X_FRAC), fmt)
+
+
+def clamp_i(m: Module, run, fmt: Formats) -> Signal:
+    """A running intensity ``run`` (Q.i_frac) clamped to ``0 .. i_max`` as the pixel takes it."""
     irun = Signal(signed(40), name="irun")
-    m.d.comb += [di.eq((col << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl),
-                 irun.eq(seg.il + ((di * seg.didx) >> X_FRAC))]
     imax = fmt.i_max << fmt.i_frac
     ic = Signal(16, name="ic")
-    m.d.comb += ic.eq(Mux(irun < 0, 0, Mux(irun > imax, imax, irun)))
+    m.d.comb += [irun.eq(run), ic.eq(Mux(irun < 0, 0, Mux(irun > imax, imax, irun)))]
     return ic
+
+
+class _Always:
+    """A context that adds nothing: the step's own cycle is its only one."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
+
+
+class _AfterFirst:
+    """``with _AfterFirst(m, ph, keep):`` the body runs in a step's second cycle; its first cycle
+    (``ph`` 0) only runs ``keep`` (sync) and sets ``ph``; the second clears it."""
+
+    def __init__(self, m: Module, ph, keep: list):
+        self.m, self.ph, self.keep = m, ph, keep
+
+    def __enter__(self):
+        m = self.m
+        with m.If(~self.ph):
+            m.d.sync += [*self.keep, self.ph.eq(1)]
+        self._else = m.Else()
+        self._else.__enter__()
+        m.d.sync += self.ph.eq(0)
+        return self
+
+    def __exit__(self, *exc):
+        return self._else.__exit__(*exc)
 
 
 def write_pixel(m: Module, fr: dict, rb, col, bg, seg, ic, slot) -> None:
@@ -279,7 +314,7 @@ class _R(enum.Enum, shape=3):
     HAND = 6      # hand the DSLB bank to the drain
 
 
-@params("width", "aj", "depth")
+@params("width", "aj", "depth", "datapath")
 class ExpertsPxpSpan(wiring.Component):
     """One span PXP with its DMM/P: DMM/P words in, the range's pixel words out, line by line.
 
@@ -293,6 +328,10 @@ class ExpertsPxpSpan(wiring.Component):
         ``"none"`` or ``"c"`` (anti-jagging, method (c)).
     depth : int
         ASBs per DMM/P bank (2..511).
+    datapath : str
+        ``"ours"`` (a multiplier each for z at a span's two ends and for i) or ``"paper"`` (one
+        16 x 16 multiplier, :func:`mul16.sm_mul`: pass A and pass B take two cycles a segment, z at
+        the left end, then at the right; ``span_cycles.one_multiplier``).
 
     Members
     -------
@@ -309,10 +348,17 @@ class ExpertsPxpSpan(wiring.Component):
         Sticky: a line had more than ``depth`` ASBs or bucket entries; ``i`` is stalled for good.
     """
 
-    def __init__(self, *, width: int = 512, intensity_bits: int = 7, aj: str = "none", depth: int = 256):
+    #: the block has the paper's datapath (``datapath="paper"``: one shared multiplier)
+    PAPER_DATAPATH = True
+
+    def __init__(self, *, width: int = 512, intensity_bits: int = 7, aj: str = "none", depth: int = 256,
+                 datapath: str = "ours"):
         check_pxp_params(width=width, aj=aj)
         if isinstance(depth, bool) or not isinstance(depth, int) or not 2 <= depth <= NO_PTR:
             raise ValueError(f"depth must be an integer in 2..{NO_PTR}, not {depth!r}")
+        if datapath not in ("ours", "paper") or (datapath == "paper" and not self.PAPER_DATAPATH):
+            raise ValueError(f"datapath must be ours{' or paper' if self.PAPER_DATAPATH else ''}, not {datapath!r}")
+        self._datapath = datapath
         self._fmt = Formats(intensity_bits)
         self._width = width
         self._aj = aj
@@ -372,9 +418,28 @@ class ExpertsPxpSpan(wiring.Component):
         krd = stk.read_port(domain="comb")
         m.d.comb += [kwr.en.eq(0), krd.addr.eq(sp - 1), kwr.addr.eq(sp)]
 
-        # the two multipliers: running z (Q16.4) at pixels sl and sr
-        zl_ = zrun_at(m, seg, sl)
-        zr_ = zrun_at(m, seg, sr)
+        ph = Signal()             # (paper) pass A / B: z at sl taken, z at sr on the multiplier
+        if self._datapath == "paper":
+            # one multiplier: z at sl (first cycle, kept in zlr), z at sr; i at sl when writing
+            zlr = Signal(signed(40))
+            d = Signal(signed(18))
+            m.d.comb += d.eq((Mux(ph, sr, sl) << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl)
+            prod = sm_mul(m, d, Mux(state == _R.WRITE, seg.didx, seg.dzdx), "pxp_mul")
+            zp = Signal(signed(40))
+            m.d.comb += zp.eq((seg.zl << DZ_FRAC) + (prod >> X_FRAC))
+            zl_, zr_ = zlr, zp
+            ic = clamp_i(m, seg.il + (prod >> X_FRAC), fmt)
+        else:
+            # the multipliers: running z (Q16.4) at pixels sl and sr, i at sl
+            zl_ = zrun_at(m, seg, sl)
+            zr_ = zrun_at(m, seg, sr)
+            ic = intensity_at(m, seg, sl, fmt)
+
+        def two_cycles():
+            """(paper) a pass's first cycle on a segment only multiplies: z at sl into ``zlr``."""
+            if self._datapath != "paper":
+                return _Always()
+            return _AfterFirst(m, ph, [zlr.eq(zp)])
         key = z_key(m, zl_)
         nearer = Signal()
         m.d.comb += nearer.eq((i == 0) | (key < skey) | ((key == skey) & (seg.addr < saddr)))
@@ -384,8 +449,6 @@ class ExpertsPxpSpan(wiring.Component):
         mid = Signal(11)
         m.d.comb += mid.eq((sl + sr + 1) >> 1)
 
-        # S.S. at pixel sl (the write cursor): intensity by the multiplier
-        ic = intensity_at(m, seg, sl, fmt)
 
         # ---------------------------------------------------------------- drain side (drain.py)
         drain = fr["drain"]
@@ -439,7 +502,7 @@ class ExpertsPxpSpan(wiring.Component):
                         m.d.sync += state.eq(_R.PASSA)
                     with m.Else():
                         m.d.sync += [wbg.eq(j == 0), S.eq(one), state.eq(_R.WRITE)]
-            with m.Case(_R.PASSA):
+            with m.Case(_R.PASSA), two_cycles():
                 with m.If(nearer):
                     m.d.sync += [S.eq(raddr), skey.eq(key), saddr.eq(seg.addr), szl.eq(zl_), szr.eq(zr_)]
                 m.d.sync += i.eq(i + 1)
@@ -449,7 +512,7 @@ class ExpertsPxpSpan(wiring.Component):
                         m.d.sync += [wbg.eq(0), state.eq(_R.WRITE)]
                     with m.Else():
                         m.d.sync += [bad.eq(0), state.eq(_R.PASSB)]
-            with m.Case(_R.PASSB):
+            with m.Case(_R.PASSB), two_cycles():
                 m.d.sync += [i.eq(i + 1), bad.eq(bad | ~good)]
                 with m.If(i + 1 >= k):
                     m.d.sync += i.eq(0)

@@ -35,15 +35,20 @@ Cycles: ``golden_model/experts/slp_cycles.py`` (every term named there).
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 from amaranth import Module, Mux, Signal, signed, unsigned
 from amaranth.lib import data, enum, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.experts.formats import ACC_EXTRA, ADDR_BITS, X_FRAC
+from rasterhw.hdl.experts.mul16 import sm_mul
 
-__all__ = ["ExpertsSlp", "slp_in_layout", "slp_out_layout", "IN_KIND"]
+__all__ = ["ExpertsSlp", "slp_in_layout", "slp_out_layout", "IN_KIND", "MUL_OPS"]
 
 IN_KIND = {"band": 0, "bound": 1, "tri": 2, "go": 3}
+#: (the paper's datapath) what the one multiplier computes, by ``msel``
+MUL_OPS = {"x_long": 0, "x_short": 1, "z_left": 2, "i_left": 3}
 
 
 def slp_in_layout() -> data.StructLayout:
@@ -160,6 +165,87 @@ class ExpertsSlp(wiring.Component):
             "overflow": Out(1),
         })
 
+    def _multipliers(self, m, tv, yc, xs):
+        """Ours: x of the three edges, z and i of the left edge, each with its own multiplier, in
+        the cycle that needs them. Returns x_L/x_R (``xs``), z_L and i_L."""
+        def edge(x0, yy0, inc, name):
+            v = Signal(signed(80), name=name)
+            m.d.comb += v.eq(((x0 << self._ex) + (((yc - yy0) * inc) >> X_FRAC)) >> self._ex)
+            return v
+        lng = edge(tv.xa, tv.ya, tv.inc_ac, "x_long")
+        sht = Signal(signed(80))
+        up = edge(tv.xa, tv.ya, tv.inc_ab, "x_ab")
+        lo_ = edge(tv.xb, tv.yb, tv.inc_bc, "x_bc")
+        m.d.comb += sht.eq(Mux(yc < tv.yb, up, lo_))
+        newx = Signal(xs)
+        m.d.comb += [newx.xl.eq(Mux(tv.ll, lng, sht)), newx.xr.eq(Mux(tv.ll, sht, lng))]
+
+        # the rest of the ASL update, for the ASB written at the walk: z_L, i_L of the left edge
+        # (two multiplies each, the edge chosen as for x)
+        def left(a_a, a_b, i_ac, i_ab, i_bc, name):
+            lg = edge(a_a, tv.ya, i_ac, f"{name}_long")
+            sh = Mux(yc < tv.yb, edge(a_a, tv.ya, i_ab, f"{name}_ab"), edge(a_b, tv.yb, i_bc, f"{name}_bc"))
+            v = Signal(signed(80), name=f"{name}_left")
+            m.d.comb += v.eq(Mux(tv.ll, lg, sh))
+            return v
+        return (newx, left(tv.za, tv.zb, tv.zinc_ac, tv.zinc_ab, tv.zinc_bc, "z"),
+                left(tv.ia, tv.ib, tv.iinc_ac, tv.iinc_ab, tv.iinc_bc, "i"))
+
+    @staticmethod
+    @contextmanager
+    def _first_multiply(m, mul, ph, first, op0="x_long", op1="x_short", hold=False):
+        """The paper's datapath (``mul`` not empty): while ``first``, a cycle that only multiplies
+        (``op0``, kept in ``xlong`` or, for ``z_left``, ``zreg``); then the step's own cycle, with
+        ``op1`` on the multiplier, which resets the phase (``hold``: the step resets it itself, when
+        its word is taken). Ours: the step alone."""
+        if not mul:
+            yield
+            return
+        m.d.comb += mul["msel"].eq(Mux(ph, MUL_OPS[op1], MUL_OPS[op0]))
+        with m.If(first):
+            keep = mul["zreg"] if op0 == "z_left" else mul["xlong"]
+            m.d.sync += [keep.eq(mul["res"]), ph.eq(1)]
+        with m.Else():
+            if not hold:
+                m.d.sync += ph.eq(0)
+            yield
+
+    @staticmethod
+    def _one_multiplier(m, tv, yc, xs):
+        """The paper's datapath: one 16 x 16 unsigned multiplier, its operands chosen by ``msel``
+        (:data:`MUL_OPS`), ``res = a0 + ((yc - y0) * inc >> 6)`` in the cycle it is chosen (the
+        edge accumulator's start value, :func:`slp_cycles._acc` with no extra bits). ``yc - y0`` is
+        0..65504 (``y0`` is the edge's upper vertex, at or above the line's centre) and the
+        increment a saturated 16-bit word (:func:`mul16.sm_mul`, sign and magnitude). The
+        FSM keeps x of the long edge in ``xlong`` (first cycle) and z_L in ``zreg``."""
+        msel = Signal(2)
+        upper = Signal()
+        a0, y0_ = Signal(signed(18)), Signal(signed(18))
+        inc = Signal(signed(16))
+        m.d.comb += upper.eq(yc < tv.yb)
+
+        def pick(a_a, a_b, i_ac, i_ab, i_bc, lng):
+            """operands of the long edge (``lng``), else of the short edge on this line."""
+            m.d.comb += [a0.eq(Mux(lng | upper, a_a, a_b)), y0_.eq(Mux(lng | upper, tv.ya, tv.yb)),
+                         inc.eq(Mux(lng, i_ac[:16], Mux(upper, i_ab[:16], i_bc[:16])).as_signed())]
+        with m.Switch(msel):
+            with m.Case(MUL_OPS["x_long"]):
+                pick(tv.xa, tv.xb, tv.inc_ac, tv.inc_ab, tv.inc_bc, 1)
+            with m.Case(MUL_OPS["x_short"]):
+                pick(tv.xa, tv.xb, tv.inc_ac, tv.inc_ab, tv.inc_bc, 0)
+            with m.Case(MUL_OPS["z_left"]):
+                pick(tv.za, tv.zb, tv.zinc_ac, tv.zinc_ab, tv.zinc_bc, tv.ll)
+            with m.Case(MUL_OPS["i_left"]):
+                pick(tv.ia, tv.ib, tv.iinc_ac, tv.iinc_ab, tv.iinc_bc, tv.ll)
+        dy = Signal(16)
+        res = Signal(signed(36))
+        m.d.comb += [dy.eq(yc - y0_), res.eq(a0 + (sm_mul(m, dy, inc, "slp_mul") >> X_FRAC))]
+        xlong = Signal(signed(18))
+        zreg = Signal(16)
+        newx = Signal(xs)
+        m.d.comb += [newx.xl.eq(Mux(tv.ll, xlong, res)), newx.xr.eq(Mux(tv.ll, res, xlong))]
+        return {"msel": msel, "res": res, "xlong": xlong, "zreg": zreg, "newx": newx}
+
     def elaborate(self, platform):
         m = Module()
         W, G = self._w, self._guard
@@ -224,27 +310,14 @@ class ExpertsSlp(wiring.Component):
         tv = Signal(tl)
         m.d.comb += tv.eq(ttr.data)
 
-        def edge(x0, yy0, inc, name):
-            v = Signal(signed(80), name=name)
-            m.d.comb += v.eq(((x0 << self._ex) + (((yc - yy0) * inc) >> X_FRAC)) >> self._ex)
-            return v
-        lng = edge(tv.xa, tv.ya, tv.inc_ac, "x_long")
-        sht = Signal(signed(80))
-        up = edge(tv.xa, tv.ya, tv.inc_ab, "x_ab")
-        lo_ = edge(tv.xb, tv.yb, tv.inc_bc, "x_bc")
-        m.d.comb += sht.eq(Mux(yc < tv.yb, up, lo_))
-        newx = Signal(xs)
-        m.d.comb += [newx.xl.eq(Mux(tv.ll, lng, sht)), newx.xr.eq(Mux(tv.ll, sht, lng))]
-        # the rest of the ASL update, for the ASB written at the walk: z_L, i_L of the left edge
-        # (two multiplies each, the edge chosen as for x) and the A.J. slopes of both edges
-        def left(a_a, a_b, i_ac, i_ab, i_bc, name):
-            lg = edge(a_a, tv.ya, i_ac, f"{name}_long")
-            sh = Mux(yc < tv.yb, edge(a_a, tv.ya, i_ab, f"{name}_ab"), edge(a_b, tv.yb, i_bc, f"{name}_bc"))
-            v = Signal(signed(80), name=f"{name}_left")
-            m.d.comb += v.eq(Mux(tv.ll, lg, sh))
-            return v
-        zl_ = left(tv.za, tv.zb, tv.zinc_ac, tv.zinc_ab, tv.zinc_bc, "z")
-        il_ = left(tv.ia, tv.ib, tv.iinc_ac, tv.iinc_ab, tv.iinc_bc, "i")
+        one = self._ex == 0      # the paper's datapath: one 16 x 16 multiplier, shared in time
+        ph = Signal()            # (paper) the multiply phase of a segment's ASL update and ASL word
+        mul: dict = {}
+        if one:
+            mul = self._one_multiplier(m, tv, yc, xs)
+            newx, zl_, il_ = mul["newx"], mul["zreg"], mul["res"]
+        else:
+            newx, zl_, il_ = self._multipliers(m, tv, yc, xs)
         s_sh, q_sh = Signal(signed(16)), Signal(signed(16))
         m.d.comb += [s_sh.eq(Mux(yc < tv.yb, tv.s_ab, tv.s_bc)), q_sh.eq(Mux(yc < tv.yb, tv.q_ab, tv.q_bc))]
 
@@ -293,14 +366,15 @@ class ExpertsSlp(wiring.Component):
             with m.Case(_S.LEAVE):
                 # leave test + ASL update of the previous ASL's segment i
                 m.d.comb += [ar.addr.eq(i), ttr.addr.eq(ar.data)]
-                with m.If(tv.r1 >= y):
-                    m.d.comb += [bw.addr.eq(ns), bw.data.eq(ar.data), bw.en.eq(1),
-                                 kyw.addr.eq(ar.data), kyw.data.eq(newx), kyw.en.eq(1)]
-                    m.d.sync += ns.eq(ns + 1)
-                m.d.sync += i.eq(i + 1)
-                with m.If(i + 1 >= m_):
-                    nsn = ns + (tv.r1 >= y)
-                    m.d.sync += state.eq(Mux(nsn >= 2, _S.BINIT, _S.ESTART))
+                with self._first_multiply(m, mul, ph, (tv.r1 >= y) & ~ph):
+                    with m.If(tv.r1 >= y):
+                        m.d.comb += [bw.addr.eq(ns), bw.data.eq(ar.data), bw.en.eq(1),
+                                     kyw.addr.eq(ar.data), kyw.data.eq(newx), kyw.en.eq(1)]
+                        m.d.sync += ns.eq(ns + 1)
+                    m.d.sync += i.eq(i + 1)
+                    with m.If(i + 1 >= m_):
+                        nsn = ns + (tv.r1 >= y)
+                        m.d.sync += state.eq(Mux(nsn >= 2, _S.BINIT, _S.ESTART))
             with m.Case(_S.BINIT):
                 m.d.comb += br.addr.eq(0)
                 m.d.sync += [cur.eq(br.data), i.eq(0), swapped.eq(0), state.eq(_S.BSTEP)]
@@ -327,12 +401,13 @@ class ExpertsSlp(wiring.Component):
                              state.eq(Mux(cnr.data == 0, _S.FSETUP, _S.EWALK))]
             with m.Case(_S.EWALK):
                 # the line's bucket: ASL update of each entering segment, into E
-                m.d.comb += [ttr.addr.eq(node), nxr.addr.eq(node),
-                             ew.addr.eq(i), ew.data.eq(node), ew.en.eq(1),
-                             kyw.addr.eq(node), kyw.data.eq(newx), kyw.en.eq(1)]
-                m.d.sync += [node.eq(nxr.data), i.eq(i + 1)]
-                with m.If(i + 1 >= ne):
-                    m.d.sync += [wdt.eq(1), src_f.eq(0), state.eq(Mux(ne >= 2, _S.MLEVEL, _S.FSETUP))]
+                m.d.comb += [ttr.addr.eq(node), nxr.addr.eq(node)]
+                with self._first_multiply(m, mul, ph, ~ph):
+                    m.d.comb += [ew.addr.eq(i), ew.data.eq(node), ew.en.eq(1),
+                                 kyw.addr.eq(node), kyw.data.eq(newx), kyw.en.eq(1)]
+                    m.d.sync += [node.eq(nxr.data), i.eq(i + 1)]
+                    with m.If(i + 1 >= ne):
+                        m.d.sync += [wdt.eq(1), src_f.eq(0), state.eq(Mux(ne >= 2, _S.MLEVEL, _S.FSETUP))]
             with m.Case(_S.MLEVEL):
                 m.d.sync += [s0.eq(0), li.eq(0), le.eq(Mux(wdt < ne, wdt, ne)), ri.eq(Mux(wdt < ne, wdt, ne)),
                              re.eq(Mux(2 * wdt < ne, 2 * wdt, ne)), o.eq(0), state.eq(_S.MMOVE)]
@@ -380,24 +455,28 @@ class ExpertsSlp(wiring.Component):
 
             # ------------------------------------------------------------ block lists
             with m.Case(_S.WSEG):
-                m.d.comb += [ar.addr.eq(pos), ky0.addr.eq(ar.data), ttr.addr.eq(ar.data),
-                             self.o.valid.eq(1), o_.kind.eq(0), o_.pos.eq(pos), o_.t.eq(ar.data), o_.y.eq(y),
-                             o_.asb.xl.eq(ky0.data.xl), o_.asb.xr.eq(ky0.data.xr), o_.asb.zl.eq(zl_),
-                             o_.asb.il.eq(il_), o_.asb.dzdx.eq(tv.dzdx), o_.asb.didx.eq(tv.didx),
-                             o_.asb.hue.eq(tv.hue), o_.asb.addr.eq(ar.data), o_.asb.poly.eq(tv.poly),
-                             o_.asb.sl.eq(Mux(tv.ll, tv.s_ac, s_sh)), o_.asb.ql.eq(Mux(tv.ll, tv.q_ac, q_sh)),
-                             o_.asb.sr.eq(Mux(tv.ll, s_sh, tv.s_ac)), o_.asb.qr.eq(Mux(tv.ll, q_sh, tv.q_ac))]
-                c0, c1 = Signal(signed(12)), Signal(signed(12))
-                m.d.comb += [c0.eq((ky0.data.xl + 31) >> X_FRAC), c1.eq(((ky0.data.xr + 31) >> X_FRAC) - 1)]
-                with m.If(self.o.ready):
-                    a_ = Mux(c0 < 0, 0, c0)
-                    e_ = Mux(c1 > W - 1, W - 1, c1)
-                    with m.If(e_ < a_):
-                        m.d.sync += pos.eq(pos + 1)
-                        with m.If(pos + 1 >= m_):
-                            m.d.sync += state.eq(_S.EOL)
-                    with m.Else():
-                        m.d.sync += state.eq(_S.WQ)
+                m.d.comb += [ar.addr.eq(pos), ky0.addr.eq(ar.data), ttr.addr.eq(ar.data)]
+                # (paper) z_L first, then i_L as the word goes out
+                with self._first_multiply(m, mul, ph, ~ph, "z_left", "i_left", hold=True):
+                    m.d.comb += [self.o.valid.eq(1), o_.kind.eq(0), o_.pos.eq(pos), o_.t.eq(ar.data), o_.y.eq(y),
+                                 o_.asb.xl.eq(ky0.data.xl), o_.asb.xr.eq(ky0.data.xr), o_.asb.zl.eq(zl_),
+                                 o_.asb.il.eq(il_), o_.asb.dzdx.eq(tv.dzdx), o_.asb.didx.eq(tv.didx),
+                                 o_.asb.hue.eq(tv.hue), o_.asb.addr.eq(ar.data), o_.asb.poly.eq(tv.poly),
+                                 o_.asb.sl.eq(Mux(tv.ll, tv.s_ac, s_sh)), o_.asb.ql.eq(Mux(tv.ll, tv.q_ac, q_sh)),
+                                 o_.asb.sr.eq(Mux(tv.ll, s_sh, tv.s_ac)), o_.asb.qr.eq(Mux(tv.ll, q_sh, tv.q_ac))]
+                    c0, c1 = Signal(signed(12)), Signal(signed(12))
+                    m.d.comb += [c0.eq((ky0.data.xl + 31) >> X_FRAC), c1.eq(((ky0.data.xr + 31) >> X_FRAC) - 1)]
+                    with m.If(self.o.ready):
+                        if mul:
+                            m.d.sync += ph.eq(0)
+                        a_ = Mux(c0 < 0, 0, c0)
+                        e_ = Mux(c1 > W - 1, W - 1, c1)
+                        with m.If(e_ < a_):
+                            m.d.sync += pos.eq(pos + 1)
+                            with m.If(pos + 1 >= m_):
+                                m.d.sync += state.eq(_S.EOL)
+                        with m.Else():
+                            m.d.sync += state.eq(_S.WQ)
             with m.Case(_S.WQ, _S.WK):
                 m.d.comb += [ar.addr.eq(pos), ky0.addr.eq(ar.data)]
                 c0, c1 = Signal(signed(12)), Signal(signed(12))

@@ -27,9 +27,15 @@ from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.experts.formats import ACC_EXTRA, ADDR_BITS, SLOPE_FRAC, X_FRAC
 from rasterhw.golden_model.experts.slp_setup import EDGES, ROM_INDEX_BITS, rom_table
 
-__all__ = ["ExpertsSlpSetup", "pl_layout", "PL_KIND"]
+__all__ = ["ExpertsSlpSetup", "pl_layout", "PL_KIND", "LIMBS"]
 
 PL_KIND = {"band": 0, "tri": 1}
+#: the paper's datapath: 16-bit limbs of each step's two operands (``slp_setup.MULTIWORD`` counts the
+#: cycles): eq. (3)'s products and an edge's multiply-and-rounds are 16 x 16 (vertex x, y, z, i are
+#: 16-bit words, so their differences and R are 16-bit magnitudes); an edge's reciprocal remainder
+#: ``|d| (ROM + 1)`` has a 17-bit factor (ROM + 1 <= 2**16); the denominator and eq. (3)'s
+#: numerators are up to 34 bits (three limbs)
+LIMBS = {"mul": (1, 1), "recip": (1, 2), "recip_den": (3, 2), "md": (1, 1), "md_plane": (3, 1)}
 
 
 def pl_layout() -> data.StructLayout:
@@ -66,6 +72,48 @@ class ExpertsSlpSetup(wiring.Component):
         from rasterhw.hdl.experts.slp import slp_in_layout
         super().__init__({"i": In(stream.Signature(pl_layout())), "o": Out(stream.Signature(slp_in_layout()))})
 
+    def _multiplier(self, m, ma, mb, prod):
+        """``prod = ma * mb``. Ours: one 40 x 20 multiplier, one product a cycle. The paper's
+        (``acc_extra`` 0): one 16 x 16 multiplier (:func:`mul16.sm_mul`'s sign and magnitude), a
+        product of ``(na, nb)`` 16-bit limbs (:data:`LIMBS`) in ``na * nb`` cycles, one partial
+        product a cycle added into a multi-word accumulator, the step's own work in the last. Returns
+        ``limbs(na, nb)``, the context a step's sync work goes in."""
+        from contextlib import contextmanager
+        if self._ex != 0:
+            m.d.comb += prod.eq(ma * mb)
+
+            @contextmanager
+            def one_cycle(na, nb):
+                yield
+            return one_cycle
+        aa, ab_ = Signal(48, name="mag_a"), Signal(32, name="mag_b")
+        neg = Signal(name="neg")
+        ia, ib = Signal(2, name="limb_a"), Signal(1, name="limb_b")
+        la, lb = Signal(16, name="word_a"), Signal(16, name="word_b")
+        part = Signal(32, name="part")
+        place = Signal(64, name="place")
+        pacc, pfull = Signal(64, name="pacc"), Signal(64, name="pfull")
+        lc = Signal(3, name="lc")
+        m.d.comb += [aa.eq(Mux(ma < 0, -ma, ma)), ab_.eq(Mux(mb < 0, -mb, mb)), neg.eq((ma < 0) ^ (mb < 0)),
+                     la.eq(aa.word_select(ia, 16)), lb.eq(ab_.word_select(ib, 16)), part.eq(la * lb),
+                     place.eq(Mux(ia + ib == 0, part, Mux(ia + ib == 1, part << 16,
+                                                          Mux(ia + ib == 2, part << 32, part << 48)))),
+                     pfull.eq(pacc + place), prod.eq(Mux(neg, -pfull, pfull))]
+
+        @contextmanager
+        def multiword(na, nb):
+            n = na * nb
+            if n == 1:
+                yield
+                return
+            m.d.comb += [ia.eq(lc >> 1 if nb == 2 else lc), ib.eq(lc[0] if nb == 2 else 0)]
+            with m.If(lc != n - 1):
+                m.d.sync += [pacc.eq(pfull), lc.eq(lc + 1)]
+            with m.Else():
+                m.d.sync += [pacc.eq(0), lc.eq(0)]
+                yield
+        return multiword
+
     def elaborate(self, platform):
         from rasterhw.hdl.experts.slp import IN_KIND
         m = Module()
@@ -90,7 +138,7 @@ class ExpertsSlpSetup(wiring.Component):
         # ---- the datapath: one multiplier, an accumulator, the reciprocal (R, S, sign, remainder)
         ma, mb = Signal(signed(40)), Signal(signed(20))
         prod = Signal(signed(60))
-        m.d.comb += prod.eq(ma * mb)
+        limbs = self._multiplier(m, ma, mb, prod)
         acc = Signal(signed(40))
         den, nz, ni = (Signal(signed(40), name=n) for n in ("den", "nz", "ni"))
         R = Signal(unsigned(18))
@@ -162,11 +210,12 @@ class ExpertsSlpSetup(wiring.Component):
                         if st[0] == "mul":
                             _, a, b, dst, first = st
                             m.d.comb += [ma.eq(a), mb.eq(b)]
-                            if first:
-                                m.d.sync += acc.eq(prod)
-                            else:
-                                m.d.sync += dst.eq(acc - prod)
-                            m.d.sync += nxt
+                            with limbs(*LIMBS["mul"]):
+                                if first:
+                                    m.d.sync += acc.eq(prod)
+                                else:
+                                    m.d.sync += dst.eq(acc - prod)
+                                m.d.sync += nxt
                         elif st[0] == "recip":
                             d = st[1]
                             ad = Signal(unsigned(40), name=f"abs_{k}")
@@ -186,11 +235,12 @@ class ExpertsSlpSetup(wiring.Component):
                                              ma.eq(ad), mb.eq(rc)]
                                 sv = Signal(unsigned(6), name=f"s_{k}")
                                 m.d.comb += sv.eq(15 + bl)
-                                m.d.sync += [S.eq(sv), dneg.eq(d < 0), dabs.eq(ad), dz.eq(ad == 0), corr.eq(1)]
-                                with m.If(ad == 0):
-                                    m.d.sync += [R.eq(0), e.eq(0)]
-                                with m.Else():
-                                    m.d.sync += [R.eq(rc), e.eq((Const(1, 72) << sv) + (ad >> 1) - prod)]
+                                with limbs(*LIMBS["recip_den" if d is den else "recip"]):
+                                    m.d.sync += [S.eq(sv), dneg.eq(d < 0), dabs.eq(ad), dz.eq(ad == 0), corr.eq(1)]
+                                    with m.If(ad == 0):
+                                        m.d.sync += [R.eq(0), e.eq(0)]
+                                    with m.Else():
+                                        m.d.sync += [R.eq(rc), e.eq((Const(1, 72) << sv) + (ad >> 1) - prod)]
                             with m.Else():
                                 with m.If(e < 0):
                                     m.d.sync += [R.eq(R - 1), e.eq(e + dabs)]
@@ -205,13 +255,14 @@ class ExpertsSlpSetup(wiring.Component):
                             v = Signal(signed(73), name=f"v_{k}")
                             m.d.comb += v.eq(Mux((num < 0) ^ dneg, -q, q))
                             tgt = getattr(res, field)
-                            if kind == "int":
-                                m.d.sync += tgt.eq(v)
-                            elif kind == "sat":
-                                m.d.sync += tgt.eq(sat16(v))
-                            else:
-                                m.d.sync += tgt.eq(Mux(dz, (1 << 15) - 1, sat16(v)))
-                            m.d.sync += nxt
+                            with limbs(*LIMBS["md_plane" if num is nz or num is ni else "md"]):
+                                if kind == "int":
+                                    m.d.sync += tgt.eq(v)
+                                elif kind == "sat":
+                                    m.d.sync += tgt.eq(sat16(v))
+                                else:
+                                    m.d.sync += tgt.eq(Mux(dz, (1 << 15) - 1, sat16(v)))
+                                m.d.sync += nxt
             # the sorted vertices and the left-edge flag into the word (they hold from the take on)
             m.d.sync += [res.ll.eq(den > 0), res.xa.eq(X[0]), res.ya.eq(Y[0]), res.xb.eq(X[1]), res.yb.eq(Y[1]),
                          res.za.eq(Z[0]), res.zb.eq(Z[1]), res.ia.eq(Iv[0]), res.ib.eq(Iv[1])]

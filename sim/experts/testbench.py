@@ -195,6 +195,9 @@ class PxpSpanBench(PxpBench):
     def stimulus(self, params: dict, seed: int) -> Stimulus:
         rng, name, fr = _frame(params, seed)
         jb = span_job_list(fr, self.lines(params, rng, fr, name, seed), pxp=self.pxp)
+        if params.get("datapath", "ours") == "paper":      # one multiplier: span_cycles.paper_jobs
+            from rasterhw.golden_model.experts.span_cycles import paper_jobs
+            jb = paper_jobs(jb)
         return job_stimulus(jb, f"{name} at {params['width']}, {jb['lines']} lines, seed {seed}")
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:

@@ -112,3 +112,69 @@ def test_slp_hdl_at_the_papers_widths_pysim():
               engine="pysim", expect_words={"o": len(sw["out"])}, max_cycles=40000)
     assert got.words["o"] == sw["out"] and int(got.stamps["o"][-1]) + 1 == sw["cycles"]
     assert len(sw["out"]) > 8 * 10
+
+
+def test_papers_slp_shares_one_multiplier_in_its_cycles(monkeypatch):
+    """The paper's SLP list work (acc_extra 0): one multiplier, so every survivor's and entering
+    segment's ASL update and every ASL word takes one more cycle than with a multiplier per operand
+    (slp_cycles.MUL_CYCLES); the cycle model counts exactly those (recounted here from its ASLs)."""
+    from rasterhw.golden_model.experts import slp_cycles
+    from rasterhw.golden_model.experts.model import equal_bounds
+    from rasterhw.golden_model.experts.slp_cycles import MUL_CYCLES, band_run, tri_words
+    fr = render_frame(run_geometry(build_scene("experts-tilt-1000"), 64, 32, z_bits=16), model="bit", aj="c",
+                      fmt=PAPER)
+    tws = tri_words(fr.setup)
+    args = (tws, (8, 16), equal_bounds(64, 3))
+    assert MUL_CYCLES == {0: 1, 16: 0}
+    one = band_run(*args, width=64, guard=1, extra=0)
+    monkeypatch.setitem(slp_cycles.MUL_CYCLES, 0, 0)        # the same widths, a multiplier per operand
+    many = band_run(*args, width=64, guard=1, extra=0)
+    assert many["words"] == one["words"]
+    extra = 0
+    prev: list = []
+    for y, asl in zip(range(8, 16), one["asl"], strict=True):
+        r1 = {t: tws[t]["r1"] for t in prev}
+        surv = sum(r1[t] >= y for t in prev)
+        entering = len(set(asl) - set(prev))
+        extra += surv + entering + len(asl)
+        prev = asl
+    assert extra > 50
+    assert one["cycles"] - many["cycles"] == extra
+
+
+def test_multipliers_are_counted_from_the_elaborated_hdl():
+    """hdl/experts/census.py counts the $mul cells of the elaborated design whose operands are both
+    signals: the paper's SLP list work has one 16 x 16 multiplier, ours nine (x of three edges, z and
+    i of three edges each, 19 x 48); constant multiplies (2 * run width) are not counted."""
+    from rasterhw.hdl.experts.census import census, multipliers
+    from rasterhw.hdl.experts.slp import ExpertsSlp
+    paper = census(ExpertsSlp(width=64, tris=64, lines=32, asl=64, acc_extra=0))
+    ours = census(ExpertsSlp(width=64, tris=64, lines=32, asl=64))
+    assert (paper["multipliers"], paper["bits"], paper["widths"]) == (1, 16, [(16, 16)])
+    assert (ours["multipliers"], ours["bits"]) == (9, 48)
+
+    from amaranth import Module, Signal
+    from amaranth.lib import wiring
+    from amaranth.lib.wiring import In, Out
+
+    class Two(wiring.Component):
+        def __init__(self):
+            super().__init__({"a": In(8), "b": In(12), "y": Out(24)})
+
+        def elaborate(self, platform):
+            m = Module()
+            k = Signal(8)
+            m.d.sync += k.eq(k + 1)
+            m.d.comb += self.y.eq(self.a * self.b + 3 * k + k * self.a)
+            return m
+    assert sorted(multipliers(Two())) == [(8, 8), (8, 12)]
+    # the chained frame at the paper's datapath without A.J.: one 16 x 16 multiplier a processor (the
+    # set-up's products wider than that multi-word); with A.J. (c) the blend's 9 are not shared yet
+    from rasterhw.hdl.experts.census import frame_census
+    f = frame_census("paper", pxp_datapath="paper", width=64, height=32, aj="none")
+    assert {b: (c["multipliers"], c["bits"]) for b, c in f["per_block"].items()} == {
+        "experts-slp-setup": (1, 16), "experts-slp": (1, 16), "experts-pxp-span": (1, 16)}
+    assert (f["multipliers"], f["datapath_bits"]) == (1, 16)
+    f = frame_census("ours", pxp_datapath="ours", width=64, height=32, aj="none")
+    assert {b: (c["multipliers"], c["bits"]) for b, c in f["per_block"].items()} == {
+        "experts-slp-setup": (1, 40), "experts-slp": (9, 48), "experts-pxp-span": (3, 20)}

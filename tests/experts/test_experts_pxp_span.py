@@ -145,3 +145,44 @@ def test_dmm_bank_overflow_stalls_the_writer_never_drops():
     sim.add_testbench(bench)
     sim.run()
     assert seen == {"taken": 4, "outs": 0, "overflow": 1, "ready": 0}
+
+
+@pytest.mark.parametrize("seed", [1, 4])     # 66 and 8 extra cycles (seeds 2, 3, 5: no depth search)
+def test_span_pxp_with_one_multiplier_pysim_word_and_cycle_exact(seed):
+    """experts-pxp-span at datapath "paper": one 16 x 16 multiplier (pass A and pass B two cycles a
+    segment, span_cycles.one_multiplier), pysim: pixels and cycles equal the golden side's; the same
+    stimulus takes more cycles than ours' (the test can fail) and the elaborated design has one
+    multiplier of 16 x 16 in the resolve side beside the drain's A.J. blend multipliers."""
+    from rasterhw.golden_model.experts.span_cycles import one_multiplier
+    from rasterhw.hdl.experts.census import multipliers
+    from rasterhw.hdl.experts.pxp_span import ExpertsPxpSpan
+    from rasterhw.sim.engines import run
+    from rasterhw.sim.testbench import compare, find_testbench
+    tb = find_testbench("experts-pxp-span")
+    p = tb.params(width=64, depth=64, aj="c", datapath="paper")
+    stim = tb.stimulus(p, seed=seed)
+    exp = tb.expect(p, stim)
+    ours = tb.expect(tb.params(width=64, depth=64, aj="c"), tb.stimulus(tb.params(width=64, depth=64, aj="c"), seed))
+    extra = sum(one_multiplier(st) for st in stim.source["steps"])
+    assert extra > 0 and exp.cycles > ours.cycles and exp.words == ours.words
+    got = run(tb, p, stim, engine="pysim", expect_words={k: len(v) for k, v in exp.words.items()})
+    c = compare(exp, got)
+    assert c["mismatches"] == 0 and c["cycle_mismatches"] == 0
+    assert multipliers(ExpertsPxpSpan(width=64, aj="none", datapath="paper")) == [(16, 16)]
+    assert len(multipliers(ExpertsPxpSpan(width=64, aj="none"))) == 3
+
+
+def test_paper_jobs_adds_the_multiplier_cycles_to_every_pxps_frame():
+    """span_cycles.paper_jobs on a frame's jobs (pxp_sim.jobs): pixels unchanged, every line's resolve
+    + pass_a + pass_b, and each PXP's frame time rescheduled: with one PXP it is the whole job list's
+    last pixel + 1; the coherent PXP's jobs are refused (it has no one-multiplier configuration)."""
+    from rasterhw.golden_model.experts.span_cycles import one_multiplier, paper_jobs
+    fr = render_frame(run_geometry(build_scene("experts-tilt-1000"), 64, 16, z_bits=16), model="bit", aj="c")
+    jb = jobs(fr, 1, 1, pxp="span")
+    pj = paper_jobs(jb)
+    assert np.array_equal(pj["pixels"], jb["pixels"])
+    assert [r for _, r, _ in pj["timing"]] == [r + one_multiplier(st) for (_, r, _), st in
+                                               zip(jb["timing"], jb["steps"], strict=True)]
+    assert int(pj["pxp_frame_cycles"][0, 0]) == pj["last_pixel"] + 1 > int(jb["pxp_frame_cycles"][0, 0])
+    with pytest.raises(RasterhwError, match="coherent PXP has no paper datapath"):
+        paper_jobs(jobs(fr, 1, 1, pxp="coherent"))

@@ -83,3 +83,30 @@ def test_hdl_words_and_cycles_on_wide_random_triangles():
               expect_words={"o": len(sw["out"])}, max_cycles=20000)
     assert got.words["o"] == sw["out"]
     assert list(got.stamps["o"]) == sw["stamps"]
+
+
+def test_papers_multi_word_products_on_wide_random_triangles():
+    """The paper's datapath (acc_extra 0): one 16 x 16 multiplier, the reciprocal remainders and
+    eq. (3)'s 34-bit numerators and denominator as multi-word products (hdl/experts/slp_setup.py:
+    LIMBS), on random PL triangles over the whole 16-bit vertex range, through pysim: the cycle
+    model's words on its cycles (+ slp_setup.MULTIWORD a triangle in the band); a vertex off the
+    16-bit word is refused in one line."""
+    from rasterhw.golden_model.errors import RasterhwError
+    from rasterhw.golden_model.experts.slp_setup import MULTIWORD
+    rng = np.random.default_rng(12)
+    pls = [_pl(rng, t) for t in range(40)]
+    for pl in pls:
+        for j in range(3):
+            pl[f"x{j}"] = abs(pl[f"x{j}"]) % 65536
+            pl[f"y{j}"] = int(rng.integers(0, 4500))
+    sw, ours = setup_words(pls, (0, 64), 64, extra=0), setup_words(pls, (0, 64), 64)
+    inb = sum(c > 2 for c in sw["tri_cycles"])
+    assert inb > 10 and sw["cycles"] - ours["cycles"] == MULTIWORD * inb == 15 * inb
+    tb = SlpSetupBench()
+    got = run(tb, tb.params(height=64, acc_extra=0), Stimulus({"i": sw["in"]}), engine="pysim",
+              expect_words={"o": len(sw["out"])}, max_cycles=40000)
+    assert got.words["o"] == sw["out"]
+    assert list(got.stamps["o"]) == sw["stamps"]
+    pls[3]["x1"] = -64
+    with pytest.raises(RasterhwError, match="16-bit word"):
+        setup_words(pls, (0, 64), 64, extra=0)
