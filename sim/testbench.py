@@ -166,15 +166,19 @@ class Testbench:
     def params(self, **given) -> dict:
         """The block's parameters: its factory's defaults, overridden by ``given`` (checked by
         the factory, which raises on a bad one)."""
-        factory = registry.load(registry.blocks()[self.block])
-        sig = inspect.signature(factory)
-        unknown = sorted(set(given) - set(sig.parameters))
+        names, defaults = self.signature()
+        unknown = sorted(set(given) - set(names))
         if unknown:
             raise RasterhwError(f"{self.block}: no parameter {', '.join(unknown)}; "
-                                f"parameters: {', '.join(sig.parameters)}")
-        out = {k: p.default for k, p in sig.parameters.items() if p.default is not inspect.Parameter.empty}
-        out.update(given)
-        return out
+                                f"parameters: {', '.join(names)}")
+        return {**defaults, **given}
+
+    def signature(self) -> tuple[list[str], dict]:
+        """(parameter names, defaults) of the block's factory (its module imported); a testbench may
+        give them from the build cache instead (``verilog_cache.factory_params``: no HDL import)."""
+        sig = inspect.signature(registry.load(registry.blocks()[self.block]))
+        return list(sig.parameters), {k: p.default for k, p in sig.parameters.items()
+                                      if p.default is not inspect.Parameter.empty}
 
     def dut(self, params: dict):
         """A fresh instance of the block (engines elaborate it once per run)."""

@@ -23,12 +23,21 @@ from functools import partial
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.engines import cocotb, pysim, verilator
+from rasterhw.sim.engines import cocotb, verilator
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, clocks_of
 
 __all__ = ["ALIASES", "ENGINES", "Tally", "run", "tally", "with_gaps"]
 
-ENGINES = {"pysim": pysim.run, "verilator": verilator.run,
+
+def _pysim(*args, **kw) -> Run:
+    """The pysim engine (``pysim.run``), imported at its first run: Amaranth's simulator is not
+    loaded by a run on another engine."""
+    from rasterhw.sim.engines import pysim
+
+    return pysim.run(*args, **kw)
+
+
+ENGINES = {"pysim": _pysim, "verilator": verilator.run,
            **{name: partial(cocotb.run, sim=sim) for name, sim in cocotb.SIMULATORS.items()}}
 #: the command line's simulator names for engines: ``icarus`` (cocotb benches' name) is cocotb on Icarus
 ALIASES = {"icarus": "cocotb-icarus"}

@@ -17,27 +17,16 @@ import os
 import re
 import shutil
 import sys
-import threading
 import time
 from pathlib import Path
 
 import numpy as np
-from amaranth.back import verilog
-from amaranth.hdl import (
-    Cat,
-    ClockDomain,
-    ClockSignal,
-    Const,
-    Elaboratable,
-    Instance,
-    Module,
-    Signal,
-)
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.cachefile import matches, sha256_file, warn_damaged
 from rasterhw.sim.engines import waves
 from rasterhw.sim.engines.memh import memh_uint64, read_memh
 from rasterhw.sim.engines.packed import as_bytes, records
+from rasterhw.sim.engines.ports import GAP_BITS, bench_ports, payload_of, ports_of, tag, unpack
 from rasterhw.sim.engines.runner import (
     HARNESS_V,
     build_plain_verilator,
@@ -45,21 +34,14 @@ from rasterhw.sim.engines.runner import (
     run_plain_verilator,
 )
 from rasterhw.sim.engines.verilog import canonical_port_lists
-from rasterhw.sim.engines.verilog_cache import convert_cached, module_sources, sources_digest
+from rasterhw.sim.engines.verilog_cache import closure_cached, convert_cached, sources_digest
 from rasterhw.sim.paths import BUILD_ROOT
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
 from rasterhw.sim.workdirs import build_lock, release, temp_run_folder
 
-__all__ = ["GAP_BITS", "PGO_OPT", "BenchTop", "bench_design", "bench_sources", "collected", "hier_marked",
+__all__ = ["GAP_BITS", "PGO_OPT", "bench_design", "bench_sources", "collected", "hier_marked",
            "memory_depths", "profile", "run",
            "status_of", "stream_plusargs", "unpack_status"]
-
-GAP_BITS = 8          # idle clocks before a word: 0..255
-
-
-def _tag(path: str) -> str:
-    """Port path -> plusarg stem: ``o_merge[3]`` -> ``o_merge_3``."""
-    return path.replace("[", "_").replace("]", "").replace(".", "_")
 
 
 def _depth(n: int) -> int:
@@ -69,99 +51,6 @@ def _depth(n: int) -> int:
     while d < n + 2:
         d *= 2
     return d
-
-
-def _payload(port):
-    p = port.payload
-    return p.as_value() if hasattr(p, "as_value") else p
-
-
-class BenchTop(Elaboratable):
-    """The block with a source on every input port and a sink on every output port; ports
-    ``clk``, ``done`` (every source played out and every sink full), ``cycles`` (edges so far) and
-    ``errors`` (clocks that broke the stream rules, every port: ``rasterhw_stream_check``).
-
-    ``port_domains`` (``{port: domain}`` of every stream port): separate clocks; the top then has
-    ``clocks`` (bit ``k``: domain ``domains[k]``'s clock, ``sync`` first) instead of ``clk``, each
-    port's source, sink and checker run on its domain's clock and a sink stamps its words with its
-    domain's edge count (``cycles`` for ``sync``). None: every domain on ``clk``."""
-
-    def __init__(self, dut, inputs: dict[str, int], outputs: dict[str, int], domains: tuple[str, ...],
-                 status: dict | None = None, port_domains: dict[str, str] | None = None):
-        self.dut = dut
-        self._status = dict(status or {})
-        self._inputs, self._outputs, self._domains = inputs, outputs, domains
-        self._port_domains = port_domains
-        self.cd = ClockDomain("sync", reset_less=True)
-        self.done = Signal(name="done")
-        self.cycles = Signal(32, name="cycles")
-        self.errors = Signal(32, name="errors")
-        self.status = Signal(64, name="status")   # the testbench's status values, packed in order
-        if port_domains is None:
-            self.ports = [self.cd.clk, self.done, self.cycles, self.errors, self.status]
-        else:
-            self.clocks = Signal(len(domains), name="clocks")
-            self.ports = [self.clocks, self.done, self.cycles, self.errors, self.status]
-
-    def elaborate(self, platform):
-        m = Module()
-        m.domains.sync = self.cd
-        separate = self._port_domains is not None
-        counters = {"sync": self.cycles}
-        for k, d in enumerate(self._domains):
-            if d != "sync":
-                m.domains += ClockDomain(d, reset_less=True)
-            if separate:   # each domain on its own bit of `clocks`, with its own edge count
-                m.d.comb += ClockSignal(d).eq(self.clocks[k])
-                if d != "sync":
-                    counters[d] = Signal(32, name=f"cycles_{d}")
-                    m.d[d] += counters[d].eq(counters[d] + 1)
-            elif d != "sync":   # every domain of the block runs on the one clock
-                m.d.comb += ClockSignal(d).eq(ClockSignal("sync"))
-        m.submodules.dut = self.dut
-        m.d.sync += self.cycles.eq(self.cycles + 1)
-
-        def dom(name):
-            return self._port_domains[name] if separate else "sync"
-
-        dones, errors = [], []
-        for name, depth in self._inputs.items():
-            port, t = port_of(self.dut, name), _tag(name)
-            ok = Signal(name=f"{t}_done")
-            m.submodules[f"src_{t}"] = Instance(
-                "rasterhw_stream_source", p_PW=len(_payload(port)), p_GW=GAP_BITS, p_DEPTH=depth,
-                p_FILE_ARG=f"{t}=%s", p_COUNT_ARG=f"{t}_n=%d", p_BINARY=1,
-                i_clk=ClockSignal(dom(name)), i_rst=Const(0, 1), i_base=Const(0, 32), i_count=Const(0, 32),
-                i_repeats=Const(1, 32),
-                o_valid=port.valid, i_ready=port.ready, o_payload=_payload(port), o_done=ok)
-            dones.append(ok)
-            errors.append(_check(m, t, port, dom(name)))
-        for name, depth in self._outputs.items():
-            port, t = port_of(self.dut, name), _tag(name)
-            ok = Signal(name=f"{t}_done")
-            m.submodules[f"sink_{t}"] = Instance(
-                "rasterhw_stream_sink", p_PW=len(_payload(port)), p_DEPTH=depth,
-                p_FILE_ARG=f"{t}=%s", p_CYC_ARG=f"{t}_cyc=%s", p_COUNT_ARG=f"{t}_n=%d",
-                p_STALL_ARG=f"{t}_stall=%d", p_SEED_ARG=f"{t}_seed=%d",
-                i_clk=ClockSignal(dom(name)), i_cycle=counters[dom(name)], i_valid=port.valid, o_ready=port.ready,
-                i_payload=_payload(port), o_done=ok)
-            dones.append(ok)
-            errors.append(_check(m, t, port, dom(name)))
-        m.d.comb += [self.done.eq(Cat(*dones).all()), self.errors.eq(sum(errors, Const(0, 32)))]
-        if self._status:
-            m.d.comb += self.status.eq(Cat(*self._status.values()))
-        return m
-
-
-def _check(m: Module, tag: str, port, domain: str = "sync") -> Signal:
-    """A stream-rule checker on ``port`` (``rasterhw_stream_check``) on ``domain``'s clock; its
-    count of bad clocks."""
-    err = Signal(32, name=f"{tag}_errors")
-    m.submodules[f"check_{tag}"] = Instance(
-        "rasterhw_stream_check", p_PW=len(_payload(port)), i_clk=ClockSignal(domain), i_rst=Const(0, 1),
-        i_valid=port.valid, i_ready=port.ready, i_payload=_payload(port), o_errors=err,
-        o_transfers=Signal(32, name=f"{tag}_transfers"))
-    return err
 
 
 def bench_sources(tb: Testbench) -> list[Path]:
@@ -178,39 +67,9 @@ def bench_sources(tb: Testbench) -> list[Path]:
 _CLOSURES = BUILD_ROOT / "bench-sources.json"
 
 
-def _stamp(f: Path) -> list[int]:
-    st = f.stat()
-    return [st.st_mtime_ns, st.st_size]
-
-
 def _closure_cached(roots: list[Path]) -> list[Path]:
-    """:func:`module_sources` of ``roots``, kept in ``build/bench-sources.json`` (parsing ~50 modules
-    for their imports cost ~0.3 CPU-s a run): reused while no file of the closure and no folder
-    holding one has changed (a file edited, added or removed there changes its stamp), else found
-    again. The closure depends only on those files' text and on which modules exist."""
-    key = "|".join(str(Path(r).resolve()) for r in roots)
-    try:
-        known = json.loads(_CLOSURES.read_text())
-    except (OSError, ValueError):
-        known = {}
-    hit = known.get(key)
-    if hit is not None:
-        try:
-            if all(_stamp(Path(f)) == st for f, st in hit["stamps"].items()):
-                return [Path(f) for f in hit["files"]]
-        except OSError:
-            pass
-    files = module_sources(roots)
-    stamps = {str(f): _stamp(f) for f in files} | {str(d): _stamp(d) for d in {f.parent for f in files}}
-    known[key] = {"files": [str(f) for f in files], "stamps": stamps}
-    try:
-        _CLOSURES.parent.mkdir(parents=True, exist_ok=True)
-        tmp = _CLOSURES.with_name(f"{_CLOSURES.name}.{os.getpid()}.{threading.get_ident()}.tmp")
-        tmp.write_text(json.dumps(known))
-        os.replace(tmp, _CLOSURES)
-    except OSError:
-        pass   # a read-only cache: found again next time
-    return files
+    """:func:`module_sources` of ``roots``, kept in ``build/bench-sources.json`` (``verilog_cache.closure_cached``)."""
+    return closure_cached(roots, _CLOSURES)
 
 
 def _class_file(cls) -> Path | None:
@@ -221,28 +80,43 @@ def _class_file(cls) -> Path | None:
         return None
 
 
+class _Design(tuple):
+    """(build name, generated files, the main's defines) of a bench top, with ``key``: the JSON
+    of everything its Verilog was cached by (:func:`ports.bench_ports` keys its port widths on it)."""
+
+    key: str = ""
+
+
 def bench_design(tb: Testbench, params: dict, inputs: dict[str, int], outputs: dict[str, int], speed: bool,
             separate: bool = False):
     """(build name, generated files, the main's defines) of the bench top around ``tb``'s block;
     ``speed``: the testbench's speed Verilog (:meth:`Testbench.sim_verilog`); ``separate``: one
-    clock per domain (one build serves every set of clocks: they are run-time arguments)."""
+    clock per domain (one build serves every set of clocks: they are run-time arguments). A cached
+    Verilog is read without constructing the block (or importing Amaranth)."""
     # what builds the DUT and its adapters (the testbench's modules and all they import) is design too
     key = {**params, "inputs": inputs, "outputs": outputs, "bench": sources_digest(bench_sources(tb))[:16],
            **({"speed": True} if speed else {}), **({"clocks": list(tb.domains)} if separate else {})}
     port_domains = {n: tb.domain_of(n) for n in (*inputs, *outputs)} if separate else None
 
     def top():
+        from rasterhw.sim.engines.benchtop import BenchTop
+
         dut = tb.dut(params)
         return BenchTop(dut, inputs, outputs, tb.domains, status_of(tb, dut, params), port_domains)
 
     def convert(top, mod):
+        from amaranth.back import verilog
+
         text = canonical_port_lists(verilog.convert(top, name=mod, ports=top.ports)) + _extra(top.dut)
         return tb.sim_verilog(params, text) if speed else text
 
     text = convert_cached(tb.block, top, params=key, module="rasterhw_bench", convert=convert)
     if separate:   # the main toggles bit k of `clocks` on domain k's own schedule
-        return f"tb-{tb.block}-clocks", {"rasterhw_bench.v": text}, {**_DEFINES, "RASTERHW_CLOCKS": len(tb.domains)}
-    return f"tb-{tb.block}", {"rasterhw_bench.v": text}, _DEFINES
+        d = _Design((f"tb-{tb.block}-clocks", {"rasterhw_bench.v": text}, {**_DEFINES, "RASTERHW_CLOCKS": len(tb.domains)}))
+    else:
+        d = _Design((f"tb-{tb.block}", {"rasterhw_bench.v": text}, _DEFINES))
+    d.key = json.dumps({"block": tb.block, **key}, sort_keys=True, default=str)
+    return d
 
 
 _DEFINES = {"RASTERHW_CYCLES": 1, "RASTERHW_ERRORS": 1, "RASTERHW_STATUS": 1}
@@ -258,11 +132,7 @@ def status_of(tb: Testbench, dut, params: dict) -> dict:
 
 def unpack_status(st: dict, word: int) -> dict[str, int]:
     """A packed status word -> ``{name: value}`` (the order and widths of ``st``)."""
-    out, at = {}, 0
-    for name, v in st.items():
-        out[name] = (word >> at) & ((1 << len(v)) - 1)
-        at += len(v)
-    return out
+    return unpack([[name, len(v)] for name, v in st.items()], word)
 
 
 def _build(design, opt: str, pgo=None, hier: tuple[str, ...] = ()) -> tuple[Path, float]:
@@ -383,11 +253,14 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
                    train=pgo is True or pgo == "train", say=pgo == "train") if pgo else None
     opt = opt or (PGO_OPT if prof is not None else tb.verilator_opt)
     exe, build_s = _build(top, opt, pgo=prof, hier=blocks)
-    dut = tb.dut(params)   # for the port widths and the status values' names and widths (not simulated)
-    waves.declare_payloads({n: port_of(dut, n) for n in (*tb.inputs_of(params), *tb.outputs_of(params))})
+    if waves.plain_trace_format() is not None:   # a trace's save file splits payloads into the block's fields
+        dut = tb.dut(params)
+        waves.declare_payloads({n: port_of(dut, n) for n in (*tb.inputs_of(params), *tb.outputs_of(params))})
+    # the port widths and the status values' names and widths, cached with the Verilog (no block constructed)
+    ports = bench_ports(tb, params, top.key, top[1]["rasterhw_bench.v"])
     words, stamps, meta, _ = _run_exe(exe, tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
-                                      inputs=inputs, max_cycles=max_cycles, dut=dut, clocks=clocks)
-    status = unpack_status(status_of(tb, dut, params), int(meta.get("status", 0)))
+                                      inputs=inputs, max_cycles=max_cycles, widths=ports["widths"], clocks=clocks)
+    status = unpack(ports["status"], int(meta.get("status", 0)))
     return Run("verilator", words, stamps, wall_s=time.perf_counter() - t0, build_s=build_s, run_s=meta["run_s"],
                cpu_s=meta["cpu_s"],
                protocol_errors=int(meta.get("errors", 0)), status=status,
@@ -407,18 +280,18 @@ def memory_depths(tb: Testbench, params: dict, stim: Stimulus, expect_words: dic
 
 def _run_exe(exe: Path, tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int,
              expect_words: dict[str, int], inputs: dict[str, int], max_cycles: int, profile: Path | None = None,
-             dut=None, clocks: dict | None = None):
-    """One run of a bench binary: (words, stamps, the main's JSON line, cycles)."""
+             widths: dict[str, int] | None = None, clocks: dict | None = None):
+    """One run of a bench binary: (words, stamps, the main's JSON line, cycles). ``widths``: every
+    stream port's payload bits (None: from the block, constructed here)."""
     run_dir = temp_run_folder(exe.parent.parent)
-    dut = tb.dut(params) if dut is None else dut
+    widths = ports_of(tb, params, tb.dut(params))["widths"] if widths is None else widths
     try:
         plus = stream_plusargs(run_dir, tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
-                               inputs=inputs, dut=dut, clocks=clocks)
+                               inputs=inputs, widths=widths, clocks=clocks)
         meta = run_plain_verilator(exe, plus + ["+dump_bin=1"], run_dir=run_dir, maxcyc=max_cycles,
                                    profile=profile)
         outs = tb.outputs_of(params)
-        words, stamps = collected(run_dir, outs, expect_words,
-                                  widths={n: len(_payload(port_of(dut, n))) for n in outs})
+        words, stamps = collected(run_dir, outs, expect_words, widths={n: widths[n] for n in outs})
     finally:
         release(run_dir)
     return words, stamps, meta, max((s[-1] + 1 for s in stamps.values() if s), default=0)
@@ -426,16 +299,17 @@ def _run_exe(exe: Path, tb: Testbench, params: dict, stim: Stimulus, *, stall: i
 
 def stream_plusargs(run_dir: Path, tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int,
                     expect_words: dict[str, int], inputs: dict[str, int], dut=None,
-                    clocks: dict | None = None) -> list[str]:
+                    clocks: dict | None = None, widths: dict[str, int] | None = None) -> list[str]:
     """The bench top's plusargs for one run in ``run_dir`` (any simulator): every input's packed
     ``{gap, word}`` records written to ``run_dir``, every sink's dump files, word count,
-    back-pressure and seed. ``clocks`` (``{domain: Clock}``, a build with separate clocks): each
+    back-pressure and seed (``widths``: the input payloads' bits, else from ``dut``, constructed if None). ``clocks`` (``{domain: Clock}``, a build with separate clocks): each
     domain's half period and first edge, as ``+clock_K=HALF,FIRST`` (default: every clock the same)."""
-    dut = tb.dut(params) if dut is None else dut
-    widths = {n: len(_payload(port_of(dut, n))) for n in inputs}
+    if widths is None:
+        dut = tb.dut(params) if dut is None else dut
+        widths = {n: len(payload_of(port_of(dut, n))) for n in inputs}
     plus = []
     for n in inputs:
-        t, words, gaps = _tag(n), stim.words[n], stim.gaps_of(n)
+        t, words, gaps = tag(n), stim.words[n], stim.gaps_of(n)
         g_arr = np.asarray(gaps, dtype=np.int64)
         if g_arr.size and (g_arr.min() < 0 or g_arr.max() >= 1 << GAP_BITS):
             raise RasterhwError(f"{tb.block}: gaps on {n} must lie in 0..{(1 << GAP_BITS) - 1}")
@@ -443,7 +317,7 @@ def stream_plusargs(run_dir: Path, tb: Testbench, params: dict, stim: Stimulus, 
         (run_dir / f"{t}.bin").write_bytes(records(as_bytes(words, pw), pw, g_arr, GAP_BITS).tobytes())
         plus += [f"+{t}={run_dir / f'{t}.bin'}", f"+{t}_n={len(words)}"]
     for k, n in enumerate(tb.outputs_of(params)):
-        t = _tag(n)
+        t = tag(n)
         plus += [f"+{t}={run_dir / f'{t}.out'}", f"+{t}_cyc={run_dir / f'{t}.cyc'}", f"+{t}_n={expect_words[n]}",
                  f"+{t}_stall={tb.stall_of(n, stall)}", f"+{t}_seed={tb.sink_seed(params, k, seed) & 0xFFFF_FFFF}"]
     # every edge after time 0 (the times are relative), as on pysim
@@ -457,7 +331,7 @@ def collected(run_dir: Path, outs, expect_words: dict[str, int], widths: dict[st
     with ``widths`` (``{port: payload bits}``, a run with ``+dump_bin=1``) the binary dumps."""
     words, stamps = {}, {}
     for n in outs:
-        t, k = _tag(n), expect_words[n]
+        t, k = tag(n), expect_words[n]
         if widths is not None:
             words[n] = _binary(run_dir / f"{t}.out", widths[n])[:k] if k else []
             stamps[n] = _binary(run_dir / f"{t}.cyc", 32)[:k] if k else []
@@ -476,7 +350,8 @@ def _binary(path: Path, bits: int) -> list[int]:
         raise RasterhwError(f"{path}: {raw.size} bytes, not whole {size}-byte words")
     if size <= 8:
         return raw.view("<u4" if size == 4 else "<u8").tolist()
-    return [int.from_bytes(row.tobytes(), "little") for row in raw.reshape(-1, size)]
+    b, from_bytes = raw.tobytes(), int.from_bytes   # slices of one bytes object: 0.6x the CPU of row.tobytes()
+    return [from_bytes(b[i:i + size], "little") for i in range(0, len(b), size)]
 
 
 def _extra(dut) -> str:

@@ -14,12 +14,13 @@ import re
 import warnings
 from collections.abc import Callable
 from functools import cache
+from typing import TYPE_CHECKING
 
-from amaranth.back import verilog
-from amaranth.hdl import UnusedElaboratable
-from amaranth.lib import wiring
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.registry import blocks, load
+
+if TYPE_CHECKING:
+    from amaranth.lib import wiring
 
 __all__ = ["block_names", "canonical_port_lists", "generate_verilog", "make_block", "merge_identical_modules",
            "parse_params"]
@@ -48,6 +49,8 @@ def _quietly(build, name: str):
     warnings after it: a constructor or ``elaborate`` that raised leaves half-built
     sub-components behind, and Amaranth warns about each (UnusedElaboratable) when it is
     collected -- so they are collected here, with that warning ignored."""
+    from amaranth.hdl import UnusedElaboratable  # here: the text functions below need no Amaranth
+
     msg = None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UnusedElaboratable)
@@ -228,6 +231,8 @@ def generate_verilog(name: str, **params) -> str:
     Ports come from the component's signature (``amaranth.back.verilog.convert``);
     streams flatten to ``<port>__valid``, ``<port>__ready``, ``<port>__payload``.
     """
+    from amaranth.back import verilog
+
     comp = make_block(name, **params)
     text = canonical_port_lists(_quietly(lambda: verilog.convert(comp, name=_module_name(name), emit_src=False),
                                          name))

@@ -22,13 +22,11 @@ from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.sim.engines.readout import sweep
+from rasterhw.sim.snu.frame_format import GAP_BITS, SCHEDULE
 from rasterhw.sim.testbench import port_of
 
 __all__ = ["GAP_BITS", "FrameAdapter", "SCHEDULE"]
 
-GAP_BITS = 16
-#: the words of ``o_sched``, in order
-SCHEDULE = ("t_clear", "t_start", "t_pixels_done", "t_swap", "cycles")
 
 
 class FrameAdapter(wiring.Component):

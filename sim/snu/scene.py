@@ -40,7 +40,7 @@ from rasterhw.golden_model.snu.formats import CLOCK_HZ, MEM_CYCLE, N_BANKS, Z_BI
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.sim import engines
 from rasterhw.sim.engines.scene import Done, Job, SceneRun, run_job
-from rasterhw.sim.snu.frame_adapter import GAP_BITS, SCHEDULE
+from rasterhw.sim.snu.frame_format import GAP_BITS, SCHEDULE
 from rasterhw.sim.snu.testbench import BusBench, FrameBench, frame_of
 
 __all__ = ["ENGINES", "PixelbusScene", "clear_cycles", "golden_schedule", "measure_rates", "producer_gaps",
@@ -252,7 +252,7 @@ def main(argv: list[str] | None = None) -> int:
 # ====================================================================== the whole frame
 def frame_job(stream: PixelStream, gaps: np.ndarray, sched: dict) -> Job:
     """The frame (``FrameBench``: clear, the producer gaps, swap) as one job: the displayed frame
-    and the :data:`~rasterhw.sim.snu.frame_adapter.SCHEDULE` words against the golden ``sched``."""
+    and the :data:`~rasterhw.sim.snu.frame_format.SCHEDULE` words against the golden ``sched``."""
     w, h = stream.width, stream.height
     tb = FrameBench()
     params = tb.params(width=w, height=h, z_bits=stream.z_bits, ram="memory" if -(-w * h // N_BANKS) <= 4096 else "verilog")

@@ -10,14 +10,13 @@ the golden frame (``golden_model/snu/pixelbus.py: pixelbus_frame``) word for wor
 from __future__ import annotations
 
 import numpy as np
-from amaranth import Cat
 from rasterhw.golden_model.snu import pixelbus as golden
 from rasterhw.golden_model.snu.formats import RGB_BITS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.golden_model.snu.words import payload_fields
 from rasterhw.sim.engines.packed import pack_fields
-from rasterhw.sim.engines.readout import ReadOut
-from rasterhw.sim.snu.frame_adapter import GAP_BITS, SCHEDULE, FrameAdapter
+from rasterhw.sim.engines.verilog_cache import factory_params
+from rasterhw.sim.snu.frame_format import GAP_BITS, SCHEDULE
 from rasterhw.sim.testbench import Expected, Run, Stimulus, Testbench
 
 __all__ = ["BankBench", "BusBench", "FrameBench", "frame_of"]
@@ -70,10 +69,13 @@ def frame_of(run: Run, z_bits: int, shape: tuple[int, int]) -> tuple[np.ndarray,
     return (w >> z_bits).reshape(shape), (w & ((1 << z_bits) - 1)).reshape(shape)
 
 
-def _read_out(block, ports: tuple[str, ...], words: int) -> ReadOut:
-    """The frame-memory block behind the engines' read-out adapter: an end token on every write
-    stream, then the draw buffer (``rd_buf`` 0) streamed out as ``{rgb, z}`` (``z`` low); ``i_cmd``
-    idle (no clear, no swap: the memory starts at zero, as after a clear)."""
+def _read_out(block, ports: tuple[str, ...], words: int):
+    """The frame-memory block behind the engines' read-out adapter (``ReadOut``): an end token on
+    every write stream, then the draw buffer (``rd_buf`` 0) streamed out as ``{rgb, z}`` (``z``
+    low); ``i_cmd`` idle (no clear, no swap: the memory starts at zero, as after a clear)."""
+    # imported here, as Amaranth: a run whose Verilog is cached constructs no block
+    from amaranth import Cat
+    from rasterhw.sim.engines.readout import ReadOut
 
     def address(m, b, addr):
         m.d.comb += b.rd_addr.eq(addr)
@@ -141,6 +143,9 @@ class BusBench(Testbench):
     block = "pixelbus"
     inputs = ("i_pipe0", "i_pipe1")
 
+    def signature(self) -> tuple[list[str], dict]:
+        return factory_params(self.block)   # from the build cache: a warm sim pixelbus imports no HDL
+
     def dut(self, params: dict):
         return _read_out(super().dut(params), self.inputs, params["width"] * params["height"])
 
@@ -180,6 +185,8 @@ class FrameBench(BusBench):
     verilator_opt = "-O2"   # one run of ~17 M clocks: the clock loop outweighs the longer build
 
     def dut(self, params: dict):
+        from rasterhw.sim.snu.frame_adapter import FrameAdapter  # Amaranth: when the block is built
+
         return FrameAdapter(Testbench.dut(self, params), self.inputs, params["width"] * params["height"])
 
     def outputs_of(self, params: dict) -> tuple[str, ...]:
