@@ -285,6 +285,10 @@ def decode_slp(words: list[int]) -> list[tuple]:
     return out
 
 
+#: the census's blocks as the result's keys name the frame's units
+_UNIT = {"experts-slp-setup": "slp_setup", "experts-slp": "slp_list", "experts-pxp-span": "pxp_span"}
+
+
 @cache
 def _census(datapath: str, width: int, height: int, aj: str) -> dict:
     """``census.frame_census`` of the frame ``sim experts`` chains (span PXP at ``datapath`` too),
@@ -296,14 +300,14 @@ def _census(datapath: str, width: int, height: int, aj: str) -> dict:
 def _accuracy(tris, datapath: str, aj: str, error: bool, *, width: int, height: int) -> dict:
     """The datapath's contract beside what the frame's HDL has, counted from its elaborated design
     (:func:`_census`, ``census_source`` hdl:elaborated): ``datapath_bits`` (the widest multiplier
-    operand), ``multipliers`` (the most in one processor), ``hdl_multipliers`` (per block);
+    operand), ``multipliers`` (the most in one processor), ``hdl_multipliers`` (per unit: ``slp_setup``, ``slp_list``, ``pxp_span``);
     ``error``: also the golden bit model's error against float (``accuracy_source`` golden; the
     float model rendered for it)."""
     from rasterhw.golden_model.experts.formats import DATAPATHS
     dp, c = DATAPATHS[datapath], _census(datapath, width, height, aj)
     out = {"datapath": dp.name, "datapath_label": dp.label, "datapath_bits": c["datapath_bits"],
            "multipliers": c["multipliers"], "census_source": c["source"],
-           "hdl_multipliers": {b: v["multipliers"] for b, v in c["per_block"].items()},
+           "hdl_multipliers": {_UNIT[b]: v["multipliers"] for b, v in c["per_block"].items()},
            "contract_datapath_bits": dp.word_bits, "contract_multipliers": dp.multipliers}
     if error:
         from rasterhw.golden_model.experts.accuracy import float_error
