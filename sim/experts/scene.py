@@ -24,6 +24,7 @@ clocked together), pixels against golden, the band's cycles as measured (no cycl
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import cache
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
@@ -68,7 +69,8 @@ def jobs(fr: ExpertsFrame, sn: int, pn: int, *, ranges: np.ndarray | None = None
          slp: dict | None = None) -> dict:
     """:func:`job_list` (``pxp="span"`` / ``"coherent"``: :func:`span_job_list`) for every (line, PXP) of an
     Sn x Pn split, in frame order, plus each PXP's own frame time by the cycle model (its band's lines
-    back to back, as that PXP runs them): ``pxp_frame_cycles`` (Sn, Pn). ``ranges`` (H, Pn + 1):
+    back to back, as that PXP runs them): ``pxp_frame_cycles`` (Sn, Pn), and each job's PXP ``owner``
+    (band, range). ``ranges`` (H, Pn + 1):
     per-line boundaries (balancing); default the equal static split."""
     from rasterhw.golden_model.experts.span_cycles import schedule as span_schedule
     H = fr.height
@@ -76,6 +78,8 @@ def jobs(fr: ExpertsFrame, sn: int, pn: int, *, ranges: np.ndarray | None = None
     rbs = np.broadcast_to(equal_bounds(fr.width, pn) if ranges is None else np.asarray(ranges), (H, pn + 1))
     todo = [(y, int(rbs[y, p]), int(rbs[y, p + 1])) for y in range(H) for p in range(pn)]
     jb = span_job_list(fr, todo, slp, pxp=pxp) if pxp in ("span", "coherent") else job_list(fr, todo)
+    # each job's PXP (band, range): span_cycles.paper_jobs schedules every PXP's own lines again
+    jb["owner"] = [(int(np.searchsorted(bands, y, side="right") - 1), p) for y in range(H) for p in range(pn)]
     per = np.zeros((sn, pn), np.int64)
     for sidx in range(sn):
         ys = range(int(bands[sidx]), int(bands[sidx + 1]))
@@ -158,7 +162,9 @@ def pxp_job(jb: dict, *, width: int, engine: str = "pysim", idle: int = 0, stall
     maxcyc = (int(jb["cycles"].sum()) * 2 + 10000 + int(np.sum(stim.gaps_of("i")))) * (1 + (idle + stall) // 16)
     run = {"stall": stall, "seed": seed, "max_cycles": maxcyc,
            "build": {"depth": IN_DEPTH, "out_depth": OUT_DEPTH} if engine == "verilator" else None}
-    return Job(tb, tb.params(width=width, aj=jb["aj"]), stim, Expected({"o": jb["pixels"].tolist()}), run,
+    # the paper's jobs (span_cycles.paper_jobs: one multiplier) on the block built at the paper's datapath
+    dp = {"datapath": "paper"} if jb.get("datapath") == "paper" else {}
+    return Job(tb, tb.params(width=width, aj=jb["aj"], **dp), stim, Expected({"o": jb["pixels"].tolist()}), run,
                cycle_exact=False, name="PXP", collect={"log": nlines})
 
 
@@ -279,24 +285,30 @@ def decode_slp(words: list[int]) -> list[tuple]:
     return out
 
 
-#: what the HDL of the chained frame has, at either datapath: its widest register (the set-up's 40 x 20
-#: multiplier, the PXPs' running z and i) and its multipliers (set-up 1; list work 3, x of a triangle's
-#: three edges at its entry; span PXP 3, z at a span's two ends and i at its start). ``paper`` makes the
-#: SLP's edge increments and accumulators 16 bits (acc_extra 0); the rest is not yet at 16 bits.
-HDL_WIDEST_BITS = 40
-HDL_MULTIPLIERS = {"slp_setup": 1, "slp_list": 3, "pxp_span": 3}
+#: the census's blocks as the result's keys name the frame's units
+_UNIT = {"experts-slp-setup": "slp_setup", "experts-slp": "slp_list", "experts-pxp-span": "pxp_span"}
 
 
-def _accuracy(tris, datapath: str, aj: str, error: bool) -> dict:
-    """The datapath's contract and what the HDL has (``datapath_bits``: the widest register,
-    ``multipliers``: the most in one processor); ``error``: also the golden bit model's error against
-    float (``accuracy_source`` golden; the float model rendered for it)."""
+@cache
+def _census(datapath: str, width: int, height: int, aj: str) -> dict:
+    """``census.frame_census`` of the frame ``sim experts`` chains (span PXP at ``datapath`` too),
+    once a process per argument set (it elaborates three designs)."""
+    from rasterhw.hdl.experts.census import frame_census
+    return frame_census(datapath, pxp_datapath=datapath, width=width, height=height, aj=aj)
+
+
+def _accuracy(tris, datapath: str, aj: str, error: bool, *, width: int, height: int) -> dict:
+    """The datapath's contract beside what the frame's HDL has, counted from its elaborated design
+    (:func:`_census`, ``census_source`` hdl:elaborated): ``datapath_bits`` (the widest multiplier
+    operand), ``multipliers`` (the most in one processor), ``hdl_multipliers`` (per unit: ``slp_setup``, ``slp_list``, ``pxp_span``);
+    ``error``: also the golden bit model's error against float (``accuracy_source`` golden; the
+    float model rendered for it)."""
     from rasterhw.golden_model.experts.formats import DATAPATHS
-    dp = DATAPATHS[datapath]
-    out = {"datapath": dp.name, "datapath_label": dp.label, "datapath_bits": HDL_WIDEST_BITS,
-           "multipliers": max(HDL_MULTIPLIERS.values()), "hdl_multipliers": HDL_MULTIPLIERS,
-           "contract_datapath_bits": dp.word_bits, "contract_multipliers": dp.multipliers,
-           "hdl_16_bit": "SLP edge increments and accumulators" if datapath == "paper" else "none"}
+    dp, c = DATAPATHS[datapath], _census(datapath, width, height, aj)
+    out = {"datapath": dp.name, "datapath_label": dp.label, "datapath_bits": c["datapath_bits"],
+           "multipliers": c["multipliers"], "census_source": c["source"],
+           "hdl_multipliers": {_UNIT[b]: v["multipliers"] for b, v in c["per_block"].items()},
+           "contract_datapath_bits": dp.word_bits, "contract_multipliers": dp.multipliers}
     if error:
         from rasterhw.golden_model.experts.accuracy import float_error
         e = float_error(tris, datapath, aj=aj)
@@ -314,7 +326,8 @@ class ExpertsScene(SceneRun):
     """``rasterhw sim experts``: the frame's SLP bands and PXP lines in HDL, against golden (module
     doc). ``cycles``: the machine's frame, the slower of the busiest SLP (set-up + list work) and the
     busiest PXP; ``path="group"``: the slowest band of ``experts-group``. ``datapath``: ours or
-    paper (the golden bit model at the paper's widths; the HDL's 16-bit parts: ``hdl_16_bit``);
+    paper (the golden bit model at the paper's widths, the SLP's and the span PXP's HDL built at it;
+    what the HDL has: ``datapath_bits`` / ``multipliers`` from its elaborated design);
     ``accuracy`` (always with ``datapath="paper"``): the bit model's error against float too."""
 
     block = "experts"
@@ -345,7 +358,8 @@ class ExpertsScene(SceneRun):
         sws = [slp_words(fr, (int(bands[s]), int(bands[s + 1])), bounds, guard=1 if aj == "c" else 0)
                for s in range(sn)]
         gold = {"fr": fr, "bands": bands, "bounds": bounds, "sws": sws, "ex": DATAPATHS[datapath].acc_extra,
-                "acc": _accuracy(tris, datapath, aj, accuracy or datapath == "paper")}
+                "acc": _accuracy(tris, datapath, aj, accuracy or datapath == "paper", width=width, height=height),
+                "datapath": datapath}
         if path == "chained":
             from rasterhw.golden_model.experts.slp_setup import pl_words
             from rasterhw.sim.experts.testbench import setup_words
@@ -416,6 +430,9 @@ class ExpertsScene(SceneRun):
         if len(lists) != fr.height * pn:
             raise RasterhwError(f"experts: the SLP HDL gave lists for {len(lists) // max(pn, 1)} of {fr.height} lines")
         gold["jb"] = jb = jobs(fr, len(gold["bands"]) - 1, pn, pxp="span", slp=lists)
+        if gold["datapath"] == "paper":      # the span PXP's one multiplier: its schedule
+            from rasterhw.golden_model.experts.span_cycles import paper_jobs
+            gold["jb"] = jb = paper_jobs(jb)
         return [pxp_job(jb, width=fr.width, engine=engine)]
 
     def result(self, gold: dict, done: list[Done], *, engine: str, sn: int = 8, pn: int = 8, aj: str = "c",

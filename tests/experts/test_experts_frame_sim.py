@@ -30,21 +30,28 @@ def test_small_frame_slp_and_pxp_hdl_exact():
         a + c for a, c in zip(r["slp_setup_cycles_per_band"], r["slp_list_cycles_per_band"], strict=True))
     # the machine's frame: the slower of the busiest SLP and the busiest PXP
     assert r["cycles"] == max(r["slp_cycles"], r["pxp_cycles"]) < r["sim_cycles"]
-    # today's datapath, and (accuracy=True) its golden bit model's error against float
-    assert (r["datapath"], r["datapath_bits"], r["multipliers"], r["accuracy_source"]) == ("ours", 40, 3, "golden")
+    # today's datapath as its elaborated HDL has it (the list work's 48-bit products, the span PXP's 3 and
+    # the A.J. blend's 9 multipliers), and (accuracy=True) its golden bit model's error against float
+    assert (r["datapath"], r["datapath_bits"], r["multipliers"], r["accuracy_source"]) == ("ours", 48, 12, "golden")
+    assert r["census_source"] == "hdl:elaborated"
     assert r["pixels_differing_from_ours"] == 0 and r["max_abs_error"] >= 0
 
 
-def test_paper_datapath_hdl_against_the_golden_model_at_its_widths():
-    """--datapath paper: the SLP HDL with 16-bit increments and accumulators, against the golden bit
-    model at the paper's widths; the result says what the HDL has (40-bit registers, 3 multipliers)
-    beside the contract (16, 1)."""
-    r = simulate_frame(build_scene("experts-tilt-1000"), 48, 16, engine="pysim", sn=2, pn=3, aj="c", datapath="paper")
+@pytest.mark.parametrize(("aj", "bits", "muls", "pxp_muls"), [("c", 20, 10, 10), ("none", 16, 1, 1)])
+def test_paper_datapath_hdl_against_the_golden_model_at_its_widths(aj, bits, muls, pxp_muls):
+    """--datapath paper: the SLP HDL with 16-bit increments and accumulators and the span PXP with one
+    16 x 16 multiplier (its jobs on span_cycles.paper_jobs' schedule), against the golden bit model at
+    the paper's widths; the result says what the elaborated HDL has beside the contract (16, 1): with
+    A.J. (c) its blend's 9 multipliers (widest operand 20 bits) are not shared yet; without, 16 and 1."""
+    r = simulate_frame(build_scene("experts-tilt-1000"), 48, 16, engine="pysim", sn=2, pn=3, aj=aj, datapath="paper")
     assert r["pixels_compared"] == 48 * 16 and r["mismatches"] == 0 and r["cycle_mismatches"] == 0
     assert r["slp_setup_word_mismatches"] == 0 and r["slp_word_mismatches"] == 0 and r["slp_words"] > 300
-    assert (r["datapath"], r["datapath_bits"], r["multipliers"]) == ("paper", 40, 3)
+    assert (r["datapath"], r["datapath_bits"], r["multipliers"]) == ("paper", bits, muls)
+    assert r["hdl_multipliers"] == {"slp_setup": 1, "slp_list": 1, "pxp_span": pxp_muls}
     assert (r["contract_datapath_bits"], r["contract_multipliers"]) == (16, 1)
-    assert r["hdl_16_bit"] == "SLP edge increments and accumulators"
+    # the PXP ran the one-multiplier schedule: slower than ours' on the same frame, each line as the HDL took it
+    ours = simulate_frame(build_scene("experts-tilt-1000"), 48, 16, engine="pysim", sn=2, pn=3, aj=aj)
+    assert r["pxp_cycles"] > ours["pxp_cycles"] and r["pxp_cycle_mismatches"] == 0
     with pytest.raises(RasterhwError, match="datapath must be"):
         simulate_frame(build_scene("experts-1000"), 64, 16, engine="pysim", datapath="wide")
     with pytest.raises(RasterhwError, match="path at chained"):
@@ -84,7 +91,7 @@ def test_the_float_model_only_when_its_error_is_asked_for():
     ``--datapath paper``); the HDL's and the contract's widths are there either way."""
     from rasterhw.sim.experts.scene import _accuracy
     tris = run_geometry(build_scene("experts-tilt-1000"), 48, 16, z_bits=16)
-    without, with_ = _accuracy(tris, "ours", "c", False), _accuracy(tris, "ours", "c", True)
+    without, with_ = (_accuracy(tris, "ours", "c", e, width=48, height=16) for e in (False, True))
     errors = {"max_abs_error", "pixels_differing_from_float", "psnr_db", "visible_differing_from_float",
               "pixels_differing_from_ours", "accuracy_source"}
     assert errors.isdisjoint(without) and errors <= set(with_) and set(without) <= set(with_)
