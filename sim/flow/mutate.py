@@ -46,7 +46,7 @@ from rasterhw.sim.engines.runner import HARNESS_V, build_plain_verilator, run_pl
 from rasterhw.sim.flow.tasks import Runner, call
 from rasterhw.sim.flow.tools import tool, tool_version
 from rasterhw.sim.paths import BUILD_ROOT
-from rasterhw.sim.testbench import Run, compare, find_testbench
+from rasterhw.sim.testbench import Run, clocks_of, compare, find_testbench
 from rasterhw.sim.workdirs import build_lock, release, temp_run_folder
 
 __all__ = ["CTRL", "SLOW_RUN", "all_configs", "campaign", "campaign_all", "mutant_result", "mutated_bench",
@@ -147,7 +147,8 @@ def mutated_bench(block: str, params: dict | None = None, *, mutants: int, seed:
     [...] (:func:`parse_mutations`), "yosys_s", "dir"}``."""
     tb, p, stim, exp, want = _setup(block, dict(params or {}), seed)
     inputs, outputs = verilator.memory_depths(tb, p, stim, want)
-    name, files, defines = verilator.bench_design(tb, p, inputs, outputs, speed=False)
+    name, files, defines = verilator.bench_design(tb, p, inputs, outputs, speed=False,
+                                                  separate=bool(tb.mutation_clocks))
     text = files["rasterhw_bench.v"]
     w = _width(mutants)
     script = ["read_verilog -sv bench.v", "hierarchy -top rasterhw_bench", "proc", "flatten", "memory_collect",
@@ -187,9 +188,11 @@ def _build(design, opt: str) -> tuple[Path, float]:
 
 
 def _run(exe: Path, tb, p: dict, stim, want: dict, mutant: int, *, idle: float = 0.0, stall: int = 0,
-         seed: int = 1) -> Run:
+         seed: int = 1, clocks: dict | None = None) -> Run:
     """One run of the mutated bench with mutant ``mutant`` active: the engine's sources, sinks,
-    gaps, back-pressure and watchdog (``sim/engines/__init__.py: run``, the plain engine's plusargs)."""
+    gaps, back-pressure and watchdog (``sim/engines/__init__.py: run``, the plain engine's plusargs);
+    ``clocks``: each domain's own :class:`Clock` (a bench built with separate clocks; none: every
+    clock the same)."""
     ins = tb.inputs_of(p)
     if idle:
         stim = with_gaps(stim, idle, seed, ins)
@@ -197,10 +200,12 @@ def _run(exe: Path, tb, p: dict, stim, want: dict, mutant: int, *, idle: float =
     words = sum(len(w) for w in stim.words.values()) + sum(want.values())
     gaps = sum(sum(int(g) for g in stim.gaps_of(n)) for n in ins)
     max_cycles = (10_000 + 64 * words + gaps) * (1 + stall // 32)   # the engine's watchdog
+    if clocks:   # the watchdog counts edges of the first domain's clock: as slow as the slowest
+        max_cycles *= -(-max(c.half for c in clocks.values()) // next(iter(clocks.values())).half)
     run_dir = temp_run_folder(exe.parent.parent)
     try:
         plus = verilator.stream_plusargs(run_dir, tb, p, stim, stall=stall, seed=seed, expect_words=want,
-                                         inputs=inputs)
+                                         inputs=inputs, clocks=clocks)
         meta = run_plain_verilator(exe, [*plus, f"+{CTRL}={mutant}"], run_dir=run_dir, maxcyc=max_cycles)
         got, stamps = verilator.collected(run_dir, tb.outputs_of(p), want)
     finally:
@@ -215,7 +220,12 @@ def mutant_result(block: str, params: str, mutants: int, seed: int, mutant: int)
     m = mutated_bench(block, json.loads(params), mutants=mutants, seed=seed)
     exe, _ = _build(m["design"], tb.verilator_opt)
     why = []
-    for label, kw, exact in (("back to back", {}, True), ("gaps and back-pressure", SLOW_RUN, False)):
+    runs = [("back to back", {}, True), ("gaps and back-pressure", SLOW_RUN, False)]
+    if tb.mutation_clocks:   # the testbench's separate clocks (a clock-domain crossing), gaps and back-pressure
+        clocks = clocks_of(tb.mutation_clocks, tb.domains)
+        runs.append(("separate clocks " + " : ".join(f"{d} {c.half}" for d, c in clocks.items()),
+                     {**SLOW_RUN, "clocks": clocks}, False))
+    for label, kw, exact in runs:
         try:
             got = _run(exe, tb, p, stim, want, mutant, **kw)
         except RasterhwError as e:   # the watchdog, or the binary failed

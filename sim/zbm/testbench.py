@@ -244,14 +244,17 @@ class MergerBench(Testbench):
     side (``i_own``), the upstream chip's on the merge side (``i_merge``), the nearest two of the
     four samples of each pair out (``o_merge``), as ``golden_model/zbm/merger.py: merge`` (upstream
     first on equal Z). Random pixels with Z ties and empty samples (``random_doublez``). Both
-    clocks run together here; the free-running unrelated clocks are the proof's
-    (``sim/zbm/proof.py``) and the cocotb bench's."""
+    clocks run together unless a run gives each its own; ``rasterhw mutate`` runs every mutant a
+    third time at segment : merge half periods 5 : 3 (:attr:`mutation_clocks`: the asynchronous
+    FIFO's Gray pointers and synchronisers only matter when the clocks differ); the free-running
+    unrelated clocks are the proof's (``sim/zbm/proof.py``) and the cocotb bench's."""
 
     block = "zbm-merger"
     inputs = ("i_own", "i_merge")
     outputs = ("o_merge",)
     domains = ("sync", "merge")
     port_domains = {"i_merge": "merge", "o_merge": "merge"}
+    mutation_clocks = {"sync": (3, 0), "merge": (7, 2)}
 
     def params(self, **given) -> dict:
         p = super().params(**given)
@@ -264,6 +267,11 @@ class MergerBench(Testbench):
         rng = np.random.default_rng(seed)
         n = int(rng.integers(60, 200))
         own, up = random_doublez(rng, n), random_doublez(rng, n)
+        # every other pixel's depths on a random base of the Z range, the same for both inputs (the
+        # ties stay; every bit of the 24-bit compares and of the words through the FIFO toggles)
+        base = rng.integers(0, F.Z_MAX_SAMPLE - 64, n) * (np.arange(n) % 2)
+        for d in (own, up):
+            d.z[:] = np.where(d.z == F.Z_EMPTY, d.z, d.z + base[:, None])
         return Stimulus({"i_own": merge_words(*doublez_words(own)), "i_merge": merge_words(*doublez_words(up))},
                         what=f"{n} random pixel pairs, seed {seed}", source=(own, up))
 
