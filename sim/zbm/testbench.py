@@ -78,24 +78,36 @@ def unit_watchdog(total_words: int, *, width: int, height: int, stall: int = 0,
 
 class SeggenBench(Testbench):
     """``zbm-seggen``: edge-pair words in (``i``), every scan line's segment words out (``o``), as
-    ``golden_model/zbm/seggen.py: segment_generator`` gives them. A random frame: 2..40 random
-    screen triangles (seeded), as many edge pairs as the memory holds at most."""
+    ``golden_model/zbm/seggen.py: segment_generator`` gives them. Two random frames, one after
+    the other (the block counts frames): a colour frame and a mapping frame (an edge pair carries
+    its mode; the mapping frame's pairs have six attribute channels, the colour frame's five), each
+    of 2..40 random screen triangles (seeded), as many edge pairs as the memory holds at most."""
 
     block = "zbm-seggen"
 
     def stimulus(self, params: dict, seed: int) -> Stimulus:
         rng = np.random.default_rng(seed)
         w, h = params["width"], params["height"]
-        n = int(rng.integers(2, 41))
-        eps = G.edge_pairs(random_triangles(rng, n, w, h, size=float(rng.uniform(3, max(4, min(w, h) / 2)))))
-        while len(eps) and G.max_active_edge_pairs(eps)[0] > params["capacity"]:
-            eps = eps.take(np.arange(len(eps) - 1))   # the frame must fit the memory
-        return Stimulus({"i": edge_pair_words(eps)}, what=f"{n} random triangles, seed {seed}", source=eps)
+        frames, ns = [], []
+        for mode in (F.MODE_COLOUR, F.MODE_MAPPING):
+            n = int(rng.integers(2, 41))
+            tris = random_triangles(rng, n, w, h, size=float(rng.uniform(3, max(4, min(w, h) / 2))))
+            eps = G.edge_pairs(tris, mode=mode)
+            while len(eps) and G.max_active_edge_pairs(eps)[0] > params["capacity"]:
+                eps = eps.take(np.arange(len(eps) - 1))   # the frame must fit the memory
+            frames.append(eps)
+            ns.append(n)
+        return Stimulus({"i": [wd for eps in frames for wd in edge_pair_words(eps)]},
+                        what=f"{ns[0]} random triangles in colour, then {ns[1]} in mapping mode, seed {seed}",
+                        source=frames)
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         h = params["height"]
-        segs = G.segment_generator(stim.source, h, width=params["width"], capacity=params["capacity"])
-        return Expected({"o": [wd for y in range(h) for wd in segment_words(segs, y)]})
+        out = []
+        for eps in stim.source:
+            segs = G.segment_generator(eps, h, width=params["width"], capacity=params["capacity"])
+            out += [wd for y in range(h) for wd in segment_words(segs, y)]
+        return Expected({"o": out})
 
 
 class UnitBench(Testbench):
