@@ -161,6 +161,11 @@ class Testbench:
     #: a testbench of one long run (millions of clocks) may ask for -O2 (``$RASTERHW_VERILATOR_OPT``
     #: then applies, as for every -O2 build)
     verilator_opt: str = "-O1"
+    #: ``{domain: (half period, first edge)}`` of every domain for a third run of each mutant in
+    #: ``rasterhw mutate`` (``sim/flow/mutate.py``), with separate clocks, idle gaps and back-pressure:
+    #: a block whose domains meet in a clock-domain crossing (an asynchronous FIFO) has logic that
+    #: only matters when the clocks differ. None: every run clocks the domains together
+    mutation_clocks: dict | None = None
 
     # ------------------------------------------------------------------ parameters and the DUT
     def params(self, **given) -> dict:

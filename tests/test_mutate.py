@@ -97,3 +97,19 @@ def test_a_block_not_built_within_the_budget_is_listed_with_why():
     assert [b["block"] for b in r["blocks"]] == ["zbm-merger", "experts-dmm"]
     assert all(b["score"] is None and "not built within the campaign's time budget" in b["error"] for b in r["blocks"])
     assert r["computed"] == 0
+
+
+@pytest.mark.heavy
+def test_a_survivor_on_a_bit_no_output_depends_on_is_proven_equivalent_and_a_killed_one_is_not():
+    """Item 2: Yosys's equivalence flow (equiv_make / equiv_simple / equiv_induct) over the ports of
+    the block as its testbench runs it. zbm-pixel at its small configuration, 30 mutants, seed 1:
+    mutant 1 ties bit 7 of the rounding add ``value + 2**23`` (``hdl/zbm/pixel.py:45``) to 0, a bit
+    the ``>> 24`` drops: proven equivalent, so no testbench could kill it; mutant 4 (killed by the
+    testbench) is not."""
+    p = json.dumps(M.all_configs()["zbm-pixel"], sort_keys=True)
+    cmds = {mu["mutant"]: mu["command"] for mu in M.mutated_bench("zbm-pixel", json.loads(p), mutants=30,
+                                                                        seed=1)["mutations"]}
+    assert "-portbit 7 " in cmds[1] and "pixel.py:45" in cmds[1]
+    assert M.mutant_result("zbm-pixel", p, 30, 1, 4)["killed"]
+    assert M.equivalence("zbm-pixel", p, 30, 1, 1)["equivalence"] == "equivalent"
+    assert M.equivalence("zbm-pixel", p, 30, 1, 4)["equivalence"] == "not proven"

