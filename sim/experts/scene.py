@@ -291,10 +291,29 @@ _UNIT = {"experts-slp-setup": "slp_setup", "experts-slp": "slp_list", "experts-p
 
 @cache
 def _census(datapath: str, width: int, height: int, aj: str) -> dict:
-    """``census.frame_census`` of the frame ``sim experts`` chains (span PXP at ``datapath`` too),
-    once a process per argument set (it elaborates three designs)."""
-    from rasterhw.hdl.experts.census import frame_census
-    return frame_census(datapath, pxp_datapath=datapath, width=width, height=height, aj=aj)
+    """``census.frame_census`` of the frame ``sim experts`` chains (span PXP at ``datapath`` too).
+    Elaborating the three designs costs ~14 s, so the count is a build-cache entry
+    (``build/verilog/experts-census-<digest>.json``, SHA-256 checked) keyed by the three blocks'
+    design digests, the counting code's own and the arguments: a run with none of them changed
+    reads it back and elaborates nothing."""
+    import hashlib
+    import json
+    from pathlib import Path
+
+    from rasterhw.hdl.experts import census
+    from rasterhw.sim.cachefile import read_entry, write_entry
+    from rasterhw.sim.engines.verilog_cache import source_digest, sources_digest
+    from rasterhw.sim.paths import BUILD_ROOT
+
+    designs = [source_digest(b) for b in sorted(_UNIT)]
+    key = json.dumps([designs, sources_digest([Path(census.__file__)]), datapath, width, height, aj])
+    path = BUILD_ROOT / "verilog" / f"experts-census-{hashlib.sha1(key.encode()).hexdigest()[:16]}.json"
+    got = read_entry(path, what="the EXPERTS multiplier census")
+    if got is not None:
+        return json.loads(got)
+    text = json.dumps(census.frame_census(datapath, pxp_datapath=datapath, width=width, height=height, aj=aj))
+    write_entry(path, text.encode(), root=BUILD_ROOT)
+    return json.loads(text)   # as a read-back gives it (lists, not tuples), on every run
 
 
 def _accuracy(tris, datapath: str, aj: str, error: bool, *, width: int, height: int) -> dict:
