@@ -60,8 +60,8 @@ def test_one_cluster_per_command_forked_workers_batches(tmp_path):
             assert run.address() == first                       # the same cluster
             again = run.map(_calls(40))
             assert run.reused == 40 and run.computed == 0
-            # equal apart from VARYING (the module's contract; a fresh-clone CI run once stored a
-            # wall_s that differed from the one returned, 4e-06 against 3.9e-05, not reproduced)
+            # equal apart from VARYING (the module's contract); that the stored value is the one
+            # returned is held below, on a future that would gather two values
             assert [_steady(r) for r in again] == [_steady(r) for r in got]
             with pytest.raises(RasterhwError, match="task 7 fails"):
                 run.map(_calls(20, "test_dask_runner:fail_on", bad=7))
@@ -119,3 +119,31 @@ def test_a_scheduler_file_names_the_scheduler_the_command_reaches(tmp_path, caps
     with pytest.raises(SystemExit) as e:
         main(["sweep", "render:experts", "--param", "sn=1", "--store", str(tmp_path / "st"), "--scheduler-file", str(f)])
     assert e.value.code == 2 and "tcp://127.0.0.1:1" in capsys.readouterr().err
+
+
+class _Regathering:
+    """A finished future whose every ``result()`` is a new value, as a task the scheduler ran
+    twice would give (``distributed.Future.result()`` gathers again on every call)."""
+
+    key = "call-regathering"
+    status = "finished"
+
+    def __init__(self):
+        self.calls = 0
+
+    def result(self):
+        self.calls += 1
+        return {"y": 1, "wall_s": self.calls * 1e-6}
+
+
+def test_the_stored_result_is_the_returned_one_when_a_future_would_gather_two_values(tmp_path):
+    """The done-callback stores, the caller returns: both from one gather of the future, so the
+    store can never hold a result that differs from the one returned (not even in ``VARYING``)."""
+    run = Runner("serial", store=tmp_path)
+    task = call("test_dask_runner:square", x=1)
+    h = tasks.Handle(task, task.digest())
+    h.future = fut = _Regathering()
+    run._finished([h], fut)                     # the callback thread stores
+    returned = run.result(h)                    # the caller's value
+    stored = json.loads(run._path(h.digest).read_text())["result"]
+    assert fut.calls == 1 and stored == returned == {"y": 1, "wall_s": 1e-6}
