@@ -51,6 +51,7 @@ from rasterhw.golden_model.experts.formats import (
     Z_BITS,
     Formats,
 )
+from rasterhw.hdl.experts.aj import MUL_IN
 from rasterhw.hdl.experts.drain import Drain, check_pxp_params, pxp_members
 from rasterhw.hdl.experts.mul16 import sm_mul
 from rasterhw.hdl.experts.pxp import asb_fields
@@ -384,11 +385,25 @@ class ExpertsPxpSpan(wiring.Component):
         m.d.comb += wr.en.eq(0)
         trd = dm["dmm"].read_port(transparent_for=()) if aj else None    # the visible segment's edges
         clr_full = dm["clr_full"]
+        mul = None
+        if self._datapath == "paper":
+            # the PXP's one 16 x 16 multiplier, shared by the resolve side and the drain's A.J. blend
+            mul = {"a": Signal(MUL_IN, name="mul_a"), "b": Signal(MUL_IN, name="mul_b")}
+            mul["p"] = sm_mul(m, mul["a"], mul["b"], "pxp_mul")
         drain = Drain(m, o=self.o, drd=drd, word=word, bank_bit=ab, width=W, ib=ib, aj=aj,
                       trd=trd, ent=asb, ent_bank_bit=pw, boundary_only=True,
-                      done_comb=lambda d: [clr_full.eq(Mux(d.dbank, 0b10, 0b01))])
+                      done_comb=lambda d: [clr_full.eq(Mux(d.dbank, 0b10, 0b01))],
+                      prod=mul["p"] if mul else None)
         return {**dm, "fmt": fmt, "W": W, "D": D, "aj": aj, "ib": ib, "asb": asb, "pw": pw, "cw": cw, "ab": ab,
-                "word": word, "wr": wr, "drain": drain}
+                "word": word, "wr": wr, "drain": drain, "mul": mul}
+
+    def _hold(self, m: Module, state, drain):
+        """(paper, A.J.) The arbitration of the one multiplier: while the drain's blend holds it
+        (``drain.mreq``), every resolve step but taking a bank (``IDLE``) and handing one over
+        (``HAND``) holds; else a context that adds nothing."""
+        if drain.mreq is None:
+            return _Always()
+        return m.If(~drain.mreq | (state == _R.IDLE) | (state == _R.HAND))
 
     def elaborate(self, platform):
         m = Module()
@@ -424,7 +439,13 @@ class ExpertsPxpSpan(wiring.Component):
             zlr = Signal(signed(40))
             d = Signal(signed(18))
             m.d.comb += d.eq((Mux(ph, sr, sl) << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl)
-            prod = sm_mul(m, d, Mux(state == _R.WRITE, seg.didx, seg.dzdx), "pxp_mul")
+            # the drain's A.J. blend has the multiplier first (drain.mreq); the resolve side then holds
+            mul, dr = fr["mul"], fr["drain"]
+            req = dr.mreq if dr.mreq is not None else 0
+            m.d.comb += [mul["a"].eq(Mux(req, dr.mul_a if dr.mul_a is not None else 0, d)),
+                         mul["b"].eq(Mux(req, dr.mul_b if dr.mul_b is not None else 0,
+                                         Mux(state == _R.WRITE, seg.didx, seg.dzdx)))]
+            prod = mul["p"]
             zp = Signal(signed(40))
             m.d.comb += zp.eq((seg.zl << DZ_FRAC) + (prod >> X_FRAC))
             zl_, zr_ = zlr, zp
@@ -468,7 +489,7 @@ class ExpertsPxpSpan(wiring.Component):
             with m.If(e + 1 < minend):
                 m.d.sync += minend.eq(e + 1)
 
-        with m.Switch(state):
+        with self._hold(m, state, drain), m.Switch(state):
             with m.Case(_R.IDLE):
                 m.d.sync += cyc.eq(1)
                 tb = take_bank(m, dm, rb, W, aj)
