@@ -186,3 +186,30 @@ def test_paper_jobs_adds_the_multiplier_cycles_to_every_pxps_frame():
     assert int(pj["pxp_frame_cycles"][0, 0]) == pj["last_pixel"] + 1 > int(jb["pxp_frame_cycles"][0, 0])
     with pytest.raises(RasterhwError, match="coherent PXP has no paper datapath"):
         paper_jobs(jobs(fr, 1, 1, pxp="coherent"))
+
+
+def test_paper_span_pxp_blends_on_its_one_multiplier_pysim_word_and_cycle_exact():
+    """experts-pxp-span at datapath "paper" with A.J. (c) on a frame of many boundaries (experts-1000
+    at 64 x 16, 4 ranges): the drain's blend takes the one multiplier, 4 or 5 multiplies a blended
+    pixel (span_cycles.aj_blends / paper_drain), and the resolve side holds while it does
+    (span_cycles.schedule's mul); pysim: every pixel and every line's finish-time counter equal
+    the golden side's, and the holds are there (the schedule without them differs)."""
+    from rasterhw.golden_model.experts.span_cycles import aj_blends, paper_jobs
+    from rasterhw.sim.experts.scene import check_jobs
+    fr = _frame("experts-1000", 64, 16)
+    pj = paper_jobs(jobs(fr, 1, 4, pxp="span"))
+    muls = [len(q["mul"]) for q in pj["paper_drain"]]
+    assert sum(muls) > 200
+    # every blended pixel costs its multiplies: 4 (steep edge) or 5, the drain that much longer
+    segs, lead, buckets = dmm_line(fr, 8, equal_bounds(64, 4))
+    job = line_job(segs, buckets[1], lead[1], 16, 32, aj="c", width=64)
+    bl = aj_blends(job_vis := resolve(segs, buckets[1], lead[1], 15, 33)[1], segs, 16, 32, width=64)
+    assert len(job_vis) == 18 and {n for _, n in bl} <= {4, 5}
+    assert job["paper_drain"]["drain"] == job["drain"] + sum(n - 1 for _, n in bl)
+    assert len(job["paper_drain"]["mul"]) == sum(n for _, n in bl)
+    held = schedule(pj["timing"])["line_cycles"]
+    assert held != pj["cycles"].tolist() and sum(held) < int(pj["cycles"].sum())
+    r = check_jobs(pj, width=64, engine="pysim")
+    assert r["pixel_mismatches"] == 0 and r["line_mismatches"] == 0
+    assert r["pixels"].size == 64 * 16 and np.array_equal(r["pixels"], pj["pixels"])
+    assert r["last_pixel"] == pj["last_pixel"] + 1          # the run's edge 0 takes the range word
