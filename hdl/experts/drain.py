@@ -14,7 +14,10 @@ jagの抑制", blending "直線成分の通過する画素"): the entry is read 
 differs from its left neighbour's (or the first of the walk), not background; every other pixel is
 offered (and a polygon-background boundary blended from the entry already held) in its second
 cycle: 2 cycles a pixel, 3 at a segment's first pixel. The resolve side hands a
-finished bank over with :meth:`Drain.hand` once :attr:`Drain.dbusy` is low. The paper does not
+finished bank over with :meth:`Drain.hand` once :attr:`Drain.dbusy` is low. With ``prod`` (the span
+PXP at ``datapath="paper"``) the blend runs on the PXP's one multiplier (``aj.aj_boundary_shared``):
+the blend-and-offer step repeats once per multiply (4 or 5 at a blended pixel), :attr:`Drain.mreq`
+high in each. The paper does not
 give the drain's rate; these are ours, as the golden cycle models (``pxp_cycles``,
 ``span_cycles``) count them.
 """

@@ -29,9 +29,11 @@ This block holds its own DMM/P (two banks; the writer fills one while the PXP re
   searched; ``k = 0`` is background, ``k = 1`` needs no search.
 * **S.S. and DSLB write**: one cycle per pixel of a decided (sub)span, the intensity by the
   multiplier at that pixel (equal to stepping), the word ``{ASB address, pixel, ASL position}``.
-* **drain** (double-banked DSLB, as :class:`hdl.experts.pxp.ExpertsPxp`): ``2 R`` cycles, with A.J.
-  (c) ``3 G`` plus one at the frame's right edge, the blend reading the visible segment's edges
-  from the DMM/P bank by its ASL position.
+* **drain** (double-banked DSLB, ``drain.py``): ``2 R`` cycles; with A.J. (c) 2 a guarded pixel, 3
+  at a segment's first, plus one at the frame's right edge, the blend reading the visible
+  segment's edges from the DMM/P bank by its ASL position. At ``datapath="paper"`` the blend is on
+  the PXP's one multiplier (``aj.aj_boundary_shared``: 4 or 5 multiplies a blended pixel, one a
+  cycle); the drain has it first and the resolve side holds meanwhile (:meth:`ExpertsPxpSpan._hold`).
 
 Cycles: ``golden_model/experts/span_cycles.py`` (every term named there). Pixels: the golden bit
 model's. The resolve side reads the DMM/P bank, the active list and the stack asynchronously
@@ -330,9 +332,10 @@ class ExpertsPxpSpan(wiring.Component):
     depth : int
         ASBs per DMM/P bank (2..511).
     datapath : str
-        ``"ours"`` (a multiplier each for z at a span's two ends and for i) or ``"paper"`` (one
-        16 x 16 multiplier, :func:`mul16.sm_mul`: pass A and pass B take two cycles a segment, z at
-        the left end, then at the right; ``span_cycles.one_multiplier``).
+        ``"ours"`` (a multiplier each for z at a span's two ends and for i, and the A.J. blend's
+        own) or ``"paper"`` (one 16 x 16 multiplier, :func:`mul16.sm_mul`: pass A and pass B take
+        two cycles a segment, z at the left end, then at the right, ``span_cycles.one_multiplier``;
+        with A.J. the drain's blend shares it, ``span_cycles.paper_drain`` and ``schedule(mul=)``).
 
     Members
     -------

@@ -60,6 +60,10 @@ def test_resolve_counts_every_step_and_halves_where_depths_cross():
     sch = schedule([(3, 10, 20), (3, 10, 20), (3, 10, 20)])
     assert sch["line_cycles"] == [11, 21, 19] and sch["last_pixel"] == 75
     assert schedule([(3, 10, 2)] * 3)["line_cycles"] == [11, 11, 11]
+    # the paper's datapath with A.J.: line 0's drain (14, 15) holds the multiplier in its cycles 1 and 2;
+    # line 1 takes its bank at 14 (not held), is held at 15: hands over at 25, not 24
+    assert schedule([(3, 10, 2)] * 2, [[1, 2], []])["line_cycles"] == [11, 12]
+    assert schedule([(3, 10, 2)] * 2, [[], []])["line_cycles"] == [11, 11]
 
 
 def test_span_work_depends_on_depth_the_line_z_buffer_does_not():
