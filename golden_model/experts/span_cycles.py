@@ -298,7 +298,8 @@ def paper_drain(vis: list[int], segs: list[dict], lo: int, hi: int, *, width: in
 
 def line_job(segs: list[dict], bucket: list[int], lead: int, lo: int, hi: int, *, aj: str, width: int,
              resolver=None) -> dict:
-    """One PXP line: its words, resolve and drain cycles and visible positions of ``[lo, hi)``.
+    """One PXP line: its words, resolve and drain cycles, visible positions of ``[lo, hi)`` and
+    ``drawn``, the guarded range's pixels a segment draws (not background; :func:`multiword`).
     ``resolver``: :func:`resolve` (default, the span PXP) or another PXP's resolve on the same
     DMM/P words, schedule and drain (``coherent.resolve``: the coherent span PXP)."""
     glo, ghi = guarded(lo, hi, width, aj)
@@ -306,7 +307,7 @@ def line_job(segs: list[dict], bucket: list[int], lead: int, lo: int, hi: int, *
     return {"words": len(segs) + len(bucket) + 1, "resolve": sum(cyc.values()), "steps": cyc,
             "drain": span_drain_cycles(vis, lo, hi, aj=aj, width=width),
             "paper_drain": paper_drain(vis, segs, lo, hi, width=width) if aj == "c" else None,
-            "visible": vis[lo - glo:lo - glo + (hi - lo)]}
+            "drawn": sum(1 for v in vis if v >= 0), "visible": vis[lo - glo:lo - glo + (hi - lo)]}
 
 
 def span_drain_cycles(vis: list[int], lo: int, hi: int, *, aj: str, width: int) -> int:
