@@ -46,7 +46,7 @@ from rasterhw.golden_model.experts.pxp_cycles import asb_record, drain_cycles, g
 from rasterhw.golden_model.experts.slp_run import block_lists
 
 __all__ = ["DMM_DEPTH", "Entering", "NO_PTR", "STEPS", "line_asl", "dmm_line", "resolve", "schedule", "span_drain_cycles",
-           "one_multiplier", "paper_jobs", "aj_blends", "paper_drain"]
+           "one_multiplier", "multiword", "paper_jobs", "aj_blends", "paper_drain"]
 
 DMM_DEPTH = 256       # ASBs per DMM/P bank (the block's default)
 NO_PTR = 511          # leading pointer: none
@@ -218,9 +218,22 @@ def one_multiplier(steps: dict) -> int:
     return steps["pass_a"] + steps["pass_b"]
 
 
+def multiword(steps: dict, drawn: int) -> int:
+    """The extra resolve cycles of one line that the paper's datapath's two-word z and i add
+    (``datapath="paper"``; docs/experts.md, "z and i in two words"): on a 16-bit datapath a
+    two-word add, subtract or compare takes two cycles, the low words with the carry / borrow kept,
+    then the high words. Each of pass A's and pass B's two cycles a segment (z at the left end,
+    then z at the right with the key compare or the guarded tests) operates on two-word z, so
+    takes two: 4 cycles a segment, 2 more than :func:`one_multiplier`'s; the write of a pixel
+    drawn by a segment (``drawn``, not background) adds its intensity ``i_L + (d * di/dx >> 6)``
+    in two words before it saturates it to the pixel: 2 cycles. ``steps``: :func:`resolve`'s."""
+    return 2 * (steps["pass_a"] + steps["pass_b"]) + drawn
+
+
 def paper_jobs(jb: dict) -> dict:
     """A span PXP job list (``sim/experts/pxp_jobs.py: span_job_list``, ours' cycles) at the paper's
-    datapath: every line's resolve cycles + :func:`one_multiplier`, with A.J. its drain's cycles and
+    datapath: every line's resolve cycles + :func:`one_multiplier` + :func:`multiword` (``jb["drawn"]``:
+    per job, the guarded range's pixels drawn by a segment), with A.J. its drain's cycles and
     multiplier cycles of :func:`paper_drain` (``jb["paper_drain"]``), scheduled again
     (:func:`schedule`, the resolve side holding while the drain blends), and a frame's
     ``pxp_frame_cycles`` (``pxp_sim.jobs``: per ``owner``, its lines back to back); words and
@@ -228,8 +241,8 @@ def paper_jobs(jb: dict) -> dict:
     if jb.get("pxp", "span") != "span":
         raise RasterhwError(f"experts: the {jb['pxp']} PXP has no paper datapath (one multiplier) yet")
     pd = jb.get("paper_drain") or [None] * len(jb["timing"])
-    lines = [(w, r + one_multiplier(st), d if q is None else q["drain"])
-             for (w, r, d), st, q in zip(jb["timing"], jb["steps"], pd, strict=True)]
+    lines = [(w, r + one_multiplier(st) + multiword(st, dn), d if q is None else q["drain"])
+             for (w, r, d), st, q, dn in zip(jb["timing"], jb["steps"], pd, jb["drawn"], strict=True)]
     mul = [[] if q is None else q["mul"] for q in pd]
     sch = schedule(lines, mul)
     out = {**jb, "timing": lines, "cycles": np.array(sch["line_cycles"], np.int64),

@@ -178,15 +178,21 @@ def test_span_pxp_with_one_multiplier_pysim_word_and_cycle_exact(seed):
 
 def test_paper_jobs_adds_the_multiplier_cycles_to_every_pxps_frame():
     """span_cycles.paper_jobs on a frame's jobs (pxp_sim.jobs): pixels unchanged, every line's resolve
-    + pass_a + pass_b, and each PXP's frame time rescheduled: with one PXP it is the whole job list's
+    + pass_a + pass_b (one multiplier) + 2 (pass_a + pass_b) + its drawn pixels (two-word z and i),
+    and each PXP's frame time rescheduled: with one PXP it is the whole job list's
     last pixel + 1; the coherent PXP's jobs are refused (it has no one-multiplier configuration)."""
-    from rasterhw.golden_model.experts.span_cycles import one_multiplier, paper_jobs
+    from rasterhw.golden_model.experts.span_cycles import multiword, one_multiplier, paper_jobs
     fr = render_frame(run_geometry(build_scene("experts-tilt-1000"), 64, 16, z_bits=16), model="bit", aj="c")
     jb = jobs(fr, 1, 1, pxp="span")
     pj = paper_jobs(jb)
     assert np.array_equal(pj["pixels"], jb["pixels"])
-    assert [r for _, r, _ in pj["timing"]] == [r + one_multiplier(st) for (_, r, _), st in
-                                               zip(jb["timing"], jb["steps"], strict=True)]
+    # drawn: the guarded range's pixels a segment draws (the whole line here: one PXP, no guard)
+    assert jb["drawn"] == [int((fr.win.reshape(16, 64)[y] >= 0).sum()) for y in range(16)]
+    assert 0 < sum(jb["drawn"]) < sum(st["write"] for st in jb["steps"])
+    assert [r for _, r, _ in pj["timing"]] == [r + 3 * (st["pass_a"] + st["pass_b"]) + dn for (_, r, _), st, dn in
+                                               zip(jb["timing"], jb["steps"], jb["drawn"], strict=True)]
+    assert [multiword(st, dn) for st, dn in zip(jb["steps"], jb["drawn"], strict=True)] == \
+        [2 * one_multiplier(st) + dn for st, dn in zip(jb["steps"], jb["drawn"], strict=True)]
     assert int(pj["pxp_frame_cycles"][0, 0]) == pj["last_pixel"] + 1 > int(jb["pxp_frame_cycles"][0, 0])
     with pytest.raises(RasterhwError, match="coherent PXP has no paper datapath"):
         paper_jobs(jobs(fr, 1, 1, pxp="coherent"))
