@@ -22,8 +22,9 @@ ASB dx/dy, dy/dx    sQ7.8      edge slopes, for anti-jagging only (saturating)
 SLP edge accum.     word+16    x, z, i stepped down an edge in 32 bits: the ASB word
                                plus 16 more fraction bits (SLP local memory)
 PXP running z       Q16.4      z word + 4 fraction bits (work 1); the register is wide enough
-                               never to wrap (40 bits in the HDL), the comparator sees the
-                               16-bit key clamped to 0..65535
+                               never to wrap (40 bits in ours' HDL; the paper's datapath: two
+                               16-bit words, |z| < 2**25 at 512 x 512, docs/experts.md "z and i
+                               in two words"), the comparator sees the 16-bit key clamped to 0..65535
 PXP running i       ASB iL     i word (di/dx has the same fraction bits), clamped when shaded
 alpha (A.J.)        Q0.8       mixing ratio, 0..256
 ==================  =========  ===================================================
@@ -78,7 +79,8 @@ class Datapath:
 #: with Q.22 increments of up to 40 bits; the span PXP has three multipliers: z at a span's two ends,
 #: i at its start). ``paper``: seed 000, 3.2, "SLP、PXPの基本演算データ幅は16ビットである" and a
 #: multiplier a processor ("乗算器 ... を装備"): every SLP edge accumulator and increment is one 16-bit
-#: word (the ASB word itself, no extra fraction bits: truncated, see docs/experts.md). These are the
+#: word (the ASB word itself, no extra fraction bits: truncated, see docs/experts.md); the span PXP's
+#: running z and i are two words, taken a word a cycle (multi-word, ``span_cycles.multiword``). These are the
 #: contracts; what the HDL has is counted from its elaborated design (``hdl/experts/census.py``).
 DATAPATHS = {"ours": Datapath("ours", word_bits=40, acc_extra=ACC_EXTRA, multipliers=3, label="ours"),
              "paper": Datapath("paper", word_bits=WORD, acc_extra=0, multipliers=1, label="the paper's")}

@@ -40,13 +40,13 @@ from __future__ import annotations
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.golden_model.experts.formats import ADDR_BITS, DZ_FRAC, X_FRAC, Z_BITS
+from rasterhw.golden_model.experts.formats import ADDR_BITS, DZ_FRAC, SLOPE_FRAC, X_FRAC, Z_BITS
 from rasterhw.golden_model.experts.model import ExpertsFrame
 from rasterhw.golden_model.experts.pxp_cycles import asb_record, drain_cycles, guarded
 from rasterhw.golden_model.experts.slp_run import block_lists
 
 __all__ = ["DMM_DEPTH", "Entering", "NO_PTR", "STEPS", "line_asl", "dmm_line", "resolve", "schedule", "span_drain_cycles",
-           "one_multiplier", "paper_jobs"]
+           "one_multiplier", "multiword", "paper_jobs", "aj_blends", "paper_drain"]
 
 DMM_DEPTH = 256       # ASBs per DMM/P bank (the block's default)
 NO_PTR = 511          # leading pointer: none
@@ -180,9 +180,14 @@ def resolve(segs: list[dict], bucket: list[int], lead: int, glo: int, ghi: int) 
     return cyc, vis
 
 
-def schedule(lines: list[tuple[int, int, int]]) -> dict:
+def schedule(lines: list[tuple[int, int, int]], mul: list[list[int]] | None = None) -> dict:
     """Exact timing of lines ``(words, resolve cycles, drain cycles)`` through the span PXP
-    (the module docstring's recurrences). Returns ``{"line_cycles": [...], "last_pixel": DE_{N-1}}``."""
+    (the module docstring's recurrences). Returns ``{"line_cycles": [...], "last_pixel": DE_{N-1}}``.
+
+    ``mul`` (the paper's datapath with A.J., :func:`paper_drain`): per line, the drain cycles
+    (1 = its first, at ``RH_k + 1``) in which its blend holds the one multiplier. The resolve side
+    of line ``k`` holds in every such cycle of line ``k - 1``'s drain after the cycle it takes its
+    bank (``RS_k``) and before the cycle it would hand over: each adds one cycle."""
     we, rh = -1, -1
     de: list[int] = []
     out = []
@@ -190,7 +195,15 @@ def schedule(lines: list[tuple[int, int, int]]) -> dict:
         ws = max(we + 1, de[k - 2] + 1 if k >= 2 else 0)
         we = ws + w - 1
         rs = max(we + 1, rh + 1)
-        rh = max(rs + r, de[k - 1] + 1 if k >= 1 else 0)
+        end = rs + r
+        if mul is not None and k >= 1:
+            for off in mul[k - 1]:
+                t = rh + off
+                if t >= end:
+                    break
+                if t > rs:
+                    end += 1
+        rh = max(end, de[k - 1] + 1 if k >= 1 else 0)
         de.append(rh + d)
         out.append(rh - rs + 1)
     return {"line_cycles": out, "last_pixel": de[-1] if de else -1}
@@ -205,38 +218,109 @@ def one_multiplier(steps: dict) -> int:
     return steps["pass_a"] + steps["pass_b"]
 
 
+def multiword(steps: dict, drawn: int) -> int:
+    """The extra resolve cycles of one line that the paper's datapath's two-word z and i add
+    (``datapath="paper"``; docs/experts.md, "z and i in two words"): on a 16-bit datapath a
+    two-word add, subtract or compare takes two cycles, the low words with the carry / borrow kept,
+    then the high words. Each of pass A's and pass B's two cycles a segment (z at the left end,
+    then z at the right with the key compare or the guarded tests) operates on two-word z, so
+    takes two: 4 cycles a segment, 2 more than :func:`one_multiplier`'s; the write of a pixel
+    drawn by a segment (``drawn``, not background) adds its intensity ``i_L + (d * di/dx >> 6)``
+    in two words before it saturates it to the pixel: 2 cycles. ``steps``: :func:`resolve`'s."""
+    return 2 * (steps["pass_a"] + steps["pass_b"]) + drawn
+
+
 def paper_jobs(jb: dict) -> dict:
     """A span PXP job list (``sim/experts/pxp_jobs.py: span_job_list``, ours' cycles) at the paper's
-    datapath: every line's resolve cycles + :func:`one_multiplier`, scheduled again (:func:`schedule`),
-    and a frame's ``pxp_frame_cycles`` (``pxp_sim.jobs``: per ``owner``, its lines back to back);
-    words and pixels unchanged. Adds ``datapath`` ``"paper"``."""
+    datapath: every line's resolve cycles + :func:`one_multiplier` + :func:`multiword` (``jb["drawn"]``:
+    per job, the guarded range's pixels drawn by a segment), with A.J. its drain's cycles and
+    multiplier cycles of :func:`paper_drain` (``jb["paper_drain"]``), scheduled again
+    (:func:`schedule`, the resolve side holding while the drain blends), and a frame's
+    ``pxp_frame_cycles`` (``pxp_sim.jobs``: per ``owner``, its lines back to back); words and
+    pixels unchanged. Adds ``datapath`` ``"paper"``."""
     if jb.get("pxp", "span") != "span":
         raise RasterhwError(f"experts: the {jb['pxp']} PXP has no paper datapath (one multiplier) yet")
-    lines = [(w, r + one_multiplier(st), d) for (w, r, d), st in zip(jb["timing"], jb["steps"], strict=True)]
-    sch = schedule(lines)
+    pd = jb.get("paper_drain") or [None] * len(jb["timing"])
+    lines = [(w, r + one_multiplier(st) + multiword(st, dn), d if q is None else q["drain"])
+             for (w, r, d), st, q, dn in zip(jb["timing"], jb["steps"], pd, jb["drawn"], strict=True)]
+    mul = [[] if q is None else q["mul"] for q in pd]
+    sch = schedule(lines, mul)
     out = {**jb, "timing": lines, "cycles": np.array(sch["line_cycles"], np.int64),
            "last_pixel": sch["last_pixel"], "datapath": "paper"}
     if "pxp_frame_cycles" in jb:      # a frame's jobs (pxp_sim.jobs): each PXP's own lines back to back
         own: dict = {}
         for k, o in enumerate(jb["owner"]):
-            own.setdefault(o, []).append(lines[k])
+            own.setdefault(o, []).append(k)
         per = np.zeros_like(jb["pxp_frame_cycles"])
-        for (s_, p), ls in own.items():
-            per[s_, p] = schedule(ls)["last_pixel"] + 1
+        for (s_, p), ks in own.items():
+            per[s_, p] = schedule([lines[k] for k in ks], [mul[k] for k in ks])["last_pixel"] + 1
         out["pxp_frame_cycles"] = per
     return out
 
 
+def aj_blends(vis: list[int], segs: list[dict], lo: int, hi: int, *, width: int) -> list[tuple[int, int]]:
+    """The boundaries the span PXP's drain blends with A.J. (c) (``hdl/experts/aj.py``), as
+    ``(j, multiplies)``: ``j`` the walk index (``glo + j``) of the boundary's right pixel, over the
+    guarded range's visible ASL positions ``vis`` (-1 background). A boundary between two
+    polygons blends where the right pixel's segment starts (its first pixel ``(xl + 31) >> 6``)
+    or else the left pixel's ends; the pixel blended is the right one if the edge's x
+    (``xl`` / ``xr``, Q10.6) is in it, else the left; only a pixel of ``[lo, hi)`` (the guard
+    pixels are another PXP's). ``multiplies``: 5 (``delta * |dy/dx|`` for alpha, one per field
+    R, G, B, I), 4 where the edge is steep (``|dx/dy| <= 1``: alpha is a shift)."""
+    glo, _ = guarded(lo, hi, width, "c")
+    none = (1 << ADDR_BITS) - 1
+    out = []
+    for j in range(1, len(vis)):
+        pv, cv = vis[j - 1], vis[j]
+        if pv == cv:
+            continue
+        dx = glo + j
+        ps = segs[pv] if pv >= 0 else None
+        cs = segs[cv] if cv >= 0 else None
+        if (ps["poly"] if ps else none) == (cs["poly"] if cs else none):
+            continue
+        if cs is not None and dx == max((cs["xl"] + 31) >> X_FRAC, 0):
+            xe, sl = cs["xl"], cs["sl"]
+        elif ps is not None and dx - 1 == min(((ps["xr"] + 31) >> X_FRAC) - 1, width - 1):
+            xe, sl = ps["xr"], ps["sr"]
+        else:
+            continue
+        q = dx if (xe >> X_FRAC) >= dx else dx - 1
+        if lo <= q < hi:
+            out.append((j, 4 if abs(sl) <= (1 << SLOPE_FRAC) else 5))
+    return out
+
+
+def paper_drain(vis: list[int], segs: list[dict], lo: int, hi: int, *, width: int) -> dict:
+    """The span PXP's A.J. (c) drain of one line at the paper's datapath (``hdl/experts/drain.py``
+    with the PXP's one multiplier): :func:`span_drain_cycles`' walk (per guarded pixel: read the
+    DSLB, then the entry at a segment's first pixel, then blend-and-offer), each blended
+    boundary (:func:`aj_blends`) repeating its blend-and-offer step once per multiply (the last
+    multiply in the cycle that offers). Returns ``drain`` (cycles) and ``mul`` (the drain cycles,
+    1 = the first, whose blend holds the multiplier)."""
+    glo, ghi = guarded(lo, hi, width, "c")
+    nm = dict(aj_blends(vis, segs, lo, hi, width=width))
+    t, mul = 0, []
+    for j, v in enumerate(vis):
+        t += 2 + (1 if v >= 0 and (j == 0 or vis[j - 1] != v) else 0)     # its blend-and-offer cycle
+        if j in nm:
+            mul += range(t, t + nm[j])
+            t += nm[j] - 1
+    return {"drain": t + (1 if ghi == hi else 0), "mul": mul}
+
+
 def line_job(segs: list[dict], bucket: list[int], lead: int, lo: int, hi: int, *, aj: str, width: int,
              resolver=None) -> dict:
-    """One PXP line: its words, resolve and drain cycles and visible positions of ``[lo, hi)``.
+    """One PXP line: its words, resolve and drain cycles, visible positions of ``[lo, hi)`` and
+    ``drawn``, the guarded range's pixels a segment draws (not background; :func:`multiword`).
     ``resolver``: :func:`resolve` (default, the span PXP) or another PXP's resolve on the same
     DMM/P words, schedule and drain (``coherent.resolve``: the coherent span PXP)."""
     glo, ghi = guarded(lo, hi, width, aj)
     cyc, vis = (resolver or resolve)(segs, bucket, lead, glo, ghi)
     return {"words": len(segs) + len(bucket) + 1, "resolve": sum(cyc.values()), "steps": cyc,
             "drain": span_drain_cycles(vis, lo, hi, aj=aj, width=width),
-            "visible": vis[lo - glo:lo - glo + (hi - lo)]}
+            "paper_drain": paper_drain(vis, segs, lo, hi, width=width) if aj == "c" else None,
+            "drawn": sum(1 for v in vis if v >= 0), "visible": vis[lo - glo:lo - glo + (hi - lo)]}
 
 
 def span_drain_cycles(vis: list[int], lo: int, hi: int, *, aj: str, width: int) -> int:

@@ -127,4 +127,5 @@ def line_job(segs: list[dict], bucket: list[int], lead: int, lo: int, hi: int, *
     cyc, vis = resolve(segs, bucket, lead, glo, ghi, engine="numba")
     return {"words": len(segs) + len(bucket) + 1, "resolve": sum(cyc.values()), "steps": cyc,
             "drain": spec.span_drain_cycles(vis, lo, hi, aj=aj, width=width),
-            "visible": vis[lo - glo:lo - glo + (hi - lo)]}
+            "paper_drain": spec.paper_drain(vis, segs, lo, hi, width=width) if aj == "c" else None,
+            "drawn": int((np.asarray(vis) >= 0).sum()), "visible": vis[lo - glo:lo - glo + (hi - lo)]}

@@ -9,8 +9,8 @@ widest operand of any multiplier: what a "16-bit basic operation width" means fo
 
 :func:`frame_census` counts the processors ``rasterhw sim experts`` chains at either datapath
 (``formats.DATAPATHS``): the SLP's set-up (``experts-slp-setup``), the SLP's list work
-(``experts-slp``), and the span PXP (``experts-pxp-span``, ``datapath="paper"``: one multiplier in its
-resolve side; the A.J. blend's are not shared yet).
+(``experts-slp``), and the span PXP (``experts-pxp-span``, ``datapath="paper"``: one multiplier, shared by its
+resolve side and its drain's A.J. blend).
 Its ``datapath_bits`` is the widest multiplier operand over them, ``multipliers`` the most
 multipliers in one processor.
 """

@@ -14,7 +14,10 @@ jagの抑制", blending "直線成分の通過する画素"): the entry is read 
 differs from its left neighbour's (or the first of the walk), not background; every other pixel is
 offered (and a polygon-background boundary blended from the entry already held) in its second
 cycle: 2 cycles a pixel, 3 at a segment's first pixel. The resolve side hands a
-finished bank over with :meth:`Drain.hand` once :attr:`Drain.dbusy` is low. The paper does not
+finished bank over with :meth:`Drain.hand` once :attr:`Drain.dbusy` is low. With ``prod`` (the span
+PXP at ``datapath="paper"``) the blend runs on the PXP's one multiplier (``aj.aj_boundary_shared``):
+the blend-and-offer step repeats once per multiply (4 or 5 at a blended pixel), :attr:`Drain.mreq`
+high in each. The paper does not
 give the drain's rate; these are ours, as the golden cycle models (``pxp_cycles``,
 ``span_cycles``) count them.
 """
@@ -25,7 +28,7 @@ from amaranth import Mux, Signal, unsigned
 from amaranth.lib import enum, stream
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.experts.formats import ADDR_BITS
-from rasterhw.hdl.experts.aj import NONE, aj_boundary
+from rasterhw.hdl.experts.aj import MUL_IN, NONE, aj_boundary, aj_boundary_shared
 
 __all__ = ["Drain", "check_pxp_params", "pxp_members"]
 
@@ -71,9 +74,18 @@ class Drain:
     """
 
     def __init__(self, m, *, o, drd, word, bank_bit: int, width: int, ib: int, aj: bool,
-                 trd=None, ent=None, ent_bank_bit: int = 0, done_comb=None, boundary_only: bool = False):
+                 trd=None, ent=None, ent_bank_bit: int = 0, done_comb=None, boundary_only: bool = False,
+                 prod=None):
         pb = len(o.payload)
         self.aj = aj
+        shared = aj and prod is not None
+        #: with ``prod`` (the PXP's one multiplier's product) and A.J.: the blend holds that multiplier
+        #: this cycle, with operands ``mul_a``, ``mul_b`` (else ``None``)
+        self.mreq = self.mul_a = self.mul_b = None
+        if shared:
+            self.mreq = Signal(name="aj_mreq")
+            self.mul_a, self.mul_b = Signal(MUL_IN, name="drain_mul_a"), Signal(MUL_IN, name="drain_mul_b")
+            m.d.comb += self.mreq.eq(0)
         self.dstate = dstate = Signal(_D)
         self.dbusy = dbusy = Signal()
         self.dbank = dbank = Signal()
@@ -105,8 +117,14 @@ class Drain:
             c_pix = Signal(pb)
             c_addr = Signal(ADDR_BITS)
             m.d.comb += [c_pix.eq(Mux(skip, dstored.pix, c_pix_r)), c_addr.eq(Mux(skip, dstored.addr, c_addr_r))]
-            o_prev, o_cur = aj_boundary(m, dx=dx, width=width, ib=ib, p_ok=p_ok, p_pix=p_pix, p_out=p_out,
-                                        p_addr=p_addr, p_ent=p_ent, c_pix=c_pix, c_addr=c_addr, c_ent=c_ent)
+            bnd = {"dx": dx, "width": width, "ib": ib, "p_ok": p_ok, "p_pix": p_pix, "p_out": p_out, "p_addr": p_addr,
+                   "p_ent": p_ent, "c_pix": c_pix, "c_addr": c_addr, "c_ent": c_ent}
+            if shared:
+                sh = aj_boundary_shared(m, lo=dlo, hi=dhi, prod=prod, **bnd)
+                o_prev, o_cur = sh["o_prev"], sh["o_cur"]
+                m.d.comb += [self.mul_a.eq(sh["a"]), self.mul_b.eq(sh["b"])]
+            else:
+                o_prev, o_cur = aj_boundary(m, **bnd)
             emit = Signal()
             m.d.comb += emit.eq(p_ok & (dx >= dlo + 1) & (dx <= dhi))
 
@@ -128,11 +146,13 @@ class Drain:
                     with m.Else():
                         m.d.sync += dstate.eq(_D.DRD)
             if aj:
-                def blend_offer():
+                def offer():
                     m.d.comb += [o.valid.eq(emit), o.payload.eq(o_prev)]
                     with m.If(~emit | o.ready):
                         m.d.sync += [p_pix.eq(c_pix), p_out.eq(o_cur), p_addr.eq(c_addr), p_ent.eq(c_ent),
                                      p_ok.eq(1), dx.eq(dx + 1)]
+                        if shared:
+                            m.d.sync += sh["done"]
                         with m.If(dx + 1 >= dghi):
                             with m.If(dghi == dhi):
                                 m.d.sync += dstate.eq(_D.FLUSH)
@@ -140,6 +160,17 @@ class Drain:
                                 drain_done()
                         with m.Else():
                             m.d.sync += dstate.eq(_D.DRD)
+
+                def blend_offer():
+                    if not shared:
+                        offer()
+                        return
+                    # the blend's multiplies, one a cycle, this step repeated; the last one offers
+                    m.d.comb += self.mreq.eq(sh["need"])
+                    with m.If(sh["last"]):
+                        offer()
+                    with m.Else():
+                        sh["step"]()
 
                 with m.Case(_D.DSEG):
                     with m.If(skip):

@@ -29,9 +29,20 @@ This block holds its own DMM/P (two banks; the writer fills one while the PXP re
   searched; ``k = 0`` is background, ``k = 1`` needs no search.
 * **S.S. and DSLB write**: one cycle per pixel of a decided (sub)span, the intensity by the
   multiplier at that pixel (equal to stepping), the word ``{ASB address, pixel, ASL position}``.
-* **drain** (double-banked DSLB, as :class:`hdl.experts.pxp.ExpertsPxp`): ``2 R`` cycles, with A.J.
-  (c) ``3 G`` plus one at the frame's right edge, the blend reading the visible segment's edges
-  from the DMM/P bank by its ASL position.
+* **drain** (double-banked DSLB, ``drain.py``): ``2 R`` cycles; with A.J. (c) 2 a guarded pixel, 3
+  at a segment's first, plus one at the frame's right edge, the blend reading the visible
+  segment's edges from the DMM/P bank by its ASL position. At ``datapath="paper"`` the blend is on
+  the PXP's one multiplier (``aj.aj_boundary_shared``: 4 or 5 multiplies a blended pixel, one a
+  cycle); the drain has it first and the resolve side holds meanwhile (:meth:`ExpertsPxpSpan._hold`).
+
+At ``datapath="paper"`` the running z and i are **two 16-bit words** (at 512 x 512 ``|z|, |i| < 2**25``,
+docs/experts.md "z and i in two words"): one 16-bit adder takes them a word a cycle, the low word
+first with its carry kept (``zlr`` z at the left end, ``zpl`` the right end's low word, ``ilo`` i's
+low word), the guarded tests subtract the low words in one cycle (borrows and flags kept,
+:class:`_GuardedWords`) and the high words in the next; the key is the high word's test and wires
+(:func:`_key_words`), the pixel's intensity the high word's sign against the low word
+(:func:`_i_words`). Pass A and pass B take 4 cycles a segment, the write 2 a drawn pixel
+(``span_cycles.multiword``).
 
 Cycles: ``golden_model/experts/span_cycles.py`` (every term named there). Pixels: the golden bit
 model's. The resolve side reads the DMM/P bank, the active list and the stack asynchronously
@@ -40,7 +51,7 @@ model's. The resolve side reads the DMM/P bank, the active list and the stack as
 
 from __future__ import annotations
 
-from amaranth import Module, Mux, Signal, signed, unsigned
+from amaranth import Cat, Module, Mux, Signal, signed, unsigned
 from amaranth.lib import data, enum, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import Out
@@ -51,6 +62,7 @@ from rasterhw.golden_model.experts.formats import (
     Z_BITS,
     Formats,
 )
+from rasterhw.hdl.experts.aj import MUL_IN
 from rasterhw.hdl.experts.drain import Drain, check_pxp_params, pxp_members
 from rasterhw.hdl.experts.mul16 import sm_mul
 from rasterhw.hdl.experts.pxp import asb_fields
@@ -226,6 +238,97 @@ def clamp_i(m: Module, run, fmt: Formats) -> Signal:
     return ic
 
 
+def _i_words(m: Module, hi, lo, fmt: Formats) -> Signal:
+    """(paper) The pixel's intensity from a two-word ``i = hi * 2**16 + lo`` (``hi`` signed, this
+    cycle's high word; ``lo`` the low word kept), clamped to ``0 .. i_max`` (Q.i_frac) as
+    :func:`clamp_i` does: a negative high word gives 0, a positive one the top, else the low word
+    against the top (one-word tests)."""
+    imax = fmt.i_max << fmt.i_frac
+    h = Signal(signed(16), name="i_hi")
+    ic = Signal(16, name="ic_w")
+    m.d.comb += [h.eq(hi), ic.eq(Mux(h < 0, 0, Mux((h > 0) | (lo > imax), imax, lo)))]
+    return ic
+
+
+def _key_words(m: Module, z) -> Signal:
+    """(paper) :func:`z_key` of a two-word running z (``signed(32)``): the sign, and the high word's
+    bits above Q16.4, pick 0 or the top; else the key is the Q16.4 integer bits (wires)."""
+    key = Signal(Z_BITS, name="key_w")
+    top = Z_BITS + DZ_FRAC
+    m.d.comb += key.eq(Mux(z[31], 0, Mux(z[top:32] != 0, (1 << Z_BITS) - 1, z[DZ_FRAC:top])))
+    return key
+
+
+class _GuardedWords:
+    """(paper) :func:`guarded_test` on two-word z, a word a cycle: every test ``Y - X >= c``
+    (``c`` 0, 16 or 1) subtracts the low words in pass B's third cycle (:meth:`low`: the borrow and
+    whether the low difference reaches ``c``, kept) and the high words with that borrow in its
+    fourth (:meth:`high`): ``Y - X >= c`` iff the high difference is positive, or zero with the low
+    flag (exact: the two-word values are below 2**25 in magnitude, so no difference wraps).
+    ``zw``: the adder's word this cycle (z at sr: its low word in the third cycle, its high in the
+    fourth); ``zlr``: z at sl, both words kept."""
+
+    G = 1 << DZ_FRAC
+    ZMAX = ((1 << Z_BITS) - 1) << DZ_FRAC      # Q16.4 of the farthest key
+
+    def __init__(self, m: Module, szl, szr, zlr, zw):
+        self.m, self.szl, self.szr, self.zlr, self.zw = m, szl, szr, zlr, zw
+        # (Y low, X low, c) of the six tests, and their kept borrows and flags
+        zmax_lo = self.ZMAX & 0xFFFF
+        self.tests = {"dl": (zlr[:16], szl[:16], self.G), "dr": (zw, szr[:16], self.G),
+                      "gl": (zlr[:16], 0, self.G), "gr": (zw, 0, self.G),
+                      "ml": (zmax_lo, szl[:16], 1), "mr": (zmax_lo, szr[:16], 1)}
+        self.b = {k: Signal(name=f"gw_b_{k}") for k in self.tests}
+        self.f = {k: Signal(name=f"gw_f_{k}") for k in self.tests}
+
+    def low(self) -> list:
+        """The low words' subtractions (sync statements of the third cycle)."""
+        out = []
+        for k, (y, x, c) in self.tests.items():
+            t = Signal(signed(18), name=f"gw_lo_{k}")
+            self.m.d.comb += t.eq(y - x)
+            out += [self.b[k].eq(t < 0), self.f[k].eq(t[:16] >= c)]
+        return out
+
+    def high(self, s_lower) -> Signal:
+        """The high words' subtractions with the kept borrows, and the test (``s_lower``: ties to S)."""
+        m = self.m
+        zmax_hi = self.ZMAX >> 16
+        hy = {"dl": self.zlr[16:], "dr": self.zw, "gl": self.zlr[16:], "gr": self.zw, "ml": zmax_hi, "mr": zmax_hi}
+        hx = {"dl": self.szl[16:], "dr": self.szr[16:], "gl": 0, "gr": 0, "ml": self.szl[16:], "mr": self.szr[16:]}
+        ok = {}
+        for k in self.tests:
+            h = Signal(signed(18), name=f"gw_hi_{k}")
+            y, x = hy[k], hx[k]
+            m.d.comb += h.eq((y.as_signed() if hasattr(y, "as_signed") else y)
+                             - (x.as_signed() if hasattr(x, "as_signed") else x) - self.b[k])
+            ok[k] = (h > 0) | ((h == 0) & self.f[k]), h >= 0
+        good = Signal(name="good_w")
+        lower = ok["dl"][1] & ok["dr"][1]
+        higher = ok["dl"][0] & ok["dr"][0] & ok["gl"][0] & ok["gr"][0] & ok["ml"][0] & ok["mr"][0]
+        m.d.comb += good.eq(Mux(s_lower, lower, higher))
+        return good
+
+
+class _Early:
+    """``with _Early(m, cond, early, last):`` where ``cond`` holds, ``early()`` adds the step's
+    early cycle (its statements advance the phase); else the body runs, with ``last`` (sync)."""
+
+    def __init__(self, m: Module, cond, early, last: list):
+        self.m, self.cond, self.early, self.last = m, cond, early, last
+
+    def __enter__(self):
+        with self.m.If(self.cond):
+            self.early()
+        self._else = self.m.Else()
+        self._else.__enter__()
+        self.m.d.sync += self.last
+        return self
+
+    def __exit__(self, *exc):
+        return self._else.__exit__(*exc)
+
+
 class _Always:
     """A context that adds nothing: the step's own cycle is its only one."""
 
@@ -234,26 +337,6 @@ class _Always:
 
     def __exit__(self, *exc):
         return False
-
-
-class _AfterFirst:
-    """``with _AfterFirst(m, ph, keep):`` the body runs in a step's second cycle; its first cycle
-    (``ph`` 0) only runs ``keep`` (sync) and sets ``ph``; the second clears it."""
-
-    def __init__(self, m: Module, ph, keep: list):
-        self.m, self.ph, self.keep = m, ph, keep
-
-    def __enter__(self):
-        m = self.m
-        with m.If(~self.ph):
-            m.d.sync += [*self.keep, self.ph.eq(1)]
-        self._else = m.Else()
-        self._else.__enter__()
-        m.d.sync += self.ph.eq(0)
-        return self
-
-    def __exit__(self, *exc):
-        return self._else.__exit__(*exc)
 
 
 def write_pixel(m: Module, fr: dict, rb, col, bg, seg, ic, slot) -> None:
@@ -329,9 +412,12 @@ class ExpertsPxpSpan(wiring.Component):
     depth : int
         ASBs per DMM/P bank (2..511).
     datapath : str
-        ``"ours"`` (a multiplier each for z at a span's two ends and for i) or ``"paper"`` (one
-        16 x 16 multiplier, :func:`mul16.sm_mul`: pass A and pass B take two cycles a segment, z at
-        the left end, then at the right; ``span_cycles.one_multiplier``).
+        ``"ours"`` (a multiplier each for z at a span's two ends and for i, and the A.J. blend's
+        own; 40-bit z registers) or ``"paper"`` (one 16 x 16 multiplier, :func:`mul16.sm_mul`: z at
+        the left end, then at the right, ``span_cycles.one_multiplier``, each in two 16-bit words a
+        word a cycle, ``span_cycles.multiword``: pass A and pass B 4 cycles a segment, the write 2
+        a drawn pixel; with A.J. the drain's blend shares the multiplier, ``span_cycles.paper_drain``
+        and ``schedule(mul=)``).
 
     Members
     -------
@@ -384,11 +470,25 @@ class ExpertsPxpSpan(wiring.Component):
         m.d.comb += wr.en.eq(0)
         trd = dm["dmm"].read_port(transparent_for=()) if aj else None    # the visible segment's edges
         clr_full = dm["clr_full"]
+        mul = None
+        if self._datapath == "paper":
+            # the PXP's one 16 x 16 multiplier, shared by the resolve side and the drain's A.J. blend
+            mul = {"a": Signal(MUL_IN, name="mul_a"), "b": Signal(MUL_IN, name="mul_b")}
+            mul["p"] = sm_mul(m, mul["a"], mul["b"], "pxp_mul")
         drain = Drain(m, o=self.o, drd=drd, word=word, bank_bit=ab, width=W, ib=ib, aj=aj,
                       trd=trd, ent=asb, ent_bank_bit=pw, boundary_only=True,
-                      done_comb=lambda d: [clr_full.eq(Mux(d.dbank, 0b10, 0b01))])
+                      done_comb=lambda d: [clr_full.eq(Mux(d.dbank, 0b10, 0b01))],
+                      prod=mul["p"] if mul else None)
         return {**dm, "fmt": fmt, "W": W, "D": D, "aj": aj, "ib": ib, "asb": asb, "pw": pw, "cw": cw, "ab": ab,
-                "word": word, "wr": wr, "drain": drain}
+                "word": word, "wr": wr, "drain": drain, "mul": mul}
+
+    def _hold(self, m: Module, state, drain):
+        """(paper, A.J.) The arbitration of the one multiplier: while the drain's blend holds it
+        (``drain.mreq``), every resolve step but taking a bank (``IDLE``) and handing one over
+        (``HAND``) holds; else a context that adds nothing."""
+        if drain.mreq is None:
+            return _Always()
+        return m.If(~drain.mreq | (state == _R.IDLE) | (state == _R.HAND))
 
     def elaborate(self, platform):
         m = Module()
@@ -407,8 +507,10 @@ class ExpertsPxpSpan(wiring.Component):
         one = Signal(pw)          # the first active entry (k = 1: the visible segment)
         sl = Signal(11)           # (sub)span searched / written
         sr = Signal(11)
-        szl = Signal(signed(40))
-        szr = Signal(signed(40))
+        paper = self._datapath == "paper"
+        zw = 32 if paper else 40  # (paper) two 16-bit words: |z| < 2**25 at 512 x 512 (docs/experts.md)
+        szl = Signal(signed(zw))
+        szr = Signal(signed(zw))
         bad = Signal()
         wbg = Signal()            # the span written is background
         sp = Signal(5)            # stack pointer
@@ -418,34 +520,80 @@ class ExpertsPxpSpan(wiring.Component):
         krd = stk.read_port(domain="comb")
         m.d.comb += [kwr.en.eq(0), krd.addr.eq(sp - 1), kwr.addr.eq(sp)]
 
-        ph = Signal()             # (paper) pass A / B: z at sl taken, z at sr on the multiplier
-        if self._datapath == "paper":
-            # one multiplier: z at sl (first cycle, kept in zlr), z at sr; i at sl when writing
-            zlr = Signal(signed(40))
+        # (paper) the step's cycle: pass A / B 0, 1 z at sl (low word, high word), 2, 3 z at sr; write 0, 1
+        ph = Signal(2)
+        if paper:
+            # one multiplier: z at sl (kept in zlr), then z at sr; i at sl when writing. z and i are two
+            # 16-bit words, added, subtracted and compared a word a cycle, low word first (carry / borrow kept)
+            zlr = Signal(signed(32))
+            zpl = Signal(16)          # z at sr, low word
+            zc = Signal()             # the low word's carry
+            ilo = Signal(16)          # i at sl, low word
             d = Signal(signed(18))
-            m.d.comb += d.eq((Mux(ph, sr, sl) << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl)
-            prod = sm_mul(m, d, Mux(state == _R.WRITE, seg.didx, seg.dzdx), "pxp_mul")
-            zp = Signal(signed(40))
-            m.d.comb += zp.eq((seg.zl << DZ_FRAC) + (prod >> X_FRAC))
-            zl_, zr_ = zlr, zp
-            ic = clamp_i(m, seg.il + (prod >> X_FRAC), fmt)
+            m.d.comb += d.eq((Mux(ph[1], sr, sl) << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl)
+            # the drain's A.J. blend has the multiplier first (drain.mreq); the resolve side then holds
+            mul, dr = fr["mul"], fr["drain"]
+            req = dr.mreq if dr.mreq is not None else 0
+            m.d.comb += [mul["a"].eq(Mux(req, dr.mul_a if dr.mul_a is not None else 0, d)),
+                         mul["b"].eq(Mux(req, dr.mul_b if dr.mul_b is not None else 0,
+                                         Mux(state == _R.WRITE, seg.didx, seg.dzdx)))]
+            prod = mul["p"]
+            # the 16-bit adder: z_L * 16 + (product >> 6), or i_L + (product >> 6), a word a cycle
+            # (ph[0]: the high word, with the low word's carry); the product's words are its wires
+            hi_word = ph[0]
+            p_hi = Signal(signed(16), name="p_hi")
+            m.d.comb += p_hi.eq(prod[X_FRAC + 16:].as_signed())
+            wa, wb, zadd = Signal(16, name="wa"), Signal(16, name="wb"), Signal(17, name="zadd")
+            m.d.comb += [wa.eq(Mux(state == _R.WRITE, Mux(hi_word, 0, seg.il),
+                                   Mux(hi_word, seg.zl[16 - DZ_FRAC:], seg.zl << DZ_FRAC))),
+                         wb.eq(Mux(hi_word, p_hi, prod[X_FRAC:X_FRAC + 16])),
+                         zadd.eq(wa + wb + (hi_word & zc))]
+            zl_ = zlr
+            zr_ = Signal(signed(32), name="zr_w")
+            m.d.comb += zr_.eq(Cat(zpl, zadd[:16]))
+            ic = _i_words(m, zadd[:16], ilo, fmt)
+            key = _key_words(m, zlr)
+            tests = _GuardedWords(m, szl, szr, zlr, zadd[:16])
         else:
             # the multipliers: running z (Q16.4) at pixels sl and sr, i at sl
             zl_ = zrun_at(m, seg, sl)
             zr_ = zrun_at(m, seg, sr)
             ic = intensity_at(m, seg, sl, fmt)
+            key = z_key(m, zl_)
 
-        def two_cycles():
-            """(paper) a pass's first cycle on a segment only multiplies: z at sl into ``zlr``."""
-            if self._datapath != "paper":
+        def four_cycles():
+            """(paper) a pass's three first cycles on a segment: z at sl's low and high word into
+            ``zlr``, z at sr's low word into ``zpl`` with the guarded tests' low words; the body runs
+            in the fourth (z at sr's high word)."""
+            if not paper:
                 return _Always()
-            return _AfterFirst(m, ph, [zlr.eq(zp)])
-        key = z_key(m, zl_)
+
+            def early():
+                m.d.sync += ph.eq(ph + 1)
+                with m.Switch(ph):
+                    with m.Case(0):
+                        m.d.sync += [zlr[:16].eq(zadd[:16]), zc.eq(zadd[16])]
+                    with m.Case(1):
+                        m.d.sync += zlr[16:].eq(zadd[:16])
+                    with m.Case(2):
+                        m.d.sync += [zpl.eq(zadd[:16]), zc.eq(zadd[16]), *tests.low()]
+            return _Early(m, ph != 3, early, [ph.eq(0)])
+
+        def write_cycles():
+            """(paper) a drawn pixel's first cycle adds i's low word (``ilo``); the body (the write)
+            runs in the second, with i's high word; a background pixel takes one."""
+            if not paper:
+                return _Always()
+
+            def early():
+                m.d.sync += [ph.eq(1), ilo.eq(zadd[:16]), zc.eq(zadd[16])]
+            return _Early(m, ~wbg & (ph == 0), early, [ph.eq(0)])
         nearer = Signal()
         m.d.comb += nearer.eq((i == 0) | (key < skey) | ((key == skey) & (seg.addr < saddr)))
         # the guarded test (span.py): S nearer than this segment B at every pixel of [sl, sr]
         good = Signal()
-        m.d.comb += good.eq((raddr == S) | guarded_test(m, szl, szr, zl_, zr_, saddr < seg.addr))
+        s_low = saddr < seg.addr
+        m.d.comb += good.eq((raddr == S) | (tests.high(s_low) if paper else guarded_test(m, szl, szr, zl_, zr_, s_low)))
         mid = Signal(11)
         m.d.comb += mid.eq((sl + sr + 1) >> 1)
 
@@ -468,7 +616,7 @@ class ExpertsPxpSpan(wiring.Component):
             with m.If(e + 1 < minend):
                 m.d.sync += minend.eq(e + 1)
 
-        with m.Switch(state):
+        with self._hold(m, state, drain), m.Switch(state):
             with m.Case(_R.IDLE):
                 m.d.sync += cyc.eq(1)
                 tb = take_bank(m, dm, rb, W, aj)
@@ -502,7 +650,7 @@ class ExpertsPxpSpan(wiring.Component):
                         m.d.sync += state.eq(_R.PASSA)
                     with m.Else():
                         m.d.sync += [wbg.eq(j == 0), S.eq(one), state.eq(_R.WRITE)]
-            with m.Case(_R.PASSA), two_cycles():
+            with m.Case(_R.PASSA), four_cycles():
                 with m.If(nearer):
                     m.d.sync += [S.eq(raddr), skey.eq(key), saddr.eq(seg.addr), szl.eq(zl_), szr.eq(zr_)]
                 m.d.sync += i.eq(i + 1)
@@ -512,7 +660,7 @@ class ExpertsPxpSpan(wiring.Component):
                         m.d.sync += [wbg.eq(0), state.eq(_R.WRITE)]
                     with m.Else():
                         m.d.sync += [bad.eq(0), state.eq(_R.PASSB)]
-            with m.Case(_R.PASSB), two_cycles():
+            with m.Case(_R.PASSB), four_cycles():
                 m.d.sync += [i.eq(i + 1), bad.eq(bad | ~good)]
                 with m.If(i + 1 >= k):
                     m.d.sync += i.eq(0)
@@ -524,13 +672,14 @@ class ExpertsPxpSpan(wiring.Component):
                         m.d.sync += [wbg.eq(0), state.eq(_R.WRITE)]
             with m.Case(_R.WRITE):
                 m.d.comb += raddr.eq(S)
-                write_pixel(m, fr, rb, sl, wbg, seg, ic, S)
-                m.d.sync += sl.eq(sl + 1)
-                with m.If(sl == sr):
-                    with m.If(sp != 0):
-                        m.d.sync += [sr.eq(krd.data), sp.eq(sp - 1), i.eq(0), state.eq(_R.PASSA)]
-                    with m.Else():
-                        m.d.sync += next_span(sr + 1)
+                with write_cycles():
+                    write_pixel(m, fr, rb, sl, wbg, seg, ic, S)
+                    m.d.sync += sl.eq(sl + 1)
+                    with m.If(sl == sr):
+                        with m.If(sp != 0):
+                            m.d.sync += [sr.eq(krd.data), sp.eq(sp - 1), i.eq(0), state.eq(_R.PASSA)]
+                        with m.Else():
+                            m.d.sync += next_span(sr + 1)
             with m.Case(_R.HAND):
                 with m.If(~dbusy):
                     m.d.sync += [*drain.hand(bank=rb, lo=lo, hi=hi, glo=glo, ghi=ghi), rb.eq(~rb), state.eq(_R.IDLE),

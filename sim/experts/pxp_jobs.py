@@ -90,7 +90,9 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
     """:func:`job_list` for the span PXP (``experts-pxp-span``): per PXP line ``(y, lo, hi)`` the
     DMM/P words the SLP writes (the line's whole ASL, the range's bucket list, the ``last`` token
     with the leading pointer and the next job's range), the expected pixels and the cycles of
-    ``golden_model/experts/span_cycles.py``; ``visible`` per job (ASL record ids, -1 background).
+    ``golden_model/experts/span_cycles.py``; ``visible`` per job (ASL record ids, -1 background);
+    ``paper_drain`` per job (with A.J.: ``span_cycles.paper_drain``, for ``span_cycles.paper_jobs``)
+    and ``drawn`` (the guarded range's pixels drawn by a segment, for ``span_cycles.multiword``).
     ``slp``: ``{(y, lo, hi): (the ASBs in ASL order, leading pointer, bucket list)}`` as an SLP
     (the ``experts-slp`` HDL) wrote them, instead of the golden SLP's. ``pxp="coherent"``: the
     coherent span PXP's cycles (``golden_model/experts/coherent.py``, ``experts-pxp-coherent``:
@@ -113,7 +115,7 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
         ranges.setdefault(y, []).append((lo, hi))
     cache: dict[int, tuple] = {}
     bucket_word: dict[int, int] = {}
-    words, exp_pix, lines, steps, visible = [], [], [], [], []
+    words, exp_pix, lines, steps, visible, pdrain, drawn = [], [], [], [], [], [], []
     for k, (y, lo, hi) in enumerate(todo):
         if y not in cache:
             segs, ids = line_asl(fr, y)
@@ -147,6 +149,8 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
         words.append((nhi << (SPAN_BITS + 10)) | (nlo << SPAN_BITS) | pack(lay, {"last": 1, "ptr": lead}))
         lines.append((job["words"], job["resolve"], job["drain"]))
         steps.append(job["steps"])
+        pdrain.append(job.get("paper_drain"))
+        drawn.append(job["drawn"])
         vis = np.asarray(job["visible"], np.int64)
         visible.append(np.where(vis >= 0, ids[np.maximum(vis, 0)], -1) if len(ids) else np.full(vis.size, -1, np.int64))
         exp_pix.append(pix[y, lo:hi])
@@ -154,4 +158,5 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
     return {"words": words, "pixels": np.concatenate(exp_pix).astype(np.int64) if exp_pix else np.zeros(0, np.int64),
             "cycles": np.array(sch["line_cycles"], np.int64), "last_pixel": sch["last_pixel"],
             "lo0": todo[0][1], "hi0": todo[0][2], "lines": len(todo), "aj": aj, "steps": steps,
-            "visible": visible, "timing": lines, "seg_bits": SPAN_BITS, "pxp": pxp}
+            "visible": visible, "timing": lines, "seg_bits": SPAN_BITS, "pxp": pxp, "paper_drain": pdrain,
+            "drawn": drawn}

@@ -60,6 +60,10 @@ def test_resolve_counts_every_step_and_halves_where_depths_cross():
     sch = schedule([(3, 10, 20), (3, 10, 20), (3, 10, 20)])
     assert sch["line_cycles"] == [11, 21, 19] and sch["last_pixel"] == 75
     assert schedule([(3, 10, 2)] * 3)["line_cycles"] == [11, 11, 11]
+    # the paper's datapath with A.J.: line 0's drain (14, 15) holds the multiplier in its cycles 1 and 2;
+    # line 1 takes its bank at 14 (not held), is held at 15: hands over at 25, not 24
+    assert schedule([(3, 10, 2)] * 2, [[1, 2], []])["line_cycles"] == [11, 12]
+    assert schedule([(3, 10, 2)] * 2, [[], []])["line_cycles"] == [11, 11]
 
 
 def test_span_work_depends_on_depth_the_line_z_buffer_does_not():
@@ -174,15 +178,152 @@ def test_span_pxp_with_one_multiplier_pysim_word_and_cycle_exact(seed):
 
 def test_paper_jobs_adds_the_multiplier_cycles_to_every_pxps_frame():
     """span_cycles.paper_jobs on a frame's jobs (pxp_sim.jobs): pixels unchanged, every line's resolve
-    + pass_a + pass_b, and each PXP's frame time rescheduled: with one PXP it is the whole job list's
+    + pass_a + pass_b (one multiplier) + 2 (pass_a + pass_b) + its drawn pixels (two-word z and i),
+    and each PXP's frame time rescheduled: with one PXP it is the whole job list's
     last pixel + 1; the coherent PXP's jobs are refused (it has no one-multiplier configuration)."""
-    from rasterhw.golden_model.experts.span_cycles import one_multiplier, paper_jobs
+    from rasterhw.golden_model.experts.span_cycles import multiword, one_multiplier, paper_jobs
     fr = render_frame(run_geometry(build_scene("experts-tilt-1000"), 64, 16, z_bits=16), model="bit", aj="c")
     jb = jobs(fr, 1, 1, pxp="span")
     pj = paper_jobs(jb)
     assert np.array_equal(pj["pixels"], jb["pixels"])
-    assert [r for _, r, _ in pj["timing"]] == [r + one_multiplier(st) for (_, r, _), st in
-                                               zip(jb["timing"], jb["steps"], strict=True)]
+    # drawn: the guarded range's pixels a segment draws (the whole line here: one PXP, no guard)
+    assert jb["drawn"] == [int((fr.win.reshape(16, 64)[y] >= 0).sum()) for y in range(16)]
+    assert 0 < sum(jb["drawn"]) < sum(st["write"] for st in jb["steps"])
+    assert [r for _, r, _ in pj["timing"]] == [r + 3 * (st["pass_a"] + st["pass_b"]) + dn for (_, r, _), st, dn in
+                                               zip(jb["timing"], jb["steps"], jb["drawn"], strict=True)]
+    assert [multiword(st, dn) for st, dn in zip(jb["steps"], jb["drawn"], strict=True)] == \
+        [2 * one_multiplier(st) + dn for st, dn in zip(jb["steps"], jb["drawn"], strict=True)]
     assert int(pj["pxp_frame_cycles"][0, 0]) == pj["last_pixel"] + 1 > int(jb["pxp_frame_cycles"][0, 0])
     with pytest.raises(RasterhwError, match="coherent PXP has no paper datapath"):
         paper_jobs(jobs(fr, 1, 1, pxp="coherent"))
+
+
+def test_paper_span_pxp_blends_on_its_one_multiplier_pysim_word_and_cycle_exact():
+    """experts-pxp-span at datapath "paper" with A.J. (c) on a frame of many boundaries (experts-1000
+    at 64 x 16, 4 ranges): the drain's blend takes the one multiplier, 4 or 5 multiplies a blended
+    pixel (span_cycles.aj_blends / paper_drain), and the resolve side holds while it does
+    (span_cycles.schedule's mul); pysim: every pixel and every line's finish-time counter equal
+    the golden side's, and the holds are there (the schedule without them differs)."""
+    from rasterhw.golden_model.experts.span_cycles import aj_blends, paper_jobs
+    from rasterhw.sim.experts.scene import check_jobs
+    fr = _frame("experts-1000", 64, 16)
+    pj = paper_jobs(jobs(fr, 1, 4, pxp="span"))
+    muls = [len(q["mul"]) for q in pj["paper_drain"]]
+    assert sum(muls) > 200
+    # every blended pixel costs its multiplies: 4 (steep edge) or 5, the drain that much longer
+    segs, lead, buckets = dmm_line(fr, 8, equal_bounds(64, 4))
+    job = line_job(segs, buckets[1], lead[1], 16, 32, aj="c", width=64)
+    bl = aj_blends(job_vis := resolve(segs, buckets[1], lead[1], 15, 33)[1], segs, 16, 32, width=64)
+    assert len(job_vis) == 18 and {n for _, n in bl} <= {4, 5}
+    assert job["paper_drain"]["drain"] == job["drain"] + sum(n - 1 for _, n in bl)
+    assert len(job["paper_drain"]["mul"]) == sum(n for _, n in bl)
+    held = schedule(pj["timing"])["line_cycles"]
+    assert held != pj["cycles"].tolist() and sum(held) < int(pj["cycles"].sum())
+    r = check_jobs(pj, width=64, engine="pysim")
+    assert r["pixel_mismatches"] == 0 and r["line_mismatches"] == 0
+    assert r["pixels"].size == 64 * 16 and np.array_equal(r["pixels"], pj["pixels"])
+    assert r["last_pixel"] == pj["last_pixel"] + 1          # the run's edge 0 takes the range word
+
+
+def _extreme_line(rng, n: int, *, slope: int | None = None) -> list[dict]:
+    """One line of ``n`` ASBs at 512 wide whose running z and i reach the formats' extremes: long
+    segments, z_L and i_L at 0 or 65535, dz/dx and di/dx at -32768 / 32767 or anywhere, so z and i
+    leave Q16.4 / 0..i_max both ways (negative and above 2**20, high words nonzero and negative).
+    ``slope``: instead dz/dx within +-slope from mid-range z_L, so segments cross at small depth
+    differences (the same high word, the low words' borrow deciding the guarded tests)."""
+    def pick(ends, lo, hi):
+        return int(rng.choice(ends)) if rng.random() < 0.6 else int(rng.integers(lo, hi + 1))
+    segs = []
+    for a in range(n):
+        xl = int(rng.integers(0, 300 << 6))
+        xr = int(min(xl + rng.integers(64, 400 << 6), 512 << 6))
+        z = ({"zl": pick([0, 65535], 0, 65535), "dzdx": pick([-32768, 32767], -32768, 32767)} if slope is None else
+             {"zl": int(rng.integers(20000, 40000)), "dzdx": int(rng.integers(-slope, slope + 1))})
+        segs.append({"xl": xl, "xr": xr, **z, "il": pick([0, 65535], 0, 65535),
+                     "didx": pick([-32768, 32767], -32768, 32767),
+                     "hue": int(rng.integers(0, 512)), "addr": a + 1, "poly": a + 1})
+    segs.sort(key=lambda s: (s["xl"], s["addr"]))
+    return segs
+
+
+def _run_lines(dut, words: list[int], n_lines: int, n_pix: int) -> tuple[list[int], list[int]]:
+    """Feed ``words`` back to back into a span PXP (range [0, 512)), output always ready: its pixel
+    words and each line's finish-time counter."""
+    from amaranth.sim import Simulator
+    sim = Simulator(dut)
+    sim.add_clock(1e-8)
+    pix, lc = [], []
+
+    async def bench(ctx):
+        ctx.set(dut.hi, 512)
+        ctx.set(dut.o.ready, 1)
+        k, lines = 0, 0
+        for _ in range(400_000):
+            if k < len(words):
+                ctx.set(dut.i.payload.as_value(), words[k])
+            ctx.set(dut.i.valid, int(k < len(words)))
+            _, _, rdy, ov, od, nl, lcy = await ctx.tick().sample(dut.i.ready, dut.o.valid, dut.o.payload,
+                                                                 dut.lines, dut.line_cycles)
+            k += int(rdy and k < len(words))
+            if ov:
+                pix.append(int(od))
+            if nl != lines:
+                lines = nl
+                lc.append(int(lcy))
+            if len(pix) == n_pix and lines == n_lines:
+                break
+
+    sim.add_testbench(bench)
+    sim.run()
+    return pix, lc
+
+
+def test_paper_two_word_z_and_i_at_the_formats_extremes_pysim():
+    """datapath "paper" keeps the running z and i in two 16-bit words, a word a cycle: on lines whose
+    z and i run far outside Q16.4 and 0..i_max both ways (z to about +-2**24, the formats' bound,
+    the cases no scene reaches) and on lines of segments crossing at small depth differences, its pixels equal the golden side's (span_cycles.resolve's visible
+    segment, the S.S. intensity clamped) and ours' 40-bit design's, and each line's finish-time
+    counter equals span_cycles.schedule with the paper's cycles (+ one_multiplier + multiword)."""
+    from rasterhw.golden_model.experts.formats import DZ_FRAC, X_FRAC, Formats
+    from rasterhw.golden_model.experts.slp_run import block_lists
+    from rasterhw.golden_model.experts.span_cycles import (
+        multiword,
+        one_multiplier,
+        span_drain_cycles,
+    )
+    from rasterhw.hdl.experts.pxp_span import ExpertsPxpSpan, dmm_layout
+    from rasterhw.hdl.pack import pack
+    fmt, lay, W = Formats(), dmm_layout(), 512
+    rng = np.random.default_rng(48)
+    words, want, lines, zs, i_out, tested = [], [], {"ours": [], "paper": []}, [], 0, False
+    for slope in (None, None, None, 400, 400, 2000):
+        segs = _extreme_line(rng, 7, slope=slope)
+        c0 = np.array([(s["xl"] + 31) >> X_FRAC for s in segs])
+        c1 = np.array([((s["xr"] + 31) >> X_FRAC) - 1 for s in segs])
+        lead, buckets, _ = block_lists(list(range(len(segs))), c0, c1, np.array([0, W]), width=W)
+        lead, bucket = (511 if lead[0] < 0 else lead[0]), buckets[0]
+        words += [pack(lay, s) for s in segs] + [pack(lay, {"list": 1, "ptr": b}) for b in bucket]
+        words.append(pack(lay, {"last": 1, "ptr": lead}))
+        cyc, vis = resolve(segs, bucket, lead, 0, W)
+        tested = tested or cyc["pass_b"] > 0
+        for c, v in enumerate(vis):
+            s = segs[v] if v >= 0 else None
+            d = (c << X_FRAC) + (1 << (X_FRAC - 1)) - s["xl"] if s else 0
+            if s:
+                zs.append((s["zl"] << DZ_FRAC) + ((d * s["dzdx"]) >> X_FRAC))
+                i = s["il"] + ((d * s["didx"]) >> X_FRAC)
+                i_out += not 0 <= i <= fmt.i_max << fmt.i_frac
+            want.append((s["hue"] << fmt.intensity_bits) | (min(max(i, 0), fmt.i_max << fmt.i_frac) >> fmt.i_frac)
+                        if s else 0)
+        nw, r, dr = len(segs) + len(bucket) + 1, sum(cyc.values()), span_drain_cycles(vis, 0, W, aj="none", width=W)
+        drawn = sum(1 for v in vis if v >= 0)
+        lines["ours"].append((nw, r, dr))
+        lines["paper"].append((nw, r + one_multiplier(cyc) + multiword(cyc, drawn), dr))
+    # the lines reach what no scene does: visible z below 0 and above Q16.4, intensities clamped;
+    # and pass B's guarded tests run (spans wider than a pixel with two segments or more)
+    assert min(zs) < -(1 << 20) and max(zs) > 1 << 22 and i_out > 100 and tested
+    for dp in ("ours", "paper"):
+        pix, lc = _run_lines(ExpertsPxpSpan(width=W, depth=16, datapath=dp), words, 6, len(want))
+        assert pix == want, dp
+        assert lc == schedule(lines[dp])["line_cycles"], dp
+    assert sum(r for _, r, _ in lines["paper"]) > sum(r for _, r, _ in lines["ours"])
