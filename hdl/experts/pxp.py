@@ -102,7 +102,7 @@ class ExpertsPxp(wiring.Component):
     -------
     i : In(stream.Signature(seg_layout()))
     o : Out(stream.Signature(unsigned(RGB_BITS + intensity_bits)))
-    lo, hi : In(10), In(11)
+    lo, hi : In(X_INT), In(X_END_BITS)
         The range ``[lo, hi)``, sampled at the start of each line.
     line_cycles : Out(16)
         Finish-time counter: cycles of the last line from its first clear cycle to its hand-over to

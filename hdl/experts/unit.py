@@ -25,7 +25,7 @@ class ExpertsPxpUnit(wiring.Component):
     -------
     i : In(stream.Signature(seg_layout()))   ASL lines from the SLP (segments, then ``last``)
     o : Out(stream.Signature(unsigned(RGB_BITS + intensity_bits)))   the range's pixels, line by line
-    lo, hi : In(10), In(11)   the range, sampled when a line starts
+    lo, hi : In(X_INT), In(X_END_BITS)   the range, sampled when a line starts
     overflow : Out(1)   sticky DMM/P overflow (the SLP side stalls; nothing is dropped)
     line_cycles, lines : Out(16)   the PXP's finish-time counter and line count
     """
