@@ -173,3 +173,13 @@ def rom_div(num, den, shift: int) -> np.ndarray:
 # the PXP's address and segment-table widths (the HDL and the cycle model take them from here)
 ADDR_BITS = 12   # ASB address (PL order) and polygon number: up to 4095 (4095 = none)
 SLOT_BITS = 8    # the A.J. segment table: 256 segments per line (= a DMM/P bank)
+
+# widths derived from the names above: what the HDL's fields and registers are (no new numbers)
+X_INT = WORD - X_FRAC           # integer bits of Q10.6: a line or pixel number, 0..MAX_SIDE
+X_END_BITS = X_INT + 1          # a pixel x or an exclusive range end, 0..MAX_SIDE + 1
+XS_BITS = WORD + 1              # a Q10.6 x or y held signed (the SLP's vertices)
+RGB_BITS = 3 * HUE_BITS         # the hue field: R, G, B
+INC_BITS = 3 * WORD             # an SLP edge-increment field, three words: the Q.22 increment
+                                # (X_FRAC + ACC_EXTRA fraction bits) is up to 40 bits
+XP_BITS = X_END_BITS + 1        # a pixel x with a spare bit: held signed, a segment's first pixel may lie left of 0
+XD_BITS = XS_BITS + 1           # a difference of two such, or a Q10.6 line centre held signed

@@ -23,6 +23,8 @@ from rasterhw.hdl.experts.pxp import seg_layout
 
 __all__ = ["ExpertsDmm"]
 
+BANKS = 2   # the double buffer: one bank filled while the other is read (a bit each in ``full``)
+
 
 class ExpertsDmm(wiring.Component):
     """Double-banked ASL buffer, SLP side ``i`` -> PXP side ``o``.
@@ -54,7 +56,7 @@ class ExpertsDmm(wiring.Component):
             "i": In(stream.Signature(seg_layout())),
             "o": Out(stream.Signature(seg_layout())),
             "overflow": Out(1),
-            "full": Out(2),
+            "full": Out(BANKS),
         })
 
     @property
@@ -75,7 +77,7 @@ class ExpertsDmm(wiring.Component):
         rbank = Signal()
         rptr = Signal(pw)
         cnt = [Signal(pw, name=f"cnt{b}") for b in range(2)]
-        full = Signal(2)
+        full = Signal(BANKS)
         m.d.comb += self.full.eq(full)
         wfull = Signal()
         m.d.comb += wfull.eq(full.bit_select(wbank, 1))
@@ -88,8 +90,8 @@ class ExpertsDmm(wiring.Component):
                      self.i.ready.eq(~wfull & ~self.overflow & (~at_end | self.i.payload.last))]
         with m.If(self.i.valid & ~wfull & at_end & ~self.i.payload.last):
             m.d.sync += self.overflow.eq(1)
-        set_full = Signal(2)
-        clr_full = Signal(2)
+        set_full = Signal(BANKS)
+        clr_full = Signal(BANKS)
         with m.If(self.i.valid & self.i.ready):
             with m.If(self.i.payload.last):
                 m.d.sync += [wptr.eq(0), wbank.eq(~wbank)]

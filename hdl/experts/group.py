@@ -17,9 +17,10 @@ from __future__ import annotations
 from amaranth import Module, Signal, unsigned
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
+from rasterhw.golden_model.experts.formats import Formats
 from rasterhw.golden_model.experts.model import equal_bounds
 from rasterhw.hdl.broadcast import StreamBroadcast
-from rasterhw.hdl.experts.pxp_span import NO_PTR, ExpertsPxpSpan, asb_layout, dmm_layout
+from rasterhw.hdl.experts.pxp_span import NO_PTR, PTR_BITS, ExpertsPxpSpan, asb_layout, dmm_layout
 from rasterhw.hdl.experts.slp import ExpertsSlp, slp_in_layout, slp_out_layout
 
 __all__ = ["ExpertsGroup"]
@@ -34,7 +35,7 @@ class _DmmWriter(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         w = self.i.payload
-        lead = Signal(9, init=NO_PTR)
+        lead = Signal(PTR_BITS, init=NO_PTR)
         mine = w.p == self._p
         m.d.comb += [self.o.payload.ptr.eq(0), self.o.valid.eq(0), self.i.ready.eq(1)]
         for name in asb_layout().members:
@@ -76,7 +77,7 @@ class ExpertsGroup(wiring.Component):
     Members
     -------
     i : In(stream.Signature(slp_in_layout()))   the SLP's input (band, bounds, PL, go)
-    o : Out(stream.Signature(unsigned(9 + 7))).array(pn)   each PXP's pixels, line by line
+    o : Out(stream.Signature(unsigned(Formats().pixel_bits))).array(pn)   each PXP's pixels, line by line
     overflow : Out(1)   an SLP ASL or a DMM/P bank overflowed (sticky)
     """
 
@@ -93,7 +94,7 @@ class ExpertsGroup(wiring.Component):
         self._ranges = [(int(b[k]), int(b[k + 1])) for k in range(pn)]
         self._pn = pn
         super().__init__({"i": In(stream.Signature(slp_in_layout())),
-                          "o": Out(stream.Signature(unsigned(16))).array(pn),
+                          "o": Out(stream.Signature(unsigned(Formats().pixel_bits))).array(pn),
                           "overflow": Out(1)})
 
     def elaborate(self, platform):

@@ -30,10 +30,15 @@ from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import Out
 from rasterhw.golden_model.experts.formats import (
     ADDR_BITS,
+    DATAPATHS,
     DZ_FRAC,
-    HUE_BITS,
+    RGB_BITS,
     SLOT_BITS,
+    WORD,
+    X_END_BITS,
     X_FRAC,
+    X_INT,
+    XP_BITS,
     Z_BITS,
     Formats,
 )
@@ -43,24 +48,26 @@ from rasterhw.hdl.params import params
 __all__ = ["ExpertsPxp", "asb_fields", "seg_layout"]
 
 NONE = (1 << ADDR_BITS) - 1     # ASB address / polygon number of the background
+#: the running z and i registers: the widest the datapath has (never wrap, formats.py)
+RUN_BITS = DATAPATHS["ours"].word_bits
 
 
 def asb_fields() -> dict:
     """The ASB fields a PXP reads (both PXPs: ``seg_layout`` here, ``dmm_layout`` in ``pxp_span.py``)."""
     return {
-        "xl": unsigned(16),           # Q10.6
-        "xr": unsigned(16),           # Q10.6
-        "zl": unsigned(16),           # Q16.0, 0 = near
-        "il": unsigned(16),           # Q(I).(16-I)
-        "dzdx": signed(16),           # sQ11.4
-        "didx": signed(16),           # sQ(I-1).(16-I)
-        "hue": unsigned(3 * HUE_BITS),
+        "xl": unsigned(WORD),         # Q10.6
+        "xr": unsigned(WORD),         # Q10.6
+        "zl": unsigned(Z_BITS),       # Q16.0, 0 = near
+        "il": unsigned(WORD),         # Q(I).(16-I)
+        "dzdx": signed(WORD),         # sQ11.4
+        "didx": signed(WORD),         # sQ(I-1).(16-I)
+        "hue": unsigned(RGB_BITS),
         "addr": unsigned(ADDR_BITS),  # ASB address = PL order: the tie-break
         "poly": unsigned(ADDR_BITS),  # Tags: polygon number (A.J. only between polygons)
-        "sl": signed(16),             # left edge dx/dy, sQ7.8 (A.J.)
-        "ql": signed(16),             # left edge dy/dx, sQ7.8
-        "sr": signed(16),             # right edge dx/dy
-        "qr": signed(16),             # right edge dy/dx
+        "sl": signed(WORD),           # left edge dx/dy, sQ7.8 (A.J.)
+        "ql": signed(WORD),           # left edge dy/dx, sQ7.8
+        "sr": signed(WORD),           # right edge dx/dy
+        "qr": signed(WORD),           # right edge dy/dx
     }
 
 
@@ -94,8 +101,8 @@ class ExpertsPxp(wiring.Component):
     Members
     -------
     i : In(stream.Signature(seg_layout()))
-    o : Out(stream.Signature(unsigned(9 + intensity_bits)))
-    lo, hi : In(10), In(11)
+    o : Out(stream.Signature(unsigned(RGB_BITS + intensity_bits)))
+    lo, hi : In(X_INT), In(X_END_BITS)
         The range ``[lo, hi)``, sampled at the start of each line.
     line_cycles : Out(16)
         Finish-time counter: cycles of the last line from its first clear cycle to its hand-over to
@@ -134,8 +141,8 @@ class ExpertsPxp(wiring.Component):
         wr = mem.write_port()
         drd = mem.read_port(transparent_for=())     # drain side
         ab = (2 * W - 1).bit_length() - 1           # bank bit position
-        ent = data.StructLayout({"xl": unsigned(16), "xr": unsigned(16), "poly": unsigned(ADDR_BITS),
-                                 "sl": signed(16), "ql": signed(16), "sr": signed(16), "qr": signed(16)})
+        ent = data.StructLayout({"xl": unsigned(WORD), "xr": unsigned(WORD), "poly": unsigned(ADDR_BITS),
+                                 "sl": signed(WORD), "ql": signed(WORD), "sr": signed(WORD), "qr": signed(WORD)})
         if aj:
             m.submodules.tab = tab = Memory(shape=ent, depth=2 << SLOT_BITS, init=[])
             trd = tab.read_port(transparent_for=())
@@ -144,16 +151,16 @@ class ExpertsPxp(wiring.Component):
         # ---------------------------------------------------------------- resolve side
         state = Signal(_S)
         rbank = Signal()
-        x = Signal(11)
-        end = Signal(11)          # last owned pixel of the segment
-        lo = Signal(10)
-        hi = Signal(11)
-        glo = Signal(11)          # resolved range, guards included
-        ghi = Signal(11)
+        x = Signal(X_END_BITS)
+        end = Signal(X_END_BITS)       # last owned pixel of the segment
+        lo = Signal(X_INT)
+        hi = Signal(X_END_BITS)
+        glo = Signal(X_END_BITS)       # resolved range, guards included
+        ghi = Signal(X_END_BITS)
         seg = Signal(seg_layout())
         slot = Signal(SLOT_BITS + 1)
-        zrun = Signal(signed(40))
-        irun = Signal(signed(40))
+        zrun = Signal(signed(RUN_BITS))
+        irun = Signal(signed(RUN_BITS))
         cyc = Signal(16)
 
         def sample_range():
@@ -166,10 +173,10 @@ class ExpertsPxp(wiring.Component):
                 stmts += [glo.eq(self.lo), ghi.eq(self.hi), x.eq(self.lo)]
             return stmts
 
-        c0 = Signal(signed(12))
-        c1 = Signal(signed(12))
-        s = Signal(signed(12))
-        e = Signal(signed(12))
+        c0 = Signal(signed(XP_BITS))
+        c1 = Signal(signed(XP_BITS))
+        s = Signal(signed(XP_BITS))
+        e = Signal(signed(XP_BITS))
         m.d.comb += [
             c0.eq((seg.xl + 31) >> X_FRAC),
             c1.eq(((seg.xr + 31) >> X_FRAC) - 1),
@@ -179,19 +186,19 @@ class ExpertsPxp(wiring.Component):
         d = Signal(signed(20))
         m.d.comb += d.eq((s << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl)
         # the multiplier: start values at the first owned pixel
-        zstart = Signal(signed(40))
-        istart = Signal(signed(40))
+        zstart = Signal(signed(RUN_BITS))
+        istart = Signal(signed(RUN_BITS))
         m.d.comb += [
             zstart.eq((seg.zl << DZ_FRAC) + ((d * seg.dzdx) >> X_FRAC)),
             istart.eq(seg.il + ((d * seg.didx) >> X_FRAC)),
         ]
         # compare key (16-bit comparator on the clamped running z) and the shaded pixel
-        zk = Signal(signed(40))
+        zk = Signal(signed(RUN_BITS))
         key = Signal(Z_BITS)
         m.d.comb += zk.eq(zrun >> DZ_FRAC)
         m.d.comb += key.eq(Mux(zk < 0, 0, Mux(zk > (1 << Z_BITS) - 1, (1 << Z_BITS) - 1, zk)))
         imax = fmt.i_max << fmt.i_frac
-        ic = Signal(16)
+        ic = Signal(WORD)
         m.d.comb += ic.eq(Mux(irun < 0, 0, Mux(irun > imax, imax, irun)))
         pix = Signal(pb)
         m.d.comb += pix.eq((seg.hue << ib) | (ic >> fmt.i_frac))

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 from amaranth import Module, Mux, Signal, signed
 from amaranth.lib import enum
+from rasterhw.golden_model.experts.formats import X_END_BITS, XP_BITS
 from rasterhw.hdl.experts.pxp_span import (
     NO_PTR,
     ExpertsPxpSpan,
@@ -79,20 +80,20 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
         (rb, glo, ghi, lo, hi, n, nb, i, j, bi, pp, S, skey, saddr, cyc, raddr, seg, c0, a, e, awr, ard, in_bkt,
          cand) = resolve_regs(m, fr)
         na = Signal(cw)           # entries on the active list
-        sl = Signal(11)           # the span's left pixel x; in WRITE the write cursor
-        sr = Signal(11)           # PASSB: the span searched ends at sr; WRITE: the last pixel written
-        ns = Signal(12)           # the next start (or ghi)
-        vu = Signal(12)           # S is nearest up to pixel vu
+        sl = Signal(X_END_BITS)           # the span's left pixel x; in WRITE the write cursor
+        sr = Signal(X_END_BITS)           # PASSB: the span searched ends at sr; WRITE: the last pixel written
+        ns = Signal(XP_BITS)           # the next start (or ghi)
+        vu = Signal(XP_BITS)           # S is nearest up to pixel vu
         vok = Signal()            # a segment is visible (S)
         fail = Signal()           # an entering segment failed its test against S
-        send = Signal(signed(12))  # S's last pixel in the guarded range
+        send = Signal(signed(XP_BITS))  # S's last pixel in the guarded range
 
         vseg = Signal(asb)
         m.d.comb += [vrd.addr.eq((rb << pw) | S), vseg.eq(vrd.data)]
 
         # the test's right end: min(vu (ENTER) / sr (PASSB), the segment's last pixel)
-        rt = Signal(12)
-        rbx = Signal(12)
+        rt = Signal(XP_BITS)
+        rbx = Signal(XP_BITS)
         m.d.comb += [rt.eq(Mux(state == _R.PASSB, sr, vu)), rbx.eq(Mux(e < rt, e, rt))]
         zl_ = zrun_at(m, seg, sl)
         zr_ = zrun_at(m, seg, rbx)
@@ -103,7 +104,7 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
         key = z_key(m, zl_)
         nearer = Signal()
         m.d.comb += nearer.eq((j == 0) | (key < skey) | ((key == skey) & (seg.addr < saddr)))
-        mid = Signal(11)
+        mid = Signal(X_END_BITS)
         m.d.comb += mid.eq((sl + sr + 1) >> 1)
         ic = intensity_at(m, vseg, sl, fmt)
 
@@ -137,7 +138,7 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
                             m.d.sync += fail.eq(1)
                     take()
                 with m.Else():
-                    nxt = Signal(12)
+                    nxt = Signal(XP_BITS)
                     m.d.comb += nxt.eq(Mux(cand, a, ghi))
                     m.d.sync += [ns.eq(nxt), i.eq(0), j.eq(0), fail.eq(0)]
                     with m.If(fail | ~vok | (sl > vu)):
@@ -149,7 +150,7 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
                         m.d.sync += write(Mux(vu < nxt - 1, vu, nxt - 1))
             with m.Case(_R.PASSA):
                 kept = Signal(cw)
-                se = Signal(signed(12))
+                se = Signal(signed(XP_BITS))
                 m.d.comb += [kept.eq(j), se.eq(send)]
                 with m.If(e >= sl):
                     m.d.comb += [awr.en.eq(1), awr.data.eq(raddr), kept.eq(j + 1)]

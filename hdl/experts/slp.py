@@ -41,7 +41,20 @@ from amaranth import Module, Mux, Signal, signed, unsigned
 from amaranth.lib import data, enum, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
-from rasterhw.golden_model.experts.formats import ACC_EXTRA, ADDR_BITS, X_FRAC
+from rasterhw.golden_model.experts.formats import (
+    ACC_EXTRA,
+    ADDR_BITS,
+    INC_BITS,
+    RGB_BITS,
+    WORD,
+    X_END_BITS,
+    X_FRAC,
+    X_INT,
+    XD_BITS,
+    XP_BITS,
+    XS_BITS,
+    Z_BITS,
+)
 from rasterhw.hdl.experts.mul16 import sm_mul
 
 __all__ = ["ExpertsSlp", "slp_in_layout", "slp_out_layout", "IN_KIND", "MUL_OPS"]
@@ -55,36 +68,36 @@ def slp_in_layout() -> data.StructLayout:
     return data.StructLayout({
         "kind": unsigned(2),
         "t": unsigned(ADDR_BITS),      # PL index
-        "r0": unsigned(10),            # first line (BAND: band start)
-        "r1": unsigned(10),            # last line (BAND: band end, exclusive)
+        "r0": unsigned(X_INT),         # first line (BAND: band start)
+        "r1": unsigned(X_INT),         # last line (BAND: band end, exclusive)
         "ll": unsigned(1),             # the long edge a->c is the left edge
-        "xa": signed(17),              # vertex a: the unsigned Q10.6 of formats.py, signed (BOUND: the bound, pixels)
-        "ya": signed(17),
-        "xb": signed(17),              # vertex b
-        "yb": signed(17),
-        "inc_ac": signed(48),          # edge increments per line, Q.22 (slp.rom_div)
-        "inc_ab": signed(48),
-        "inc_bc": signed(48),
-        "za": unsigned(16),            # z at a and b, Q16.0, and the edges' z increments
-        "zb": unsigned(16),
-        "zinc_ac": signed(48),
-        "zinc_ab": signed(48),
-        "zinc_bc": signed(48),
-        "ia": unsigned(16),            # intensity at a and b, and the edges' increments
-        "ib": unsigned(16),
-        "iinc_ac": signed(48),
-        "iinc_ab": signed(48),
-        "iinc_bc": signed(48),
-        "dzdx": signed(16),            # eq. (3), passed into the ASB
-        "didx": signed(16),
-        "hue": unsigned(9),
+        "xa": signed(XS_BITS),         # vertex a: the unsigned Q10.6 of formats.py, signed (BOUND: the bound, pixels)
+        "ya": signed(XS_BITS),
+        "xb": signed(XS_BITS),         # vertex b
+        "yb": signed(XS_BITS),
+        "inc_ac": signed(INC_BITS),    # edge increments per line, Q.22 (slp.rom_div)
+        "inc_ab": signed(INC_BITS),
+        "inc_bc": signed(INC_BITS),
+        "za": unsigned(Z_BITS),        # z at a and b, Q16.0, and the edges' z increments
+        "zb": unsigned(Z_BITS),
+        "zinc_ac": signed(INC_BITS),
+        "zinc_ab": signed(INC_BITS),
+        "zinc_bc": signed(INC_BITS),
+        "ia": unsigned(WORD),          # intensity at a and b, and the edges' increments
+        "ib": unsigned(WORD),
+        "iinc_ac": signed(INC_BITS),
+        "iinc_ab": signed(INC_BITS),
+        "iinc_bc": signed(INC_BITS),
+        "dzdx": signed(WORD),          # eq. (3), passed into the ASB
+        "didx": signed(WORD),
+        "hue": unsigned(RGB_BITS),
         "poly": unsigned(ADDR_BITS),
-        "s_ac": signed(16),            # A.J.: each edge's dx/dy and dy/dx, sQ7.8
-        "s_ab": signed(16),
-        "s_bc": signed(16),
-        "q_ac": signed(16),
-        "q_ab": signed(16),
-        "q_bc": signed(16),
+        "s_ac": signed(WORD),          # A.J.: each edge's dx/dy and dy/dx, sQ7.8
+        "s_ab": signed(WORD),
+        "s_bc": signed(WORD),
+        "q_ac": signed(WORD),
+        "q_ab": signed(WORD),
+        "q_bc": signed(WORD),
     })
 
 
@@ -95,7 +108,7 @@ def slp_out_layout() -> data.StructLayout:
         "p": unsigned(6),              # range
         "pos": unsigned(9),            # ASL position
         "t": unsigned(ADDR_BITS),
-        "y": unsigned(10),
+        "y": unsigned(X_INT),
         "asb": asb_layout(),           # ASL word: the ASB as it goes into the DMM/P
     })
 
@@ -220,14 +233,14 @@ class ExpertsSlp(wiring.Component):
         FSM keeps x of the long edge in ``xlong`` (first cycle) and z_L in ``zreg``."""
         msel = Signal(2)
         upper = Signal()
-        a0, y0_ = Signal(signed(18)), Signal(signed(18))
-        inc = Signal(signed(16))
+        a0, y0_ = Signal(signed(XD_BITS)), Signal(signed(XD_BITS))
+        inc = Signal(signed(WORD))
         m.d.comb += upper.eq(yc < tv.yb)
 
         def pick(a_a, a_b, i_ac, i_ab, i_bc, lng):
             """operands of the long edge (``lng``), else of the short edge on this line."""
             m.d.comb += [a0.eq(Mux(lng | upper, a_a, a_b)), y0_.eq(Mux(lng | upper, tv.ya, tv.yb)),
-                         inc.eq(Mux(lng, i_ac[:16], Mux(upper, i_ab[:16], i_bc[:16])).as_signed())]
+                         inc.eq(Mux(lng, i_ac[:WORD], Mux(upper, i_ab[:WORD], i_bc[:WORD])).as_signed())]
         with m.Switch(msel):
             with m.Case(MUL_OPS["x_long"]):
                 pick(tv.xa, tv.xb, tv.inc_ac, tv.inc_ab, tv.inc_bc, 1)
@@ -237,11 +250,11 @@ class ExpertsSlp(wiring.Component):
                 pick(tv.za, tv.zb, tv.zinc_ac, tv.zinc_ab, tv.zinc_bc, tv.ll)
             with m.Case(MUL_OPS["i_left"]):
                 pick(tv.ia, tv.ib, tv.iinc_ac, tv.iinc_ab, tv.iinc_bc, tv.ll)
-        dy = Signal(16)
+        dy = Signal(WORD)
         res = Signal(signed(36))
         m.d.comb += [dy.eq(yc - y0_), res.eq(a0 + (sm_mul(m, dy, inc, "slp_mul") >> X_FRAC))]
-        xlong = Signal(signed(18))
-        zreg = Signal(16)
+        xlong = Signal(signed(XD_BITS))
+        zreg = Signal(Z_BITS)
         newx = Signal(xs)
         m.d.comb += [newx.xl.eq(Mux(tv.ll, xlong, res)), newx.xr.eq(Mux(tv.ll, res, xlong))]
         return {"msel": msel, "res": res, "xlong": xlong, "zreg": zreg, "newx": newx}
@@ -254,7 +267,7 @@ class ExpertsSlp(wiring.Component):
         lb = max((self._lines - 1).bit_length(), 1)
         ab = max((self._asl - 1).bit_length(), 1)
         cw = ab + 1
-        xs = data.StructLayout({"xl": signed(18), "xr": signed(18)})
+        xs = data.StructLayout({"xl": signed(XD_BITS), "xr": signed(XD_BITS)})
 
         def mem(name, shape, depth, reads):
             mm = Memory(shape=shape, depth=depth, init=[])
@@ -273,12 +286,12 @@ class ExpertsSlp(wiring.Component):
         bw, (br,) = mem("B", unsigned(tb), self._asl, 1)
         ew, (er0, er1) = mem("E", unsigned(tb), self._asl, 2)
         fw, (fr0, fr1) = mem("F", unsigned(tb), self._asl, 2)
-        ndw, (nd0, nd1) = mem("bnd", unsigned(11), 64, 2)
+        ndw, (nd0, nd1) = mem("bnd", unsigned(X_END_BITS), 64, 2)
 
         state = Signal(_S)
-        y0 = Signal(10)
-        y1 = Signal(10)
-        y = Signal(10)
+        y0 = Signal(X_INT)
+        y1 = Signal(X_INT)
+        y = Signal(X_INT)
         nb = Signal(7)           # bounds taken (P + 1)
         clr = Signal(lb + 1)
         m_ = Signal(cw)          # previous ASL length
@@ -305,7 +318,7 @@ class ExpertsSlp(wiring.Component):
         m.d.comb += [self.i.ready.eq(0), self.o.valid.eq(0)]
 
         # ASL update: x_L, x_R of triangle ``tt`` entry on line y (one multiply per edge)
-        yc = Signal(signed(18))
+        yc = Signal(signed(XD_BITS))
         m.d.comb += yc.eq((y << X_FRAC) + (1 << (X_FRAC - 1)))
         tv = Signal(tl)
         m.d.comb += tv.eq(ttr.data)
@@ -318,7 +331,7 @@ class ExpertsSlp(wiring.Component):
             newx, zl_, il_ = mul["newx"], mul["zreg"], mul["res"]
         else:
             newx, zl_, il_ = self._multipliers(m, tv, yc, xs)
-        s_sh, q_sh = Signal(signed(16)), Signal(signed(16))
+        s_sh, q_sh = Signal(signed(WORD)), Signal(signed(WORD))
         m.d.comb += [s_sh.eq(Mux(yc < tv.yb, tv.s_ab, tv.s_bc)), q_sh.eq(Mux(yc < tv.yb, tv.q_ab, tv.q_bc))]
 
         def less(ka, ta, kb, tb_):
@@ -464,7 +477,7 @@ class ExpertsSlp(wiring.Component):
                                  o_.asb.hue.eq(tv.hue), o_.asb.addr.eq(ar.data), o_.asb.poly.eq(tv.poly),
                                  o_.asb.sl.eq(Mux(tv.ll, tv.s_ac, s_sh)), o_.asb.ql.eq(Mux(tv.ll, tv.q_ac, q_sh)),
                                  o_.asb.sr.eq(Mux(tv.ll, s_sh, tv.s_ac)), o_.asb.qr.eq(Mux(tv.ll, q_sh, tv.q_ac))]
-                    c0, c1 = Signal(signed(12)), Signal(signed(12))
+                    c0, c1 = Signal(signed(XP_BITS)), Signal(signed(XP_BITS))
                     m.d.comb += [c0.eq((ky0.data.xl + 31) >> X_FRAC), c1.eq(((ky0.data.xr + 31) >> X_FRAC) - 1)]
                     with m.If(self.o.ready):
                         if mul:
@@ -479,13 +492,13 @@ class ExpertsSlp(wiring.Component):
                             m.d.sync += state.eq(_S.WQ)
             with m.Case(_S.WQ, _S.WK):
                 m.d.comb += [ar.addr.eq(pos), ky0.addr.eq(ar.data)]
-                c0, c1 = Signal(signed(12)), Signal(signed(12))
+                c0, c1 = Signal(signed(XP_BITS)), Signal(signed(XP_BITS))
                 m.d.comb += [c0.eq((ky0.data.xl + 31) >> X_FRAC), c1.eq(((ky0.data.xr + 31) >> X_FRAC) - 1)]
-                a_, e_ = Signal(signed(12)), Signal(signed(12))
+                a_, e_ = Signal(signed(XP_BITS)), Signal(signed(XP_BITS))
                 m.d.comb += [a_.eq(Mux(c0 < 0, 0, c0)), e_.eq(Mux(c1 > W - 1, W - 1, c1))]
                 r = Signal(7)
                 m.d.comb += [r.eq(Mux(state == _S.WQ, q, k)), nd0.addr.eq(r), nd1.addr.eq(r + 1)]
-                glo, ghi = Signal(signed(12)), Signal(signed(12))
+                glo, ghi = Signal(signed(XP_BITS)), Signal(signed(XP_BITS))
                 m.d.comb += [glo.eq(Mux(nd0.data >= G, nd0.data - G, 0)),
                              ghi.eq(Mux(nd1.data + G <= W, nd1.data + G, W))]
                 live = (ghi > glo) & (nd1.data > nd0.data)

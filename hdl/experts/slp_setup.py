@@ -24,7 +24,20 @@ from amaranth import Const, Module, Mux, Signal, signed, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
-from rasterhw.golden_model.experts.formats import ACC_EXTRA, ADDR_BITS, SLOPE_FRAC, X_FRAC
+from rasterhw.golden_model.experts.formats import (
+    ACC_EXTRA,
+    ADDR_BITS,
+    DZ_FRAC,
+    RGB_BITS,
+    SLOPE_FRAC,
+    WORD,
+    X_FRAC,
+    X_INT,
+    XD_BITS,
+    XP_BITS,
+    XS_BITS,
+    Z_BITS,
+)
 from rasterhw.golden_model.experts.slp_setup import EDGES, ROM_INDEX_BITS, rom_table
 
 __all__ = ["ExpertsSlpSetup", "pl_layout", "PL_KIND", "LIMBS"]
@@ -39,10 +52,11 @@ LIMBS = {"mul": (1, 1), "recip": (1, 2), "recip_den": (3, 2), "md": (1, 1), "md_
 
 
 def pl_layout() -> data.StructLayout:
-    f = {"kind": unsigned(1), "t": unsigned(ADDR_BITS), "r0": unsigned(10), "r1": unsigned(10)}
+    f = {"kind": unsigned(1), "t": unsigned(ADDR_BITS), "r0": unsigned(X_INT), "r1": unsigned(X_INT)}
     for j in range(3):
-        f.update({f"x{j}": signed(17), f"y{j}": signed(17), f"z{j}": unsigned(16), f"i{j}": unsigned(16)})
-    f.update({"hue": unsigned(9), "poly": unsigned(ADDR_BITS)})
+        f.update({f"x{j}": signed(XS_BITS), f"y{j}": signed(XS_BITS), f"z{j}": unsigned(Z_BITS),
+                  f"i{j}": unsigned(WORD)})
+    f.update({"hue": unsigned(RGB_BITS), "poly": unsigned(ADDR_BITS)})
     return data.StructLayout(f)
 
 
@@ -89,13 +103,13 @@ class ExpertsSlpSetup(wiring.Component):
         aa, ab_ = Signal(48, name="mag_a"), Signal(32, name="mag_b")
         neg = Signal(name="neg")
         ia, ib = Signal(2, name="limb_a"), Signal(1, name="limb_b")
-        la, lb = Signal(16, name="word_a"), Signal(16, name="word_b")
+        la, lb = Signal(WORD, name="word_a"), Signal(WORD, name="word_b")
         part = Signal(32, name="part")
         place = Signal(64, name="place")
         pacc, pfull = Signal(64, name="pacc"), Signal(64, name="pfull")
         lc = Signal(3, name="lc")
         m.d.comb += [aa.eq(Mux(ma < 0, -ma, ma)), ab_.eq(Mux(mb < 0, -mb, mb)), neg.eq((ma < 0) ^ (mb < 0)),
-                     la.eq(aa.word_select(ia, 16)), lb.eq(ab_.word_select(ib, 16)), part.eq(la * lb),
+                     la.eq(aa.word_select(ia, WORD)), lb.eq(ab_.word_select(ib, WORD)), part.eq(la * lb),
                      place.eq(Mux(ia + ib == 0, part, Mux(ia + ib == 1, part << 16,
                                                           Mux(ia + ib == 2, part << 32, part << 48)))),
                      pfull.eq(pacc + place), prod.eq(Mux(neg, -pfull, pfull))]
@@ -120,19 +134,19 @@ class ExpertsSlpSetup(wiring.Component):
         p = self.i.payload
         res = Signal(self.o.payload.shape())
         m.d.comb += [self.o.payload.eq(res), self.i.ready.eq(0), self.o.valid.eq(0)]
-        rom = Memory(shape=16, depth=1 << ROM_INDEX_BITS, init=[int(v) for v in rom_table()])
+        rom = Memory(shape=WORD, depth=1 << ROM_INDEX_BITS, init=[int(v) for v in rom_table()])
         m.submodules.rom = rom
         rp = rom.read_port(domain="comb")
 
         # ---- the vertices, sorted on y in the cycle the word is taken (stable: ties keep PL order)
-        X = [Signal(signed(17), name=f"X{k}") for k in range(3)]
-        Y = [Signal(signed(17), name=f"Y{k}") for k in range(3)]
-        Z = [Signal(unsigned(16), name=f"Z{k}") for k in range(3)]
-        Iv = [Signal(unsigned(16), name=f"I{k}") for k in range(3)]
+        X = [Signal(signed(XS_BITS), name=f"X{k}") for k in range(3)]
+        Y = [Signal(signed(XS_BITS), name=f"Y{k}") for k in range(3)]
+        Z = [Signal(unsigned(Z_BITS), name=f"Z{k}") for k in range(3)]
+        Iv = [Signal(unsigned(WORD), name=f"I{k}") for k in range(3)]
         py = [p.y0, p.y1, p.y2]
         before = {(a, b): (py[a] <= py[b]) if a < b else (py[a] < py[b]) for a in range(3) for b in range(3) if a != b}
         rank = [sum((before[(b, a)] for b in range(3) if b != a), Const(0, 2)) for a in range(3)]
-        y0, y1 = Signal(10), Signal(10)
+        y0, y1 = Signal(X_INT), Signal(X_INT)
         half = 1 << (X_FRAC - 1)
 
         # ---- the datapath: one multiplier, an accumulator, the reciprocal (R, S, sign, remainder)
@@ -157,7 +171,7 @@ class ExpertsSlpSetup(wiring.Component):
 
         # the program: ("mul", a, b, dst, first) | ("recip", d) | ("md", num, shift, field, kind)
         def df(A, i, j):
-            v = Signal(signed(18), name=f"d_{A[0].name}_{i}{j}")
+            v = Signal(signed(XD_BITS), name=f"d_{A[0].name}_{i}{j}")
             m.d.comb += v.eq(A[j] - A[i])
             return v
         prog = [("mul", df(Y, 2, 1), df(X, 1, 0), den, True), ("mul", df(Y, 1, 0), df(X, 2, 1), den, False),
@@ -170,10 +184,11 @@ class ExpertsSlpSetup(wiring.Component):
             prog += [("recip", dY), ("md", dX, sh, f"inc_{e_}", ik), ("md", df(Z, i, j), sh, f"zinc_{e_}", ik),
                      ("md", df(Iv, i, j), sh, f"iinc_{e_}", ik), ("md", dX, SLOPE_FRAC, f"s_{e_}", "sat"),
                      ("recip", dX), ("md", dY, SLOPE_FRAC, f"q_{e_}", "satq")]
-        prog += [("recip", den), ("md", nz, 6 + 4, "dzdx", "sat"), ("md", ni, 6, "didx", "sat")]
+        prog += [("recip", den), ("md", nz, X_FRAC + DZ_FRAC, "dzdx", "sat"), ("md", ni, X_FRAC, "didx", "sat")]
 
         def sat16(v):
-            return Mux(v > (1 << 15) - 1, (1 << 15) - 1, Mux(v < -(1 << 15), -(1 << 15), v))
+            top = 1 << (WORD - 1)
+            return Mux(v > top - 1, top - 1, Mux(v < -top, -top, v))
 
         # ---- take a PL word
         with m.If(~busy & ~out):
@@ -190,7 +205,7 @@ class ExpertsSlpSetup(wiring.Component):
                                                  Z[r].eq(getattr(p, f"z{a}")), Iv[r].eq(getattr(p, f"i{a}"))]
                     ytop = Mux(rank[0] == 0, p.y0, Mux(rank[1] == 0, p.y1, p.y2))
                     ybot = Mux(rank[0] == 2, p.y0, Mux(rank[1] == 2, p.y1, p.y2))
-                    r0v, r1v = Signal(signed(12)), Signal(signed(12))
+                    r0v, r1v = Signal(signed(XP_BITS)), Signal(signed(XP_BITS))
                     m.d.comb += [r0v.eq((ytop + half - 1) >> X_FRAC), r1v.eq(((ybot + half - 1) >> X_FRAC) - 1)]
                     r0c = Mux(r0v < 0, 0, r0v)
                     r1c = Mux(r1v > self._h - 1, self._h - 1, r1v)
@@ -226,7 +241,7 @@ class ExpertsSlpSetup(wiring.Component):
                                 for b_ in range(40):
                                     with m.If(ad[b_]):
                                         m.d.comb += bl.eq(b_ + 1)
-                                mant = Signal(unsigned(16), name=f"mant_{k}")
+                                mant = Signal(unsigned(WORD), name=f"mant_{k}")
                                 shr, shl = Signal(6, name=f"shr_{k}"), Signal(6, name=f"shl_{k}")
                                 m.d.comb += [shr.eq(bl - 16), shl.eq(16 - bl),
                                              mant.eq(Mux(bl > 16, ad >> shr, ad << shl))]

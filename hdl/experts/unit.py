@@ -5,6 +5,7 @@ from __future__ import annotations
 from amaranth import Module, unsigned
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
+from rasterhw.golden_model.experts.formats import X_END_BITS, X_INT
 from rasterhw.hdl.experts.dmm import ExpertsDmm
 from rasterhw.hdl.experts.pxp import ExpertsPxp, seg_layout
 
@@ -23,8 +24,8 @@ class ExpertsPxpUnit(wiring.Component):
     Members
     -------
     i : In(stream.Signature(seg_layout()))   ASL lines from the SLP (segments, then ``last``)
-    o : Out(stream.Signature(unsigned(9 + intensity_bits)))   the range's pixels, line by line
-    lo, hi : In(10), In(11)   the range, sampled when a line starts
+    o : Out(stream.Signature(unsigned(RGB_BITS + intensity_bits)))   the range's pixels, line by line
+    lo, hi : In(X_INT), In(X_END_BITS)   the range, sampled when a line starts
     overflow : Out(1)   sticky DMM/P overflow (the SLP side stalls; nothing is dropped)
     line_cycles, lines : Out(16)   the PXP's finish-time counter and line count
     """
@@ -35,7 +36,7 @@ class ExpertsPxpUnit(wiring.Component):
         super().__init__({
             "i": In(stream.Signature(seg_layout())),
             "o": Out(stream.Signature(unsigned(self._pxp.o.payload.shape().width))),
-            "lo": In(10), "hi": In(11), "overflow": Out(1), "line_cycles": Out(16), "lines": Out(16),
+            "lo": In(X_INT), "hi": In(X_END_BITS), "overflow": Out(1), "line_cycles": Out(16), "lines": Out(16),
         })
 
     def elaborate(self, platform):
