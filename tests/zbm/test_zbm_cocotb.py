@@ -5,9 +5,9 @@ Each run uses random idle gaps on every input stream, seeded random back-pressur
 output stream, a segment:merge clock ratio (half periods in ns), the Python stream checker of
 cocotb_tests/common.py on every stream feeding in-order scoreboards (which must end empty),
 the Verilog stream checkers, and compares every scan line bit for bit (both samples, Z and
-colour) with golden_model/zbm/.  Frames are 64x16.  From cold build folders the default set
-(not ``slow``) takes about 70 s here (Verilator builds: unit ~28 s, chip ~21 s); later runs
-reuse build/.
+colour) with golden_model/zbm/.  Frames are 64x16.  The unit's Verilator runs are ``slow`` (the
+fast suite compares the engine with their committed records, tests/zbm_cocotb/records.py); the
+default set runs the chip (cocotb build ~21 s cold) and Table 1 on the plain engine.
 """
 
 from __future__ import annotations
@@ -31,11 +31,15 @@ W, H = 64, 16
 # (segment, merge) half periods in ns: 1:1, merge slower (3:2 periods), merge faster
 RATIOS = [(5, 5), (2, 3), (3, 2)]
 #: the first ratio builds the bench (heavy: handed out first, tests/conftest.py); the others reuse it.
-#: The unit's two unequal ratios are slow: in the fast suite the engine runs the unit at ratios
-#: against the cocotb bench's recorded runs (test_engine_clocks.py, tests/zbm_cocotb/records.py)
+#: The unit's cocotb runs on Verilator are all slow (the cocotb unit builds, ~30 s each cold, left
+#: the fast suite): there the engine runs the same cases against the cocotb bench's recorded runs
+#: (tests/zbm_cocotb/records.py; ratio (5, 5) and the full-rate run: test_zbm_unit_engine.py::
+#: test_unit_engine_equals_the_cocotb_record[ratio-5-5-*]; the unequal ratios: test_engine_clocks.py)
 HEAVY_FIRST = [pytest.param(RATIOS[0], marks=pytest.mark.heavy), *RATIOS[1:]]
-UNIT_RATIOS = [pytest.param(RATIOS[0], marks=pytest.mark.heavy),
+UNIT_RATIOS = [pytest.param(RATIOS[0], marks=[pytest.mark.heavy, pytest.mark.slow]),
                *(pytest.param(r, marks=pytest.mark.slow) for r in RATIOS[1:])]
+#: Verilator (slow, see above), Icarus when ``iverilog`` is on PATH
+UNIT_SIMS = [pytest.param("verilator", marks=pytest.mark.slow), SIMS[1]]
 
 
 def _scene(seed: int, n: int = 30):
@@ -61,7 +65,7 @@ def test_unit_verilator_ratios(ratio):
     _unit_run("verilator", 2, 1, ratio, stall=80, seed=sum(ratio))
 
 
-@pytest.mark.parametrize("sim", SIMS)
+@pytest.mark.parametrize("sim", UNIT_SIMS)
 def test_unit_no_gaps_full_rate(sim):
     _unit_run(sim, 2, 1, (5, 5), stall=0, seed=11)
 
@@ -107,8 +111,13 @@ def test_bench_rejects_bad_settings():
 
 
 @pytest.mark.heavy
+@pytest.mark.slow
 def test_unit_paper_schedule_verilator_protocol():
-    """The paper-schedule unit under random gaps, back-pressure and a 3:2 clock ratio: same words."""
+    """The paper-schedule unit under random gaps, back-pressure and a 3:2 clock ratio: same words.
+    Slow (its own cocotb build, ~35 s cold); in the fast suite the paper schedule's Verilog gives the
+    golden words on Verilator (test_table1_paper_schedule_verilator) and its HDL at a 3:2 clock
+    ratio under back-pressure with protocol checkers on every stream on pysim
+    (tests/zbm/test_zbm_unit_pysim.py::test_units_match_render_zbm[...-paper])."""
     tris = _scene(5)
     gold = G.render_zbm(tris, interleave=2)
     exp = doublez_words(gold.pixels)

@@ -23,7 +23,8 @@ RECORDS = Path(__file__).parent / "unit_records.json"
 W, H = 64, 16
 
 #: name -> case. "eq-*": equal clocks in phase (test_zbm_unit_engine.py); "ratio-*": the cocotb
-#: bench's clocks at a segment:merge ratio (test_engine_clocks.py)
+#: bench's clocks at a segment:merge ratio, the merge clock 1 ns behind (test_engine_clocks.py,
+#: test_zbm_unit_engine.py)
 CASES = {
     "eq-s0-11": {"scene_seed": 11, "stall": 0, "gap_seed": None, "seed": 11, "ratio": None},
     "eq-s90-g7-101": {"scene_seed": 101, "stall": 90, "gap_seed": 7, "seed": 101, "ratio": None},
@@ -32,6 +33,12 @@ CASES = {
     "ratio-2-3": {"scene_seed": 5, "stall": 80, "gap_seed": 5, "seed": 8, "ratio": (2, 3)},
     "ratio-3-2": {"scene_seed": 5, "stall": 0, "gap_seed": None, "seed": 8, "ratio": (3, 2)},
     "ratio-7-2": {"scene_seed": 9, "stall": 60, "gap_seed": 9, "seed": 12, "ratio": (7, 2)},
+    # the runs of test_zbm_cocotb.py's unit tests, now slow (test_unit_verilator_ratios[ratio0],
+    # test_unit_no_gaps_full_rate[verilator]), and of the watchdog test (was a cocotb run):
+    # test_zbm_unit_engine.py
+    "ratio-5-5-s80-g10": {"scene_seed": 10, "stall": 80, "gap_seed": 10, "seed": 10, "ratio": (5, 5)},
+    "ratio-5-5-s0-g11": {"scene_seed": 11, "stall": 0, "gap_seed": 11, "seed": 11, "ratio": (5, 5)},
+    "ratio-2-7-s254": {"scene_seed": 5, "stall": 254, "gap_seed": None, "seed": 3, "ratio": (2, 7)},
 }
 
 
