@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -94,3 +95,11 @@ def check_engine(name: str) -> dict:
     assert rec["frame"] == frame_digest(*gold)
     assert as_record(r) == rec and rec["cycles"] > H
     return r
+
+
+def hold_records(path: Path, got: dict) -> None:
+    """The committed records at ``path`` must equal ``got`` (case -> record, from the cocotb runs);
+    with ``RASTERHW_WRITE_RECORDS=1`` they are written from ``got`` first (one case a line)."""
+    if os.environ.get("RASTERHW_WRITE_RECORDS") == "1":
+        path.write_text("{\n" + ",\n".join(f" {json.dumps(k)}: {json.dumps(v)}" for k, v in got.items()) + "\n}\n")
+    assert json.loads(path.read_text()) == got
