@@ -6,8 +6,10 @@ scan lines bit for bit, in the same number of segment-clock cycles as the cocotb
 The fast test compares the engine's cycles with that bench's committed record
 (``tests/zbm_cocotb/chip_record.json``: cycles and frame digest); the slow test runs the cocotb
 bench again and holds the record equal to it (``RASTERHW_WRITE_RECORDS=1`` writes it instead). The
-chip is the one ``tests/zbm/test_zbm_cocotb.py`` runs under cocotb, so the cocotb model is built
-once for both files; cold, the fast test adds the engine's build (g++ -O1) only."""
+chip is the one ``tests/zbm/test_zbm_cocotb.py`` runs under cocotb. That file's chip runs at clock
+ratios, gaps and back-pressure are slow; here the engine runs each at the bench's clocks against
+the bench's recorded run (``tests/zbm_cocotb/chip_records.py``, one separate-clock engine build),
+and the slow test holds those records equal to cocotb. The fast suite builds no cocotb chip."""
 
 from __future__ import annotations
 
@@ -22,8 +24,9 @@ from rasterhw.golden_model.zbm.stimulus import random_doublez, random_triangles
 from rasterhw.golden_model.zbm.words import merge_words
 from rasterhw.sim.engines import run
 from rasterhw.sim.testbench import Stimulus, find_testbench
+from zbm_cocotb import chip_records as CR
 from zbm_cocotb.chip_bench import chip_stimulus, run_chip_bench
-from zbm_cocotb.records import frame_digest
+from zbm_cocotb.records import frame_digest, hold_records
 
 pytestmark = pytest.mark.cocotb
 
@@ -70,3 +73,31 @@ def test_cocotb_chip_bench_equals_its_record():
     if os.environ.get("RASTERHW_WRITE_RECORDS") == "1":
         RECORD.write_text(json.dumps(got) + "\n")
     assert json.loads(RECORD.read_text()) == got
+
+
+@pytest.mark.parametrize("case", list(CR.CASES))
+def test_engine_chip_at_the_cocotb_benchs_clocks_equals_its_record(case):
+    """The chip on the engine at the cocotb chip bench's segment : merge clocks, idle gaps and
+    back-pressure (``tests/zbm_cocotb/chip_records.py``): the golden merged words, no protocol error,
+    every line, and the cocotb bench's segment-clock count as recorded
+    (``tests/zbm_cocotb/chip_ratio_records.json``, held equal to cocotb by the slow test below).
+    Was a cocotb run each: test_zbm_cocotb.py's test_chip_verilator_ratios and
+    test_chip_sims[verilator], now slow."""
+    CR.check_engine(case)
+
+
+@pytest.mark.slow
+def test_cocotb_chip_runs_equal_their_records():
+    got = {}
+    for name in CR.CASES:
+        r = CR.cocotb_run(name)
+        _, _, exp = CR.chip_case(CR.CASES[name][2])
+        assert np.array_equal(r["s0"], exp[0]) and np.array_equal(r["s1"], exp[1]), name
+        assert r["proto_errors"] == 0 and r["lines"] == H, name
+        got[name] = CR.as_record(r)
+    hold_records(CR.RECORDS, got)
+
+
+def test_every_chip_case_is_recorded():
+    """One record per case, no stale ones (fast: reads the file)."""
+    assert set(json.loads(CR.RECORDS.read_text())) == set(CR.CASES)

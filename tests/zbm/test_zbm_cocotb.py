@@ -5,9 +5,10 @@ Each run uses random idle gaps on every input stream, seeded random back-pressur
 output stream, a segment:merge clock ratio (half periods in ns), the Python stream checker of
 cocotb_tests/common.py on every stream feeding in-order scoreboards (which must end empty),
 the Verilog stream checkers, and compares every scan line bit for bit (both samples, Z and
-colour) with golden_model/zbm/.  Frames are 64x16.  From cold build folders the default set
-(not ``slow``) takes about 70 s here (Verilator builds: unit ~28 s, chip ~21 s); later runs
-reuse build/.
+colour) with golden_model/zbm/.  Frames are 64x16.  The unit's Verilator runs are ``slow`` (the
+fast suite compares the engine with their committed records, tests/zbm_cocotb/records.py); the
+chip's too (tests/zbm_cocotb/chip_records.py); the default set keeps the bench's argument checks and
+Table 1 on the plain engine (and the Icarus runs, when ``iverilog`` is on PATH).
 """
 
 from __future__ import annotations
@@ -18,9 +19,10 @@ import numpy as np
 import pytest
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.golden_model.zbm.stimulus import random_doublez, random_triangles
+from rasterhw.golden_model.zbm.stimulus import random_triangles
 from rasterhw.golden_model.zbm.words import doublez_words
-from zbm_cocotb.chip_bench import chip_stimulus, run_chip_bench
+from zbm_cocotb.chip_bench import run_chip_bench
+from zbm_cocotb.chip_records import chip_case
 from zbm_cocotb.unit_bench import plusargs, run_unit_bench
 
 pytestmark = pytest.mark.cocotb
@@ -31,11 +33,15 @@ W, H = 64, 16
 # (segment, merge) half periods in ns: 1:1, merge slower (3:2 periods), merge faster
 RATIOS = [(5, 5), (2, 3), (3, 2)]
 #: the first ratio builds the bench (heavy: handed out first, tests/conftest.py); the others reuse it.
-#: The unit's two unequal ratios are slow: in the fast suite the engine runs the unit at ratios
-#: against the cocotb bench's recorded runs (test_engine_clocks.py, tests/zbm_cocotb/records.py)
+#: The unit's cocotb runs on Verilator are all slow (the cocotb unit builds, ~30 s each cold, left
+#: the fast suite): there the engine runs the same cases against the cocotb bench's recorded runs
+#: (tests/zbm_cocotb/records.py; ratio (5, 5) and the full-rate run: test_zbm_unit_engine.py::
+#: test_unit_engine_equals_the_cocotb_record[ratio-5-5-*]; the unequal ratios: test_engine_clocks.py)
 HEAVY_FIRST = [pytest.param(RATIOS[0], marks=pytest.mark.heavy), *RATIOS[1:]]
-UNIT_RATIOS = [pytest.param(RATIOS[0], marks=pytest.mark.heavy),
+UNIT_RATIOS = [pytest.param(RATIOS[0], marks=[pytest.mark.heavy, pytest.mark.slow]),
                *(pytest.param(r, marks=pytest.mark.slow) for r in RATIOS[1:])]
+#: Verilator (slow, see above and below), Icarus when ``iverilog`` is on PATH
+UNIT_SIMS = [pytest.param("verilator", marks=pytest.mark.slow), SIMS[1]]
 
 
 def _scene(seed: int, n: int = 30):
@@ -61,7 +67,7 @@ def test_unit_verilator_ratios(ratio):
     _unit_run("verilator", 2, 1, ratio, stall=80, seed=sum(ratio))
 
 
-@pytest.mark.parametrize("sim", SIMS)
+@pytest.mark.parametrize("sim", UNIT_SIMS)
 def test_unit_no_gaps_full_rate(sim):
     _unit_run(sim, 2, 1, (5, 5), stall=0, seed=11)
 
@@ -73,13 +79,7 @@ def test_two_chained_units(sim):
 
 
 def _chip_run(sim, ratio, stall, seed, interleave=4, chip=1):
-    tris = _scene(seed, 40)
-    segs = G.segment_generator(G.edge_pairs(tris), H, width=W)
-    npx = -(-(W - chip) // interleave)
-    up = random_doublez(np.random.default_rng(seed), H * npx)
-    up = G.DoubleZ(up.z.reshape(H, npx, 2), up.a.reshape(H, npx, 2), up.c.reshape(H, npx, 2, 4),
-                   up.tag.reshape(H, npx, 2))
-    seg_w, up_w, exp = chip_stimulus(segs, H, up, chip=chip, interleave=interleave, width=W)
+    seg_w, up_w, exp = chip_case(seed, interleave=interleave, chip=chip)
     r = run_chip_bench(seg_w, up_w, lines=H, chip=chip, interleave=interleave, width=W, sim=sim,
                          ratio=ratio, stall=stall, seed=seed, gap_seed=seed, expect=exp, check_protocol=True)
     assert np.array_equal(r["s0"], exp[0]) and np.array_equal(r["s1"], exp[1])
@@ -87,12 +87,16 @@ def _chip_run(sim, ratio, stall, seed, interleave=4, chip=1):
     return r
 
 
+# the chip's cocotb runs on Verilator are slow too: in the fast suite the engine runs each of them at
+# the bench's clocks, gaps and back-pressure against the bench's recorded run (tests/zbm_cocotb/
+# chip_records.py: tests/zbm/test_zbm_chip_engine.py::test_engine_chip_at_the_cocotb_benchs_clocks_equals_its_record)
+@pytest.mark.slow
 @pytest.mark.parametrize("ratio", HEAVY_FIRST)
 def test_chip_verilator_ratios(ratio):
     _chip_run("verilator", ratio, stall=80, seed=ratio[0] * 7 + ratio[1])
 
 
-@pytest.mark.parametrize("sim", SIMS)
+@pytest.mark.parametrize("sim", UNIT_SIMS)
 def test_chip_sims(sim):
     _chip_run(sim, (5, 5), stall=40, seed=3)
 
@@ -107,8 +111,13 @@ def test_bench_rejects_bad_settings():
 
 
 @pytest.mark.heavy
+@pytest.mark.slow
 def test_unit_paper_schedule_verilator_protocol():
-    """The paper-schedule unit under random gaps, back-pressure and a 3:2 clock ratio: same words."""
+    """The paper-schedule unit under random gaps, back-pressure and a 3:2 clock ratio: same words.
+    Slow (its own cocotb build, ~35 s cold); in the fast suite the paper schedule's Verilog gives the
+    golden words on Verilator (test_table1_paper_schedule_verilator) and its HDL at a 3:2 clock
+    ratio under back-pressure with protocol checkers on every stream on pysim
+    (tests/zbm/test_zbm_unit_pysim.py::test_units_match_render_zbm[...-paper])."""
     tris = _scene(5)
     gold = G.render_zbm(tris, interleave=2)
     exp = doublez_words(gold.pixels)

@@ -42,11 +42,14 @@ def _compare(units: int, stall: int, gap_seed, seed: int, schedule: str = "overl
     return fast
 
 
-@pytest.mark.parametrize("case", ["eq-s0-11", "eq-s90-g7-101"])
+@pytest.mark.parametrize("case", ["eq-s0-11", "eq-s90-g7-101", "ratio-5-5-s80-g10", "ratio-5-5-s0-g11"])
 def test_unit_engine_equals_the_cocotb_record(case):
     """The golden frame, and the cocotb bench's cycle count, per-line log and frame as recorded
     (``tests/zbm_cocotb/unit_records.json``; held equal to cocotb's runs by the slow
-    test_zbm_unit_records.py). Was a cocotb run beside each engine run."""
+    test_zbm_unit_records.py). Was a cocotb run beside each engine run. The two ``ratio-5-5``
+    cases are the runs of test_zbm_cocotb.py's test_unit_verilator_ratios[ratio0] (random gaps,
+    back-pressure 80) and test_unit_no_gaps_full_rate[verilator] (no back-pressure), now slow:
+    the same scene, seeds and clocks (half periods 5 : 5, the merge clock 1 ns behind)."""
     R.check_engine(case)
 
 
@@ -82,16 +85,14 @@ def test_watchdog_covers_heavy_backpressure_and_a_slow_merge_clock():
     1.4 x slower than the segment clock (half periods 5 : 7) outran the cocotb bench's watchdog,
     which had no term for either (the plain bench's had one for the stall only; the engine run uses it). Here a small frame
     with a merge clock 3.5 x slower (2 : 7): it finishes, every word golden, past the old budget
-    and inside the shared watchdog."""
-    tris = random_triangles(np.random.default_rng(5), 30, W, H, size=10)
-    eps = G.edge_pairs(tris)
-    gold = doublez_words(G.render_zbm(tris, interleave=2).pixels)
-    total = len(eps) * 9 + 1
-    r = run_unit_bench([eps], width=W, height=H, interleave=2, sim="verilator", ratio=(2, 7), stall=254,
-                         seed=3, speed_run=True)
-    assert np.array_equal(r["s0"], gold[0]) and np.array_equal(r["s1"], gold[1])
+    and inside the shared watchdog. The run is the engine's at the cocotb bench's clocks, equal to
+    cocotb's recorded run of it (case ``ratio-2-7-s254``: cycles, per-line log, frame), which the
+    slow test_zbm_unit_records.py runs on the cocotb bench again (was a cocotb run here)."""
+    eps, gold = R.scene("ratio-2-7-s254")
+    total = len(eps[0]) * 9 + 1
+    r = R.check_engine("ratio-2-7-s254")   # the golden frame, cocotb's recorded cycles and per-line log
     old = 200 * (total + 64) + 40 * H * (W + 64)          # the cocotb bench's watchdog before
     assert old < r["cycles"] < unit_watchdog(total, width=W, height=H, stall=254, ratio=(2, 7))
     assert unit_watchdog(total, width=W, height=H) == old   # unchanged for free-running runs
-    fast = run_scene([eps], width=W, height=H, interleave=2, stall=255, seed=3, build={"speed": True, "opt": "-O1"})
+    fast = run_scene(eps, width=W, height=H, interleave=2, stall=255, seed=3, build={"speed": True, "opt": "-O1"})
     assert np.array_equal(fast["s0"], gold[0])

@@ -65,9 +65,11 @@ def run_units(units, words_per_unit, n_lines, *, merge_period=1e-8, stall_p=0.0,
     return got
 
 
+# the last case: the paper schedule with the merge clock at 2/3 of the segment clock's period (the
+# 3:2 half periods of test_zbm_cocotb.py::test_unit_paper_schedule_verilator_protocol, now slow)
 @pytest.mark.parametrize("interleave,n_units,merge_period,schedule",
                          [(2, 1, 1e-8, "overlap"), (4, 2, 1.9e-8, "overlap"), (2, 1, 1e-8, "paper"),
-                          (4, 2, 1.9e-8, "paper")])
+                          (4, 2, 1.9e-8, "paper"), (2, 1, 2e-8 / 3, "paper")])
 def test_units_match_render_zbm(interleave, n_units, merge_period, schedule):
     w, h = 32, 10
     rng = np.random.default_rng(interleave)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +24,8 @@ RECORDS = Path(__file__).parent / "unit_records.json"
 W, H = 64, 16
 
 #: name -> case. "eq-*": equal clocks in phase (test_zbm_unit_engine.py); "ratio-*": the cocotb
-#: bench's clocks at a segment:merge ratio (test_engine_clocks.py)
+#: bench's clocks at a segment:merge ratio, the merge clock 1 ns behind (test_engine_clocks.py,
+#: test_zbm_unit_engine.py)
 CASES = {
     "eq-s0-11": {"scene_seed": 11, "stall": 0, "gap_seed": None, "seed": 11, "ratio": None},
     "eq-s90-g7-101": {"scene_seed": 101, "stall": 90, "gap_seed": 7, "seed": 101, "ratio": None},
@@ -32,6 +34,12 @@ CASES = {
     "ratio-2-3": {"scene_seed": 5, "stall": 80, "gap_seed": 5, "seed": 8, "ratio": (2, 3)},
     "ratio-3-2": {"scene_seed": 5, "stall": 0, "gap_seed": None, "seed": 8, "ratio": (3, 2)},
     "ratio-7-2": {"scene_seed": 9, "stall": 60, "gap_seed": 9, "seed": 12, "ratio": (7, 2)},
+    # the runs of test_zbm_cocotb.py's unit tests, now slow (test_unit_verilator_ratios[ratio0],
+    # test_unit_no_gaps_full_rate[verilator]), and of the watchdog test (was a cocotb run):
+    # test_zbm_unit_engine.py
+    "ratio-5-5-s80-g10": {"scene_seed": 10, "stall": 80, "gap_seed": 10, "seed": 10, "ratio": (5, 5)},
+    "ratio-5-5-s0-g11": {"scene_seed": 11, "stall": 0, "gap_seed": 11, "seed": 11, "ratio": (5, 5)},
+    "ratio-2-7-s254": {"scene_seed": 5, "stall": 254, "gap_seed": None, "seed": 3, "ratio": (2, 7)},
 }
 
 
@@ -87,3 +95,11 @@ def check_engine(name: str) -> dict:
     assert rec["frame"] == frame_digest(*gold)
     assert as_record(r) == rec and rec["cycles"] > H
     return r
+
+
+def hold_records(path: Path, got: dict) -> None:
+    """The committed records at ``path`` must equal ``got`` (case -> record, from the cocotb runs);
+    with ``RASTERHW_WRITE_RECORDS=1`` they are written from ``got`` first (one case a line)."""
+    if os.environ.get("RASTERHW_WRITE_RECORDS") == "1":
+        path.write_text("{\n" + ",\n".join(f" {json.dumps(k)}: {json.dumps(v)}" for k, v in got.items()) + "\n}\n")
+    assert json.loads(path.read_text()) == got
