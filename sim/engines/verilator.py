@@ -63,12 +63,13 @@ def bench_sources(tb: Testbench) -> list[Path]:
     return _closure_cached(roots)
 
 
-#: the transitive sources of each set of roots, with every file's and folder's (mtime, size) when found
-_CLOSURES = BUILD_ROOT / "bench-sources.json"
+#: the transitive sources of each set of roots, with every file's and folder's (mtime, size) when found:
+#: ``build/verilog/bench-sources-<digest>.json``, one per set of roots
+_CLOSURES = BUILD_ROOT / "verilog" / "bench-sources"
 
 
 def _closure_cached(roots: list[Path]) -> list[Path]:
-    """:func:`module_sources` of ``roots``, kept in ``build/bench-sources.json`` (``verilog_cache.closure_cached``)."""
+    """:func:`module_sources` of ``roots``, kept in ``build/verilog/bench-sources-*.json`` (``verilog_cache.closure_cached``)."""
     return closure_cached(roots, _CLOSURES)
 
 

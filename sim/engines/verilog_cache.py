@@ -17,12 +17,12 @@ from __future__ import annotations
 import ast
 import hashlib
 import json
-import os
 import threading
 from collections.abc import Callable, Iterable, Mapping
 from functools import cache
 from pathlib import Path
 
+from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.cachefile import check_writable, read_entry, write_entry
 from rasterhw.sim.engines.verilog import canonical_port_lists, generate_verilog
 from rasterhw.sim.outfile import write_text
@@ -123,32 +123,29 @@ def _stamp(f: Path) -> list[int]:
 
 
 def closure_cached(roots: list[Path], store: Path) -> list[Path]:
-    """:func:`module_sources` of ``roots``, kept in the JSON file ``store`` (parsing ~50 modules
-    for their imports cost ~0.3 CPU-s a run): reused while no file of the closure and no folder
-    holding one has changed (a file edited, added or removed there changes its stamp), else found
-    again. The closure depends only on those files' text and on which modules exist."""
+    """:func:`module_sources` of ``roots``, kept in a cache entry of its own per set of roots,
+    ``<store>-<digest of the roots>.json`` (``store``: a path in the build cache without the suffix,
+    e.g. ``build/verilog/design-sources``), written and read through ``cachefile.write_entry`` /
+    ``read_entry`` (SHA-256 checked: a damaged entry is said in one line and found again, never
+    served; parsing ~50 modules for their imports cost ~0.3 CPU-s a run). Reused while no file of
+    the closure and no folder holding one has changed (a file edited, added or removed there
+    changes its stamp), else found again. The closure depends only on those files' text and on
+    which modules exist."""
     key = "|".join(str(Path(r).resolve()) for r in roots)
+    path = store.with_name(f"{store.name}-{hashlib.sha1(key.encode()).hexdigest()[:16]}.json")
+    raw = read_entry(path, what="an index of Python sources")
     try:
-        known = json.loads(store.read_text())
-    except (OSError, ValueError):
-        known = {}
-    hit = known.get(key)
-    if hit is not None:
-        try:
-            if all(_stamp(Path(f)) == st for f, st in hit["stamps"].items()):
-                return [Path(f) for f in hit["files"]]
-        except OSError:
-            pass
+        hit = json.loads(raw) if raw is not None else None
+        if hit is not None and hit["roots"] == key and all(_stamp(Path(f)) == st for f, st in hit["stamps"].items()):
+            return [Path(f) for f in hit["files"]]
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        pass   # a file of the closure gone, or an entry of another shape: found again
     files = module_sources(roots)
     stamps = {str(f): _stamp(f) for f in files} | {str(d): _stamp(d) for d in {f.parent for f in files}}
-    known[key] = {"files": [str(f) for f in files], "stamps": stamps}
     try:
-        store.parent.mkdir(parents=True, exist_ok=True)
-        tmp = store.with_name(f"{store.name}.{os.getpid()}.{threading.get_ident()}.tmp")
-        tmp.write_text(json.dumps(known))
-        os.replace(tmp, store)
-    except OSError:
-        pass   # a read-only cache: found again next time
+        write_entry(path, json.dumps({"roots": key, "files": [str(f) for f in files], "stamps": stamps}).encode())
+    except (OSError, RasterhwError):
+        pass   # a read-only cache (or a link planted on the way): found again next time
     return files
 
 
@@ -187,8 +184,9 @@ def design_sources(block: str | None = None) -> list[Path]:
     return closure_cached([*roots, PKG_ROOT / "sim" / "engines" / "verilog.py"], _DESIGN_CLOSURES)
 
 
-#: :func:`design_sources` of each block, with every file's and folder's stamp (:func:`closure_cached`)
-_DESIGN_CLOSURES = BUILD_ROOT / "design-sources.json"
+#: :func:`design_sources` of each block, with every file's and folder's stamp (:func:`closure_cached`):
+#: ``build/verilog/design-sources-<digest>.json``, one per block
+_DESIGN_CLOSURES = BUILD_ROOT / "verilog" / "design-sources"
 
 
 def factory_params(block: str) -> tuple[list[str], dict]:
