@@ -89,7 +89,7 @@ def unit_job(eps_per_unit: list, *, width: int, height: int, interleave: int, sc
     stim = tb.scene_stimulus(p, eps_per_unit, gap_seed=gap_seed)
     cap = unit_watchdog(sum(map(len, stim.words.values())), width=width, height=height, stall=stall,
                         ratio=(clocks["sync"].half, clocks["merge"].half) if clocks else (5, 5))
-    run = {"stall": stall, "seed": seed, "max_cycles": cap, "clocks": clocks,
+    run = {"stall": stall, "seed": seed, "max_cycles": cap, "clocks": clocks, "packed": True,
            "build": (SPEED_BUILD if build is None else build) if engine == "verilator" else None}
     return Job(tb, p, stim, tb.expect(p, stim), run, cycle_exact=False)
 
