@@ -276,8 +276,8 @@ def compare(exp: Expected, got: Run, *, cycle_exact: bool = True) -> dict:
 
 def _ints(words) -> list:
     """A port's words as a list of ints (packed rows converted: ``packed.as_ints``)."""
-    if isinstance(words, np.ndarray):
-        from rasterhw.sim.engines.packed import as_ints   # here: the engines package imports this module
+    if isinstance(words, np.ndarray):   # imported here: the engines package imports this module
+        from rasterhw.sim.engines.packed import as_ints
 
         return as_ints(words)
     return words if isinstance(words, list) else list(words)
