@@ -91,3 +91,21 @@ def test_a_parameter_at_its_default_finds_the_same_cache_entry(tmp_path, monkeyp
     assert a == b and calls == [{"fifo_depth": 4}]
     c = vc.generate_cached("zbm-merger", fifo_depth=4, z_bits=16)
     assert c != a and len(calls) == 2 and len(list((tmp_path / "verilog").glob("zbm-merger-*.v"))) == 2
+
+
+def test_the_amaranth_version_is_the_installed_metadata():
+    """``amaranth_version`` (read from the one dist-info beside the package, Amaranth not imported)
+    is what ``importlib.metadata`` and Amaranth itself say."""
+    import importlib.metadata
+    import subprocess
+    import sys
+
+    from rasterhw.sim.engines import verilog_cache as vc
+
+    assert vc.amaranth_version() == importlib.metadata.version("amaranth")
+    out = subprocess.run([sys.executable, "-c", "import sys; from rasterhw.sim.engines.verilog_cache import "
+                          "amaranth_version as v; print(v(), 'amaranth' in sys.modules)"],
+                         capture_output=True, text=True, check=True, timeout=120)
+    import amaranth
+
+    assert out.stdout.split() == [amaranth.__version__, "False"]
