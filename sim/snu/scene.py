@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import sys
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
@@ -159,10 +160,22 @@ def golden_schedule(stream: PixelStream, gaps: np.ndarray, first_work: list[floa
             fill_bus = int(np.ceil(first_work[p] / ratio))
             first_bench[p] = max(0, fill_bus - t_start)
             g[idx[0]] = t_start + first_bench[p]
-    acc = golden.pixelbus_accept_cycles(stream, gaps=g)
+    acc = accept_cycles(stream, g)
     t_pix = int(acc.max()) + MEM_CYCLE if len(stream) else t_start
     return {"t_clear": 0, "t_start": t_start, "t_pixels_done": t_pix, "t_swap": t_pix + 1,
             "cycles": t_pix + 2, "accept": acc, "first_bench_gap": first_bench}
+
+
+def accept_cycles(stream: PixelStream, gaps: np.ndarray) -> np.ndarray:
+    """``golden.pixelbus_accept_cycles(stream, gaps=gaps)``, kept in the build cache
+    (``verilog_cache.arrays_cached``: keyed by the stream's writes and gaps and by the model's sources):
+    its event loop is Python, one step per write (snu-100px's 199,970: 0.15-0.28 CPU-s a run)."""
+    from rasterhw.sim.engines.verilog_cache import arrays_cached
+
+    g = np.asarray(gaps, dtype=np.int64)
+    key = [stream.width, stream.height, stream.addr, stream.pipe, g, MEM_CYCLE, N_BANKS]
+    return arrays_cached("snu-accept", Path(golden.__file__), key,
+                         lambda: {"accept": golden.pixelbus_accept_cycles(stream, gaps=g)})["accept"]
 
 
 # ====================================================================== the pixel stream alone
