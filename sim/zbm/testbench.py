@@ -192,10 +192,12 @@ class UnitBench(Testbench):
                         gaps={p: gaps[at[k]:at[k + 1]] for k, p in enumerate(ins)} if gap_seed is not None else {},
                         what=what, source=list(eps_per_unit))
 
-    def expect(self, params: dict, stim: Stimulus) -> Expected:
-        """Every slot's merge words of ``chain_frame``'s frame, as packed rows (``merge_rows``)."""
+    def expect(self, params: dict, stim: Stimulus, segments: list | None = None) -> Expected:
+        """Every slot's merge words of ``chain_frame``'s frame, as packed rows (``merge_rows``);
+        ``segments``: each unit's segments, when the caller has them (``chain_frame``)."""
         i = params["interleave"]
-        frame = G.chain_frame(stim.source, params["width"], params["height"], capacity=params["capacity"])
+        frame = G.chain_frame(stim.source, params["width"], params["height"], capacity=params["capacity"],
+                              segments=segments)
         g0, g1 = doublez_words(frame)
         outs = self.outputs_of(params)
         return Expected({outs[c]: merge_rows(g0[:, c::i], g1[:, c::i]) for c in range(i)}, golden=frame)

@@ -79,3 +79,18 @@ def test_compare_counts_packed_rows_as_it_counts_ints():
         assert compare(Expected({"o": want}), Run("x", {"o": as_ints(bad)}, {}))["mismatches"] == 2
         assert compare(Expected({"o": want}), Run("x", {"o": short}, {}))["mismatches"] == 3
         assert compare(Expected({"o": want}), Run("x", {}, {}))["mismatches"] == 40
+
+
+def test_given_segments_give_the_same_frames():
+    """``chain_frame(..., segments=)`` and ``render_zbm_float(..., segs=)`` (a one-unit scene run
+    generates the segments once for both) equal what they compute themselves; a segment list per
+    unit is required."""
+    tris = ref.random_triangles(48, 40, 25, mean_area=90, seed=9)
+    eps = G.edge_pairs(tris)
+    segs = G.segment_generator(eps, 40, width=48)
+    a, b = G.chain_frame([eps], 48, 40), G.chain_frame([eps], 48, 40, segments=[segs])
+    assert all(np.array_equal(getattr(a, k), getattr(b, k)) for k in ("z", "a", "c", "tag"))
+    fa, fb = G.render_zbm_float(tris), G.render_zbm_float(tris, segs=segs)
+    assert all(np.array_equal(fa[k], fb[k]) for k in ("rgb", "z", "tag"))
+    with pytest.raises(RasterhwError, match="segment lists"):
+        G.chain_frame([eps, eps], 48, 40, segments=[segs])
