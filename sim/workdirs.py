@@ -30,7 +30,6 @@ import os
 import re
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import tempfile
@@ -40,7 +39,7 @@ from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 
 __all__ = ["OrphanWatch", "become_subreaper", "build_lock", "cleanup", "end_descendants", "end_orphans", "end_tree",
-           "keep", "remove_dead_work_folders", "run_child", "run_folder", "temp_run_folder", "work_folder"]
+           "host_tag", "keep", "remove_dead_work_folders", "run_child", "run_folder", "temp_run_folder", "work_folder"]
 
 _live: set[Path] = set()
 _held: set[str] = set()
@@ -302,7 +301,19 @@ def work_folder(parent: str | Path, name: str) -> Path:
     return Path(tempfile.mkdtemp(prefix=f".{name}.tmp-{_HOST}-{os.getpid()}-", dir=parent))
 
 
-_HOST = re.sub(r"[^A-Za-z0-9]", "", socket.gethostname())[:32] or "host"
+def host_tag() -> str:
+    """This host's name as it goes into work and run folder names: letters and digits, at most 32.
+    On POSIX the kernel's node name (what ``socket.gethostname`` returns, without importing socket)."""
+    if hasattr(os, "uname"):
+        name = os.uname().nodename
+    else:
+        import socket
+
+        name = socket.gethostname()
+    return re.sub(r"[^A-Za-z0-9]", "", name)[:32] or "host"
+
+
+_HOST = host_tag()
 
 
 def remove_dead_work_folders(parent: str | Path | None = None) -> int:
