@@ -9,33 +9,41 @@ import pytest
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="/proc children lists: Linux")
 
+CHILDREN = """
+import subprocess, threading, time, psutil
+from rasterhw.sim import workdirs as w
+assert w._child_pids() == [], w._child_pids()
+assert w.end_descendants() == 0
+a = subprocess.Popen(['sleep', '30'])
+box = []
+t = threading.Thread(target=lambda: box.append(subprocess.Popen(['sleep', '30'])))
+t.start(); t.join()
+w.become_subreaper()
+subprocess.run(['sh', '-c', 'sleep 30 & exit 0'], check=True)
+time.sleep(0.3)
+kids = sorted(w._child_pids())
+assert len(kids) == 3 and kids == sorted(k.pid for k in psutil.Process().children()), kids
+assert w.end_descendants() == 3
+assert w._child_pids() == []
+"""
 
-def test_the_kernel_list_holds_what_psutil_sees():
-    code = (
-        "import subprocess, threading, time, psutil\n"
-        "from rasterhw.sim import workdirs as w\n"
-        "assert w._child_pids() == [], w._child_pids()\n"
-        "assert w.end_descendants() == 0\n"
-        "a = subprocess.Popen(['sleep', '30'])\n"
-        "box = []\n"
-        "t = threading.Thread(target=lambda: box.append(subprocess.Popen(['sleep', '30'])))\n"
-        "t.start(); t.join()\n"
-        "w.become_subreaper()\n"
-        "subprocess.run(['sh', '-c', 'sleep 30 & exit 0'], check=True)\n"
-        "time.sleep(0.3)\n"
-        "kids = sorted(w._child_pids())\n"
-        "assert len(kids) == 3 and kids == sorted(k.pid for k in psutil.Process().children()), kids\n"
-        "assert w.end_descendants() == 3\n"
-        "assert w._child_pids() == []\n"
-    )
+NO_CHILD = """
+import sys
+from rasterhw.sim import workdirs as w
+assert w.end_descendants() == 0
+print('psutil' in sys.modules)
+"""
+
+
+def _python(code: str) -> str:
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr
+    return r.stdout
+
+
+def test_the_kernel_list_holds_what_psutil_sees():
+    _python(CHILDREN)
 
 
 def test_no_child_means_no_psutil_import():
-    code = ("import sys\nfrom rasterhw.sim import workdirs as w\n"
-            "assert w.end_descendants() == 0\nprint('psutil' in sys.modules)")
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
-    assert r.returncode == 0, r.stderr
-    assert r.stdout.split() == ["False"]
-
+    assert _python(NO_CHILD).split() == ["False"]
