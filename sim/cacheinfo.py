@@ -31,6 +31,7 @@ from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.cachefile import NESTED, RECORD_SUFFIX
+from rasterhw.sim.workdirs import host_tag
 
 __all__ = ["KINDS", "CAP_ENV", "Entry", "apply_cap", "cap_from_env", "clean", "entries", "parse_age",
            "parse_size"]
@@ -57,7 +58,7 @@ _NESTED_KIND = {"verilog": "verilog", "zbm-verilog": "verilog", "verilator-runti
 #: what the name of an entry says besides its design (removed to name the design)
 _AFFIXES = (r"^(tb|mut|mutate|synth|prove|pnr-ecp5|pnr-ice40|pnr)-", r"-[0-9a-f]{10,16}(\.v|\.json)?$",
             r"-trace-(vcd|fst)$", r"-hier$", r"-pgo(gen)?$", r"-cocotb$", r"-(verilator|icarus)$")
-_HOST = re.sub(r"[^A-Za-z0-9]", "", __import__("socket").gethostname())[:32] or "host"
+_HOST = host_tag()
 #: a run folder (``workdirs.temp_run_folder``) and a build's work folder (``workdirs.work_folder``)
 #: carry the host and the process that made them
 _RUN = re.compile(r"^run-(?P<host>[A-Za-z0-9]+)-(?P<pid>\d+)-")

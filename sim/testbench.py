@@ -11,8 +11,11 @@ same way: they own clocks, stream sources with idle gaps, sinks with seeded back
 stamps, build caches and run folders. This module and the engines know no machine.
 
 Words are integers: a stream's payload as one packed word (``payload.as_value()``); a port's words
-in a :class:`Stimulus` are a list of ints or, for millions of words, the same values packed as
-``(N, bytes)`` uint8 rows, big-endian (``sim/engines/packed.py``; outputs are always ints).
+in a :class:`Stimulus` or an :class:`Expected` are a list of ints or, for millions of words, the
+same values packed as ``(N, bytes)`` uint8 rows, big-endian (``sim/engines/packed.py``); a
+:class:`Run`'s are ints, or such rows where the run asked for them (``engines.run(...,
+packed=True)``: the Verilator engine reads its binary dumps so, no Python int per word).
+:func:`compare` takes either form on either side.
 
 Cycles: clock edges are counted from 0 at the first rising edge of the run (no reset: the
 design starts at its ``init`` values in every engine); a transfer's stamp is the index of the
@@ -255,9 +258,13 @@ def compare(exp: Expected, got: Run, *, cycle_exact: bool = True) -> dict:
     ports, total = {}, 0
     for p, want in exp.words.items():
         have = got.words.get(p, [])
-        # equal lists (the usual run) compare in C at once; otherwise count the differing words
-        same = isinstance(want, list) and isinstance(have, list) and want == have
-        bad = 0 if same else sum(map(ne, want, have)) + abs(len(want) - len(have))
+        if isinstance(want, np.ndarray) and isinstance(have, np.ndarray) and want.shape[1:] == have.shape[1:]:
+            n = min(len(want), len(have))   # packed rows on both sides: rows that differ, in NumPy
+            bad = int(np.count_nonzero((want[:n] != have[:n]).reshape(n, -1).any(axis=1))) + abs(len(want) - len(have))
+        else:
+            want, have = _ints(want), _ints(have)
+            # equal lists (the usual run) compare in C at once; otherwise count the differing words
+            bad = 0 if want == have else sum(map(ne, want, have)) + abs(len(want) - len(have))
         ports[p] = {"words": len(want), "mismatches": bad}
         total += bad
     cyc = None
@@ -265,6 +272,15 @@ def compare(exp: Expected, got: Run, *, cycle_exact: bool = True) -> dict:
         cyc = int(got.cycles != exp.cycles) if cycle_exact else int(got.cycles < exp.cycles)
     return {"mismatches": total, "ports": ports, "cycles": got.cycles, "cycles_golden": exp.cycles,
             "cycle_mismatches": cyc}
+
+
+def _ints(words) -> list:
+    """A port's words as a list of ints (packed rows converted: ``packed.as_ints``)."""
+    if isinstance(words, np.ndarray):   # imported here: the engines package imports this module
+        from rasterhw.sim.engines.packed import as_ints
+
+        return as_ints(words)
+    return words if isinstance(words, list) else list(words)
 
 
 def find_testbench(block: str) -> Testbench:

@@ -91,3 +91,58 @@ def test_a_parameter_at_its_default_finds_the_same_cache_entry(tmp_path, monkeyp
     assert a == b and calls == [{"fifo_depth": 4}]
     c = vc.generate_cached("zbm-merger", fifo_depth=4, z_bits=16)
     assert c != a and len(calls) == 2 and len(list((tmp_path / "verilog").glob("zbm-merger-*.v"))) == 2
+
+
+def test_the_amaranth_version_is_the_installed_metadata():
+    """``amaranth_version`` (read from the one dist-info beside the package, Amaranth not imported)
+    is what ``importlib.metadata`` and Amaranth itself say."""
+    import importlib.metadata
+    import subprocess
+    import sys
+
+    from rasterhw.sim.engines import verilog_cache as vc
+
+    assert vc.amaranth_version() == importlib.metadata.version("amaranth")
+    out = subprocess.run([sys.executable, "-c", "import sys; from rasterhw.sim.engines.verilog_cache import "
+                          "amaranth_version as v; print(v(), 'amaranth' in sys.modules)"],
+                         capture_output=True, text=True, check=True, timeout=120)
+    import amaranth
+
+    assert out.stdout.split() == [amaranth.__version__, "False"]
+
+
+def test_cached_arrays_are_computed_once_per_key_and_damage_is_recomputed(tmp_path, monkeypatch, capsys):
+    """``arrays_cached``: the result read back equals the computed one (dtype and shape too); another
+    key value (an array's bytes, dtype or shape, a scalar) computes again; an entry that no longer
+    matches its SHA-256 is said in one line and computed again, not served."""
+    import numpy as np
+    from rasterhw.golden_model.snu import pixelbus
+    from rasterhw.sim import cachefile
+    from rasterhw.sim.engines import verilog_cache as vc
+
+    monkeypatch.setattr(vc, "BUILD_ROOT", tmp_path)
+    monkeypatch.setattr(cachefile, "BUILD_ROOT", tmp_path)
+    src = vc.Path(pixelbus.__file__)
+    calls = []
+
+    def compute(a):
+        calls.append(1)
+        return {"x": a * 2, "n": np.array(7, np.int64)}
+
+    a = np.arange(6, dtype=np.int64).reshape(2, 3)
+    for _ in range(2):
+        got = vc.arrays_cached("t", src, [a, 4], lambda: compute(a))
+        assert np.array_equal(got["x"], a * 2) and got["x"].dtype == np.int64 and got["x"].shape == (2, 3)
+        assert int(got["n"]) == 7
+    assert len(calls) == 1
+    (entry,) = (tmp_path / "verilog").glob("t-*.npz")
+    raw = bytearray(entry.read_bytes())
+    raw[-30] ^= 0xFF
+    entry.write_bytes(bytes(raw))
+    capsys.readouterr()
+    got = vc.arrays_cached("t", src, [a, 4], lambda: compute(a))
+    assert len(calls) == 2 and np.array_equal(got["x"], a * 2)
+    assert "does not match the SHA-256" in capsys.readouterr().err
+    for key in ([a.reshape(3, 2), 4], [a.astype(np.int32), 4], [a + 1, 4], [a, 5]):
+        vc.arrays_cached("t", src, key, lambda: compute(a))
+    assert len(calls) == 6 and len(list((tmp_path / "verilog").glob("t-*.npz"))) == 5

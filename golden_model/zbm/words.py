@@ -11,13 +11,45 @@ import numpy as np
 from rasterhw.golden_model import zbm as G
 from rasterhw.golden_model.zbm import formats as F
 
-__all__ = ["merge_words", "split_merge_words", "doublez_words", "edge_pair_words", "packets", "pixel2_words", "segment_words",
-           "words_to_doublez"]
+__all__ = ["merge_rows", "merge_words", "split_merge_words", "doublez_words", "edge_pair_rows", "edge_pair_words",
+           "packets", "pixel2_words", "rows_to_samples", "segment_words", "words_to_doublez"]
 
 
 def edge_pair_words(eps: G.EdgePairs) -> list[int]:
     """All edge pairs' 9 loader words, then the end-of-frame marker (EP_HEADER h = 0)."""
     return [w for i in range(len(eps)) for w in eps.words(i)] + [F.EP_HEADER.pack(y=0, h=0)]
+
+
+_SLOT_MASK = np.int64((1 << F.SLOT_BITS) - 1)
+_SLOT_BYTES = F.SLOT_BITS // 8                 # 7: a 56-bit slot is whole bytes
+_EP_BYTES = F.EP_WORD_BITS // 8                # 21
+
+
+def edge_pair_rows(eps: G.EdgePairs) -> np.ndarray:
+    """:func:`edge_pair_words` (the specification; ``tests/zbm/test_zbm_words_rows.py`` holds the
+    two equal) as packed rows (``sim/engines/packed.py``: ``(9 E + 1, 21)`` uint8, each 168-bit
+    word big-endian), built column by column: no Python int per word (22,786 ``Layout.pack``
+    calls for c300's 2,848 edge pairs). A value that does not fit its field is left to
+    :func:`edge_pair_words`, which raises the field's one-line error."""
+    n, c = len(eps), eps.val.shape[1]
+    names = ("x", "len") + F.CHANNELS[eps.mode]
+    slot_lo, slot_hi = -(1 << (F.SLOT_BITS - 1)), (1 << (F.SLOT_BITS - 1)) - 1
+    # (E, 9, 3): per word its three 56-bit slots, bits 0.., 56.., 112..
+    slots = np.zeros((n, F.EP_WORDS, 3), np.int64)
+    slots[:, 0, 0] = eps.y | (eps.h << 9) | (eps.mode << 19)          # EP_HEADER: y (9), h (10), mode (1)
+    slots[:, 1, :2] = np.stack([eps.x, eps.dxdy], -1)
+    slots[:, 2, :2] = np.stack([eps.len, eps.dlendy], -1)
+    slots[:, 3:3 + c] = np.stack([eps.val, eps.ddy, eps.ddx], -1)
+    head = [(eps.y, 9), (eps.h, 10)]
+    chans = slots[:, 1:3 + c]
+    if n and (len(names) != 2 + c or eps.mode not in (0, 1) or any(v.min() < 0 or v.max() >> b for v, b in head)
+              or chans.min() < slot_lo or chans.max() > slot_hi):
+        edge_pair_words(eps)   # raises the specification's one-line error
+        raise AssertionError("edge_pair_rows: a check the specification does not make")
+    be = (slots & _SLOT_MASK).astype(">u8").view(np.uint8).reshape(n, F.EP_WORDS, 3, 8)[..., 8 - _SLOT_BYTES:]
+    rows = np.zeros((n * F.EP_WORDS + 1, _EP_BYTES), np.uint8)   # the last row: the end-of-frame marker (0)
+    rows[:-1] = be[:, :, ::-1].reshape(-1, _EP_BYTES)            # the top slot's bytes first
+    return rows
 
 
 def segment_words(segs: G.Segments, y: int) -> list[int]:
@@ -72,6 +104,18 @@ def merge_words(s0, s1) -> list[int]:
     flattened in C order."""
     return [int(a) | (int(b) << _SAMPLE_BITS)
             for a, b in zip(np.ravel(s0).tolist(), np.ravel(s1).tolist(), strict=True)]
+
+
+def merge_rows(s0, s1) -> np.ndarray:
+    """:func:`merge_words` as packed rows (``sim/engines/packed.py``): ``(N, 16)`` uint8, each
+    PIXEL2 word ``s1 << 64 | s0`` big-endian, flattened in C order; no Python int per word."""
+    return np.stack([np.ravel(s1), np.ravel(s0)], -1).astype(">u8").view(np.uint8)
+
+
+def rows_to_samples(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Packed PIXEL2 rows (:func:`merge_rows`' form) -> their (s0, s1) uint64 sample words."""
+    w = np.ascontiguousarray(rows, np.uint8).view(">u8").reshape(-1, 2)
+    return w[:, 1].astype(np.uint64), w[:, 0].astype(np.uint64)
 
 
 def split_merge_words(words) -> tuple[np.ndarray, np.ndarray]:

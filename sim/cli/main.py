@@ -246,11 +246,12 @@ def _nothing_to_draw(sc, w: int, h: int):
     (all back-facing, or all outside the view), else None. A machine's renderer or simulation is
     not run on an empty triangle list (some ended in an IndexError): the command warns, as the
     reference does, and writes the blank frame."""
-    from rasterhw.golden_model.reference import rasterise_rgb8
-
     tris = _geometry(sc, w, h)
     if tris.n_triangles:
         return None
+    # imported here: a frame with triangles never needs the reference rasteriser
+    from rasterhw.golden_model.reference import rasterise_rgb8
+
     rgb8, _counts = rasterise_rgb8(tris)
     return rgb8
 

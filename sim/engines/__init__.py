@@ -88,7 +88,7 @@ def tally():
 
 def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", idle: float = 0.0, stall: int = 0,
         seed: int = 1, expect_words: dict[str, int] | None = None, max_cycles: int | None = None,
-        build: dict | None = None, clocks: dict | None = None) -> Run:
+        build: dict | None = None, clocks: dict | None = None, packed: bool = False) -> Run:
     """Run ``stim`` through block ``tb.block`` with ``params`` on ``engine``.
 
     ``idle`` (0 <= idle < 1): every input word without a gap of its own in ``stim`` waits a random
@@ -105,6 +105,10 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
     ``clocks``: ``{domain: Clock | half period | (half, first edge)}`` for every domain of the block
     (``tb.domains``): separate clocks (``sim/testbench.py``: :class:`Clock`); each port's gaps,
     back-pressure and stamps then count its own domain's edges. None: every domain on one clock.
+    ``packed``: the Verilator engine gives the output words as packed rows (``packed.py``: ``(N,
+    bytes)`` uint8, big-endian), read from its binary dumps without a Python int per word (262,144
+    128-bit words: 0.2 CPU-s as ints); the other engines give ints (``testbench.compare`` and the
+    testbenches that ask for rows take either).
     """
     engine = ALIASES.get(engine, engine)
     if engine not in ENGINES:
@@ -139,6 +143,8 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
         raise RasterhwError(f"build settings are for the verilator engine (cocotb's: depth, out_depth), not {engine}")
     if build:
         kw["build"] = build
+    if packed and engine == "verilator":
+        kw["packed"] = True
     got = ENGINES[engine](tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
                           max_cycles=max_cycles, **kw)
     with _tally_lock:

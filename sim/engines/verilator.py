@@ -36,7 +36,7 @@ from rasterhw.sim.engines.runner import (
 from rasterhw.sim.engines.verilog import canonical_port_lists
 from rasterhw.sim.engines.verilog_cache import closure_cached, convert_cached, sources_digest
 from rasterhw.sim.paths import BUILD_ROOT
-from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
+from rasterhw.sim.testbench import Run, Stimulus, Testbench, compare, port_of
 from rasterhw.sim.workdirs import build_lock, release, temp_run_folder
 
 __all__ = ["GAP_BITS", "PGO_OPT", "bench_design", "bench_sources", "collected", "hier_marked",
@@ -63,12 +63,13 @@ def bench_sources(tb: Testbench) -> list[Path]:
     return _closure_cached(roots)
 
 
-#: the transitive sources of each set of roots, with every file's and folder's (mtime, size) when found
-_CLOSURES = BUILD_ROOT / "bench-sources.json"
+#: the transitive sources of each set of roots, with every file's and folder's (mtime, size) when found:
+#: ``build/verilog/bench-sources-<digest>.json``, one per set of roots
+_CLOSURES = BUILD_ROOT / "verilog" / "bench-sources"
 
 
 def _closure_cached(roots: list[Path]) -> list[Path]:
-    """:func:`module_sources` of ``roots``, kept in ``build/bench-sources.json`` (``verilog_cache.closure_cached``)."""
+    """:func:`module_sources` of ``roots``, kept in ``build/verilog/bench-sources-*.json`` (``verilog_cache.closure_cached``)."""
     return closure_cached(roots, _CLOSURES)
 
 
@@ -213,8 +214,8 @@ def profile(tb: Testbench, params: dict, design, *, inputs: dict[str, int], outp
         prof.mkdir(parents=True)
         got = _run_exe(exe, tb, params, stim, stall=0, seed=1, expect_words=want, inputs=inputs,
                        max_cycles=(10_000 + 64 * (sum(want.values()) + sum(map(len, stim.words.values())))),
-                       profile=prof)
-        bad = sum(a != b for p in want for a, b in zip(exp.words[p], got[0][p], strict=True))
+                       profile=prof, packed=True)
+        bad = compare(exp, Run("verilator", got[0], got[1]))["mismatches"]
         if bad:
             shutil.rmtree(prof, ignore_errors=True)
             raise RasterhwError(f"{tb.block} profile: the instrumented build's training run ({stim.what}) "
@@ -240,7 +241,7 @@ def _trained(prof: Path, *, quiet: bool = False) -> bool:
 
 
 def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, expect_words: dict[str, int],
-        max_cycles: int, build: dict | None = None, clocks: dict | None = None) -> Run:
+        max_cycles: int, build: dict | None = None, clocks: dict | None = None, packed: bool = False) -> Run:
     t0 = time.perf_counter()
     speed, opt, pgo, depth, out_depth, hier = _settings(build, tb.verilator_opt)
     blocks = tb.hier_blocks(params) if hier else ()
@@ -259,7 +260,8 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, e
     # the port widths and the status values' names and widths, cached with the Verilog (no block constructed)
     ports = bench_ports(tb, params, top.key, top[1]["rasterhw_bench.v"])
     words, stamps, meta, _ = _run_exe(exe, tb, params, stim, stall=stall, seed=seed, expect_words=expect_words,
-                                      inputs=inputs, max_cycles=max_cycles, widths=ports["widths"], clocks=clocks)
+                                      inputs=inputs, max_cycles=max_cycles, widths=ports["widths"], clocks=clocks,
+                                      packed=packed)
     status = unpack(ports["status"], int(meta.get("status", 0)))
     return Run("verilator", words, stamps, wall_s=time.perf_counter() - t0, build_s=build_s, run_s=meta["run_s"],
                cpu_s=meta["cpu_s"],
@@ -280,9 +282,10 @@ def memory_depths(tb: Testbench, params: dict, stim: Stimulus, expect_words: dic
 
 def _run_exe(exe: Path, tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int,
              expect_words: dict[str, int], inputs: dict[str, int], max_cycles: int, profile: Path | None = None,
-             widths: dict[str, int] | None = None, clocks: dict | None = None):
+             widths: dict[str, int] | None = None, clocks: dict | None = None, packed: bool = False):
     """One run of a bench binary: (words, stamps, the main's JSON line, cycles). ``widths``: every
-    stream port's payload bits (None: from the block, constructed here)."""
+    stream port's payload bits (None: from the block, constructed here); ``packed``: the words as
+    packed rows (:func:`collected`)."""
     run_dir = temp_run_folder(exe.parent.parent)
     widths = ports_of(tb, params, tb.dut(params))["widths"] if widths is None else widths
     try:
@@ -291,7 +294,7 @@ def _run_exe(exe: Path, tb: Testbench, params: dict, stim: Stimulus, *, stall: i
         meta = run_plain_verilator(exe, plus + ["+dump_bin=1"], run_dir=run_dir, maxcyc=max_cycles,
                                    profile=profile)
         outs = tb.outputs_of(params)
-        words, stamps = collected(run_dir, outs, expect_words, widths={n: widths[n] for n in outs})
+        words, stamps = collected(run_dir, outs, expect_words, widths={n: widths[n] for n in outs}, packed=packed)
     finally:
         release(run_dir)
     return words, stamps, meta, max((s[-1] + 1 for s in stamps.values() if s), default=0)
@@ -326,14 +329,19 @@ def stream_plusargs(run_dir: Path, tb: Testbench, params: dict, stim: Stimulus, 
 
 
 def collected(run_dir: Path, outs, expect_words: dict[str, int], widths: dict[str, int] | None = None,
-              ) -> tuple[dict[str, list[int]], dict[str, list[int]]]:
+              packed: bool = False) -> tuple[dict[str, list[int]], dict[str, list[int]]]:
     """(words, stamps) per output port from the sinks' dumps in ``run_dir``: ``$writememh`` text, or
-    with ``widths`` (``{port: payload bits}``, a run with ``+dump_bin=1``) the binary dumps."""
+    with ``widths`` (``{port: payload bits}``, a run with ``+dump_bin=1``) the binary dumps, the
+    words then as packed rows if ``packed`` (:func:`_binary_rows`)."""
     words, stamps = {}, {}
     for n in outs:
         t, k = tag(n), expect_words[n]
         if widths is not None:
-            words[n] = _binary(run_dir / f"{t}.out", widths[n])[:k] if k else []
+            if packed:
+                words[n] = (_binary_rows(run_dir / f"{t}.out", widths[n])[:k] if k
+                            else np.zeros((0, -(-widths[n] // 8)), np.uint8))
+            else:
+                words[n] = _binary(run_dir / f"{t}.out", widths[n])[:k] if k else []
             stamps[n] = _binary(run_dir / f"{t}.cyc", 32)[:k] if k else []
         else:
             words[n] = _ints(read_memh(run_dir / f"{t}.out", None))[:k] if k else []
@@ -341,13 +349,25 @@ def collected(run_dir: Path, outs, expect_words: dict[str, int], widths: dict[st
     return words, stamps
 
 
-def _binary(path: Path, bits: int) -> list[int]:
+def _dump(path: Path, bits: int) -> tuple[np.ndarray, int]:
     """A sink's binary dump (``$fwrite`` ``"%u"``: each word little-endian in ``4 * ceil(bits / 32)``
-    bytes) as Python ints; words of up to 64 bits in one NumPy pass."""
+    bytes) as its bytes, and that word size."""
     size = 4 * -(-bits // 32)
     raw = np.fromfile(path, np.uint8)
     if raw.size % size:
         raise RasterhwError(f"{path}: {raw.size} bytes, not whole {size}-byte words")
+    return raw, size
+
+
+def _binary_rows(path: Path, bits: int) -> np.ndarray:
+    """A sink's binary dump as packed rows (``packed.py``: ``(N, ceil(bits / 8))`` uint8, big-endian)."""
+    raw, size = _dump(path, bits)
+    return np.ascontiguousarray(raw.reshape(-1, size)[:, ::-1][:, size - -(-bits // 8):])
+
+
+def _binary(path: Path, bits: int) -> list[int]:
+    """A sink's binary dump as Python ints; words of up to 64 bits in one NumPy pass."""
+    raw, size = _dump(path, bits)
     if size <= 8:
         return raw.view("<u4" if size == 4 else "<u8").tolist()
     b, from_bytes = raw.tobytes(), int.from_bytes   # slices of one bytes object: 0.6x the CPU of row.tobytes()

@@ -56,13 +56,88 @@ def hdl_image(fr: ExpertsFrame, got) -> np.ndarray | None:
     """The frame the HDL wrote, as 8-bit RGB: its pixel words (R3 G3 B3 I, frame order: every
     line's PXP ranges left to right) decoded and shown as the VOC shows them (``to_rgb8``);
     None when the run did not give one word per pixel."""
-    H, W = fr.height, fr.width
+    return _image(_display(fr), got)
+
+
+def _display(fr: ExpertsFrame) -> dict:
+    """What :func:`hdl_image` needs of a frame: its size and the pixel word's format (the fields of
+    its set-up that ``to_rgb8`` reads: ``bit``, ``fmt.i_max``)."""
+    return {"width": int(fr.width), "height": int(fr.height), "intensity_bits": int(fr.setup.fmt.intensity_bits),
+            "bit": bool(fr.setup.bit), "i_max": int(fr.setup.fmt.i_max)}
+
+
+def _image(d: dict, got) -> np.ndarray | None:
+    """:func:`hdl_image` from the frame's :func:`_display`."""
+    from types import SimpleNamespace
+
+    H, W, ib = d["height"], d["width"], d["intensity_bits"]
     w = np.asarray(got, np.int64)
     if w.size != H * W:
         return None
-    ib = fr.setup.fmt.intensity_bits
     fields = np.stack([(w >> (6 + ib)) & 7, (w >> (3 + ib)) & 7, (w >> ib) & 7, w & ((1 << ib) - 1)], axis=1)
-    return to_rgb8(fr.setup, fields, H, W)
+    return to_rgb8(SimpleNamespace(bit=d["bit"], fmt=SimpleNamespace(i_max=d["i_max"])), fields, H, W)
+
+
+#: the jobs' fields a scene run reads (``pxp_job``, :meth:`PxpScene.result`), kept in the build cache
+_KEPT = ("pixels", "cycles", "last_pixel", "lo0", "hi0", "lines", "aj", "seg_bits", "pxp", "datapath",
+         "pxp_frame_cycles")
+
+
+def _cached_jobs(tris, compute, **options) -> dict:
+    """``compute()`` (the golden frame's display format and :func:`jobs`) for these triangles and
+    ``options``, kept as a build-cache entry (``build/verilog/experts-pxp-jobs-<digest>.npz``,
+    SHA-256 checked through ``cachefile.read_entry`` / ``write_entry``) keyed by the triangles' bytes,
+    the options and the digest of every Python source the jobs are made from (this module and,
+    transitively, every module of ours it imports: the golden model, the job packing, the HDL's
+    layouts; ``verilog_cache.closure_cached``). A warm run so neither renders the frame nor walks the
+    span cycle model (nor loads numba and Amaranth for it): experts-1000 at 512 x 512, 8 x 8: ~1 CPU-s.
+    Kept: the words as packed rows (``sim/engines/packed.py``, the input port's width), the fields of
+    :data:`_KEPT`, ``resolve`` (each line's resolve cycles: a stalled run's floor) and ``span_steps``
+    (the step counts summed)."""
+    import hashlib
+    import io
+    import json
+    from pathlib import Path
+
+    from rasterhw.sim.cachefile import read_entry, write_entry
+    from rasterhw.sim.engines.packed import as_bytes
+    from rasterhw.sim.engines.verilog_cache import closure_cached, sources_digest
+    from rasterhw.sim.experts.pxp_jobs import RANGE_BITS
+    from rasterhw.sim.paths import BUILD_ROOT
+
+    h = hashlib.sha1()
+    for k, v in sorted(vars(tris).items()):
+        h.update(k.encode())
+        h.update(v.tobytes() + str((v.dtype, v.shape)).encode() if isinstance(v, np.ndarray)
+                 else json.dumps(v, sort_keys=True, default=str).encode())
+    src = sources_digest(closure_cached([Path(__file__)], BUILD_ROOT / "verilog" / "model-sources"))
+    key = json.dumps([h.hexdigest(), src, options], sort_keys=True)
+    path = BUILD_ROOT / "verilog" / f"experts-pxp-jobs-{hashlib.sha1(key.encode()).hexdigest()[:16]}.npz"
+    raw = read_entry(path, what="the EXPERTS PXP jobs of a scene")
+    if raw is None:
+        gold = compute()
+        jb = gold["jb"]
+        meta = {"fr": gold["fr"], "key": key, **{k: jb.get(k) for k in _KEPT if not isinstance(jb.get(k), np.ndarray)},
+                "span_steps": ({k: int(sum(st[k] for st in jb["steps"])) for k in jb["steps"][0]}
+                               if jb.get("steps") else {})}
+        arrays = {k: np.asarray(jb[k]) for k in _KEPT if isinstance(jb.get(k), np.ndarray)}
+        arrays["rows"] = as_bytes(jb["words"], jb.get("seg_bits", SEG_BITS) + RANGE_BITS)
+        arrays["resolve"] = np.array([t[1] for t in jb.get("timing", [])], np.int64)
+        buf = io.BytesIO()
+        np.savez(buf, meta=np.frombuffer(json.dumps(meta).encode(), np.uint8), **arrays)
+        raw = buf.getvalue()
+        try:
+            write_entry(path, raw, root=BUILD_ROOT)
+        except (OSError, RasterhwError):
+            pass   # a read-only cache: computed again next time
+    with np.load(io.BytesIO(raw), allow_pickle=False) as z:
+        meta = json.loads(z["meta"].tobytes())
+        if meta.pop("key") != key:
+            raise RasterhwError(f"{path}: a cache entry of another key (remove it)")
+        jb = {**{k: z[k] for k in z.files if k != "meta"}, **meta}
+    fr = jb.pop("fr")
+    jb["words"] = jb.pop("rows")
+    return {"fr": fr, "jb": jb}
 
 
 def jobs(fr: ExpertsFrame, sn: int, pn: int, *, ranges: np.ndarray | None = None, pxp: str = "zbuffer",
@@ -150,7 +225,15 @@ def pxp_job(jb: dict, *, width: int, engine: str = "pysim", idle: int = 0, stall
         tb = (PxpCoherentBench if jb.get("pxp") == "coherent" else PxpSpanBench)(log=True)
     else:
         tb = PxpBench(log=True)
-    stim = job_stimulus(jb)
+    if isinstance(jb["words"], np.ndarray):   # packed rows (the cached jobs: _cached_jobs): the range word packed too
+        from rasterhw.sim.engines.packed import as_bytes
+        from rasterhw.sim.experts.pxp_jobs import RANGE_BITS
+
+        first = job_stimulus({**jb, "words": []})
+        rows = np.concatenate([as_bytes(first.words["i"], jb.get("seg_bits", SEG_BITS) + RANGE_BITS), jb["words"]])
+        stim = replace(first, words={"i": rows}, source=jb)
+    else:
+        stim = job_stimulus(jb)
     if idle:
         # the range word first, always on edge 0 (the PXP's clock starts after it): gaps from the next
         g = with_gaps(stim, idle / 256, seed, ("i",)).gaps["i"]
@@ -227,7 +310,15 @@ class PxpScene(SceneRun):
 
     def golden(self, scene, width: int, height: int, *, engine: str, sn: int = 8, pn: int = 8, aj: str = "c",
                ranges: str = "static", pxp: str = "span", **_) -> dict:
-        fr = render_frame(run_geometry(scene, width, height, z_bits=16), model="bit", aj=aj)
+        """``{"fr": the frame's display format (:func:`_display`), "jb": the jobs}``, the jobs kept
+        as a build-cache entry (:func:`_cached_jobs`)."""
+        tris = run_geometry(scene, width, height, z_bits=16)
+        return _cached_jobs(tris, lambda: self._golden(tris, sn=sn, pn=pn, aj=aj, ranges=ranges, pxp=pxp),
+                            sn=sn, pn=pn, aj=aj, ranges=ranges, pxp=pxp)
+
+    @staticmethod
+    def _golden(tris, *, sn: int, pn: int, aj: str, ranges: str, pxp: str) -> dict:
+        fr = render_frame(tris, model="bit", aj=aj)
         rb = None
         if ranges != "static" and pxp != "zbuffer":
             rb = span_ranges(fr, sn, pn, ranges, pxp=pxp)
@@ -236,17 +327,17 @@ class PxpScene(SceneRun):
             # resolve cycles, as the cycle model the HDL matches gives them)
             from rasterhw.golden_model.experts.parallel import run_parallel
             rb = run_parallel(fr, sn, pn, band_method="equal", range_method=ranges, pxp_unit="cycles").ranges
-        return {"fr": fr, "jb": jobs(fr, sn, pn, ranges=rb, pxp=pxp)}
+        return {"fr": _display(fr), "jb": jobs(fr, sn, pn, ranges=rb, pxp=pxp)}
 
     def jobs(self, gold: dict, *, engine: str, idle: int = 0, stall: int = 0, seed: int = 1, **_) -> list[Job]:
-        return [pxp_job(gold["jb"], width=gold["fr"].width, engine=engine, idle=idle, stall=stall, seed=seed)]
+        return [pxp_job(gold["jb"], width=gold["fr"]["width"], engine=engine, idle=idle, stall=stall, seed=seed)]
 
     def result(self, gold: dict, done: list[Done], *, engine: str, sn: int = 8, pn: int = 8, aj: str = "c",
                ranges: str = "static", idle: int = 0, stall: int = 0, pxp: str = "span", **_) -> dict:
         (d,), jb, exact = done, gold["jb"], idle == 0 and stall == 0
         # input idle delays a line's start and so may shorten its wait for the drain: the floor of a
         # stalled span line is its own resolve work (+ the hand-over cycle)
-        floor = None if exact or pxp == "zbuffer" else np.array([t[1] + 1 for t in jb["timing"]], np.int64)
+        floor = None if exact or pxp == "zbuffer" else np.asarray(jb["resolve"], np.int64) + 1
         r = _pxp_checks(jb, d, exact, floor)
         frame = int(jb["pxp_frame_cycles"].max())
         cyc = r["cycles"]
@@ -257,10 +348,9 @@ class PxpScene(SceneRun):
                 "pxp_cycles_per_line_mean": round(float(cyc.mean()), 2) if cyc.size else 0.0,
                 "pxp_clock_for_30fps_hz": frame * 30, "sn": sn, "pn": pn, "aj": aj, "ranges": ranges, "pxp": pxp,
                 "pxp_is": PXP_IS[pxp],
-                **({"span_steps": {k: int(sum(st[k] for st in jb["steps"])) for k in jb["steps"][0]}}
-                   if pxp != "zbuffer" and jb["steps"] else {}),
+                **({"span_steps": jb["span_steps"]} if jb["span_steps"] else {}),
                 # the machine's frame on its Sn x Pn PXPs (all at once): the busiest PXP's
-                "frame_cycles": frame, "frame_rgb": hdl_image(gold["fr"], r["pixels"])}
+                "frame_cycles": frame, "frame_rgb": _image(gold["fr"], r["pixels"])}
 
 
 simulate_scene = PxpScene().simulate

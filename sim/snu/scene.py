@@ -30,6 +30,8 @@ Times are reported at the paper's clocks: 12.5 MHz bus (80 ns slot), i860 at
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
@@ -80,7 +82,7 @@ def producer_gaps(tris, stream: PixelStream, cpu: i860.I860 | None = None, *, n_
 
     cpu = cpu or i860.I860()
     sc = i860.scan_clocks(cpu)
-    geo = i860.table1_model(cpu)
+    geo = i860.table1_model(cpu, stream_triangles=0)   # one triangle's clocks: the 8-triangle stream schedules are not used here (0.15 -> 0.014 CPU-s)
     groups = [("vertex_transform", "normal_transform"), ("normalise", "light"),
               ("clip", "perspective_divide", "screen_map")]
     group_clocks = [sum(geo[s]["clocks"] for s in g) for g in groups]
@@ -158,10 +160,22 @@ def golden_schedule(stream: PixelStream, gaps: np.ndarray, first_work: list[floa
             fill_bus = int(np.ceil(first_work[p] / ratio))
             first_bench[p] = max(0, fill_bus - t_start)
             g[idx[0]] = t_start + first_bench[p]
-    acc = golden.pixelbus_accept_cycles(stream, gaps=g)
+    acc = accept_cycles(stream, g)
     t_pix = int(acc.max()) + MEM_CYCLE if len(stream) else t_start
     return {"t_clear": 0, "t_start": t_start, "t_pixels_done": t_pix, "t_swap": t_pix + 1,
             "cycles": t_pix + 2, "accept": acc, "first_bench_gap": first_bench}
+
+
+def accept_cycles(stream: PixelStream, gaps: np.ndarray) -> np.ndarray:
+    """``golden.pixelbus_accept_cycles(stream, gaps=gaps)``, kept in the build cache
+    (``verilog_cache.arrays_cached``: keyed by the stream's writes and gaps and by the model's sources):
+    its event loop is Python, one step per write (snu-100px's 199,970: 0.15-0.28 CPU-s a run)."""
+    from rasterhw.sim.engines.verilog_cache import arrays_cached
+
+    g = np.asarray(gaps, dtype=np.int64)
+    key = [stream.width, stream.height, stream.addr, stream.pipe, g, MEM_CYCLE, N_BANKS]
+    return arrays_cached("snu-accept", Path(golden.__file__), key,
+                         lambda: {"accept": golden.pixelbus_accept_cycles(stream, gaps=g)})["accept"]
 
 
 # ====================================================================== the pixel stream alone
@@ -264,19 +278,24 @@ def frame_job(stream: PixelStream, gaps: np.ndarray, sched: dict) -> Job:
     if len(stream) and int(g.max()) >= (1 << GAP_BITS):
         raise RasterhwError(f"a producer gap of {int(g.max())} clocks does not fit {GAP_BITS} bits")
     stim = tb.stimulus_of(params, stream, g, schedule=sched)
-    return Job(tb, params, stim, tb.expect(params, stim), {"max_cycles": int(sched["cycles"]) + w * h + 10_000},
-               cycle_exact=False)
+    # the run's length, held exactly (``cycle_mismatches``, as BusBench's on the other engines): the
+    # schedule word k leaves at edge ``cycles + k``, display word j at ``cycles + 1 + j``, so the
+    # last at ``cycles + w h`` (``FrameAdapter``: the sweep starts the clock after SWAP's)
+    exp = replace(tb.expect(params, stim), cycles=int(sched["cycles"]) + w * h + 1)
+    return Job(tb, params, stim, exp, {"max_cycles": int(sched["cycles"]) + w * h + 10_000})
 
 
 def frame_words(d: Done) -> dict:
     """A :func:`frame_job`'s schedule numbers, displayed frame (``rgb``, ``z``) and ``mismatches``
-    (read-out and schedule words that differ from the golden schedule)."""
+    (read-out and schedule words that differ from the golden schedule, plus one if the run's
+    length differs from the golden schedule's: ``frame_job``)."""
     stream = d.job.stim.source[0]
     words = np.array(d.got.words["o"], dtype=np.int64)
     zmask = (1 << stream.z_bits) - 1
     got = dict(zip(SCHEDULE, d.got.words["o_sched"], strict=False))
     return {**got, "rgb": (words >> stream.z_bits).reshape(stream.height, stream.width),
-            "z": (words & zmask).reshape(stream.height, stream.width), "mismatches": d.cmp["mismatches"]}
+            "z": (words & zmask).reshape(stream.height, stream.width),
+            "mismatches": d.cmp["mismatches"] + (d.cmp["cycle_mismatches"] or 0)}
 
 
 def run_frame_engine(stream: PixelStream, gaps: np.ndarray, sched: dict, *, engine: str = "verilator") -> dict:

@@ -23,13 +23,13 @@ __all__ = ["PLAIN_BUILD", "SPEED_BUILD", "ZbmScene", "float_tolerance", "run_sce
 
 
 # ====================================================================== float tolerance
-def float_tolerance(tris, px: G.DoubleZ, rgb8: np.ndarray, eps: G.EdgePairs, tags: np.ndarray) -> dict:
+def float_tolerance(tris, px: G.DoubleZ, rgb8: np.ndarray, eps: G.EdgePairs, tags: np.ndarray, segs=None) -> dict:
     """Compare the composited HDL frame with ``render_zbm_float`` under docs/zbm.md's stated
     tolerance: coverage identical; nearest triangle identical (pixels with a different nearest
     triangle -- Z ties -- are counted and left out of the value checks); Z within
     ``1 + |dz/dx| * 2**-16`` LSB; opaque colour within 1 LSB (2 where the front sample is
-    translucent)."""
-    fl = G.render_zbm_float(tris)
+    translucent); ``segs``: ``eps``' segments, when the caller has them (``render_zbm_float``)."""
+    fl = G.render_zbm_float(tris, segs=segs)
     cov_h = px.z[..., 0] != F.Z_EMPTY
     cov_f = np.isfinite(fl["z"][..., 0])
     same = cov_h & cov_f & (tags[..., 0] == fl["tag"][..., 0])
@@ -74,7 +74,8 @@ PLAIN_BUILD = {"speed": False, "opt": "-O1", "pgo": False}
 
 def unit_job(eps_per_unit: list, *, width: int, height: int, interleave: int, schedule: str = "overlap",
              capacity: int = F.AEP_CAPACITY, engine: str = "verilator", stall: int = 0, seed: int = 1,
-             gap_seed: int | None = None, build: dict | None = None, clocks: dict | None = None) -> Job:
+             gap_seed: int | None = None, build: dict | None = None, clocks: dict | None = None,
+             segments: list | None = None) -> Job:
     """Edge pairs through ``len(eps_per_unit)`` chained ZB/M units (unit ``k`` gets
     ``eps_per_unit[k]``; a scene's: ``testbench.deal``) as one job of the ``zbm-unit`` testbench
     (:class:`rasterhw.sim.zbm.testbench.UnitBench`; its expected words come from ``chain_frame``, the
@@ -82,16 +83,17 @@ def unit_job(eps_per_unit: list, *, width: int, height: int, interleave: int, sc
     ``stall``, ``seed``: back-pressure on every merge slot; ``gap_seed``: random idle gaps on the
     edge-pair input (None: none); ``clocks``: separate segment and merge clocks (``{"sync": Clock,
     "merge": Clock}``, e.g. the cocotb bench's at a ratio: ``testbench.bench_clocks``; one build for
-    every ratio; cycles stay in segment clocks); None: one clock for both."""
+    every ratio; cycles stay in segment clocks); None: one clock for both. ``segments``: each unit's
+    segments, when the caller has them (``chain_frame``)."""
     tb = find_testbench("zbm-unit")
     p = tb.params(interleave=interleave, width=width, height=height, capacity=capacity, schedule=schedule,
                   units=len(eps_per_unit))
     stim = tb.scene_stimulus(p, eps_per_unit, gap_seed=gap_seed)
     cap = unit_watchdog(sum(map(len, stim.words.values())), width=width, height=height, stall=stall,
                         ratio=(clocks["sync"].half, clocks["merge"].half) if clocks else (5, 5))
-    run = {"stall": stall, "seed": seed, "max_cycles": cap, "clocks": clocks,
+    run = {"stall": stall, "seed": seed, "max_cycles": cap, "clocks": clocks, "packed": True,
            "build": (SPEED_BUILD if build is None else build) if engine == "verilator" else None}
-    return Job(tb, p, stim, tb.expect(p, stim), run, cycle_exact=False)
+    return Job(tb, p, stim, tb.expect(p, stim, segments), run, cycle_exact=False)
 
 
 def run_scene(eps_per_unit: list, *, engine: str = "verilator", line_log: bool = False, **kw) -> dict:
@@ -152,15 +154,17 @@ class ZbmScene(SceneRun):
                 raise RasterhwError(f"ZB/M: {name} must be an integer in {lo}..512, not {v!r}")
         tris = run_geometry(scene, width, height)
         eps = G.edge_pairs(tris)
-        return {"tris": tris, "eps": eps, "peak": check_edge_pairs(eps, width, height, units=units),
-                "width": width, "height": height}
+        peak = check_edge_pairs(eps, width, height, units=units)
+        # one unit: its segments are the float twin's too (the same generator on the same edge pairs)
+        segs = G.segment_generator(eps, height, width=width) if units == 1 else None
+        return {"tris": tris, "eps": eps, "peak": peak, "width": width, "height": height, "segs": segs}
 
     def jobs(self, gold: dict, *, engine: str, interleave: int = 8, units: int = 1, schedule: str = "overlap"):
         # icarus: the unit's testbench under cocotb on Icarus (the generic cocotb engine). On Verilator
         # the profiled build, trained with the first build (said on stderr; RASTERHW_PGO=0 skips it)
         engine = engines.ALIASES.get(engine, engine)
         return [unit_job(deal(gold["eps"], units), width=gold["width"], height=gold["height"], interleave=interleave,
-                         schedule=schedule, engine=engine,
+                         schedule=schedule, engine=engine, segments=None if gold["segs"] is None else [gold["segs"]],
                          build={**SPEED_BUILD, "pgo": "train"} if engine == "verilator" else None)]
 
     def result(self, gold: dict, done: list, *, engine: str, interleave: int = 8, units: int = 1,
@@ -175,7 +179,8 @@ class ZbmScene(SceneRun):
                 "cycle_mismatches": None,   # a scene has no golden cycle count here (the Table 1 rows compare cycles)
                 "edge_pairs": len(gold["eps"]), "aep_peak": gold["peak"], "triangles": n_tri,
                 "polygons_per_s": n_tri * clock / cycles if cycles else float("inf"), "frame_rgb": rgb8,
-                "float_tolerance": float_tolerance(gold["tris"], px, rgb8, gold["eps"], d.job.expect.golden.tag)}
+                "float_tolerance": float_tolerance(gold["tris"], px, rgb8, gold["eps"], d.job.expect.golden.tag,
+                                                   gold["segs"])}
 
 
 simulate = ZbmScene().simulate

@@ -20,10 +20,13 @@ from rasterhw.golden_model.zbm.stimulus import (
 )
 from rasterhw.golden_model.zbm.words import (
     doublez_words,
+    edge_pair_rows,
     edge_pair_words,
+    merge_rows,
     merge_words,
     packets,
     pixel2_words,
+    rows_to_samples,
     segment_words,
 )
 from rasterhw.sim import registry
@@ -36,8 +39,8 @@ __all__ = ["RESET_EDGES", "ChipBench", "LoopBench", "MergerBench", "PixelBench",
 
 
 def random_gaps(n: int, seed: int | None, *, p_idle: float = 0.3, max_gap: int = 4) -> np.ndarray:
-    """Idle clocks before each of ``n`` words: 0 with probability ``1 - p_idle``, else 1..max_gap.
-    ``seed=None`` gives no gaps. (The ZB/M cocotb cross-check in ``tests/zbm_cocotb/`` plays the same.)"""
+    """Idle clocks before each of ``n`` words: 0 with probability ``1 - p_idle``, else 1..max_gap; ``seed=None``: none
+    (the ZB/M cocotb cross-check in ``tests/zbm_cocotb/`` plays the same)."""
     if seed is None:
         return np.zeros(n, np.int64)
     rng = np.random.default_rng(seed)
@@ -49,12 +52,11 @@ RESET_EDGES = 6
 
 
 def bench_clocks(ratio: tuple[int, int], phase: int = 1) -> dict[str, Clock]:
-    """The generic engine's separate clocks (``engines.run(..., clocks=...)``, 1 ns units) of a unit
-    run at segment : merge half periods ``ratio`` (ns) with the merge clock ``phase`` (0 or 1) ns
-    behind, timed as the cocotb unit bench's Verilog-side clocks after its reset
-    (``tests/zbm_cocotb/``: ``rasterhw_two_clocks`` raises ``clk`` at 1 + (2k + 1) * segment half ns
-    and ``mclk`` ``phase`` ns later on its own half period; the engine has no reset, so edge 0 of
-    each domain is the bench's edge :data:`RESET_EDGES`)."""
+    """The generic engine's separate clocks (``engines.run(..., clocks=...)``, 1 ns units) of a unit run at
+    segment : merge half periods ``ratio`` (ns) with the merge clock ``phase`` (0 or 1) ns behind, timed as
+    the cocotb unit bench's Verilog-side clocks after its reset (``tests/zbm_cocotb/``: ``rasterhw_two_clocks``
+    raises ``clk`` at 1 + (2k + 1) * segment half ns and ``mclk`` ``phase`` ns later on its own half
+    period; the engine has no reset, so edge 0 of each domain is the bench's edge :data:`RESET_EDGES`)."""
     sh, mh = ratio
     if phase not in (0, 1):
         raise RasterhwError(f"merge clock phase must be 0 or 1 ns, not {phase!r}")
@@ -65,10 +67,9 @@ def bench_clocks(ratio: tuple[int, int], phase: int = 1) -> dict[str, Clock]:
 
 def unit_watchdog(total_words: int, *, width: int, height: int, stall: int = 0,
                   ratio: tuple[int, int] = (5, 5)) -> int:
-    """A unit run's watchdog in segment clocks: generously above any frame this design can take
-    with ready always high and equal clocks, times the expected slow-down of the back-pressure
-    (ready high in ``256 - stall`` of 256 merge clocks) and of a merge clock slower than the
-    segment clock (``ratio`` = half periods, segment : merge)."""
+    """A unit run's watchdog in segment clocks: generously above any frame this design can take with
+    ready always high and equal clocks, times the expected slow-down of the back-pressure (ready high in
+    ``256 - stall`` of 256 merge clocks) and of a merge clock slower than the segment clock (``ratio``: half periods)."""
     base = 200 * (total_words + 64) + 40 * height * (width + 64)
     slow = 256 / max(1, 256 - stall) * max(1.0, ratio[1] / ratio[0])
     return min(int(base * max(1.0, slow)), 2**31 - 1)   # the cocotb bench's MAXCYC is a Verilog integer
@@ -114,13 +115,12 @@ class UnitBench(Testbench):
     merge-bus words out (``o_merge[c]``, the last unit's in a chain; chip ``c`` owning columns
     ``c, c + I, ...``, line by line), the double-Z samples of ``golden_model/zbm/render.py:
     render_zbm``. The merge clock runs with the segment clock, or at any ratio and phase as a run's
-    separate clocks (``engines.run(..., clocks=...)``; :func:`bench_clocks`: the cocotb bench's). A random frame: 2..40 random screen triangles (seeded), the first ones that fit
-    the active-edge-pair memory; a scene: :meth:`scene_stimulus` (``rasterhw sim zbm``, the soak).
+    separate clocks (``engines.run(..., clocks=...)``; :func:`bench_clocks`: the cocotb bench's). A random frame: 2..40 random
+    screen triangles (seeded), the first ones that fit the active-edge-pair memory; a scene: :meth:`scene_stimulus` (``rasterhw sim zbm``, the soak).
 
-    The back-pressure of slot ``c`` is the cocotb unit bench's (``cocotb_tests/zbm/tb_zbm_unit.v``:
-    seed ``0x9E3779B9 ^ (7919 seed + 104729 c + 1)``), so a run equals that bench's, stalls
-    included. The speed build (``build={"speed": True}``): identical modules merged, the pixel
-    processor kept out of line (:meth:`sim_verilog`); its gcc profile is trained on c50."""
+    The back-pressure of slot ``c`` is the cocotb unit bench's (``cocotb_tests/zbm/tb_zbm_unit.v``: seed ``0x9E3779B9 ^
+    (7919 seed + 104729 c + 1)``), so a run equals that bench's, stalls included. The speed build (``build={"speed": True}``):
+    identical modules merged, the pixel processor kept out of line (:meth:`sim_verilog`); its gcc profile is trained on c50."""
 
     block = "zbm-unit"
     domains = ("sync", "merge")
@@ -180,28 +180,31 @@ class UnitBench(Testbench):
     def scene_stimulus(self, params: dict, eps_per_unit: list, *, gap_seed: int | None = None,
                        what: str = "") -> Stimulus:
         """Unit ``k``'s edge pairs (:func:`deal`: a scene's, as ``render_zbm`` deals them) as its
-        edge-pair words; ``gap_seed``: random idle gaps (:func:`random_gaps` over all units'
-        words in order, as the cocotb bench plays them; None: none)."""
+        edge-pair words, packed rows (``edge_pair_rows``); ``gap_seed``: random idle gaps (:func:`random_gaps`
+        over all units' words in order, as the cocotb bench plays them; None: none)."""
         ins = self.inputs_of(params)
         if len(eps_per_unit) != len(ins):
             raise RasterhwError(f"zbm-unit: {len(eps_per_unit)} edge-pair lists for {len(ins)} units")
-        words = [edge_pair_words(e) for e in eps_per_unit]
+        words = [edge_pair_rows(e) for e in eps_per_unit]
         gaps = random_gaps(sum(map(len, words)), gap_seed).tolist()
         at = np.cumsum([0] + [len(w) for w in words])
         return Stimulus(dict(zip(ins, words, strict=True)),
                         gaps={p: gaps[at[k]:at[k + 1]] for k, p in enumerate(ins)} if gap_seed is not None else {},
                         what=what, source=list(eps_per_unit))
 
-    def expect(self, params: dict, stim: Stimulus) -> Expected:
+    def expect(self, params: dict, stim: Stimulus, segments: list | None = None) -> Expected:
+        """Every slot's merge words of ``chain_frame``'s frame, as packed rows (``merge_rows``);
+        ``segments``: each unit's segments, when the caller has them (``chain_frame``)."""
         i = params["interleave"]
-        frame = G.chain_frame(stim.source, params["width"], params["height"], capacity=params["capacity"])
+        frame = G.chain_frame(stim.source, params["width"], params["height"], capacity=params["capacity"],
+                              segments=segments)
         g0, g1 = doublez_words(frame)
         outs = self.outputs_of(params)
-        return Expected({outs[c]: merge_words(g0[:, c::i], g1[:, c::i]) for c in range(i)}, golden=frame)
+        return Expected({outs[c]: merge_rows(g0[:, c::i], g1[:, c::i]) for c in range(i)}, golden=frame)
 
-    def frame(self, params: dict, words: dict[str, list[int]]) -> tuple[np.ndarray, np.ndarray]:
-        """The merge words of every slot as the frame's (s0, s1) (H, W) uint64 samples (all ones
-        where a slot gave no word, as the benches' frame memories)."""
+    def frame(self, params: dict, words: dict) -> tuple[np.ndarray, np.ndarray]:
+        """The merge words of every slot (ints or packed rows) as the frame's (s0, s1) (H, W) uint64
+        samples (all ones where a slot gave no word, as the benches' frame memories)."""
         i, w, h = params["interleave"], params["width"], params["height"]
         s0 = np.full((h, w), ~np.uint64(0), np.uint64)
         s1 = s0.copy()
@@ -209,8 +212,11 @@ class UnitBench(Testbench):
             npx = len(range(c, w, i))
             got = words.get(port, [])[:h * npx]
             n = len(got) // npx * npx
-            lo = np.fromiter((x & _M64 for x in got[:n]), np.uint64, n)
-            hi = np.fromiter((x >> 64 for x in got[:n]), np.uint64, n)
+            if isinstance(got, np.ndarray):
+                lo, hi = rows_to_samples(got[:n])
+            else:
+                lo = np.fromiter((x & _M64 for x in got[:n]), np.uint64, n)
+                hi = np.fromiter((x >> 64 for x in got[:n]), np.uint64, n)
             s0[:n // npx, c::i], s1[:n // npx, c::i] = lo.reshape(-1, npx), hi.reshape(-1, npx)
         return s0, s1
 

@@ -147,3 +147,13 @@ def test_bad_input_raises():
     with pytest.raises(RasterhwError, match="pattern"):
         g.pattern_stream("diagonal", 4, 4, 4)
     assert g.pixelbus_cycles(ps(4, 4, [], [], [], [])) == 0
+
+
+def test_rgb_image_is_the_shifted_bytes():
+    """``rgb_image`` (bytes of the little-endian word) equals the shifts and masks it replaced."""
+    rgb = np.random.default_rng(4).integers(0, 1 << 24, (17, 23))
+    rgb[0, :4] = [0, 0xFFFFFF, 0x800001, 0x123456]
+    want = np.stack([(rgb >> 16) & 0xFF, (rgb >> 8) & 0xFF, rgb & 0xFF], axis=-1).astype(np.uint8)
+    got = g.rgb_image(rgb)
+    assert got.dtype == np.uint8 and got.flags.c_contiguous and np.array_equal(got, want)
+    assert list(g.rgb_image(np.array([[0x123456]]))[0, 0]) == [0x12, 0x34, 0x56]

@@ -87,7 +87,7 @@ def test_frame_on_verilator_equals_golden():
     scene = build_scene("sp27")
     r = F.frame_run(scene, 80, 64)
     f = r["frame"]
-    assert r["mismatches"] == 0 and f["schedule_mismatches"] == 0
+    assert r["mismatches"] == 0 and f["schedule_mismatches"] == 0 and r["cycle_mismatches"] == 0
     assert f["schedule_hdl"] == f["schedule_golden"]
     assert r["pixels_compared"] == 80 * 64 and r["writes"] == f["pixel_writes"] > 3000
     # the displayed frame is the SNU golden render (clear, then the stream, then swap)
@@ -133,6 +133,24 @@ def test_frame_adapter_on_pysim_equals_golden():
     assert [r[k] for k in ("t_clear", "t_start", "t_pixels_done", "t_swap", "cycles")] == \
         [sch[k] for k in ("t_clear", "t_start", "t_pixels_done", "t_swap", "cycles")]
     assert np.array_equal(r["rgb"], rgb) and np.array_equal(r["z"], z)
+
+
+def test_the_frame_run_length_is_held_on_the_engine():
+    """``frame_job`` holds the run's length (the last read-out word's edge + 1: the golden
+    schedule's ``cycles`` + the frame's words + 1) as ``cycle_mismatches``, an integer on every
+    engine (it was None on Verilator); one clock off is counted, and counted in ``mismatches``."""
+    from dataclasses import replace
+
+    from rasterhw.sim.engines.scene import Done, run_job
+    from rasterhw.sim.testbench import compare
+
+    s, p, sch, _ = _frame_inputs("sp27", 24, 16)
+    job = F.frame_job(s, p["gaps"], sch)
+    d = run_job(job, "pysim")
+    assert d.cmp["cycle_mismatches"] == 0 and d.got.cycles == job.expect.cycles == sch["cycles"] + 24 * 16 + 1
+    off = compare(replace(job.expect, cycles=job.expect.cycles + 1), d.got)
+    assert off["cycle_mismatches"] == 1 and off["mismatches"] == 0
+    assert F.frame_words(Done(job, d.got, off))["mismatches"] == 1
 
 
 @pytest.mark.cocotb
