@@ -244,7 +244,7 @@ def mutant_result(block: str, params: str, mutants: int, seed: int, mutant: int)
 
 
 #: time limit of one survivor's equivalence proof (Yosys ``equiv_simple`` + ``equiv_induct``)
-EQUIV_TIMEOUT_S = 300.0
+EQUIV_TIMEOUT_S = 120.0
 #: the block as its testbench runs it (inside its adapter): every cell of the bench but the harness's
 #: sources, sinks and checkers and the bench top's own logic, moved into one module ``blk`` by ``submod``
 _CARVE = ["select -set blk t:rasterhw_* %n a:src=*/sim/engines/* %d", "submod -name blk @blk", "hierarchy -top blk",

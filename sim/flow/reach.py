@@ -78,6 +78,20 @@ def _const_int(bits) -> int | None:
     return None
 
 
+def _outs(cell: dict) -> dict:
+    return {p: cell["connections"][p] for p, d in cell.get("port_directions", {}).items() if d == "output"}
+
+
+def _to_all(cell: dict, port: str) -> bool:
+    """Does every bit of ``port`` reach every output bit of ``cell`` (the rule :func:`_fanout` ends with)?"""
+    typ = cell["type"]
+    if typ in _BITWISE | _CARRY and port in ("A", "B") and "Y" in _outs(cell):
+        return False
+    if typ in _SHIFT and port == "A":
+        return False
+    return port not in _FF_DATA or _FF_DATA[port] not in _outs(cell)
+
+
 def _fanout(cell: dict, port: str, i: int) -> list[int]:
     """The output bits (net numbers) of ``cell`` that input bit ``i`` of ``port`` can change."""
     typ, conn, dirs = cell["type"], cell["connections"], cell.get("port_directions", {})
@@ -143,24 +157,35 @@ def reach(bdir: str | Path, commands: dict[int, str]) -> dict[int, list[str]]:
     readers, outputs = _graph(mod)
     out_of = {b: n for n, bits in outputs.items() for b in bits if isinstance(b, int)}
     cells = mod["cells"]
+    # every net -> the nets it drives directly, and the outputs it is read by
+    nxt, term = {}, defaultdict(set)
+    for b, rs in readers.items():
+        step = set()
+        for name, port, i in rs:
+            cell = cells[name]
+            if cell["type"] in _OBSERVED:
+                what = {"rasterhw_stream_sink": {"payload": "words", "valid": "valid"},
+                        "rasterhw_stream_source": {"ready": "ready"}}.get(cell["type"], {}).get(port, "checker")
+                term[b].add((what, name.split("_", 1)[1]))
+            elif _to_all(cell, port):   # one node for the cell: its outputs are listed once, not per input bit
+                step.add(name)
+                nxt.setdefault(name, {x for bits in _outs(cell).values() for x in bits if isinstance(x, int)})
+            else:
+                step.update(x for x in _fanout(cell, port, i) if isinstance(x, int))
+        nxt[b] = step
+    for b, n in out_of.items():
+        term[b].add(("top", n))
+    every = set().union(*term.values()) if term else set()
     result = {}
     for k, cmd in commands.items():
         seen, todo, hits = set(), list(_start(mod, cmd)), set()
-        while todo:
+        while todo and hits != every:   # every output reached: nothing more to learn
             b = todo.pop()
             if b in seen:
                 continue
             seen.add(b)
-            if b in out_of:
-                hits.add(("top", out_of[b]))
-            for name, port, i in readers.get(b, ()):
-                cell = cells[name]
-                if cell["type"] in _OBSERVED:
-                    what = {"rasterhw_stream_sink": {"payload": "words", "valid": "valid"},
-                            "rasterhw_stream_source": {"ready": "ready"}}.get(cell["type"], {}).get(port, "checker")
-                    hits.add((what, name.split("_", 1)[1]))
-                    continue
-                todo.extend(x for x in _fanout(cell, port, i) if isinstance(x, int) and x not in seen)
+            hits |= term.get(b, set())
+            todo.extend(nxt.get(b, ()))
         named = {f"{w} {p}" for w, p in hits}
         # a port's checker also sees what its sink or source sees: name it alone only when nothing else does
         named -= {f"checker {p}" for w, p in hits if w != "checker" and w != "top"}

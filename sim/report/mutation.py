@@ -86,7 +86,8 @@ def classify_record(blocks: list[str] | None = None, path=None) -> list[str]:
             continue
         m = mutated_bench(b["block"], b["params"], mutants=b["mutants"], seed=b["seed"])
         by = {mu["mutant"]: mu for mu in m["mutations"]}
-        if any(_same(by.get(s["mutant"], {}).get("mutation", "")) != _same(s["mutation"]) for s in b["survivors"]):
+        if any(_same(by.get(s["mutant"], {}).get("mutation", "")) != _same(s["mutation"]) for s in b["survivors"]) \
+                or len(by) != b["mutants"]:
             skipped.append(f"{b['block']}: its mutations today differ from the record's (the design changed)")
             continue
         reached = survivor_reach(b["block"], b["params"], b["seed"], m["dir"], m["mutations"])
@@ -102,10 +103,10 @@ def classify_record(blocks: list[str] | None = None, path=None) -> list[str]:
 
 
 def _same(mutation: str) -> str:
-    """A mutation in words without the number Yosys's ``proc`` gives a flip-flop (``$procdff$N``: it
-    counts every process of the file, so it moves when the bench top does; the wire names the
-    register)."""
-    return re.sub(r"\$procdff\$\d+", "$procdff", mutation)
+    """A mutation in words without the serial number Yosys gives its cell (``$add$bench.v:829$216``,
+    ``$procdff$1801``: it counts every cell of the file, so it moves when the bench top around the
+    block gains or loses one; the kind of cell, its source line, port, bit and wire stay)."""
+    return re.sub(r"\$\d+ port ", " port ", mutation)
 
 
 def _read(path=None) -> dict | None:
