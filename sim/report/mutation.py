@@ -49,6 +49,9 @@ def merge_blocks(results: list[dict], commands: list[str], path=None) -> None:
     blocks = record["campaign"]["blocks"]
     for r in results:
         want = small.get(r["block"], {"": None})
+        if "error" in r:   # a block that could not be mutated at its small configuration: said, no score
+            r = {"block": r["block"], "params": r.get("params") or want, "seed": SEED, "mutants": MUTANTS,
+                 "error": r["error"], "score": None}
         if (r["mutants"], r["seed"]) != (MUTANTS, SEED) or any(r["params"].get(k) != v for k, v in want.items()):
             raise RasterhwError(f"{r['block']}: the record holds {MUTANTS} mutants, seed {SEED}, at the small "
                                 f"configuration {want}; not {r['mutants']}, {r['seed']}, {r['params']}")
