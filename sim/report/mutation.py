@@ -108,8 +108,9 @@ def classify_record(blocks: list[str] | None = None, path=None) -> list[str]:
 def _same(mutation: str) -> str:
     """A mutation in words without the serial number Yosys gives its cell (``$add$bench.v:829$216``,
     ``$procdff$1801``: it counts every cell of the file, so it moves when the bench top around the
-    block gains or loses one; the kind of cell, its source line, port, bit and wire stay)."""
-    return re.sub(r"\$\d+ port ", " port ", mutation)
+    block gains or loses one) and without the wire's name (Yosys picks one of the names a net has);
+    the kind of cell, its source line, port and bit stay)."""
+    return re.sub(r" \(wire .*\)$", "", re.sub(r"\$\d+ port ", " port ", mutation))
 
 
 def _read(path=None) -> dict | None:
