@@ -3,9 +3,12 @@ its class; a survivor that reaches no output is equivalent by structure."""
 
 from __future__ import annotations
 
+import json
+
 import pytest
 from rasterhw.sim.flow import mutate as M
 from rasterhw.sim.flow import reach as R
+from rasterhw.sim.report.mutation import RECORD
 
 
 def _cell(typ, outs, ins, **params):
@@ -45,3 +48,14 @@ def test_a_bit_the_block_drops_reaches_no_output_and_a_killed_mutant_reaches_the
     assert got["reaches"][1] == [] and R.classify(got["reaches"][1], set(got["compared"])) == "unobservable"
     assert "words o" in got["reaches"][4]
 
+
+
+def test_no_killed_mutant_of_the_record_is_called_unreachable():
+    """The analysis over-approximates: a mutant a testbench killed must reach some output. Every
+    killed mutant of the record with a ``reaches`` does, and every survivor called equivalent by
+    structure reaches nothing."""
+    rec = json.loads(RECORD.read_text())["campaign"]["blocks"]
+    killed = [k for b in rec for k in b.get("killed_by", []) if "reaches" in k]
+    assert killed and all(k["reaches"] for k in killed)
+    structural = [s for b in rec for s in b.get("survivors", []) if s.get("equivalence_how", "").startswith("structural")]
+    assert structural and all(s["reaches"] == [] and s["reach_class"] == "unobservable" for s in structural)
