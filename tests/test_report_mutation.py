@@ -52,3 +52,27 @@ def test_without_a_record_every_row_says_how_to_make_one(tmp_path, monkeypatch):
     rows, sections = R.rows(out_dir=tmp_path)
     assert rows and sections == []
     assert all(r["measured"] is None and "--rerun" in r["reason"] for r in rows)
+
+
+def test_survivors_show_their_class_and_a_block_that_could_not_be_mutated_is_merged_with_why(tmp_path):
+    rec = tmp_path / "mutation_runs.json"
+    camp, proofs = _record()
+    camp["blocks"][0]["survivors"] = [
+        {"mutant": 2, "src": ["hdl/experts/dmm.py:76"], "mutation": "inv on $x port Q bit 0", "reaches": [],
+         "reach_class": "unobservable", "equivalence": "equivalent",
+         "equivalence_how": "structural: no path to any output"},
+        {"mutant": 3, "src": ["hdl/experts/dmm.py:80"], "mutation": "const0 on $y port Y bit 1",
+         "reaches": ["words o"], "reach_class": "compared", "equivalence": "not proven",
+         "equivalence_why": "Yosys took more than 120 s"}]
+    R.write_record(camp, proofs, ["rasterhw mutate --all --mutants 2 --json"], path=rec)
+    md = "\n".join(R.sections(R._read(rec)))
+    assert "Survivors by class (`sim/flow/reach.py`, computed): unobservable 1, compared 1." in md
+    assert "inv on $x port Q bit 0 — **unobservable** (no path to any output)" in md
+    assert ("const0 on $y port Y bit 1 — **compared** (reaches words o); equivalence: **not proven**: "
+            "Yosys took more than 120 s") in md
+    small = {"block": "experts-slp-setup", "error": "Yosys took more than 600 s"}
+    R.write_record(camp, proofs, ["x"], path=rec)
+    R.merge_blocks([small], ["rasterhw mutate experts-slp-setup ..."], path=rec)
+    got = [b for b in R._read(rec)["campaign"]["blocks"] if b["block"] == "experts-slp-setup"]
+    assert got and got[0]["error"] == "Yosys took more than 600 s" and got[0]["score"] is None
+    assert got[0]["params"] == {"height": 64}

@@ -50,7 +50,7 @@ from rasterhw.sim.testbench import Run, clocks_of, compare, find_testbench
 from rasterhw.sim.workdirs import build_lock, release, temp_run_folder
 
 __all__ = ["CTRL", "SLOW_RUN", "all_configs", "campaign", "campaign_all", "equivalence", "mutant_result", "mutated_bench",
-           "mutation_blocks", "parse_mutations", "prepare"]
+           "mutation_blocks", "parse_mutations", "prepare", "survivor_reach"]
 
 #: the control input Yosys adds (``mutate -ctrl``), read from ``+mutsel=K``
 CTRL = "mutsel"
@@ -244,7 +244,7 @@ def mutant_result(block: str, params: str, mutants: int, seed: int, mutant: int)
 
 
 #: time limit of one survivor's equivalence proof (Yosys ``equiv_simple`` + ``equiv_induct``)
-EQUIV_TIMEOUT_S = 300.0
+EQUIV_TIMEOUT_S = 120.0
 #: the block as its testbench runs it (inside its adapter): every cell of the bench but the harness's
 #: sources, sinks and checkers and the bench top's own logic, moved into one module ``blk`` by ``submod``
 _CARVE = ["select -set blk t:rasterhw_* %n a:src=*/sim/engines/* %d", "submod -name blk @blk", "hierarchy -top blk",
@@ -355,7 +355,8 @@ def prepare(block: str, params: str, mutants: int, seed: int) -> dict:
     except RasterhwError as e:
         return {"block": block, "params": given, "config": config, "error": str(e).splitlines()[0]}
     return {"block": block, "params": given, "config": config, "mutations": m["mutations"],
-            "build_s": round(build_s, 2), "dir": str(m["dir"])}
+            "build_s": round(build_s, 2), "dir": str(m["dir"]),
+            "reached": survivor_reach(block, given, seed, m["dir"], m["mutations"])}
 
 
 def _mutant_tasks(block: str, given: str, mutants: int, seed: int, n: int) -> list:
@@ -363,19 +364,48 @@ def _mutant_tasks(block: str, given: str, mutants: int, seed: int, n: int) -> li
                  mutant=k) for k in range(n + 1)]
 
 
+def survivor_reach(block: str, params: dict, seed: int, bdir: str | Path, mutations: list[dict]) -> dict:
+    """Every mutant's :func:`rasterhw.sim.flow.reach.reach` in the campaign's folder ``bdir``, with
+    the testbench's compared ports: ``{"reaches": {mutant: [...]}, "compared": [tags]}``."""
+    from rasterhw.sim.flow.reach import compared_tags, reach
+
+    _tb, _p, _stim, exp, _want = _setup(block, dict(params), seed)
+    return {"reaches": reach(bdir, {mu["mutant"]: mu["command"] for mu in mutations}),
+            "compared": sorted(compared_tags(exp.words))}
+
+
+def _survivor(r: dict, mu: dict, eq: dict | None, reached: dict | None) -> dict:
+    """One survivor's entry: its source, mutation, the outputs it reaches and its class
+    (:mod:`rasterhw.sim.flow.reach`), and its equivalence (``unobservable``: ``equivalent`` by structure)."""
+    from rasterhw.sim.flow.reach import classify
+
+    out = {"mutant": r["mutant"], "src": mu["src"], "mutation": mu["mutation"]}
+    if reached is not None:
+        hits = reached["reaches"][r["mutant"]]
+        out.update(reaches=hits, reach_class=classify(hits, set(reached["compared"])))
+        if out["reach_class"] == "unobservable":
+            return {**out, "equivalence": "equivalent", "equivalence_how": "structural: no path to any output"}
+    if eq is not None:
+        out["equivalence"] = eq["equivalence"]
+        if eq["equivalence"] == "equivalent":
+            out["equivalence_how"] = "Yosys equiv_induct"
+        if eq["why"]:
+            out["equivalence_why"] = eq["why"]
+    return out
+
+
 def _summary(block: str, p: dict, seed: int, mutations: list[dict], res: list[dict],
-             equiv: dict[int, dict] | None = None) -> dict:
+             equiv: dict[int, dict] | None = None, reached: dict | None = None) -> dict:
     """The counts, score and survivors of one block's campaign from its mutants' results (0 first);
-    ``equiv``: the survivors' :func:`equivalence` results by mutant (a proven one leaves the score)."""
+    ``equiv``: the survivors' :func:`equivalence` results by mutant (a proven one leaves the score);
+    ``reached``: :func:`survivor_reach` (a survivor that reaches no output leaves it too)."""
     base, rest = res[0], res[1:]
     by = {mu["mutant"]: mu for mu in mutations}
     equiv = equiv or {}
+    if reached is not None:   # a stored task result's keys are strings
+        reached = {**reached, "reaches": {int(k): v for k, v in reached["reaches"].items()}}
     killed = sum(r["killed"] for r in rest)
-    survivors = [{"mutant": r["mutant"], "src": by[r["mutant"]]["src"], "mutation": by[r["mutant"]]["mutation"],
-                  **({"equivalence": equiv[r["mutant"]]["equivalence"],
-                      **({"equivalence_why": equiv[r["mutant"]]["why"]} if equiv[r["mutant"]]["why"] else {})}
-                     if r["mutant"] in equiv else {})}
-                 for r in rest if not r["killed"]]
+    survivors = [_survivor(r, by[r["mutant"]], equiv.get(r["mutant"]), reached) for r in rest if not r["killed"]]
     equivalent = sum(s.get("equivalence") == "equivalent" for s in survivors)
     n = len(rest)
     score = killed / (n - equivalent) if not base["killed"] and n > equivalent else None
@@ -383,7 +413,9 @@ def _summary(block: str, p: dict, seed: int, mutations: list[dict], res: list[di
             "baseline_passed": not base["killed"], "baseline_why": base["why"], "killed": killed,
             "equivalent": equivalent, "survived": n - killed - equivalent, "bounded_equivalent": 0,
             "score": None if score is None else round(score, 4), "survivors": survivors,
-            "killed_by": [{"mutant": r["mutant"], "why": r["why"]} for r in rest if r["killed"]]}
+            "killed_by": [{"mutant": r["mutant"], "why": r["why"],
+                           **({"reaches": reached["reaches"][r["mutant"]]} if reached else {})}
+                          for r in rest if r["killed"]]}
 
 
 def campaign(block: str, params: dict | None = None, *, mutants: int = 40, seed: int = 1,
@@ -404,12 +436,14 @@ def campaign(block: str, params: dict | None = None, *, mutants: int = 40, seed:
                       progress=(lambda i, _h: print(f"mutate {block}: mutant {i} done", file=sys.stderr))
                       if progress else None)
         runs_s = time.perf_counter() - built
-        alive = [r["mutant"] for r in res[1:] if not r["killed"]] if equivalence and not res[0]["killed"] else []
+        reached = survivor_reach(block, dict(params or {}), seed, m["dir"], m["mutations"])
+        alive = [r["mutant"] for r in res[1:] if not r["killed"] and reached["reaches"][r["mutant"]]] \
+            if equivalence and not res[0]["killed"] else []
         eq = run.map([call("rasterhw.sim.flow.mutate:equivalence", block=block, params=given, mutants=mutants,
                            seed=seed, mutant=k) for k in alive]) if alive else []
         where, computed, reused = run.address(), run.computed, run.reused
     equiv_s = time.perf_counter() - built - runs_s
-    return {**_summary(block, p, seed, m["mutations"], res, {e["mutant"]: e for e in eq}),
+    return {**_summary(block, p, seed, m["mutations"], res, {e["mutant"]: e for e in eq}, reached),
             **({"equiv_s": round(equiv_s, 2)} if equivalence else {}),
             "scheduler": where, "computed": computed, "reused": reused,
             "yosys_s": m["yosys_s"], "build_s": round(build_s, 2), "runs_s": round(runs_s, 2),
@@ -494,7 +528,8 @@ def campaign_all(*, mutants: int = 30, seed: int = 1, scheduler: str = "serial",
                             "error": prep["error"], "score": None})
                 continue
             res = [run.result(h) for h in handles[b]]
-            out.append({**_summary(b, full, seed, prep["mutations"], res), "config": prep["config"],
+            out.append({**_summary(b, full, seed, prep["mutations"], res, None, prep.get("reached")),
+                        "config": prep["config"],
                         "yosys_s": _yosys_s(prep["dir"]), "build_s": prep.get("build_s"),
                         "runs_s": round(sum(r.get("wall_s", 0.0) for r in res), 2), "dir": prep["dir"]})
             say(f"mutate --all: {b}: score {out[-1]['score']}")

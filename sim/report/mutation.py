@@ -13,12 +13,13 @@ tied to one machine (``EXTRA_REPORTS`` in :mod:`rasterhw.sim.report.rows`).
 from __future__ import annotations
 
 import json
+import re
 
 from rasterhw.sim import registry
 from rasterhw.sim.paths import REPO_ROOT
 from rasterhw.sim.report.rows import make_row
 
-__all__ = ["MUTANTS", "RECORD", "SEED", "merge_blocks", "rows", "sections", "write_record"]
+__all__ = ["MUTANTS", "RECORD", "SEED", "classify_record", "merge_blocks", "rows", "sections", "write_record"]
 
 #: where the campaign's and the proofs' results are kept
 RECORD = REPO_ROOT / "docs" / "reproduction" / "mutation_runs.json"
@@ -48,6 +49,9 @@ def merge_blocks(results: list[dict], commands: list[str], path=None) -> None:
     blocks = record["campaign"]["blocks"]
     for r in results:
         want = small.get(r["block"], {"": None})
+        if "error" in r:   # a block that could not be mutated at its small configuration: said, no score
+            r = {"block": r["block"], "params": r.get("params") or want, "seed": SEED, "mutants": MUTANTS,
+                 "error": r["error"], "score": None}
         if (r["mutants"], r["seed"]) != (MUTANTS, SEED) or any(r["params"].get(k) != v for k, v in want.items()):
             raise RasterhwError(f"{r['block']}: the record holds {MUTANTS} mutants, seed {SEED}, at the small "
                                 f"configuration {want}; not {r['mutants']}, {r['seed']}, {r['params']}")
@@ -58,6 +62,55 @@ def merge_blocks(results: list[dict], commands: list[str], path=None) -> None:
         else:
             blocks.append(entry)
     write_record(record["campaign"], record["proofs"], [*record["commands"], *commands], path)
+
+
+def _rescore(b: dict, survivors: list[dict]) -> dict:
+    """A block's result with ``survivors`` in place of its own and its counts and score from them."""
+    equivalent = sum(s.get("equivalence") == "equivalent" for s in survivors)
+    n, killed = b["mutants"], b["killed"]
+    score = killed / (n - equivalent) if b["baseline_passed"] and n > equivalent else None
+    return {**b, "survivors": survivors, "equivalent": equivalent, "survived": n - killed - equivalent,
+            "score": None if score is None else round(score, 4)}
+
+
+def classify_record(blocks: list[str] | None = None, path=None) -> list[str]:
+    """Every survivor of the record's blocks (``blocks``: only those) with the outputs its fault
+    reaches and its class (:mod:`rasterhw.sim.flow.reach`; a survivor that reaches no output becomes
+    ``equivalent``, ``equivalence_how`` ``structural``, and leaves the score), from the block's
+    mutated bench made again at the record's parameters, mutants and seed. A block whose mutations
+    today differ from the record's (its design changed since) is left as it is; its name is returned
+    with why."""
+    from rasterhw.sim.flow.mutate import _survivor, mutated_bench, survivor_reach
+
+    record = _read(path)
+    camp, skipped = record["campaign"], []
+    for i, b in enumerate(camp["blocks"]):
+        if "error" in b or not b.get("survivors") or (blocks is not None and b["block"] not in blocks):
+            continue
+        m = mutated_bench(b["block"], b["params"], mutants=b["mutants"], seed=b["seed"])
+        by = {mu["mutant"]: mu for mu in m["mutations"]}
+        if any(_same(by.get(s["mutant"], {}).get("mutation", "")) != _same(s["mutation"]) for s in b["survivors"]) \
+                or len(by) != b["mutants"]:
+            skipped.append(f"{b['block']}: its mutations today differ from the record's (the design changed)")
+            continue
+        reached = survivor_reach(b["block"], b["params"], b["seed"], m["dir"], m["mutations"])
+        kept = []
+        for s in b["survivors"]:
+            eq = ({"equivalence": s["equivalence"], "why": s.get("equivalence_why", "")}
+                  if s.get("equivalence") and s.get("equivalence_how", "").split(":")[0] != "structural" else None)
+            kept.append(_survivor({"mutant": s["mutant"]}, by[s["mutant"]], eq, reached))
+        camp["blocks"][i] = {**_rescore(b, kept), "killed_by": [
+            {**k, "reaches": reached["reaches"][k["mutant"]]} for k in b.get("killed_by", [])]}
+    write_record(camp, record["proofs"], record["commands"], path)
+    return skipped
+
+
+def _same(mutation: str) -> str:
+    """A mutation in words without the serial number Yosys gives its cell (``$add$bench.v:829$216``,
+    ``$procdff$1801``: it counts every cell of the file, so it moves when the bench top around the
+    block gains or loses one) and without the wire's name (Yosys picks one of the names a net has);
+    the kind of cell, its source line, port and bit stay)."""
+    return re.sub(r" \(wire .*\)$", "", re.sub(r"\$\d+ port ", " port ", mutation))
 
 
 def _read(path=None) -> dict | None:
@@ -96,9 +149,12 @@ def sections(record: dict) -> list[str]:
           f"campaign wall time {camp['wall_s']:.0f} s on `{camp['scheduler'].split(':')[0]}` "
           f"({camp['computed']} tasks run, {camp['reused']} from the store). A mutant is killed when its "
           "testbench (words against the golden model, cycles, stream rules, watchdog) fails; "
-          "`equivalent`: survivors Yosys's equivalence flow proves equivalent to the block (they leave the "
-          "score; 0 where the campaign tried none: `mutate --all` does not, `mutate BLOCK` does; "
-          "docs/mutation.md). Stream proof: "
+          "`equivalent`: survivors proven equivalent to the block, by structure (the mutated bit has no path "
+          "to any output, `sim/flow/reach.py`, every block) or by Yosys's equivalence flow (`mutate BLOCK` "
+          "only; `mutate --all` tries none); they leave the score (docs/mutation.md). Every other survivor "
+          "has a class: `uncompared` (it reaches only outputs no check reads) or `compared` (it reaches "
+          "compared outputs: the stimulus never makes the fault visible, or an equivalence not shown). "
+          "Stream proof: "
           "`rasterhw prove --all` (sim/flow/stream_proof.py); own proof: the block's registered proof.", "",
           "| block | configuration | mutants | killed | equivalent | survived | score | stream proof | own proof |",
           "|---|---|---|---|---|---|---|---|---|"]
@@ -117,11 +173,37 @@ def sections(record: dict) -> list[str]:
         if not b.get("survivors"):
             continue
         md += [f"### `{b['block']}` ({b['survived']} of {b['mutants']})", ""]
+        classes = [s.get("reach_class") for s in b["survivors"]]
+        if any(classes):
+            md += ["Survivors by class (`sim/flow/reach.py`, computed): "
+                   + ", ".join(f"{c} {classes.count(c)}" for c in _CLASSES if c in classes) + ".", ""]
         md += [f"- mutant {s['mutant']}: {', '.join(f'`{x}`' for x in s['src']) or '(no Amaranth source)'}: "
-               f"{s['mutation'].replace('|', '/')}"
-               + (f" — **{s['equivalence']}**" if "equivalence" in s else "") for s in b["survivors"]]
+               f"{s['mutation'].replace('|', '/')}" + _survivor_note(s) for s in b["survivors"]]
         md.append("")
     return md
+
+
+#: a survivor's class (:mod:`rasterhw.sim.flow.reach`) and what it says about the checks
+_CLASSES = {"unobservable": "no path to any output: equivalent by structure",
+            "uncompared": "reaches only outputs no check reads",
+            "compared": "reaches compared outputs; the stimulus never makes it visible there, or it is equivalent "
+                        "in a way neither the structure nor the proof shows"}
+
+
+def _survivor_note(s: dict) -> str:
+    """A survivor's class, the outputs it reaches and its equivalence, for the page."""
+    out = ""
+    if s.get("reach_class"):
+        out += f" — **{s['reach_class']}**"
+        if s["reach_class"] == "unobservable":
+            out += " (no path to any output)"
+        else:
+            out += f" (reaches {', '.join(s['reaches'])})"
+    if "equivalence" in s and s.get("equivalence_how", "").split(":")[0] != "structural":
+        how = f", {s['equivalence_how']}" if s.get("equivalence_how") else ""
+        why = f": {s['equivalence_why']}" if s.get("equivalence_why") else ""
+        out += f"; equivalence: **{s['equivalence']}**{how}{why}"
+    return out
 
 
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir=None, fast: bool = False, rerun: bool = False,
