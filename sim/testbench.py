@@ -12,7 +12,7 @@ stamps, build caches and run folders. This module and the engines know no machin
 
 Words are integers: a stream's payload as one packed word (``payload.as_value()``); a port's words
 in a :class:`Stimulus` or an :class:`Expected` are a list of ints or, for millions of words, the
-same values packed as ``(N, bytes)`` uint8 rows, big-endian (``sim/engines/packed.py``); a
+same values packed as ``(N, bytes)`` uint8 rows, big-endian (``sim/packed.py``); a
 :class:`Run`'s are ints, or such rows where the run asked for them (``engines.run(...,
 packed=True)``: the Verilator engine reads its binary dumps so, no Python int per word).
 :func:`compare` takes either form on either side.
@@ -39,6 +39,7 @@ from operator import ne
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim import registry
+from rasterhw.sim.packed import as_ints
 
 __all__ = ["Clock", "Expected", "Run", "Stimulus", "Testbench", "clocks_of", "compare", "find_testbench", "port_of"]
 
@@ -276,9 +277,7 @@ def compare(exp: Expected, got: Run, *, cycle_exact: bool = True) -> dict:
 
 def _ints(words) -> list:
     """A port's words as a list of ints (packed rows converted: ``packed.as_ints``)."""
-    if isinstance(words, np.ndarray):   # imported here: the engines package imports this module
-        from rasterhw.sim.engines.packed import as_ints
-
+    if isinstance(words, np.ndarray):
         return as_ints(words)
     return words if isinstance(words, list) else list(words)
 

@@ -1,4 +1,4 @@
-"""Packed stream words (sim/engines/packed.py): the bytes equal the Python-int arithmetic they
+"""Packed stream words (sim/packed.py): the bytes equal the Python-int arithmetic they
 replace, gaps sit right above the word, and bad input is refused."""
 
 import numpy as np
@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.engines.packed import as_bytes, as_ints, pack_fields, records
+from rasterhw.sim.packed import as_bytes, as_ints, pack_fields, records
 
 WIDTHS = st.lists(st.integers(1, 64), min_size=1, max_size=6).filter(lambda bs: sum(bs) <= 128)
 

@@ -10,9 +10,9 @@ import pytest
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.sim import cachefile, paths
-from rasterhw.sim.engines.packed import as_bytes
 from rasterhw.sim.experts import scene as S
 from rasterhw.sim.experts.pxp_jobs import RANGE_BITS
+from rasterhw.sim.packed import as_bytes
 
 OPTS = {"sn": 2, "pn": 4, "aj": "c", "ranges": "static", "pxp": "span"}
 

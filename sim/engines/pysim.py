@@ -11,9 +11,9 @@ import time
 from amaranth.sim import Simulator
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.engines.harness import as_plain, stream_protocol_checker, stream_put
-from rasterhw.sim.engines.packed import as_ints
 from rasterhw.sim.engines.pattern import ready_pattern
 from rasterhw.sim.engines.waves import declare_streams
+from rasterhw.sim.packed import as_ints
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, port_of
 
 __all__ = ["run"]

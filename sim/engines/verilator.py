@@ -25,7 +25,6 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.sim.cachefile import matches, sha256_file, warn_damaged
 from rasterhw.sim.engines import waves
 from rasterhw.sim.engines.memh import memh_uint64, read_memh
-from rasterhw.sim.engines.packed import as_bytes, records
 from rasterhw.sim.engines.ports import GAP_BITS, bench_ports, payload_of, ports_of, tag, unpack
 from rasterhw.sim.engines.runner import (
     HARNESS_V,
@@ -35,6 +34,7 @@ from rasterhw.sim.engines.runner import (
 )
 from rasterhw.sim.engines.verilog import canonical_port_lists
 from rasterhw.sim.engines.verilog_cache import closure_cached, convert_cached, sources_digest
+from rasterhw.sim.packed import as_bytes, records
 from rasterhw.sim.paths import BUILD_ROOT
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, compare, port_of
 from rasterhw.sim.workdirs import build_lock, release, temp_run_folder

@@ -91,7 +91,7 @@ def _cached_jobs(tris, compute, **options) -> dict:
     transitively, every module of ours it imports: the golden model, the job packing, the HDL's
     layouts; ``verilog_cache.closure_cached``). A warm run so neither renders the frame nor walks the
     span cycle model (nor loads numba and Amaranth for it): experts-1000 at 512 x 512, 8 x 8: ~1 CPU-s.
-    Kept: the words as packed rows (``sim/engines/packed.py``, the input port's width), the fields of
+    Kept: the words as packed rows (``sim/packed.py``, the input port's width), the fields of
     :data:`_KEPT`, ``resolve`` (each line's resolve cycles: a stalled run's floor) and ``span_steps``
     (the step counts summed)."""
     import hashlib
@@ -100,9 +100,9 @@ def _cached_jobs(tris, compute, **options) -> dict:
     from pathlib import Path
 
     from rasterhw.sim.cachefile import read_entry, write_entry
-    from rasterhw.sim.engines.packed import as_bytes
     from rasterhw.sim.engines.verilog_cache import closure_cached, sources_digest
     from rasterhw.sim.experts.pxp_jobs import RANGE_BITS
+    from rasterhw.sim.packed import as_bytes
     from rasterhw.sim.paths import BUILD_ROOT
 
     h = hashlib.sha1()
@@ -226,8 +226,8 @@ def pxp_job(jb: dict, *, width: int, engine: str = "pysim", idle: int = 0, stall
     else:
         tb = PxpBench(log=True)
     if isinstance(jb["words"], np.ndarray):   # packed rows (the cached jobs: _cached_jobs): the range word packed too
-        from rasterhw.sim.engines.packed import as_bytes
         from rasterhw.sim.experts.pxp_jobs import RANGE_BITS
+        from rasterhw.sim.packed import as_bytes
 
         first = job_stimulus({**jb, "words": []})
         rows = np.concatenate([as_bytes(first.words["i"], jb.get("seg_bits", SEG_BITS) + RANGE_BITS), jb["words"]])

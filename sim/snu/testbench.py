@@ -14,8 +14,8 @@ from rasterhw.golden_model.snu import pixelbus as golden
 from rasterhw.golden_model.snu.formats import RGB_BITS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.golden_model.snu.words import payload_fields
-from rasterhw.sim.engines.packed import pack_fields
 from rasterhw.sim.engines.verilog_cache import factory_params
+from rasterhw.sim.packed import pack_fields
 from rasterhw.sim.snu.frame_format import GAP_BITS, SCHEDULE
 from rasterhw.sim.testbench import Expected, Run, Stimulus, Testbench
 
@@ -28,7 +28,7 @@ def _addr_bits(n: int) -> int:
 
 def _port_words(stream: PixelStream, idx: np.ndarray, aw: int, gaps) -> tuple[np.ndarray, np.ndarray | None]:
     """The writes ``idx`` as port words, then the end token (the payload's top bit + 1), packed
-    (``sim/engines/packed.py``: one row of bytes per word, no Python int per write)."""
+    (``sim/packed.py``: one row of bytes per word, no Python int per write)."""
     fields = payload_fields(stream, idx, aw)
     words = _then_end(pack_fields([(np.zeros(idx.size, np.int64), 1)] + fields), 1 + sum(b for _, b in fields))
     return words, (None if gaps is None else np.append(np.asarray(gaps, dtype=np.int64)[idx], 0))

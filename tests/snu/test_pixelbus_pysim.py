@@ -290,7 +290,7 @@ def test_bank_testbench_reads_out_after_the_last_memory_cycle():
 @pytest.mark.parametrize("pipe", [0, 1])
 def test_bus_testbench_with_one_pipeline_empty(pipe):
     from rasterhw.sim.engines import run
-    from rasterhw.sim.engines.packed import as_ints
+    from rasterhw.sim.packed import as_ints
     from rasterhw.sim.snu.testbench import frame_of
     from rasterhw.sim.testbench import compare, find_testbench
 

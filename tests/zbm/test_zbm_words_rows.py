@@ -18,7 +18,7 @@ from rasterhw.golden_model.zbm.words import (
     merge_words,
     rows_to_samples,
 )
-from rasterhw.sim.engines.packed import as_ints
+from rasterhw.sim.packed import as_ints
 from rasterhw.sim.testbench import Expected, Run, compare
 
 
