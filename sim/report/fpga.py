@@ -48,7 +48,8 @@ _UNLABELLED = {"ram", "schedule", "head", "index", "chip", "aj", "alpha", "beta"
 
 
 def _cfg(block: str, params: dict, kind: str) -> str:
-    """Row label: ``full``/``reduced`` and the block's size parameters (defaults filled in)."""
+    """Row label: ``full``/``reduced`` and the block's size parameters (defaults filled in), each
+    value in the words its machine gives it (``Flow.labels``, e.g. which datapath) or as ``name value``."""
     import inspect
 
     from rasterhw.sim.engines.verilog import blocks, load
@@ -56,7 +57,8 @@ def _cfg(block: str, params: dict, kind: str) -> str:
     sig = inspect.signature(load(blocks()[block]))
     eff = {k: v.default for k, v in sig.parameters.items() if v.default is not inspect.Parameter.empty}
     eff.update(params)
-    shown = ", ".join(f"{k} {v}" for k, v in eff.items() if k not in _UNLABELLED)
+    words = registry.flow(block).labels
+    shown = ", ".join(words.get(k, {}).get(v, f"{k} {v}") for k, v in eff.items() if k not in _UNLABELLED)
     return f"{kind}: {shown}"
 
 
