@@ -116,6 +116,8 @@ class Flow:
     fpga_runs: tuple[tuple[dict, str], ...] = (({}, "full"),)
     clocks: tuple[Clock, ...] = ()                # the clocks the paper names for this block
     demand_from_synth: bool = False               # its full size is measured against the device by synthesis
+    #: how ``rasterhw report fpga`` names a parameter's value in a row label: {param: {value: words}}
+    labels: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -171,3 +171,29 @@ def test_summary_of_a_run_that_did_not_finish_names_why():
          "utilization": {"DP16KD": 38}, "progress": "placed, router1 after 9 iterations with 5 arcs queued"}
     text = fpga_summary(r)
     assert "not measured: nextpnr did not finish in 60 min (packed DP16KD 38; placed, router1" in text
+
+
+def test_experts_blocks_are_placed_at_both_datapaths_labelled_so():
+    """Issue 48: the SLP, its set-up and the span PXP each have, at every size the report places,
+    a row group at the paper's datapath beside ours, and the label names which; the labels'
+    acc_extra is the one ``sim experts --datapath`` builds each datapath with."""
+    from rasterhw.golden_model.experts.formats import DATAPATHS
+    from rasterhw.sim.report.fpga import _cfg
+
+    for block, key in (("experts-slp", "acc_extra"), ("experts-slp-setup", "acc_extra"),
+                       ("experts-pxp-span", "datapath")):
+        groups: dict = {}
+        for b, p, kind in fpga_configs():
+            if b == block:
+                size = (kind, tuple(sorted((k, v) for k, v in p.items() if k != key)))
+                groups.setdefault(size, []).append(_cfg(b, p, kind))
+        assert ("full", ()) in groups, block
+        for size, labels in groups.items():
+            assert len(labels) == 2, (block, size, labels)
+            assert sorted(("datapath paper" in lab, "datapath ours" in lab) for lab in labels) == \
+                [(False, True), (True, False)], (block, size, labels)
+    for name in ("paper", "ours"):
+        ex = DATAPATHS[name].acc_extra
+        assert f"datapath {name} (acc_extra {ex})" in _cfg("experts-slp", {"acc_extra": ex}, "full")
+    assert "width 64, tris 64, lines 32, asl 64" in _cfg("experts-slp", {"width": 64, "tris": 64, "lines": 32,
+                                                                          "asl": 64}, "reduced")

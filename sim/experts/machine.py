@@ -3,6 +3,11 @@
 from rasterhw.sim.registry import Arch, Clock, Flow, Machine, Option, SimBlock
 
 _NO_CLOCK = Clock("sync", "EXPERTS: the paper names no clock (times in operation times)", None, "clock")
+#: the SLP's and its set-up's datapath in the fpga report's labels (``acc_extra`` 0: the paper's 16-bit
+#: words and one 16 x 16 multiplier, ``--datapath paper``; 16, formats.ACC_EXTRA: ours)
+_SLP_DATAPATH = {"acc_extra": {0: "datapath paper (acc_extra 0)", 16: "datapath ours (acc_extra 16)"}}
+#: the SLP placed at a reduced size at both datapaths (full size: Yosys over 480 s under load, issue 48)
+_SLP_REDUCED = {"width": 64, "tris": 64, "lines": 32, "asl": 64}
 
 MACHINE = Machine(
     headline=("fig. 4.1 / text: balance Pn", "table 2.2: work with A.J.", "5: processor op rate for 30 frames/s",
@@ -73,10 +78,16 @@ MACHINE = Machine(
     soak={"pxp": "rasterhw.sim.experts.soak:pxp_round"},
     flows={"experts-dmm": Flow(small={"depth": 16}, clocks=(_NO_CLOCK,)),
            "experts-pxp": Flow(small={"width": 64}, clocks=(_NO_CLOCK,)),
-           "experts-pxp-span": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,)),
+           "experts-pxp-span": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,),
+                                    fpga_runs=(({"datapath": "paper"}, "full"), ({}, "full"))),
            "experts-pxp-coherent": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,)),
-           "experts-slp": Flow(small={"width": 64, "tris": 64, "lines": 16, "asl": 32}, clocks=(_NO_CLOCK,)),
-           "experts-slp-setup": Flow(small={"height": 64}, clocks=(_NO_CLOCK,)),
+           "experts-slp": Flow(small={"width": 64, "tris": 64, "lines": 16, "asl": 32}, clocks=(_NO_CLOCK,),
+                               fpga_runs=(({"acc_extra": 0}, "full"), ({}, "full"),
+                                          ({**_SLP_REDUCED, "acc_extra": 0}, "reduced"), (_SLP_REDUCED, "reduced")),
+                               labels=_SLP_DATAPATH),
+           # no reduced set-up: its one size, height, is a clamp constant (the ROM and multiplier do not scale)
+           "experts-slp-setup": Flow(small={"height": 64}, clocks=(_NO_CLOCK,),
+                                     fpga_runs=(({"acc_extra": 0}, "full"), ({}, "full")), labels=_SLP_DATAPATH),
            "experts-group": Flow(small={"width": 64, "pn": 2, "tris": 64, "lines": 16, "asl": 32, "depth": 32},
                                  clocks=(_NO_CLOCK,)),
            "experts-pxp-unit": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,))},

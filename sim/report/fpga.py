@@ -48,7 +48,8 @@ _UNLABELLED = {"ram", "schedule", "head", "index", "chip", "aj", "alpha", "beta"
 
 
 def _cfg(block: str, params: dict, kind: str) -> str:
-    """Row label: ``full``/``reduced`` and the block's size parameters (defaults filled in)."""
+    """Row label: ``full``/``reduced`` and the block's size parameters (defaults filled in), each
+    value in the words its machine gives it (``Flow.labels``, e.g. which datapath) or as ``name value``."""
     import inspect
 
     from rasterhw.sim.engines.verilog import blocks, load
@@ -56,7 +57,8 @@ def _cfg(block: str, params: dict, kind: str) -> str:
     sig = inspect.signature(load(blocks()[block]))
     eff = {k: v.default for k, v in sig.parameters.items() if v.default is not inspect.Parameter.empty}
     eff.update(params)
-    shown = ", ".join(f"{k} {v}" for k, v in eff.items() if k not in _UNLABELLED)
+    words = registry.flow(block).labels
+    shown = ", ".join(words.get(k, {}).get(v, f"{k} {v}") for k, v in eff.items() if k not in _UNLABELLED)
     return f"{kind}: {shown}"
 
 
@@ -183,8 +185,8 @@ def _sweep_label(sw: FpgaSweep) -> str:
 def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool = False,
          timeout: float = REPORT_TIMEOUT_S, cached_only: bool = False, records_only: bool = False,
          scheduler: str = "serial", store=None, fresh: bool = False):
-    """Report rows: per configuration of :func:`fpga_configs`, ECP5 LUTs, flip-flops, block RAMs
-    and Fmax per clock beside the paper's clock (``source`` ``hdl:nextpnr``; a full frame memory
+    """Report rows: per configuration of :func:`fpga_configs`, ECP5 LUTs, flip-flops, block RAMs,
+    multiplier blocks and Fmax per clock beside the paper's clock (``source`` ``hdl:nextpnr``; a full frame memory
     measured by synthesis: ``hdl:yosys``), and each sweep of :func:`fpga_sweeps` (the ZB/M chip's
     Fmax at each interleave) with a plot. ``fast``: the rows stay, unmeasured (place and route takes
     minutes to an hour per block). ``cached_only``: use the results cached in ``build/pnr-*`` and
@@ -221,7 +223,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
 
         out += [row("LUT4s", r["luts"] if ok else None, "LUT4"),
                 row("flip-flops", r["ffs"] if ok else None, "flip-flops"),
-                row("block RAMs (DP16KD, 18 Kbit)", r["brams"] if ok else None, "DP16KD")]
+                row("block RAMs (DP16KD, 18 Kbit)", r["brams"] if ok else None, "DP16KD"),
+                row("multiplier blocks (MULT18X18D, 18 x 18)", r.get("dsps") if ok else None, "MULT18X18D")]
         for dom, what, hz in paper_clock(block):
             f = r["fmax_mhz"].get(dom) if ok else None
             if ok and f is None:
