@@ -27,7 +27,7 @@ _EP_BYTES = F.EP_WORD_BITS // 8                # 21
 
 def edge_pair_rows(eps: G.EdgePairs) -> np.ndarray:
     """:func:`edge_pair_words` (the specification; ``tests/zbm/test_zbm_words_rows.py`` holds the
-    two equal) as packed rows (``sim/engines/packed.py``: ``(9 E + 1, 21)`` uint8, each 168-bit
+    two equal) as packed rows (``sim/packed.py``: ``(9 E + 1, 21)`` uint8, each 168-bit
     word big-endian), built column by column: no Python int per word (22,786 ``Layout.pack``
     calls for c300's 2,848 edge pairs). A value that does not fit its field is left to
     :func:`edge_pair_words`, which raises the field's one-line error."""
@@ -107,7 +107,7 @@ def merge_words(s0, s1) -> list[int]:
 
 
 def merge_rows(s0, s1) -> np.ndarray:
-    """:func:`merge_words` as packed rows (``sim/engines/packed.py``): ``(N, 16)`` uint8, each
+    """:func:`merge_words` as packed rows (``sim/packed.py``): ``(N, 16)`` uint8, each
     PIXEL2 word ``s1 << 64 | s0`` big-endian, flattened in C order; no Python int per word."""
     return np.stack([np.ravel(s1), np.ravel(s0)], -1).astype(">u8").view(np.uint8)
 
