@@ -1,4 +1,4 @@
-"""``rasterhw sim pxp``'s golden jobs as a build-cache entry (``sim/experts/scene.py: _cached_jobs``,
+"""``rasterhw sim pxp``'s golden jobs as a build-cache entry (``sim/experts/scene.py: _cached_jobs`` on ``verilog_cache.arrays_cached``,
 issue 51): a warm run reads them back instead of rendering the frame and walking the span cycle
 model; what it reads equals what is computed; a damaged entry is computed again, not served; another
 scene, option or source gets its own entry."""
@@ -10,6 +10,7 @@ import pytest
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.scenes import build_scene
 from rasterhw.sim import cachefile, paths
+from rasterhw.sim.engines import verilog_cache
 from rasterhw.sim.experts import scene as S
 from rasterhw.sim.experts.pxp_jobs import RANGE_BITS
 from rasterhw.sim.packed import as_bytes
@@ -21,6 +22,7 @@ OPTS = {"sn": 2, "pn": 4, "aj": "c", "ranges": "static", "pxp": "span"}
 def cache(tmp_path, monkeypatch):
     monkeypatch.setattr(paths, "BUILD_ROOT", tmp_path)
     monkeypatch.setattr(cachefile, "BUILD_ROOT", tmp_path)
+    monkeypatch.setattr(verilog_cache, "BUILD_ROOT", tmp_path)
     calls = []
     real = S.PxpScene._golden
 

@@ -146,3 +146,23 @@ def test_cached_arrays_are_computed_once_per_key_and_damage_is_recomputed(tmp_pa
     for key in ([a.reshape(3, 2), 4], [a.astype(np.int32), 4], [a + 1, 4], [a, 5]):
         vc.arrays_cached("t", src, key, lambda: compute(a))
     assert len(calls) == 6 and len(list((tmp_path / "verilog").glob("t-*.npz"))) == 5
+
+
+def test_a_cached_arrays_entry_of_another_key_under_its_name_is_computed_again(tmp_path, monkeypatch):
+    """An ``arrays_cached`` entry's name holds 64 bits of its key's digest, the entry the whole
+    digest: another key's entry (its SHA-256 record intact) found under the name is not served."""
+    import numpy as np
+    from rasterhw.golden_model.snu import pixelbus
+    from rasterhw.sim import cachefile
+    from rasterhw.sim.engines import verilog_cache as vc
+
+    monkeypatch.setattr(vc, "BUILD_ROOT", tmp_path)
+    monkeypatch.setattr(cachefile, "BUILD_ROOT", tmp_path)
+    src = vc.Path(pixelbus.__file__)
+    vc.arrays_cached("t", src, [1], lambda: {"x": np.array([1])})
+    (one,) = (tmp_path / "verilog").glob("t-*.npz")
+    vc.arrays_cached("t", src, [2], lambda: {"x": np.array([2])})
+    (two,) = set((tmp_path / "verilog").glob("t-*.npz")) - {one}
+    cachefile.write_entry(two, one.read_bytes(), root=tmp_path)    # key 1's entry under key 2's name
+    got = vc.arrays_cached("t", src, [2], lambda: {"x": np.array([2])})
+    assert got["x"].tolist() == [2]

@@ -193,8 +193,10 @@ def arrays_cached(name: str, sources: Path, key: Sequence, compute: Callable[[],
     ``write_entry``; read without pickle), keyed by ``key`` (the inputs: arrays by their bytes,
     dtype and shape; anything else by its JSON) and the digest of ``sources`` and every module of
     ours it imports, transitively (:func:`closure_cached`): an edit to the model computes it again.
-    For a result that costs more than reading it back (``rasterhw sim pixelbus``: the pixel bus's
-    accept cycles, 0.15-0.28 CPU-s a run)."""
+    The entry holds its whole digest (its name only the first 64 bits): an entry of another key
+    under the same name is computed again, never served. For a result that costs more than reading
+    it back (``rasterhw sim pixelbus``: the pixel bus's accept cycles, 0.15-0.28 CPU-s a run;
+    ``rasterhw sim pxp``: a scene's golden PXP jobs, ~1 CPU-s)."""
     import io
 
     h = hashlib.sha1(sources_digest(closure_cached([sources], BUILD_ROOT / "verilog" / "model-sources")).encode())
@@ -202,21 +204,28 @@ def arrays_cached(name: str, sources: Path, key: Sequence, compute: Callable[[],
         if isinstance(v, np.ndarray):
             h.update(str((v.dtype.str, v.shape)).encode() + np.ascontiguousarray(v).tobytes())
         else:
-            h.update(json.dumps(v, sort_keys=True).encode())
+            h.update(json.dumps(v, sort_keys=True, default=str).encode())
         h.update(b"\0")
+    digest = np.frombuffer(h.hexdigest().encode(), np.uint8)
     path = BUILD_ROOT / "verilog" / f"{name}-{h.hexdigest()[:16]}.npz"
     raw = read_entry(path, what=f"a cached result of {name}")
     if raw is not None:
         with np.load(io.BytesIO(raw), allow_pickle=False) as z:
-            return {k: z[k] for k in z.files}
+            got = {k: z[k] for k in z.files}
+        if np.array_equal(got.pop(_DIGEST, None), digest):
+            return got
     out = {k: np.asarray(v) for k, v in compute().items()}
     buf = io.BytesIO()
-    np.savez(buf, **out)
+    np.savez(buf, **out, **{_DIGEST: digest})
     try:
         write_entry(path, buf.getvalue())
     except (OSError, RasterhwError):
         pass   # a read-only cache: computed again next time
     return out
+
+
+#: the array of an :func:`arrays_cached` entry that holds its key's whole digest
+_DIGEST = "__digest__"
 
 
 def design_sources(block: str | None = None) -> list[Path]:

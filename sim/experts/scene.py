@@ -85,57 +85,38 @@ _KEPT = ("pixels", "cycles", "last_pixel", "lo0", "hi0", "lines", "aj", "seg_bit
 
 def _cached_jobs(tris, compute, **options) -> dict:
     """``compute()`` (the golden frame's display format and :func:`jobs`) for these triangles and
-    ``options``, kept as a build-cache entry (``build/verilog/experts-pxp-jobs-<digest>.npz``,
-    SHA-256 checked through ``cachefile.read_entry`` / ``write_entry``) keyed by the triangles' bytes,
+    ``options``, kept as a build-cache entry (``verilog_cache.arrays_cached``:
+    ``build/verilog/experts-pxp-jobs-<digest>.npz``, SHA-256 checked) keyed by the triangles' bytes,
     the options and the digest of every Python source the jobs are made from (this module and,
     transitively, every module of ours it imports: the golden model, the job packing, the HDL's
-    layouts; ``verilog_cache.closure_cached``). A warm run so neither renders the frame nor walks the
-    span cycle model (nor loads numba and Amaranth for it): experts-1000 at 512 x 512, 8 x 8: ~1 CPU-s.
-    Kept: the words as packed rows (``sim/packed.py``, the input port's width), the fields of
-    :data:`_KEPT`, ``resolve`` (each line's resolve cycles: a stalled run's floor) and ``span_steps``
-    (the step counts summed)."""
-    import hashlib
-    import io
+    layouts). A warm run so neither renders the frame nor walks the span cycle model (nor loads
+    numba and Amaranth for it): experts-1000 at 512 x 512, 8 x 8: ~1 CPU-s. Kept: the words as
+    packed rows (``sim/packed.py``, the input port's width), the fields of :data:`_KEPT`, ``resolve``
+    (each line's resolve cycles: a stalled run's floor) and ``span_steps`` (the step counts summed)."""
     import json
     from pathlib import Path
 
-    from rasterhw.sim.cachefile import read_entry, write_entry
-    from rasterhw.sim.engines.verilog_cache import closure_cached, sources_digest
+    from rasterhw.sim.engines.verilog_cache import arrays_cached
     from rasterhw.sim.experts.pxp_jobs import RANGE_BITS
     from rasterhw.sim.packed import as_bytes
-    from rasterhw.sim.paths import BUILD_ROOT
 
-    h = hashlib.sha1()
-    for k, v in sorted(vars(tris).items()):
-        h.update(k.encode())
-        h.update(v.tobytes() + str((v.dtype, v.shape)).encode() if isinstance(v, np.ndarray)
-                 else json.dumps(v, sort_keys=True, default=str).encode())
-    src = sources_digest(closure_cached([Path(__file__)], BUILD_ROOT / "verilog" / "model-sources"))
-    key = json.dumps([h.hexdigest(), src, options], sort_keys=True)
-    path = BUILD_ROOT / "verilog" / f"experts-pxp-jobs-{hashlib.sha1(key.encode()).hexdigest()[:16]}.npz"
-    raw = read_entry(path, what="the EXPERTS PXP jobs of a scene")
-    if raw is None:
+    def arrays() -> dict:
         gold = compute()
         jb = gold["jb"]
-        meta = {"fr": gold["fr"], "key": key, **{k: jb.get(k) for k in _KEPT if not isinstance(jb.get(k), np.ndarray)},
+        meta = {"fr": gold["fr"], **{k: jb.get(k) for k in _KEPT if not isinstance(jb.get(k), np.ndarray)},
                 "span_steps": ({k: int(sum(st[k] for st in jb["steps"])) for k in jb["steps"][0]}
                                if jb.get("steps") else {})}
-        arrays = {k: np.asarray(jb[k]) for k in _KEPT if isinstance(jb.get(k), np.ndarray)}
-        arrays["rows"] = as_bytes(jb["words"], jb.get("seg_bits", SEG_BITS) + RANGE_BITS)
-        arrays["resolve"] = np.array([t[1] for t in jb.get("timing", [])], np.int64)
-        buf = io.BytesIO()
-        np.savez(buf, meta=np.frombuffer(json.dumps(meta).encode(), np.uint8), **arrays)
-        raw = buf.getvalue()
-        try:
-            write_entry(path, raw, root=BUILD_ROOT)
-        except (OSError, RasterhwError):
-            pass   # a read-only cache: computed again next time
-    with np.load(io.BytesIO(raw), allow_pickle=False) as z:
-        meta = json.loads(z["meta"].tobytes())
-        if meta.pop("key") != key:
-            raise RasterhwError(f"{path}: a cache entry of another key (remove it)")
-        jb = {**{k: z[k] for k in z.files if k != "meta"}, **meta}
-    fr = jb.pop("fr")
+        out = {k: np.asarray(jb[k]) for k in _KEPT if isinstance(jb.get(k), np.ndarray)}
+        out["rows"] = as_bytes(jb["words"], jb.get("seg_bits", SEG_BITS) + RANGE_BITS)
+        out["resolve"] = np.array([t[1] for t in jb.get("timing", [])], np.int64)
+        out["meta"] = np.frombuffer(json.dumps(meta).encode(), np.uint8)
+        return out
+
+    key = [x for k, v in sorted(vars(tris).items()) for x in (k, v)] + [options]
+    jb = arrays_cached("experts-pxp-jobs", Path(__file__), key, arrays)
+    meta = json.loads(jb.pop("meta").tobytes())
+    fr = meta.pop("fr")
+    jb = {**jb, **meta}
     jb["words"] = jb.pop("rows")
     return {"fr": fr, "jb": jb}
 
