@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import json
 import os
+import threading
+import time
 
 import pytest
 from rasterhw.golden_model.errors import RasterhwError
@@ -72,6 +74,29 @@ def test_one_cluster_per_command_forked_workers_batches(tmp_path):
     with Runner("serial") as run:
         ser = run.map(_calls(40))
     assert [r["y"] for r in ser] == [r["y"] for r in got]
+
+
+def test_a_result_being_stored_by_a_callback_is_in_the_store_when_result_returns(tmp_path, monkeypatch):
+    """The race a fresh-clone CI run hit (39 of 40 found by the next Runner): a Dask callback
+    thread is writing a handle's result when the caller asks for it; the caller's ``_keep`` must
+    not return before the file is there."""
+    run = Runner("serial", store=tmp_path)
+    task = call("test_dask_runner:square", x=3)
+    h = tasks.Handle(task, task.digest())
+    writing, real_save = threading.Event(), Runner._save
+
+    def slow_save(self, handle, res):
+        writing.set()
+        time.sleep(0.5)
+        real_save(self, handle, res)
+
+    monkeypatch.setattr(Runner, "_save", slow_save)
+    callback = threading.Thread(target=run._keep, args=(h, {"y": 9}))
+    callback.start()
+    assert writing.wait(5)
+    run._keep(h, {"y": 9})                 # the caller's turn while the callback is writing
+    assert run._path(h.digest).exists() and run.computed == 1
+    callback.join()
 
 
 def test_the_batch_size_leaves_every_worker_busy():

@@ -742,13 +742,16 @@ class Runner:
         return val
 
     def _keep(self, h: Handle, res: dict) -> None:
-        """Store a fresh result, once per handle, and count it."""
+        """Store a fresh result, once per handle, and count it. The store write is under the lock:
+        a caller whose result a Dask callback thread is storing waits until the file is there (a
+        fresh-clone CI run's second Runner once found 39 of 40 results, the 40th still being
+        written by the first Runner's callback after its map had returned)."""
         with self._lock:
             if h.saved:
                 return
             h.saved = True
             self.computed += 1
-        self._save(h, res)
+            self._save(h, res)
 
     def result(self, h: Handle) -> dict:
         """The task's result (waits; a task's error is raised here)."""
