@@ -51,8 +51,9 @@ _FF_DATA = {"D": "Q", "AD": "Q"}
 #: the harness's ports that observe the block (its inputs), by instance type
 _OBSERVED = {"rasterhw_stream_sink": {"valid", "payload"}, "rasterhw_stream_source": {"ready"},
              "rasterhw_stream_check": {"valid", "ready", "payload"}}
-#: time limit of the one Yosys run (``write_json``) per campaign
-TIMEOUT_S = 600.0
+#: time limit of the one Yosys run (``write_json``) per campaign: the same passes as ``mutate``'s
+#: Yosys run, so the same limit (experts-slp-setup's took 376 s alone, more under load)
+TIMEOUT_S = 3600.0
 
 
 def _netlist(bdir: Path) -> dict:
