@@ -39,8 +39,13 @@ __all__ = ["KINDS", "CAP_ENV", "Entry", "apply_cap", "cap_from_env", "clean", "e
 #: the environment variable of the size cap applied after every command (:func:`apply_cap`)
 CAP_ENV = "RASTERHW_CACHE_MAX"
 
+#: the import closures kept beside the generated Verilog (``verilog_cache.closure_cached``):
+#: ``verilog/design-sources-<digest>.json`` (a block's), ``bench-sources-`` (a bench's roots,
+#: ``engines/verilator.py``), ``model-sources-`` (a golden array's); of no one design
+_SOURCE_INDEX = r"^(design|bench|model)-sources-[0-9a-f]+\.json$"
 #: (pattern on an entry's name, kind): the first that matches names the kind; a folder of
-#: :data:`~rasterhw.sim.cachefile.NESTED` gives its entries' kind by the folder's name
+#: :data:`~rasterhw.sim.cachefile.NESTED` gives its entries' kind by the folder's name, except the
+#: import closures among the generated Verilog (:data:`_SOURCE_INDEX`)
 KINDS: tuple[tuple[str, str], ...] = (
     (r"^tb-.*-cocotb-(verilator|icarus)-[0-9a-f]+$", "cocotb-build"),
     (r"^tb-.*-pgogen-", "pgo-training-build"),
@@ -51,7 +56,6 @@ KINDS: tuple[tuple[str, str], ...] = (
     (r"^prove-", "proof"),
     (r"^pnr-", "place-and-route"),
     (r"^.+-(verilator|icarus)-[0-9a-f]{10}$", "cocotb-build"),
-    (r"^bench-sources\.json$", "bench-source-index"),
 )
 _NESTED_KIND = {"verilog": "verilog", "zbm-verilog": "verilog", "verilator-runtime": "verilator-runtime",
                 "pgo": "pgo-profile", "tasks": "task-result"}
@@ -142,7 +146,7 @@ def _alive(host: str, pid: str) -> bool:
 
 def _kind(name: str, nested: str | None) -> str:
     if nested is not None:
-        return _NESTED_KIND[nested]
+        return "source-index" if re.search(_SOURCE_INDEX, name) else _NESTED_KIND[nested]
     for pat, kind in KINDS:
         if re.search(pat, name):
             return kind
@@ -158,7 +162,7 @@ def _design(path: Path, kind: str) -> str | None:
             return None
         m = re.search(r'"name": "([^"]+)"', head)
         return m.group(1) if m else None
-    if kind in ("verilator-runtime", "bench-source-index", "other"):
+    if kind in ("verilator-runtime", "source-index", "other"):
         return None
     name = path.name
     build = path / "build.json"
