@@ -14,6 +14,19 @@ Paper (seed 000, 3.2): "SLPにおけるASL作成の処理は、以後のイン�
   cycle per correction, one to finish) each followed by its multiply-and-rounds (``formats.rom_div``:
   ``(|num| R << shift + 2**(S-1)) >> S`` with the sign), then the word out.
 
+**One sequencer, its steps in turn.** The set-up is the first part of the paper's SLP, one
+processor (its ALU, "乗算器、および逆数表(ROMによる)", 3.2), so its steps are sub-components (methods
+that emit their states and datapath into the one sequencer, over the registers they share,
+:class:`_Triangle`), not stages joined by streams: take a PL word (vertex sort and the band test, the
+SLP's clipping: :meth:`ExpertsSlpSetup._take`), eq. (3)'s products (:meth:`~ExpertsSlpSetup._product`),
+the reciprocals (:meth:`~ExpertsSlpSetup._reciprocal`), the increments
+(:meth:`~ExpertsSlpSetup._multiply_round`), in the order :meth:`~ExpertsSlpSetup._program` lists, then
+the word out (:meth:`~ExpertsSlpSetup._word_out`). A stream between them would let one triangle's
+steps overlap the next's and change the cycles ``golden_model/experts/slp_setup.py`` holds (one step
+after another). The stream ``o`` to the list work (``hdl/experts/slp.py``) is ours: the paper's SLP
+does both in one processor, and the frame's SLP cycles are the set-up's plus the list work's
+(``docs/experts.md``, "SLP (set-up + list work)").
+
 Output: ``hdl/experts/slp.py``'s input word (:func:`~rasterhw.hdl.experts.slp.slp_in_layout`,
 kind ``TRI``), as ``slp_cycles.tri_words`` gives it.
 """
@@ -100,18 +113,18 @@ class ExpertsSlpSetup(wiring.Component):
             def one_cycle(na, nb):
                 yield
             return one_cycle
-        aa, ab_ = Signal(48, name="mag_a"), Signal(32, name="mag_b")
+        aa, ab_ = Signal(3 * WORD, name="mag_a"), Signal(2 * WORD, name="mag_b")
         neg = Signal(name="neg")
         ia, ib = Signal(2, name="limb_a"), Signal(1, name="limb_b")
         la, lb = Signal(WORD, name="word_a"), Signal(WORD, name="word_b")
-        part = Signal(32, name="part")
-        place = Signal(64, name="place")
-        pacc, pfull = Signal(64, name="pacc"), Signal(64, name="pfull")
+        part = Signal(2 * WORD, name="part")
+        place = Signal(4 * WORD, name="place")
+        pacc, pfull = Signal(4 * WORD, name="pacc"), Signal(4 * WORD, name="pfull")
         lc = Signal(3, name="lc")
         m.d.comb += [aa.eq(Mux(ma < 0, -ma, ma)), ab_.eq(Mux(mb < 0, -mb, mb)), neg.eq((ma < 0) ^ (mb < 0)),
                      la.eq(aa.word_select(ia, WORD)), lb.eq(ab_.word_select(ib, WORD)), part.eq(la * lb),
-                     place.eq(Mux(ia + ib == 0, part, Mux(ia + ib == 1, part << 16,
-                                                          Mux(ia + ib == 2, part << 32, part << 48)))),
+                     place.eq(Mux(ia + ib == 0, part, Mux(ia + ib == 1, part << WORD,
+                                                          Mux(ia + ib == 2, part << 2 * WORD, part << 3 * WORD)))),
                      pfull.eq(pacc + place), prod.eq(Mux(neg, -pfull, pfull))]
 
         @contextmanager
@@ -131,45 +144,68 @@ class ExpertsSlpSetup(wiring.Component):
     def elaborate(self, platform):
         from rasterhw.hdl.experts.slp import IN_KIND
         m = Module()
+        r = _Triangle()
         p = self.i.payload
-        res = Signal(self.o.payload.shape())
-        m.d.comb += [self.o.payload.eq(res), self.i.ready.eq(0), self.o.valid.eq(0)]
+        r.res = Signal(self.o.payload.shape())
+        m.d.comb += [self.o.payload.eq(r.res), self.i.ready.eq(0), self.o.valid.eq(0)]
         rom = Memory(shape=WORD, depth=1 << ROM_INDEX_BITS, init=[int(v) for v in rom_table()])
         m.submodules.rom = rom
-        rp = rom.read_port(domain="comb")
+        r.rp = rom.read_port(domain="comb")
+        self._vertices(r, p)
+        self._datapath(m, r)
+        r.pc = Signal(range(64))
+        r.busy = Signal()
+        r.out = Signal()
+        prog = self._program(m, r)
+        self._take(m, r, p, IN_KIND["tri"])
+        self._sequencer(m, r, prog)
+        self._word_out(m, r)
+        return m
 
-        # ---- the vertices, sorted on y in the cycle the word is taken (stable: ties keep PL order)
-        X = [Signal(signed(XS_BITS), name=f"X{k}") for k in range(3)]
-        Y = [Signal(signed(XS_BITS), name=f"Y{k}") for k in range(3)]
-        Z = [Signal(unsigned(Z_BITS), name=f"Z{k}") for k in range(3)]
-        Iv = [Signal(unsigned(WORD), name=f"I{k}") for k in range(3)]
+    @staticmethod
+    def _vertices(r, p):
+        """The triangle's vertices, sorted on y in the cycle the word is taken (stable: ties keep PL
+        order), and the band's lines."""
+        r.X = [Signal(signed(XS_BITS), name=f"X{k}") for k in range(3)]
+        r.Y = [Signal(signed(XS_BITS), name=f"Y{k}") for k in range(3)]
+        r.Z = [Signal(unsigned(Z_BITS), name=f"Z{k}") for k in range(3)]
+        r.Iv = [Signal(unsigned(WORD), name=f"I{k}") for k in range(3)]
         py = [p.y0, p.y1, p.y2]
         before = {(a, b): (py[a] <= py[b]) if a < b else (py[a] < py[b]) for a in range(3) for b in range(3) if a != b}
-        rank = [sum((before[(b, a)] for b in range(3) if b != a), Const(0, 2)) for a in range(3)]
-        y0, y1 = Signal(X_INT), Signal(X_INT)
-        half = 1 << (X_FRAC - 1)
+        r.rank = [sum((before[(b, a)] for b in range(3) if b != a), Const(0, 2)) for a in range(3)]
+        y0, y1 = Signal(X_INT), Signal(X_INT)   # locals: Amaranth names a signal after its variable
+        r.y0, r.y1 = y0, y1
 
-        # ---- the datapath: one multiplier, an accumulator, the reciprocal (R, S, sign, remainder)
+    def _datapath(self, m, r):
+        """The one multiplier ("乗算器", seed 000, 3.2; :meth:`_multiplier`), an accumulator for
+        eq. (3)'s sums (``den``, ``nz``, ``ni``), and the reciprocal's registers (``R``, ``S``, the
+        divisor's sign, magnitude and zero flag, the remainder ``e``)."""
         ma, mb = Signal(signed(40)), Signal(signed(20))
-        prod = Signal(signed(60))
-        limbs = self._multiplier(m, ma, mb, prod)
-        acc = Signal(signed(40))
-        den, nz, ni = (Signal(signed(40), name=n) for n in ("den", "nz", "ni"))
-        R = Signal(unsigned(18))
-        S = Signal(unsigned(6))
-        dneg = Signal()
-        dz = Signal()                         # the divisor is 0
-        dabs = Signal(unsigned(40))
-        e = Signal(signed(72))
-        corr = Signal()                       # in a reciprocal's correction cycles
-        s1 = Signal(unsigned(6))              # S - 1: the rounding bit
-        m.d.comb += s1.eq(S - 1)
+        r.ma, r.mb = ma, mb
+        r.prod = Signal(signed(60))
+        r.limbs = self._multiplier(m, r.ma, r.mb, r.prod)
+        r.acc = Signal(signed(40))
+        r.den, r.nz, r.ni = (Signal(signed(40), name=n) for n in ("den", "nz", "ni"))
+        r.R = Signal(unsigned(18))
+        r.S = Signal(unsigned(6))
+        r.dneg = Signal()
+        r.dz = Signal()                       # the divisor is 0
+        r.dabs = Signal(unsigned(40))
+        r.e = Signal(signed(72))
+        r.corr = Signal()                     # in a reciprocal's correction cycles
+        r.s1 = Signal(unsigned(6))            # S - 1: the rounding bit
+        m.d.comb += r.s1.eq(r.S - 1)
 
-        pc = Signal(range(64))
-        busy = Signal()
-        out = Signal()
+    def _program(self, m, r) -> list:
+        """The ASL creation's increments, in the order the sequencer runs them: "SLPにおけるASL作成の処理は、
+        以後のインクリメンタルな計算のための各種の増分値の計算を含んだりするため、乗除算の高速化を行なう
+        必要がある" (seed 000, 3.2). Eq. (3)'s denominator and z, i numerators (six products,
+        :meth:`_product`); per edge its ``dY``'s reciprocal (:meth:`_reciprocal`) and the x, z, i
+        increments and the A.J. slope dx/dy (:meth:`_multiply_round`), its ``dX``'s reciprocal and
+        dy/dx; the denominator's reciprocal, dz/dx and di/dx. A step is ``("mul", a, b, dst,
+        first)``, ``("recip", d)`` or ``("md", num, shift, field, kind)``."""
+        X, Y, Z, Iv, den, nz, ni = r.X, r.Y, r.Z, r.Iv, r.den, r.nz, r.ni
 
-        # the program: ("mul", a, b, dst, first) | ("recip", d) | ("md", num, shift, field, kind)
         def df(A, i, j):
             v = Signal(signed(XD_BITS), name=f"d_{A[0].name}_{i}{j}")
             m.d.comb += v.eq(A[j] - A[i])
@@ -185,106 +221,146 @@ class ExpertsSlpSetup(wiring.Component):
                      ("md", df(Iv, i, j), sh, f"iinc_{e_}", ik), ("md", dX, SLOPE_FRAC, f"s_{e_}", "sat"),
                      ("recip", dX), ("md", dY, SLOPE_FRAC, f"q_{e_}", "satq")]
         prog += [("recip", den), ("md", nz, X_FRAC + DZ_FRAC, "dzdx", "sat"), ("md", ni, X_FRAC, "didx", "sat")]
+        return prog
 
-        def sat16(v):
-            top = 1 << (WORD - 1)
-            return Mux(v > top - 1, top - 1, Mux(v < -top, -top, v))
-
-        # ---- take a PL word
-        with m.If(~busy & ~out):
+    def _take(self, m, r, p, tri_kind):
+        """Take a PL word: a ``BAND`` word sets the band; a triangle's vertices are sorted on y, its
+        first and last line found and tested against the band, the SLP's clipping: "各SLPは、ホスト
+        計算機から送られたPLを基に、自らの担当画面領域における最初のスキャン・ラインについてのASLを生成
+        する。これは、一種のクリッピング(clipping)処理をSLPが分担したことになり" (seed 000, 3.2). In the
+        band, the program runs (``busy``); out of it, the word goes out at once with ``t``, ``r0``,
+        ``r1`` only."""
+        X, Y, Z, Iv, rank, res = r.X, r.Y, r.Z, r.Iv, r.rank, r.res
+        half = 1 << (X_FRAC - 1)
+        with m.If(~r.busy & ~r.out):
             m.d.comb += self.i.ready.eq(1)
             with m.If(self.i.valid):
                 with m.If(p.kind == PL_KIND["band"]):
-                    m.d.sync += [y0.eq(p.r0), y1.eq(p.r1)]
+                    m.d.sync += [r.y0.eq(p.r0), r.y1.eq(p.r1)]
                 with m.Else():
                     for a in range(3):
                         with m.Switch(rank[a]):
-                            for r in range(3):
-                                with m.Case(r):
-                                    m.d.sync += [X[r].eq(getattr(p, f"x{a}")), Y[r].eq(getattr(p, f"y{a}")),
-                                                 Z[r].eq(getattr(p, f"z{a}")), Iv[r].eq(getattr(p, f"i{a}"))]
+                            for k in range(3):
+                                with m.Case(k):
+                                    m.d.sync += [X[k].eq(getattr(p, f"x{a}")), Y[k].eq(getattr(p, f"y{a}")),
+                                                 Z[k].eq(getattr(p, f"z{a}")), Iv[k].eq(getattr(p, f"i{a}"))]
                     ytop = Mux(rank[0] == 0, p.y0, Mux(rank[1] == 0, p.y1, p.y2))
                     ybot = Mux(rank[0] == 2, p.y0, Mux(rank[1] == 2, p.y1, p.y2))
                     r0v, r1v = Signal(signed(XP_BITS)), Signal(signed(XP_BITS))
                     m.d.comb += [r0v.eq((ytop + half - 1) >> X_FRAC), r1v.eq(((ybot + half - 1) >> X_FRAC) - 1)]
                     r0c = Mux(r0v < 0, 0, r0v)
                     r1c = Mux(r1v > self._h - 1, self._h - 1, r1v)
-                    m.d.sync += [res.eq(0), res.kind.eq(IN_KIND["tri"]), res.t.eq(p.t), res.r0.eq(r0c),
-                                 res.r1.eq(r1c), res.hue.eq(p.hue), res.poly.eq(p.poly), pc.eq(0)]
-                    inb = (r1c >= y0) & (r0c < y1)
-                    m.d.sync += [busy.eq(inb), out.eq(~inb)]
+                    m.d.sync += [res.eq(0), res.kind.eq(tri_kind), res.t.eq(p.t), res.r0.eq(r0c),
+                                 res.r1.eq(r1c), res.hue.eq(p.hue), res.poly.eq(p.poly), r.pc.eq(0)]
+                    inb = (r1c >= r.y0) & (r0c < r.y1)
+                    m.d.sync += [r.busy.eq(inb), r.out.eq(~inb)]
                     with m.If(~inb):
                         m.d.sync += [res.hue.eq(0), res.poly.eq(0)]
 
-        # ---- the program, one step a cycle (a reciprocal's corrections stay on its step)
-        with m.If(busy):
-            with m.Switch(pc):
+    def _sequencer(self, m, r, prog):
+        """The program (:meth:`_program`), one step a cycle (a reciprocal's corrections stay on its
+        step; the paper's datapath: a multi-word product a partial product a cycle), then the sorted
+        vertices and the left-edge flag into the word (they hold from the take on)."""
+        res = r.res
+        with m.If(r.busy):
+            with m.Switch(r.pc):
                 for k, st in enumerate(prog):
                     with m.Case(k):
-                        nxt = [pc.eq(k + 1)] if k + 1 < len(prog) else [busy.eq(0), out.eq(1)]
+                        nxt = [r.pc.eq(k + 1)] if k + 1 < len(prog) else [r.busy.eq(0), r.out.eq(1)]
                         if st[0] == "mul":
-                            _, a, b, dst, first = st
-                            m.d.comb += [ma.eq(a), mb.eq(b)]
-                            with limbs(*LIMBS["mul"]):
-                                if first:
-                                    m.d.sync += acc.eq(prod)
-                                else:
-                                    m.d.sync += dst.eq(acc - prod)
-                                m.d.sync += nxt
+                            self._product(m, r, st, nxt)
                         elif st[0] == "recip":
-                            d = st[1]
-                            ad = Signal(unsigned(40), name=f"abs_{k}")
-                            m.d.comb += ad.eq(Mux(d < 0, -d, d))
-                            with m.If(~corr):
-                                # normalise |d| to its 16-bit mantissa, ROM word + 1, remainder (one multiply)
-                                bl = Signal(range(41), name=f"bl_{k}")
-                                for b_ in range(40):
-                                    with m.If(ad[b_]):
-                                        m.d.comb += bl.eq(b_ + 1)
-                                mant = Signal(unsigned(WORD), name=f"mant_{k}")
-                                shr, shl = Signal(6, name=f"shr_{k}"), Signal(6, name=f"shl_{k}")
-                                m.d.comb += [shr.eq(bl - 16), shl.eq(16 - bl),
-                                             mant.eq(Mux(bl > 16, ad >> shr, ad << shl))]
-                                rc = Signal(unsigned(18), name=f"rc_{k}")
-                                m.d.comb += [rp.addr.eq(mant[:ROM_INDEX_BITS]), rc.eq(rp.data + 1),
-                                             ma.eq(ad), mb.eq(rc)]
-                                sv = Signal(unsigned(6), name=f"s_{k}")
-                                m.d.comb += sv.eq(15 + bl)
-                                with limbs(*LIMBS["recip_den" if d is den else "recip"]):
-                                    m.d.sync += [S.eq(sv), dneg.eq(d < 0), dabs.eq(ad), dz.eq(ad == 0), corr.eq(1)]
-                                    with m.If(ad == 0):
-                                        m.d.sync += [R.eq(0), e.eq(0)]
-                                    with m.Else():
-                                        m.d.sync += [R.eq(rc), e.eq((Const(1, 72) << sv) + (ad >> 1) - prod)]
-                            with m.Else():
-                                with m.If(e < 0):
-                                    m.d.sync += [R.eq(R - 1), e.eq(e + dabs)]
-                                with m.Else():
-                                    m.d.sync += [R.eq(Mux(R > 0xFFFF, 0xFFFF, R)), corr.eq(0), *nxt]
+                            self._reciprocal(m, r, k, st[1], nxt)
                         else:
-                            _, num, shift, field, kind = st
-                            an = Signal(unsigned(40), name=f"an_{k}")
-                            m.d.comb += [an.eq(Mux(num < 0, -num, num)), ma.eq(an), mb.eq(R)]
-                            q = Signal(unsigned(72), name=f"q_{k}")
-                            m.d.comb += q.eq(((prod.as_unsigned() << shift) + (Const(1, 72) << s1)) >> S)
-                            v = Signal(signed(73), name=f"v_{k}")
-                            m.d.comb += v.eq(Mux((num < 0) ^ dneg, -q, q))
-                            tgt = getattr(res, field)
-                            with limbs(*LIMBS["md_plane" if num is nz or num is ni else "md"]):
-                                if kind == "int":
-                                    m.d.sync += tgt.eq(v)
-                                elif kind == "sat":
-                                    m.d.sync += tgt.eq(sat16(v))
-                                else:
-                                    m.d.sync += tgt.eq(Mux(dz, (1 << 15) - 1, sat16(v)))
-                                m.d.sync += nxt
-            # the sorted vertices and the left-edge flag into the word (they hold from the take on)
-            m.d.sync += [res.ll.eq(den > 0), res.xa.eq(X[0]), res.ya.eq(Y[0]), res.xb.eq(X[1]), res.yb.eq(Y[1]),
-                         res.za.eq(Z[0]), res.zb.eq(Z[1]), res.ia.eq(Iv[0]), res.ib.eq(Iv[1])]
+                            self._multiply_round(m, r, k, st, nxt)
+            m.d.sync += [res.ll.eq(r.den > 0), res.xa.eq(r.X[0]), res.ya.eq(r.Y[0]), res.xb.eq(r.X[1]),
+                         res.yb.eq(r.Y[1]), res.za.eq(r.Z[0]), res.zb.eq(r.Z[1]), res.ia.eq(r.Iv[0]),
+                         res.ib.eq(r.Iv[1])]
 
-        # ---- the word out
-        with m.If(out):
+    @staticmethod
+    def _product(m, r, st, nxt):
+        """One of eq. (3)'s products, "(2)式、(3)式はいずれも三角形の各頂点の輝度が与えられた時点での
+        計算できる定数値である" (seed 000, 2.3): ``acc = a b`` (``first``), else ``dst = acc - a b``."""
+        _, a, b, dst, first = st
+        m.d.comb += [r.ma.eq(a), r.mb.eq(b)]
+        with r.limbs(*LIMBS["mul"]):
+            if first:
+                m.d.sync += r.acc.eq(r.prod)
+            else:
+                m.d.sync += dst.eq(r.acc - r.prod)
+            m.d.sync += nxt
+
+    @staticmethod
+    def _reciprocal(m, r, k, d, nxt):
+        """The reciprocal of ``d`` from the ROM, "乗算器、および逆数表(ROMによる)を装備した" (seed 000,
+        3.2): ``|d|`` normalised to its 16-bit mantissa, ROM word + 1 and the remainder (one
+        multiply); then one ALU cycle per correction and one to finish (``formats.rom_div``)."""
+        rp, R, e = r.rp, r.R, r.e
+        ad = Signal(unsigned(40), name=f"abs_{k}")
+        m.d.comb += ad.eq(Mux(d < 0, -d, d))
+        with m.If(~r.corr):
+            # normalise |d| to its 16-bit mantissa, ROM word + 1, remainder (one multiply)
+            bl = Signal(range(41), name=f"bl_{k}")
+            for b_ in range(40):
+                with m.If(ad[b_]):
+                    m.d.comb += bl.eq(b_ + 1)
+            mant = Signal(unsigned(WORD), name=f"mant_{k}")
+            shr, shl = Signal(6, name=f"shr_{k}"), Signal(6, name=f"shl_{k}")
+            m.d.comb += [shr.eq(bl - WORD), shl.eq(WORD - bl),
+                         mant.eq(Mux(bl > WORD, ad >> shr, ad << shl))]
+            rc = Signal(unsigned(18), name=f"rc_{k}")
+            m.d.comb += [rp.addr.eq(mant[:ROM_INDEX_BITS]), rc.eq(rp.data + 1),
+                         r.ma.eq(ad), r.mb.eq(rc)]
+            sv = Signal(unsigned(6), name=f"s_{k}")
+            m.d.comb += sv.eq(WORD - 1 + bl)
+            with r.limbs(*LIMBS["recip_den" if d is r.den else "recip"]):
+                m.d.sync += [r.S.eq(sv), r.dneg.eq(d < 0), r.dabs.eq(ad), r.dz.eq(ad == 0), r.corr.eq(1)]
+                with m.If(ad == 0):
+                    m.d.sync += [R.eq(0), e.eq(0)]
+                with m.Else():
+                    m.d.sync += [R.eq(rc), e.eq((Const(1, 72) << sv) + (ad >> 1) - r.prod)]
+        with m.Else():
+            with m.If(e < 0):
+                m.d.sync += [R.eq(R - 1), e.eq(e + r.dabs)]
+            with m.Else():
+                m.d.sync += [R.eq(Mux(R > (1 << WORD) - 1, (1 << WORD) - 1, R)), r.corr.eq(0), *nxt]
+
+    @staticmethod
+    def _multiply_round(m, r, k, st, nxt):
+        """An increment, a slope or eq. (3)'s quotient: ``num`` times the last reciprocal, rounded
+        (``(|num| R << shift + 2**(S-1)) >> S`` with the sign), into the word's ``field``: whole
+        (``int``), saturated to 16 bits (``sat``), or, for dy/dx of a horizontal edge, the largest
+        word (``satq``)."""
+        _, num, shift, field, kind = st
+        an = Signal(unsigned(40), name=f"an_{k}")
+        m.d.comb += [an.eq(Mux(num < 0, -num, num)), r.ma.eq(an), r.mb.eq(r.R)]
+        q = Signal(unsigned(72), name=f"q_{k}")
+        m.d.comb += q.eq(((r.prod.as_unsigned() << shift) + (Const(1, 72) << r.s1)) >> r.S)
+        v = Signal(signed(73), name=f"v_{k}")
+        m.d.comb += v.eq(Mux((num < 0) ^ r.dneg, -q, q))
+        tgt = getattr(r.res, field)
+        with r.limbs(*LIMBS["md_plane" if num is r.nz or num is r.ni else "md"]):
+            if kind == "int":
+                m.d.sync += tgt.eq(v)
+            elif kind == "sat":
+                m.d.sync += tgt.eq(_sat16(v))
+            else:
+                m.d.sync += tgt.eq(Mux(r.dz, (1 << (WORD - 1)) - 1, _sat16(v)))
+            m.d.sync += nxt
+
+    def _word_out(self, m, r):
+        """The word out, to the SLP's list work (``hdl/experts/slp.py``'s input word)."""
+        with m.If(r.out):
             m.d.comb += self.o.valid.eq(1)
             with m.If(self.o.ready):
-                m.d.sync += out.eq(0)
-        return m
+                m.d.sync += r.out.eq(0)
+
+
+class _Triangle:
+    """The set-up's registers and datapath signals, which every step reads and writes (one
+    sequencer's steps in turn: see the module's docstring)."""
+
+
+def _sat16(v):
+    top = 1 << (WORD - 1)
+    return Mux(v > top - 1, top - 1, Mux(v < -top, -top, v))
