@@ -39,9 +39,9 @@ At ``datapath="paper"`` the running z and i are **two 16-bit words** (at 512 x 5
 docs/experts.md "z and i in two words"): one 16-bit adder takes them a word a cycle, the low word
 first with its carry kept (``zlr`` z at the left end, ``zpl`` the right end's low word, ``ilo`` i's
 low word), the guarded tests subtract the low words in one cycle (borrows and flags kept,
-:class:`_GuardedWords`) and the high words in the next; the key is the high word's test and wires
-(:func:`_key_words`), the pixel's intensity the high word's sign against the low word
-(:func:`_i_words`). Pass A and pass B take 4 cycles a segment, the write 2 a drawn pixel
+:class:`GuardedWords`) and the high words in the next; the key is the high word's test and wires
+(:func:`key_words`), the pixel's intensity the high word's sign against the low word
+(:func:`i_words`). Pass A and pass B take 4 cycles a segment, the write 2 a drawn pixel
 (``span_cycles.multiword``).
 
 Cycles: ``golden_model/experts/span_cycles.py`` (every term named there). Pixels: the golden bit
@@ -69,7 +69,8 @@ from rasterhw.hdl.experts.pxp import asb_fields
 from rasterhw.hdl.params import params
 
 __all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "candidate", "dmm_p", "resolve_regs", "seg_ends", "write_pixel", "take_bank", "zrun_at", "z_key", "guarded_test",
-           "intensity_at", "PTR_BITS", "NO_PTR"]
+           "intensity_at", "PTR_BITS", "NO_PTR", "word_adder", "GuardedWords", "Early", "Always", "i_words",
+           "key_words"]
 
 NONE = (1 << ADDR_BITS) - 1     # ASB address / polygon number of the background
 PTR_BITS = 9                    # ASL position in a DMM/P bank
@@ -238,7 +239,7 @@ def clamp_i(m: Module, run, fmt: Formats) -> Signal:
     return ic
 
 
-def _i_words(m: Module, hi, lo, fmt: Formats) -> Signal:
+def i_words(m: Module, hi, lo, fmt: Formats) -> Signal:
     """(paper) The pixel's intensity from a two-word ``i = hi * 2**16 + lo`` (``hi`` signed, this
     cycle's high word; ``lo`` the low word kept), clamped to ``0 .. i_max`` (Q.i_frac) as
     :func:`clamp_i` does: a negative high word gives 0, a positive one the top, else the low word
@@ -250,7 +251,7 @@ def _i_words(m: Module, hi, lo, fmt: Formats) -> Signal:
     return ic
 
 
-def _key_words(m: Module, z) -> Signal:
+def key_words(m: Module, z) -> Signal:
     """(paper) :func:`z_key` of a two-word running z (``signed(32)``): the sign, and the high word's
     bits above Q16.4, pick 0 or the top; else the key is the Q16.4 integer bits (wires)."""
     key = Signal(Z_BITS, name="key_w")
@@ -259,7 +260,33 @@ def _key_words(m: Module, z) -> Signal:
     return key
 
 
-class _GuardedWords:
+def word_adder(m: Module, fr: dict, *, seg, col, write, hi_word, zc) -> Signal:
+    """(paper) The resolve side's half of the PXP's one 16 x 16 multiplier (:meth:`ExpertsPxpSpan.frame`'s
+    ``mul``) and its one 16-bit adder, added to ``m``: the product ``d * dz/dx`` (``d * di/dx`` where
+    ``write()``) of ASB ``seg`` at pixel ``col`` (``d = 64 col + 32 - xL``, the drain's A.J. blend
+    having the multiplier first, ``drain.mreq``), and the adder's 17-bit sum ``z_L * 16 + (product
+    >> 6)`` (``i_L + (product >> 6)``) a word a cycle: the low word, or where ``hi_word`` the high
+    word with the low word's carry ``zc`` (the product's words are its wires). Returns the sum."""
+    d = Signal(signed(18), name="d")
+    m.d.comb += d.eq((col << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl)
+    # the drain's A.J. blend has the multiplier first (drain.mreq); the resolve side then holds
+    mul, dr = fr["mul"], fr["drain"]
+    req = dr.mreq if dr.mreq is not None else 0
+    m.d.comb += [mul["a"].eq(Mux(req, dr.mul_a if dr.mul_a is not None else 0, d)),
+                 mul["b"].eq(Mux(req, dr.mul_b if dr.mul_b is not None else 0,
+                                 Mux(write(), seg.didx, seg.dzdx)))]
+    prod = mul["p"]
+    p_hi = Signal(signed(16), name="p_hi")
+    m.d.comb += p_hi.eq(prod[X_FRAC + 16:].as_signed())
+    wa, wb, zadd = Signal(16, name="wa"), Signal(16, name="wb"), Signal(17, name="zadd")
+    m.d.comb += [wa.eq(Mux(write(), Mux(hi_word, 0, seg.il),
+                           Mux(hi_word, seg.zl[16 - DZ_FRAC:], seg.zl << DZ_FRAC))),
+                 wb.eq(Mux(hi_word, p_hi, prod[X_FRAC:X_FRAC + 16])),
+                 zadd.eq(wa + wb + (hi_word & zc))]
+    return zadd
+
+
+class GuardedWords:
     """(paper) :func:`guarded_test` on two-word z, a word a cycle: every test ``Y - X >= c``
     (``c`` 0, 16 or 1) subtracts the low words in pass B's third cycle (:meth:`low`: the borrow and
     whether the low difference reaches ``c``, kept) and the high words with that borrow in its
@@ -310,8 +337,8 @@ class _GuardedWords:
         return good
 
 
-class _Early:
-    """``with _Early(m, cond, early, last):`` where ``cond`` holds, ``early()`` adds the step's
+class Early:
+    """``with Early(m, cond, early, last):`` where ``cond`` holds, ``early()`` adds the step's
     early cycle (its statements advance the phase); else the body runs, with ``last`` (sync)."""
 
     def __init__(self, m: Module, cond, early, last: list):
@@ -329,7 +356,7 @@ class _Early:
         return self._else.__exit__(*exc)
 
 
-class _Always:
+class Always:
     """A context that adds nothing: the step's own cycle is its only one."""
 
     def __enter__(self):
@@ -482,13 +509,13 @@ class ExpertsPxpSpan(wiring.Component):
         return {**dm, "fmt": fmt, "W": W, "D": D, "aj": aj, "ib": ib, "asb": asb, "pw": pw, "cw": cw, "ab": ab,
                 "word": word, "wr": wr, "drain": drain, "mul": mul}
 
-    def _hold(self, m: Module, state, drain):
+    def _hold(self, m: Module, state, drain, idle=_R.IDLE, hand=_R.HAND):
         """(paper, A.J.) The arbitration of the one multiplier: while the drain's blend holds it
-        (``drain.mreq``), every resolve step but taking a bank (``IDLE``) and handing one over
-        (``HAND``) holds; else a context that adds nothing."""
+        (``drain.mreq``), every resolve step but taking a bank (``idle``) and handing one over
+        (``hand``; the coherent PXP passes its own states) holds; else a context that adds nothing."""
         if drain.mreq is None:
-            return _Always()
-        return m.If(~drain.mreq | (state == _R.IDLE) | (state == _R.HAND))
+            return Always()
+        return m.If(~drain.mreq | (state == idle) | (state == hand))
 
     def elaborate(self, platform):
         m = Module()
@@ -529,31 +556,14 @@ class ExpertsPxpSpan(wiring.Component):
             zpl = Signal(16)          # z at sr, low word
             zc = Signal()             # the low word's carry
             ilo = Signal(16)          # i at sl, low word
-            d = Signal(signed(18))
-            m.d.comb += d.eq((Mux(ph[1], sr, sl) << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl)
-            # the drain's A.J. blend has the multiplier first (drain.mreq); the resolve side then holds
-            mul, dr = fr["mul"], fr["drain"]
-            req = dr.mreq if dr.mreq is not None else 0
-            m.d.comb += [mul["a"].eq(Mux(req, dr.mul_a if dr.mul_a is not None else 0, d)),
-                         mul["b"].eq(Mux(req, dr.mul_b if dr.mul_b is not None else 0,
-                                         Mux(state == _R.WRITE, seg.didx, seg.dzdx)))]
-            prod = mul["p"]
-            # the 16-bit adder: z_L * 16 + (product >> 6), or i_L + (product >> 6), a word a cycle
-            # (ph[0]: the high word, with the low word's carry); the product's words are its wires
-            hi_word = ph[0]
-            p_hi = Signal(signed(16), name="p_hi")
-            m.d.comb += p_hi.eq(prod[X_FRAC + 16:].as_signed())
-            wa, wb, zadd = Signal(16, name="wa"), Signal(16, name="wb"), Signal(17, name="zadd")
-            m.d.comb += [wa.eq(Mux(state == _R.WRITE, Mux(hi_word, 0, seg.il),
-                                   Mux(hi_word, seg.zl[16 - DZ_FRAC:], seg.zl << DZ_FRAC))),
-                         wb.eq(Mux(hi_word, p_hi, prod[X_FRAC:X_FRAC + 16])),
-                         zadd.eq(wa + wb + (hi_word & zc))]
+            zadd = word_adder(m, fr, seg=seg, col=Mux(ph[1], sr, sl), write=lambda: state == _R.WRITE,
+                              hi_word=ph[0], zc=zc)
             zl_ = zlr
             zr_ = Signal(signed(32), name="zr_w")
             m.d.comb += zr_.eq(Cat(zpl, zadd[:16]))
-            ic = _i_words(m, zadd[:16], ilo, fmt)
-            key = _key_words(m, zlr)
-            tests = _GuardedWords(m, szl, szr, zlr, zadd[:16])
+            ic = i_words(m, zadd[:16], ilo, fmt)
+            key = key_words(m, zlr)
+            tests = GuardedWords(m, szl, szr, zlr, zadd[:16])
         else:
             # the multipliers: running z (Q16.4) at pixels sl and sr, i at sl
             zl_ = zrun_at(m, seg, sl)
@@ -566,7 +576,7 @@ class ExpertsPxpSpan(wiring.Component):
             ``zlr``, z at sr's low word into ``zpl`` with the guarded tests' low words; the body runs
             in the fourth (z at sr's high word)."""
             if not paper:
-                return _Always()
+                return Always()
 
             def early():
                 m.d.sync += ph.eq(ph + 1)
@@ -577,17 +587,17 @@ class ExpertsPxpSpan(wiring.Component):
                         m.d.sync += zlr[16:].eq(zadd[:16])
                     with m.Case(2):
                         m.d.sync += [zpl.eq(zadd[:16]), zc.eq(zadd[16]), *tests.low()]
-            return _Early(m, ph != 3, early, [ph.eq(0)])
+            return Early(m, ph != 3, early, [ph.eq(0)])
 
         def write_cycles():
             """(paper) a drawn pixel's first cycle adds i's low word (``ilo``); the body (the write)
             runs in the second, with i's high word; a background pixel takes one."""
             if not paper:
-                return _Always()
+                return Always()
 
             def early():
                 m.d.sync += [ph.eq(1), ilo.eq(zadd[:16]), zc.eq(zadd[16])]
-            return _Early(m, ~wbg & (ph == 0), early, [ph.eq(0)])
+            return Early(m, ~wbg & (ph == 0), early, [ph.eq(0)])
         nearer = Signal()
         m.d.comb += nearer.eq((i == 0) | (key < skey) | ((key == skey) & (seg.addr < saddr)))
         # the guarded test (span.py): S nearer than this segment B at every pixel of [sl, sr]

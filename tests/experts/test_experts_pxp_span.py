@@ -180,7 +180,8 @@ def test_paper_jobs_adds_the_multiplier_cycles_to_every_pxps_frame():
     """span_cycles.paper_jobs on a frame's jobs (pxp_sim.jobs): pixels unchanged, every line's resolve
     + pass_a + pass_b (one multiplier) + 2 (pass_a + pass_b) + its drawn pixels (two-word z and i),
     and each PXP's frame time rescheduled: with one PXP it is the whole job list's
-    last pixel + 1; the coherent PXP's jobs are refused (it has no one-multiplier configuration)."""
+    last pixel + 1; the coherent PXP's jobs carry their own rule (coherent.paper_resolve), and jobs
+    of a PXP other than the span one without it are refused."""
     from rasterhw.golden_model.experts.span_cycles import multiword, one_multiplier, paper_jobs
     fr = render_frame(run_geometry(build_scene("experts-tilt-1000"), 64, 16, z_bits=16), model="bit", aj="c")
     jb = jobs(fr, 1, 1, pxp="span")
@@ -194,8 +195,10 @@ def test_paper_jobs_adds_the_multiplier_cycles_to_every_pxps_frame():
     assert [multiword(st, dn) for st, dn in zip(jb["steps"], jb["drawn"], strict=True)] == \
         [2 * one_multiplier(st) + dn for st, dn in zip(jb["steps"], jb["drawn"], strict=True)]
     assert int(pj["pxp_frame_cycles"][0, 0]) == pj["last_pixel"] + 1 > int(jb["pxp_frame_cycles"][0, 0])
-    with pytest.raises(RasterhwError, match="coherent PXP has no paper datapath"):
-        paper_jobs(jobs(fr, 1, 1, pxp="coherent"))
+    co = jobs(fr, 1, 1, pxp="coherent")
+    assert paper_jobs(co)["last_pixel"] > co["last_pixel"]
+    with pytest.raises(RasterhwError, match="coherent PXP's jobs carry no paper-datapath cycles"):
+        paper_jobs({k: v for k, v in co.items() if k != "paper_extra"})
 
 
 def test_paper_span_pxp_blends_on_its_one_multiplier_pysim_word_and_cycle_exact():
