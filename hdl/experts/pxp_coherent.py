@@ -31,7 +31,7 @@ from __future__ import annotations
 
 from amaranth import Cat, Module, Mux, Signal, signed
 from amaranth.lib import enum
-from rasterhw.golden_model.experts.formats import X_END_BITS, XP_BITS
+from rasterhw.golden_model.experts.formats import WORD, X_END_BITS, XP_BITS
 from rasterhw.hdl.experts.pxp_span import (
     NO_PTR,
     Always,
@@ -128,19 +128,19 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
             m.d.comb += pe.eq(ph + Mux(state == _R.PASSB, 2, Mux(state == _R.PASSA, 4, 0)))
             mseg = Signal(fr["asb"])  # the multiplier's segment: the visible one (and the write's), else the entry
             m.d.comb += mseg.eq(Mux(~pe[2], vseg.as_value(), seg.as_value()))
-            szl, szr, zlr = Signal(signed(32)), Signal(signed(32)), Signal(signed(32))
-            zpl = Signal(16)          # the entry's z at rbx, low word
+            szl, szr, zlr = Signal(signed(2 * WORD)), Signal(signed(2 * WORD)), Signal(signed(2 * WORD))
+            zpl = Signal(WORD)          # the entry's z at rbx, low word
             zc = Signal()             # the low word's carry
-            ilo = Signal(16)          # i at sl, low word
+            ilo = Signal(WORD)          # i at sl, low word
             zadd = word_adder(m, fr, seg=mseg, col=Mux(pe[1], rbx, sl), write=lambda: state == _R.WRITE,
                               hi_word=pe[0], zc=zc)
-            tests = GuardedWords(m, szl, szr, zlr, zadd[:16])
-            zx = Signal(signed(32))   # PASSA: the entry's z at sl, this cycle's high word
-            m.d.comb += zx.eq(Cat(zlr[:16], zadd[:16]))
+            tests = GuardedWords(m, szl, szr, zlr, zadd[:WORD])
+            zx = Signal(signed(2 * WORD))   # PASSA: the entry's z at sl, this cycle's high word
+            m.d.comb += zx.eq(Cat(zlr[:WORD], zadd[:WORD]))
             key = key_words(m, zx)
             good = Signal()
             m.d.comb += good.eq(tests.high(vseg.addr < seg.addr))
-            ic = i_words(m, zadd[:16], ilo, fmt)
+            ic = i_words(m, zadd[:WORD], ilo, fmt)
 
             def phases(cond):
                 """The step's early cycles where ``cond`` (each stores its word, ``ph`` advances);
@@ -150,11 +150,11 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
                     with m.Switch(pe):
                         for k, reg in enumerate((szl, szr, zlr)):
                             with m.Case(2 * k):
-                                m.d.sync += [reg[:16].eq(zadd[:16]), zc.eq(zadd[16])]
+                                m.d.sync += [reg[:WORD].eq(zadd[:WORD]), zc.eq(zadd[WORD])]
                             with m.Case(2 * k + 1):
-                                m.d.sync += reg[16:].eq(zadd[:16])
+                                m.d.sync += reg[WORD:].eq(zadd[:WORD])
                         with m.Case(6):
-                            m.d.sync += [zpl.eq(zadd[:16]), zc.eq(zadd[16]), *tests.low()]
+                            m.d.sync += [zpl.eq(zadd[:WORD]), zc.eq(zadd[WORD]), *tests.low()]
                 return Early(m, cond, early, [ph.eq(0)])
         else:
             zl_ = zrun_at(m, seg, sl)
@@ -250,7 +250,7 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
             with m.Case(_R.WRITE):
                 if paper:       # a drawn pixel: i's low word first (ilo), the write with its high word
                     def ilow():
-                        m.d.sync += [ph.eq(1), ilo.eq(zadd[:16]), zc.eq(zadd[16])]
+                        m.d.sync += [ph.eq(1), ilo.eq(zadd[:WORD]), zc.eq(zadd[WORD])]
                     wctx = Early(m, vok & (ph == 0), ilow, [ph.eq(0)])
                 else:
                     wctx = Always()
