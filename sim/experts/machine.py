@@ -51,7 +51,8 @@ MACHINE = Machine(
                             Option("pxp", "PXP: span (span cull at every segment end + depth search per span, "
                                    "experts-pxp-span), coherent (span cull once per segment + depth search where "
                                    "the visible segment can change, experts-pxp-coherent) or zbuffer (a one-line "
-                                   "Z-buffer, experts-pxp); all ours, the same pixels", "span",
+                                   "Z-buffer, experts-pxp); all ours, the same pixels. sim experts: default (coherent; span "
+                                   "with --path group), coherent or span. sim pxp", "span",
                                    ("span", "coherent", "zbuffer")))),
           SimBlock("experts", "the whole frame: every band through the SLP's set-up HDL (experts-slp-setup) and "
                    "list-work HDL (experts-slp), its ASL order and "
