@@ -51,7 +51,7 @@ from __future__ import annotations
 from rasterhw.golden_model.experts.formats import DZ_FRAC, Z_BITS
 from rasterhw.golden_model.experts.span_cycles import Entering, _ends, _good, _zrun
 
-__all__ = ["STEPS", "TERMS", "resolve"]
+__all__ = ["STEPS", "TERMS", "paper_resolve", "resolve", "resolve_counts"]
 
 STEPS = ("init", "enter", "drop", "pass_a", "pass_b", "write")
 #: the paper's two terms from the steps: span cull (iv) and depth search (v)
@@ -80,9 +80,10 @@ def resolve(segs: list[dict], bucket: list[int], lead: int, glo: int, ghi: int) 
 def resolve_counts(segs: list[dict], bucket: list[int], lead: int, glo: int,
                    ghi: int) -> tuple[dict, list[int], dict]:
     """:func:`resolve`, and its counts: ``searches`` (depth searches with at least two segments
-    present), ``searches_all`` (every first pass), ``halvings``, ``spans``."""
+    present), ``searches_all`` (every first pass), ``halvings``, ``spans``, ``tests_enter`` (entering
+    segments tested against the visible one: :func:`paper_resolve`)."""
     cyc = dict.fromkeys(STEPS, 0)
-    cnt = {"searches": 0, "searches_all": 0, "halvings": 0, "spans": 0}
+    cnt = {"searches": 0, "searches_all": 0, "halvings": 0, "spans": 0, "tests_enter": 0}
     cyc["init"] = 1
     vis: list[int] = []
     if ghi <= glo:
@@ -98,6 +99,8 @@ def resolve_counts(segs: list[dict], bucket: list[int], lead: int, glo: int,
         ns = walk.take(x, cyc, entered.append)
         act += entered
         # each entering segment tested against the visible one up to vu (in its entering cycle)
+        if V >= 0 and vu >= x:
+            cnt["tests_enter"] += len(entered)
         fail = V >= 0 and vu >= x and not all(
             _good(_zrun(segs[V], x), _zrun(segs[V], min(vu, ends[p][2])), _zrun(segs[p], x),
                   _zrun(segs[p], min(vu, ends[p][2])), segs[V]["addr"] < segs[p]["addr"]) for p in entered)
@@ -130,3 +133,23 @@ def resolve_counts(segs: list[dict], bucket: list[int], lead: int, glo: int,
         vis += [V] * (wend - x + 1)
         x = wend + 1
     return cyc, vis, cnt
+
+
+def paper_resolve(steps: dict, drawn: int, counts: dict) -> int:
+    """The extra resolve cycles of one line at the paper's datapath (``experts-pxp-coherent`` with
+    ``datapath="paper"``; docs/experts.md, "The coherent PXP at the paper's datapath"): the PXP's one
+    16 x 16 multiplier gives one product a cycle, and z and i are two 16-bit words added a word a
+    cycle, low word first with the carry kept (the span PXP's rule, ``span_cycles.multiword``), so a
+    running z or i takes two cycles. Per step:
+
+    * pass A, a segment present (``pass_a``): z at ``x`` (2 cycles; the key and the nearest in the
+      second): +1; a segment dropped (``drop``) multiplies nothing: 1 cycle, as ours;
+    * pass B, a test (``pass_b``): S's z at ``x`` is kept from pass A; S's z at the test's right
+      pixel, the segment's z at ``x`` and at the right pixel (2 cycles each; the guarded tests'
+      low words with the last one's low word, their high words with its high word): 6 cycles, +5;
+    * an entering segment tested against the visible one (``counts["tests_enter"]``): the visible
+      one's z at ``x`` as well: 8 cycles, +7;
+    * the write of a pixel drawn by a segment (``drawn``): its intensity in two words, +1.
+
+    ``steps``, ``counts``: :func:`resolve_counts`'."""
+    return steps["pass_a"] + 5 * steps["pass_b"] + 7 * counts["tests_enter"] + drawn

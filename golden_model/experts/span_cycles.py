@@ -46,7 +46,7 @@ from rasterhw.golden_model.experts.pxp_cycles import asb_record, drain_cycles, g
 from rasterhw.golden_model.experts.slp_run import block_lists
 
 __all__ = ["DMM_DEPTH", "Entering", "NO_PTR", "STEPS", "line_asl", "dmm_line", "resolve", "schedule", "span_drain_cycles",
-           "one_multiplier", "multiword", "paper_jobs", "aj_blends", "paper_drain"]
+           "one_multiplier", "multiword", "paper_resolve", "paper_jobs", "aj_blends", "paper_drain"]
 
 DMM_DEPTH = 256       # ASBs per DMM/P bank (the block's default)
 NO_PTR = 511          # leading pointer: none
@@ -237,12 +237,17 @@ def paper_jobs(jb: dict) -> dict:
     multiplier cycles of :func:`paper_drain` (``jb["paper_drain"]``), scheduled again
     (:func:`schedule`, the resolve side holding while the drain blends), and a frame's
     ``pxp_frame_cycles`` (``pxp_sim.jobs``: per ``owner``, its lines back to back); words and
-    pixels unchanged. Adds ``datapath`` ``"paper"``."""
-    if jb.get("pxp", "span") != "span":
-        raise RasterhwError(f"experts: the {jb['pxp']} PXP has no paper datapath (one multiplier) yet")
+    pixels unchanged. Adds ``datapath`` ``"paper"``. Each line's extra resolve cycles are its
+    job's ``paper_extra`` (:func:`line_job`: the PXP's own rule, :func:`paper_resolve` for the span
+    PXP, ``coherent.paper_resolve`` for the coherent one), else the span PXP's from its steps."""
     pd = jb.get("paper_drain") or [None] * len(jb["timing"])
-    lines = [(w, r + one_multiplier(st) + multiword(st, dn), d if q is None else q["drain"])
-             for (w, r, d), st, q, dn in zip(jb["timing"], jb["steps"], pd, jb["drawn"], strict=True)]
+    extra = jb.get("paper_extra")
+    if extra is None:
+        if jb.get("pxp", "span") != "span":
+            raise RasterhwError(f"experts: the {jb['pxp']} PXP's jobs carry no paper-datapath cycles")
+        extra = [paper_resolve(st, dn) for st, dn in zip(jb["steps"], jb["drawn"], strict=True)]
+    lines = [(w, r + x, d if q is None else q["drain"])
+             for (w, r, d), x, q in zip(jb["timing"], extra, pd, strict=True)]
     mul = [[] if q is None else q["mul"] for q in pd]
     sch = schedule(lines, mul)
     out = {**jb, "timing": lines, "cycles": np.array(sch["line_cycles"], np.int64),
@@ -309,18 +314,30 @@ def paper_drain(vis: list[int], segs: list[dict], lo: int, hi: int, *, width: in
     return {"drain": t + (1 if ghi == hi else 0), "mul": mul}
 
 
+def paper_resolve(steps: dict, drawn: int, counts: dict | None = None) -> int:
+    """The span PXP's extra resolve cycles of one line at the paper's datapath:
+    :func:`one_multiplier` + :func:`multiword` (``counts``: unused, the coherent PXP's rule,
+    ``coherent.paper_resolve``, takes its own)."""
+    return one_multiplier(steps) + multiword(steps, drawn)
+
+
 def line_job(segs: list[dict], bucket: list[int], lead: int, lo: int, hi: int, *, aj: str, width: int,
-             resolver=None) -> dict:
+             resolver=None, paper=None) -> dict:
     """One PXP line: its words, resolve and drain cycles, visible positions of ``[lo, hi)`` and
     ``drawn``, the guarded range's pixels a segment draws (not background; :func:`multiword`).
     ``resolver``: :func:`resolve` (default, the span PXP) or another PXP's resolve on the same
-    DMM/P words, schedule and drain (``coherent.resolve``: the coherent span PXP)."""
+    DMM/P words, schedule and drain (``coherent.resolve``, or ``coherent.resolve_counts``, whose
+    third value, its counts, goes to ``paper``); ``paper``: the PXP's extra resolve cycles at the
+    paper's datapath from the line's steps, ``drawn`` and counts (default :func:`paper_resolve`,
+    the span PXP's), kept as ``paper_extra`` (:func:`paper_jobs`)."""
     glo, ghi = guarded(lo, hi, width, aj)
-    cyc, vis = (resolver or resolve)(segs, bucket, lead, glo, ghi)
+    cyc, vis, *more = (resolver or resolve)(segs, bucket, lead, glo, ghi)
+    drawn = sum(1 for v in vis if v >= 0)
     return {"words": len(segs) + len(bucket) + 1, "resolve": sum(cyc.values()), "steps": cyc,
             "drain": span_drain_cycles(vis, lo, hi, aj=aj, width=width),
             "paper_drain": paper_drain(vis, segs, lo, hi, width=width) if aj == "c" else None,
-            "drawn": sum(1 for v in vis if v >= 0), "visible": vis[lo - glo:lo - glo + (hi - lo)]}
+            "paper_extra": (paper or paper_resolve)(cyc, drawn, more[0] if more else None),
+            "drawn": drawn, "visible": vis[lo - glo:lo - glo + (hi - lo)]}
 
 
 def span_drain_cycles(vis: list[int], lo: int, hi: int, *, aj: str, width: int) -> int:

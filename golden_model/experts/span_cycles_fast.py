@@ -118,14 +118,16 @@ def resolve(segs: list[dict], bucket: list[int], lead: int, glo: int, ghi: int, 
 
 
 def line_job(segs: list[dict], bucket: list[int], lead: int, lo: int, hi: int, *, aj: str, width: int,
-             resolver=None, engine: str | None = None) -> dict:
+             resolver=None, paper=None, engine: str | None = None) -> dict:
     """:func:`.span_cycles.line_job` with the compiled :func:`resolve` (another ``resolver``: the
     specification's)."""
     if resolver is not None or choose_engine(engine) == "python":
-        return spec.line_job(segs, bucket, lead, lo, hi, aj=aj, width=width, resolver=resolver)
+        return spec.line_job(segs, bucket, lead, lo, hi, aj=aj, width=width, resolver=resolver, paper=paper)
     glo, ghi = guarded(lo, hi, width, aj)
     cyc, vis = resolve(segs, bucket, lead, glo, ghi, engine="numba")
+    drawn = int((np.asarray(vis) >= 0).sum())
     return {"words": len(segs) + len(bucket) + 1, "resolve": sum(cyc.values()), "steps": cyc,
             "drain": spec.span_drain_cycles(vis, lo, hi, aj=aj, width=width),
             "paper_drain": spec.paper_drain(vis, segs, lo, hi, width=width) if aj == "c" else None,
-            "drawn": int((np.asarray(vis) >= 0).sum()), "visible": vis[lo - glo:lo - glo + (hi - lo)]}
+            "paper_extra": spec.paper_resolve(cyc, drawn), "drawn": drawn,
+            "visible": vis[lo - glo:lo - glo + (hi - lo)]}

@@ -7,7 +7,15 @@ edge's end x and slope (``golden_model/experts/alpha.py`` is the golden side).""
 from __future__ import annotations
 
 from amaranth import Mux, Signal, signed
-from rasterhw.golden_model.experts.formats import ADDR_BITS, ALPHA_BITS, SLOPE_FRAC, X_FRAC
+from rasterhw.golden_model.experts.formats import (
+    ADDR_BITS,
+    ALPHA_BITS,
+    SLOPE_FRAC,
+    WORD,
+    X_END_BITS,
+    X_FRAC,
+    XP_BITS,
+)
 
 __all__ = ["aj_boundary", "aj_boundary_shared", "MUL_IN"]
 
@@ -25,8 +33,8 @@ def _edge(m, *, dx, width: int, p_ok, p_addr, p_ent, c_addr, c_ent) -> dict:
     poly_c = Signal(ADDR_BITS)
     poly_p = Signal(ADDR_BITS)
     m.d.comb += [poly_c.eq(Mux(bg_c, NONE, c_ent.poly)), poly_p.eq(Mux(bg_p, NONE, p_ent.poly))]
-    cc0 = Signal(signed(12))
-    pc1 = Signal(signed(12))
+    cc0 = Signal(signed(XP_BITS))
+    pc1 = Signal(signed(XP_BITS))
     m.d.comb += [cc0.eq((c_ent.xl + 31) >> X_FRAC), pc1.eq(((p_ent.xr + 31) >> X_FRAC) - 1)]
     starts = Signal()
     ends = Signal()
@@ -37,20 +45,20 @@ def _edge(m, *, dx, width: int, p_ok, p_addr, p_ent, c_addr, c_ent) -> dict:
     use_a = Signal()
     m.d.comb += [edge.eq(p_ok & (dx > 0) & (p_addr != c_addr) & (poly_p != poly_c)),
                  use_b.eq(edge & starts), use_a.eq(edge & ~starts & ends)]
-    xe = Signal(16)
-    esl = Signal(signed(16))
-    qq = Signal(signed(16))
+    xe = Signal(WORD)
+    esl = Signal(signed(WORD))
+    qq = Signal(signed(WORD))
     m.d.comb += [xe.eq(Mux(use_b, c_ent.xl, p_ent.xr)), esl.eq(Mux(use_b, c_ent.sl, p_ent.sr)),
                  qq.eq(Mux(use_b, c_ent.ql, p_ent.qr))]
     right = Signal()              # the blended pixel is dx (else dx - 1)
     m.d.comb += right.eq((xe >> X_FRAC) >= dx)
-    q = Signal(11)
+    q = Signal(X_END_BITS)
     m.d.comb += q.eq(Mux(right, dx, dx - 1))
     delta = Signal(signed(20))
     m.d.comb += delta.eq(xe - ((q << X_FRAC) + (1 << (X_FRAC - 1))))
     steep = Signal()
     m.d.comb += steep.eq(Mux(esl < 0, -esl, esl) <= (1 << SLOPE_FRAC))
-    aq = Signal(17)
+    aq = Signal(WORD + 1)
     m.d.comb += aq.eq(Mux(qq < 0, -qq, qq))
     return {"use_a": use_a, "use_b": use_b, "right": right, "q": q, "delta": delta, "steep": steep, "aq": aq}
 
@@ -98,7 +106,7 @@ def aj_boundary(m, *, dx, width: int, ib: int, p_ok, p_pix, p_out, p_addr, p_ent
 
 
 #: operand width of the shared multiplier's inputs (``mul16.sm_mul``: magnitudes below 2**16)
-MUL_IN = signed(18)
+MUL_IN = signed(WORD + 2)
 
 
 def aj_boundary_shared(m, *, dx, width: int, ib: int, lo, hi, prod, p_ok, p_pix, p_out, p_addr, p_ent, c_pix,

@@ -9,8 +9,9 @@ widest operand of any multiplier: what a "16-bit basic operation width" means fo
 
 :func:`frame_census` counts the processors ``rasterhw sim experts`` chains at either datapath
 (``formats.DATAPATHS``): the SLP's set-up (``experts-slp-setup``), the SLP's list work
-(``experts-slp``), and the span PXP (``experts-pxp-span``, ``datapath="paper"``: one multiplier, shared by its
-resolve side and its drain's A.J. blend).
+(``experts-slp``), and the frame's PXP: the coherent span PXP (``experts-pxp-coherent``) or the span
+PXP (``experts-pxp-span``); at ``datapath="paper"`` each has one multiplier, shared by its resolve
+side and its drain's A.J. blend.
 Its ``datapath_bits`` is the widest multiplier operand over them, ``multipliers`` the most
 multipliers in one processor.
 """
@@ -43,19 +44,23 @@ def census(component) -> dict:
     return {"multipliers": len(ms), "bits": max((max(a, b) for a, b in ms), default=0), "widths": ms}
 
 
-def frame_census(datapath: str, *, pxp_datapath: str, width: int = 512, height: int = 512, aj: str = "c") -> dict:
+def frame_census(datapath: str, *, pxp_datapath: str, width: int = 512, height: int = 512, aj: str = "c",
+                 pxp: str = "span") -> dict:
     """The chained frame's processors, each elaborated and counted (:func:`census`): the SLP's
-    set-up and list work at ``datapath``, the span PXP at ``pxp_datapath`` (what the driver builds:
-    ``"ours"`` until it passes ``datapath`` to the block). Returns ``per_block`` (block -> census),
+    set-up and list work at ``datapath``, the frame's PXP (``pxp``: ``"span"``, ``experts-pxp-span``,
+    or ``"coherent"``, ``experts-pxp-coherent``) at ``pxp_datapath`` (what the driver builds).
+    Returns ``per_block`` (block -> census),
     ``datapath_bits`` (widest multiplier operand of them all), ``multipliers`` (most in one
     processor), ``source`` ``"hdl:elaborated"``."""
     from rasterhw.golden_model.experts.formats import DATAPATHS
+    from rasterhw.hdl.experts.pxp_coherent import ExpertsPxpCoherent
     from rasterhw.hdl.experts.pxp_span import ExpertsPxpSpan
     from rasterhw.hdl.experts.slp import ExpertsSlp
     from rasterhw.hdl.experts.slp_setup import ExpertsSlpSetup
     ex = DATAPATHS[datapath].acc_extra
     per = {"experts-slp-setup": census(ExpertsSlpSetup(height=height, acc_extra=ex)),
            "experts-slp": census(ExpertsSlp(width=width, lines=height, acc_extra=ex)),
-           "experts-pxp-span": census(ExpertsPxpSpan(width=width, aj=aj, datapath=pxp_datapath))}
+           f"experts-pxp-{pxp}": census({"span": ExpertsPxpSpan, "coherent": ExpertsPxpCoherent}[pxp](
+               width=width, aj=aj, datapath=pxp_datapath))}
     return {"datapath": datapath, "per_block": per, "datapath_bits": max(c["bits"] for c in per.values()),
             "multipliers": max(c["multipliers"] for c in per.values()), "source": "hdl:elaborated"}

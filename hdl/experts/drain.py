@@ -27,7 +27,7 @@ from __future__ import annotations
 from amaranth import Mux, Signal, unsigned
 from amaranth.lib import enum, stream
 from amaranth.lib.wiring import In, Out
-from rasterhw.golden_model.experts.formats import ADDR_BITS
+from rasterhw.golden_model.experts.formats import ADDR_BITS, X_END_BITS, X_INT
 from rasterhw.hdl.experts.aj import MUL_IN, NONE, aj_boundary, aj_boundary_shared
 
 __all__ = ["Drain", "check_pxp_params", "pxp_members"]
@@ -47,8 +47,8 @@ def pxp_members(i_layout, pixel_bits: int) -> dict:
     return {
         "i": In(stream.Signature(i_layout)),
         "o": Out(stream.Signature(unsigned(pixel_bits))),
-        "lo": In(10),
-        "hi": In(11),
+        "lo": In(X_INT),
+        "hi": In(X_END_BITS),
         "line_cycles": Out(16),
         "lines": Out(16),
     }
@@ -89,10 +89,10 @@ class Drain:
         self.dstate = dstate = Signal(_D)
         self.dbusy = dbusy = Signal()
         self.dbank = dbank = Signal()
-        self.dx = dx = Signal(11)
-        self.dlo = dlo = Signal(10)
-        self.dhi = dhi = Signal(11)
-        self.dghi = dghi = Signal(11)
+        self.dx = dx = Signal(X_END_BITS)
+        self.dlo = dlo = Signal(X_INT)
+        self.dhi = dhi = Signal(X_END_BITS)
+        self.dghi = dghi = Signal(X_END_BITS)
         dstored = Signal(word)
         m.d.comb += [dstored.eq(drd.data), o.payload.eq(dstored.pix), o.valid.eq(0), drd.en.eq(0)]
 

@@ -11,6 +11,7 @@ multiplier as both processors use it under ``--datapath paper``: ``a * b`` for `
 from __future__ import annotations
 
 from amaranth import Module, Mux, Signal, signed
+from rasterhw.golden_model.experts.formats import WORD
 
 __all__ = ["sm_mul"]
 
@@ -18,9 +19,9 @@ __all__ = ["sm_mul"]
 def sm_mul(m: Module, a, b, name: str = "mul") -> Signal:
     """``a * b`` (signed, ``|a|, |b| < 2**16``) through one 16 x 16 unsigned multiplier."""
     na, nb = Signal(name=f"{name}_na"), Signal(name=f"{name}_nb")
-    ma, mb = Signal(16, name=f"{name}_ma"), Signal(16, name=f"{name}_mb")
-    pu = Signal(32, name=f"{name}_pu")
-    p = Signal(signed(34), name=name)
+    ma, mb = Signal(WORD, name=f"{name}_ma"), Signal(WORD, name=f"{name}_mb")
+    pu = Signal(2 * WORD, name=f"{name}_pu")
+    p = Signal(signed(2 * WORD + 2), name=name)
     m.d.comb += [na.eq(a < 0), nb.eq(b < 0), ma.eq(Mux(na, -a, a)), mb.eq(Mux(nb, -b, b)),
                  pu.eq(ma * mb), p.eq(Mux(na ^ nb, -pu, pu))]
     return p

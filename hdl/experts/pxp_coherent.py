@@ -29,17 +29,23 @@ visible segment ``S`` (``vok``: one is visible) and the last pixel ``vu`` it has
 
 from __future__ import annotations
 
-from amaranth import Module, Mux, Signal, signed
+from amaranth import Cat, Module, Mux, Signal, signed
 from amaranth.lib import enum
-from rasterhw.golden_model.experts.formats import X_END_BITS, XP_BITS
+from rasterhw.golden_model.experts.formats import WORD, X_END_BITS, XP_BITS
 from rasterhw.hdl.experts.pxp_span import (
     NO_PTR,
+    Always,
+    Early,
     ExpertsPxpSpan,
+    GuardedWords,
     candidate,
     guarded_test,
+    i_words,
     intensity_at,
+    key_words,
     resolve_regs,
     take_bank,
+    word_adder,
     write_pixel,
     z_key,
     zrun_at,
@@ -57,17 +63,37 @@ class _R(enum.Enum, shape=3):
     HAND = 5      # hand the DSLB bank to the drain
 
 
-@params("width", "aj", "depth")
+@params("width", "aj", "depth", "datapath")
 class ExpertsPxpCoherent(ExpertsPxpSpan):
     """One coherent span PXP with its DMM/P: DMM/P words in, the range's pixel words out, line by
-    line. Parameters (``width``, ``intensity_bits``, ``aj``, ``depth``), ports (``i``, ``o``, ``lo``,
-    ``hi``, ``line_cycles``, ``lines``, ``overflow``), DMM/P, DSLB and drain:
-    :class:`hdl.experts.pxp_span.ExpertsPxpSpan`'s (``frame``); the resolve side is this block's."""
+    line. Parameters (``width``, ``intensity_bits``, ``aj``, ``depth``, ``datapath``), ports (``i``,
+    ``o``, ``lo``, ``hi``, ``line_cycles``, ``lines``, ``overflow``), DMM/P, DSLB and drain:
+    :class:`hdl.experts.pxp_span.ExpertsPxpSpan`'s (``frame``); the resolve side is this block's.
 
-    PAPER_DATAPATH = False     # ours only: its resolve side has no one-multiplier configuration yet
+    ``datapath="paper"``: the span PXP's one 16 x 16 multiplier and 16-bit adder
+    (``pxp_span.word_adder``; the drain's A.J. blend has the multiplier first and the resolve side
+    holds, ``ExpertsPxpSpan._hold``), z and i in two words a word a cycle, the guarded tests a word a
+    cycle (``pxp_span.GuardedWords``). One product a cycle, in the order of the phase ``pe`` (each
+    step's first phase below; ``ph`` counts from 0 within the step):
 
-    def __init__(self, *, width: int = 512, intensity_bits: int = 7, aj: str = "none", depth: int = 256):
-        super().__init__(width=width, intensity_bits=intensity_bits, aj=aj, depth=depth)
+    * ``pe`` 0, 1: the visible segment's z at ``sl`` (``szl``; ENTER's test only: in a depth search
+      it is the nearest's, kept from pass A), low word then high;
+    * ``pe`` 2, 3: the visible segment's z at the test's right pixel ``rbx`` (``szr``);
+    * ``pe`` 4, 5: the entry's z at ``sl`` (``zlr``; pass A ends here: the key and the nearest, with
+      ``szl`` taken if it is nearer);
+    * ``pe`` 6, 7: the entry's z at ``rbx``: its low word with the six tests' low words, its high
+      word with their high words and the test's outcome (the step's own cycle).
+
+    ENTER's test starts at ``pe`` 0 (8 cycles), pass B's at 2 (6 cycles), pass A's on a present
+    entry at 4 (2 cycles; an entry dropped takes 1), the write of a drawn pixel 2 (i's low word,
+    then the high word and the write; background 1). Counted in ``coherent.paper_resolve``."""
+
+    #: the block has the paper's datapath (``datapath="paper"``: one shared multiplier)
+    PAPER_DATAPATH = True
+
+    def __init__(self, *, width: int = 512, intensity_bits: int = 7, aj: str = "none", depth: int = 256,
+                 datapath: str = "ours"):
+        super().__init__(width=width, intensity_bits=intensity_bits, aj=aj, depth=depth, datapath=datapath)
 
     def elaborate(self, platform):
         m = Module()
@@ -95,18 +121,58 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
         rt = Signal(XP_BITS)
         rbx = Signal(XP_BITS)
         m.d.comb += [rt.eq(Mux(state == _R.PASSB, sr, vu)), rbx.eq(Mux(e < rt, e, rt))]
-        zl_ = zrun_at(m, seg, sl)
-        zr_ = zrun_at(m, seg, rbx)
-        zsl = zrun_at(m, vseg, sl)
-        zsr = zrun_at(m, vseg, rbx)
-        good = Signal()
-        m.d.comb += good.eq(guarded_test(m, zsl, zsr, zl_, zr_, vseg.addr < seg.addr))
-        key = z_key(m, zl_)
+        paper = self._datapath == "paper"
+        if paper:
+            ph = Signal(3)            # the cycle within a step
+            pe = Signal(3)            # its phase (class docstring): ENTER from 0, PASSB from 2, PASSA from 4
+            m.d.comb += pe.eq(ph + Mux(state == _R.PASSB, 2, Mux(state == _R.PASSA, 4, 0)))
+            mseg = Signal(fr["asb"])  # the multiplier's segment: the visible one (and the write's), else the entry
+            m.d.comb += mseg.eq(Mux(~pe[2], vseg.as_value(), seg.as_value()))
+            szl, szr, zlr = Signal(signed(2 * WORD)), Signal(signed(2 * WORD)), Signal(signed(2 * WORD))
+            zpl = Signal(WORD)          # the entry's z at rbx, low word
+            zc = Signal()             # the low word's carry
+            ilo = Signal(WORD)          # i at sl, low word
+            zadd = word_adder(m, fr, seg=mseg, col=Mux(pe[1], rbx, sl), write=lambda: state == _R.WRITE,
+                              hi_word=pe[0], zc=zc)
+            tests = GuardedWords(m, szl, szr, zlr, zadd[:WORD])
+            zx = Signal(signed(2 * WORD))   # PASSA: the entry's z at sl, this cycle's high word
+            m.d.comb += zx.eq(Cat(zlr[:WORD], zadd[:WORD]))
+            key = key_words(m, zx)
+            good = Signal()
+            m.d.comb += good.eq(tests.high(vseg.addr < seg.addr))
+            ic = i_words(m, zadd[:WORD], ilo, fmt)
+
+            def phases(cond):
+                """The step's early cycles where ``cond`` (each stores its word, ``ph`` advances);
+                else its own cycle, ``ph`` back to 0."""
+                def early():
+                    m.d.sync += ph.eq(ph + 1)
+                    with m.Switch(pe):
+                        for k, reg in enumerate((szl, szr, zlr)):
+                            with m.Case(2 * k):
+                                m.d.sync += [reg[:WORD].eq(zadd[:WORD]), zc.eq(zadd[WORD])]
+                            with m.Case(2 * k + 1):
+                                m.d.sync += reg[WORD:].eq(zadd[:WORD])
+                        with m.Case(6):
+                            m.d.sync += [zpl.eq(zadd[:WORD]), zc.eq(zadd[WORD]), *tests.low()]
+                return Early(m, cond, early, [ph.eq(0)])
+        else:
+            zl_ = zrun_at(m, seg, sl)
+            zr_ = zrun_at(m, seg, rbx)
+            zsl = zrun_at(m, vseg, sl)
+            zsr = zrun_at(m, vseg, rbx)
+            good = Signal()
+            m.d.comb += good.eq(guarded_test(m, zsl, zsr, zl_, zr_, vseg.addr < seg.addr))
+            key = z_key(m, zl_)
+
+            def phases(cond):
+                return Always()
         nearer = Signal()
         m.d.comb += nearer.eq((j == 0) | (key < skey) | ((key == skey) & (seg.addr < saddr)))
         mid = Signal(X_END_BITS)
         m.d.comb += mid.eq((sl + sr + 1) >> 1)
-        ic = intensity_at(m, vseg, sl, fmt)
+        if not paper:
+            ic = intensity_at(m, vseg, sl, fmt)
 
 
         def write(last):
@@ -117,7 +183,7 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
             """S is nearest over ``[sl, r]``: write up to ``min(r, ns - 1)``."""
             return [vok.eq(1), vu.eq(r), *write(Mux(r < ns - 1, r, ns - 1))]
 
-        with m.Switch(state):
+        with self._hold(m, state, drain, _R.IDLE, _R.HAND), m.Switch(state):
             with m.Case(_R.IDLE):
                 m.d.sync += cyc.eq(1)
                 tb = take_bank(m, fr, rb, W, aj)
@@ -130,25 +196,28 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
             with m.Case(_R.ENTER):
                 take = candidate(m, raddr=raddr, cand=cand, in_bkt=in_bkt, brd=brd, bi=bi, pp=pp, n=n,
                                  c0=c0, ghi=ghi)
-                with m.If(cand & ((e < a) | (a == sl))):
-                    with m.If(a <= e):
-                        m.d.comb += [awr.en.eq(1), awr.addr.eq(na), awr.data.eq(raddr)]
-                        m.d.sync += na.eq(na + 1)
-                        with m.If(vok & (vu >= sl) & ~good):
-                            m.d.sync += fail.eq(1)
-                    take()
-                with m.Else():
-                    nxt = Signal(XP_BITS)
-                    m.d.comb += nxt.eq(Mux(cand, a, ghi))
-                    m.d.sync += [ns.eq(nxt), i.eq(0), j.eq(0), fail.eq(0)]
-                    with m.If(fail | ~vok | (sl > vu)):
-                        with m.If(na == 0):
-                            m.d.sync += [vok.eq(0), vu.eq(nxt - 1), *write(nxt - 1)]
-                        with m.Else():
-                            m.d.sync += state.eq(_R.PASSA)
+                # (paper) an entering segment tested against the visible one: 8 cycles
+                etest = cand & (a == sl) & (a <= e) & vok & (vu >= sl)
+                with phases(etest & (ph != 7) if paper else None):
+                    with m.If(cand & ((e < a) | (a == sl))):
+                        with m.If(a <= e):
+                            m.d.comb += [awr.en.eq(1), awr.addr.eq(na), awr.data.eq(raddr)]
+                            m.d.sync += na.eq(na + 1)
+                            with m.If(vok & (vu >= sl) & ~good):
+                                m.d.sync += fail.eq(1)
+                        take()
                     with m.Else():
-                        m.d.sync += write(Mux(vu < nxt - 1, vu, nxt - 1))
-            with m.Case(_R.PASSA):
+                        nxt = Signal(XP_BITS)
+                        m.d.comb += nxt.eq(Mux(cand, a, ghi))
+                        m.d.sync += [ns.eq(nxt), i.eq(0), j.eq(0), fail.eq(0)]
+                        with m.If(fail | ~vok | (sl > vu)):
+                            with m.If(na == 0):
+                                m.d.sync += [vok.eq(0), vu.eq(nxt - 1), *write(nxt - 1)]
+                            with m.Else():
+                                m.d.sync += state.eq(_R.PASSA)
+                        with m.Else():
+                            m.d.sync += write(Mux(vu < nxt - 1, vu, nxt - 1))
+            with m.Case(_R.PASSA), phases((e >= sl) & (ph == 0) if paper else None):
                 kept = Signal(cw)
                 se = Signal(signed(XP_BITS))
                 m.d.comb += [kept.eq(j), se.eq(send)]
@@ -158,6 +227,8 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
                     with m.If(nearer):
                         m.d.comb += se.eq(e)
                         m.d.sync += [S.eq(raddr), skey.eq(key), saddr.eq(seg.addr), send.eq(e)]
+                        if paper:
+                            m.d.sync += szl.eq(zx)
                 m.d.sync += i.eq(i + 1)
                 with m.If(i + 1 >= na):
                     m.d.sync += [na.eq(kept), i.eq(0)]
@@ -167,7 +238,7 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
                         m.d.sync += [sr.eq(se), state.eq(_R.PASSB)]
                     with m.Else():
                         m.d.sync += decided(se)
-            with m.Case(_R.PASSB):
+            with m.Case(_R.PASSB), phases(ph != 5 if paper else None):
                 with m.If(good | (raddr == S)):
                     m.d.sync += i.eq(i + 1)
                     with m.If(i + 1 >= na):
@@ -177,10 +248,17 @@ class ExpertsPxpCoherent(ExpertsPxpSpan):
                     with m.If(mid - 1 == sl):
                         m.d.sync += decided(sl)
             with m.Case(_R.WRITE):
-                write_pixel(m, fr, rb, sl, ~vok, vseg, ic, S)
-                m.d.sync += sl.eq(sl + 1)
-                with m.If(sl == sr):
-                    m.d.sync += state.eq(Mux(sl + 1 >= ghi, _R.HAND, _R.ENTER))
+                if paper:       # a drawn pixel: i's low word first (ilo), the write with its high word
+                    def ilow():
+                        m.d.sync += [ph.eq(1), ilo.eq(zadd[:WORD]), zc.eq(zadd[WORD])]
+                    wctx = Early(m, vok & (ph == 0), ilow, [ph.eq(0)])
+                else:
+                    wctx = Always()
+                with wctx:
+                    write_pixel(m, fr, rb, sl, ~vok, vseg, ic, S)
+                    m.d.sync += sl.eq(sl + 1)
+                    with m.If(sl == sr):
+                        m.d.sync += state.eq(Mux(sl + 1 >= ghi, _R.HAND, _R.ENTER))
             with m.Case(_R.HAND):
                 with m.If(~drain.dbusy):
                     m.d.sync += [*drain.hand(bank=rb, lo=lo, hi=hi, glo=glo, ghi=ghi), rb.eq(~rb), state.eq(_R.IDLE),

@@ -39,9 +39,9 @@ At ``datapath="paper"`` the running z and i are **two 16-bit words** (at 512 x 5
 docs/experts.md "z and i in two words"): one 16-bit adder takes them a word a cycle, the low word
 first with its carry kept (``zlr`` z at the left end, ``zpl`` the right end's low word, ``ilo`` i's
 low word), the guarded tests subtract the low words in one cycle (borrows and flags kept,
-:class:`_GuardedWords`) and the high words in the next; the key is the high word's test and wires
-(:func:`_key_words`), the pixel's intensity the high word's sign against the low word
-(:func:`_i_words`). Pass A and pass B take 4 cycles a segment, the write 2 a drawn pixel
+:class:`GuardedWords`) and the high words in the next; the key is the high word's test and wires
+(:func:`key_words`), the pixel's intensity the high word's sign against the low word
+(:func:`i_words`). Pass A and pass B take 4 cycles a segment, the write 2 a drawn pixel
 (``span_cycles.multiword``).
 
 Cycles: ``golden_model/experts/span_cycles.py`` (every term named there). Pixels: the golden bit
@@ -58,18 +58,23 @@ from amaranth.lib.wiring import Out
 from rasterhw.golden_model.experts.formats import (
     ADDR_BITS,
     DZ_FRAC,
+    WORD,
+    X_END_BITS,
     X_FRAC,
+    X_INT,
+    XP_BITS,
     Z_BITS,
     Formats,
 )
 from rasterhw.hdl.experts.aj import MUL_IN
 from rasterhw.hdl.experts.drain import Drain, check_pxp_params, pxp_members
 from rasterhw.hdl.experts.mul16 import sm_mul
-from rasterhw.hdl.experts.pxp import asb_fields
+from rasterhw.hdl.experts.pxp import RUN_BITS, asb_fields
 from rasterhw.hdl.params import params
 
 __all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "candidate", "dmm_p", "resolve_regs", "seg_ends", "write_pixel", "take_bank", "zrun_at", "z_key", "guarded_test",
-           "intensity_at", "PTR_BITS", "NO_PTR"]
+           "intensity_at", "PTR_BITS", "NO_PTR", "word_adder", "GuardedWords", "Early", "Always", "i_words",
+           "key_words"]
 
 NONE = (1 << ADDR_BITS) - 1     # ASB address / polygon number of the background
 PTR_BITS = 9                    # ASL position in a DMM/P bank
@@ -112,8 +117,8 @@ def dmm_p(m: Module, comp, asb, D: int) -> dict:
     bn = [Signal(cw, name=f"n{b}") for b in range(2)]
     bnb = [Signal(cw, name=f"nb{b}") for b in range(2)]
     blead = [Signal(PTR_BITS, name=f"lead{b}") for b in range(2)]
-    blo = [Signal(10, name=f"lo{b}") for b in range(2)]
-    bhi = [Signal(11, name=f"hi{b}") for b in range(2)]
+    blo = [Signal(X_INT, name=f"lo{b}") for b in range(2)]
+    bhi = [Signal(X_END_BITS, name=f"hi{b}") for b in range(2)]
     set_full = Signal(2)
     clr_full = Signal(2)
     wfull = Signal()
@@ -152,8 +157,8 @@ def take_bank(m: Module, dm: dict, rb, W: int, aj: bool) -> dict:
     """Bank ``rb`` of :func:`dmm_p` as the resolve side takes it: its range ``lo``/``hi``, the
     guarded range ``glo``/``ghi`` (one guard pixel each side with A.J., within the frame), the ASB
     count ``n``, bucket count ``nb`` and leading pointer ``lead``."""
-    lo_b, hi_b = Signal(10), Signal(11)
-    glo_b, ghi_b = Signal(11), Signal(11)
+    lo_b, hi_b = Signal(X_INT), Signal(X_END_BITS)
+    glo_b, ghi_b = Signal(X_END_BITS), Signal(X_END_BITS)
     m.d.comb += [lo_b.eq(Mux(rb, dm["blo"][1], dm["blo"][0])), hi_b.eq(Mux(rb, dm["bhi"][1], dm["bhi"][0]))]
     if aj:
         m.d.comb += [glo_b.eq(Mux(lo_b > 0, lo_b - 1, 0)), ghi_b.eq(Mux(hi_b < W, hi_b + 1, hi_b))]
@@ -166,7 +171,7 @@ def take_bank(m: Module, dm: dict, rb, W: int, aj: bool) -> dict:
 def zrun_at(m: Module, seg, col):
     """A multiplier: the running z (Q16.4) of ASB ``seg`` at pixel ``col`` (``span_cycles._zrun``)."""
     d = Signal(signed(20), name="d_z")
-    z = Signal(signed(40), name="zrun")
+    z = Signal(signed(RUN_BITS), name="zrun")
     m.d.comb += [d.eq((col << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl),
                  z.eq((seg.zl << DZ_FRAC) + ((d * seg.dzdx) >> X_FRAC))]
     return z
@@ -175,8 +180,8 @@ def zrun_at(m: Module, seg, col):
 def seg_ends(m: Module, seg, glo, ghi) -> tuple[Signal, Signal, Signal]:
     """ASB ``seg``'s first pixel ``c0`` (``(xl + 31) >> 6``, the top-left rule) and its first and
     last pixel ``a``, ``e`` in the guarded range ``[glo, ghi)`` (``e < a``: none there)."""
-    c0, c1 = Signal(signed(12), name="c0"), Signal(signed(12), name="c1")
-    a, e = Signal(signed(12), name="a"), Signal(signed(12), name="e")
+    c0, c1 = Signal(signed(XP_BITS), name="c0"), Signal(signed(XP_BITS), name="c1")
+    a, e = Signal(signed(XP_BITS), name="a"), Signal(signed(XP_BITS), name="e")
     m.d.comb += [c0.eq((seg.xl + 31) >> X_FRAC), c1.eq(((seg.xr + 31) >> X_FRAC) - 1),
                  a.eq(Mux(c0 > glo, c0, glo)), e.eq(Mux(c1 < ghi - 1, c1, ghi - 1))]
     return c0, a, e
@@ -202,7 +207,7 @@ def candidate(m: Module, *, raddr, cand, in_bkt, brd, bi, pp, n, c0, ghi):
 
 def z_key(m: Module, zrun) -> Signal:
     """The 16-bit compare key of a running z: ``zrun >> DZ_FRAC`` clamped to ``0 .. 2**Z_BITS - 1``."""
-    zk = Signal(signed(40), name="zk")
+    zk = Signal(signed(RUN_BITS), name="zk")
     key = Signal(Z_BITS, name="key")
     m.d.comb += [zk.eq(zrun >> DZ_FRAC), key.eq(Mux(zk < 0, 0, Mux(zk > (1 << Z_BITS) - 1, (1 << Z_BITS) - 1, zk)))]
     return key
@@ -231,35 +236,61 @@ def intensity_at(m: Module, seg, col, fmt: Formats) -> Signal:
 
 def clamp_i(m: Module, run, fmt: Formats) -> Signal:
     """A running intensity ``run`` (Q.i_frac) clamped to ``0 .. i_max`` as the pixel takes it."""
-    irun = Signal(signed(40), name="irun")
+    irun = Signal(signed(RUN_BITS), name="irun")
     imax = fmt.i_max << fmt.i_frac
-    ic = Signal(16, name="ic")
+    ic = Signal(WORD, name="ic")
     m.d.comb += [irun.eq(run), ic.eq(Mux(irun < 0, 0, Mux(irun > imax, imax, irun)))]
     return ic
 
 
-def _i_words(m: Module, hi, lo, fmt: Formats) -> Signal:
+def i_words(m: Module, hi, lo, fmt: Formats) -> Signal:
     """(paper) The pixel's intensity from a two-word ``i = hi * 2**16 + lo`` (``hi`` signed, this
     cycle's high word; ``lo`` the low word kept), clamped to ``0 .. i_max`` (Q.i_frac) as
     :func:`clamp_i` does: a negative high word gives 0, a positive one the top, else the low word
     against the top (one-word tests)."""
     imax = fmt.i_max << fmt.i_frac
-    h = Signal(signed(16), name="i_hi")
-    ic = Signal(16, name="ic_w")
+    h = Signal(signed(WORD), name="i_hi")
+    ic = Signal(WORD, name="ic_w")
     m.d.comb += [h.eq(hi), ic.eq(Mux(h < 0, 0, Mux((h > 0) | (lo > imax), imax, lo)))]
     return ic
 
 
-def _key_words(m: Module, z) -> Signal:
+def key_words(m: Module, z) -> Signal:
     """(paper) :func:`z_key` of a two-word running z (``signed(32)``): the sign, and the high word's
     bits above Q16.4, pick 0 or the top; else the key is the Q16.4 integer bits (wires)."""
     key = Signal(Z_BITS, name="key_w")
     top = Z_BITS + DZ_FRAC
-    m.d.comb += key.eq(Mux(z[31], 0, Mux(z[top:32] != 0, (1 << Z_BITS) - 1, z[DZ_FRAC:top])))
+    m.d.comb += key.eq(Mux(z[2 * WORD - 1], 0, Mux(z[top:2 * WORD] != 0, (1 << Z_BITS) - 1, z[DZ_FRAC:top])))
     return key
 
 
-class _GuardedWords:
+def word_adder(m: Module, fr: dict, *, seg, col, write, hi_word, zc) -> Signal:
+    """(paper) The resolve side's half of the PXP's one 16 x 16 multiplier (:meth:`ExpertsPxpSpan.frame`'s
+    ``mul``) and its one 16-bit adder, added to ``m``: the product ``d * dz/dx`` (``d * di/dx`` where
+    ``write()``) of ASB ``seg`` at pixel ``col`` (``d = 64 col + 32 - xL``, the drain's A.J. blend
+    having the multiplier first, ``drain.mreq``), and the adder's 17-bit sum ``z_L * 16 + (product
+    >> 6)`` (``i_L + (product >> 6)``) a word a cycle: the low word, or where ``hi_word`` the high
+    word with the low word's carry ``zc`` (the product's words are its wires). Returns the sum."""
+    d = Signal(MUL_IN, name="d")
+    m.d.comb += d.eq((col << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl)
+    # the drain's A.J. blend has the multiplier first (drain.mreq); the resolve side then holds
+    mul, dr = fr["mul"], fr["drain"]
+    req = dr.mreq if dr.mreq is not None else 0
+    m.d.comb += [mul["a"].eq(Mux(req, dr.mul_a if dr.mul_a is not None else 0, d)),
+                 mul["b"].eq(Mux(req, dr.mul_b if dr.mul_b is not None else 0,
+                                 Mux(write(), seg.didx, seg.dzdx)))]
+    prod = mul["p"]
+    p_hi = Signal(signed(WORD), name="p_hi")
+    m.d.comb += p_hi.eq(prod[X_FRAC + WORD:].as_signed())
+    wa, wb, zadd = Signal(WORD, name="wa"), Signal(WORD, name="wb"), Signal(WORD + 1, name="zadd")
+    m.d.comb += [wa.eq(Mux(write(), Mux(hi_word, 0, seg.il),
+                           Mux(hi_word, seg.zl[WORD - DZ_FRAC:], seg.zl << DZ_FRAC))),
+                 wb.eq(Mux(hi_word, p_hi, prod[X_FRAC:X_FRAC + WORD])),
+                 zadd.eq(wa + wb + (hi_word & zc))]
+    return zadd
+
+
+class GuardedWords:
     """(paper) :func:`guarded_test` on two-word z, a word a cycle: every test ``Y - X >= c``
     (``c`` 0, 16 or 1) subtracts the low words in pass B's third cycle (:meth:`low`: the borrow and
     whether the low difference reaches ``c``, kept) and the high words with that borrow in its
@@ -274,10 +305,10 @@ class _GuardedWords:
     def __init__(self, m: Module, szl, szr, zlr, zw):
         self.m, self.szl, self.szr, self.zlr, self.zw = m, szl, szr, zlr, zw
         # (Y low, X low, c) of the six tests, and their kept borrows and flags
-        zmax_lo = self.ZMAX & 0xFFFF
-        self.tests = {"dl": (zlr[:16], szl[:16], self.G), "dr": (zw, szr[:16], self.G),
-                      "gl": (zlr[:16], 0, self.G), "gr": (zw, 0, self.G),
-                      "ml": (zmax_lo, szl[:16], 1), "mr": (zmax_lo, szr[:16], 1)}
+        zmax_lo = self.ZMAX & ((1 << WORD) - 1)
+        self.tests = {"dl": (zlr[:WORD], szl[:WORD], self.G), "dr": (zw, szr[:WORD], self.G),
+                      "gl": (zlr[:WORD], 0, self.G), "gr": (zw, 0, self.G),
+                      "ml": (zmax_lo, szl[:WORD], 1), "mr": (zmax_lo, szr[:WORD], 1)}
         self.b = {k: Signal(name=f"gw_b_{k}") for k in self.tests}
         self.f = {k: Signal(name=f"gw_f_{k}") for k in self.tests}
 
@@ -285,20 +316,20 @@ class _GuardedWords:
         """The low words' subtractions (sync statements of the third cycle)."""
         out = []
         for k, (y, x, c) in self.tests.items():
-            t = Signal(signed(18), name=f"gw_lo_{k}")
+            t = Signal(signed(WORD + 2), name=f"gw_lo_{k}")
             self.m.d.comb += t.eq(y - x)
-            out += [self.b[k].eq(t < 0), self.f[k].eq(t[:16] >= c)]
+            out += [self.b[k].eq(t < 0), self.f[k].eq(t[:WORD] >= c)]
         return out
 
     def high(self, s_lower) -> Signal:
         """The high words' subtractions with the kept borrows, and the test (``s_lower``: ties to S)."""
         m = self.m
-        zmax_hi = self.ZMAX >> 16
-        hy = {"dl": self.zlr[16:], "dr": self.zw, "gl": self.zlr[16:], "gr": self.zw, "ml": zmax_hi, "mr": zmax_hi}
-        hx = {"dl": self.szl[16:], "dr": self.szr[16:], "gl": 0, "gr": 0, "ml": self.szl[16:], "mr": self.szr[16:]}
+        zmax_hi = self.ZMAX >> WORD
+        hy = {"dl": self.zlr[WORD:], "dr": self.zw, "gl": self.zlr[WORD:], "gr": self.zw, "ml": zmax_hi, "mr": zmax_hi}
+        hx = {"dl": self.szl[WORD:], "dr": self.szr[WORD:], "gl": 0, "gr": 0, "ml": self.szl[WORD:], "mr": self.szr[WORD:]}
         ok = {}
         for k in self.tests:
-            h = Signal(signed(18), name=f"gw_hi_{k}")
+            h = Signal(signed(WORD + 2), name=f"gw_hi_{k}")
             y, x = hy[k], hx[k]
             m.d.comb += h.eq((y.as_signed() if hasattr(y, "as_signed") else y)
                              - (x.as_signed() if hasattr(x, "as_signed") else x) - self.b[k])
@@ -310,8 +341,8 @@ class _GuardedWords:
         return good
 
 
-class _Early:
-    """``with _Early(m, cond, early, last):`` where ``cond`` holds, ``early()`` adds the step's
+class Early:
+    """``with Early(m, cond, early, last):`` where ``cond`` holds, ``early()`` adds the step's
     early cycle (its statements advance the phase); else the body runs, with ``last`` (sync)."""
 
     def __init__(self, m: Module, cond, early, last: list):
@@ -329,7 +360,7 @@ class _Early:
         return self._else.__exit__(*exc)
 
 
-class _Always:
+class Always:
     """A context that adds nothing: the step's own cycle is its only one."""
 
     def __enter__(self):
@@ -368,8 +399,8 @@ def resolve_regs(m: Module, fr: dict) -> tuple:
     says otherwise; ``cyc`` counts every cycle unless one says otherwise), and the bucket read (``in_bkt``, ``brd`` at ``bi``)
     with the candidate flag ``cand``."""
     cw, pw, D = fr["cw"], fr["pw"], fr["D"]
-    r = {"rb": Signal(name="rb"), "glo": Signal(11, name="glo"), "ghi": Signal(11, name="ghi"),
-         "lo": Signal(10, name="lo"), "hi": Signal(11, name="hi"), "n": Signal(cw, name="n"),
+    r = {"rb": Signal(name="rb"), "glo": Signal(X_END_BITS, name="glo"), "ghi": Signal(X_END_BITS, name="ghi"),
+         "lo": Signal(X_INT, name="lo"), "hi": Signal(X_END_BITS, name="hi"), "n": Signal(cw, name="n"),
          "nb": Signal(cw, name="nb"), "i": Signal(cw, name="i"), "j": Signal(cw, name="j"),
          "bi": Signal(cw, name="bi"), "pp": Signal(PTR_BITS + 1, name="pp"), "S": Signal(pw, name="S"),
          "skey": Signal(Z_BITS, name="skey"), "saddr": Signal(ADDR_BITS, name="saddr"),
@@ -423,7 +454,7 @@ class ExpertsPxpSpan(wiring.Component):
     -------
     i : In(stream.Signature(dmm_layout()))
     o : Out(stream.Signature(unsigned(9 + intensity_bits)))
-    lo, hi : In(10), In(11)
+    lo, hi : In(X_INT), In(X_END_BITS)
         The range ``[lo, hi)`` of the line being written, sampled with its ``last`` token.
     line_cycles : Out(16)
         Finish-time counter: cycles of the last line from its first resolve cycle to its hand-over
@@ -482,13 +513,13 @@ class ExpertsPxpSpan(wiring.Component):
         return {**dm, "fmt": fmt, "W": W, "D": D, "aj": aj, "ib": ib, "asb": asb, "pw": pw, "cw": cw, "ab": ab,
                 "word": word, "wr": wr, "drain": drain, "mul": mul}
 
-    def _hold(self, m: Module, state, drain):
+    def _hold(self, m: Module, state, drain, idle=_R.IDLE, hand=_R.HAND):
         """(paper, A.J.) The arbitration of the one multiplier: while the drain's blend holds it
-        (``drain.mreq``), every resolve step but taking a bank (``IDLE``) and handing one over
-        (``HAND``) holds; else a context that adds nothing."""
+        (``drain.mreq``), every resolve step but taking a bank (``idle``) and handing one over
+        (``hand``; the coherent PXP passes its own states) holds; else a context that adds nothing."""
         if drain.mreq is None:
-            return _Always()
-        return m.If(~drain.mreq | (state == _R.IDLE) | (state == _R.HAND))
+            return Always()
+        return m.If(~drain.mreq | (state == idle) | (state == hand))
 
     def elaborate(self, platform):
         m = Module()
@@ -501,21 +532,21 @@ class ExpertsPxpSpan(wiring.Component):
         state = Signal(_R)
         (rb, glo, ghi, lo, hi, n, nb, i, j, bi, pp, S, skey, saddr, cyc, raddr, seg, c0, a, e, awr, ard, in_bkt,
          cand) = resolve_regs(m, fr)
-        x = Signal(11)            # the current span's left pixel
+        x = Signal(X_END_BITS)    # the current span's left pixel
         k = Signal(cw)            # segments present in the span
-        minend = Signal(12)       # nearest end + 1 of the segments present
+        minend = Signal(XP_BITS)  # nearest end + 1 of the segments present
         one = Signal(pw)          # the first active entry (k = 1: the visible segment)
-        sl = Signal(11)           # (sub)span searched / written
-        sr = Signal(11)
+        sl = Signal(X_END_BITS)   # (sub)span searched / written
+        sr = Signal(X_END_BITS)
         paper = self._datapath == "paper"
-        zw = 32 if paper else 40  # (paper) two 16-bit words: |z| < 2**25 at 512 x 512 (docs/experts.md)
+        zw = 2 * WORD if paper else RUN_BITS  # (paper) two 16-bit words: |z| < 2**25 at 512 x 512 (docs/experts.md)
         szl = Signal(signed(zw))
         szr = Signal(signed(zw))
         bad = Signal()
         wbg = Signal()            # the span written is background
         sp = Signal(5)            # stack pointer
 
-        m.submodules.stk = stk = Memory(shape=unsigned(11), depth=16, init=[])
+        m.submodules.stk = stk = Memory(shape=unsigned(X_END_BITS), depth=16, init=[])
         kwr = stk.write_port()
         krd = stk.read_port(domain="comb")
         m.d.comb += [kwr.en.eq(0), krd.addr.eq(sp - 1), kwr.addr.eq(sp)]
@@ -525,35 +556,18 @@ class ExpertsPxpSpan(wiring.Component):
         if paper:
             # one multiplier: z at sl (kept in zlr), then z at sr; i at sl when writing. z and i are two
             # 16-bit words, added, subtracted and compared a word a cycle, low word first (carry / borrow kept)
-            zlr = Signal(signed(32))
-            zpl = Signal(16)          # z at sr, low word
+            zlr = Signal(signed(2 * WORD))
+            zpl = Signal(WORD)          # z at sr, low word
             zc = Signal()             # the low word's carry
-            ilo = Signal(16)          # i at sl, low word
-            d = Signal(signed(18))
-            m.d.comb += d.eq((Mux(ph[1], sr, sl) << X_FRAC) + (1 << (X_FRAC - 1)) - seg.xl)
-            # the drain's A.J. blend has the multiplier first (drain.mreq); the resolve side then holds
-            mul, dr = fr["mul"], fr["drain"]
-            req = dr.mreq if dr.mreq is not None else 0
-            m.d.comb += [mul["a"].eq(Mux(req, dr.mul_a if dr.mul_a is not None else 0, d)),
-                         mul["b"].eq(Mux(req, dr.mul_b if dr.mul_b is not None else 0,
-                                         Mux(state == _R.WRITE, seg.didx, seg.dzdx)))]
-            prod = mul["p"]
-            # the 16-bit adder: z_L * 16 + (product >> 6), or i_L + (product >> 6), a word a cycle
-            # (ph[0]: the high word, with the low word's carry); the product's words are its wires
-            hi_word = ph[0]
-            p_hi = Signal(signed(16), name="p_hi")
-            m.d.comb += p_hi.eq(prod[X_FRAC + 16:].as_signed())
-            wa, wb, zadd = Signal(16, name="wa"), Signal(16, name="wb"), Signal(17, name="zadd")
-            m.d.comb += [wa.eq(Mux(state == _R.WRITE, Mux(hi_word, 0, seg.il),
-                                   Mux(hi_word, seg.zl[16 - DZ_FRAC:], seg.zl << DZ_FRAC))),
-                         wb.eq(Mux(hi_word, p_hi, prod[X_FRAC:X_FRAC + 16])),
-                         zadd.eq(wa + wb + (hi_word & zc))]
+            ilo = Signal(WORD)        # i at sl, low word
+            zadd = word_adder(m, fr, seg=seg, col=Mux(ph[1], sr, sl), write=lambda: state == _R.WRITE,
+                              hi_word=ph[0], zc=zc)
             zl_ = zlr
-            zr_ = Signal(signed(32), name="zr_w")
-            m.d.comb += zr_.eq(Cat(zpl, zadd[:16]))
-            ic = _i_words(m, zadd[:16], ilo, fmt)
-            key = _key_words(m, zlr)
-            tests = _GuardedWords(m, szl, szr, zlr, zadd[:16])
+            zr_ = Signal(signed(2 * WORD), name="zr_w")
+            m.d.comb += zr_.eq(Cat(zpl, zadd[:WORD]))
+            ic = i_words(m, zadd[:WORD], ilo, fmt)
+            key = key_words(m, zlr)
+            tests = GuardedWords(m, szl, szr, zlr, zadd[:WORD])
         else:
             # the multipliers: running z (Q16.4) at pixels sl and sr, i at sl
             zl_ = zrun_at(m, seg, sl)
@@ -566,35 +580,35 @@ class ExpertsPxpSpan(wiring.Component):
             ``zlr``, z at sr's low word into ``zpl`` with the guarded tests' low words; the body runs
             in the fourth (z at sr's high word)."""
             if not paper:
-                return _Always()
+                return Always()
 
             def early():
                 m.d.sync += ph.eq(ph + 1)
                 with m.Switch(ph):
                     with m.Case(0):
-                        m.d.sync += [zlr[:16].eq(zadd[:16]), zc.eq(zadd[16])]
+                        m.d.sync += [zlr[:WORD].eq(zadd[:WORD]), zc.eq(zadd[WORD])]
                     with m.Case(1):
-                        m.d.sync += zlr[16:].eq(zadd[:16])
+                        m.d.sync += zlr[WORD:].eq(zadd[:WORD])
                     with m.Case(2):
-                        m.d.sync += [zpl.eq(zadd[:16]), zc.eq(zadd[16]), *tests.low()]
-            return _Early(m, ph != 3, early, [ph.eq(0)])
+                        m.d.sync += [zpl.eq(zadd[:WORD]), zc.eq(zadd[WORD]), *tests.low()]
+            return Early(m, ph != 3, early, [ph.eq(0)])
 
         def write_cycles():
             """(paper) a drawn pixel's first cycle adds i's low word (``ilo``); the body (the write)
             runs in the second, with i's high word; a background pixel takes one."""
             if not paper:
-                return _Always()
+                return Always()
 
             def early():
-                m.d.sync += [ph.eq(1), ilo.eq(zadd[:16]), zc.eq(zadd[16])]
-            return _Early(m, ~wbg & (ph == 0), early, [ph.eq(0)])
+                m.d.sync += [ph.eq(1), ilo.eq(zadd[:WORD]), zc.eq(zadd[WORD])]
+            return Early(m, ~wbg & (ph == 0), early, [ph.eq(0)])
         nearer = Signal()
         m.d.comb += nearer.eq((i == 0) | (key < skey) | ((key == skey) & (seg.addr < saddr)))
         # the guarded test (span.py): S nearer than this segment B at every pixel of [sl, sr]
         good = Signal()
         s_low = saddr < seg.addr
         m.d.comb += good.eq((raddr == S) | (tests.high(s_low) if paper else guarded_test(m, szl, szr, zl_, zr_, s_low)))
-        mid = Signal(11)
+        mid = Signal(X_END_BITS)
         m.d.comb += mid.eq((sl + sr + 1) >> 1)
 
 
@@ -643,7 +657,7 @@ class ExpertsPxpSpan(wiring.Component):
                     take()
                 with m.Else():
                     # the span's right end: the nearest end, the next start, the range's end
-                    nxt = Signal(12)
+                    nxt = Signal(XP_BITS)
                     m.d.comb += nxt.eq(Mux(cand & (a < minend), a, minend))
                     m.d.sync += [k.eq(j), sl.eq(x), sr.eq(nxt - 1), sp.eq(0), i.eq(0)]
                     with m.If(j >= 2):

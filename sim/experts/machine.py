@@ -51,11 +51,13 @@ MACHINE = Machine(
                             Option("pxp", "PXP: span (span cull at every segment end + depth search per span, "
                                    "experts-pxp-span), coherent (span cull once per segment + depth search where "
                                    "the visible segment can change, experts-pxp-coherent) or zbuffer (a one-line "
-                                   "Z-buffer, experts-pxp); all ours, the same pixels", "span",
+                                   "Z-buffer, experts-pxp); all ours, the same pixels. sim experts: default (coherent; span "
+                                   "with --path group), coherent or span. sim pxp", "span",
                                    ("span", "coherent", "zbuffer")))),
           SimBlock("experts", "the whole frame: every band through the SLP's set-up HDL (experts-slp-setup) and "
                    "list-work HDL (experts-slp), its ASL order and "
-                   "block lists then into every span PXP's DMM/P (experts-pxp-span); words, pixels and cycles "
+                   "block lists then into every PXP's DMM/P (--pxp: experts-pxp-coherent or experts-pxp-span); "
+                   "words, pixels and cycles "
                    "against golden, SLP and PXP clocks for 30 frames/s", "rasterhw.sim.experts.scene:simulate_frame",
                    default_scene="experts-1000",
                    options=(Option("sn", "SLPs (bands)", 8, type=int),
@@ -65,13 +67,18 @@ MACHINE = Machine(
                                    "cycle model) or group (one SLP + Pn PXPs clocked together per band, "
                                    "experts-group; pixels against golden, cycles measured)", "chained",
                                    ("chained", "group")),
-                            Option("datapath", "ours (today's HDL: 40-bit registers, three multipliers in the span "
+                            Option("datapath", "ours (today's HDL: 40-bit registers, several multipliers in the "
                                    "PXP) or paper (the paper's 16-bit words, one multiplier a processor: the golden "
-                                   "bit model at those widths; in HDL so far the SLP's 16-bit edge increments and "
-                                   "accumulators); paper also reports the golden bit model's error against float",
+                                   "bit model at those widths, the SLP, its set-up and the PXP in HDL at them: z and "
+                                   "i in two words); paper also reports the golden bit model's error against float",
                                    "ours", ("ours", "paper")),
                             Option("accuracy", "also the golden bit model's error against the float model (renders "
-                                   "the float model; always on with --datapath paper)", False, type=bool)),
+                                   "the float model; always on with --datapath paper)", False, type=bool),
+                            Option("pxp", "the chained frame's PXP: coherent (experts-pxp-coherent: span cull once per "
+                                   "segment + depth search where the visible segment can change), span "
+                                   "(experts-pxp-span: span cull at every segment end + depth search per span); "
+                                   "both ours, the same pixels; default: coherent, span with --path group (its PXPs)",
+                                   "default", ("default", "coherent", "span"))),
                    no_image={"path": "group"}),),   # the group's bands: pixels compared, no frame written
     report="rasterhw.sim.experts.report:rows",
     bench="rasterhw.sim.experts.bench:bench",

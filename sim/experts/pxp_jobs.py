@@ -92,12 +92,13 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
     with the leading pointer and the next job's range), the expected pixels and the cycles of
     ``golden_model/experts/span_cycles.py``; ``visible`` per job (ASL record ids, -1 background);
     ``paper_drain`` per job (with A.J.: ``span_cycles.paper_drain``, for ``span_cycles.paper_jobs``)
-    and ``drawn`` (the guarded range's pixels drawn by a segment, for ``span_cycles.multiword``).
+    and ``drawn`` (the guarded range's pixels drawn by a segment, for ``span_cycles.multiword``);
+    ``paper_extra`` per job (the PXP's extra resolve cycles at the paper's datapath, for ``paper_jobs``).
     ``slp``: ``{(y, lo, hi): (the ASBs in ASL order, leading pointer, bucket list)}`` as an SLP
     (the ``experts-slp`` HDL) wrote them, instead of the golden SLP's. ``pxp="coherent"``: the
     coherent span PXP's cycles (``golden_model/experts/coherent.py``, ``experts-pxp-coherent``:
     the same words and pixels)."""
-    from rasterhw.golden_model.experts.coherent import resolve as coherent_resolve
+    from rasterhw.golden_model.experts import coherent
     from rasterhw.golden_model.experts.span_cycles import schedule as span_schedule
     from rasterhw.golden_model.experts.span_cycles_fast import NO_PTR, dmm_line, line_asl, line_job
     from rasterhw.hdl.experts.pxp_span import dmm_layout
@@ -115,7 +116,7 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
         ranges.setdefault(y, []).append((lo, hi))
     cache: dict[int, tuple] = {}
     bucket_word: dict[int, int] = {}
-    words, exp_pix, lines, steps, visible, pdrain, drawn = [], [], [], [], [], [], []
+    words, exp_pix, lines, steps, visible, pdrain, drawn, pextra = [], [], [], [], [], [], [], []
     for k, (y, lo, hi) in enumerate(todo):
         if y not in cache:
             segs, ids = line_asl(fr, y)
@@ -139,7 +140,8 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
         else:
             _, (lead,), (bucket,) = dmm_line(fr, y, [lo, hi])
         job = line_job(segs, bucket, lead, lo, hi, aj=aj, width=W,
-                       resolver=coherent_resolve if pxp == "coherent" else None)
+                       **({"resolver": coherent.resolve_counts, "paper": coherent.paper_resolve}
+                          if pxp == "coherent" else {}))
         _, nlo, nhi = todo[k + 1] if k + 1 < len(todo) else todo[k]
         words += packed
         for b in bucket:
@@ -151,6 +153,7 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
         steps.append(job["steps"])
         pdrain.append(job.get("paper_drain"))
         drawn.append(job["drawn"])
+        pextra.append(job["paper_extra"])
         vis = np.asarray(job["visible"], np.int64)
         visible.append(np.where(vis >= 0, ids[np.maximum(vis, 0)], -1) if len(ids) else np.full(vis.size, -1, np.int64))
         exp_pix.append(pix[y, lo:hi])
@@ -159,4 +162,4 @@ def span_job_list(fr: ExpertsFrame, todo: list[tuple[int, int, int]], slp: dict 
             "cycles": np.array(sch["line_cycles"], np.int64), "last_pixel": sch["last_pixel"],
             "lo0": todo[0][1], "hi0": todo[0][2], "lines": len(todo), "aj": aj, "steps": steps,
             "visible": visible, "timing": lines, "seg_bits": SPAN_BITS, "pxp": pxp, "paper_drain": pdrain,
-            "drawn": drawn}
+            "drawn": drawn, "paper_extra": pextra}

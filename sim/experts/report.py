@@ -630,7 +630,7 @@ def _hdl_span_slp(out: list, engine: str, progress: bool) -> None:
     from rasterhw.golden_model.scenes import build_scene
     from rasterhw.sim.experts.scene import jobs, simulate_frame, simulate_scene
     from rasterhw.sim.experts.testbench import slp_words
-    small = simulate_frame(build_scene("experts-tilt-1000"), 48, 16, engine="pysim", sn=2, pn=3, aj="c")
+    small = simulate_frame(build_scene("experts-tilt-1000"), 48, 16, engine="pysim", sn=2, pn=3, aj="c", pxp="span")
     out.append(make_row(SYS, "HDL", "SLP (experts-slp) + span PXP (experts-pxp-span) word and pixel mismatches, "
                         "experts-tilt-1000 at 48x16, 2x3 (pysim)", paper=None, formula=None,
                         measured=small["mismatches"], unit="words + pixels", source="hdl:pysim"))
@@ -689,7 +689,7 @@ def _hdl_span_slp(out: list, engine: str, progress: bool) -> None:
     if engine == "verilator":
         if progress:
             print("experts: experts-1000 through the SLP and span PXP HDL on Verilator")
-        r = simulate_frame(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c")
+        r = simulate_frame(build_scene("experts-1000"), 512, 512, engine="verilator", sn=8, pn=8, aj="c", pxp="span")
         out.append(make_row(SYS, "HDL", "SLP + span PXP word and pixel mismatches, experts-1000, 8x8 (262,144 pixels)",
                             paper=None, formula=None, measured=r["mismatches"], unit="words + pixels",
                             source="hdl:verilator"))

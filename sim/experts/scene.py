@@ -13,8 +13,8 @@ words (:meth:`SceneRun.more`): every band's set-up through one ``experts-slp-set
 then the PL: ``slp_setup.pl_words``), words and stamps against ``slp_setup.band_setup``; every
 band's list work through one ``experts-slp`` on the set-up HDL's words (the SLPs are identical and
 independent, "ホスト計算機はすべての SLP に同一の PL を送出するだけ"), words and end-of-line stamps
-against ``slp_cycles``; then the SLP HDL's lists as every span PXP's DMM/P words through
-``experts-pxp-span`` as ``sim pxp`` runs them. An SLP's frame is its band's set-up plus list-work
+against ``slp_cycles``; then the SLP HDL's lists as every PXP's DMM/P words through
+``experts-pxp-coherent`` (``--pxp``: by default; ``span``: ``experts-pxp-span``) as ``sim pxp`` runs them. An SLP's frame is its band's set-up plus list-work
 cycles (one processor's two phases, both as the HDL took them), a PXP's its own lines back to back;
 the clock for 30 frames/s is the busiest one's cycles x 30 (the paper names no clock).
 ``path="group"``: every band through ``experts-group`` (SLP, DMM/P writers and Pn span PXPs
@@ -357,12 +357,23 @@ def decode_slp(words: list[int]) -> list[tuple]:
 
 
 #: the census's blocks as the result's keys name the frame's units
-_UNIT = {"experts-slp-setup": "slp_setup", "experts-slp": "slp_list", "experts-pxp-span": "pxp_span"}
+_UNIT = {"experts-slp-setup": "slp_setup", "experts-slp": "slp_list", "experts-pxp-span": "pxp_span",
+         "experts-pxp-coherent": "pxp_coherent"}
+#: ``sim experts --pxp``: the PXP the chained frame runs (``default``: the coherent span PXP; in
+#: ``experts-group``, whose PXPs are span PXPs, the span PXP)
+FRAME_PXPS = ("default", "coherent", "span")
+
+
+def frame_pxp(pxp: str, path: str) -> str:
+    """The PXP ``sim experts --pxp PXP --path PATH`` runs (:data:`FRAME_PXPS`)."""
+    if pxp == "default":
+        return "span" if path == "group" else "coherent"
+    return pxp
 
 
 @cache
-def _census(datapath: str, width: int, height: int, aj: str) -> dict:
-    """``census.frame_census`` of the frame ``sim experts`` chains (span PXP at ``datapath`` too).
+def _census(datapath: str, width: int, height: int, aj: str, pxp: str = "span") -> dict:
+    """``census.frame_census`` of the frame ``sim experts`` chains (its PXP ``pxp`` at ``datapath`` too).
     Elaborating the three designs costs ~14 s, so the count is a build-cache entry
     (``build/verilog/experts-census-<digest>.json``, SHA-256 checked) keyed by the three blocks'
     design digests, the counting code's own and the arguments: a run with none of them changed
@@ -377,24 +388,26 @@ def _census(datapath: str, width: int, height: int, aj: str) -> dict:
     from rasterhw.sim.paths import BUILD_ROOT
 
     designs = [source_digest(b) for b in sorted(_UNIT)]
-    key = json.dumps([designs, sources_digest([Path(census.__file__)]), datapath, width, height, aj])
+    key = json.dumps([designs, sources_digest([Path(census.__file__)]), datapath, width, height, aj, pxp])
     path = BUILD_ROOT / "verilog" / f"experts-census-{hashlib.sha1(key.encode()).hexdigest()[:16]}.json"
     got = read_entry(path, what="the EXPERTS multiplier census")
     if got is not None:
         return json.loads(got)
-    text = json.dumps(census.frame_census(datapath, pxp_datapath=datapath, width=width, height=height, aj=aj))
+    text = json.dumps(census.frame_census(datapath, pxp_datapath=datapath, width=width, height=height, aj=aj,
+                                          pxp=pxp))
     write_entry(path, text.encode(), root=BUILD_ROOT)
     return json.loads(text)   # as a read-back gives it (lists, not tuples), on every run
 
 
-def _accuracy(tris, datapath: str, aj: str, error: bool, *, width: int, height: int) -> dict:
+def _accuracy(tris, datapath: str, aj: str, error: bool, *, width: int, height: int, pxp: str = "span") -> dict:
     """The datapath's contract beside what the frame's HDL has, counted from its elaborated design
     (:func:`_census`, ``census_source`` hdl:elaborated): ``datapath_bits`` (the widest multiplier
-    operand), ``multipliers`` (the most in one processor), ``hdl_multipliers`` (per unit: ``slp_setup``, ``slp_list``, ``pxp_span``);
+    operand), ``multipliers`` (the most in one processor), ``hdl_multipliers`` (per unit: ``slp_setup``, ``slp_list``,
+    ``pxp_span`` or ``pxp_coherent``: the frame's PXP ``pxp``);
     ``error``: also the golden bit model's error against float (``accuracy_source`` golden; the
     float model rendered for it)."""
     from rasterhw.golden_model.experts.formats import DATAPATHS
-    dp, c = DATAPATHS[datapath], _census(datapath, width, height, aj)
+    dp, c = DATAPATHS[datapath], _census(datapath, width, height, aj, pxp)
     out = {"datapath": dp.name, "datapath_label": dp.label, "datapath_bits": c["datapath_bits"],
            "multipliers": c["multipliers"], "census_source": c["source"],
            "hdl_multipliers": {_UNIT[b]: v["multipliers"] for b, v in c["per_block"].items()},
@@ -415,8 +428,10 @@ def _mism(want: list, have: list) -> int:
 class ExpertsScene(SceneRun):
     """``rasterhw sim experts``: the frame's SLP bands and PXP lines in HDL, against golden (module
     doc). ``cycles``: the machine's frame, the slower of the busiest SLP (set-up + list work) and the
-    busiest PXP; ``path="group"``: the slowest band of ``experts-group``. ``datapath``: ours or
-    paper (the golden bit model at the paper's widths, the SLP's and the span PXP's HDL built at it;
+    busiest PXP; ``path="group"``: the slowest band of ``experts-group``. ``pxp``
+    (:data:`FRAME_PXPS`, :func:`frame_pxp`): the chained frame's PXP, the coherent span PXP by
+    default or the span PXP. ``datapath``: ours or
+    paper (the golden bit model at the paper's widths, the SLP's and the PXP's HDL built at it;
     what the HDL has: ``datapath_bits`` / ``multipliers`` from its elaborated design);
     ``accuracy`` (always with ``datapath="paper"``): the bit model's error against float too."""
 
@@ -425,18 +440,21 @@ class ExpertsScene(SceneRun):
     steps = ("golden model + SLP words", "HDL simulation (set-up, list work, PXPs)", "frame")
 
     def check(self, engine: str, sn: int = 8, pn: int = 8, aj: str = "c", path: str = "chained",
-              datapath: str = "ours", accuracy: bool = False) -> None:
+              datapath: str = "ours", accuracy: bool = False, pxp: str = "default") -> None:
         from rasterhw.golden_model.experts.formats import DATAPATHS
         for name, v, ok in (("aj", aj, ("none", "c")), ("path", path, ("chained", "group")),
-                            ("datapath", datapath, tuple(DATAPATHS))):
+                            ("datapath", datapath, tuple(DATAPATHS)), ("pxp", pxp, FRAME_PXPS)):
             if v not in ok:
                 raise RasterhwError(f"experts: sim experts {name} must be one of {', '.join(ok)}, not {v!r}")
         if datapath == "paper" and path != "chained":
             raise RasterhwError("experts: sim experts --datapath paper: experts-group has no 16-bit configuration; "
                                 "leave --path at chained")
+        if path == "group" and frame_pxp(pxp, path) != "span":
+            raise RasterhwError("experts: sim experts --path group: experts-group's PXPs are span PXPs; "
+                                "leave --pxp at default or give span")
 
     def golden(self, scene, width: int, height: int, *, engine: str, sn: int = 8, pn: int = 8, aj: str = "c",
-               path: str = "chained", datapath: str = "ours", accuracy: bool = False) -> dict:
+               path: str = "chained", datapath: str = "ours", accuracy: bool = False, pxp: str = "default") -> dict:
         from rasterhw.golden_model.experts.formats import DATAPATHS, Formats
         from rasterhw.sim.experts.testbench import slp_words
         if not (1 <= sn <= height and 1 <= pn <= min(width, 63)):
@@ -448,8 +466,9 @@ class ExpertsScene(SceneRun):
         sws = [slp_words(fr, (int(bands[s]), int(bands[s + 1])), bounds, guard=1 if aj == "c" else 0)
                for s in range(sn)]
         gold = {"fr": fr, "bands": bands, "bounds": bounds, "sws": sws, "ex": DATAPATHS[datapath].acc_extra,
-                "acc": _accuracy(tris, datapath, aj, accuracy or datapath == "paper", width=width, height=height),
-                "datapath": datapath}
+                "acc": _accuracy(tris, datapath, aj, accuracy or datapath == "paper", width=width, height=height,
+                                 pxp=frame_pxp(pxp, path)),
+                "datapath": datapath, "pxp": frame_pxp(pxp, path)}
         if path == "chained":
             from rasterhw.golden_model.experts.slp_setup import pl_words
             from rasterhw.sim.experts.testbench import setup_words
@@ -519,8 +538,8 @@ class ExpertsScene(SceneRun):
                 line = {"asl": [], "lead": {}, "bk": {}}
         if len(lists) != fr.height * pn:
             raise RasterhwError(f"experts: the SLP HDL gave lists for {len(lists) // max(pn, 1)} of {fr.height} lines")
-        gold["jb"] = jb = jobs(fr, len(gold["bands"]) - 1, pn, pxp="span", slp=lists)
-        if gold["datapath"] == "paper":      # the span PXP's one multiplier: its schedule
+        gold["jb"] = jb = jobs(fr, len(gold["bands"]) - 1, pn, pxp=gold["pxp"], slp=lists)
+        if gold["datapath"] == "paper":      # the PXP's one multiplier and two-word z, i: its schedule
             from rasterhw.golden_model.experts.span_cycles import paper_jobs
             gold["jb"] = jb = paper_jobs(jb)
         return [pxp_job(jb, width=fr.width, engine=engine)]
@@ -530,7 +549,8 @@ class ExpertsScene(SceneRun):
         head = {"sn": sn, "pn": pn, "aj": aj, **gold["acc"]}
         if path == "group":
             band = [int(d.got.cycles) for d in done]
-            return {**head, "path": "group", "cycles": max(band), "cycle_mismatches": None,
+            return {**head, "path": "group", "pxp": gold["pxp"], "pxp_block": "experts-group",
+                    "pxp_is": PXP_IS[gold["pxp"]], "cycles": max(band), "cycle_mismatches": None,
                     "pixels_compared": sum(len(w) for d in done for w in d.job.expect.words.values()),
                     "group_cycles_per_band": band, "group_clock_for_30fps_hz": max(band) * 30,
                     "slp_cycles_alone": max(sw["cycles"] for sw in gold["sws"])}
@@ -579,7 +599,8 @@ class ExpertsScene(SceneRun):
                 "slp_setup_cycles_per_band": [int(v) for v in setup_band],
                 "slp_list_cycles_per_band": [int(v) for v in list_band], "pxp_cycles": pxp_frame,
                 "slp_clock_for_30fps_hz": slp_frame * 30, "pxp_clock_for_30fps_hz": pxp_frame * 30,
-                "bottleneck": "SLP" if slp_frame > pxp_frame else "PXP", "pxp": "span",
+                "bottleneck": "SLP" if slp_frame > pxp_frame else "PXP", "pxp": gold["pxp"],
+                "pxp_block": f"experts-pxp-{gold['pxp']}", "pxp_is": PXP_IS[gold["pxp"]],
                 "slp_run_s": round(slp.got.run_s, 3), "slp_setup_run_s": round(su.got.run_s, 3) if su else 0.0,
                 "pxp_run_s": round(px.got.run_s, 3), "frame_rgb": hdl_image(gold["fr"], r["pixels"])}
 

@@ -74,3 +74,19 @@ def test_pixel_ports_are_the_contract_pixel(ib):
 def test_group_pixels_fill_the_word():
     g = ExpertsGroup(width=64, pn=2, aj="none", lines=16)
     assert [p.payload.shape().width for p in g.o] == [F.Formats().pixel_bits] * 2 == [F.WORD] * 2
+
+
+@pytest.mark.parametrize("block", ["span", "coherent"])
+@pytest.mark.parametrize("datapath", ["ours", "paper"])
+def test_span_pxps_ports_and_the_paper_datapaths_words_are_the_contracts(block, datapath):
+    """The span PXPs' range ports and pixel port, and the paper datapath's one multiplier (its operand
+    ``MUL_IN`` holds a 16-bit magnitude with its sign: a word of Q10.6 pixel offset or an increment),
+    are the contract's widths."""
+    from rasterhw.hdl.experts.aj import MUL_IN
+    from rasterhw.hdl.experts.pxp_coherent import ExpertsPxpCoherent
+    from rasterhw.hdl.experts.pxp_span import ExpertsPxpSpan
+    p = {"span": ExpertsPxpSpan, "coherent": ExpertsPxpCoherent}[block](width=64, depth=16, datapath=datapath)
+    assert (len(p.lo), len(p.hi)) == (F.X_INT, F.X_END_BITS)
+    assert p.o.payload.shape().width == F.Formats().pixel_bits
+    w = Shape.cast(MUL_IN)          # a 16-bit magnitude, either sign, fits the operand
+    assert w.signed and (1 << F.WORD) - 1 <= (1 << (w.width - 1)) - 1

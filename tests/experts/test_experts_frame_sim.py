@@ -30,32 +30,45 @@ def test_small_frame_slp_and_pxp_hdl_exact():
         a + c for a, c in zip(r["slp_setup_cycles_per_band"], r["slp_list_cycles_per_band"], strict=True))
     # the machine's frame: the slower of the busiest SLP and the busiest PXP
     assert r["cycles"] == max(r["slp_cycles"], r["pxp_cycles"]) < r["sim_cycles"]
-    # today's datapath as its elaborated HDL has it (the list work's 48-bit products, the span PXP's 3 and
-    # the A.J. blend's 9 multipliers), and (accuracy=True) its golden bit model's error against float
-    assert (r["datapath"], r["datapath_bits"], r["multipliers"], r["accuracy_source"]) == ("ours", 48, 12, "golden")
+    # today's datapath as its elaborated HDL has it (the list work's 48-bit products; the default PXP,
+    # the coherent span PXP: 5 multipliers, z at two pixels of two segments and i, and the A.J. blend's 9),
+    # and (accuracy=True) its golden bit model's error against float
+    assert (r["pxp"], r["pxp_block"]) == ("coherent", "experts-pxp-coherent")
+    assert (r["datapath"], r["datapath_bits"], r["multipliers"], r["accuracy_source"]) == ("ours", 48, 14, "golden")
+    assert r["hdl_multipliers"]["pxp_coherent"] == 14
     assert r["census_source"] == "hdl:elaborated"
     assert r["pixels_differing_from_ours"] == 0 and r["max_abs_error"] >= 0
 
 
-@pytest.mark.parametrize("aj", ["c", "none"])
-def test_paper_datapath_hdl_against_the_golden_model_at_its_widths(aj):
-    """--datapath paper: the SLP HDL with 16-bit increments and accumulators and the span PXP with one
-    16 x 16 multiplier (its jobs on span_cycles.paper_jobs' schedule), against the golden bit model at
+@pytest.mark.parametrize(("aj", "pxp", "block"), [("c", "default", "coherent"), ("none", "span", "span")])
+def test_paper_datapath_hdl_against_the_golden_model_at_its_widths(aj, pxp, block):
+    """--datapath paper: the SLP HDL with 16-bit increments and accumulators and the PXP (the default,
+    the coherent span PXP, with A.J. (c); the span PXP without) with one 16 x 16 multiplier and z, i
+    in two words (its jobs on span_cycles.paper_jobs' schedule), against the golden bit model at
     the paper's widths; the result says what the elaborated HDL has beside the contract (16, 1): with
     A.J. (c) too, the blend on the PXP's one multiplier (the drain first, the resolve side holding)."""
-    r = simulate_frame(build_scene("experts-tilt-1000"), 48, 16, engine="pysim", sn=2, pn=3, aj=aj, datapath="paper")
+    from rasterhw.sim.experts.scene import jobs
+    r = simulate_frame(build_scene("experts-tilt-1000"), 48, 16, engine="pysim", sn=2, pn=3, aj=aj, datapath="paper",
+                       pxp=pxp)
+    assert (r["pxp"], r["pxp_block"]) == (block, f"experts-pxp-{block}")
     assert r["pixels_compared"] == 48 * 16 and r["mismatches"] == 0 and r["cycle_mismatches"] == 0
     assert r["slp_setup_word_mismatches"] == 0 and r["slp_word_mismatches"] == 0 and r["slp_words"] > 300
     assert (r["datapath"], r["datapath_bits"], r["multipliers"]) == ("paper", 16, 1)
-    assert r["hdl_multipliers"] == {"slp_setup": 1, "slp_list": 1, "pxp_span": 1}
+    assert r["hdl_multipliers"] == {"slp_setup": 1, "slp_list": 1, f"pxp_{block}": 1}
     assert (r["contract_datapath_bits"], r["contract_multipliers"]) == (16, 1)
-    # the PXP ran the one-multiplier schedule: slower than ours' on the same frame, each line as the HDL took it
-    ours = simulate_frame(build_scene("experts-tilt-1000"), 48, 16, engine="pysim", sn=2, pn=3, aj=aj)
-    assert r["pxp_cycles"] > ours["pxp_cycles"] and r["pxp_cycle_mismatches"] == 0
+    # the PXP ran the paper's schedule, each line as the HDL took it, and it is slower than ours' on the
+    # same frame: ours' cycle model (golden; the HDL matches it line for line, the tests of each PXP)
+    fr = render_frame(run_geometry(build_scene("experts-tilt-1000"), 48, 16, z_bits=16), model="bit", aj=aj)
+    ours = int(jobs(fr, 2, 3, pxp=block)["pxp_frame_cycles"].max())
+    assert r["pxp_cycles"] > ours and r["pxp_cycle_mismatches"] == 0
     with pytest.raises(RasterhwError, match="datapath must be"):
         simulate_frame(build_scene("experts-1000"), 64, 16, engine="pysim", datapath="wide")
     with pytest.raises(RasterhwError, match="path at chained"):
         simulate_frame(build_scene("experts-1000"), 64, 16, engine="pysim", datapath="paper", path="group")
+    with pytest.raises(RasterhwError, match="experts-group's PXPs are span PXPs"):
+        simulate_frame(build_scene("experts-1000"), 64, 16, engine="pysim", path="group", pxp="coherent")
+    with pytest.raises(RasterhwError, match="pxp must be"):
+        simulate_frame(build_scene("experts-1000"), 64, 16, engine="pysim", pxp="zbuffer")
 
 
 def test_the_pxp_needs_the_slps_bucket_list():

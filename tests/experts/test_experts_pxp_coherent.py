@@ -125,3 +125,40 @@ def test_registered_testbench_runs_the_block():
         got = run(tb, p, stim, engine="pysim", expect_words={"o": len(exp.words["o"])})
         c = compare(exp, got)
         assert c["mismatches"] == 0 and c["cycle_mismatches"] == 0, c
+
+
+@pytest.mark.parametrize(("name", "aj"), [("experts-1000", "c"), ("experts-tilt-1000", "none")])
+def test_paper_coherent_pxp_pysim_word_and_cycle_exact(name, aj):
+    """experts-pxp-coherent at datapath "paper" (the span PXP's one 16 x 16 multiplier and 16-bit adder,
+    z and i in two words) on a 64 x 16 frame of 4 ranges: every pixel and every line's finish-time
+    counter equal the golden side's (span_cycles.paper_jobs with coherent.paper_resolve; with A.J. (c)
+    the drain's blend holding the multiplier); the rule adds cycles for each of its terms, and the
+    elaborated design has one multiplier of 16 x 16."""
+    from rasterhw.golden_model.experts.pxp_cycles import guarded
+    from rasterhw.golden_model.experts.span_cycles import dmm_line, paper_jobs, schedule
+    from rasterhw.hdl.experts.census import multipliers
+    from rasterhw.hdl.experts.pxp_coherent import ExpertsPxpCoherent
+    from rasterhw.sim.experts.scene import check_jobs
+    fr = _frame(name, 64, 16, aj)
+    jb = jobs(fr, 1, 4, pxp="coherent")
+    pj = paper_jobs(jb)
+    assert pj["datapath"] == "paper" and np.array_equal(pj["pixels"], jb["pixels"])
+    # each term of the rule is exercised: pass A and B, entering tests, drawn pixels
+    cnt = {"pass_a": 0, "pass_b": 0, "tests_enter": 0}
+    b = equal_bounds(64, 4)
+    for y, p in ((y, p) for y in range(16) for p in range(4)):
+        segs, lead, buckets = dmm_line(fr, y, b)
+        glo, ghi = guarded(int(b[p]), int(b[p + 1]), 64, aj)
+        cyc, _, c = resolve_counts(segs, buckets[p], lead[p], glo, ghi)
+        cnt["pass_a"] += cyc["pass_a"]
+        cnt["pass_b"] += cyc["pass_b"]
+        cnt["tests_enter"] += c["tests_enter"]
+    assert min(cnt.values()) > 10
+    assert sum(pj["paper_extra"]) == cnt["pass_a"] + 5 * cnt["pass_b"] + 7 * cnt["tests_enter"] + sum(jb["drawn"])
+    if aj == "c":       # the drain's blend holds the multiplier: the schedule without the holds is shorter
+        assert sum(schedule(pj["timing"])["line_cycles"]) < int(pj["cycles"].sum())
+    r = check_jobs(pj, width=64, engine="pysim")
+    assert r["pixel_mismatches"] == 0 and r["line_mismatches"] == 0
+    assert r["pixels"].size == 64 * 16 and np.array_equal(r["pixels"], pj["pixels"])
+    assert r["last_pixel"] == pj["last_pixel"] + 1 > jb["last_pixel"] + 1
+    assert multipliers(ExpertsPxpCoherent(width=64, aj=aj, datapath="paper")) == [(16, 16)]

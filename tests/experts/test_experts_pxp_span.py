@@ -180,7 +180,8 @@ def test_paper_jobs_adds_the_multiplier_cycles_to_every_pxps_frame():
     """span_cycles.paper_jobs on a frame's jobs (pxp_sim.jobs): pixels unchanged, every line's resolve
     + pass_a + pass_b (one multiplier) + 2 (pass_a + pass_b) + its drawn pixels (two-word z and i),
     and each PXP's frame time rescheduled: with one PXP it is the whole job list's
-    last pixel + 1; the coherent PXP's jobs are refused (it has no one-multiplier configuration)."""
+    last pixel + 1; the coherent PXP's jobs carry their own rule (coherent.paper_resolve), and jobs
+    of a PXP other than the span one without it are refused."""
     from rasterhw.golden_model.experts.span_cycles import multiword, one_multiplier, paper_jobs
     fr = render_frame(run_geometry(build_scene("experts-tilt-1000"), 64, 16, z_bits=16), model="bit", aj="c")
     jb = jobs(fr, 1, 1, pxp="span")
@@ -194,8 +195,10 @@ def test_paper_jobs_adds_the_multiplier_cycles_to_every_pxps_frame():
     assert [multiword(st, dn) for st, dn in zip(jb["steps"], jb["drawn"], strict=True)] == \
         [2 * one_multiplier(st) + dn for st, dn in zip(jb["steps"], jb["drawn"], strict=True)]
     assert int(pj["pxp_frame_cycles"][0, 0]) == pj["last_pixel"] + 1 > int(jb["pxp_frame_cycles"][0, 0])
-    with pytest.raises(RasterhwError, match="coherent PXP has no paper datapath"):
-        paper_jobs(jobs(fr, 1, 1, pxp="coherent"))
+    co = jobs(fr, 1, 1, pxp="coherent")
+    assert paper_jobs(co)["last_pixel"] > co["last_pixel"]
+    with pytest.raises(RasterhwError, match="coherent PXP's jobs carry no paper-datapath cycles"):
+        paper_jobs({k: v for k, v in co.items() if k != "paper_extra"})
 
 
 def test_paper_span_pxp_blends_on_its_one_multiplier_pysim_word_and_cycle_exact():
@@ -278,12 +281,16 @@ def _run_lines(dut, words: list[int], n_lines: int, n_pix: int) -> tuple[list[in
     return pix, lc
 
 
-def test_paper_two_word_z_and_i_at_the_formats_extremes_pysim():
-    """datapath "paper" keeps the running z and i in two 16-bit words, a word a cycle: on lines whose
+@pytest.mark.parametrize("pxp", ["span", "coherent"])
+def test_paper_two_word_z_and_i_at_the_formats_extremes_pysim(pxp):
+    """datapath "paper" keeps the running z and i in two 16-bit words, a word a cycle, in the span PXP
+    and in the coherent span PXP (which shares its adder and guarded word tests): on lines whose
     z and i run far outside Q16.4 and 0..i_max both ways (z to about +-2**24, the formats' bound,
     the cases no scene reaches) and on lines of segments crossing at small depth differences, its pixels equal the golden side's (span_cycles.resolve's visible
     segment, the S.S. intensity clamped) and ours' 40-bit design's, and each line's finish-time
-    counter equals span_cycles.schedule with the paper's cycles (+ one_multiplier + multiword)."""
+    counter equals span_cycles.schedule with the paper's cycles (+ one_multiplier + multiword; the
+    coherent PXP: coherent.paper_resolve, whose entering segments' tests run here too)."""
+    from rasterhw.golden_model.experts import coherent
     from rasterhw.golden_model.experts.formats import DZ_FRAC, X_FRAC, Formats
     from rasterhw.golden_model.experts.slp_run import block_lists
     from rasterhw.golden_model.experts.span_cycles import (
@@ -291,11 +298,13 @@ def test_paper_two_word_z_and_i_at_the_formats_extremes_pysim():
         one_multiplier,
         span_drain_cycles,
     )
+    from rasterhw.hdl.experts.pxp_coherent import ExpertsPxpCoherent
     from rasterhw.hdl.experts.pxp_span import ExpertsPxpSpan, dmm_layout
     from rasterhw.hdl.pack import pack
     fmt, lay, W = Formats(), dmm_layout(), 512
     rng = np.random.default_rng(48)
     words, want, lines, zs, i_out, tested = [], [], {"ours": [], "paper": []}, [], 0, False
+    entered = 0
     for slope in (None, None, None, 400, 400, 2000):
         segs = _extreme_line(rng, 7, slope=slope)
         c0 = np.array([(s["xl"] + 31) >> X_FRAC for s in segs])
@@ -304,7 +313,11 @@ def test_paper_two_word_z_and_i_at_the_formats_extremes_pysim():
         lead, bucket = (511 if lead[0] < 0 else lead[0]), buckets[0]
         words += [pack(lay, s) for s in segs] + [pack(lay, {"list": 1, "ptr": b}) for b in bucket]
         words.append(pack(lay, {"last": 1, "ptr": lead}))
-        cyc, vis = resolve(segs, bucket, lead, 0, W)
+        if pxp == "span":
+            cyc, vis = resolve(segs, bucket, lead, 0, W)
+        else:
+            cyc, vis, cnt = coherent.resolve_counts(segs, bucket, lead, 0, W)
+            entered += cnt["tests_enter"]
         tested = tested or cyc["pass_b"] > 0
         for c, v in enumerate(vis):
             s = segs[v] if v >= 0 else None
@@ -318,12 +331,16 @@ def test_paper_two_word_z_and_i_at_the_formats_extremes_pysim():
         nw, r, dr = len(segs) + len(bucket) + 1, sum(cyc.values()), span_drain_cycles(vis, 0, W, aj="none", width=W)
         drawn = sum(1 for v in vis if v >= 0)
         lines["ours"].append((nw, r, dr))
-        lines["paper"].append((nw, r + one_multiplier(cyc) + multiword(cyc, drawn), dr))
+        extra = (one_multiplier(cyc) + multiword(cyc, drawn) if pxp == "span" else
+                 coherent.paper_resolve(cyc, drawn, cnt))
+        lines["paper"].append((nw, r + extra, dr))
     # the lines reach what no scene does: visible z below 0 and above Q16.4, intensities clamped;
     # and pass B's guarded tests run (spans wider than a pixel with two segments or more)
     assert min(zs) < -(1 << 20) and max(zs) > 1 << 22 and i_out > 100 and tested
+    assert pxp == "span" or entered > 5
+    block = ExpertsPxpSpan if pxp == "span" else ExpertsPxpCoherent
     for dp in ("ours", "paper"):
-        pix, lc = _run_lines(ExpertsPxpSpan(width=W, depth=16, datapath=dp), words, 6, len(want))
+        pix, lc = _run_lines(block(width=W, depth=16, datapath=dp), words, 6, len(want))
         assert pix == want, dp
         assert lc == schedule(lines[dp])["line_cycles"], dp
     assert sum(r for _, r, _ in lines["paper"]) > sum(r for _, r, _ in lines["ours"])
