@@ -15,7 +15,6 @@ from rasterhw.golden_model.zbm.edgepair import EdgePairs
 from rasterhw.golden_model.zbm.formats import (
     AEP_CAPACITY,
     HALF_X,
-    MAX_HEIGHT,
     MAX_WIDTH,
     MODE_MAPPING,
     OFF_FRAC,
@@ -25,16 +24,10 @@ from rasterhw.golden_model.zbm.formats import (
 from rasterhw.golden_model.zbm.seggen import Segments, _px_ceil, check_edge_pair_stream
 
 
-def _by_lines(eps: EdgePairs, height: int, *, width: int = MAX_WIDTH,
-                      capacity: int = AEP_CAPACITY) -> Segments:
-    """The segment generator as written before its vectorisation (line by line): the specification."""
+def _by_lines(eps: EdgePairs, height: int, *, width: int = MAX_WIDTH, capacity: int = AEP_CAPACITY) -> Segments:
+    """The segment generator as written before its vectorisation (line by line): the specification
+    (its argument checks, unchanged, left out)."""
     n = len(eps)
-    if not isinstance(height, (int, np.integer)) or not 1 <= height <= MAX_HEIGHT:
-        raise RasterhwError(f"segment generator: height must be in 1..{MAX_HEIGHT}, not {height!r}")
-    if not isinstance(width, (int, np.integer)) or not 1 <= width <= MAX_WIDTH:
-        raise RasterhwError(f"segment generator: width must be in 1..{MAX_WIDTH}, not {width!r}")
-    if not isinstance(capacity, (int, np.integer)) or capacity < 1:
-        raise RasterhwError(f"segment generator: capacity must be a positive integer, not {capacity!r}")
     check_edge_pair_stream(eps, height, who="segment generator")
     C = eps.val.shape[1]
     x = eps.x.copy()
