@@ -36,10 +36,12 @@ def test_band_bad_lines():
 
 
 @pytest.mark.slow
-def test_two_bands_through_the_unit_hdl_equal_the_whole_frame():
+@pytest.mark.parametrize("own_height", [False, True])
+def test_two_bands_through_the_unit_hdl_equal_the_whole_frame(own_height):
     from rasterhw.sim.zbm.bands import two_bands
 
-    r = two_bands("c50", width=32, height=16, interleave=1, engine="pysim")
+    r = two_bands("c50", width=32, height=16, interleave=1, engine="pysim", own_height=own_height)
     assert r["identical"] and 1 <= r["split_line"] < 16
+    assert (r["split_line"] == 8) == own_height             # own height: two equal bands, one build
     assert r["whole_mismatches"] == r["top_mismatches"] == r["bottom_mismatches"] == 0
     assert r["whole_frames_ok"] == r["top_frames_ok"] == r["bottom_frames_ok"] == 1
