@@ -30,6 +30,7 @@ Times are reported at the paper's clocks: 12.5 MHz bus (80 ns slot), i860 at
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -37,14 +38,12 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.snu import i860
 from rasterhw.golden_model.snu import pixelbus as golden
-from rasterhw.golden_model.snu.formats import CLOCK_HZ, MEM_CYCLE, N_BANKS, RGB_BITS, Z_BITS
+from rasterhw.golden_model.snu.formats import CLOCK_HZ, MEM_CYCLE, N_BANKS, Z_BITS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.sim import engines
 from rasterhw.sim.engines.scene import Done, Job, SceneRun, run_job
-from rasterhw.sim.packed import as_ints, pack_fields
 from rasterhw.sim.snu.frame_format import GAP_BITS, SCHEDULE
 from rasterhw.sim.snu.testbench import BusBench, FrameBench, frame_of
-from rasterhw.sim.testbench import Expected
 
 __all__ = ["ENGINES", "PixelbusScene", "clear_cycles", "golden_schedule", "i860_clocks", "measure_rates", "producer_gaps",
            "run_frame_engine", "simulate", "simulate_pixelbus"]
@@ -299,14 +298,8 @@ def frame_job(stream: PixelStream, gaps: np.ndarray, sched: dict) -> Job:
     # the run's length, held exactly (``cycle_mismatches``, as BusBench's on the other engines): the
     # schedule word k leaves at edge ``cycles + k``, display word j at ``cycles + 1 + j``, so the
     # last at ``cycles + w h`` (``FrameAdapter``: the sweep starts the clock after SWAP's)
-    # FrameBench.expect's words, the frame's as packed rows (``pack_fields``: ``rgb << z_bits | z``):
-    # compared with the engine's rows in NumPy, no Python int per pixel (1.3 M at 1280 x 1024)
-    rgb, z = golden.pixelbus_frame(stream, accept=sched["accept"], mem_cycle=params["mem_cycle"],
-                                   n_banks=params["n_banks"])
-    words = {"o": pack_fields([(rgb.ravel(), RGB_BITS), (z.ravel(), params["z_bits"])]),
-             "o_sched": [int(sched[k]) for k in SCHEDULE]}
-    exp = Expected(words, cycles=int(sched["cycles"]) + w * h + 1)
-    return Job(tb, params, stim, exp, {"max_cycles": int(sched["cycles"]) + w * h + 10_000, "packed": True})
+    exp = replace(tb.expect(params, stim), cycles=int(sched["cycles"]) + w * h + 1)
+    return Job(tb, params, stim, exp, {"max_cycles": int(sched["cycles"]) + w * h + 10_000})
 
 
 def frame_words(d: Done) -> dict:
@@ -314,15 +307,9 @@ def frame_words(d: Done) -> dict:
     (read-out and schedule words that differ from the golden schedule, plus one if the run's
     length differs from the golden schedule's: ``frame_job``)."""
     stream = d.job.stim.source[0]
-    words = d.got.words["o"]
-    if isinstance(words, np.ndarray):   # packed rows (Verilator), big-endian: widened to 8 bytes
-        wide = np.zeros((len(words), 8), np.uint8)
-        wide[:, 8 - words.shape[1]:] = words
-        words = wide.view(">u8").ravel().astype(np.int64)
-    else:
-        words = np.array(words, dtype=np.int64)
+    words = np.array(d.got.words["o"], dtype=np.int64)
     zmask = (1 << stream.z_bits) - 1
-    got = dict(zip(SCHEDULE, as_ints(d.got.words["o_sched"]), strict=False))
+    got = dict(zip(SCHEDULE, d.got.words["o_sched"], strict=False))
     return {**got, "rgb": (words >> stream.z_bits).reshape(stream.height, stream.width),
             "z": (words & zmask).reshape(stream.height, stream.width),
             "mismatches": d.cmp["mismatches"] + (d.cmp["cycle_mismatches"] or 0)}
