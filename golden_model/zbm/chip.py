@@ -21,13 +21,18 @@ from rasterhw.golden_model.zbm.formats import (
 from rasterhw.golden_model.zbm.initial import initial_processor
 from rasterhw.golden_model.zbm.seggen import Segments
 
-__all__ = ["chip_scanline"]
+__all__ = ["chip_scanline", "sample_z"]
+
+
+def sample_z(v: np.ndarray) -> np.ndarray:
+    """The depth channel's DDA values (N,) Q.24 -> sample z: round half up, clamp."""
+    return np.clip((v + HALF_A) >> ATTR_FRAC, 0, Z_MAX_SAMPLE)
 
 
 def _samples(v: np.ndarray, mode: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per-pixel DDA values (N, C) Q.24 -> sample fields z, a, c (N, 4). Round half up, clamp."""
     r = (v + HALF_A) >> ATTR_FRAC
-    z = np.clip(r[:, 0], 0, Z_MAX_SAMPLE)
+    z = sample_z(v[:, 0])
     a = np.clip(r[:, -1], 0, 255)
     c = np.zeros((v.shape[0], 4), np.int64)
     if mode == MODE_COLOUR:

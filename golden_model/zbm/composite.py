@@ -26,10 +26,16 @@ def composite(px: DoubleZ, background=(0, 0, 0)) -> np.ndarray:
     bg = np.asarray(background, np.int64)
     if bg.shape != (3,) or bg.min() < 0 or bg.max() > 255:
         raise RasterhwError(f"ZB/M: background must be three integers 0..255, not {background!r}")
-    v0 = (px.z[..., 0] != Z_EMPTY)[..., None]
-    v1 = (px.z[..., 1] != Z_EMPTY)[..., None]
-    a0, a1 = px.a[..., 0:1], px.a[..., 1:2]
-    c0, c1 = px.c[..., 0, :3], px.c[..., 1, :3]
+    # worked out where the nearest sample is translucent; an opaque one (a0 = 255) gives c0
+    # exactly ((255 * c0 + 127) // 255 = c0); no sample: the background
+    v0 = px.z[..., 0] != Z_EMPTY
+    out = np.empty(px.z.shape[:-1] + (3,), np.uint8)
+    out[...] = bg
+    out[v0] = px.c[..., 0, :3][v0]
+    t = v0 & (px.a[..., 0] != 255)
+    v1 = (px.z[..., 1][t] != Z_EMPTY)[:, None]
+    a0, a1 = px.a[..., 0][t][:, None], px.a[..., 1][t][:, None]
+    c0, c1 = px.c[..., 0, :3][t], px.c[..., 1, :3][t]
     back = np.where(v1, (a1 * c1 + (255 - a1) * bg + 127) // 255, bg)
-    out = np.where(v0, (a0 * c0 + (255 - a0) * back + 127) // 255, bg)
-    return out.astype(np.uint8)
+    out[t] = (a0 * c0 + (255 - a0) * back + 127) // 255
+    return out

@@ -14,7 +14,7 @@ from rasterhw.golden_model.zbm.formats import (
     pack_samples,
 )
 
-__all__ = ["DoubleZ", "arrival_layers"]
+__all__ = ["DoubleZ", "arrival_layers", "nearest_two"]
 
 
 @dataclass
@@ -65,3 +65,34 @@ def arrival_layers(pos: np.ndarray) -> list[np.ndarray]:
     by_rank = np.argsort(rank, kind="stable")
     bounds = np.searchsorted(rank[by_rank], np.arange(int(rank.max()) + 2))
     return [np.sort(order[by_rank[bounds[r]:bounds[r + 1]]]) for r in range(int(rank.max()) + 1)]
+
+
+def nearest_two(pos: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """What inserting fragments one by one in arrival order into empty double-Z pixels keeps
+    (strict ``<``: on a tie the stored sample stays), when every ``z`` is nearer than the empty
+    value and none is NaN: per pixel, the two least fragments by (``z``, arrival), found without
+    the insertion (:func:`arrival_layers` + ``chip._insert``, which the golden model's write count
+    needs; ``tests/zbm/test_zbm_golden.py`` holds the two equal).
+
+    Returns ``(pixels, first, second)``: every pixel with a fragment (ascending), the index into
+    ``pos`` of its nearest fragment and of its second (-1: it has one fragment)."""
+    pos, z = np.asarray(pos), np.asarray(z)
+    n = pos.size
+    if n == 0:
+        e = np.zeros(0, np.int64)
+        return e, e, e
+    order = np.argsort(pos, kind="stable")          # per pixel, arrivals in order
+    sp, sz = pos[order], z[order]
+    head = np.ones(n, bool)
+    head[1:] = sp[1:] != sp[:-1]
+    starts = np.flatnonzero(head)
+    group = np.cumsum(head) - 1
+    idx = np.arange(n)
+    # the nearest: least z, the earliest of equal z (a tie leaves the stored sample ahead)
+    i1 = np.minimum.reduceat(np.where(sz == np.minimum.reduceat(sz, starts)[group], idx, n), starts)
+    rest = idx != i1[group]
+    far = np.inf if sz.dtype.kind == "f" else np.iinfo(sz.dtype).max
+    z2 = np.minimum.reduceat(np.where(rest, sz, far), starts)
+    i2 = np.minimum.reduceat(np.where(rest & (sz == z2[group]), idx, n), starts)
+    second = np.where(i2 < n, order[np.minimum(i2, n - 1)], -1)
+    return sp[starts], order[i1], second

@@ -25,7 +25,7 @@ import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.screen import ScreenTriangles, snap
 from rasterhw.golden_model.zbm.composite import composite
-from rasterhw.golden_model.zbm.doublez import DoubleZ, arrival_layers
+from rasterhw.golden_model.zbm.doublez import DoubleZ, nearest_two
 from rasterhw.golden_model.zbm.edgepair import _attributes, edge_pairs
 from rasterhw.golden_model.zbm.formats import (
     AEP_CAPACITY,
@@ -39,7 +39,12 @@ from rasterhw.golden_model.zbm.formats import (
 from rasterhw.golden_model.zbm.mapping import default_maps, map_samples
 from rasterhw.golden_model.zbm.merger import merge_chain
 from rasterhw.golden_model.zbm.seggen import segment_generator
-from rasterhw.golden_model.zbm.unit import _unit_frame_fast, segment_fragments, unit_scanline
+from rasterhw.golden_model.zbm.unit import (
+    _unit_frame_fast,
+    segment_fragments,
+    unit_frame,
+    unit_scanline,
+)
 
 __all__ = ["ZbmResult", "chain_frame", "render_zbm", "render_zbm_float", "render_scene"]
 
@@ -109,7 +114,7 @@ def chain_frame(eps_per_unit: list, width: int, height: int, *, capacity: int = 
         segments = [segment_generator(e, height, width=width, capacity=capacity) for e in eps_per_unit]
     if len(segments) != len(eps_per_unit):
         raise RasterhwError(f"chain_frame: {len(segments)} segment lists for {len(eps_per_unit)} units")
-    return merge_chain([_unit_frame_fast(s, height, width)[0] for s in segments])
+    return merge_chain([unit_frame(s, height, width) for s in segments])
 
 
 def render_zbm_float(tris: ScreenTriangles, *, alpha=None, background=(0.0, 0.0, 0.0), segs=None) -> dict:
@@ -130,35 +135,45 @@ def render_zbm_float(tris: ScreenTriangles, *, alpha=None, background=(0.0, 0.0,
     X = snap(xy[..., 0]) / SUB
     Y = snap(xy[..., 1]) / SUB
     att = _attributes(tris, MODE_COLOUR, alpha) / np.array([Z_SCALE, 255, 255, 255, 255])
-    zb = np.full((H * W, 2), np.inf)
-    cb = np.zeros((H * W, 2, 4))
-    tg = np.full((H * W, 2), -1, np.int64)
+    # per triangle what every fragment of it uses (the same float operations as per fragment)
+    dx1, dx2 = X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]
+    dy1, dy2 = Y[:, 1] - Y[:, 0], Y[:, 2] - Y[:, 0]
+    det = dx1 * dy2 - dx2 * dy1
+    d1, d2 = att[:, 1] - att[:, 0], att[:, 2] - att[:, 0]
     seg, k = segment_fragments(segs)
     t = segs.tag[seg]
-    xc = (segs.x[seg] + k) + 0.5
-    yc = segs.y[seg] + 0.5
-    x0, y0 = X[t], Y[t]
-    det = (x0[:, 1] - x0[:, 0]) * (y0[:, 2] - y0[:, 0]) - (x0[:, 2] - x0[:, 0]) * (y0[:, 1] - y0[:, 0])
-    w1 = ((xc - x0[:, 0]) * (y0[:, 2] - y0[:, 0]) - (x0[:, 2] - x0[:, 0]) * (yc - y0[:, 0])) / det
-    w2 = ((x0[:, 1] - x0[:, 0]) * (yc - y0[:, 0]) - (xc - x0[:, 0]) * (y0[:, 1] - y0[:, 0])) / det
-    at = att[t]
-    v = at[:, 0] + w1[:, None] * (at[:, 1] - at[:, 0]) + w2[:, None] * (at[:, 2] - at[:, 0])
+    ex = ((segs.x[seg] + k) + 0.5) - X[t, 0]
+    ey = (segs.y[seg] + 0.5) - Y[t, 0]
+    w1 = (ex * dy2[t] - dx2[t] * ey) / det[t]
+    w2 = (dx1[t] * ey - ex * dy1[t]) / det[t]
+
+    def value(i, ch):   # the float plane equation of fragments i, channels ch
+        ti = t[i]
+        return att[ti, 0, ch] + w1[i, None] * d1[ti, ch] + w2[i, None] * d2[ti, ch]
+
+    z = value(slice(None), slice(0, 1))[:, 0]
     pos = segs.y[seg] * W + segs.x[seg] + k
-    for ly in arrival_layers(pos):   # in emission order: strict <, the earlier segment wins ties
-        p, z, vv, tt = pos[ly], v[ly, 0], v[ly, 1:], t[ly]
-        f = z < zb[p, 0]
-        sc = (~f) & (z < zb[p, 1])
-        pf, psc = p[f], p[sc]
-        zb[pf, 1], cb[pf, 1], tg[pf, 1] = zb[pf, 0], cb[pf, 0], tg[pf, 0]
-        zb[pf, 0], cb[pf, 0], tg[pf, 0] = z[f], vv[f], tt[f]
-        zb[psc, 1], cb[psc, 1], tg[psc, 1] = z[sc], vv[sc], tt[sc]
-    zb, cb, tg = zb.reshape(H, W, 2), cb.reshape(H, W, 2, 4), tg.reshape(H, W, 2)
+    # in emission order, strict <, the earlier segment wins ties: a fragment not nearer than
+    # "empty" (inf, NaN) is never kept, the rest are the two least by (z, emission) per pixel
+    near = np.flatnonzero(z < np.inf)
+    pix, f, s = nearest_two(pos[near], z[near])
+    f, two = near[f], s >= 0
+    s = near[s[two]]
+    zb = np.full((H * W, 2), np.inf)
+    tg = np.full((H * W, 2), -1, np.int64)
+    zb[pix, 0], tg[pix, 0] = z[f], t[f]
+    zb[pix[two], 1], tg[pix[two], 1] = z[s], t[s]
+    # alpha-composited where a pixel has a sample (elsewhere the background), the same float
+    # operations per pixel as over the whole frame
     bg = np.asarray(background, np.float64)
-    v0 = np.isfinite(zb[..., 0])[..., None]
-    v1 = np.isfinite(zb[..., 1])[..., None]
-    a0, a1 = cb[..., 0, 3:4], cb[..., 1, 3:4]
-    back = np.where(v1, a1 * cb[..., 1, :3] + (1 - a1) * bg, bg)
-    rgb = np.where(v0, a0 * cb[..., 0, :3] + (1 - a0) * back, bg)
+    c0, c1 = value(f, slice(1, None)), np.zeros((pix.size, 4))
+    c1[two] = value(s, slice(1, None))
+    a0, a1 = c0[:, 3:4], c1[:, 3:4]
+    back = np.where(two[:, None], a1 * c1[:, :3] + (1 - a1) * bg, bg)
+    rgb = np.empty((H * W, 3))
+    rgb[:] = bg
+    rgb[pix] = a0 * c0[:, :3] + (1 - a0) * back
+    zb, tg, rgb = zb.reshape(H, W, 2), tg.reshape(H, W, 2), rgb.reshape(H, W, 3)
     return {"rgb": rgb, "z": zb, "tag": tg}
 
 

@@ -128,63 +128,44 @@ def segment_generator(eps: EdgePairs, height: int, *, width: int = MAX_WIDTH,
         raise RasterhwError(f"segment generator: capacity must be a positive integer, not {capacity!r}")
     check_edge_pair_stream(eps, height, who="segment generator")
     C = eps.val.shape[1]
-    x = eps.x.copy()
-    ln = eps.len.copy()
-    val = eps.val.copy()
-    left = eps.h.copy()
-    active = np.zeros(0, np.int64)
-    nxt = 0
-    out = {k: [] for k in ("y", "x", "len", "val", "inc", "ep")}
+    # every (pair, line) it is active on; the active memory holds pairs in load (FIFO) order, so
+    # a line's segments come out by pair index. k steps of 56-bit wrapping adds are one add of k
+    # times the step (modular arithmetic; int64 products wrap mod 2**64, then to 56 bits)
+    h = eps.h.astype(np.int64)
+    pair = np.repeat(np.arange(n), h)
+    k = np.arange(pair.size) - np.repeat(np.cumsum(h) - h, h)
+    line = eps.y[pair] + k
+    active = np.bincount(line, minlength=height)
+    over = np.flatnonzero(active > capacity)
+    if over.size:
+        y = int(over[0])
+        raise RasterhwError(f"segment generator: line {y} needs {int(active[y])} "
+                            f"simultaneously active edge pairs, more than the active-edge-pair "
+                            f"memory's capacity {int(capacity)} (the hardware stalls with "
+                            f"'overflow'; split the stream or raise capacity)")
+    at = np.argsort(line * max(n, 1) + pair, kind="stable")
+    pair, k, line = pair[at], k[at], line[at]
+    x = wrap(eps.x[pair] + k * eps.dxdy[pair])
+    ln = wrap(eps.len[pair] + k * eps.dlendy[pair])
+    xs = np.maximum(_px_ceil(x), 0)
+    xe = np.minimum(_px_ceil(x + ln), width)
+    cnt = xe - xs
+    ok = cnt > 0
+    empty = np.bincount(line[~ok], minlength=height)
+    p, xs, x, line, k = pair[ok], xs[ok], x[ok], line[ok], k[ok]
+    val = wrap(eps.val[p] + k[:, None] * eps.ddy[p])
+    off = ((xs << X_FRAC) + HALF_X - x) >> (X_FRAC - OFF_FRAC)   # Q.16, >= 0
+    oi = (off >> OFF_FRAC)[:, None]
+    of = (off & ((1 << OFF_FRAC) - 1))[:, None]
+    d = eps.ddx[p]
+    v0 = wrap(val + oi * d + ((of * d) >> OFF_FRAC))
     line_start = np.zeros(height + 1, np.int64)
-    loads = np.zeros(height, np.int64)
-    empty = np.zeros(height, np.int64)
-    aep_max = 0
-    count = 0
-    for y in range(height):
-        # (1) loader
-        start = nxt
-        while nxt < n and eps.y[nxt] <= y:
-            nxt += 1
-        if active.size + (nxt - start) > capacity:
-            raise RasterhwError(f"segment generator: line {y} needs {active.size + nxt - start} "
-                                f"simultaneously active edge pairs, more than the active-edge-pair "
-                                f"memory's capacity {int(capacity)} (the hardware stalls with "
-                                f"'overflow'; split the stream or raise capacity)")
-        active = np.concatenate([active, np.arange(start, nxt)])
-        loads[y] = nxt - start
-        aep_max = max(aep_max, active.size)
-        # (2) emit
-        if active.size:
-            a = active
-            xs = np.maximum(_px_ceil(x[a]), 0)
-            xe = np.minimum(_px_ceil(x[a] + ln[a]), width)
-            cnt = xe - xs
-            ok = cnt > 0
-            empty[y] = int((~ok).sum())
-            k = a[ok]
-            if k.size:
-                off = ((xs[ok] << X_FRAC) + HALF_X - x[k]) >> (X_FRAC - OFF_FRAC)   # Q.16, >= 0
-                oi = (off >> OFF_FRAC)[:, None]
-                of = (off & ((1 << OFF_FRAC) - 1))[:, None]
-                d = eps.ddx[k]
-                v0 = wrap(val[k] + oi * d + ((of * d) >> OFF_FRAC))
-                for key, arr in (("y", np.full(k.size, y)), ("x", xs[ok]), ("len", cnt[ok]),
-                                 ("val", v0), ("inc", d), ("ep", k)):
-                    out[key].append(arr)
-                count += k.size
-            # step
-            x[a] = wrap(x[a] + eps.dxdy[a])
-            ln[a] = wrap(ln[a] + eps.dlendy[a])
-            val[a] = wrap(val[a] + eps.ddy[a])
-            left[a] -= 1
-            active = a[left[a] > 0]
-        line_start[y + 1] = count
-    cat = {k: (np.concatenate(v) if v else np.zeros((0, C) if k in ("val", "inc") else 0, np.int64))
-           for k, v in out.items()}
-    stats = {"segments": count, "empty_segments": int(empty.sum()), "aep_max": aep_max,
+    line_start[1:] = np.cumsum(np.bincount(line, minlength=height))
+    loads = np.bincount(eps.y, minlength=height).astype(np.int64) if n else np.zeros(height, np.int64)
+    stats = {"segments": int(p.size), "empty_segments": int(empty.sum()), "aep_max": int(active.max(initial=0)),
              "aep_capacity": int(capacity),
              "edge_pairs": n}
-    return Segments(cat["y"].astype(np.int64), cat["x"].astype(np.int64), cat["len"].astype(np.int64),
-                    cat["val"].astype(np.int64), cat["inc"].astype(np.int64), cat["ep"].astype(np.int64),
-                    eps.tag[cat["ep"].astype(np.int64)] if n else cat["ep"].astype(np.int64),
-                    line_start, loads, empty, eps.mode, stats)
+    return Segments(line.astype(np.int64), xs.astype(np.int64), cnt[ok].astype(np.int64),
+                    v0.reshape(-1, C).astype(np.int64), d.reshape(-1, C).astype(np.int64), p.astype(np.int64),
+                    eps.tag[p].astype(np.int64) if n else p.astype(np.int64),
+                    line_start, loads, empty.astype(np.int64), eps.mode, stats)

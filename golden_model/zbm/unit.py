@@ -8,14 +8,14 @@ Golden model of the ZB/M (seed 003); integer arithmetic with the hardware's widt
 from __future__ import annotations
 
 import numpy as np
-from rasterhw.golden_model.zbm.chip import _insert, _samples, chip_scanline
-from rasterhw.golden_model.zbm.doublez import DoubleZ, arrival_layers
+from rasterhw.golden_model.zbm.chip import _insert, _samples, chip_scanline, sample_z
+from rasterhw.golden_model.zbm.doublez import DoubleZ, arrival_layers, nearest_two
 from rasterhw.golden_model.zbm.formats import (
     wrap,
 )
 from rasterhw.golden_model.zbm.seggen import Segments
 
-__all__ = ["unit_scanline", "segment_fragments"]
+__all__ = ["unit_frame", "unit_scanline", "segment_fragments"]
 
 
 def unit_scanline(segs: Segments, y: int, interleave: int, width: int) -> tuple[DoubleZ, dict]:
@@ -50,6 +50,23 @@ def _unit_frame_fast(segs: Segments, height: int, width: int) -> tuple[DoubleZ, 
     for ly in arrival_layers(pos):   # fragments in emission order, one vectorised step per layer
         writes += _insert(flat, pos[ly], z[ly], a[ly], c[ly], tag[ly])
     return buf, {"pixels": int(k.size), "writes": writes, "packets": None}
+
+
+def unit_frame(segs: Segments, height: int, width: int) -> DoubleZ:
+    """:func:`_unit_frame_fast`'s buffer without its counts: the two nearest samples of each
+    pixel by (z, emission) (:func:`nearest_two`; every sample z is at most ``Z_MAX_SAMPLE``,
+    nearer than ``Z_EMPTY``), without inserting layer by layer (the write count needs that)."""
+    buf = DoubleZ.empty((height, width))
+    flat = DoubleZ(buf.z.reshape(-1, 2), buf.a.reshape(-1, 2), buf.c.reshape(-1, 2, 4), buf.tag.reshape(-1, 2))
+    seg, k = segment_fragments(segs)
+    # the same int64 operations as _unit_frame_fast's, the other channels only for the kept samples
+    z = sample_z(wrap(segs.val[seg, 0] + k * segs.inc[seg, 0]))
+    pix, f, s = nearest_two(segs.y[seg] * width + segs.x[seg] + k, z)
+    two = s >= 0
+    for j, (p, i) in enumerate(((pix, f), (pix[two], s[two]))):
+        _, a, c = _samples(wrap(segs.val[seg[i]] + k[i, None] * segs.inc[seg[i]]), segs.mode)
+        flat.z[p, j], flat.a[p, j], flat.c[p, j], flat.tag[p, j] = z[i], a, c, segs.tag[seg[i]]
+    return buf
 
 
 def segment_fragments(segs: Segments) -> tuple[np.ndarray, np.ndarray]:

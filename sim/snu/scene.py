@@ -45,7 +45,7 @@ from rasterhw.sim.engines.scene import Done, Job, SceneRun, run_job
 from rasterhw.sim.snu.frame_format import GAP_BITS, SCHEDULE
 from rasterhw.sim.snu.testbench import BusBench, FrameBench, frame_of
 
-__all__ = ["ENGINES", "PixelbusScene", "clear_cycles", "golden_schedule", "measure_rates", "producer_gaps",
+__all__ = ["ENGINES", "PixelbusScene", "clear_cycles", "golden_schedule", "i860_clocks", "measure_rates", "producer_gaps",
            "run_frame_engine", "simulate", "simulate_pixelbus"]
 
 ENGINES = (*engines.ENGINES, *engines.ALIASES)   # pysim, verilator, cocotb-verilator, cocotb-icarus, icarus
@@ -58,6 +58,27 @@ RELEASE_DELAY = 2
 def clear_cycles(width: int, height: int, n_banks: int = N_BANKS) -> int:
     """Clocks a clear keeps the banks busy: one word per clock per bank, all banks at once."""
     return -(-width * height // n_banks)
+
+
+def i860_clocks(cpu: i860.I860) -> tuple[dict, list[int]]:
+    """``i860.scan_clocks(cpu)`` and the three geometry groups' clocks of one triangle
+    (``i860.table1_model``; its 8-triangle stream schedules are not used here), kept in the build
+    cache (``verilog_cache.arrays_cached``: keyed by ``cpu`` and the i860 model's sources): nine
+    list schedules in Python that do not depend on the scene (~0.1 CPU-s a run)."""
+    from rasterhw.sim.engines.verilog_cache import arrays_cached
+
+    groups = [("vertex_transform", "normal_transform"), ("normalise", "light"),
+              ("clip", "perspective_divide", "screen_map")]
+
+    def compute() -> dict:
+        sc = i860.scan_clocks(cpu)
+        geo = i860.table1_model(cpu, stream_triangles=0)
+        return {"triangle": np.int64(sc["triangle"]), "span": np.int64(sc["span"]), "pixel": np.float64(sc["pixel"]),
+                "groups": np.array([sum(geo[s]["clocks"] for s in g) for g in groups], np.int64)}
+
+    got = arrays_cached("snu-i860", Path(i860.__file__), [repr(cpu)], compute)
+    return ({"triangle": int(got["triangle"]), "span": int(got["span"]), "pixel": float(got["pixel"])},
+            [int(c) for c in got["groups"]])
 
 
 def producer_gaps(tris, stream: PixelStream, cpu: i860.I860 | None = None, *, n_pipes: int = 2,
@@ -81,11 +102,7 @@ def producer_gaps(tris, stream: PixelStream, cpu: i860.I860 | None = None, *, n_
     from rasterhw.golden_model.snu.gouraud import setup_spans
 
     cpu = cpu or i860.I860()
-    sc = i860.scan_clocks(cpu)
-    geo = i860.table1_model(cpu, stream_triangles=0)   # one triangle's clocks: the 8-triangle stream schedules are not used here (0.15 -> 0.014 CPU-s)
-    groups = [("vertex_transform", "normal_transform"), ("normalise", "light"),
-              ("clip", "perspective_divide", "screen_map")]
-    group_clocks = [sum(geo[s]["clocks"] for s in g) for g in groups]
+    sc, group_clocks = i860_clocks(cpu)
     ratio = cpu.clock_hz / clock_hz
     spans = setup_spans(tris) if spans is None else spans
     n_tri = tris.n_triangles
