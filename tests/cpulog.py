@@ -1,7 +1,8 @@
 """Where a test run's CPU goes (opt-in: ``RASTERHW_TEST_CPULOG=FILE``): every test appends one JSON
 line to FILE with its CPU seconds (user + sys of the pytest process and of the child processes it
-waited for: simulators, compilers, Yosys) from its setup to its teardown, its wall seconds and the
-worker's pid. CPU is what the suite costs whatever else runs on the machine (wall time is not: on
+waited for: simulators, compilers, Yosys) from its setup to its teardown, its wall seconds, when it
+ended (``end``, Unix time: a build folder's ``built`` time then says which test paid for the build)
+and the worker's pid. CPU is what the suite costs whatever else runs on the machine (wall time is not: on
 a loaded machine it grows with the load), so the sum over tests is the run's worker-CPU; a child
 process that outlives its test (a Dask cluster kept for the session) is counted in the test that
 reaps it. Used for docs/speed.md's account of the suite."""
@@ -31,4 +32,5 @@ class CpuLog:
         yield
         with open(self.path, "a") as fh:
             fh.write(json.dumps({"test": item.nodeid, "cpu_s": round(_cpu() - c, 3),
-                                 "wall_s": round(time.perf_counter() - t, 3), "pid": os.getpid()}) + "\n")
+                                 "wall_s": round(time.perf_counter() - t, 3), "end": round(time.time(), 1),
+                                 "pid": os.getpid()}) + "\n")
