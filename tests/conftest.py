@@ -36,6 +36,10 @@ def pytest_configure(config):
         from buildlog import install
 
         install(os.environ["RASTERHW_TEST_BUILDLOG"])
+    if os.environ.get("RASTERHW_TEST_CPULOG"):   # CPU seconds per test, load-robust (tests/cpulog.py)
+        from cpulog import CpuLog
+
+        config.pluginmanager.register(CpuLog(os.environ["RASTERHW_TEST_CPULOG"]), "rasterhw-cpulog")
 
 
 #: the YoWASP tools the suite runs (Yosys: synth, prove, mutate, the FPGA flow; nextpnr: the FPGA flow)

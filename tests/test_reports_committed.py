@@ -82,14 +82,18 @@ def test_zbm_report_measures_its_hdl_rows(monkeypatch):
     """The ZB/M report's HDL rows come back measured, word for word against the golden model: the
     skew pair (two chained units, twice) and the 1-unit chain on Verilator through the report's
     own rows (``skew`` and ``chain`` raise on a differing word), Table 1's steady state on pysim
-    at interleave 1 and 4, both schedules, each run comparing every merge word. The other runs of a
+    at interleave 1 and 4, both schedules, each run comparing every merge word (the test below,
+    one case per run, so that they run beside the Verilator runs under ``-n 2``). The skew's unit
+    "alone" is Table 1's paper-schedule unit at interleave 1 on Verilator (its frame 2 lines
+    taller): its steady state is the paper's 74 cycles per edge pair (it stands in the fast suite
+    for test_table1_paper_schedule_verilator[1], now slow: one build fewer). The other runs of a
     fast report, each checked in every test run elsewhere: Table 1 in pysim at interleave 2,
-    tests/zbm/test_zbm_unit_pysim.py::test_line_log_steady_state_equals_model (and at 1 and 8 on
+    tests/zbm/test_zbm_unit_pysim.py::test_line_log_steady_state_equals_model (and at 8 on
     Verilator, tests/zbm/test_zbm_cocotb.py::test_table1_paper_schedule_verilator); the pixel rate
     at interleave 1 and 4, test_pixel_rate_scales_with_interleave; all of them through the
     report: the ``slow`` test below."""
     from rasterhw.golden_model.zbm.cycles import formula_cycles_per_edge_pair
-    from rasterhw.sim.zbm import report, scaling
+    from rasterhw.sim.zbm import scaling
 
     monkeypatch.setattr(scaling, "FAST_SKIP_PIXEL_RATE", (1, 2, 4, 8, 16))
     monkeypatch.setattr(scaling, "FAST_SKIP_CHAIN", (2, 4, 8))
@@ -98,15 +102,27 @@ def test_zbm_report_measures_its_hdl_rows(monkeypatch):
     chain = {r["quantity"].split(",")[0]: r["measured"] for r in rows
              if r["figure"] == "6.1 (chain)" and r["quantity"].endswith("speed-up over 1 unit")}
     assert len(skew) == 2 and all(r["measured"] is not None and r["source"] == "hdl:verilator" for r in skew)
+    # the unit alone on Verilator (its value is in the pair row's label; measured, as the pair is)
+    (pair,) = [r for r in skew if "alone" in r["quantity"]]
+    assert f"(interleave 1, paper schedule; alone {formula_cycles_per_edge_pair(1):.1f};" in pair["quantity"]
     assert chain["1 chained unit"] == 1 and chain["2 chained units"] is None
     assert all(r["measured"] is None for r in rows if r["figure"] == "5.3")
-    for i in (1, 4):   # the interleaves a fast report measures on pysim besides 2
-        for sched in ("paper", "overlap"):
-            r = report.measure_steady_state(i, "pysim", sched)
-            assert r["words_compared"] > 0 and r["mismatches"] == 0
-            assert r["per_edge_pair"] == r["model_marginal"]
-            if sched == "paper":   # the paper's Table 1 formula: 74 cycles at 1, 59 at 4
-                assert r["per_edge_pair"] == formula_cycles_per_edge_pair(i)
+
+
+@pytest.mark.parametrize("sched", ["paper", "overlap"])
+@pytest.mark.parametrize("interleave", [1, 4])   # the interleaves a fast report measures on pysim besides 2
+def test_zbm_report_table1_steady_state_in_pysim(interleave, sched):
+    """The ZB/M report's Table 1 runs on pysim (``report.measure_steady_state``): every merge word
+    golden, the steady state = the exact model's marginal, and on the paper schedule = the paper's
+    Table 1 formula (74 cycles per edge pair at interleave 1, 59 at 4)."""
+    from rasterhw.golden_model.zbm.cycles import formula_cycles_per_edge_pair
+    from rasterhw.sim.zbm import report
+
+    r = report.measure_steady_state(interleave, "pysim", sched)
+    assert r["words_compared"] > 0 and r["mismatches"] == 0
+    assert r["per_edge_pair"] == r["model_marginal"]
+    if sched == "paper":
+        assert r["per_edge_pair"] == formula_cycles_per_edge_pair(interleave)
 
 
 @pytest.mark.slow
