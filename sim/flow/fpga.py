@@ -336,11 +336,12 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
         cached.write_text(json.dumps({"digest": digest, "result": r}, indent=1))
         return {**r, "build_dir": bdir, "cached": False, "digest": digest}
 
-    def unfinished(stage, why, t_stage, util=None, avail=None):
+    def unfinished(stage, why, t_stage, util=None, avail=None, synth_s=None):
+        """``synth_s``: Yosys's time when it was nextpnr that ran out of time (kept, not dropped)."""
         log = bdir / "nextpnr.log"
         progress = _progress(log.read_text(errors="replace"), router) if log.exists() and util else None
         return done(progress=progress, finished=False, fits=None if util is None else True, stage=stage, reason=why,
-                    timeout_s=timeout, utilization=util or {}, available=avail or {}, synth_s=None, pnr_s=t_stage)
+                    timeout_s=timeout, utilization=util or {}, available=avail or {}, synth_s=synth_s, pnr_s=t_stage)
 
     t0 = time.perf_counter()
     # the netlist is reused when the Verilog, the script and Yosys are the same (a second run
@@ -376,7 +377,7 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
     except _Timeout:
         return unfinished("place and route", f"nextpnr did not finish in {timeout / 60:.0f} min",
                           time.perf_counter() - t1, {k: v[0] for k, v in demand.items()},
-                          {k: v[1] for k, v in demand.items()})
+                          {k: v[1] for k, v in demand.items()}, synth_s=synth_s)
     t2 = time.perf_counter()
     rep = json.loads((bdir / "report.json").read_text())
     util = {k: v["used"] for k, v in rep.get("utilization", {}).items()}
