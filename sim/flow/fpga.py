@@ -336,11 +336,16 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
         cached.write_text(json.dumps({"digest": digest, "result": r}, indent=1))
         return {**r, "build_dir": bdir, "cached": False, "digest": digest}
 
-    def unfinished(stage, why, t_stage, util=None, avail=None):
+    def unfinished(stage, why, t_stage, util=None, avail=None, synth_s=None):
+        """``synth_s``: Yosys's time when it was nextpnr that ran out of time (kept, not dropped);
+        ``progress``: where the tool was, from its log (Yosys's last pass begun, or nextpnr's router)."""
         log = bdir / "nextpnr.log"
         progress = _progress(log.read_text(errors="replace"), router) if log.exists() and util else None
+        steps = sdir / YOSYS_STEPS
+        if stage == "synthesis" and steps.exists():
+            progress = _yosys_step(steps.read_text(errors="replace"))
         return done(progress=progress, finished=False, fits=None if util is None else True, stage=stage, reason=why,
-                    timeout_s=timeout, utilization=util or {}, available=avail or {}, synth_s=None, pnr_s=t_stage)
+                    timeout_s=timeout, utilization=util or {}, available=avail or {}, synth_s=synth_s, pnr_s=t_stage)
 
     t0 = time.perf_counter()
     # the netlist is reused when the Verilog, the script and Yosys are the same (a second run
@@ -353,7 +358,7 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
     else:
         stamp.unlink(missing_ok=True)
         try:
-            run([yosys, "-q", "-s", "synth.ys"], "yosys", "yosys.log", cwd=sdir)
+            run([yosys, "-q", "-l", YOSYS_STEPS, "-s", "synth.ys"], "yosys", "yosys.log", cwd=sdir)
         except _Timeout:
             return unfinished("synthesis", f"Yosys {synth_cmd} did not finish in {timeout / 60:.0f} min",
                               time.perf_counter() - t0)
@@ -376,7 +381,7 @@ def _place_and_route(block: str, *, family: str, device: str | None, seed: int, 
     except _Timeout:
         return unfinished("place and route", f"nextpnr did not finish in {timeout / 60:.0f} min",
                           time.perf_counter() - t1, {k: v[0] for k, v in demand.items()},
-                          {k: v[1] for k, v in demand.items()})
+                          {k: v[1] for k, v in demand.items()}, synth_s=synth_s)
     t2 = time.perf_counter()
     rep = json.loads((bdir / "report.json").read_text())
     util = {k: v["used"] for k, v in rep.get("utilization", {}).items()}
@@ -417,6 +422,8 @@ def not_measured_reason(r: dict) -> str | None:
                  if k in r["over"] or (k in _MAIN_KINDS and r["utilization"][k])]
         dev = DEVICE_NAMES[r["family"]][r["device"]]
         return f"does not fit {dev} (nextpnr --pack-only after {SYNTH_CMD[r['family']]}): " + "; ".join(shown)
+    if r.get("finished") is False and r.get("stage") == "synthesis" and r.get("progress"):
+        return f"{r['reason']} ({r['progress']})"
     where = _stopped_at(r) if r.get("finished") is False and r.get("stage") == "place and route" else None
     if where:
         demand = ", ".join(f"{k} {r['utilization'][k]:,}" for k in sorted(r.get("utilization", {}))
@@ -479,6 +486,19 @@ def synth_demand(block: str, **params) -> dict:
         f"against {ECP5_85K_BRAM_BITS:,} block-RAM bits (208 DP16KD) + at most {16 * ECP5_85K_LUT4:,} as LUT RAM")
     return {"block": block, "params": r["params"], "ram_bits": r["ram_bits"], "flipflops": r["flipflops"],
             "logic_cells": r["logic_cells"], "fits": fits, "reason": why}
+
+
+#: Yosys's full log of a place-and-route run's synthesis (``-l``; its console output, warnings only, is
+#: ``yosys.log``): where a synthesis that ran out of time had got to
+YOSYS_STEPS = "yosys_steps.log"
+
+_STEP_RE = re.compile(r"^(\d+(?:\.\d+)*)\. Executing (.+?)\.?$", re.M)
+
+
+def _yosys_step(log: str) -> str:
+    """Where Yosys was when its time ran out: the last pass its log says it began."""
+    steps = _STEP_RE.findall(log)
+    return f"Yosys at step {steps[-1][0]}: {steps[-1][1]}" if steps else "Yosys before its first pass"
 
 
 def _progress(log: str, router: str) -> str:

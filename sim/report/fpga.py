@@ -49,7 +49,9 @@ _UNLABELLED = {"ram", "schedule", "head", "index", "chip", "aj", "alpha", "beta"
 
 def _cfg(block: str, params: dict, kind: str) -> str:
     """Row label: ``full``/``reduced`` and the block's size parameters (defaults filled in), each
-    value in the words its machine gives it (``Flow.labels``, e.g. which datapath) or as ``name value``."""
+    value in the words its machine gives it (``Flow.labels``, e.g. which datapath) or as ``name value``;
+    a parameter that is not a size (``_UNLABELLED``) is shown only where ``Flow.labels`` names it
+    (the EXPERTS span PXP's anti-jagging)."""
     import inspect
 
     from rasterhw.sim.engines.verilog import blocks, load
@@ -57,8 +59,8 @@ def _cfg(block: str, params: dict, kind: str) -> str:
     sig = inspect.signature(load(blocks()[block]))
     eff = {k: v.default for k, v in sig.parameters.items() if v.default is not inspect.Parameter.empty}
     eff.update(params)
-    words = registry.flow(block).labels
-    shown = ", ".join(words.get(k, {}).get(v, f"{k} {v}") for k, v in eff.items() if k not in _UNLABELLED)
+    words = registry.flow(block).labels   # a parameter the machine names is shown, even one of _UNLABELLED
+    shown = ", ".join(words.get(k, {}).get(v, f"{k} {v}") for k, v in eff.items() if k not in _UNLABELLED or k in words)
     return f"{kind}: {shown}"
 
 
