@@ -73,34 +73,53 @@ def _rescore(b: dict, survivors: list[dict]) -> dict:
             "score": None if score is None else round(score, 4)}
 
 
-def classify_record(blocks: list[str] | None = None, path=None) -> list[str]:
+def classify_record(blocks: list[str] | None = None, path=None, folders: dict | None = None,
+                    toggle: bool = True) -> list[str]:
     """Every survivor of the record's blocks (``blocks``: only those) with the outputs its fault
     reaches and its class (:mod:`rasterhw.sim.flow.reach`; a survivor that reaches no output becomes
-    ``equivalent``, ``equivalence_how`` ``structural``, and leaves the score), from the block's
-    mutated bench made again at the record's parameters, mutants and seed. A block whose mutations
-    today differ from the record's (its design changed since) is left as it is; its name is returned
-    with why."""
-    from rasterhw.sim.flow.mutate import _survivor, mutated_bench, survivor_reach
+    ``equivalent``, ``equivalence_how`` ``structural``, and leaves the score) and, ``toggle``, whether
+    mutant 0's runs ever activate it (:mod:`rasterhw.sim.flow.toggle`: ``exercise``; every killed
+    mutant gets ``activated``), from the block's mutated bench made again at the record's parameters,
+    mutants and seed, or taken from ``folders`` (block -> a campaign's folder holding its
+    ``bench.v``, ``done.json`` and ``reach.json``, e.g. a copy of another tree's ``mutate --all``
+    folders: only read). A block whose mutations today differ from the record's (its design changed
+    since) is left as it is; its name is returned with why."""
+    import json as _json
+    from pathlib import Path
+
+    from rasterhw.sim.flow.mutate import _activation, _survivor, mutated_bench, survivor_reach
 
     record = _read(path)
     camp, skipped = record["campaign"], []
     for i, b in enumerate(camp["blocks"]):
         if "error" in b or not b.get("survivors") or (blocks is not None and b["block"] not in blocks):
             continue
-        m = mutated_bench(b["block"], b["params"], mutants=b["mutants"], seed=b["seed"])
-        by = {mu["mutant"]: mu for mu in m["mutations"]}
+        if folders and b["block"] in folders:
+            bdir = Path(folders[b["block"]])
+            muts = _json.loads((bdir / "done.json").read_text())["mutations"]
+        else:
+            m = mutated_bench(b["block"], b["params"], mutants=b["mutants"], seed=b["seed"])
+            bdir, muts = m["dir"], m["mutations"]
+        by = {mu["mutant"]: mu for mu in muts}
         if any(_same(by.get(s["mutant"], {}).get("mutation", "")) != _same(s["mutation"]) for s in b["survivors"]) \
                 or len(by) != b["mutants"]:
             skipped.append(f"{b['block']}: its mutations today differ from the record's (the design changed)")
             continue
-        reached = survivor_reach(b["block"], b["params"], b["seed"], m["dir"], m["mutations"])
+        reached = survivor_reach(b["block"], b["params"], b["seed"], bdir, muts)
+        act = _activation(b["block"], b["params"], b["seed"], bdir, muts) if toggle else None
+        if act is not None and "error" in act:
+            skipped.append(f"{b['block']}: toggle pass: {act['error']}")
+        acts = act["mutants"] if act and "mutants" in act else None
         kept = []
         for s in b["survivors"]:
             eq = ({"equivalence": s["equivalence"], "why": s.get("equivalence_why", "")}
                   if s.get("equivalence") and s.get("equivalence_how", "").split(":")[0] != "structural" else None)
-            kept.append(_survivor({"mutant": s["mutant"]}, by[s["mutant"]], eq, reached))
+            kept.append(_survivor({"mutant": s["mutant"]}, by[s["mutant"]], eq, reached, acts))
         camp["blocks"][i] = {**_rescore(b, kept), "killed_by": [
-            {**k, "reaches": reached["reaches"][k["mutant"]]} for k in b.get("killed_by", [])]}
+            {**k, "reaches": reached["reaches"][k["mutant"]],
+             **({"activated": acts[k["mutant"]]["activated"]} if acts else {})} for k in b.get("killed_by", [])]}
+        if acts:
+            camp["blocks"][i].update(toggle_build_s=act["build_s"], toggle_runs_s=act["runs_s"])
     write_record(camp, record["proofs"], record["commands"], path)
     return skipped
 
