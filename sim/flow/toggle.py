@@ -74,22 +74,22 @@ def activated(t: dict, seen: dict) -> tuple[bool, str]:
 
     def said(b):
         v = took(b)
-        return "tied to constant " + b if isinstance(b, str) else \
-            "toggles" if v == {0, 1} else f"always {next(iter(v))}" if v else "never sampled"
+        return "is tied to constant " + b if isinstance(b, str) else \
+            "toggles" if v == {0, 1} else f"is always {next(iter(v))}" if v else "is never sampled"
 
     mode = t["mode"]
     if mode == "inv":
-        return True, "an inversion changes the bit at every edge"
+        return True, f"an inversion changes the bit at every edge (the bit {said(t['bit'])})"
     if mode in ("const0", "const1"):
         need = 1 if mode == "const0" else 0
         ok = need in took(t["bit"])
-        return ok, (f"the bit is {need} at some edge ({said(t['bit'])}); {mode} changes it there" if ok else
-                    f"the bit is never {need} ({said(t['bit'])}): {mode} never changes it")
+        return ok, (f"the bit is {need} at some edge (it {said(t['bit'])}); {mode} changes it there" if ok else
+                    f"the bit is never {need} (it {said(t['bit'])}): {mode} never changes it")
     if mode in ("cnot0", "cnot1"):
         need = 1 if mode == "cnot1" else 0
         ok = need in took(t["ctrl"])
-        return ok, (f"its control bit is {need} at some edge ({said(t['ctrl'])})" if ok else
-                    f"its control bit is never {need} ({said(t['ctrl'])}): {mode} never changes the bit")
+        return ok, (f"its control bit is {need} at some edge (it {said(t['ctrl'])})" if ok else
+                    f"its control bit is never {need} (it {said(t['ctrl'])}): {mode} never changes the bit")
     raise RasterhwError(f"toggle: mutation mode {mode!r} not known here")
 
 
