@@ -497,12 +497,15 @@ def activation_task(block: str, params: str, seed: int, bdir: str) -> dict:
 
 
 def _toggle_cost(act: dict | None) -> dict:
-    """The toggle pass's cost (its build and runs) or why it has none, for a campaign's result."""
+    """The toggle pass's cost (its build and runs) or why it has none, for a campaign's result. Run
+    as a task (``mutate --all``) its ``runs_s`` is folded into the task's ``wall_s``
+    (:mod:`rasterhw.sim.flow.tasks`): the runs are then that less the build (and the probe's Yosys run)."""
     if act is None:
         return {}
     if "error" in act:
         return {"toggle_error": act["error"]}
-    return {"toggle_build_s": act["build_s"], "toggle_runs_s": act["runs_s"]}
+    runs = act["runs_s"] if "runs_s" in act else round(act["wall_s"] - act["build_s"], 2)
+    return {"toggle_build_s": act["build_s"], "toggle_runs_s": runs}
 
 
 def _yosys_s(folder: str) -> float | None:
