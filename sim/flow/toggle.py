@@ -8,7 +8,7 @@ the same cell and net numbers as ``list.ys``): every bit a mutation changes, and
 mutation's control bit, is wired to one probe vector; the bench top samples it at every edge of every
 clock input and keeps, per bit, whether it was ever 0 and ever 1; a ``final`` block writes the two
 vectors. One extra Verilator build per block (the unmutated netlist, no mutation multiplexers),
-then every run a mutant gets (:func:`rasterhw.sim.flow.mutate.runs_of`: back to back, gaps and
+then every run a mutant gets (:func:`rasterhw.sim.flow.mutant_run.runs_of`: back to back, gaps and
 back-pressure, separate clocks) with mutant 0's stimulus; the runs must pass the testbench's checks
 (the probe build is the block), and their samples are merged.
 
@@ -161,7 +161,7 @@ def activation(block: str, params: dict, seed: int, bdir: str | Path, mutations:
     import time
 
     from rasterhw.sim.engines import verilator
-    from rasterhw.sim.flow.mutate import _build, _run, _setup, runs_of
+    from rasterhw.sim.flow.mutant_run import build, run_mutant, runs_of, setup
     from rasterhw.sim.flow.reach import _netlist
     from rasterhw.sim.testbench import compare
 
@@ -170,7 +170,7 @@ def activation(block: str, params: dict, seed: int, bdir: str | Path, mutations:
         json.loads((bdir / "reach.json").read_text())["modules"]["rasterhw_bench"]
     tg = {mu["mutant"]: targets(mod, mu["command"]) for mu in mutations}
     nets = sorted({b for t in tg.values() for b in (t["bit"], t["ctrl"]) if isinstance(b, int)})
-    tb, p, stim, exp, want = _setup(block, dict(params), seed)
+    tb, p, stim, exp, want = setup(block, dict(params), seed)
     seen: dict[int, set] = {b: set() for b in nets}
     build_s = runs_s = 0.0
     if nets:
@@ -178,11 +178,11 @@ def activation(block: str, params: dict, seed: int, bdir: str | Path, mutations:
         _name, _files, defines = verilator.bench_design(tb, p, inputs, outputs, speed=False,
                                                         separate=bool(tb.mutation_clocks))
         text = _probe_bench(bdir, mod, nets)
-        exe, build_s = _build((f"tgl-{block}", {"rasterhw_bench.v": text}, defines), tb.verilator_opt)
+        exe, build_s = build((f"tgl-{block}", {"rasterhw_bench.v": text}, defines), tb.verilator_opt)
         t0 = time.perf_counter()
         for label, kw, exact in runs_of(tb):
             got_files: dict = {}
-            got = _run(exe, tb, p, stim, want, 0, **kw, read=lambda d, into=got_files: into.update(
+            got = run_mutant(exe, tb, p, stim, want, 0, **kw, read=lambda d, into=got_files: into.update(
                 text=(d / OUT).read_text() if (d / OUT).exists() else ""))
             c = compare(exp, got, cycle_exact=exact)
             if c["mismatches"] or c["cycle_mismatches"] or got.protocol_errors:
