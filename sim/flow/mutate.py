@@ -335,9 +335,12 @@ def _survivor(r: dict, mu: dict, eq: dict | None, reached: dict | None, act: dic
         if out["reach_class"] == "unobservable":
             return {**out, "equivalence": "equivalent", "equivalence_how": "structural: no path to any output"}
     if act is not None and r["mutant"] in act:
-        from rasterhw.sim.flow.toggle import exercise
+        from rasterhw.sim.flow.toggle import CONSTANT, exercise
 
-        out.update(exercise=exercise(act[r["mutant"]]), exercise_why=act[r["mutant"]]["why"])
+        a = act[r["mutant"]]
+        out.update(exercise=exercise(a), exercise_why=a["why"])
+        if a.get("constant"):   # the netlist is unchanged: equivalent by structure, no proof needed
+            return {**out, "equivalence": "equivalent", "equivalence_how": CONSTANT}
     if eq is not None:
         out["equivalence"] = eq["equivalence"]
         if eq["equivalence"] == "equivalent":

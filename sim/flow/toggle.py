@@ -24,7 +24,9 @@ them can take in; a value a net holds only between edges changes nothing.
 Each ``compared`` survivor then gets ``exercise``: ``not_exercised`` (never activated: the
 stimulus never drives the bit to the value the fault needs) or ``exercised`` (activated, yet no
 compared output differs in any run: masked downstream, or equivalent in a way neither tracing nor
-proof shows). Nothing here knows a machine.
+proof shows). A mutation that needs a value its bit can never take — the bit (a ``cnot``'s control
+bit) is a constant in the netlist and the fault needs the other value — leaves the netlist as it
+was: equivalent by structure, with ``constant`` set (:data:`CONSTANT`). Nothing here knows a machine.
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ from rasterhw.sim.flow.tools import tool
 from rasterhw.sim.paths import BUILD_ROOT
 from rasterhw.sim.workdirs import build_lock
 
-__all__ = ["activation", "activated", "exercise", "probe_verilog", "targets"]
+__all__ = ["CONSTANT", "activation", "activated", "exercise", "probe_verilog", "targets"]
 
 #: the probe vector's name in the netlist, and the file the bench's ``final`` block writes
 PROBE, OUT = "tgl_probe", "toggle.txt"
@@ -200,6 +202,8 @@ def activation(block: str, params: dict, seed: int, bdir: str | Path, mutations:
     for k, t in tg.items():
         ok, why = activated(t, seen)
         out[k] = {"activated": ok, "why": why}
+        if not ok and isinstance(t["ctrl"] if t["mode"].startswith("cnot") else t["bit"], str):
+            out[k]["constant"] = True   # the value it needs is a constant's other value: no stimulus has it
     return {"mutants": out, "build_s": round(build_s, 2), "runs_s": round(runs_s, 2),
             "runs": [label for label, _kw, _e in runs_of(tb)]}
 
@@ -207,3 +211,8 @@ def activation(block: str, params: dict, seed: int, bdir: str | Path, mutations:
 def exercise(act: dict) -> str:
     """A ``compared`` survivor's class from its :func:`activation` entry."""
     return "exercised" if act["activated"] else "not_exercised"
+
+
+#: ``equivalence_how`` of a mutation that can never change its bit: the bit (a ``cnot``'s control
+#: bit) is a constant in the netlist and the fault needs the other value
+CONSTANT = "structural: the mutation needs a value its bit, tied to a constant, never takes"

@@ -133,7 +133,7 @@ def classify_all(result: dict, folders: dict) -> list[str]:
     campaign's own folders (``folders``: block -> its folder, or a copy: only read). Returns the
     blocks left without, with why."""
     from rasterhw.sim.flow.mutate import _activation
-    from rasterhw.sim.flow.toggle import exercise
+    from rasterhw.sim.flow.toggle import CONSTANT, exercise
 
     left = []
     for b in result["blocks"]:
@@ -150,9 +150,11 @@ def classify_all(result: dict, folders: dict) -> list[str]:
         for s in b["survivors"]:
             if s.get("equivalence") != "equivalent":
                 s.update(exercise=exercise(acts[s["mutant"]]), exercise_why=acts[s["mutant"]]["why"])
+                if acts[s["mutant"]].get("constant"):
+                    s.update(equivalence="equivalent", equivalence_how=CONSTANT)
         for k in b.get("killed_by", []):
             k["activated"] = acts[k["mutant"]]["activated"]
-        b.update(toggle_build_s=act["build_s"], toggle_runs_s=act["runs_s"])
+        b.update(_rescore(b, b["survivors"]), toggle_build_s=act["build_s"], toggle_runs_s=act["runs_s"])
     return left
 
 
@@ -336,6 +338,8 @@ def _survivor_note(s: dict) -> str:
         out += f"; equivalence: **{s['equivalence']}**{how}{why}"
     if s.get("exercise"):
         out += f"; **{s['exercise'].replace('_', ' ')}**: {s['exercise_why']}"
+        if s.get("equivalence") == "equivalent" and s.get("reach_class") != "unobservable":
+            out += " — **equivalent** by structure (the netlist is unchanged)"
     return out
 
 
