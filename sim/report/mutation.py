@@ -309,7 +309,8 @@ def why_table(blocks: list[dict]) -> list[str]:
           "a stimulus gap, the bit and value named below. **exercised**: the fault changes the bit at some "
           "clock edge, yet no compared output differs in any run (masked downstream, or equivalent in a way "
           "neither the tracing nor the proof shows). **not classed**: no toggle pass for the block (its "
-          "mutations today differ from the record's, so the record's survivors cannot be mapped).", "",
+          "mutations today differ from the record's, so the record's survivors cannot be mapped, or its "
+          "campaign's folder was not at hand).", "",
           "| block | score | survived | not exercised | exercised | not classed |", "|---|---|---|---|---|---|"]
     tot = [0, 0, 0, 0]
     for b in blocks:
