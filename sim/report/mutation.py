@@ -376,5 +376,5 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir=None, fast: b
             v = None if why else b[key]
             out.append(make_row(system, fig, q, paper=None, formula=None, measured=v, unit=unit,
                                 source="hdl:verilator", reason=why))
-    run_all = _read(ALL_RECORD)
+    run_all = _read(ALL_RECORD) if record else None
     return out, (sections(record) if record else []) + (all_section(run_all, record) if run_all else [])
