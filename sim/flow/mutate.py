@@ -41,21 +41,21 @@ import time
 from pathlib import Path
 
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.engines import verilator, with_gaps
-from rasterhw.sim.engines.runner import HARNESS_V, build_plain_verilator, run_plain_verilator
+from rasterhw.sim.engines import verilator
+from rasterhw.sim.flow.mutant_run import CTRL, SLOW_RUN, mutation_blocks, runs_of
+from rasterhw.sim.flow.mutant_run import build as _build
+from rasterhw.sim.flow.mutant_run import run_mutant as _run
+from rasterhw.sim.flow.mutant_run import setup as _setup
 from rasterhw.sim.flow.tasks import Runner, call
 from rasterhw.sim.flow.tools import tool, tool_version
 from rasterhw.sim.paths import BUILD_ROOT
-from rasterhw.sim.testbench import Run, clocks_of, compare, find_testbench
-from rasterhw.sim.workdirs import build_lock, release, temp_run_folder
+from rasterhw.sim.testbench import compare, find_testbench
+from rasterhw.sim.workdirs import build_lock
 
-__all__ = ["CTRL", "SLOW_RUN", "all_configs", "campaign", "campaign_all", "equivalence", "mutant_result", "mutated_bench",
-           "mutation_blocks", "parse_mutations", "prepare", "survivor_reach"]
+__all__ = ["CTRL", "SLOW_RUN", "activation_task", "all_configs", "campaign", "campaign_all", "equivalence",
+           "mutant_result", "mutated_bench", "mutation_blocks", "parse_mutations", "prepare", "runs_of",
+           "survivor_reach"]
 
-#: the control input Yosys adds (``mutate -ctrl``), read from ``+mutsel=K``
-CTRL = "mutsel"
-#: the second run of every mutant: idle gaps and back-pressure, as ``tests/test_engines.py``
-SLOW_RUN = {"idle": 0.3, "stall": 90, "seed": 5}
 #: cells that may be mutated: Amaranth source (``.py``), not the bench (``sim/``)
 SELECTION = "a:src=*.py:* a:src=*/sim/* %d"
 #: ``mutate --all``: blocks whose Yosys run and build are under way at once (the rest of the
@@ -65,24 +65,6 @@ PREPARING = 2
 #: bank at its default size had not finished in 300 s; experts-slp-setup at its small size took
 #: 1,864 s on the shared 2-core machine at load 7-10, so ``mutate --all`` needs more than 600)
 YOSYS_TIMEOUT_S = 3600.0
-
-
-def mutation_blocks() -> list[str]:
-    """Every block with a registered testbench (what ``mutate`` can run), sorted."""
-    from rasterhw.sim import registry
-
-    return sorted(registry.entries("testbenches"))
-
-
-def _setup(block: str, params: dict, seed: int):
-    """(testbench, parameters, stimulus, expected, words to collect) of a campaign."""
-    if block not in mutation_blocks():
-        raise RasterhwError(f"no testbench for block {block!r}; blocks: {', '.join(mutation_blocks())}")
-    tb = find_testbench(block)
-    p = tb.params(**params)
-    stim = tb.stimulus(p, seed)
-    exp = tb.expect(p, stim)
-    return tb, p, stim, exp, {k: len(v) for k, v in exp.words.items()}
 
 
 def _width(mutants: int) -> int:
@@ -183,38 +165,6 @@ def mutated_bench(block: str, params: dict | None = None, *, mutants: int, seed:
     return {"design": design, "mutations": done["mutations"], "yosys_s": done["yosys_s"], "dir": bdir}
 
 
-def _build(design, opt: str) -> tuple[Path, float]:
-    name, generated, defines = design
-    return build_plain_verilator(name, "rasterhw_bench", [HARNESS_V], params={}, opt=opt, defines=defines,
-                                 generated=generated)
-
-
-def _run(exe: Path, tb, p: dict, stim, want: dict, mutant: int, *, idle: float = 0.0, stall: int = 0,
-         seed: int = 1, clocks: dict | None = None) -> Run:
-    """One run of the mutated bench with mutant ``mutant`` active: the engine's sources, sinks,
-    gaps, back-pressure and watchdog (``sim/engines/__init__.py: run``, the plain engine's plusargs);
-    ``clocks``: each domain's own :class:`Clock` (a bench built with separate clocks; none: every
-    clock the same)."""
-    ins = tb.inputs_of(p)
-    if idle:
-        stim = with_gaps(stim, idle, seed, ins)
-    inputs, _outputs = verilator.memory_depths(tb, p, stim, want)
-    words = sum(len(w) for w in stim.words.values()) + sum(want.values())
-    gaps = sum(sum(int(g) for g in stim.gaps_of(n)) for n in ins)
-    max_cycles = (10_000 + 64 * words + gaps) * (1 + stall // 32)   # the engine's watchdog
-    if clocks:   # the watchdog counts edges of the first domain's clock: as slow as the slowest
-        max_cycles *= -(-max(c.half for c in clocks.values()) // next(iter(clocks.values())).half)
-    run_dir = temp_run_folder(exe.parent.parent)
-    try:
-        plus = verilator.stream_plusargs(run_dir, tb, p, stim, stall=stall, seed=seed, expect_words=want,
-                                         inputs=inputs, clocks=clocks)
-        meta = run_plain_verilator(exe, [*plus, f"+{CTRL}={mutant}"], run_dir=run_dir, maxcyc=max_cycles)
-        got, stamps = verilator.collected(run_dir, tb.outputs_of(p), want)
-    finally:
-        release(run_dir)
-    return Run("verilator", got, stamps, run_s=meta["run_s"], protocol_errors=int(meta.get("errors", 0)))
-
-
 def mutant_result(block: str, params: str, mutants: int, seed: int, mutant: int) -> dict:
     """Mutant ``mutant`` of a campaign through the block's testbench (one task): ``{"mutant",
     "killed", "why"}`` (``why``: the first check that failed; empty when it survived)."""
@@ -222,12 +172,7 @@ def mutant_result(block: str, params: str, mutants: int, seed: int, mutant: int)
     m = mutated_bench(block, json.loads(params), mutants=mutants, seed=seed)
     exe, _ = _build(m["design"], tb.verilator_opt)
     why = []
-    runs = [("back to back", {}, True), ("gaps and back-pressure", SLOW_RUN, False)]
-    if tb.mutation_clocks:   # the testbench's separate clocks (a clock-domain crossing), gaps and back-pressure
-        clocks = clocks_of(tb.mutation_clocks, tb.domains)
-        runs.append(("separate clocks " + " : ".join(f"{d} {c.half}" for d, c in clocks.items()),
-                     {**SLOW_RUN, "clocks": clocks}, False))
-    for label, kw, exact in runs:
+    for label, kw, exact in runs_of(tb):
         try:
             got = _run(exe, tb, p, stim, want, mutant, **kw)
         except RasterhwError as e:   # the watchdog, or the binary failed
@@ -376,9 +321,11 @@ def survivor_reach(block: str, params: dict, seed: int, bdir: str | Path, mutati
             "compared": sorted(compared_tags(exp.words))}
 
 
-def _survivor(r: dict, mu: dict, eq: dict | None, reached: dict | None) -> dict:
+def _survivor(r: dict, mu: dict, eq: dict | None, reached: dict | None, act: dict | None = None) -> dict:
     """One survivor's entry: its source, mutation, the outputs it reaches and its class
-    (:mod:`rasterhw.sim.flow.reach`), and its equivalence (``unobservable``: ``equivalent`` by structure)."""
+    (:mod:`rasterhw.sim.flow.reach`), and its equivalence (``unobservable``: ``equivalent`` by
+    structure); ``act``: the campaign's :func:`rasterhw.sim.flow.toggle.activation` by mutant: a
+    survivor that reaches an output gets ``exercise`` (``exercised`` / ``not_exercised``) and why."""
     from rasterhw.sim.flow.reach import classify
 
     out = {"mutant": r["mutant"], "src": mu["src"], "mutation": mu["mutation"]}
@@ -387,6 +334,13 @@ def _survivor(r: dict, mu: dict, eq: dict | None, reached: dict | None) -> dict:
         out.update(reaches=hits, reach_class=classify(hits, set(reached["compared"])))
         if out["reach_class"] == "unobservable":
             return {**out, "equivalence": "equivalent", "equivalence_how": "structural: no path to any output"}
+    if act is not None and r["mutant"] in act:
+        from rasterhw.sim.flow.toggle import CONSTANT, exercise
+
+        a = act[r["mutant"]]
+        out.update(exercise=exercise(a), exercise_why=a["why"])
+        if a.get("constant"):   # the netlist is unchanged: equivalent by structure, no proof needed
+            return {**out, "equivalence": "equivalent", "equivalence_how": CONSTANT}
     if eq is not None:
         out["equivalence"] = eq["equivalence"]
         if eq["equivalence"] == "equivalent":
@@ -397,17 +351,21 @@ def _survivor(r: dict, mu: dict, eq: dict | None, reached: dict | None) -> dict:
 
 
 def _summary(block: str, p: dict, seed: int, mutations: list[dict], res: list[dict],
-             equiv: dict[int, dict] | None = None, reached: dict | None = None) -> dict:
+             equiv: dict[int, dict] | None = None, reached: dict | None = None, act: dict | None = None) -> dict:
     """The counts, score and survivors of one block's campaign from its mutants' results (0 first);
     ``equiv``: the survivors' :func:`equivalence` results by mutant (a proven one leaves the score);
-    ``reached``: :func:`survivor_reach` (a survivor that reaches no output leaves it too)."""
+    ``reached``: :func:`survivor_reach` (a survivor that reaches no output leaves it too); ``act``:
+    :func:`rasterhw.sim.flow.toggle.activation` (each survivor's ``exercise``, each killed mutant's
+    ``activated``)."""
     base, rest = res[0], res[1:]
     by = {mu["mutant"]: mu for mu in mutations}
     equiv = equiv or {}
     if reached is not None:   # a stored task result's keys are strings
         reached = {**reached, "reaches": {int(k): v for k, v in reached["reaches"].items()}}
+    act = {int(k): v for k, v in act["mutants"].items()} if act and "mutants" in act else None
     killed = sum(r["killed"] for r in rest)
-    survivors = [_survivor(r, by[r["mutant"]], equiv.get(r["mutant"]), reached) for r in rest if not r["killed"]]
+    survivors = [_survivor(r, by[r["mutant"]], equiv.get(r["mutant"]), reached, act)
+                 for r in rest if not r["killed"]]
     equivalent = sum(s.get("equivalence") == "equivalent" for s in survivors)
     n = len(rest)
     score = killed / (n - equivalent) if not base["killed"] and n > equivalent else None
@@ -416,7 +374,8 @@ def _summary(block: str, p: dict, seed: int, mutations: list[dict], res: list[di
             "equivalent": equivalent, "survived": n - killed - equivalent, "bounded_equivalent": 0,
             "score": None if score is None else round(score, 4), "survivors": survivors,
             "killed_by": [{"mutant": r["mutant"], "why": r["why"],
-                           **({"reaches": reached["reaches"][r["mutant"]]} if reached else {})}
+                           **({"reaches": reached["reaches"][r["mutant"]]} if reached else {}),
+                           **({"activated": act[r["mutant"]]["activated"]} if act else {})}
                           for r in rest if r["killed"]]}
 
 
@@ -425,7 +384,10 @@ def campaign(block: str, params: dict | None = None, *, mutants: int = 40, seed:
              progress: bool = False, equivalence: bool = True) -> dict:
     """A mutation campaign on ``block`` (the module docstring); the result ``--json`` prints.
     ``equivalence``: every survivor's :func:`equivalence` proof too (a task each, after the runs;
-    ``survivors[i]["equivalence"]``; a proven one counts in ``equivalent``, not in the score)."""
+    ``survivors[i]["equivalence"]``; a proven one counts in ``equivalent``, not in the score). Every
+    survivor that reaches an output gets ``exercise`` from the toggle pass on mutant 0's runs
+    (:mod:`rasterhw.sim.flow.toggle`: one more build, of the unmutated bench; its cost in
+    ``toggle_build_s`` and ``toggle_runs_s``)."""
     _check(mutants, seed)
     tb, p, _stim, _exp, _want = _setup(block, dict(params or {}), seed)
     t0 = time.perf_counter()
@@ -439,17 +401,48 @@ def campaign(block: str, params: dict | None = None, *, mutants: int = 40, seed:
                       if progress else None)
         runs_s = time.perf_counter() - built
         reached = survivor_reach(block, dict(params or {}), seed, m["dir"], m["mutations"])
+        act = _activation(block, dict(params or {}), seed, m["dir"], m["mutations"]) if not res[0]["killed"] else None
         alive = [r["mutant"] for r in res[1:] if not r["killed"] and reached["reaches"][r["mutant"]]] \
             if equivalence and not res[0]["killed"] else []
         eq = run.map([call("rasterhw.sim.flow.mutate:equivalence", block=block, params=given, mutants=mutants,
                            seed=seed, mutant=k) for k in alive]) if alive else []
         where, computed, reused = run.address(), run.computed, run.reused
     equiv_s = time.perf_counter() - built - runs_s
-    return {**_summary(block, p, seed, m["mutations"], res, {e["mutant"]: e for e in eq}, reached),
-            **({"equiv_s": round(equiv_s, 2)} if equivalence else {}),
+    return {**_summary(block, p, seed, m["mutations"], res, {e["mutant"]: e for e in eq}, reached, act),
+            **({"equiv_s": round(equiv_s, 2)} if equivalence else {}), **_toggle_cost(act),
             "scheduler": where, "computed": computed, "reused": reused,
             "yosys_s": m["yosys_s"], "build_s": round(build_s, 2), "runs_s": round(runs_s, 2),
             "wall_s": round(time.perf_counter() - t0, 2), "dir": str(m["dir"])}
+
+
+def _activation(block: str, params: dict, seed: int, bdir, mutations: list[dict]) -> dict:
+    """:func:`rasterhw.sim.flow.toggle.activation`, or ``{"error"}`` (one line) when the probe build
+    or its runs fail: the campaign's result stands without it."""
+    from rasterhw.sim.flow.toggle import activation
+
+    try:
+        return activation(block, params, seed, bdir, mutations)
+    except RasterhwError as e:
+        return {"error": str(e).splitlines()[0]}
+
+
+def activation_task(block: str, params: str, seed: int, bdir: str) -> dict:
+    """:func:`_activation` of a prepared block (``mutate --all``: one task; the mutations are read
+    from the campaign's folder)."""
+    muts = json.loads((Path(bdir) / "done.json").read_text())["mutations"]
+    return _activation(block, json.loads(params), seed, bdir, muts)
+
+
+def _toggle_cost(act: dict | None) -> dict:
+    """The toggle pass's cost (its build and runs) or why it has none, for a campaign's result. Run
+    as a task (``mutate --all``) its ``runs_s`` is folded into the task's ``wall_s``
+    (:mod:`rasterhw.sim.flow.tasks`): the runs are then that less the build (and the probe's Yosys run)."""
+    if act is None:
+        return {}
+    if "error" in act:
+        return {"toggle_error": act["error"]}
+    runs = act["runs_s"] if "runs_s" in act else round(act["wall_s"] - act["build_s"], 2)
+    return {"toggle_build_s": act["build_s"], "toggle_runs_s": runs}
 
 
 def _yosys_s(folder: str) -> float | None:
@@ -493,7 +486,7 @@ def campaign_all(*, mutants: int = 30, seed: int = 1, scheduler: str = "serial",
         raise RasterhwError(f"--budget must be a number of seconds above 0, not {budget_s!r}")
     t0 = time.perf_counter()
     say = (lambda msg: print(msg, file=sys.stderr)) if progress else (lambda msg: None)
-    preps, handles = {}, {}
+    preps, handles, acts = {}, {}, {}
     with Runner(scheduler, store=store, fresh=fresh) as run:
         t_run = time.perf_counter()
         queue, inflight = list(configs), {}
@@ -519,8 +512,10 @@ def campaign_all(*, mutants: int = 30, seed: int = 1, scheduler: str = "serial",
                 say(f"mutate --all: {b}: " + (f"error: {prep['error']}" if "error" in prep else
                                               f"{len(prep['mutations'])} mutants built"))
                 if "error" not in prep:
-                    handles[b] = [run.submit(t) for t in _mutant_tasks(b, json.dumps(prep["params"], sort_keys=True),
-                                                                       mutants, seed, len(prep["mutations"]))]
+                    given = json.dumps(prep["params"], sort_keys=True)
+                    handles[b] = [run.submit(t) for t in _mutant_tasks(b, given, mutants, seed, len(prep["mutations"]))]
+                    acts[b] = run.submit(call("rasterhw.sim.flow.mutate:activation_task", block=b, params=given,
+                                              seed=seed, bdir=prep["dir"]))
         out = []
         for b in configs:
             prep = preps[b]
@@ -530,8 +525,9 @@ def campaign_all(*, mutants: int = 30, seed: int = 1, scheduler: str = "serial",
                             "error": prep["error"], "score": None})
                 continue
             res = [run.result(h) for h in handles[b]]
-            out.append({**_summary(b, full, seed, prep["mutations"], res, None, prep.get("reached")),
-                        "config": prep["config"],
+            act = run.result(acts[b]) if not res[0]["killed"] else None
+            out.append({**_summary(b, full, seed, prep["mutations"], res, None, prep.get("reached"), act),
+                        "config": prep["config"], **_toggle_cost(act),
                         "yosys_s": _yosys_s(prep["dir"]), "build_s": prep.get("build_s"),
                         "runs_s": round(sum(r.get("wall_s", 0.0) for r in res), 2), "dir": prep["dir"]})
             say(f"mutate --all: {b}: score {out[-1]['score']}")

@@ -88,32 +88,139 @@ def _frame_words(rgb: np.ndarray, z: np.ndarray, z_bits: int) -> list[int]:
     return ((rgb.ravel() << z_bits) | z.ravel()).tolist()
 
 
+#: the bank's commands in its testbench's stream (``PixelBusBank``'s ``Command``: CLEAR 0, SWAP 1)
+CLEAR, SWAP = 0, 1
+
+
+def _with_commands(bank):
+    """The bank with one write stream ``i`` of ``{write, is_cmd, cmd}`` words, in order: a word with
+    ``is_cmd`` goes to ``i_cmd`` (``cmd``: CLEAR or SWAP), the others to ``i``; so the testbench
+    orders writes and commands exactly, and the bank sees each when it is offered (its own rule,
+    "commands win", is then never a race). Read port, ``busy`` and ``draw_buf`` pass through."""
+    from amaranth import Module, Mux
+    from amaranth.lib import data, stream, wiring
+    from amaranth.lib.wiring import In, Out
+
+    w = len(bank.i.payload.as_value())
+    word = data.StructLayout({"write": w, "is_cmd": 1, "cmd": 1})   # the write in the low bits
+
+    class BankWithCommands(wiring.Component):
+        def __init__(self):
+            super().__init__({"i": In(stream.Signature(word)), "rd_addr": In(len(bank.rd_addr)), "rd_buf": In(1),
+                              "rd_rgb": Out(len(bank.rd_rgb)), "rd_z": Out(len(bank.rd_z)), "busy": Out(1)})
+
+        def extra_verilog(self) -> str:
+            return bank.extra_verilog()
+
+        def elaborate(self, platform):
+            m = Module()
+            m.submodules.bank = bank
+            cmd = self.i.payload.is_cmd
+            m.d.comb += [
+                bank.i.payload.as_value().eq(self.i.payload.write), bank.i.valid.eq(self.i.valid & ~cmd),
+                bank.i_cmd.payload.as_value().eq(self.i.payload.cmd), bank.i_cmd.valid.eq(self.i.valid & cmd),
+                self.i.ready.eq(Mux(cmd, bank.i_cmd.ready, bank.i.ready)),
+                bank.rd_addr.eq(self.rd_addr), bank.rd_buf.eq(self.rd_buf),
+                self.rd_rgb.eq(bank.rd_rgb), self.rd_z.eq(bank.rd_z), self.busy.eq(bank.busy)]
+            return m
+
+    return BankWithCommands()
+
+
+def _bank_read_out(bank, depth: int):
+    """:func:`_with_commands` behind ``ReadOut``: both RGB buffers out, the draw buffer's ``depth``
+    words first (``rd_buf`` 0), then the display buffer's (``rd_buf`` 1), each ``{rgb, z}``."""
+    from amaranth import Cat, Mux
+    from rasterhw.sim.engines.readout import ReadOut
+
+    def address(m, b, addr):
+        second = addr >= depth
+        m.d.comb += [b.rd_addr.eq(Mux(second, addr - depth, addr)), b.rd_buf.eq(second)]
+
+    return ReadOut(_with_commands(bank), ports=("i",), words=2 * depth, address=address,
+                   data=lambda b: Cat(b.rd_z, b.rd_rgb))
+
+
+def bank_frame(depth: int, stream: PixelStream, commands) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The golden bank after ``stream``'s writes and ``commands`` (``[(k, CLEAR or SWAP)]``: before
+    write ``k``, in order): ``(rgb of buffer 0 and 1, (2, depth); z; draw)``. A write is kept when
+    its Z is strictly greater than the stored Z (``pixelbus_frame``'s rule, the Z compare
+    ``PixelBusBank`` makes); CLEAR sets every Z and the draw buffer's RGB to 0, SWAP exchanges
+    the draw and display buffers (``Command``'s words: "Z := 0 (far), draw-buffer RGB := 0
+    (black)"; "exchange draw and display RGB buffers")."""
+    rgb, z, draw = np.zeros((2, depth), np.int64), np.zeros(depth, np.int64), 0
+    at = {}
+    for k, c in commands:
+        at.setdefault(int(k), []).append(c)
+    for k in range(len(stream) + 1):
+        for c in at.get(k, ()):
+            if c == CLEAR:
+                z[:] = 0
+                rgb[draw] = 0
+            else:
+                draw ^= 1
+        if k < len(stream):
+            a = int(stream.addr[k])
+            if int(stream.z[k]) > z[a]:
+                z[a], rgb[draw, a] = int(stream.z[k]), int(stream.rgb[k])
+    return rgb, z, np.int64(draw)
+
+
 class BankBench(Testbench):
-    """``pixelbus-bank``: pixel writes (bank-local address, RGB, Z) in on ``i`` back to back, the
-    bank's draw buffer and Z out (``o``, ``depth`` words). Golden: the writes applied in order with
-    the strict Z test (``pixelbus_frame``), and the cycle count of one bank (:func:`bank_cycles`:
-    one write per memory cycle, the block's documented throughput; the read-out once the last
+    """``pixelbus-bank``: pixel writes (bank-local address, RGB, Z) and commands (CLEAR, SWAP) in
+    on ``i`` in one ordered stream (:func:`_with_commands`), back to back; both RGB buffers and Z
+    out (``o``, ``2 * depth`` words: the draw buffer, then the display buffer). Golden:
+    :func:`bank_frame` (the writes in order with the strict Z test, the commands between them),
+    and the cycle count of one bank (:func:`bank_cycles`: one write per memory cycle, the block's
+    documented throughput; a CLEAR ``depth`` clocks, a SWAP one; the read-out once the last
     memory cycle ended). The bus's golden cycle model (two pipelines' slots) is not one bank's."""
 
     block = "pixelbus-bank"
 
     def dut(self, params: dict):
-        return _read_out(super().dut(params), self.inputs, params["depth"])
+        return _bank_read_out(super().dut(params), params["depth"])
 
     def stimulus(self, params: dict, seed: int) -> Stimulus:
+        """A random stream (:func:`_stream`) and, drawn after it, one to four commands at random
+        places (CLEAR or SWAP, as likely), so a seed's writes are those it had before commands."""
         rng = np.random.default_rng(seed)
         s, what = _stream(rng, params["depth"], 1, int(rng.integers(40, 200)), 1, params["z_bits"], 1)
-        return self.stimulus_of(params, s, what=f"{what}, seed {seed}")
+        n = int(rng.integers(1, 5))
+        cmds = sorted(zip(rng.integers(0, len(s) + 1, n).tolist(), rng.integers(0, 2, n).tolist(), strict=True),
+                      key=lambda kc: kc[0])
+        said = ", ".join(f"{'CLEAR' if c == CLEAR else 'SWAP'} before write {k}" for k, c in cmds)
+        return self.stimulus_of(params, s, what=f"{what}, {said}, seed {seed}", commands=cmds)
 
-    def stimulus_of(self, params: dict, stream: PixelStream, gaps=None, what: str = "") -> Stimulus:
-        """``stream`` (one pipeline, ``addr`` bank-local, a ``depth`` x 1 frame) as the bank's words."""
-        words, g = _port_words(stream, np.arange(len(stream)), _addr_bits(params["depth"]), gaps)
-        return Stimulus({"i": words}, {} if g is None else {"i": g}, what=what, source=stream)
+    def stimulus_of(self, params: dict, stream: PixelStream, gaps=None, what: str = "", *,
+                    commands=()) -> Stimulus:
+        """``stream`` (one pipeline, ``addr`` bank-local, a ``depth`` x 1 frame) and ``commands``
+        (``[(k, CLEAR or SWAP)]``: before write ``k``, in order) as the bank's words (``gaps``: idle
+        clocks before each write; none before a command)."""
+        cmds = sorted(((int(k), int(c)) for k, c in commands), key=lambda kc: kc[0])   # stable: in order
+        n = len(stream)
+        pos = np.arange(n) + np.searchsorted([k for k, _ in cmds], np.arange(n), side="right")
+        total = n + len(cmds)
+        is_cmd, cmd = np.ones(total, np.int64), np.zeros(total, np.int64)
+        is_cmd[pos] = 0
+        cmd[is_cmd == 1] = [c for _, c in cmds]
+        aw = _addr_bits(params["depth"])
+        fields = [(np.zeros(total, np.int64), 1), (cmd, 1), (is_cmd, 1)]
+        for col, bits in payload_fields(stream, np.arange(n), aw):
+            full = np.zeros(total, np.int64)
+            full[pos] = col
+            fields.append((full, bits))
+        words = _then_end(pack_fields(fields), sum(b for _, b in fields))
+        g = None
+        if gaps is not None:
+            g = np.zeros(total + 1, np.int64)
+            g[pos] = np.asarray(gaps, dtype=np.int64)
+        return Stimulus({"i": words}, {} if g is None else {"i": g}, what=what, source=(stream, cmds))
 
     def expect(self, params: dict, stim: Stimulus) -> Expected:
-        s = stim.source
-        rgb, z = golden.pixelbus_frame(s, accept=np.arange(len(s)))
-        return Expected({"o": _frame_words(rgb, z, params["z_bits"])}, cycles=bank_cycles(params, stim))
+        s, cmds = stim.source
+        rgb, z, draw = bank_frame(params["depth"], s, cmds)
+        words = _frame_words(rgb[draw], z, params["z_bits"]) + _frame_words(rgb[1 - draw], z, params["z_bits"])
+        return Expected({"o": words}, cycles=bank_cycles(params, stim))
 
 
 def bank_cycles(params: dict, stim: Stimulus) -> int:
@@ -123,14 +230,22 @@ def bank_cycles(params: dict, stim: Stimulus) -> int:
     ``mem_cycle`` clocks"); the end token is taken when offered; the sweep starts at the first
     clock with the token seen and the last memory cycle over, and gives word ``j`` at the edge
     after it plus ``j``: the cycles are that start + ``depth`` + 1 (added for mutation coverage,
-    docs/mutation.md: the bank's memory-cycle counter was unchecked)."""
-    m, g = params["mem_cycle"], stim.gaps_of("i")
-    n = len(stim.words["i"]) - 1           # the writes; the last word is the end token
+    docs/mutation.md: the bank's memory-cycle counter was unchecked). A command is taken like a
+    write, once the bank is free, and keeps it busy: a CLEAR for ``depth`` clocks after the clock
+    it is taken in (one word a clock), a SWAP for none; the read-out is ``2 * depth`` words."""
+    s, cmds = stim.source
+    m, depth, g = params["mem_cycle"], params["depth"], stim.gaps_of("i")
+    busy = np.full(len(s) + len(cmds), m, np.int64)   # clocks from a word's accept to the next possible one
+    pos = np.arange(len(s)) + np.searchsorted([k for k, _ in cmds], np.arange(len(s)), side="right")
+    is_cmd = np.ones(busy.size, bool)
+    is_cmd[pos] = False
+    busy[is_cmd] = [depth + 1 if c == CLEAR else 1 for _, c in cmds]
+    n, words = busy.size, 2 * depth
     if n == 0:
-        return int(g[0]) + 1 + params["depth"] + 1
-    accept = int(g[0]) + int(np.maximum(m, 1 + g[1:n]).sum())
-    start = max(accept + 1 + int(g[n]) + 1, accept + m)
-    return start + params["depth"] + 1
+        return int(g[0]) + 1 + words + 1
+    accept = int(g[0]) + int(np.maximum(busy[:-1], 1 + g[1:n]).sum())
+    start = max(accept + 1 + int(g[n]) + 1, accept + int(busy[-1]))
+    return start + words + 1
 
 
 class BusBench(Testbench):
