@@ -90,7 +90,9 @@ MACHINE = Machine(
                                     fpga_runs=(({"datapath": "paper"}, "full"), ({"datapath": "paper", "aj": "c"}, "full"),
                                                ({}, "full"), ({"aj": "c"}, "full")),
                                     labels={"aj": {"none": "A.J. none", "c": "A.J. (c)"}}),
-           "experts-pxp-coherent": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,)),
+           # the default PXP at both datapaths (at the paper's: one shared 16 x 16 multiplier, z and i in two words)
+           "experts-pxp-coherent": Flow(small={"width": 64, "depth": 16}, clocks=(_NO_CLOCK,),
+                                        fpga_runs=(({"datapath": "paper"}, "full"), ({}, "full"))),
            "experts-slp": Flow(small={"width": 64, "tris": 64, "lines": 16, "asl": 32}, clocks=(_NO_CLOCK,),
                                fpga_runs=(({"acc_extra": 0}, "full"), ({}, "full"),
                                           ({**_SLP_REDUCED, "acc_extra": 0}, "reduced"), (_SLP_REDUCED, "reduced")),
