@@ -35,6 +35,21 @@ This block holds its own DMM/P (two banks; the writer fills one while the PXP re
   the PXP's one multiplier (``aj.aj_boundary_shared``: 4 or 5 multiplies a blended pixel, one a
   cycle); the drain has it first and the resolve side holds meanwhile (:meth:`ExpertsPxpSpan._hold`).
 
+**One processor, its steps in sequence.** The paper's PXP is one processor with a multiplier ("PXP
+においても ... SLP同様、乗算器を装備している", 3.2) that takes the two stages "iv) v)をPXPに" (section 4)
+and, once its initial processing is done, runs on alone to its range's last pixel ("初期処理が終了
+した後の処理は、2章で述べたSLAと同じであり、自らの担当範囲の終点となる画素まで、他のPXPとの通信なしに独立
+に動作できる", 3.2). Its queues are between processors only: the DMM/P from the SLP ("上位プロセッサ
+による書込みと下位プロセッサによる読み出しと並行して同時に行なう") and the DSLB to the frame buffer. So
+each step is a sub-component of the resolve side (a class that emits its datapath and its states
+into the one FSM) over the registers they share (:class:`_Resolve`): the initial processing
+(:class:`_Initial`), the span cull (:class:`_SpanCull`), the depth search (:class:`_DepthSearch`),
+S.S. and the DSLB write (:class:`_ShadeWrite`), the hand-over (:func:`hand_over`), with the
+multiplier datapath they use (:class:`_Multiply`). They are not joined by streams: a stream
+between two steps of one sequential processor would let them overlap, which changes the per-line
+cycles ``golden_model/experts/span_cycles.py`` holds (a sum of every step's cycles). The block's
+own streams are the paper's queues: ``i`` (the DMM/P's writer) and ``o`` (the DSLB's drain).
+
 At ``datapath="paper"`` the running z and i are **two 16-bit words** (at 512 x 512 ``|z|, |i| < 2**25``,
 docs/experts.md "z and i in two words"): one 16-bit adder takes them a word a cycle, the low word
 first with its carry kept (``zlr`` z at the left end, ``zpl`` the right end's low word, ``ilo`` i's
@@ -74,7 +89,7 @@ from rasterhw.hdl.params import params
 
 __all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "candidate", "dmm_p", "resolve_regs", "seg_ends", "write_pixel", "take_bank", "zrun_at", "z_key", "guarded_test",
            "intensity_at", "PTR_BITS", "NO_PTR", "word_adder", "GuardedWords", "Early", "Always", "i_words",
-           "key_words"]
+           "key_words", "hand_over"]
 
 NONE = (1 << ADDR_BITS) - 1     # ASB address / polygon number of the background
 PTR_BITS = 9                    # ASL position in a DMM/P bank
@@ -428,6 +443,303 @@ class _R(enum.Enum, shape=3):
     HAND = 6      # hand the DSLB bank to the drain
 
 
+class _Resolve:
+    """The resolve side's registers and memories over one line, which every step reads and writes.
+
+    The paper's PXP is one processor with its own local memory ("DMMははじめとして各プロセッサの局所
+    メモリ、内部レジスタ・ファイル等を1語16ビットで構成する", seed 000, 3.2): the steps below are that
+    processor's steps, run one after another over these registers, so they share them rather than
+    pass words to each other.
+
+    ``state`` (:class:`_R`); the registers both span PXPs declare alike (:func:`resolve_regs`, an
+    attribute each, named as in :data:`RESOLVE_REGS`); this block's own: the span's left pixel ``x``,
+    the segments present ``k``, the nearest end + 1 ``minend``, the first active entry ``one``, the
+    (sub)span ``sl``..``sr`` searched or written, the nearest's z at its two ends ``szl``/``szr``
+    (``paper``: two 16-bit words each), a failed test ``bad``, the span written is background
+    ``wbg``; the stack of right ends (memory ``stk``, 16 entries: ``kwr`` at ``sp``, ``krd`` at
+    ``sp - 1``; the depth search pushes, the write pops) and (``paper``) the step's cycle ``ph``.
+    """
+
+    def __init__(self, m: Module, pxp: ExpertsPxpSpan, fr: dict):
+        self.paper = pxp._datapath == "paper"
+        self.state = Signal(_R, name="state")
+        for key, reg in zip(RESOLVE_REGS, resolve_regs(m, fr), strict=True):
+            setattr(self, key, reg)
+        pw, cw = fr["pw"], fr["cw"]
+        self.x = Signal(X_END_BITS, name="x")
+        self.k = Signal(cw, name="k")
+        self.minend = Signal(XP_BITS, name="minend")
+        self.one = Signal(pw, name="one")
+        self.sl = Signal(X_END_BITS, name="sl")
+        self.sr = Signal(X_END_BITS, name="sr")
+        zw = 2 * WORD if self.paper else RUN_BITS  # (paper) two 16-bit words: |z| < 2**25 at 512 x 512 (docs/experts.md)
+        self.szl = Signal(signed(zw), name="szl")
+        self.szr = Signal(signed(zw), name="szr")
+        self.bad = Signal(name="bad")
+        self.wbg = Signal(name="wbg")
+        self.sp = Signal(5, name="sp")
+        m.submodules.stk = stk = Memory(shape=unsigned(X_END_BITS), depth=16, init=[])
+        self.kwr = stk.write_port()
+        self.krd = stk.read_port(domain="comb")
+        m.d.comb += [self.kwr.en.eq(0), self.krd.addr.eq(self.sp - 1), self.kwr.addr.eq(self.sp)]
+        # (paper) the step's cycle: pass A / B 0, 1 z at sl (low word, high word), 2, 3 z at sr; write 0, 1
+        self.ph = Signal(2, name="ph")
+
+
+class _Multiply:
+    """The PXP's multiplier: "PXPにおいても、担当の画面領域の初期処理、及び、A.J.における画素データ値の
+    混合計算など、乗算が多数出現するため、SLP同様、乗算器を装備している" (seed 000, 3.2).
+
+    What it gives the steps: ``zl``, ``zr`` the running z of the segment read (``seg``) at ``sl`` and
+    ``sr``, ``key`` the compare key of ``zl`` and ``ic`` the intensity at ``sl``. Ours (the paper
+    gives no count): a multiplier each for z at the two ends (:func:`zrun_at`) and one for i
+    (:func:`intensity_at`), all in one cycle. The paper's datapath: its one 16 x 16 multiplier and
+    one 16-bit adder (:func:`word_adder`), z at ``sl`` (kept in ``zlr``), then at ``sr``, each in
+    two words a word a cycle (:meth:`four_cycles`, the guarded tests' words in ``tests``,
+    :class:`GuardedWords`), i at ``sl`` in two (:meth:`write_cycles`).
+    """
+
+    def __init__(self, m: Module, fr: dict, r: _Resolve):
+        self.m, self.r = m, r
+        if r.paper:
+            # one multiplier: z at sl (kept in zlr), then z at sr; i at sl when writing. z and i are two
+            # 16-bit words, added, subtracted and compared a word a cycle, low word first (carry / borrow kept)
+            zlr = Signal(signed(2 * WORD))
+            zpl = Signal(WORD)          # z at sr, low word
+            zc = Signal()             # the low word's carry
+            ilo = Signal(WORD)        # i at sl, low word
+            zadd = word_adder(m, fr, seg=r.seg, col=Mux(r.ph[1], r.sr, r.sl), write=lambda: r.state == _R.WRITE,
+                              hi_word=r.ph[0], zc=zc)
+            zr_ = Signal(signed(2 * WORD), name="zr_w")
+            m.d.comb += zr_.eq(Cat(zpl, zadd[:WORD]))
+            self.zl, self.zr = zlr, zr_
+            self.ic = i_words(m, zadd[:WORD], ilo, fr["fmt"])
+            self.key = key_words(m, zlr)
+            self.tests = GuardedWords(m, r.szl, r.szr, zlr, zadd[:WORD])
+            self.zlr, self.zpl, self.zc, self.ilo, self.zadd = zlr, zpl, zc, ilo, zadd
+        else:
+            # the multipliers: running z (Q16.4) at pixels sl and sr, i at sl
+            self.zl = zrun_at(m, r.seg, r.sl)
+            self.zr = zrun_at(m, r.seg, r.sr)
+            self.ic = intensity_at(m, r.seg, r.sl, fr["fmt"])
+            self.key = z_key(m, self.zl)
+            self.tests = None
+
+    def four_cycles(self):
+        """(paper) a pass's three first cycles on a segment: z at sl's low and high word into
+        ``zlr``, z at sr's low word into ``zpl`` with the guarded tests' low words; the body runs
+        in the fourth (z at sr's high word)."""
+        if not self.r.paper:
+            return Always()
+        m, ph, zadd = self.m, self.r.ph, self.zadd
+
+        def early():
+            m.d.sync += ph.eq(ph + 1)
+            with m.Switch(ph):
+                with m.Case(0):
+                    m.d.sync += [self.zlr[:WORD].eq(zadd[:WORD]), self.zc.eq(zadd[WORD])]
+                with m.Case(1):
+                    m.d.sync += self.zlr[WORD:].eq(zadd[:WORD])
+                with m.Case(2):
+                    m.d.sync += [self.zpl.eq(zadd[:WORD]), self.zc.eq(zadd[WORD]), *self.tests.low()]
+        return Early(m, ph != 3, early, [ph.eq(0)])
+
+    def write_cycles(self):
+        """(paper) a drawn pixel's first cycle adds i's low word (``ilo``); the body (the write)
+        runs in the second, with i's high word; a background pixel takes one."""
+        if not self.r.paper:
+            return Always()
+        m, ph, zadd = self.m, self.r.ph, self.zadd
+
+        def early():
+            m.d.sync += [ph.eq(1), self.ilo.eq(zadd[:WORD]), self.zc.eq(zadd[WORD])]
+        return Early(m, ~self.r.wbg & (ph == 0), early, [ph.eq(0)])
+
+
+class _Initial:
+    """The PXP's **initial processing** of a line ("初期処理", seed 000, 3.2), state ``IDLE``: the
+    PXP first decides the visible segment at its range's first pixel ("自らが担当する部分スキャン・
+    ライン上の最初の画素(左端の画素)における可視セグメントをまず決定する"), clipping the ASL to its range
+    ("担当範囲よりも左側の部分に存在しているセグメントをASLから除去する"), helped by the SLP's lists
+    ("PXPでの初期処理によるオーバヘッドを軽減するために、図3.2に示すBlock Boundary Bucket List、および
+    Block Leading Segment Pointer").
+
+    Ours: one cycle takes a full DMM/P bank (:func:`take_bank`): its range, the guarded range, the
+    counts, and the ASL walk's start at the leading pointer (none: past the last ASB); the first
+    span's cull (:class:`_SpanCull`, ``ENTER``) then reads the bucket list (the segments that start
+    left of the range and reach into it) and the ASL from the leading pointer.
+    """
+
+    def __init__(self, m: Module, fr: dict, r: _Resolve):
+        self.m, self.fr, self.r = m, fr, r
+
+    def states(self):
+        m, fr, r = self.m, self.fr, self.r
+        with m.Case(_R.IDLE):
+            m.d.sync += r.cyc.eq(1)
+            tb = take_bank(m, fr, r.rb, fr["W"], fr["aj"])
+            lo_b, hi_b, glo_b, ghi_b, lead, n_b = tb["lo"], tb["hi"], tb["glo"], tb["ghi"], tb["lead"], tb["n"]
+            with m.If(fr["full"].bit_select(r.rb, 1)):
+                m.d.sync += [r.lo.eq(lo_b), r.hi.eq(hi_b), r.glo.eq(glo_b), r.ghi.eq(ghi_b), r.x.eq(glo_b),
+                             r.n.eq(n_b), r.nb.eq(tb["nb"]),
+                             r.pp.eq(Mux(lead == NO_PTR, n_b, lead)),
+                             r.i.eq(0), r.j.eq(0), r.k.eq(0), r.bi.eq(0), r.minend.eq(ghi_b),
+                             r.state.eq(Mux(ghi_b <= glo_b, _R.HAND, _R.ENTER))]
+
+
+class _SpanCull:
+    """iv) **span cull**: "スキャン・ラインをスパンに分割し、そのスパン内に現われる範囲のセグメントを抽出する
+    《span cull》" (seed 000, section 4, iv).
+
+    States ``CULL`` and ``ENTER`` (the paper names the step, not its cycles; these are ours, every
+    term in ``span_cycles``): one cycle per segment of the active list (in place: those ending
+    before ``x`` leave, the others stay and give the nearest end), then one cycle per candidate
+    entering at ``x`` (:func:`candidate`: the bucket list first, then the ASL from the leading
+    pointer; one with no pixel in the range is skipped in a cycle), and one cycle that sets the
+    span's right end ``min(nearest end, next start, ghi) - 1``: a depth search if two or more
+    segments are present, else the write.
+    """
+
+    def __init__(self, m: Module, fr: dict, r: _Resolve):
+        self.m, self.fr, self.r = m, fr, r
+
+    def next_span(self, xn):
+        """Start the span cull at pixel ``xn`` (the line's end: hand over)."""
+        r = self.r
+        return [r.x.eq(xn), r.i.eq(0), r.j.eq(0), r.minend.eq(r.ghi),
+                r.state.eq(Mux(xn >= r.ghi, _R.HAND, Mux(r.k == 0, _R.ENTER, _R.CULL)))]
+
+    def keep_active(self):
+        """The segment read (``raddr``) is present in the span: onto the active list."""
+        m, r = self.m, self.r
+        m.d.comb += [r.awr.en.eq(1), r.awr.data.eq(r.raddr)]
+        m.d.sync += r.j.eq(r.j + 1)
+        with m.If(r.j == 0):
+            m.d.sync += r.one.eq(r.raddr)
+        with m.If(r.e + 1 < r.minend):
+            m.d.sync += r.minend.eq(r.e + 1)
+
+    def states(self):
+        m, r = self.m, self.r
+        i, j, e, a, cand = r.i, r.j, r.e, r.a, r.cand
+        with m.Case(_R.CULL):
+            with m.If(e >= r.x):
+                self.keep_active()
+            m.d.sync += i.eq(i + 1)
+            with m.If(i + 1 >= r.k):
+                m.d.sync += r.state.eq(_R.ENTER)
+        with m.Case(_R.ENTER):
+            take = candidate(m, raddr=r.raddr, cand=cand, in_bkt=r.in_bkt, brd=self.fr["brd"], bi=r.bi, pp=r.pp,
+                             n=r.n, c0=r.c0, ghi=r.ghi)
+            with m.If(cand & (e < a)):
+                take()              # no pixel in the range: skipped
+            with m.Elif(cand & (a == r.x)):
+                self.keep_active()
+                take()
+            with m.Else():
+                # the span's right end: the nearest end, the next start, the range's end
+                nxt = Signal(XP_BITS)
+                m.d.comb += nxt.eq(Mux(cand & (a < r.minend), a, r.minend))
+                m.d.sync += [r.k.eq(j), r.sl.eq(r.x), r.sr.eq(nxt - 1), r.sp.eq(0), i.eq(0)]
+                with m.If(j >= 2):
+                    m.d.sync += r.state.eq(_R.PASSA)
+                with m.Else():
+                    m.d.sync += [r.wbg.eq(j == 0), r.S.eq(r.one), r.state.eq(_R.WRITE)]
+
+
+class _DepthSearch:
+    """v) **depth search**: "iv)で抽出したセグメントに応じてデプス・サーチを行ない、可視セグメントを決定する
+    《depth search》" (seed 000, section 4, v), on the rules of ``golden_model/experts/span.py``.
+
+    States ``PASSA`` and ``PASSB`` (ours, as the span cull's): pass A, one step per segment present:
+    z at the (sub)span's two end pixels and the nearest at the left pixel (``nearer``: 16-bit key,
+    ties to the lower ASB address); pass B (spans wider than a pixel), one step per segment: the
+    guarded end-depth test (``good``: S stays nearest at every pixel). If a test fails the span is
+    halved at ``mid = (sl + sr + 1) >> 1``, the right half's end pushed on the stack and the left
+    half searched. A step is a cycle (ours) or four (the paper's datapath,
+    :meth:`_Multiply.four_cycles`).
+    """
+
+    def __init__(self, m: Module, r: _Resolve, mul: _Multiply):
+        self.m, self.r, self.mul = m, r, mul
+        self.nearer = nearer = Signal(name="nearer")
+        m.d.comb += nearer.eq((r.i == 0) | (mul.key < r.skey) | ((mul.key == r.skey) & (r.seg.addr < r.saddr)))
+        # the guarded test (span.py): S nearer than this segment B at every pixel of [sl, sr]
+        self.good = good = Signal(name="good")
+        s_low = r.saddr < r.seg.addr
+        m.d.comb += good.eq((r.raddr == r.S) | (mul.tests.high(s_low) if r.paper
+                                                else guarded_test(m, r.szl, r.szr, mul.zl, mul.zr, s_low)))
+        self.mid = mid = Signal(X_END_BITS, name="mid")
+        m.d.comb += mid.eq((r.sl + r.sr + 1) >> 1)
+
+    def states(self):
+        m, r, mul = self.m, self.r, self.mul
+        i, good, bad = r.i, self.good, r.bad
+        with m.Case(_R.PASSA), mul.four_cycles():
+            with m.If(self.nearer):
+                m.d.sync += [r.S.eq(r.raddr), r.skey.eq(mul.key), r.saddr.eq(r.seg.addr), r.szl.eq(mul.zl),
+                             r.szr.eq(mul.zr)]
+            m.d.sync += i.eq(i + 1)
+            with m.If(i + 1 >= r.k):
+                m.d.sync += i.eq(0)
+                with m.If(r.sl == r.sr):
+                    m.d.sync += [r.wbg.eq(0), r.state.eq(_R.WRITE)]
+                with m.Else():
+                    m.d.sync += [bad.eq(0), r.state.eq(_R.PASSB)]
+        with m.Case(_R.PASSB), mul.four_cycles():
+            m.d.sync += [i.eq(i + 1), bad.eq(bad | ~good)]
+            with m.If(i + 1 >= r.k):
+                m.d.sync += i.eq(0)
+                with m.If(bad | ~good):
+                    # the end depths do not settle it: halve, search the left half first
+                    m.d.comb += [r.kwr.en.eq(1), r.kwr.data.eq(r.sr)]
+                    m.d.sync += [r.sp.eq(r.sp + 1), r.sr.eq(self.mid - 1), r.state.eq(_R.PASSA)]
+                with m.Else():
+                    m.d.sync += [r.wbg.eq(0), r.state.eq(_R.WRITE)]
+
+
+class _ShadeWrite:
+    """**S.S. and the DSLB write** of a decided (sub)span, state ``WRITE``: "HSEによって可視セグメントが
+    決定した後、直ちに(1)式によつてS.S.を開始する事ができる" (seed 000, 2.3), uniform along the visible
+    segment ("一旦可視セグメントが決定されればその中では一様な計算で各画素の値を決める", 2.2).
+
+    One pixel a cycle (ours; two a drawn pixel at the paper's datapath,
+    :meth:`_Multiply.write_cycles`): the intensity by the multiplier at that pixel (equal to
+    stepping), the DSLB word ``{ASB address, pixel, ASL position}`` (:func:`write_pixel`). At the
+    (sub)span's end: the next half off the stack, else the next span's cull.
+    """
+
+    def __init__(self, m: Module, fr: dict, r: _Resolve, mul: _Multiply, cull: _SpanCull):
+        self.m, self.fr, self.r, self.mul, self.cull = m, fr, r, mul, cull
+
+    def states(self):
+        m, r = self.m, self.r
+        with m.Case(_R.WRITE):
+            m.d.comb += r.raddr.eq(r.S)
+            with self.mul.write_cycles():
+                write_pixel(m, self.fr, r.rb, r.sl, r.wbg, r.seg, self.mul.ic, r.S)
+                m.d.sync += r.sl.eq(r.sl + 1)
+                with m.If(r.sl == r.sr):
+                    with m.If(r.sp != 0):
+                        m.d.sync += [r.sr.eq(r.krd.data), r.sp.eq(r.sp - 1), r.i.eq(0), r.state.eq(_R.PASSA)]
+                    with m.Else():
+                        m.d.sync += self.cull.next_span(r.sr + 1)
+
+
+def hand_over(m: Module, pxp, drain, r, idle) -> None:
+    """The line's end (both span PXPs' ``HAND``): the DSLB bank written goes to the drain once it is
+    free ("DSLBもDMM同様、2重系の構成とい、PXPによる書き込みと、FBへの転送のための読み出しとを並行して
+    同時にに行なうことができる", seed 000, 3.2, the seed's OCR); the resolve side turns to the other
+    bank (``r.state`` to ``idle``) and the finish-time counter ``line_cycles`` takes the line's
+    cycles. ``r``: the resolve side's registers (``rb``, ``lo``, ``hi``, ``glo``, ``ghi``, ``cyc``,
+    ``state``)."""
+    with m.If(~drain.dbusy):
+        m.d.sync += [*drain.hand(bank=r.rb, lo=r.lo, hi=r.hi, glo=r.glo, ghi=r.ghi), r.rb.eq(~r.rb),
+                     r.state.eq(idle),
+                     pxp.line_cycles.eq(r.cyc + 1), pxp.lines.eq(pxp.lines + 1)]
+
+
+
 @params("width", "aj", "depth", "datapath")
 class ExpertsPxpSpan(wiring.Component):
     """One span PXP with its DMM/P: DMM/P words in, the range's pixel words out, line by line.
@@ -524,179 +836,18 @@ class ExpertsPxpSpan(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         fr = self.frame(m)
-        fmt, W, aj, pw, cw = fr["fmt"], fr["W"], fr["aj"], fr["pw"], fr["cw"]
-        dm = fr
-        brd, full = dm["brd"], dm["full"]
-
-        # ---------------------------------------------------------------- resolve side
-        state = Signal(_R)
-        (rb, glo, ghi, lo, hi, n, nb, i, j, bi, pp, S, skey, saddr, cyc, raddr, seg, c0, a, e, awr, ard, in_bkt,
-         cand) = resolve_regs(m, fr)
-        x = Signal(X_END_BITS)    # the current span's left pixel
-        k = Signal(cw)            # segments present in the span
-        minend = Signal(XP_BITS)  # nearest end + 1 of the segments present
-        one = Signal(pw)          # the first active entry (k = 1: the visible segment)
-        sl = Signal(X_END_BITS)   # (sub)span searched / written
-        sr = Signal(X_END_BITS)
-        paper = self._datapath == "paper"
-        zw = 2 * WORD if paper else RUN_BITS  # (paper) two 16-bit words: |z| < 2**25 at 512 x 512 (docs/experts.md)
-        szl = Signal(signed(zw))
-        szr = Signal(signed(zw))
-        bad = Signal()
-        wbg = Signal()            # the span written is background
-        sp = Signal(5)            # stack pointer
-
-        m.submodules.stk = stk = Memory(shape=unsigned(X_END_BITS), depth=16, init=[])
-        kwr = stk.write_port()
-        krd = stk.read_port(domain="comb")
-        m.d.comb += [kwr.en.eq(0), krd.addr.eq(sp - 1), kwr.addr.eq(sp)]
-
-        # (paper) the step's cycle: pass A / B 0, 1 z at sl (low word, high word), 2, 3 z at sr; write 0, 1
-        ph = Signal(2)
-        if paper:
-            # one multiplier: z at sl (kept in zlr), then z at sr; i at sl when writing. z and i are two
-            # 16-bit words, added, subtracted and compared a word a cycle, low word first (carry / borrow kept)
-            zlr = Signal(signed(2 * WORD))
-            zpl = Signal(WORD)          # z at sr, low word
-            zc = Signal()             # the low word's carry
-            ilo = Signal(WORD)        # i at sl, low word
-            zadd = word_adder(m, fr, seg=seg, col=Mux(ph[1], sr, sl), write=lambda: state == _R.WRITE,
-                              hi_word=ph[0], zc=zc)
-            zl_ = zlr
-            zr_ = Signal(signed(2 * WORD), name="zr_w")
-            m.d.comb += zr_.eq(Cat(zpl, zadd[:WORD]))
-            ic = i_words(m, zadd[:WORD], ilo, fmt)
-            key = key_words(m, zlr)
-            tests = GuardedWords(m, szl, szr, zlr, zadd[:WORD])
-        else:
-            # the multipliers: running z (Q16.4) at pixels sl and sr, i at sl
-            zl_ = zrun_at(m, seg, sl)
-            zr_ = zrun_at(m, seg, sr)
-            ic = intensity_at(m, seg, sl, fmt)
-            key = z_key(m, zl_)
-
-        def four_cycles():
-            """(paper) a pass's three first cycles on a segment: z at sl's low and high word into
-            ``zlr``, z at sr's low word into ``zpl`` with the guarded tests' low words; the body runs
-            in the fourth (z at sr's high word)."""
-            if not paper:
-                return Always()
-
-            def early():
-                m.d.sync += ph.eq(ph + 1)
-                with m.Switch(ph):
-                    with m.Case(0):
-                        m.d.sync += [zlr[:WORD].eq(zadd[:WORD]), zc.eq(zadd[WORD])]
-                    with m.Case(1):
-                        m.d.sync += zlr[WORD:].eq(zadd[:WORD])
-                    with m.Case(2):
-                        m.d.sync += [zpl.eq(zadd[:WORD]), zc.eq(zadd[WORD]), *tests.low()]
-            return Early(m, ph != 3, early, [ph.eq(0)])
-
-        def write_cycles():
-            """(paper) a drawn pixel's first cycle adds i's low word (``ilo``); the body (the write)
-            runs in the second, with i's high word; a background pixel takes one."""
-            if not paper:
-                return Always()
-
-            def early():
-                m.d.sync += [ph.eq(1), ilo.eq(zadd[:WORD]), zc.eq(zadd[WORD])]
-            return Early(m, ~wbg & (ph == 0), early, [ph.eq(0)])
-        nearer = Signal()
-        m.d.comb += nearer.eq((i == 0) | (key < skey) | ((key == skey) & (seg.addr < saddr)))
-        # the guarded test (span.py): S nearer than this segment B at every pixel of [sl, sr]
-        good = Signal()
-        s_low = saddr < seg.addr
-        m.d.comb += good.eq((raddr == S) | (tests.high(s_low) if paper else guarded_test(m, szl, szr, zl_, zr_, s_low)))
-        mid = Signal(X_END_BITS)
-        m.d.comb += mid.eq((sl + sr + 1) >> 1)
-
-
-        # ---------------------------------------------------------------- drain side (drain.py)
-        drain = fr["drain"]
-        dbusy = drain.dbusy
-
-        def next_span(xn):
-            """Start the span cull at pixel ``xn`` (the line's end: hand over)."""
-            return [x.eq(xn), i.eq(0), j.eq(0), minend.eq(ghi),
-                    state.eq(Mux(xn >= ghi, _R.HAND, Mux(k == 0, _R.ENTER, _R.CULL)))]
-
-        def keep_active():
-            """The segment read (``raddr``) is present in the span: onto the active list."""
-            m.d.comb += [awr.en.eq(1), awr.data.eq(raddr)]
-            m.d.sync += j.eq(j + 1)
-            with m.If(j == 0):
-                m.d.sync += one.eq(raddr)
-            with m.If(e + 1 < minend):
-                m.d.sync += minend.eq(e + 1)
-
-        with self._hold(m, state, drain), m.Switch(state):
-            with m.Case(_R.IDLE):
-                m.d.sync += cyc.eq(1)
-                tb = take_bank(m, dm, rb, W, aj)
-                lo_b, hi_b, glo_b, ghi_b, lead, n_b = tb["lo"], tb["hi"], tb["glo"], tb["ghi"], tb["lead"], tb["n"]
-                with m.If(full.bit_select(rb, 1)):
-                    m.d.sync += [lo.eq(lo_b), hi.eq(hi_b), glo.eq(glo_b), ghi.eq(ghi_b), x.eq(glo_b),
-                                 n.eq(n_b), nb.eq(tb["nb"]),
-                                 pp.eq(Mux(lead == NO_PTR, n_b, lead)),
-                                 i.eq(0), j.eq(0), k.eq(0), bi.eq(0), minend.eq(ghi_b),
-                                 state.eq(Mux(ghi_b <= glo_b, _R.HAND, _R.ENTER))]
-            with m.Case(_R.CULL):
-                with m.If(e >= x):
-                    keep_active()
-                m.d.sync += i.eq(i + 1)
-                with m.If(i + 1 >= k):
-                    m.d.sync += state.eq(_R.ENTER)
-            with m.Case(_R.ENTER):
-                take = candidate(m, raddr=raddr, cand=cand, in_bkt=in_bkt, brd=brd, bi=bi, pp=pp, n=n,
-                                 c0=c0, ghi=ghi)
-                with m.If(cand & (e < a)):
-                    take()              # no pixel in the range: skipped
-                with m.Elif(cand & (a == x)):
-                    keep_active()
-                    take()
-                with m.Else():
-                    # the span's right end: the nearest end, the next start, the range's end
-                    nxt = Signal(XP_BITS)
-                    m.d.comb += nxt.eq(Mux(cand & (a < minend), a, minend))
-                    m.d.sync += [k.eq(j), sl.eq(x), sr.eq(nxt - 1), sp.eq(0), i.eq(0)]
-                    with m.If(j >= 2):
-                        m.d.sync += state.eq(_R.PASSA)
-                    with m.Else():
-                        m.d.sync += [wbg.eq(j == 0), S.eq(one), state.eq(_R.WRITE)]
-            with m.Case(_R.PASSA), four_cycles():
-                with m.If(nearer):
-                    m.d.sync += [S.eq(raddr), skey.eq(key), saddr.eq(seg.addr), szl.eq(zl_), szr.eq(zr_)]
-                m.d.sync += i.eq(i + 1)
-                with m.If(i + 1 >= k):
-                    m.d.sync += i.eq(0)
-                    with m.If(sl == sr):
-                        m.d.sync += [wbg.eq(0), state.eq(_R.WRITE)]
-                    with m.Else():
-                        m.d.sync += [bad.eq(0), state.eq(_R.PASSB)]
-            with m.Case(_R.PASSB), four_cycles():
-                m.d.sync += [i.eq(i + 1), bad.eq(bad | ~good)]
-                with m.If(i + 1 >= k):
-                    m.d.sync += i.eq(0)
-                    with m.If(bad | ~good):
-                        # the end depths do not settle it: halve, search the left half first
-                        m.d.comb += [kwr.en.eq(1), kwr.data.eq(sr)]
-                        m.d.sync += [sp.eq(sp + 1), sr.eq(mid - 1), state.eq(_R.PASSA)]
-                    with m.Else():
-                        m.d.sync += [wbg.eq(0), state.eq(_R.WRITE)]
-            with m.Case(_R.WRITE):
-                m.d.comb += raddr.eq(S)
-                with write_cycles():
-                    write_pixel(m, fr, rb, sl, wbg, seg, ic, S)
-                    m.d.sync += sl.eq(sl + 1)
-                    with m.If(sl == sr):
-                        with m.If(sp != 0):
-                            m.d.sync += [sr.eq(krd.data), sp.eq(sp - 1), i.eq(0), state.eq(_R.PASSA)]
-                        with m.Else():
-                            m.d.sync += next_span(sr + 1)
+        # the resolve side's registers and datapaths outside the FSM, in this order (the netlist's
+        # statement order)
+        r = _Resolve(m, self, fr)
+        mul = _Multiply(m, fr, r)
+        search = _DepthSearch(m, r, mul)
+        cull = _SpanCull(m, fr, r)
+        # one FSM: the steps' states, each step after the one before it on the same registers
+        with self._hold(m, r.state, fr["drain"]), m.Switch(r.state):
+            _Initial(m, fr, r).states()
+            cull.states()
+            search.states()
+            _ShadeWrite(m, fr, r, mul, cull).states()
             with m.Case(_R.HAND):
-                with m.If(~dbusy):
-                    m.d.sync += [*drain.hand(bank=rb, lo=lo, hi=hi, glo=glo, ghi=ghi), rb.eq(~rb), state.eq(_R.IDLE),
-                                 self.line_cycles.eq(cyc + 1), self.lines.eq(self.lines + 1)]
-
+                hand_over(m, self, fr["drain"], r, _R.IDLE)
         return m
