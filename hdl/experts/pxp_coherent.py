@@ -43,7 +43,6 @@ from amaranth import Cat, Module, Mux, Signal, signed
 from amaranth.lib import enum
 from rasterhw.golden_model.experts.formats import WORD, X_END_BITS, XP_BITS
 from rasterhw.hdl.experts.pxp_span import (
-    NO_PTR,
     RESOLVE_REGS,
     Always,
     Early,
@@ -56,7 +55,7 @@ from rasterhw.hdl.experts.pxp_span import (
     intensity_at,
     key_words,
     resolve_regs,
-    take_bank,
+    take_line,
     word_adder,
     write_pixel,
     z_key,
@@ -192,7 +191,7 @@ class _Multiply:
 
 class _Initial:
     """The PXP's **initial processing** of a line ("初期処理", seed 000, 3.2), state ``IDLE``: as the
-    span PXP's (``pxp_span._Initial``), one cycle takes a full DMM/P bank; the first ``ENTER`` then
+    span PXP's (``pxp_span._Initial``, ``pxp_span.take_line``), one cycle takes a full DMM/P bank; the first ``ENTER`` then
     reads the bucket list and the ASL from the leading pointer ("PXPでの初期処理によるオーバヘッドを
     軽減するために、図3.2に示すBlock Boundary Bucket List、およびBlock Leading Segment Pointer"). No
     segment is visible yet (``vok`` 0), so the first span searches.
@@ -202,16 +201,10 @@ class _Initial:
         self.m, self.fr, self.v = m, fr, v
 
     def states(self):
-        m, fr, v = self.m, self.fr, self.v
-        with m.Case(_R.IDLE):
-            m.d.sync += v.cyc.eq(1)
-            tb = take_bank(m, fr, v.rb, fr["W"], fr["aj"])
-            with m.If(fr["full"].bit_select(v.rb, 1)):
-                m.d.sync += [v.lo.eq(tb["lo"]), v.hi.eq(tb["hi"]), v.glo.eq(tb["glo"]), v.ghi.eq(tb["ghi"]),
-                             v.sl.eq(tb["glo"]), v.n.eq(tb["n"]), v.nb.eq(tb["nb"]),
-                             v.pp.eq(Mux(tb["lead"] == NO_PTR, tb["n"], tb["lead"])),
-                             v.na.eq(0), v.bi.eq(0), v.vok.eq(0), v.fail.eq(0),
-                             v.state.eq(Mux(tb["ghi"] <= tb["glo"], _R.HAND, _R.ENTER))]
+        v = self.v
+        with self.m.Case(_R.IDLE):
+            take_line(self.m, self.fr, v, v.sl, lambda tb: [v.na.eq(0), v.bi.eq(0), v.vok.eq(0), v.fail.eq(0)],
+                      hand=_R.HAND, enter=_R.ENTER)
 
 
 class _Enter:

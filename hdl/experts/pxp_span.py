@@ -89,7 +89,7 @@ from rasterhw.hdl.params import params
 
 __all__ = ["ExpertsPxpSpan", "asb_layout", "dmm_layout", "candidate", "dmm_p", "resolve_regs", "seg_ends", "write_pixel", "take_bank", "zrun_at", "z_key", "guarded_test",
            "intensity_at", "PTR_BITS", "NO_PTR", "word_adder", "GuardedWords", "Early", "Always", "i_words",
-           "key_words", "hand_over"]
+           "key_words", "hand_over", "take_line"]
 
 NONE = (1 << ADDR_BITS) - 1     # ASB address / polygon number of the background
 PTR_BITS = 9                    # ASL position in a DMM/P bank
@@ -564,9 +564,9 @@ class _Initial:
     ("PXPでの初期処理によるオーバヘッドを軽減するために、図3.2に示すBlock Boundary Bucket List、および
     Block Leading Segment Pointer").
 
-    Ours: one cycle takes a full DMM/P bank (:func:`take_bank`): its range, the guarded range, the
-    counts, and the ASL walk's start at the leading pointer (none: past the last ASB); the first
-    span's cull (:class:`_SpanCull`, ``ENTER``) then reads the bucket list (the segments that start
+    Ours (:func:`take_line`, both span PXPs'): one cycle takes a full DMM/P bank (:func:`take_bank`):
+    its range, the guarded range, the counts, and the ASL walk's start at the leading pointer (none:
+    past the last ASB); the first span's cull (:class:`_SpanCull`, ``ENTER``) then reads the bucket list (the segments that start
     left of the range and reach into it) and the ASL from the leading pointer.
     """
 
@@ -574,17 +574,25 @@ class _Initial:
         self.m, self.fr, self.r = m, fr, r
 
     def states(self):
-        m, fr, r = self.m, self.fr, self.r
-        with m.Case(_R.IDLE):
-            m.d.sync += r.cyc.eq(1)
-            tb = take_bank(m, fr, r.rb, fr["W"], fr["aj"])
-            lo_b, hi_b, glo_b, ghi_b, lead, n_b = tb["lo"], tb["hi"], tb["glo"], tb["ghi"], tb["lead"], tb["n"]
-            with m.If(fr["full"].bit_select(r.rb, 1)):
-                m.d.sync += [r.lo.eq(lo_b), r.hi.eq(hi_b), r.glo.eq(glo_b), r.ghi.eq(ghi_b), r.x.eq(glo_b),
-                             r.n.eq(n_b), r.nb.eq(tb["nb"]),
-                             r.pp.eq(Mux(lead == NO_PTR, n_b, lead)),
-                             r.i.eq(0), r.j.eq(0), r.k.eq(0), r.bi.eq(0), r.minend.eq(ghi_b),
-                             r.state.eq(Mux(ghi_b <= glo_b, _R.HAND, _R.ENTER))]
+        r = self.r
+        with self.m.Case(_R.IDLE):
+            take_line(self.m, self.fr, r, r.x, lambda tb: [r.i.eq(0), r.j.eq(0), r.k.eq(0), r.bi.eq(0),
+                                                           r.minend.eq(tb["ghi"])], hand=_R.HAND, enter=_R.ENTER)
+
+
+def take_line(m: Module, fr: dict, r, start, clear, *, hand, enter) -> None:
+    """Both span PXPs' ``IDLE``: count from 1 and, once bank ``r.rb`` is full, take its line
+    (:func:`take_bank`): the range and guarded range, the counts, the ASL walk from the leading
+    pointer (none: past the last ASB), the first span at ``start`` (the guarded range's first
+    pixel); ``clear(tb)``: the block's own registers set for the line; then ``enter``, or ``hand``
+    for an empty range."""
+    m.d.sync += r.cyc.eq(1)
+    tb = take_bank(m, fr, r.rb, fr["W"], fr["aj"])
+    lo_b, hi_b, glo_b, ghi_b, lead, n_b = tb["lo"], tb["hi"], tb["glo"], tb["ghi"], tb["lead"], tb["n"]
+    with m.If(fr["full"].bit_select(r.rb, 1)):
+        m.d.sync += [r.lo.eq(lo_b), r.hi.eq(hi_b), r.glo.eq(glo_b), r.ghi.eq(ghi_b), start.eq(glo_b),
+                     r.n.eq(n_b), r.nb.eq(tb["nb"]), r.pp.eq(Mux(lead == NO_PTR, n_b, lead)), *clear(tb),
+                     r.state.eq(Mux(ghi_b <= glo_b, hand, enter))]
 
 
 class _SpanCull:
