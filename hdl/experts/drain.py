@@ -1,8 +1,8 @@
 """The DSLB drain of an EXPERTS PXP, its ports and parameter checks, shared by both PXPs
 (``pxp.py``, the line Z-buffer; ``pxp_span.py`` and ``pxp_coherent.py``, the span PXPs).
 
-Paper (seed 000, 3.2): "DSLBもDMM同様、2重系の構成とし、PXPによる書き込みと、FBへの転送のための読み出し
-とを並行して同時に行なう" -- the DSLB is double-banked; one bank is written by the resolve side while
+Paper (seed 000, 3.2, the seed's OCR): "DSLBもDMM同様、2重系の構成とい、PXPによる書き込みと、FBへの転送のため
+の読み出しとを並行して同時にに行なう" -- the DSLB is double-banked; one bank is written by the resolve side while
 the other is read out towards the frame buffer. The drain walks its bank left to right: without
 A.J., over ``[lo, hi)``, one pixel per two cycles (read, offer); with A.J. (c), over the guarded
 range ``[lo-1, hi+1)`` within the frame, one pixel per three cycles (read the DSLB, read the
@@ -76,7 +76,7 @@ class Drain:
     def __init__(self, m, *, o, drd, word, bank_bit: int, width: int, ib: int, aj: bool,
                  trd=None, ent=None, ent_bank_bit: int = 0, done_comb=None, boundary_only: bool = False,
                  prod=None):
-        pb = len(o.payload)
+        self._pb = len(o.payload)
         self.aj = aj
         shared = aj and prod is not None
         #: with ``prod`` (the PXP's one multiplier's product) and A.J.: the blend holds that multiplier
@@ -86,47 +86,76 @@ class Drain:
             self.mreq = Signal(name="aj_mreq")
             self.mul_a, self.mul_b = Signal(MUL_IN, name="drain_mul_a"), Signal(MUL_IN, name="drain_mul_b")
             m.d.comb += self.mreq.eq(0)
-        self.dstate = dstate = Signal(_D)
-        self.dbusy = dbusy = Signal()
-        self.dbank = dbank = Signal()
-        self.dx = dx = Signal(X_END_BITS)
-        self.dlo = dlo = Signal(X_INT)
-        self.dhi = dhi = Signal(X_END_BITS)
-        self.dghi = dghi = Signal(X_END_BITS)
+        self.dstate = Signal(_D)
+        self.dbusy = Signal()
+        self.dbank = Signal()
+        self.dx = Signal(X_END_BITS)
+        self.dlo = Signal(X_INT)
+        self.dhi = Signal(X_END_BITS)
+        self.dghi = Signal(X_END_BITS)
         dstored = Signal(word)
+        self._dstored = dstored
         m.d.comb += [dstored.eq(drd.data), o.payload.eq(dstored.pix), o.valid.eq(0), drd.en.eq(0)]
 
+        self._blend = self._aj_datapath(m, trd=trd, ent=ent, dstored=dstored, width=width, ib=ib,
+                                        boundary_only=boundary_only, prod=prod, shared=shared) if aj else None
+        self._walk(m, o=o, drd=drd, bank_bit=bank_bit, ent_bank_bit=ent_bank_bit, done_comb=done_comb,
+                   trd=trd, shared=shared)
+
+    def _aj_datapath(self, m, *, trd, ent, dstored, width, ib, boundary_only, prod, shared) -> dict:
+        """With A.J. (c): the pixel on the walk's left (``p_*``, :attr:`p_ok`: there is one) and the
+        current one (``c_*``; its entry from ``trd``), which of them needs its entry read (``skip``:
+        ``boundary_only`` and the pixel's segment is its left neighbour's, or background), the blend
+        (``aj.aj_boundary``, or ``aj.aj_boundary_shared`` on the PXP's one multiplier ``prod``) and
+        ``emit`` (the left pixel is in ``[lo, hi)``). Returns them by name for :meth:`_walk`."""
+        dx, dlo, dhi, dstate, pb = self.dx, self.dlo, self.dhi, self.dstate, self._pb
+        m.d.comb += trd.en.eq(0)
+        p_pix = Signal(pb)            # pixel dx-1 before A.J.
+        p_out = Signal(pb)            # pixel dx-1 as it will be output
+        p_addr = Signal(ADDR_BITS)
+        p_ent = Signal(ent)
+        self.p_ok = p_ok = Signal()   # there is a pixel dx-1 in the walk
+        c_pix_r = Signal(pb)
+        c_addr_r = Signal(ADDR_BITS)
+        c_ent = Signal(ent)
+        m.d.comb += c_ent.eq(trd.data)
+        # boundary_only: in DSEG, a pixel whose segment is its left neighbour's (or background)
+        # needs no entry read: it is blended (or passed) in that cycle from the DSLB word itself
+        # (the sync read ports hold their data: trd still has the run's segment's entry)
+        seg_read = Signal()
+        skip = Signal()
+        m.d.comb += [seg_read.eq(~((dstored.addr == NONE) | (p_ok & (dstored.addr == p_addr)))),
+                     skip.eq((dstate == _D.DSEG) & ~seg_read if boundary_only else 0)]
+        c_pix = Signal(pb)
+        c_addr = Signal(ADDR_BITS)
+        m.d.comb += [c_pix.eq(Mux(skip, dstored.pix, c_pix_r)), c_addr.eq(Mux(skip, dstored.addr, c_addr_r))]
+        bnd = {"dx": dx, "width": width, "ib": ib, "p_ok": p_ok, "p_pix": p_pix, "p_out": p_out, "p_addr": p_addr,
+               "p_ent": p_ent, "c_pix": c_pix, "c_addr": c_addr, "c_ent": c_ent}
+        if shared:
+            sh = aj_boundary_shared(m, lo=dlo, hi=dhi, prod=prod, **bnd)
+            o_prev, o_cur = sh["o_prev"], sh["o_cur"]
+            m.d.comb += [self.mul_a.eq(sh["a"]), self.mul_b.eq(sh["b"])]
+        else:
+            o_prev, o_cur = aj_boundary(m, **bnd)
+        emit = Signal()
+        m.d.comb += emit.eq(p_ok & (dx >= dlo + 1) & (dx <= dhi))
+        return {"p_pix": p_pix, "p_out": p_out, "p_addr": p_addr, "p_ent": p_ent, "p_ok": p_ok,
+                "c_pix_r": c_pix_r, "c_addr_r": c_addr_r, "c_ent": c_ent, "skip": skip, "c_pix": c_pix,
+                "c_addr": c_addr, "o_prev": o_prev, "o_cur": o_cur, "emit": emit, "sh": sh if shared else None}
+
+    def _walk(self, m, *, o, drd, bank_bit, ent_bank_bit, done_comb, trd, shared) -> None:
+        """The drain's walk over its bank, one state machine (:class:`_D`): ``DRD`` reads the DSLB,
+        ``DOUT`` offers the pixel (without A.J.); with A.J. ``DSEG`` reads the visible segment's
+        entry (or, ``skip``, blends and offers at once), ``DAJ`` blends the boundary and offers the
+        pixel on its left (one multiply a cycle on the shared multiplier), ``FLUSH`` offers the
+        range's last pixel at the frame's right edge."""
+        aj, dstate, dbusy, dbank, dx, dhi, dghi = self.aj, self.dstate, self.dbusy, self.dbank, self.dx, self.dhi, self.dghi
+        dstored = self._dstored
         if aj:
-            m.d.comb += trd.en.eq(0)
-            p_pix = Signal(pb)            # pixel dx-1 before A.J.
-            p_out = Signal(pb)            # pixel dx-1 as it will be output
-            p_addr = Signal(ADDR_BITS)
-            p_ent = Signal(ent)
-            self.p_ok = p_ok = Signal()   # there is a pixel dx-1 in the walk
-            c_pix_r = Signal(pb)
-            c_addr_r = Signal(ADDR_BITS)
-            c_ent = Signal(ent)
-            m.d.comb += c_ent.eq(trd.data)
-            # boundary_only: in DSEG, a pixel whose segment is its left neighbour's (or background)
-            # needs no entry read: it is blended (or passed) in that cycle from the DSLB word itself
-            # (the sync read ports hold their data: trd still has the run's segment's entry)
-            seg_read = Signal()
-            skip = Signal()
-            m.d.comb += [seg_read.eq(~((dstored.addr == NONE) | (p_ok & (dstored.addr == p_addr)))),
-                         skip.eq((dstate == _D.DSEG) & ~seg_read if boundary_only else 0)]
-            c_pix = Signal(pb)
-            c_addr = Signal(ADDR_BITS)
-            m.d.comb += [c_pix.eq(Mux(skip, dstored.pix, c_pix_r)), c_addr.eq(Mux(skip, dstored.addr, c_addr_r))]
-            bnd = {"dx": dx, "width": width, "ib": ib, "p_ok": p_ok, "p_pix": p_pix, "p_out": p_out, "p_addr": p_addr,
-                   "p_ent": p_ent, "c_pix": c_pix, "c_addr": c_addr, "c_ent": c_ent}
-            if shared:
-                sh = aj_boundary_shared(m, lo=dlo, hi=dhi, prod=prod, **bnd)
-                o_prev, o_cur = sh["o_prev"], sh["o_cur"]
-                m.d.comb += [self.mul_a.eq(sh["a"]), self.mul_b.eq(sh["b"])]
-            else:
-                o_prev, o_cur = aj_boundary(m, **bnd)
-            emit = Signal()
-            m.d.comb += emit.eq(p_ok & (dx >= dlo + 1) & (dx <= dhi))
+            b = self._blend
+            p_pix, p_out, p_addr, p_ent, p_ok, c_pix_r, c_addr_r, c_ent, skip, c_pix, c_addr, o_prev, o_cur, emit, sh = (
+                b[k] for k in ("p_pix", "p_out", "p_addr", "p_ent", "p_ok", "c_pix_r", "c_addr_r", "c_ent", "skip",
+                               "c_pix", "c_addr", "o_prev", "o_cur", "emit", "sh"))
 
         def drain_done():
             m.d.sync += [dbusy.eq(0), dstate.eq(_D.IDLE)]
