@@ -81,8 +81,16 @@ class ExpertsDmm(wiring.Component):
         m.d.comb += self.full.eq(full)
         wfull = Signal()
         m.d.comb += wfull.eq(full.bit_select(wbank, 1))
+        set_full, clr_full = self._writer(m, wr, d=d, aw=aw, wbank=wbank, wptr=wptr, cnt=cnt, wfull=wfull)
+        self._reader(m, rd, aw=aw, pw=pw, rbank=rbank, rptr=rptr, cnt=cnt, full=full, clr_full=clr_full)
+        m.d.sync += full.eq((full | set_full) & ~clr_full)
+        return m
 
-        # --- writer (SLP side)
+    def _writer(self, m, wr, *, d, aw, wbank, wptr, cnt, wfull):
+        """The writer (SLP side, "上位プロセッサによる書込み"): one word of ``i`` a cycle into bank
+        ``wbank`` at ``wptr``; the ``last`` token records the line's count in ``cnt`` and sets the
+        bank full (``set_full``, returned with the reader's ``clr_full``); a segment that does not
+        fit is not taken (``overflow``)."""
         at_end = Signal()
         m.d.comb += at_end.eq(wptr == d)
         # a segment that does not fit is not taken: it stays on ``i`` and ``overflow`` rises
@@ -104,8 +112,12 @@ class ExpertsDmm(wiring.Component):
             with m.Else():
                 m.d.comb += wr.en.eq(1)
                 m.d.sync += wptr.eq(wptr + 1)
+        return set_full, clr_full
 
-        # --- reader (PXP side): RD issues the read (or the token), OUT offers it
+    def _reader(self, m, rd, *, aw, pw, rbank, rptr, cnt, full, clr_full):
+        """The reader (PXP side, "下位プロセッサによる読み出し"): a full bank ``rbank`` played out on
+        ``o``, two cycles a word (the read, then the offer), then the ``last`` token; the bank is
+        released (``clr_full``) when the token is taken."""
         rcnt = Signal(pw)
         with m.If(rbank):
             m.d.comb += rcnt.eq(cnt[1])
@@ -135,5 +147,3 @@ class ExpertsDmm(wiring.Component):
                     m.d.comb += clr_full.eq(0b01)
             with m.Else():
                 m.d.sync += rptr.eq(rptr + 1)
-        m.d.sync += full.eq((full | set_full) & ~clr_full)
-        return m
