@@ -1,8 +1,9 @@
-"""The span PXPs' sub-components (issue 46 item 6): the span PXP's and the coherent span PXP's
-resolve side, one sub-component per step the paper names (initial processing, span cull, depth
-search, S.S., the DSLB hand-over) or per step of ours where the paper is silent; each docstring
-quotes the paper's words for it, which stand in seed 000 (spaces aside; pieces between ``...``
-each), and each state of the one FSM is emitted by exactly one step."""
+"""The PXPs' sub-components (issue 46 item 6): the span PXP's and the coherent span PXP's resolve
+side, one sub-component per step the paper names (initial processing, span cull, depth search,
+S.S., the DSLB hand-over) or per step of ours where the paper is silent, and likewise the line
+Z-buffer PXP (``pxp.py``) and the DMM/P's writer and reader (``dmm.py``); each docstring quotes the
+paper's words for it, which stand in seed 000 (spaces aside; pieces between ``...`` each), and each
+state of a PXP's one FSM is emitted by exactly one step."""
 
 from __future__ import annotations
 
@@ -10,13 +11,17 @@ import inspect
 import re
 
 import pytest
-from rasterhw.hdl.experts import pxp_coherent, pxp_span
+from rasterhw.hdl.experts import dmm, pxp, pxp_coherent, pxp_span
 
 _JP = re.compile(r"[\u3040-\u30ff\u4e00-\u9fff]")
 STEPS = [pxp_span._Resolve, pxp_span._Multiply, pxp_span._Initial, pxp_span._SpanCull,
          pxp_span._DepthSearch, pxp_span._ShadeWrite, pxp_span.hand_over,
          pxp_coherent._Visible, pxp_coherent._Multiply, pxp_coherent._Initial, pxp_coherent._Enter,
-         pxp_coherent._DepthSearch, pxp_coherent._ShadeWrite]
+         pxp_coherent._DepthSearch, pxp_coherent._ShadeWrite,
+         pxp._Line, pxp._StartValues, pxp._DepthCompare, dmm.ExpertsDmm._writer, dmm.ExpertsDmm._reader]
+#: each PXP module, its top class and the enum of its FSM's states
+PXPS = {"pxp_span": (pxp_span, "ExpertsPxpSpan", "_R"), "pxp_coherent": (pxp_coherent, "ExpertsPxpCoherent", "_R"),
+        "pxp": (pxp, "ExpertsPxp", "_S")}
 
 
 def quotes(doc: str) -> list[str]:
@@ -37,27 +42,28 @@ def test_each_step_quotes_the_paper_and_the_quote_stands_in_seed_000(step, pv):
     assert not missing, missing
 
 
-@pytest.mark.parametrize("mod", [pxp_span, pxp_coherent], ids=lambda m: m.__name__.rsplit(".", 1)[-1])
+@pytest.mark.parametrize("mod", [pxp_span, pxp_coherent, pxp], ids=lambda m: m.__name__.rsplit(".", 1)[-1])
 def test_the_modules_say_why_the_steps_are_not_joined_by_streams(mod, pv):
     text = _squashed_seed(pv)
     assert "joined by streams" in " ".join(mod.__doc__.split())
     assert all(pv._squash(p) in text for q in quotes(mod.__doc__) for p in q.split("..."))
 
 
-@pytest.mark.parametrize("mod", [pxp_span, pxp_coherent], ids=lambda m: m.__name__.rsplit(".", 1)[-1])
-def test_each_state_is_emitted_by_exactly_one_step(mod):
-    """Every state of the resolve FSM (``_R``) has its ``m.Case`` in one step's ``states`` (the
-    hand-over's in ``elaborate``, which calls the shared :func:`pxp_span.hand_over`), and ``elaborate``
-    writes no other state's case itself."""
-    steps = [c for c in vars(mod).values() if inspect.isclass(c) and c.__module__ == mod.__name__
-             and hasattr(c, "states")]
+@pytest.mark.parametrize("name", list(PXPS))
+def test_each_state_is_emitted_by_exactly_one_step(name):
+    """Every state of the PXP's FSM has its ``m.Case`` in one step's ``states`` or, for the few
+    one-line steps (the hand-over, the Z-buffer PXP's clear), in ``elaborate`` (which calls the
+    step's function), never in two places."""
+    mod, top, enum_name = PXPS[name]
+    case = re.compile(rf"m\.Case\({enum_name}\.(\w+)\)")
     owners = {}
-    for c in steps:
-        for name in re.findall(r"m\.Case\(_R\.(\w+)\)", inspect.getsource(c.states)):
-            owners.setdefault(name, []).append(c.__name__)
-    elab = inspect.getsource(getattr(mod, {"pxp_span": "ExpertsPxpSpan"}.get(
-        mod.__name__.rsplit(".", 1)[-1], "ExpertsPxpCoherent")).elaborate)
-    for name in re.findall(r"m\.Case\(_R\.(\w+)\)", elab):
-        owners.setdefault(name, []).append("elaborate")
-    assert owners == {s.name: owners.get(s.name) for s in mod._R} and all(len(v) == 1 for v in owners.values()), owners
+    for c in vars(mod).values():
+        if inspect.isclass(c) and c.__module__ == mod.__name__ and hasattr(c, "states"):
+            for state in case.findall(inspect.getsource(c.states)):
+                owners.setdefault(state, []).append(c.__name__)
+    elab = inspect.getsource(getattr(mod, top).elaborate)
+    for state in case.findall(elab):
+        owners.setdefault(state, []).append("elaborate")
+    assert sorted(owners) == sorted(s.name for s in getattr(mod, enum_name)), owners
+    assert all(len(v) == 1 for v in owners.values()), owners
     assert owners["HAND"] == ["elaborate"] and "hand_over(" in elab
