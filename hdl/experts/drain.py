@@ -145,17 +145,8 @@ class Drain:
 
     def _walk(self, m, *, o, drd, bank_bit, ent_bank_bit, done_comb, trd, shared) -> None:
         """The drain's walk over its bank, one state machine (:class:`_D`): ``DRD`` reads the DSLB,
-        ``DOUT`` offers the pixel (without A.J.); with A.J. ``DSEG`` reads the visible segment's
-        entry (or, ``skip``, blends and offers at once), ``DAJ`` blends the boundary and offers the
-        pixel on its left (one multiply a cycle on the shared multiplier), ``FLUSH`` offers the
-        range's last pixel at the frame's right edge."""
-        aj, dstate, dbusy, dbank, dx, dhi, dghi = self.aj, self.dstate, self.dbusy, self.dbank, self.dx, self.dhi, self.dghi
-        dstored = self._dstored
-        if aj:
-            b = self._blend
-            p_pix, p_out, p_addr, p_ent, p_ok, c_pix_r, c_addr_r, c_ent, skip, c_pix, c_addr, o_prev, o_cur, emit, sh = (
-                b[k] for k in ("p_pix", "p_out", "p_addr", "p_ent", "p_ok", "c_pix_r", "c_addr_r", "c_ent", "skip",
-                               "c_pix", "c_addr", "o_prev", "o_cur", "emit", "sh"))
+        ``DOUT`` offers the pixel (without A.J.); with A.J. the blend's states (:meth:`_aj_states`)."""
+        aj, dstate, dbusy, dbank, dx, dhi = self.aj, self.dstate, self.dbusy, self.dbank, self.dx, self.dhi
 
         def drain_done():
             m.d.sync += [dbusy.eq(0), dstate.eq(_D.IDLE)]
@@ -175,44 +166,57 @@ class Drain:
                     with m.Else():
                         m.d.sync += dstate.eq(_D.DRD)
             if aj:
-                def offer():
-                    m.d.comb += [o.valid.eq(emit), o.payload.eq(o_prev)]
-                    with m.If(~emit | o.ready):
-                        m.d.sync += [p_pix.eq(c_pix), p_out.eq(o_cur), p_addr.eq(c_addr), p_ent.eq(c_ent),
-                                     p_ok.eq(1), dx.eq(dx + 1)]
-                        if shared:
-                            m.d.sync += sh["done"]
-                        with m.If(dx + 1 >= dghi):
-                            with m.If(dghi == dhi):
-                                m.d.sync += dstate.eq(_D.FLUSH)
-                            with m.Else():
-                                drain_done()
-                        with m.Else():
-                            m.d.sync += dstate.eq(_D.DRD)
+                self._aj_states(m, o=o, trd=trd, ent_bank_bit=ent_bank_bit, shared=shared, drain_done=drain_done)
 
-                def blend_offer():
-                    if not shared:
-                        offer()
-                        return
-                    # the blend's multiplies, one a cycle, this step repeated; the last one offers
-                    m.d.comb += self.mreq.eq(sh["need"])
-                    with m.If(sh["last"]):
-                        offer()
-                    with m.Else():
-                        sh["step"]()
+    def _aj_states(self, m, *, o, trd, ent_bank_bit, shared, drain_done) -> None:
+        """With A.J. (c): ``DSEG`` reads the visible segment's entry (or, ``skip``, blends and offers
+        at once), ``DAJ`` blends the boundary and offers the pixel on its left (with ``shared``, one
+        multiply a cycle on the PXP's one multiplier, the step repeated), ``FLUSH`` offers the
+        range's last pixel at the frame's right edge."""
+        dstate, dbank, dx, dhi, dghi, dstored = self.dstate, self.dbank, self.dx, self.dhi, self.dghi, self._dstored
+        b = self._blend
+        p_pix, p_out, p_addr, p_ent, p_ok, c_pix_r, c_addr_r, c_ent, skip, c_pix, c_addr, o_prev, o_cur, emit, sh = (
+            b[k] for k in ("p_pix", "p_out", "p_addr", "p_ent", "p_ok", "c_pix_r", "c_addr_r", "c_ent", "skip",
+                           "c_pix", "c_addr", "o_prev", "o_cur", "emit", "sh"))
 
-                with m.Case(_D.DSEG):
-                    with m.If(skip):
-                        blend_offer()
+        def offer():
+            m.d.comb += [o.valid.eq(emit), o.payload.eq(o_prev)]
+            with m.If(~emit | o.ready):
+                m.d.sync += [p_pix.eq(c_pix), p_out.eq(o_cur), p_addr.eq(c_addr), p_ent.eq(c_ent),
+                             p_ok.eq(1), dx.eq(dx + 1)]
+                if shared:
+                    m.d.sync += sh["done"]
+                with m.If(dx + 1 >= dghi):
+                    with m.If(dghi == dhi):
+                        m.d.sync += dstate.eq(_D.FLUSH)
                     with m.Else():
-                        m.d.comb += [trd.addr.eq((dbank << ent_bank_bit) | dstored.slot), trd.en.eq(1)]
-                        m.d.sync += [c_pix_r.eq(dstored.pix), c_addr_r.eq(dstored.addr), dstate.eq(_D.DAJ)]
-                with m.Case(_D.DAJ):
-                    blend_offer()
-                with m.Case(_D.FLUSH):
-                    m.d.comb += [o.valid.eq(1), o.payload.eq(p_out)]
-                    with m.If(o.ready):
                         drain_done()
+                with m.Else():
+                    m.d.sync += dstate.eq(_D.DRD)
+
+        def blend_offer():
+            if not shared:
+                offer()
+                return
+            # the blend's multiplies, one a cycle, this step repeated; the last one offers
+            m.d.comb += self.mreq.eq(sh["need"])
+            with m.If(sh["last"]):
+                offer()
+            with m.Else():
+                sh["step"]()
+
+        with m.Case(_D.DSEG):
+            with m.If(skip):
+                blend_offer()
+            with m.Else():
+                m.d.comb += [trd.addr.eq((dbank << ent_bank_bit) | dstored.slot), trd.en.eq(1)]
+                m.d.sync += [c_pix_r.eq(dstored.pix), c_addr_r.eq(dstored.addr), dstate.eq(_D.DAJ)]
+        with m.Case(_D.DAJ):
+            blend_offer()
+        with m.Case(_D.FLUSH):
+            m.d.comb += [o.valid.eq(1), o.payload.eq(p_out)]
+            with m.If(o.ready):
+                drain_done()
 
     def hand(self, *, bank, lo, hi, glo, ghi) -> list:
         """Sync statements that hand the resolved ``bank`` (range ``[lo, hi)``, guarded
