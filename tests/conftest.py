@@ -93,3 +93,21 @@ def pytest_generate_tests(metafunc):
     """``pv``: tests/paper_values.py (the paper-cell checks of tests/*/test_*_paper.py)."""
     if "pv" in metafunc.fixturenames:
         metafunc.parametrize("pv", [_paper_values_module()], ids=["paper_values"])
+
+
+@pytest.fixture(scope="session")
+def experts_tilt_300():
+    """The EXPERTS HDL frame tests' scene: every third of experts-tilt-1000's triangles from the
+    second (300; tilted and interpenetrating as they are). The SLP set-up HDL works per polygon and
+    band, so at 48 x 16 (Sn 2, Pn 3) the whole scene cost 3.2-3.3x the HDL cycles (87.5 k against
+    27.4 k at the paper's datapath with A.J. (c); 68.0 k against 21.0 k at ours) for no kind of work
+    these lack: 297 polygons set up, 412-415 list words, the paper datapath's extra resolve cycles
+    on every line, all 16 A.J. drains with multiplies, the coherent PXP's entering segments tested
+    against the visible one on the same 4 lines (7 tests of the whole scene's 13)."""
+    from dataclasses import replace
+
+    from rasterhw.golden_model.scenes import build_scene
+    s = build_scene("experts-tilt-1000")
+    k = slice(1, 900, 3)
+    return replace(s, name="experts-tilt-1000-every-3rd", positions=s.positions[k], normals=s.normals[k],
+                   colours=s.colours[k], nverts=s.nverts[k], uv=None if s.uv is None else s.uv[k])

@@ -89,7 +89,7 @@ def test_slp_cycle_model_and_set_up_at_the_papers_widths(name):
     assert n > 300 and wide > 0
 
 
-def test_slp_hdl_at_the_papers_widths_pysim():
+def test_slp_hdl_at_the_papers_widths_pysim(experts_tilt_300):
     """experts-slp-setup and experts-slp with acc_extra 0 (the paper's 16-bit increments and edge
     accumulators), pysim, on one band of the paper bit model's frame: words and cycle stamps equal
     the golden side's at the same widths; the same words at ours' widths differ (the test can fail)."""
@@ -98,8 +98,7 @@ def test_slp_hdl_at_the_papers_widths_pysim():
     from rasterhw.sim.engines import run
     from rasterhw.sim.experts.testbench import SlpBench, SlpSetupBench, setup_words, slp_words
     from rasterhw.sim.testbench import Stimulus
-    fr = render_frame(run_geometry(build_scene("experts-tilt-1000"), 64, 32, z_bits=16), model="bit", aj="c",
-                      fmt=PAPER)
+    fr = render_frame(run_geometry(experts_tilt_300, 64, 32, z_bits=16), model="bit", aj="c", fmt=PAPER)
     su = setup_words(pl_words(fr.setup), (8, 16), 32, extra=0)
     assert su["out"] != setup_words(pl_words(fr.setup), (8, 16), 32)["out"]
     tb = SlpSetupBench()
@@ -169,12 +168,14 @@ def test_multipliers_are_counted_from_the_elaborated_hdl():
             return m
     assert sorted(multipliers(Two())) == [(8, 8), (8, 12)]
     # the chained frame at the paper's datapath without A.J.: one 16 x 16 multiplier a processor (the
-    # set-up's products wider than that multi-word); with A.J. (c) the blend's 9 are not shared yet
-    from rasterhw.hdl.experts.census import frame_census
-    f = frame_census("paper", pxp_datapath="paper", width=64, height=32, aj="none")
+    # set-up's products wider than that multi-word); with A.J. (c) the blend's 9 are not shared yet.
+    # frame_census through sim experts' cache entry (the frame test's [none] one at the paper's datapath):
+    # keyed by the three blocks' design digests and census.py's, so a changed block or count elaborates again
+    from rasterhw.sim.experts.scene import _census
+    f = _census("paper", 48, 16, "none", "span")
     assert {b: (c["multipliers"], c["bits"]) for b, c in f["per_block"].items()} == {
         "experts-slp-setup": (1, 16), "experts-slp": (1, 16), "experts-pxp-span": (1, 16)}
     assert (f["multipliers"], f["datapath_bits"]) == (1, 16)
-    f = frame_census("ours", pxp_datapath="ours", width=64, height=32, aj="none")
+    f = _census("ours", 48, 16, "none", "span")
     assert {b: (c["multipliers"], c["bits"]) for b, c in f["per_block"].items()} == {
         "experts-slp-setup": (1, 40), "experts-slp": (9, 48), "experts-pxp-span": (3, 20)}
