@@ -1,7 +1,8 @@
 """``rasterhw sim pixelbus``'s scene level (``sim/engines/scene.py``): the scene's frame through the SNU
 pixel-bus HDL, checked against the golden model (``golden_model/snu/pixelbus.py``).
 
-On Verilator the whole frame as the machine draws it (the snu-100k headline frame end to end):
+On every engine the whole frame as the machine draws it (the snu-100k headline frame end to end), so
+``cycles`` is one quantity whatever the engine: the frame's length, CLEAR accepted to SWAP + 1:
 
 1. **Geometry**: the scene through the golden geometry (``pipeline.run_geometry``, far = 0);
    triangle ``i`` goes to pipeline ``i % 2``. Its cost on the i860 model: the three-processor
@@ -19,9 +20,11 @@ On Verilator the whole frame as the machine draws it (the snu-100k headline fram
    the players, every acceptance cycle, swap) and the same frame; ``mismatches`` counts pixels
    that differ plus one per schedule number that differs.
 
-On the other engines the pixel stream alone (no clear, no swap, no producer gaps) through the
-block's testbench (``BusBench``, the frame memory streamed out by the engines' ``ReadOut``):
-:func:`simulate_pixelbus`, which the soak and the report's rate rows also run.
+The pixel stream alone (no clear, no swap, no producer gaps) through the block's testbench
+(``BusBench``, the frame memory streamed out by the engines' ``ReadOut``) is :func:`simulate_pixelbus`,
+which the soak and the report's rate rows run; ``rasterhw sim pixelbus`` does not (before, its pysim
+run did, and its ``cycles`` were the pixel writes' 861 where Verilator's were the frame's 35,845: snu-100px
+at 64 x 48).
 
 Times are reported at the paper's clocks: 12.5 MHz bus (80 ns slot), i860 at
 ``I860.clock_hz`` (40 MHz, assumed: the paper never states it).
@@ -281,12 +284,15 @@ def main(argv: list[str] | None = None) -> int:
 
 
 # ====================================================================== the whole frame
-def frame_job(stream: PixelStream, gaps: np.ndarray, sched: dict) -> Job:
+def frame_job(stream: PixelStream, gaps: np.ndarray, sched: dict, *, engine: str = "verilator") -> Job:
     """The frame (``FrameBench``: clear, the producer gaps, swap) as one job: the displayed frame
-    and the :data:`~rasterhw.sim.snu.frame_format.SCHEDULE` words against the golden ``sched``."""
+    and the :data:`~rasterhw.sim.snu.frame_format.SCHEDULE` words against the golden ``sched``. The
+    bank RAMs: Amaranth's ``Memory`` for banks of up to 4096 words and always on pysim (which cannot
+    run the hand-written Verilog RAM), else the Verilog RAM (``PixelBusBank``: the same ports and clocks)."""
     w, h = stream.width, stream.height
     tb = FrameBench()
-    params = tb.params(width=w, height=h, z_bits=stream.z_bits, ram="memory" if -(-w * h // N_BANKS) <= 4096 else "verilog")
+    small = -(-w * h // N_BANKS) <= 4096 or engine == "pysim"
+    params = tb.params(width=w, height=h, z_bits=stream.z_bits, ram="memory" if small else "verilog")
     g = np.asarray(gaps, dtype=np.int64).copy()
     for p in range(2):
         i = np.flatnonzero(stream.pipe == p)
@@ -317,13 +323,12 @@ def frame_words(d: Done) -> dict:
 
 def run_frame_engine(stream: PixelStream, gaps: np.ndarray, sched: dict, *, engine: str = "verilator") -> dict:
     """:func:`frame_job` on ``engine``: :func:`frame_words`' keys."""
-    return frame_words(run_job(frame_job(stream, gaps, sched), engine))
+    return frame_words(run_job(frame_job(stream, gaps, sched, engine=engine), engine))
 
 
 class PixelbusScene(SceneRun):
-    """``rasterhw sim pixelbus``: on Verilator the whole frame (module docstring; ``frame`` in the
-    result holds the schedule, the frame time and each stage's share); on the other engines the
-    scene's pixel stream alone (:func:`bus_job`)."""
+    """``rasterhw sim pixelbus``: the whole frame on every engine (module docstring; ``frame`` in the
+    result holds the schedule, the frame time and each stage's share)."""
 
     block = "pixelbus"
     steps = ("geometry + scan conversion + golden model", "HDL simulation", "frame")
@@ -333,24 +338,19 @@ class PixelbusScene(SceneRun):
         from rasterhw.golden_model.snu.gouraud import scan_convert, setup_spans
 
         tris = run_geometry(scene, width, height, z_bits=Z_BITS, z_far_is_zero=True)
-        if engine != "verilator":
-            return {"stream": scan_convert(tris)}
         ran: dict = {}
         spans = setup_spans(tris)
         stream = scan_convert(tris, counts=ran, spans=spans)
-        prod = producer_gaps(tris, stream, cpu or i860.I860(), spans=spans)
+        cpu = cpu or i860.I860()
+        prod = producer_gaps(tris, stream, cpu, spans=spans)
         sched = golden_schedule(stream, prod["gaps"], prod["first_work"], ratio=prod["ratio"])
-        return {"tris": tris, "stream": stream, "ran": ran, "prod": prod, "sched": sched, "cpu": cpu or i860.I860()}
+        return {"tris": tris, "stream": stream, "ran": ran, "prod": prod, "sched": sched, "cpu": cpu}
 
     def jobs(self, gold: dict, *, engine: str, **_) -> list[Job]:
-        if "sched" not in gold:
-            return [bus_job(gold["stream"])]
-        return [frame_job(gold["stream"], gold["prod"]["gaps"], gold["sched"])]
+        return [frame_job(gold["stream"], gold["prod"]["gaps"], gold["sched"], engine=engine)]
 
     def result(self, gold: dict, done: list[Done], *, engine: str, bus_only_bound: bool = False, **_) -> dict:
         (d,) = done
-        if "sched" not in gold:
-            return bus_result(d)
         return frame_result(gold, frame_words(d), bus_only_bound=bus_only_bound)
 
 

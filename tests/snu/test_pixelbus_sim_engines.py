@@ -1,0 +1,58 @@
+"""``rasterhw sim pixelbus`` runs and reports one thing on every engine (issue 46): the whole frame
+(CLEAR, the two pipelines' writes after their producer gaps, SWAP, the display buffer read out), so
+``cycles`` is the frame's length on pysim as on Verilator. Before, pysim ran the pixel writes alone
+(snu-100px at 64 x 48: 861 cycles, ``extra`` without ``frame``) and Verilator the frame (35,845).
+
+The scene is tiny for pysim's sake: experts-solid-5 at 16 x 16 is 2 triangles, 55 writes, a
+305-clock frame (the pixel writes alone take about a fifth of that)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from PIL import Image
+from rasterhw.sim.cli.main import main
+
+ARGS = ["sim", "pixelbus", "--scene", "experts-solid-5", "--size", "16x16", "--json"]
+SCHEDULE = ("t_clear", "t_start", "t_pixels_done", "t_swap", "cycles")
+
+
+def _sim(engine: str, tmp_path, capsys) -> dict:
+    try:
+        main([*ARGS, "--engine", engine, "-o", str(tmp_path / f"{engine}.png")])
+    except SystemExit as e:
+        assert not e.code, capsys.readouterr().err
+    return json.loads(capsys.readouterr().out)
+
+
+def test_sim_pixelbus_on_pysim_is_the_frame(tmp_path, capsys):
+    """pysim runs the whole frame: ``cycles`` is the golden schedule's frame length (SWAP + 1), the
+    schedule words the HDL gave are the golden ones, and ``extra.frame`` is there."""
+    r = _sim("pysim", tmp_path, capsys)
+    frame = r["extra"]["frame"]
+    assert r["mismatches"] == 0 and r["cycle_mismatches"] == 0 and frame["schedule_mismatches"] == 0
+    assert frame["schedule_hdl"] == frame["schedule_golden"]
+    assert r["cycles"] == frame["schedule_golden"]["cycles"] == r["extra"]["cycles_golden"]
+    # the frame's length is more than the pixel writes: the clear comes first (16 x 16 / 5 banks)
+    assert frame["schedule_hdl"]["t_start"] > 16 * 16 // 5 and r["cycles"] > frame["schedule_hdl"]["t_start"]
+    # the run's clocks: the frame, then the schedule word and the display buffer read out
+    assert r["sim_cycles"] == r["cycles"] + 16 * 16 + 1
+
+
+@pytest.mark.cocotb   # the Verilator engine (a build of the small frame bench the first time)
+def test_sim_pixelbus_pysim_and_verilator_report_the_same(tmp_path, capsys):
+    """The same command on both engines: the same top-level and ``extra`` keys, the same ``cycles``,
+    ``sim_cycles``, schedule and frame figures, and the same image."""
+    got = {e: _sim(e, tmp_path, capsys) for e in ("pysim", "verilator")}
+    a, b = got["pysim"], got["verilator"]
+    assert set(a) == set(b) and set(a["extra"]) == set(b["extra"]) and set(a["extra"]["frame"]) == set(b["extra"]["frame"])
+    for k in ("cycles", "sim_cycles", "mismatches", "cycle_mismatches", "pixels_compared", "clock_hz"):
+        assert a[k] == b[k], (k, a[k], b[k])
+    assert a["mismatches"] == 0 and a["cycle_mismatches"] == 0
+    wall = {"golden_wall_s", "hdl_wall_s"}
+    assert {k: v for k, v in a["extra"].items() if k not in wall} == {k: v for k, v in b["extra"].items() if k not in wall}
+    assert [a["extra"]["frame"]["schedule_hdl"][k] for k in SCHEDULE] == \
+        [b["extra"]["frame"]["schedule_hdl"][k] for k in SCHEDULE]
+    assert np.array_equal(np.asarray(Image.open(a["image"])), np.asarray(Image.open(b["image"])))
