@@ -45,6 +45,7 @@ from rasterhw.golden_model.snu.formats import CLOCK_HZ, MEM_CYCLE, N_BANKS, Z_BI
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.sim import engines
 from rasterhw.sim.engines.scene import Done, Job, SceneRun, run_job
+from rasterhw.sim.packed import as_ints
 from rasterhw.sim.snu.frame_format import GAP_BITS, SCHEDULE
 from rasterhw.sim.snu.testbench import BusBench, FrameBench, frame_of
 
@@ -305,7 +306,8 @@ def frame_job(stream: PixelStream, gaps: np.ndarray, sched: dict, *, engine: str
     # schedule word k leaves at edge ``cycles + k``, display word j at ``cycles + 1 + j``, so the
     # last at ``cycles + w h`` (``FrameAdapter``: the sweep starts the clock after SWAP's)
     exp = replace(tb.expect(params, stim), cycles=int(sched["cycles"]) + w * h + 1)
-    return Job(tb, params, stim, exp, {"max_cycles": int(sched["cycles"]) + w * h + 10_000})
+    # packed: the Verilator engine gives the display words as rows, as ``FrameBench.expect`` does
+    return Job(tb, params, stim, exp, {"max_cycles": int(sched["cycles"]) + w * h + 10_000, "packed": True})
 
 
 def frame_words(d: Done) -> dict:
@@ -313,17 +315,78 @@ def frame_words(d: Done) -> dict:
     (read-out and schedule words that differ from the golden schedule, plus one if the run's
     length differs from the golden schedule's: ``frame_job``)."""
     stream = d.job.stim.source[0]
-    words = np.array(d.got.words["o"], dtype=np.int64)
+    words = _int64(d.got.words["o"])
     zmask = (1 << stream.z_bits) - 1
-    got = dict(zip(SCHEDULE, d.got.words["o_sched"], strict=False))
+    got = dict(zip(SCHEDULE, as_ints(d.got.words["o_sched"]), strict=False))
     return {**got, "rgb": (words >> stream.z_bits).reshape(stream.height, stream.width),
             "z": (words & zmask).reshape(stream.height, stream.width),
             "mismatches": d.cmp["mismatches"] + (d.cmp["cycle_mismatches"] or 0)}
 
 
+def _int64(words) -> np.ndarray:
+    """A port's words of up to 63 bits (ints, or packed rows: ``sim/packed.py``) as int64."""
+    if not isinstance(words, np.ndarray):
+        return np.array(words, dtype=np.int64)
+    full = np.zeros((len(words), 8), np.uint8)   # big-endian rows, right-aligned in 8 bytes
+    full[:, 8 - words.shape[1]:] = words
+    return full.view(">u8").ravel().astype(np.int64)
+
+
 def run_frame_engine(stream: PixelStream, gaps: np.ndarray, sched: dict, *, engine: str = "verilator") -> dict:
     """:func:`frame_job` on ``engine``: :func:`frame_words`' keys."""
     return frame_words(run_job(frame_job(stream, gaps, sched, engine=engine), engine))
+
+
+def frame_golden(tris, cpu: i860.I860, *, cached: bool = True) -> dict:
+    """The frame's golden model for the screen triangles ``tris`` on the i860 model ``cpu``: the two
+    pipelines' pixel stream (``gouraud.scan_convert``; ``ran``: what its inner loop executed), the
+    producer gaps (:func:`producer_gaps`: ``prod``) and the schedule (:func:`golden_schedule`:
+    ``sched``). ``cached``: kept as a build-cache entry (``verilog_cache.arrays_cached``:
+    ``build/verilog/snu-frame-golden-<digest>.npz``, SHA-256 checked, keyed by the triangles' bytes,
+    ``cpu`` and the digest of every Python source of ours this module imports, transitively), so a
+    warm ``rasterhw sim pixelbus`` neither scan-converts nor walks the producer model (snu-100px at
+    1280 x 1024: 0.045-0.07 CPU-s computed, ~0.01 read back); ``False``: computed here (the
+    specification the entry is held equal to, ``tests/snu/test_pixelbus_sim_engines.py``)."""
+    from rasterhw.golden_model.snu.gouraud import scan_convert, setup_spans
+
+    def compute() -> dict:
+        ran: dict = {}
+        spans = setup_spans(tris)
+        stream = scan_convert(tris, counts=ran, spans=spans)
+        prod = producer_gaps(tris, stream, cpu, spans=spans)
+        sched = golden_schedule(stream, prod["gaps"], prod["first_work"], ratio=prod["ratio"])
+        return {"stream": stream, "ran": ran, "prod": prod, "sched": sched}
+
+    if not cached:
+        return compute()
+
+    import json
+
+    from rasterhw.sim.engines.verilog_cache import arrays_cached
+
+    def arrays() -> dict:
+        g = compute()
+        s = g["stream"]
+        meta = {"ran": g["ran"], "prod": {k: v for k, v in g["prod"].items() if k != "gaps"},
+                "sched": {k: v for k, v in g["sched"].items() if k != "accept"},
+                "stream": {"width": s.width, "height": s.height, "z_bits": s.z_bits}}
+        cols = {"addr": s.addr, "rgb": s.rgb, "z": s.z, "pipe": s.pipe, "gaps": g["prod"]["gaps"],
+                "accept": g["sched"]["accept"]}
+        # int64 columns kept as int32 where every value fits (half the bytes to read and check)
+        return {**{k: v.astype(np.int32) if _fits32(v) else v for k, v in cols.items()},
+                "meta": np.frombuffer(json.dumps(meta).encode(), np.uint8)}
+
+    key = [x for k, v in sorted(vars(tris).items()) for x in (k, v)] + [repr(cpu)]
+    got = arrays_cached("snu-frame-golden", Path(__file__), key, arrays)
+    meta = json.loads(got["meta"].tobytes())
+    m = meta["stream"]
+    stream = PixelStream(m["width"], m["height"], got["addr"], got["rgb"], got["z"], got["pipe"], z_bits=m["z_bits"])
+    return {"stream": stream, "ran": meta["ran"], "prod": {**meta["prod"], "gaps": got["gaps"].astype(np.int64)},
+            "sched": {**meta["sched"], "accept": got["accept"].astype(np.int64)}}
+
+
+def _fits32(v: np.ndarray) -> bool:
+    return v.dtype == np.int64 and (v.size == 0 or (int(v.min()) >= -(1 << 31) and int(v.max()) < 1 << 31))
 
 
 class PixelbusScene(SceneRun):
@@ -335,16 +398,9 @@ class PixelbusScene(SceneRun):
 
     def golden(self, scene, width: int, height: int, *, engine: str, cpu: i860.I860 | None = None,
                bus_only_bound: bool = False) -> dict:
-        from rasterhw.golden_model.snu.gouraud import scan_convert, setup_spans
-
         tris = run_geometry(scene, width, height, z_bits=Z_BITS, z_far_is_zero=True)
-        ran: dict = {}
-        spans = setup_spans(tris)
-        stream = scan_convert(tris, counts=ran, spans=spans)
         cpu = cpu or i860.I860()
-        prod = producer_gaps(tris, stream, cpu, spans=spans)
-        sched = golden_schedule(stream, prod["gaps"], prod["first_work"], ratio=prod["ratio"])
-        return {"tris": tris, "stream": stream, "ran": ran, "prod": prod, "sched": sched, "cpu": cpu}
+        return {"tris": tris, "cpu": cpu, **frame_golden(tris, cpu)}
 
     def jobs(self, gold: dict, *, engine: str, **_) -> list[Job]:
         return [frame_job(gold["stream"], gold["prod"]["gaps"], gold["sched"], engine=engine)]
