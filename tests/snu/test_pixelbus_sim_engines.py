@@ -56,3 +56,28 @@ def test_sim_pixelbus_pysim_and_verilator_report_the_same(tmp_path, capsys):
     assert [a["extra"]["frame"]["schedule_hdl"][k] for k in SCHEDULE] == \
         [b["extra"]["frame"]["schedule_hdl"][k] for k in SCHEDULE]
     assert np.array_equal(np.asarray(Image.open(a["image"])), np.asarray(Image.open(b["image"])))
+
+
+#: modules a Verilator ``sim pixelbus`` run has no use for (issue 51: its harness CPU): the cocotb
+#: package and engine, Pillow (the .png is written by ``outfile.png_bytes``), the mesh reader (the
+#: scene is built in), the cache-size report (no ``RASTERHW_CACHE_MAX``)
+UNNEEDED = ("cocotb", "PIL", "rasterhw.sim.engines.cocotb", "rasterhw.golden_model.meshio", "rasterhw.sim.cacheinfo")
+
+
+@pytest.mark.cocotb   # the Verilator engine (a build of the small frame bench the first time)
+def test_a_verilator_run_imports_nothing_it_does_not_use(tmp_path):
+    """The command in a fresh process: after the run, none of :data:`UNNEEDED` is in ``sys.modules``."""
+    import os
+    import subprocess
+    import sys
+
+    code = ("import json, sys\nfrom rasterhw.sim.cli.main import main\n"
+            f"try:\n    main({[*ARGS, '--engine', 'verilator', '-o', str(tmp_path / 'f.png')]!r})\n"
+            "except SystemExit as e:\n    assert not e.code, e.code\n"
+            f"print(json.dumps(sorted(m for m in sys.modules if m.split('.')[0] in {UNNEEDED!r} or m in {UNNEEDED!r})),"
+            " file=sys.stderr)")
+    env = {k: v for k, v in os.environ.items() if k != "RASTERHW_CACHE_MAX"}
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600, env=env)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert json.loads(r.stdout)["mismatches"] == 0
+    assert json.loads(r.stderr.strip().splitlines()[-1]) == []
