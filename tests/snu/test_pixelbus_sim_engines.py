@@ -81,3 +81,34 @@ def test_a_verilator_run_imports_nothing_it_does_not_use(tmp_path):
     assert r.returncode == 0, r.stderr[-2000:]
     assert json.loads(r.stdout)["mismatches"] == 0
     assert json.loads(r.stderr.strip().splitlines()[-1]) == []
+
+
+def _equal(a, b, path=""):
+    """``a == b`` through dicts and dataclasses, arrays by dtype and value, scalars by type and value."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        assert isinstance(a, np.ndarray) and isinstance(b, np.ndarray) and a.dtype == b.dtype, path
+        assert np.array_equal(a, b), path
+    elif isinstance(a, dict):
+        assert isinstance(b, dict) and set(a) == set(b), path
+        for k in a:
+            _equal(a[k], b[k], f"{path}/{k}")
+    elif hasattr(a, "__dataclass_fields__"):
+        assert type(a) is type(b), path
+        _equal(vars(a), vars(b), path)
+    else:
+        assert type(a) is type(b) and a == b, (path, a, b)
+
+
+@pytest.mark.parametrize("scene, w, h", [("experts-solid-5", 16, 16), ("c50", 64, 48)])
+def test_the_cached_frame_golden_is_the_computed_one(scene, w, h):
+    """``frame_golden`` read back from its build-cache entry (the second call at least) gives the
+    stream, producer gaps, schedule and inner-loop counts the golden model computes, value and type."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.scenes import build_scene
+    from rasterhw.golden_model.snu import i860
+    from rasterhw.sim.snu.scene import frame_golden
+
+    tris = run_geometry(build_scene(scene), w, h, z_bits=24, z_far_is_zero=True)
+    want = frame_golden(tris, i860.I860(), cached=False)
+    for _ in range(2):
+        _equal(frame_golden(tris, i860.I860()), want)
