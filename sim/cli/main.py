@@ -8,6 +8,7 @@ traceback. ``--json`` puts a machine-readable result on stdout; progress goes to
 from __future__ import annotations
 
 import contextlib
+import os
 import sys
 import time
 from pathlib import Path
@@ -142,12 +143,14 @@ def cli() -> None:
       rasterhw demo                        golden model + hardware, images and a report
       rasterhw report snu                  paper figures beside measured ones
     """
-    from rasterhw.sim.cacheinfo import apply_cap, cap_from_env
     from rasterhw.sim.flow.tasks import one_cluster
 
     ctx = click.get_current_context()
-    if cap_from_env() is not None:   # RASTERHW_CACHE_MAX: checked now, applied when the command ends
-        ctx.call_on_close(apply_cap)
+    if os.environ.get("RASTERHW_CACHE_MAX", "").strip():   # cacheinfo.CAP_ENV, imported only when set
+        from rasterhw.sim.cacheinfo import apply_cap, cap_from_env
+
+        if cap_from_env() is not None:   # checked now, applied when the command ends
+            ctx.call_on_close(apply_cap)
     ctx.with_resource(one_cluster())   # one local Dask cluster per command (sim/flow/tasks.py)
 
 
@@ -170,8 +173,7 @@ def scenes(as_json: bool) -> None:
 def load_scene_and_size(scene: str, size: str | None, *, bytes_per_pixel: int = 0, what: str = ""):
     """The scene and frame size; the size is checked first (before a big mesh loads), and if
     ``bytes_per_pixel`` is given, so is the memory the frame will need."""
-    from rasterhw.golden_model.meshio import load_scene
-    from rasterhw.golden_model.scenes import SCENES
+    from rasterhw.golden_model.scenes import SCENES, build_scene
 
     wh = parse_size(size)
     if wh is None:
@@ -185,7 +187,12 @@ def load_scene_and_size(scene: str, size: str | None, *, bytes_per_pixel: int = 
     big = scene not in SCENES and p.is_file() and p.stat().st_size > _BIG_MESH_BYTES
     if big and sys.stderr.isatty():   # a big mesh takes seconds to minutes to read: say so first
         info(f"loading {p.name} ({p.stat().st_size / 1e6:.0f} MB) ...")
-    sc = load_scene(scene)
+    if scene in SCENES:
+        sc = build_scene(scene)
+    else:   # a mesh file (meshio.load_scene: a built-in name first, as here)
+        from rasterhw.golden_model.meshio import load_scene
+
+        sc = load_scene(scene)
     if sc.n_polygons > _BIG_SCENE_POLYGONS and sys.stderr.isatty():
         info(f"{sc.name}: {sc.n_polygons:,} polygons; transforming and rendering ...")
     return sc, wh

@@ -23,7 +23,8 @@ from functools import partial
 
 import numpy as np
 from rasterhw.golden_model.errors import RasterhwError
-from rasterhw.sim.engines import cocotb, verilator
+from rasterhw.sim.engines import verilator
+from rasterhw.sim.engines.runner import SIMULATORS as _COCOTB_SIMS
 from rasterhw.sim.testbench import Run, Stimulus, Testbench, clocks_of
 
 __all__ = ["ALIASES", "ENGINES", "Tally", "run", "tally", "with_gaps"]
@@ -37,8 +38,17 @@ def _pysim(*args, **kw) -> Run:
     return pysim.run(*args, **kw)
 
 
+def _cocotb(*args, sim: str, **kw) -> Run:
+    """The cocotb engine on simulator ``sim`` (``cocotb.run``), imported at its first run, as pysim."""
+    from rasterhw.sim.engines import cocotb
+
+    return cocotb.run(*args, sim=sim, **kw)
+
+
+#: the cocotb engines' names (``cocotb.SIMULATORS``: one per simulator of the cocotb runner)
+_COCOTB = {f"cocotb-{sim}": sim for sim in _COCOTB_SIMS}
 ENGINES = {"pysim": _pysim, "verilator": verilator.run,
-           **{name: partial(cocotb.run, sim=sim) for name, sim in cocotb.SIMULATORS.items()}}
+           **{name: partial(_cocotb, sim=sim) for name, sim in _COCOTB.items()}}
 #: the command line's simulator names for engines: ``icarus`` (cocotb benches' name) is cocotb on Icarus
 ALIASES = {"icarus": "cocotb-icarus"}
 
@@ -107,7 +117,8 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
     back-pressure and stamps then count its own domain's edges. None: every domain on one clock.
     ``packed``: the Verilator engine gives the output words as packed rows (``packed.py``: ``(N,
     bytes)`` uint8, big-endian), read from its binary dumps without a Python int per word (262,144
-    128-bit words: 0.2 CPU-s as ints); the other engines give ints (``testbench.compare`` and the
+    128-bit words: 0.2 CPU-s as ints), and each port's stamps as one int64 array (1.3 M stamps:
+    ~0.04 CPU-s as ints); the other engines give ints (``testbench.compare`` and the
     testbenches that ask for rows take either).
     """
     engine = ALIASES.get(engine, engine)
@@ -139,7 +150,7 @@ def run(tb: Testbench, params: dict, stim: Stimulus, *, engine: str = "pysim", i
         if "clocks" in kw:   # a slower clock than the reference takes more reference edges
             slow = max(c.half for c in kw["clocks"].values()) / kw["clocks"]["sync"].half
             max_cycles = int(max_cycles * max(1.0, slow))
-    if build and engine != "verilator" and (engine not in cocotb.SIMULATORS or set(build) - {"depth", "out_depth"}):
+    if build and engine != "verilator" and (engine not in _COCOTB or set(build) - {"depth", "out_depth"}):
         raise RasterhwError(f"build settings are for the verilator engine (cocotb's: depth, out_depth), not {engine}")
     if build:
         kw["build"] = build

@@ -297,7 +297,7 @@ def _run_exe(exe: Path, tb: Testbench, params: dict, stim: Stimulus, *, stall: i
         words, stamps = collected(run_dir, outs, expect_words, widths={n: widths[n] for n in outs}, packed=packed)
     finally:
         release(run_dir)
-    return words, stamps, meta, max((s[-1] + 1 for s in stamps.values() if s), default=0)
+    return words, stamps, meta, max((int(s[-1]) + 1 for s in stamps.values() if len(s)), default=0)
 
 
 def stream_plusargs(run_dir: Path, tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int,
@@ -332,7 +332,7 @@ def collected(run_dir: Path, outs, expect_words: dict[str, int], widths: dict[st
               packed: bool = False) -> tuple[dict[str, list[int]], dict[str, list[int]]]:
     """(words, stamps) per output port from the sinks' dumps in ``run_dir``: ``$writememh`` text, or
     with ``widths`` (``{port: payload bits}``, a run with ``+dump_bin=1``) the binary dumps, the
-    words then as packed rows if ``packed`` (:func:`_binary_rows`)."""
+    words then as packed rows if ``packed`` (:func:`_binary_rows`) and the stamps an int64 array."""
     words, stamps = {}, {}
     for n in outs:
         t, k = tag(n), expect_words[n]
@@ -342,7 +342,10 @@ def collected(run_dir: Path, outs, expect_words: dict[str, int], widths: dict[st
                             else np.zeros((0, -(-widths[n] // 8)), np.uint8))
             else:
                 words[n] = _binary(run_dir / f"{t}.out", widths[n])[:k] if k else []
-            stamps[n] = _binary(run_dir / f"{t}.cyc", 32)[:k] if k else []
+            if packed:   # the stamps as one int64 array too: no Python int per word (1.3 M: ~0.04 CPU-s)
+                stamps[n] = _dump(run_dir / f"{t}.cyc", 32)[0].view("<u4")[:k].astype(np.int64)
+            else:
+                stamps[n] = _binary(run_dir / f"{t}.cyc", 32)[:k] if k else []
         else:
             words[n] = _ints(read_memh(run_dir / f"{t}.out", None))[:k] if k else []
             stamps[n] = _ints(read_memh(run_dir / f"{t}.cyc", None))[:k] if k else []

@@ -1,7 +1,8 @@
 """``rasterhw sim pixelbus``'s scene level (``sim/engines/scene.py``): the scene's frame through the SNU
 pixel-bus HDL, checked against the golden model (``golden_model/snu/pixelbus.py``).
 
-On Verilator the whole frame as the machine draws it (the snu-100k headline frame end to end):
+On every engine the whole frame as the machine draws it (the snu-100k headline frame end to end), so
+``cycles`` is one quantity whatever the engine: the frame's length, CLEAR accepted to SWAP + 1:
 
 1. **Geometry**: the scene through the golden geometry (``pipeline.run_geometry``, far = 0);
    triangle ``i`` goes to pipeline ``i % 2``. Its cost on the i860 model: the three-processor
@@ -19,9 +20,11 @@ On Verilator the whole frame as the machine draws it (the snu-100k headline fram
    the players, every acceptance cycle, swap) and the same frame; ``mismatches`` counts pixels
    that differ plus one per schedule number that differs.
 
-On the other engines the pixel stream alone (no clear, no swap, no producer gaps) through the
-block's testbench (``BusBench``, the frame memory streamed out by the engines' ``ReadOut``):
-:func:`simulate_pixelbus`, which the soak and the report's rate rows also run.
+The pixel stream alone (no clear, no swap, no producer gaps) through the block's testbench
+(``BusBench``, the frame memory streamed out by the engines' ``ReadOut``) is :func:`simulate_pixelbus`,
+which the soak and the report's rate rows run; ``rasterhw sim pixelbus`` does not (before, its pysim
+run did, and its ``cycles`` were the pixel writes' 861 where Verilator's were the frame's 35,845: snu-100px
+at 64 x 48).
 
 Times are reported at the paper's clocks: 12.5 MHz bus (80 ns slot), i860 at
 ``I860.clock_hz`` (40 MHz, assumed: the paper never states it).
@@ -38,10 +41,11 @@ from rasterhw.golden_model.errors import RasterhwError
 from rasterhw.golden_model.pipeline import run_geometry
 from rasterhw.golden_model.snu import i860
 from rasterhw.golden_model.snu import pixelbus as golden
-from rasterhw.golden_model.snu.formats import CLOCK_HZ, MEM_CYCLE, N_BANKS, Z_BITS
+from rasterhw.golden_model.snu.formats import CLOCK_HZ, MEM_CYCLE, N_BANKS, RGB_BITS, Z_BITS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.sim import engines
 from rasterhw.sim.engines.scene import Done, Job, SceneRun, run_job
+from rasterhw.sim.packed import as_ints
 from rasterhw.sim.snu.frame_format import GAP_BITS, SCHEDULE
 from rasterhw.sim.snu.testbench import BusBench, FrameBench, frame_of
 
@@ -281,12 +285,15 @@ def main(argv: list[str] | None = None) -> int:
 
 
 # ====================================================================== the whole frame
-def frame_job(stream: PixelStream, gaps: np.ndarray, sched: dict) -> Job:
+def frame_job(stream: PixelStream, gaps: np.ndarray, sched: dict, *, engine: str = "verilator") -> Job:
     """The frame (``FrameBench``: clear, the producer gaps, swap) as one job: the displayed frame
-    and the :data:`~rasterhw.sim.snu.frame_format.SCHEDULE` words against the golden ``sched``."""
+    and the :data:`~rasterhw.sim.snu.frame_format.SCHEDULE` words against the golden ``sched``. The
+    bank RAMs: Amaranth's ``Memory`` for banks of up to 4096 words and always on pysim (which cannot
+    run the hand-written Verilog RAM), else the Verilog RAM (``PixelBusBank``: the same ports and clocks)."""
     w, h = stream.width, stream.height
     tb = FrameBench()
-    params = tb.params(width=w, height=h, z_bits=stream.z_bits, ram="memory" if -(-w * h // N_BANKS) <= 4096 else "verilog")
+    small = -(-w * h // N_BANKS) <= 4096 or engine == "pysim"
+    params = tb.params(width=w, height=h, z_bits=stream.z_bits, ram="memory" if small else "verilog")
     g = np.asarray(gaps, dtype=np.int64).copy()
     for p in range(2):
         i = np.flatnonzero(stream.pipe == p)
@@ -299,59 +306,116 @@ def frame_job(stream: PixelStream, gaps: np.ndarray, sched: dict) -> Job:
     # schedule word k leaves at edge ``cycles + k``, display word j at ``cycles + 1 + j``, so the
     # last at ``cycles + w h`` (``FrameAdapter``: the sweep starts the clock after SWAP's)
     exp = replace(tb.expect(params, stim), cycles=int(sched["cycles"]) + w * h + 1)
-    return Job(tb, params, stim, exp, {"max_cycles": int(sched["cycles"]) + w * h + 10_000})
+    # packed: the Verilator engine gives the display words as rows, as ``FrameBench.expect`` does
+    return Job(tb, params, stim, exp, {"max_cycles": int(sched["cycles"]) + w * h + 10_000, "packed": True})
 
 
-def frame_words(d: Done) -> dict:
-    """A :func:`frame_job`'s schedule numbers, displayed frame (``rgb``, ``z``) and ``mismatches``
-    (read-out and schedule words that differ from the golden schedule, plus one if the run's
-    length differs from the golden schedule's: ``frame_job``)."""
+def frame_words(d: Done, *, ints: bool = True) -> dict:
+    """A :func:`frame_job`'s schedule numbers, displayed frame and ``mismatches`` (read-out and
+    schedule words that differ from the golden schedule, plus one if the run's length differs from
+    the golden schedule's: ``frame_job``). The frame as ``rgb8`` ((H, W, 3) uint8, the image) and, if
+    ``ints``, as ``rgb`` and ``z`` ((H, W) int64); from the Verilator engine's packed rows (``{rgb,
+    z}`` big-endian: the red, green and blue bytes first) ``rgb8`` is the rows' first three bytes, no
+    int per pixel (the scene run asks for no more: 1,310,720 pixels, ~0.03 CPU-s saved)."""
     stream = d.job.stim.source[0]
-    words = np.array(d.got.words["o"], dtype=np.int64)
-    zmask = (1 << stream.z_bits) - 1
-    got = dict(zip(SCHEDULE, d.got.words["o_sched"], strict=False))
-    return {**got, "rgb": (words >> stream.z_bits).reshape(stream.height, stream.width),
-            "z": (words & zmask).reshape(stream.height, stream.width),
-            "mismatches": d.cmp["mismatches"] + (d.cmp["cycle_mismatches"] or 0)}
+    h, w, zb = stream.height, stream.width, stream.z_bits
+    o = d.got.words["o"]
+    out = {**dict(zip(SCHEDULE, as_ints(d.got.words["o_sched"]), strict=False)),
+           "mismatches": d.cmp["mismatches"] + (d.cmp["cycle_mismatches"] or 0)}
+    if isinstance(o, np.ndarray) and zb % 8 == 0 and o.shape[1] * 8 == RGB_BITS + zb:
+        out["rgb8"] = o[:, :RGB_BITS // 8].reshape(h, w, 3)
+    if ints or "rgb8" not in out:
+        words = _int64(o)
+        out["rgb"], out["z"] = (words >> zb).reshape(h, w), (words & ((1 << zb) - 1)).reshape(h, w)
+        out.setdefault("rgb8", golden.rgb_image(out["rgb"]))
+    return out
+
+
+def _int64(words) -> np.ndarray:
+    """A port's words of up to 63 bits (ints, or packed rows: ``sim/packed.py``) as int64."""
+    if not isinstance(words, np.ndarray):
+        return np.array(words, dtype=np.int64)
+    full = np.zeros((len(words), 8), np.uint8)   # big-endian rows, right-aligned in 8 bytes
+    full[:, 8 - words.shape[1]:] = words
+    return full.view(">u8").ravel().astype(np.int64)
 
 
 def run_frame_engine(stream: PixelStream, gaps: np.ndarray, sched: dict, *, engine: str = "verilator") -> dict:
     """:func:`frame_job` on ``engine``: :func:`frame_words`' keys."""
-    return frame_words(run_job(frame_job(stream, gaps, sched), engine))
+    return frame_words(run_job(frame_job(stream, gaps, sched, engine=engine), engine))
+
+
+def frame_golden(tris, cpu: i860.I860, *, cached: bool = True) -> dict:
+    """The frame's golden model for the screen triangles ``tris`` on the i860 model ``cpu``: the two
+    pipelines' pixel stream (``gouraud.scan_convert``; ``ran``: what its inner loop executed), the
+    producer gaps (:func:`producer_gaps`: ``prod``) and the schedule (:func:`golden_schedule`:
+    ``sched``). ``cached``: kept as a build-cache entry (``verilog_cache.arrays_cached``:
+    ``build/verilog/snu-frame-golden-<digest>.npz``, SHA-256 checked, keyed by the triangles' bytes,
+    ``cpu`` and the digest of every Python source of ours this module imports, transitively), so a
+    warm ``rasterhw sim pixelbus`` neither scan-converts nor walks the producer model (snu-100px at
+    1280 x 1024: 0.045-0.07 CPU-s computed, ~0.01 read back); ``False``: computed here (the
+    specification the entry is held equal to, ``tests/snu/test_pixelbus_sim_engines.py``)."""
+    from rasterhw.golden_model.snu.gouraud import scan_convert, setup_spans
+
+    def compute() -> dict:
+        ran: dict = {}
+        spans = setup_spans(tris)
+        stream = scan_convert(tris, counts=ran, spans=spans)
+        prod = producer_gaps(tris, stream, cpu, spans=spans)
+        sched = golden_schedule(stream, prod["gaps"], prod["first_work"], ratio=prod["ratio"])
+        return {"stream": stream, "ran": ran, "prod": prod, "sched": sched}
+
+    if not cached:
+        return compute()
+
+    import json
+
+    from rasterhw.sim.engines.verilog_cache import arrays_cached
+
+    def arrays() -> dict:
+        g = compute()
+        s = g["stream"]
+        meta = {"ran": g["ran"], "prod": {k: v for k, v in g["prod"].items() if k != "gaps"},
+                "sched": {k: v for k, v in g["sched"].items() if k != "accept"},
+                "stream": {"width": s.width, "height": s.height, "z_bits": s.z_bits}}
+        cols = {"addr": s.addr, "rgb": s.rgb, "z": s.z, "pipe": s.pipe, "gaps": g["prod"]["gaps"],
+                "accept": g["sched"]["accept"]}
+        # int64 columns kept as int32 where every value fits (half the bytes to read and check)
+        return {**{k: v.astype(np.int32) if _fits32(v) else v for k, v in cols.items()},
+                "meta": np.frombuffer(json.dumps(meta).encode(), np.uint8)}
+
+    key = [x for k, v in sorted(vars(tris).items()) for x in (k, v)] + [repr(cpu)]
+    got = arrays_cached("snu-frame-golden", Path(__file__), key, arrays)
+    meta = json.loads(got["meta"].tobytes())
+    m = meta["stream"]
+    stream = PixelStream(m["width"], m["height"], got["addr"], got["rgb"], got["z"], got["pipe"], z_bits=m["z_bits"])
+    return {"stream": stream, "ran": meta["ran"], "prod": {**meta["prod"], "gaps": got["gaps"].astype(np.int64)},
+            "sched": {**meta["sched"], "accept": got["accept"].astype(np.int64)}}
+
+
+def _fits32(v: np.ndarray) -> bool:
+    return v.dtype == np.int64 and (v.size == 0 or (int(v.min()) >= -(1 << 31) and int(v.max()) < 1 << 31))
 
 
 class PixelbusScene(SceneRun):
-    """``rasterhw sim pixelbus``: on Verilator the whole frame (module docstring; ``frame`` in the
-    result holds the schedule, the frame time and each stage's share); on the other engines the
-    scene's pixel stream alone (:func:`bus_job`)."""
+    """``rasterhw sim pixelbus``: the whole frame on every engine (module docstring; ``frame`` in the
+    result holds the schedule, the frame time and each stage's share)."""
 
     block = "pixelbus"
     steps = ("geometry + scan conversion + golden model", "HDL simulation", "frame")
 
     def golden(self, scene, width: int, height: int, *, engine: str, cpu: i860.I860 | None = None,
                bus_only_bound: bool = False) -> dict:
-        from rasterhw.golden_model.snu.gouraud import scan_convert, setup_spans
-
         tris = run_geometry(scene, width, height, z_bits=Z_BITS, z_far_is_zero=True)
-        if engine != "verilator":
-            return {"stream": scan_convert(tris)}
-        ran: dict = {}
-        spans = setup_spans(tris)
-        stream = scan_convert(tris, counts=ran, spans=spans)
-        prod = producer_gaps(tris, stream, cpu or i860.I860(), spans=spans)
-        sched = golden_schedule(stream, prod["gaps"], prod["first_work"], ratio=prod["ratio"])
-        return {"tris": tris, "stream": stream, "ran": ran, "prod": prod, "sched": sched, "cpu": cpu or i860.I860()}
+        cpu = cpu or i860.I860()
+        return {"tris": tris, "cpu": cpu, **frame_golden(tris, cpu)}
 
     def jobs(self, gold: dict, *, engine: str, **_) -> list[Job]:
-        if "sched" not in gold:
-            return [bus_job(gold["stream"])]
-        return [frame_job(gold["stream"], gold["prod"]["gaps"], gold["sched"])]
+        return [frame_job(gold["stream"], gold["prod"]["gaps"], gold["sched"], engine=engine)]
 
     def result(self, gold: dict, done: list[Done], *, engine: str, bus_only_bound: bool = False, **_) -> dict:
         (d,) = done
-        if "sched" not in gold:
-            return bus_result(d)
-        return frame_result(gold, frame_words(d), bus_only_bound=bus_only_bound)
+        return frame_result(gold, frame_words(d, ints=False), bus_only_bound=bus_only_bound)
 
 
 def frame_result(gold: dict, hdl: dict, *, bus_only_bound: bool = False) -> dict:
@@ -387,7 +451,7 @@ def frame_result(gold: dict, hdl: dict, *, bus_only_bound: bool = False) -> dict
     return {
         "cycles": int(hdl["cycles"]), "cycles_golden": int(sched["cycles"]), "writes": len(stream),
         "pixels_compared": width * height, "mismatches": hdl["mismatches"],
-        "frame_rgb": golden.rgb_image(hdl["rgb"]),
+        "frame_rgb": hdl["rgb8"],
         "frame": {
             "triangles": tris.n_triangles, "pixel_writes": len(stream),
             "schedule_hdl": {k: hdl[k] for k in SCHEDULE}, "schedule_golden": {k: sched[k] for k in SCHEDULE},

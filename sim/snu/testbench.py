@@ -324,4 +324,7 @@ class FrameBench(BusBench):
         s, sched = stim.source
         rgb, z = golden.pixelbus_frame(s, accept=sched["accept"], mem_cycle=params["mem_cycle"],
                                        n_banks=params["n_banks"])
-        return Expected({"o": _frame_words(rgb, z, params["z_bits"]), "o_sched": [int(sched[k]) for k in SCHEDULE]})
+        # the display words as packed rows (``sim/packed.py``): compared with the Verilator engine's
+        # rows (``frame_job`` asks for them) in NumPy, without a Python int per pixel
+        rows = pack_fields([(rgb.ravel(), RGB_BITS), (z.ravel(), params["z_bits"])])
+        return Expected({"o": rows, "o_sched": [int(sched[k]) for k in SCHEDULE]})
