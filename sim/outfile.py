@@ -75,8 +75,6 @@ def image_format(ext: str) -> str | None:
     """The Pillow format that saves extension ``ext`` (``".png"`` -> ``"PNG"``), None if none: the
     common formats from Pillow's ``preinit`` (five plugins) before loading every plugin
     (:func:`image_formats`, ~40 of them: 0.1-0.2 CPU-s of a ``rasterhw sim`` run writing its .png)."""
-    if ext == ".png":
-        return "PNG"   # written without Pillow (:func:`png_bytes`): a run writing its .png does not import it
     from PIL import Image
 
     Image.preinit()
@@ -125,7 +123,7 @@ def _holds_rgb(fmt: str) -> bool:
     return _RGB_OK[fmt]
 
 
-_RGB_OK: dict[str, bool] = {"PNG": True}
+_RGB_OK: dict[str, bool] = {}
 
 
 @contextmanager
@@ -191,17 +189,14 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
 
 def write_image(path: str | Path, rgb8: np.ndarray) -> Path:
     """Write an (H, W, 3) uint8 image to ``path`` (format from the extension), whole or not at all."""
+    from PIL import Image
+
     check_image_output(path)
     fmt = "PNG" if str(path) == STDOUT else image_format(Path(path).suffix.lower())
     side = _MAX_SIDE.get(fmt)
     if side is not None and max(rgb8.shape[:2]) > side:
         raise RasterhwError(f"cannot write {path}: {fmt} holds at most {side}x{side} pixels, the frame is "
                             f"{rgb8.shape[1]}x{rgb8.shape[0]}; use .png")
-    img = np.asarray(rgb8)
-    if fmt == "PNG" and img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3 and img.shape[0] and img.shape[1]:
-        return write_bytes(path, png_bytes(img))
-    from PIL import Image
-
     with atomic_path(path) as tmp:
         try:
             # PNG at zlib level 1: a 1280 x 1024 frame encodes in 0.054 CPU-s instead of 0.105 (level 6),
@@ -210,29 +205,6 @@ def write_image(path: str | Path, rgb8: np.ndarray) -> Path:
         except (ValueError, OSError, KeyError, TypeError) as e:  # a format that cannot hold RGB or this size
             raise RasterhwError(f"cannot write {path} as {fmt}: {str(e).splitlines()[0] if str(e) else type(e).__name__}") from None
     return Path(path)
-
-
-def png_bytes(rgb8: np.ndarray) -> bytes:
-    """An (H, W, 3) uint8 image as a PNG file (8-bit RGB, not interlaced): every row with filter 1
-    (Sub: each byte less the same channel of the pixel to its left), zlib level 1. Without Pillow:
-    1280 x 1024 in 0.017 CPU-s against Pillow's 0.040 at level 1 (and ~0.02 for importing it), and
-    6 % smaller (sim pixelbus snu-100px: 464 against 494 kB); the pixels are the same
-    (``tests/test_outfile_png.py`` reads them back with Pillow)."""
-    import struct
-    import zlib
-
-    h, w, _ = rgb8.shape
-    px = np.ascontiguousarray(rgb8).reshape(h, 3 * w)
-    rows = np.empty((h, 1 + 3 * w), np.uint8)
-    rows[:, 0] = 1                                # filter type 1, Sub
-    rows[:, 1:4] = px[:, :3]
-    np.subtract(px[:, 3:], px[:, :-3], out=rows[:, 4:])   # modulo 256, as the filter is defined
-
-    def chunk(kind: bytes, data: bytes) -> bytes:
-        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
-
-    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
-            + chunk(b"IDAT", zlib.compress(rows.tobytes(), 1)) + chunk(b"IEND", b""))
 
 
 def write_text(path: str | Path, text: str) -> Path:
