@@ -7,6 +7,7 @@ from amaranth.hdl import Const, Module, Signal
 from amaranth.lib import fifo, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import MATRIX_LOG2_MAX, TRI_BITS
+from rasterhw.hdl.sparse.benchread import bench_read_ports, forward_bench_read
 from rasterhw.hdl.sparse.layouts import layouts
 from rasterhw.hdl.sparse.stack_vp import StackProcessor
 from rasterhw.hdl.sparse.vp import VideoProcessor
@@ -51,14 +52,17 @@ class MatrixCell(wiring.Component):
     ``colour``, ``kp``, ``ke``: the processor's surface parameters (R, G, B broadcast with the
     edges: ``rec`` is ``BROADCAST_RGB`` and ``rd_rgb`` reads the colour memory) and formula (5)'s
     cost of their additions, either processor (``hdl/sparse/vp.py``, ``hdl/sparse/stack_vp.py``).
+    ``read_lanes`` > 0: the processor's bench read port ``rdw_addr``, ``rdw_data``
+    (``hdl/sparse/benchread.py``; not the paper's, the matrix's ``wide_read``).
     """
 
     def __init__(self, *, n: int, p: int, q: int, alpha: int = 2, beta: int = 2, z_bits: int = 24,
                  fifo_depth: int = 8, in_depth: int = 64, vp: str = "pipeline", colour: bool = False, kp: int = 0,
-                 ke: int = 3):
+                 ke: int = 3, read_lanes: int = 0):
         if not isinstance(in_depth, int) or not 1 <= in_depth <= 1024:
             raise ValueError(f"in_depth must be an integer in 1..1024, not {in_depth!r}")
-        par = dict(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, colour=colour, kp=kp, ke=ke)
+        par = dict(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, colour=colour, kp=kp, ke=ke,
+                   read_lanes=read_lanes)
         if vp == "pipeline":
             self._vp = VideoProcessor(**par, fifo_depth=fifo_depth)
         elif vp == "stack":
@@ -66,7 +70,7 @@ class MatrixCell(wiring.Component):
         else:
             raise ValueError(f"vp must be 'pipeline' or 'stack', not {vp!r}")
         self._stack = vp == "stack"
-        self._n, self._in_depth, self._colour = n, in_depth, colour
+        self._n, self._in_depth, self._colour, self._lanes = n, in_depth, colour, read_lanes
         self._rec = layouts(colour)[0]
         ports = {"a": In(MATRIX_LOG2_MAX), "b": In(MATRIX_LOG2_MAX), "limit": In(range(in_depth + 1)),
                  "push": In(1), "rec": In(self._rec), "room": Out(1), "busy": Out(1),
@@ -74,6 +78,7 @@ class MatrixCell(wiring.Component):
                  "stat_sel": In(range(len(cell_stats(n)))), "stat": Out(32)}
         if colour:
             ports["rd_rgb"] = Out(24)
+        ports.update(bench_read_ports(n, z_bits, colour, read_lanes))
         super().__init__(ports)
 
     def elaborate(self, platform):
@@ -87,6 +92,7 @@ class MatrixCell(wiring.Component):
                      self.rd_tri.eq(vp.rd_tri), self.busy.eq(vp.busy | (f.level != 0))]
         if self._colour:
             m.d.comb += self.rd_rgb.eq(vp.rd_rgb)
+        forward_bench_read(m, self, vp, self._lanes)
         busy_cycles = Signal(32)
         peak = Signal(range(self._in_depth + 1))
         records = Signal(32)

@@ -3,10 +3,11 @@ back by the fullest, the interleaved read-out, and the bench's parallel read-out
 
 from __future__ import annotations
 
-from amaranth.hdl import Cat, ClockSignal, Instance, Module, Mux, ResetSignal, Signal
+from amaranth.hdl import Cat, ClockSignal, Instance, Module, ResetSignal, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import TRI_BITS
+from rasterhw.hdl.sparse.benchread import check_lanes, lane_bits
 from rasterhw.hdl.sparse.cell import MatrixCell, cell_stats
 from rasterhw.hdl.sparse.layouts import layouts
 
@@ -46,12 +47,15 @@ class Matrix(wiring.Component):
     limit : In — run-time input FIFO depth (1..in_depth).
     rd_x, rd_y : In — full-raster pixel to read; rd_z, rd_tri : Out — its depth and triangle one
         cycle later (empty: ``z = 2**z_bits``, ``tri = 2**TRI_BITS - 1``).
-    rd_all, rd_addr : In; rd_words : Out — only with ``wide_read=True``: the bench's parallel
-        read-out (not the paper's video controller, which reads one pixel a clock through ``rd_x``,
-        ``rd_y``; the block as the hardware flow takes it has no such port): with ``rd_all`` high
-        every processor reads sparse address ``rd_addr`` and ``rd_words`` carries all ``p*q`` words
-        one cycle later, processor ``k = b * p + a`` in lane ``k`` (``{rd_rgb, rd_tri, rd_z}`` of
-        that processor, ``lane_bits`` wide, lane 0 the lowest).
+    rd_addr : In(2n - log2 read_lanes); rd_words : Out — only with ``wide_read=True``: the bench's
+        parallel read-out (not the paper's video controller, which reads one pixel a clock through
+        ``rd_x``, ``rd_y``; the block as the hardware flow takes it has no such port): every
+        processor reads sparse addresses ``rd_addr * read_lanes + j``, ``j = 0 .. read_lanes - 1``,
+        on its bench read port (``hdl/sparse/benchread.py``: ``read_lanes`` more read ports on each
+        local memory) and ``rd_words`` carries all ``p*q*read_lanes`` words one cycle later, word
+        ``j`` of processor ``k = b * p + a`` in lane ``k * read_lanes + j`` (``{rd_rgb, rd_tri,
+        rd_z}``, ``lane_bits`` wide, lane 0 the lowest): the raster in ``2**(2n) / read_lanes``
+        clocks.
     busy : Out(1) — a record in some FIFO or processor.
     cycles : Out(32) — cycles on which ``i.valid`` or ``busy`` was high (the frame, for a source
         that offers from its first cycle with no gaps).
@@ -62,11 +66,17 @@ class Matrix(wiring.Component):
 
     def __init__(self, *, n: int, p: int = 2, q: int = 2, alpha: int = 2, beta: int = 2, z_bits: int = 24,
                  fifo_depth: int = 8, in_depth: int = 64, cells: str = "inline", vp: str = "pipeline",
-                 colour: bool = False, kp: int = 0, ke: int = 3, wide_read: bool = False):
+                 colour: bool = False, kp: int = 0, ke: int = 3, wide_read: bool = False, read_lanes: int = 1):
         if cells not in ("inline", "instance"):
             raise ValueError(f"cells must be 'inline' or 'instance', not {cells!r}")
+        if not isinstance(wide_read, bool):
+            raise ValueError(f"wide_read must be True or False, not {wide_read!r}")
+        if wide_read and read_lanes == 0:
+            raise ValueError("read_lanes must be at least 1 with wide_read")
+        # the cells' bench read port only with wide_read: the block as the hardware flow takes it has none
+        self._lanes = read_lanes if wide_read else 0
         self._kw = dict(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, fifo_depth=fifo_depth,
-                        in_depth=in_depth, vp=vp, colour=colour, kp=kp, ke=ke)
+                        in_depth=in_depth, vp=vp, colour=colour, kp=kp, ke=ke, read_lanes=self._lanes)
         # the processor's checks run here (a bad parameter set fails before any instance is made)
         self._cells = [MatrixCell(**self._kw)] if cells == "instance" else [MatrixCell(**self._kw) for _ in range(p * q)]
         if cells == "instance":
@@ -82,10 +92,10 @@ class Matrix(wiring.Component):
                  "stat_cell": In(range(max(p * q, 2))), "stat_sel": In(range(len(cell_stats(n)))), "stat": Out(32)}
         if colour:
             ports["rd_rgb"] = Out(24)
-        self.lane_bits = z_bits + 1 + TRI_BITS + (24 if colour else 0)
-        self._wide_read = wide_read
+        self.lane_bits = lane_bits(z_bits, colour)
         if wide_read:
-            ports.update({"rd_all": In(1), "rd_addr": In(2 * n), "rd_words": Out(p * q * self.lane_bits)})
+            ports.update({"rd_addr": In(2 * n - check_lanes(n, read_lanes)),
+                          "rd_words": Out(p * q * read_lanes * self.lane_bits)})
         super().__init__(ports)
 
     def elaborate(self, platform):
@@ -95,8 +105,7 @@ class Matrix(wiring.Component):
         P = p * q
         push = Signal()
         addr = Signal(2 * n)
-        port_addr = (self.rd_y[lq:] << n) | self.rd_x[lp:]
-        m.d.comb += addr.eq(Mux(self.rd_all, self.rd_addr, port_addr) if self._wide_read else port_addr)
+        m.d.comb += addr.eq((self.rd_y[lq:] << n) | self.rd_x[lp:])
         ports = []
         for k in range(P):
             c = {"room": Signal(name=f"room{k}"), "busy": Signal(name=f"busy{k}"),
@@ -106,6 +115,9 @@ class Matrix(wiring.Component):
                 c["rd_rgb"] = Signal(24, name=f"rd_rgb{k}")
             ins = {"a": k % p, "b": k // p, "limit": self.limit, "push": push, "rec": self.i.payload.as_value(),
                    "rd_addr": addr, "stat_sel": self.stat_sel}
+            if self._lanes:
+                c["rdw_data"] = Signal(self._lanes * self.lane_bits, name=f"rdw_data{k}")
+                ins["rdw_addr"] = self.rd_addr
             if self._mode == "inline":
                 cell = self._cells[k]
                 m.submodules[f"cell{k}"] = cell
@@ -135,9 +147,8 @@ class Matrix(wiring.Component):
                     m.d.comb += [self.rd_z.eq(c["rd_z"]), self.rd_tri.eq(c["rd_tri"])]
                     if self._colour:
                         m.d.comb += self.rd_rgb.eq(c["rd_rgb"])
-        if self._wide_read:   # the bench's parallel read-out: every processor's word of rd_addr, side by side
-            m.d.comb += self.rd_words.eq(Cat(*(Cat(c["rd_z"], c["rd_tri"], *([c["rd_rgb"]] if self._colour else []))
-                                               for c in ports)))
+        if self._lanes:   # the bench's parallel read-out: every processor's words of the group, side by side
+            m.d.comb += self.rd_words.eq(Cat(*(c["rdw_data"] for c in ports)))
         with m.Switch(self.stat_cell):
             for k, c in enumerate(ports):
                 with m.Case(k):

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from amaranth.hdl import Module, Mux, Signal, signed, unsigned
+from amaranth.hdl import Cat, Const, Module, Mux, Signal, signed, unsigned
 from amaranth.lib import memory, stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.fixed import COLOUR_BITS
 from rasterhw.golden_model.sparse.formats import TRI_BITS, Z_ACC_BITS, Z_FRAC_BITS
+from rasterhw.hdl.sparse.benchread import bench_read_ports, check_lanes
 from rasterhw.hdl.sparse.layouts import layouts
 
 __all__ = ["PixelProcessor"]
@@ -27,6 +28,9 @@ class PixelProcessor(wiring.Component):
     writes : Out(32) — pixels written (passed the Z test).
     idle : Out(1).
     rd_rgb : Out(24) (``colour`` only) — R | G << 8 | B << 16 at ``rd_addr`` (one cycle latency).
+    rdw_addr : In, rdw_data : Out (``read_lanes`` > 0 only) — the bench's read port
+        (``hdl/sparse/benchread.py``): ``read_lanes`` more read ports on each memory, reading sparse
+        addresses ``rdw_addr * read_lanes + j`` (one cycle latency), word ``j`` ``{rgb, tri, z}``.
 
     ``colour``: the pixels are ``WINDOW_RGB`` (the headers ``HEADER_RGB``); each pixel's colour is
     rounded as ``fixed.colour_rgb8`` (``clamp((c + 2**15) >> 16, 0, 255)``) beside its depth and
@@ -36,13 +40,15 @@ class PixelProcessor(wiring.Component):
     transparent for the write, so back-to-back pixels at one address see each other).
     """
 
-    def __init__(self, *, n: int, z_bits: int = 24, colour: bool = False):
-        self._n, self._z_bits, self._colour = n, z_bits, colour
+    def __init__(self, *, n: int, z_bits: int = 24, colour: bool = False, read_lanes: int = 0):
+        self._n, self._z_bits, self._colour, self._lanes = n, z_bits, colour, read_lanes
+        self._lane_log2 = check_lanes(n, read_lanes)
         _, header, window = layouts(colour)
         ports = {"i": In(stream.Signature(window)), "i_hdr": In(stream.Signature(header)), "rd_addr": In(2 * n),
                  "rd_z": Out(z_bits + 1), "rd_tri": Out(TRI_BITS), "writes": Out(32), "idle": Out(1)}
         if colour:
             ports["rd_rgb"] = Out(3 * COLOUR_BITS)
+        ports.update(bench_read_ports(n, z_bits, colour, read_lanes))
         super().__init__(ports)
 
     def elaborate(self, platform):
@@ -88,13 +94,27 @@ class PixelProcessor(wiring.Component):
         with m.If(v2 & (z2 < zr.data)):
             m.d.comb += [zw.en.eq(1), tw.en.eq(1)]
             m.d.sync += self.writes.eq(self.writes + 1)
+        mems = [zmem, tmem]
         if self._colour:
-            self._rgb(m, depth, a2, zw.en)
+            mems.append(self._rgb(m, depth, a2, zw.en))
+        if self._lanes:
+            self._bench_read(m, mems)
         return m
 
+    def _bench_read(self, m, mems):
+        """The bench's port: ``read_lanes`` read ports on every memory, lane ``j`` at sparse address
+        ``rdw_addr * read_lanes + j``."""
+        words = []
+        for j in range(self._lanes):
+            addr = Cat(Const(j, self._lane_log2), self.rdw_addr)
+            ports = [mem.read_port() for mem in mems]
+            m.d.comb += [rp.addr.eq(addr) for rp in ports]
+            words.append(Cat(*(rp.data for rp in ports)))
+        m.d.comb += self.rdw_data.eq(Cat(*words))
+
     def _rgb(self, m, depth, a2, wen):
-        """The colour memory: the pixel's R, G, B rounded on its way in, carried beside the
-        pipeline's depth and written with it."""
+        """The colour memory (returned): the pixel's R, G, B rounded on its way in, carried beside
+        the pipeline's depth and written with it."""
         m.submodules.cmem = cmem = memory.Memory(shape=unsigned(3 * COLOUR_BITS), depth=depth, init=[0] * depth)
         cw, cr = cmem.write_port(), cmem.read_port()
         m.d.comb += [cr.addr.eq(self.rd_addr), self.rd_rgb.eq(cr.data)]
@@ -107,3 +127,4 @@ class PixelProcessor(wiring.Component):
         c1, c2 = Signal(3 * COLOUR_BITS), Signal(3 * COLOUR_BITS)
         m.d.sync += [c1.eq(rgb), c2.eq(c1)]
         m.d.comb += [cw.addr.eq(a2), cw.data.eq(c2), cw.en.eq(wen)]
+        return cmem

@@ -14,6 +14,7 @@ from rasterhw.golden_model.sparse.formats import (
     UV_BITS,
     Z_ACC_BITS,
 )
+from rasterhw.hdl.sparse.benchread import bench_read_ports, check_lanes, forward_bench_read
 from rasterhw.hdl.sparse.layouts import layouts
 from rasterhw.hdl.sparse.pixel import PixelProcessor
 from rasterhw.hdl.sparse.stage import param_charge
@@ -63,18 +64,21 @@ class StackProcessor(wiring.Component):
     rd_rgb : Out(24) (``colour`` only) — R | G << 8 | B << 16 at ``rd_addr`` (one cycle latency).
     writes : Out(32) — pixels written.
     busy : Out(1) — a record is still somewhere in the processor.
+    rdw_addr, rdw_data (``read_lanes`` > 0 only) — the pixel processor's bench read port
+        (``hdl/sparse/benchread.py``; not the paper's).
     """
 
     def __init__(self, *, n: int, p: int = 4, q: int = 4, alpha: int = 2, beta: int = 2, z_bits: int = 24,
-                 colour: bool = False, kp: int = 0, ke: int = 3):
+                 colour: bool = False, kp: int = 0, ke: int = 3, read_lanes: int = 0):
         try:
             self._lp, self._lq = check_params(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, colour=colour,
                                               kp=kp, ke=ke)
+            check_lanes(n, read_lanes)
         except ValueError:
             self._MustUse__silence = True  # a rejected parameter set is not an unused design
             raise
         self._n, self._p, self._q, self._alpha, self._beta, self._z_bits = n, p, q, alpha, beta, z_bits
-        self._colour, self._kp, self._ke = colour, kp, ke
+        self._colour, self._kp, self._ke, self._lanes = colour, kp, ke, read_lanes
         ports = {"a": In(MATRIX_LOG2_MAX), "b": In(MATRIX_LOG2_MAX),
                  "i": In(stream.Signature(layouts(colour)[0])),
                  "rd_addr": In(2 * n), "rd_z": Out(z_bits + 1), "rd_tri": Out(TRI_BITS), "writes": Out(32),
@@ -83,6 +87,7 @@ class StackProcessor(wiring.Component):
             ports["rd_rgb"] = Out(24)
         for lvl in range(1, n + 1):
             ports[f"tests_{lvl}"] = Out(32)
+        ports.update(bench_read_ports(n, z_bits, colour, read_lanes))
         super().__init__(ports)
 
     @property
@@ -107,7 +112,8 @@ class StackProcessor(wiring.Component):
         m.submodules.stack = st = memory.Memory(shape=entry, depth=D, init=[])
         wr = st.write_port()
         rd = st.read_port(domain="comb")
-        m.submodules.pixel = px = PixelProcessor(n=n, z_bits=self._z_bits, colour=self._colour)
+        m.submodules.pixel = px = PixelProcessor(n=n, z_bits=self._z_bits, colour=self._colour, read_lanes=self._lanes)
+        forward_bench_read(m, self, px, self._lanes)
         m.d.comb += [px.rd_addr.eq(self.rd_addr), self.rd_z.eq(px.rd_z), self.rd_tri.eq(px.rd_tri),
                      self.writes.eq(px.writes)]
         if self._colour:

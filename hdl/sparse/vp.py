@@ -6,6 +6,7 @@ from amaranth.hdl import Module, Mux, Signal
 from amaranth.lib import fifo, stream, wiring
 from amaranth.lib.wiring import In, Out
 from rasterhw.golden_model.sparse.formats import MATRIX_LOG2_MAX, TRI_BITS
+from rasterhw.hdl.sparse.benchread import bench_read_ports, check_lanes, forward_bench_read
 from rasterhw.hdl.sparse.layouts import layouts
 from rasterhw.hdl.sparse.pixel import PixelProcessor
 from rasterhw.hdl.sparse.stage import LevelStage
@@ -80,6 +81,8 @@ class VideoProcessor(wiring.Component):
     writes : Out(32) — pixels written.
     busy : Out(1) — a record is still somewhere in the processor.
     rd_rgb : Out(24) (``colour`` only) — R | G << 8 | B << 16 at ``rd_addr`` (one cycle latency).
+    rdw_addr, rdw_data (``read_lanes`` > 0 only) — the pixel processor's bench read port
+        (``hdl/sparse/benchread.py``; not the paper's).
 
     **Surface parameters** (``colour``): the record is ``BROADCAST_RGB``; R, G, B travel as three
     linear functions with the edges (set-up: ``C0 = c00 + a cx + b cy``, ``cu = p cx``,
@@ -91,7 +94,7 @@ class VideoProcessor(wiring.Component):
 
     def __init__(self, *, n: int, p: int = 4, q: int = 4, alpha: int = 2, beta: int = 2,
                  z_bits: int = 24, fifo_depth: int = 8, test: str = "exact", colour: bool = False,
-                 kp: int = 0, ke: int = 3):
+                 kp: int = 0, ke: int = 3, read_lanes: int = 0):
         try:
             self._lp, self._lq = check_params(n=n, p=p, q=q, alpha=alpha, beta=beta, z_bits=z_bits, colour=colour,
                                               kp=kp, ke=ke)
@@ -99,12 +102,13 @@ class VideoProcessor(wiring.Component):
                 raise ValueError(f"test must be 'exact' or 'edges', not {test!r}")
             if not isinstance(fifo_depth, int) or fifo_depth < 2:
                 raise ValueError(f"fifo_depth must be an integer >= 2, not {fifo_depth!r}")
+            check_lanes(n, read_lanes)
         except ValueError:
             self._MustUse__silence = True  # a rejected parameter set is not an unused design
             raise
         self._n, self._p, self._q = n, p, q
         self._alpha, self._beta, self._z_bits, self._depth, self._test = alpha, beta, z_bits, fifo_depth, test
-        self._colour, self._kp, self._ke = colour, kp, ke
+        self._colour, self._kp, self._ke, self._lanes = colour, kp, ke, read_lanes
         broadcast, _, _ = layouts(colour)
         ports = {"a": In(MATRIX_LOG2_MAX), "b": In(MATRIX_LOG2_MAX), "i": In(stream.Signature(broadcast)), "rd_addr": In(2 * n), "rd_z": Out(z_bits + 1),
                  "rd_tri": Out(TRI_BITS), "writes": Out(32), "busy": Out(1)}
@@ -113,6 +117,7 @@ class VideoProcessor(wiring.Component):
         for lvl in range(1, n + 1):
             ports[f"tests_{lvl}"] = Out(32)
             ports[f"stalls_{lvl}"] = Out(32)
+        ports.update(bench_read_ports(n, z_bits, colour, read_lanes))
         super().__init__(ports)
 
     @property
@@ -137,7 +142,8 @@ class VideoProcessor(wiring.Component):
             m.submodules[f"fifo{k}"] = f
             m.submodules[f"hfifo{k}"] = h
             fifos.append((f, h))
-        m.submodules.pixel = px = PixelProcessor(n=n, z_bits=self._z_bits, colour=self._colour)
+        m.submodules.pixel = px = PixelProcessor(n=n, z_bits=self._z_bits, colour=self._colour, read_lanes=self._lanes)
+        forward_bench_read(m, self, px, self._lanes)
 
         def push(src, f):
             m.d.comb += [f.w_data.eq(src.payload), f.w_en.eq(src.valid), src.ready.eq(f.w_rdy)]

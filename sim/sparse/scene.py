@@ -262,7 +262,10 @@ class SparseScene(SceneRun):
             "tests_per_level_hdl": tests.sum(axis=0).tolist(),
             "tests_match_golden": bool(np.array_equal(tests, g.tests_per_proc[:, 1:])),
             "writes": int(st["writes"].sum()), "pixels_written_golden": int(g.pixels_written),
-            "readout_cycles": int(h["tri"].size)})
+            # the paper's video controller at one pixel a clock (ours: the paper gives no rate) and the
+            # bench's clocks for the raster through its wide read-out, readout_lanes sparse addresses a clock
+            "readout_cycles": int(h["tri"].size), "readout_lanes": d.job.tb.lanes,
+            "bench_readout_clocks": d.job.tb.pixel_words(prm)})
         if colour:
             out.update(frame_rgb=h["rgb"].astype(np.uint8),
                        frame_note="the HDL's colour memories (R, G, B as linear functions), read out interleaved")

@@ -15,7 +15,7 @@ from rasterhw.sim import registry
 from rasterhw.sim.engines.readout import ReadOut
 from rasterhw.sim.testbench import Expected, Stimulus, Testbench
 
-__all__ = ["MatrixFrameBench", "MatrixBench", "ProcessorBench", "StackVPBench", "VPBench"]
+__all__ = ["READ_LANES", "MatrixFrameBench", "MatrixBench", "ProcessorBench", "StackVPBench", "VPBench"]
 
 
 def _word(rgb: bool):
@@ -227,6 +227,8 @@ class ProcessorBench(VPBench):
                 "writes": t[2 * n], "cycles": t[2 * n + 1]}
 
 
+#: sparse addresses the frame bench reads a clock through the matrix's wide read-out (ours; docs/sparse.md)
+READ_LANES = 4
 #: cell parameters left out of the cell Verilog's cache key at these values
 _CELL_DEFAULTS = {"alpha": 2, "beta": 2, "vp": "pipeline", "colour": False, "kp": 0, "ke": 3}
 
@@ -246,17 +248,21 @@ class MatrixFrameBench(MatrixBench):
     module by name, generated once (a 1024 x 1024 frame's cell is 4.6 MB of Verilog, mostly its
     local memories' initial values); ``"inline"`` elaborates every cell (pysim too).
 
-    ``readout="wide"`` (default): the raster leaves through the matrix's parallel read-out, one
-    sparse address a clock with every processor's word side by side (``rd_words``: ``2**(2n)``
-    words of ``p*q`` lanes, lane ``k`` processor ``k``'s ``{tri, z}`` or ``{rgb, tri, z}``), so the
-    read-out costs ``1 / (p*q)`` of the raster's pixels in clocks; ``"port"``: through the paper's
-    interleaved read port, one pixel a clock, row-major (the counters follow either way, one a
-    word). :meth:`decode` gives the same full raster from either."""
+    ``readout="wide"`` (default): the raster leaves through the matrix's parallel read-out (ours,
+    the bench's; ``Matrix(wide_read=True)``), ``lanes`` sparse addresses a clock with every
+    processor's words side by side (``rd_words``: ``2**(2n) / lanes`` words of ``p*q*lanes``
+    lanes, lane ``k * lanes + j`` processor ``k``'s word of sparse address ``g * lanes + j``,
+    ``{tri, z}`` or ``{rgb, tri, z}``), so the read-out costs ``1 / (p*q*lanes)`` of the raster's
+    pixels in clocks; ``"port"``: through the paper's interleaved read port, one pixel a clock,
+    row-major (the counters follow either way, one a word). :meth:`decode` gives the same full
+    raster from either."""
 
-    def __init__(self, cells: str = "instance", readout: str = "wide"):
+    def __init__(self, cells: str = "instance", readout: str = "wide", lanes: int = READ_LANES):
         if readout not in ("wide", "port"):
             raise ValueError(f"sparse frame bench: readout must be 'wide' or 'port', not {readout!r}")
-        self.cells, self.readout = cells, readout
+        if isinstance(lanes, bool) or not isinstance(lanes, int) or lanes < 1 or lanes & (lanes - 1):
+            raise ValueError(f"sparse frame bench: lanes must be a power of two, not {lanes!r}")
+        self.cells, self.readout, self.lanes = cells, readout, lanes
         #: the Verilator engine's C++ level: a frame is one run of up to millions of clocks
         self.verilator_opt = "-O2"
 
@@ -282,20 +288,25 @@ class MatrixFrameBench(MatrixBench):
         from rasterhw.sim.engines.verilog_cache import convert_cached
 
         kw = dict(params)
-        mx = Matrix(**kw, cells=self.cells, wide_read=self.readout == "wide")
+        wide = self.readout == "wide"
+        lanes = self._check_lanes(params) if wide else 0
+        mx = Matrix(**kw, cells=self.cells, wide_read=wide, read_lanes=max(lanes, 1))
         extra = ""
         if self.cells == "instance":
             # the cell's cache key as the plain bench had it: parameters at their defaults left out
             key = {k: kw[k] for k in ("n", "p", "q", "z_bits", "fifo_depth", "in_depth")}
             key.update({k: kw[k] for k, v in _CELL_DEFAULTS.items() if kw[k] != v})
-            extra = convert_cached("sparse-matrix", lambda: MatrixCell(**kw), params=key, module=CELL_MODULE)
-        if self.readout == "wide":
-            nb = 2 * params["n"]
+            if lanes:
+                key["read_lanes"] = lanes
+            extra = convert_cached("sparse-matrix", lambda: MatrixCell(**kw, read_lanes=lanes), params=key,
+                                   module=CELL_MODULE)
+        if wide:
+            nb = len(mx.rd_addr)
 
             def address(m, b, addr):
-                m.d.comb += [b.rd_all.eq(1), b.rd_addr.eq(addr[:nb])]
+                m.d.comb += b.rd_addr.eq(addr[:nb])
 
-            words, data = 1 << nb, (lambda b: b.rd_words)
+            words, data = self.pixel_words(params), (lambda b: b.rd_words)
         else:
             w, h = self.raster(params)
             xb = (w - 1).bit_length()
@@ -309,39 +320,52 @@ class MatrixFrameBench(MatrixBench):
                        stats=(params["p"] * params["q"], len(cell_stats(params["n"]))),
                        record_bits=layouts(params["colour"])[0].size, extra=extra)
 
+    def _check_lanes(self, params: dict) -> int:
+        if self.lanes > 1 << (2 * params["n"]):
+            raise ValueError(f"sparse frame bench: {self.lanes} lanes read more than the {1 << (2 * params['n'])} "
+                             "sparse addresses")
+        return self.lanes
+
     def pixel_words(self, params: dict) -> int:
-        """The raster's words on ``o`` (before the counters)."""
+        """The raster's words on ``o`` (before the counters): ``2**(2n) / lanes`` through the wide
+        read-out, ``W * H`` through the port."""
         w, h = self.raster(params)
-        return 1 << (2 * params["n"]) if self.readout == "wide" else w * h
+        return (1 << (2 * params["n"])) // self._check_lanes(params) if self.readout == "wide" else w * h
 
     @staticmethod
     def _lane_bits(params: dict) -> int:
-        return params["z_bits"] + 1 + TRI_BITS + (24 if params["colour"] else 0)
+        from rasterhw.hdl.sparse.benchread import lane_bits
+
+        return lane_bits(params["z_bits"], params["colour"])
 
     def _lanes(self, params: dict, words: list[int]) -> list[int]:
-        """Row-major full-raster words -> the parallel read-out's words: sparse address ``s = v *
-        2**n + u`` carries pixel ``(u p + a, v q + b)`` of every processor ``k = b p + a`` in lane ``k``."""
-        p, q, lb = params["p"], params["q"], self._lane_bits(params)
+        """Row-major full-raster words -> the parallel read-out's words: word ``g`` carries sparse
+        address ``s = g * lanes + j`` (``s = v * 2**n + u``: pixel ``(u p + a, v q + b)``) of every
+        processor ``k = b p + a`` in lane ``k * lanes + j``."""
+        p, q, lb, L = params["p"], params["q"], self._lane_bits(params), self._check_lanes(params)
         w, h = self.raster(params)
         rows = [words[y * w:(y + 1) * w] for y in range(h)]
-        out = [0] * (1 << (2 * params["n"]))
+        out = [0] * self.pixel_words(params)
         for k in range(p * q):
             a, b = k % p, k // p
             lane = [v for row in rows[b::q] for v in row[a::p]]
-            out = [o | v << (k * lb) for o, v in zip(out, lane, strict=True)]
+            for j in range(L):
+                out = [o | v << ((k * L + j) * lb) for o, v in zip(out, lane[j::L], strict=True)]
         return out
 
     def _unlanes(self, params: dict, wide: list[int]) -> list[int]:
         """The inverse of :meth:`_lanes`: the row-major full-raster words."""
-        p, q, lb, n = params["p"], params["q"], self._lane_bits(params), params["n"]
+        p, q, lb, n, L = params["p"], params["q"], self._lane_bits(params), params["n"], self._check_lanes(params)
         w, h = self.raster(params)
         N, mask = 1 << n, (1 << lb) - 1
         out = [0] * (w * h)
         for k in range(p * q):
             a, b = k % p, k // p
-            sh = k * lb
-            for s, v in enumerate(wide):
-                out[((s >> n) * q + b) * w + (s & (N - 1)) * p + a] = (v >> sh) & mask
+            for j in range(L):
+                sh = (k * L + j) * lb
+                for g, v in enumerate(wide):
+                    s = g * L + j
+                    out[((s >> n) * q + b) * w + (s & (N - 1)) * p + a] = (v >> sh) & mask
         return out
 
     def frame(self, tris, params: dict, limit: int, what: str = "") -> Stimulus:
