@@ -18,8 +18,8 @@ from rasterhw.sim.testbench import find_testbench
 from rasterhw.sim.zbm.edge_check import check_edge_pairs
 from rasterhw.sim.zbm.testbench import deal, unit_watchdog
 
-__all__ = ["PLAIN_BUILD", "SPEED_BUILD", "ZbmScene", "float_tolerance", "run_scene", "run_units_equal_clocks",
-           "simulate", "unit_job"]
+__all__ = ["CYCLE_MODEL", "PLAIN_BUILD", "SPEED_BUILD", "ZbmScene", "float_tolerance", "line_cycle_check",
+           "model_line_cycles", "run_scene", "run_units_equal_clocks", "simulate", "unit_job"]
 
 
 # ====================================================================== float tolerance
@@ -127,6 +127,47 @@ def run_units_equal_clocks(per_unit: list, *, width: int, height: int, interleav
                      line_log=line_log, engine=engines.ALIASES.get(engine, engine))
 
 
+# ====================================================================== the golden cycle model, per line
+#: what ``cycle_mismatches`` of ``rasterhw sim zbm`` compares (``extra.cycle_model``)
+CYCLE_MODEL = ("golden_model/zbm/cycles.py: hdl_cycles, per line: the segment clock after the last merge "
+               "word of line y left every chip slot")
+#: why a chain of units compares no cycles (``extra.cycle_model``)
+NO_CHAIN_MODEL = ("none: hdl_cycles models one unit; a chain's line timing also waits on the upstream "
+                  "unit's merge words (its words are compared, its cycles are not)")
+
+
+def model_line_cycles(eps, height: int, *, width: int, interleave: int, schedule: str = "overlap",
+                      capacity: int = F.AEP_CAPACITY) -> np.ndarray:
+    """``hdl_cycles(...)["line_cycles"]``: the exact cycle model's segment clock, per line ``y``, after
+    the last merge word of line ``y`` left every chip slot of one unit (edge-pair words back to back
+    from cycle 0, outputs ready, one clock: a scene run's conditions), kept in the build cache
+    (``verilog_cache.arrays_cached``, keyed by the edge pairs, the parameters and the model's sources:
+    its cycle loop is Python, ~1.1 CPU-s for c300 at interleave 8)."""
+    from pathlib import Path
+
+    from rasterhw.golden_model.zbm import cycles as C
+    from rasterhw.sim.engines.verilog_cache import arrays_cached
+
+    key = [eps.y, eps.h, eps.x, eps.dxdy, eps.len, eps.dlendy, eps.val, eps.ddy, eps.ddx, eps.tag, int(eps.mode),
+           int(height), int(width), int(interleave), schedule, int(capacity)]
+    return arrays_cached("zbm-line-cycles", Path(C.__file__), key, lambda: {"lines": C.hdl_cycles(
+        eps, height, width=width, interleave=interleave, capacity=capacity, schedule=schedule)["line_cycles"]})["lines"]
+
+
+def line_cycle_check(model, hdl) -> dict:
+    """The HDL's per-line log (``UnitBench.line_cycles``) against the model's (:func:`model_line_cycles`;
+    None: no model, a chain): ``cycle_mismatches`` (lines whose cycle differs, a line the HDL never
+    finished counted too; None without a model), ``lines_compared``, ``cycles_golden`` (the model's
+    last line: the frame's cycles) and ``cycle_model`` (what was compared)."""
+    if model is None:
+        return {"cycle_mismatches": None, "lines_compared": 0, "cycles_golden": None, "cycle_model": NO_CHAIN_MODEL}
+    model, hdl = np.asarray(model, np.int64), np.asarray(hdl, np.int64)
+    n = min(len(model), len(hdl))
+    bad = int(np.count_nonzero(model[:n] != hdl[:n])) + abs(len(model) - len(hdl))
+    return {"cycle_mismatches": bad, "lines_compared": len(model),
+            "cycles_golden": int(model[-1]) if len(model) else 0, "cycle_model": CYCLE_MODEL}
+
+
 class ZbmScene(SceneRun):
     """``rasterhw sim zbm``: ``run_geometry`` -> ``edge_pairs`` -> checks (:func:`check_edge_pairs`: bad
     or over-capacity streams raise ``RasterhwError`` before any simulation) -> triangles dealt to
@@ -134,7 +175,10 @@ class ZbmScene(SceneRun):
     compared with the ``zbm-unit`` testbench's golden frame (``chain_frame``) -> composite -> the
     float tolerance. ``schedule``: ``"overlap"`` (ours) or ``"paper"`` (sec. 6.1's; the image is the
     same, only the timing differs). ``cycles``: segment clocks until the last merge word left the
-    chain; ``mismatches``: merge words (pixels' 128-bit double-Z words) that differ; extra:
+    chain; ``mismatches``: merge words (pixels' 128-bit double-Z words) that differ;
+    ``cycle_mismatches``: lines whose cycle in the HDL's per-line log (``UnitBench.line_cycles``) differs
+    from the exact cycle model's (:func:`model_line_cycles`; one unit: a chain has no cycle model, None);
+    extra: ``lines_compared``, ``cycles_golden``, ``cycle_model``,
     ``edge_pairs``, ``aep_peak``, ``triangles``, ``polygons_per_s`` (triangles x 25 MHz / cycles),
     ``float_tolerance``."""
 
@@ -157,7 +201,10 @@ class ZbmScene(SceneRun):
         peak = check_edge_pairs(eps, width, height, units=units)
         # one unit: its segments are the float twin's too (the same generator on the same edge pairs)
         segs = G.segment_generator(eps, height, width=width) if units == 1 else None
-        return {"tris": tris, "eps": eps, "peak": peak, "width": width, "height": height, "segs": segs}
+        lines = model_line_cycles(eps, height, width=width, interleave=interleave, schedule=schedule) \
+            if units == 1 else None
+        return {"tris": tris, "eps": eps, "peak": peak, "width": width, "height": height, "segs": segs,
+                "model_lines": lines}
 
     def jobs(self, gold: dict, *, engine: str, interleave: int = 8, units: int = 1, schedule: str = "overlap"):
         # icarus: the unit's testbench under cocotb on Icarus (the generic cocotb engine). On Verilator
@@ -176,7 +223,7 @@ class ZbmScene(SceneRun):
         clock = self.clock_hz(done)
         return {"interleave": interleave, "units": units, "schedule": schedule, "width": gold["width"],
                 "height": gold["height"], "pixels_compared": gold["width"] * gold["height"],
-                "cycle_mismatches": None,   # a scene has no golden cycle count here (the Table 1 rows compare cycles)
+                **line_cycle_check(gold["model_lines"], d.job.tb.line_cycles(d.job.params, d.got)),
                 "edge_pairs": len(gold["eps"]), "aep_peak": gold["peak"], "triangles": n_tri,
                 "polygons_per_s": n_tri * clock / cycles if cycles else float("inf"), "frame_rgb": rgb8,
                 "float_tolerance": float_tolerance(gold["tris"], px, rgb8, gold["eps"], d.job.expect.golden.tag,
