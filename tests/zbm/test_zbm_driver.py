@@ -139,3 +139,33 @@ def test_cycle_mismatches_counts_perturbed_lines(monkeypatch):
         r = simulate(_scene(), 32, 8, interleave=2, engine="pysim")
         assert r["mismatches"] == 0 and r["cycle_mismatches"] == want, (by, r["cycle_mismatches"])
         assert r["cycles"] != r["cycles_golden"]
+
+
+def test_scene_golden_is_the_golden_models_and_cached(monkeypatch):
+    """``scene_golden`` (what ``sim zbm`` compares with): every slot's rows = the ``zbm-unit``
+    testbench's expected words, ``lines`` = ``hdl_cycles``' line log, the float arrays =
+    ``float_reference``; a second call is served from the build cache (no golden model runs)."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.zbm import cycles as C
+    from rasterhw.sim.testbench import find_testbench
+    from rasterhw.sim.zbm import scene as S
+
+    tris = run_geometry(build_scene("c50"), 32, 16)
+    eps = G.edge_pairs(tris)
+    g = S.scene_golden(tris, eps, width=32, height=16, interleave=2, units=1, schedule="paper")
+    tb = find_testbench("zbm-unit")
+    p = tb.params(interleave=2, width=32, height=16)
+    exp = tb.expect(p, tb.scene_stimulus(p, [eps]))
+    assert np.array_equal(g["rows"], np.concatenate([exp.words[o] for o in tb.outputs_of(p)]))
+    assert g["counts"].tolist() == [len(exp.words[o]) for o in tb.outputs_of(p)]
+    assert g["lines"].tolist() == C.hdl_cycles(eps, 16, width=32, interleave=2, schedule="paper")["line_cycles"].tolist()
+    ref = S.float_reference(tris, exp.golden.tag[..., 0])
+    assert all(np.array_equal(g[k], v) for k, v in ref.items())
+
+    def no(*a, **k):
+        raise AssertionError("computed again")
+
+    monkeypatch.setattr(G, "render_zbm_float", no)
+    monkeypatch.setattr(C, "hdl_cycles", no)
+    again = S.scene_golden(tris, eps, width=32, height=16, interleave=2, units=1, schedule="paper")
+    assert all(np.array_equal(again[k], v) for k, v in g.items())
