@@ -57,7 +57,7 @@ from rasterhw.golden_model.zbm.paper import PAPER_KPOLYS as PAPER_TABLE1_KPOLYS
 
 __all__ = ["PAPER_TABLE1_KPOLYS", "PAPER_LEN_CHIP", "len_chip", "formula_cycles_per_edge_pair",
            "formula_polygons_per_s", "paper_table1", "event_cycles", "paper_workload", "hdl_cycles",
-           "FIFO_LATENCY", "SCHEDULES", "paper_lead", "check_schedule"]
+           "FIFO_LATENCY", "MERGE_OUT_LATENCY", "SCHEDULES", "paper_lead", "check_schedule"]
 
 CLOCK_HZ = PAPER_CLOCK_HZ  # condition 3 (golden_model/zbm/paper.py)
 
@@ -152,6 +152,12 @@ def paper_workload(n_pairs: int, *, interleave_phase: int = 0, lines_apart: int 
 #: cycles from a word's write into the segment generator's input FIFO (``SyncFIFOBuffered``)
 #: until the generator can read it
 FIFO_LATENCY = 2
+#: segment clocks from a chip's swap of line ``y`` to the clock after its merge output's last word of
+#: that line, beyond the line's ``chip_pixels`` words (one a clock; outputs ready, merge clock = segment
+#: clock): the merge-bus reader's first read the clock after the swap, its data register, the
+#: AsyncFIFO's write and two-flop read synchroniser, the merger's output register, and the clock after
+#: the transfer. Held line for line against the HDL by tests/zbm/test_zbm_driver.py::test_line_log_equals_cycle_model
+MERGE_OUT_LATENCY = 6
 #: ``"overlap"``: our design (the chip buffers a packet, loads overlap the loop's work);
 #: ``"paper"``: the paper's sec. 6.1 schedule (a load leaves the loop idle 9 cycles, nothing
 #: runs ahead of the loop), see ``docs/zbm.md#paper-schedule``.
@@ -186,7 +192,10 @@ def hdl_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: int
     are always ready and the merge clock equals the segment clock (the merge-bus reader never
     waits). Returns ``cycles`` = the first cycle in which every chip has swapped the last
     line (``ZbmUnit.lines == height``), ``seggen_done`` = cycle of the last end-of-line word,
-    and per-cause counts of the generator's cycles.
+    per-cause counts of the generator's cycles and ``line_cycles`` ((height,) int64: per line, the
+    clock after the last merge word of that line left every chip, each chip's swap + its pixels +
+    :data:`MERGE_OUT_LATENCY`: the per-line log of a scene run, ``sim/zbm/testbench.py:
+    UnitBench.line_cycles``; its last entry is the run's ``cycles``).
 
     ``schedule="paper"`` models the paper-schedule configuration (``schedule="paper"`` of the
     HDL blocks): a chip takes a segment header only when its ring gap (cycles until the ring
@@ -222,6 +231,7 @@ def hdl_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: int
     q = list(npx)
     dv = [0] * ni
     nlines = [0] * ni
+    swaps = [[] for _ in range(ni)]   # per chip, the cycle of each line's swap
     count = {"check": 0, "load": 0, "seg_words": 0, "empty": 0, "eol": 0, "wait_chips": 0, "wait_zbm": 0}
     t = 0
     while min(nlines) < height:
@@ -279,6 +289,7 @@ def hdl_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: int
             if swap[ch]:
                 q[ch] = 0
                 nlines[ch] += 1
+                swaps[ch].append(t)
         # ---------------- generator: update
         if o_valid and not xfer:
             count["wait_chips"] += 1
@@ -341,5 +352,7 @@ def hdl_cycles(eps: EdgePairs, height: int, *, width: int = 512, interleave: int
         t += 1
     # ``lines`` reaches height the cycle after the last swap: that cycle's number is t.
     n = max(len(eps), 1)
+    sw = np.asarray(swaps, np.int64)                                  # (chips, height)
     return {"cycles": t, "edge_pairs": len(eps), "cycles_per_edge_pair": t / n,
-            "seggen_done": gen_done, "generator": count}
+            "seggen_done": gen_done, "generator": count,
+            "line_cycles": (sw + np.asarray(npx, np.int64)[:, None] + MERGE_OUT_LATENCY).max(axis=0)}

@@ -87,12 +87,19 @@ def doublez_words(px: G.DoubleZ) -> tuple[np.ndarray, np.ndarray]:
 
 
 def words_to_doublez(s0: np.ndarray, s1: np.ndarray) -> G.DoubleZ:
-    """(s0, s1) uint64 sample words -> DoubleZ (tags unknown: -1)."""
-    d = G.DoubleZ.empty(s0.shape)
-    for k, w in enumerate((s0, s1)):
-        z, a, c = F.unpack_samples(w)
-        d.z[..., k], d.a[..., k], d.c[..., k, :] = z, a, c
-    return d
+    """(s0, s1) uint64 sample words -> DoubleZ (tags unknown: -1): ``formats.unpack_samples`` with the
+    fields after z read as whole bytes of the little-endian words (a: bits 24..31, c[i]: 32 + 8 i ..;
+    the SAMPLE layout, checked here), one pass over both samples."""
+    w = np.stack([np.asarray(s0, np.uint64), np.asarray(s1, np.uint64)], axis=-1)
+    b = np.ascontiguousarray(w, dtype="<u8").view(np.uint8).reshape(w.shape + (8,))
+    z = (w & np.uint64(F.Z_EMPTY)).astype(np.int64)
+    return G.DoubleZ(z, b[..., 3].astype(np.int64), b[..., 4:8].astype(np.int64), np.full(w.shape, -1, np.int64))
+
+
+# words_to_doublez reads the sample's fields after z as bytes: the layout it assumes
+if [(f.name, F.SAMPLE.offsets[f.name], f.width) for f in F.SAMPLE.fields] != [
+        ("z", 0, 24), ("a", 24, 8), ("c0", 32, 8), ("c1", 40, 8), ("c2", 48, 8), ("c3", 56, 8)]:
+    raise RuntimeError("words_to_doublez: the SAMPLE layout changed; its byte reads must follow it")
 
 
 _SAMPLE_BITS = F.SAMPLE.width

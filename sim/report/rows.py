@@ -13,7 +13,9 @@ A row is a dict with the keys of :data:`ROW_KEYS`:
               or timing model ran, e.g. on counted operations; NAME = which model or machine), ``formula`` (arithmetic on other
               values), ``fit:NAME`` (a model calibrated on NAME, e.g. ``fit:table2``: shown as a fit, never as
               agreement), ``hdl:pysim``, ``hdl:verilator``, ``hdl:icarus`` (the HDL was simulated),
-              ``hdl:yosys`` / ``hdl:nextpnr`` (the generated Verilog was synthesised / placed)
+              ``hdl:yosys`` / ``hdl:nextpnr`` (the generated Verilog was synthesised / placed); ``not run``
+              (:data:`NOT_RUN`): this run left the row's simulation or synthesis out (``--fast``, rows-only),
+              so nothing produced it; ``source_when_run`` then names what measures it in a run that does
 
 Each machine names a function ``rows(engine, progress, out_dir, **known) -> (rows, sections)``
 in its registry entry (``Machine.report``); reports not tied to one machine are named in
@@ -50,6 +52,9 @@ SOURCES = ("golden", "model", "formula", "hdl:pysim", "hdl:verilator", "hdl:icar
 EXTRA_REPORTS: dict[str, str] = {"fpga": "rasterhw.sim.report.fpga:rows",
                                  "mutation": "rasterhw.sim.report.mutation:rows"}
 
+#: ``source`` of a row whose run this report left out (``make_row(..., run=False)``): nothing produced
+#: ``measured``; the row's ``source_when_run`` names what does in a run that measures it
+NOT_RUN = "not run"
 #: ``reason`` of a row a fast run leaves unmeasured
 FAST_SKIP = "slow row: not measured in a fast run (rasterhw report without --fast measures it)"
 #: ``reason`` of a row a rows-only run leaves unmeasured (:func:`run_report`'s ``rows_only``)
@@ -58,12 +63,14 @@ ROWS_ONLY = ("rows-only run: nothing simulated or synthesised (a check of the ro
 
 
 def make_row(system: str, figure: str, quantity: str, *, paper, formula, measured, unit: str,
-             source: str, reason: str | None = None) -> dict:
+             source: str, reason: str | None = None, run: bool = True) -> dict:
     """Build one row, checking the source label (one of :data:`SOURCES`, ``model:NAME``, or two of
     them joined by ``" + "`` when both produced the value; ``fit:NAME`` for a calibration).
 
     ``measured=None`` needs a ``reason`` (why this run could not measure it): a row is never
-    dropped for lack of a tool or of time, it is kept unmeasured.
+    dropped for lack of a tool or of time, it is kept unmeasured. ``run=False``: this run left
+    out what measures the row (``--fast``, rows-only; ``measured`` must be None): its ``source`` is
+    :data:`NOT_RUN` and ``source_when_run`` keeps ``source`` (what measures it in a run that does).
     """
     # a value two models produced together names both, joined by " + " (e.g. an HDL frame whose
     # producers' timing is a processor model: "hdl:verilator + model:i860")
@@ -73,8 +80,12 @@ def make_row(system: str, figure: str, quantity: str, *, paper, formula, measure
                              f"' + '), not {source!r}")
     if measured is None and not reason:
         raise ValueError(f"row {quantity!r}: measured is None, so say why (reason=...)")
+    if not run and measured is not None:
+        raise ValueError(f"row {quantity!r}: not run, yet measured is {measured!r}")
     row = {"system": system, "figure": figure, "quantity": quantity, "paper": paper,
-           "formula": formula, "measured": measured, "unit": unit, "source": source}
+           "formula": formula, "measured": measured, "unit": unit, "source": source if run else NOT_RUN}
+    if not run:
+        row["source_when_run"] = source
     if reason:
         row["reason"] = reason
     return row

@@ -127,7 +127,8 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: 
             checked = {"words_compared": r["words_compared"], "mismatches": r["mismatches"]}
         out.append({**make_row("zbm", "table 1 / 6.1", f"cycles per edge pair, interleave {i}, {label}",
                                paper=PAPER_CYCLES[i], formula=formula_cycles_per_edge_pair(i),
-                               measured=measured[sched].get(i), unit="cycles", source=f"hdl:{eng}", reason=why),
+                               measured=measured[sched].get(i), unit="cycles", source=f"hdl:{eng}", reason=why,
+                               run=not skip),
                     **checked})
     for sched in ("paper", "overlap"):
         for i in (1, 2, 4, 8, 16):
@@ -137,7 +138,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir: Path, fast: 
                 "(HDL cycles of this run x the paper's arithmetic incl. x1/2 skew, cond. 7)",
                 paper=PAPER_KPOLYS[i] * 1e3, formula=polygons_per_s(formula_cycles_per_edge_pair(i)),
                 measured=None if m is None else polygons_per_s(m), unit="polygons/s", source="model",
-                reason=None if m is not None else skipped[(sched, i)]))
+                reason=None if m is not None else skipped[(sched, i)], run=m is not None))
     out.append(make_row("zbm", "6.1", f"{UNITS_SECOND_LEVEL} units, best interleave (not simulated: "
                         f"{UNITS_SECOND_LEVEL} x the paper's per-unit arithmetic)",
                         paper=PAPER_UNITS_RATE, formula=UNITS_SECOND_LEVEL * polygons_per_s(min(PAPER_CYCLES.values())),
@@ -337,7 +338,7 @@ def i860_rows(measured: dict[str, dict[int, float]], *, progress: bool = False,
                         f"{' x 1/2 (cond. 7)' if factor > 1 else ' (our HDL skew pair: no skew loss)'}; i860: "
                         "model, assembler column)", paper=PAPER_I860S_PER_UNIT, formula=None,
                         measured=None if cyc is None else unit_rate / per_proc[k], unit="i860s", source=src,
-                        reason=None if cyc is not None else why))
+                        reason=None if cyc is not None else why, run=cyc is not None))
                 if il == 8:
                     unit_rate = polygons_per_s(cyc)
                     out.append(make_row(
@@ -472,14 +473,14 @@ def mapping_rows(results: list[dict], *, progress: bool = False, why: str = FAST
                      paper=None, formula=None, measured=after_g, unit="reads", source="golden"),
             make_row("zbm", fig, f"{name}: mapping-memory reads per frame, mapped after the merge (HDL mapper's "
                      "lookup counters)", paper=None, formula=None, measured=after_h, unit="reads",
-                     source="hdl:pysim", reason=reason),
+                     source="hdl:pysim", reason=reason, run=hw is not None),
             make_row("zbm", fig, f"{name}: share of mapping-memory reads saved by mapping after the merge (HDL)",
                      paper=None, formula=None, measured=None if hw is None else 1 - after_h / before, unit="",
-                     source="hdl:pysim", reason=reason),
+                     source="hdl:pysim", reason=reason, run=hw is not None),
             make_row("zbm", "5.2 (composite)", f"{name}: pixels of the HDL alpha-composite (mapper -> compositor) "
                      "differing from the golden frame", paper=None, formula=0,
                      measured=None if hw is None else hw["pixel_mismatches"], unit="pixels",
-                     source="hdl:pysim", reason=reason),
+                     source="hdl:pysim", reason=reason, run=hw is not None),
         ]
     return out
 
@@ -570,34 +571,34 @@ def area_rows(*, fast: bool = False, skip_why: str = FAST_SKIP, progress: bool =
         chip = what == "chip"
         out += [make_row("zbm", "section 7", f"{what} logic, 2-input gate equivalents ({cfg})",
                          paper=PAPER_GATES if chip else None, formula=None,
-                         measured=get("gate_equivalent"), unit="gates", source="hdl:yosys", reason=why),
+                         measured=get("gate_equivalent"), unit="gates", source="hdl:yosys", reason=why, run=why is None),
                 make_row("zbm", "section 7", f"{what} flip-flops ({cfg})", paper=None, formula=None,
-                         measured=get("flipflops"), unit="flip-flops", source="hdl:yosys", reason=why),
+                         measured=get("flipflops"), unit="flip-flops", source="hdl:yosys", reason=why, run=why is None),
                 make_row("zbm", "section 7", f"{what} RAM bits ({cfg}; pixel memories + merge FIFO"
                          + ("; + segment generator's edge-pair memories)" if not chip else ")"),
                          paper=None, formula=None,
-                         measured=get("ram_bits"), unit="bits", source="hdl:yosys", reason=why)]
+                         measured=get("ram_bits"), unit="bits", source="hdl:yosys", reason=why, run=why is None)]
         if chip and sched == "paper":
             ff, ge = (None, None) if g is None else (g["packet_ff"], g["packet_ge"])
             out += [
                 make_row("zbm", "section 7", f"chip ({cfg}): flip-flops of our two packet registers "
                          "(initial processor's and segment processor's 8 x 112 bits; not in the paper)",
                          paper=None, formula=2 * 8 * 112, measured=ff, unit="flip-flops", source="hdl:yosys",
-                         reason=why),
+                         reason=why, run=why is None),
                 make_row("zbm", "section 7", f"chip ({cfg}): gate equivalents of those flip-flops", paper=None,
-                         formula=None, measured=ge, unit="gates", source="hdl:yosys", reason=why),
+                         formula=None, measured=ge, unit="gates", source="hdl:yosys", reason=why, run=why is None),
                 make_row("zbm", "section 7", f"chip logic, like for like: without our packet registers' flip-flops "
                          f"({cfg}; gate equivalents minus the row above; their input multiplexers stay counted)",
                          paper=PAPER_GATES, formula=None,
                          measured=None if r is None else r["gate_equivalent"] - ge, unit="gates",
-                         source="formula", reason=why),
+                         source="formula", reason=why, run=why is None),
                 make_row("zbm", "section 7", f"chip RAM, like for like: the pixel memories the paper counts (8 pixel "
                          "processors, double-buffered, double Z: 2 x 2 samples of 64 bits per pixel; our merge FIFO "
                          f"excluded), Yosys RAM bits minus the FIFO's {MERGE_FIFO_BITS}, in Kbits ({cfg}; formula: "
                          "2 x 2 x 64 x pixels per chip / 1024)", paper=PAPER_RAM_KBITS,
                          formula=2 * 2 * 64 * (params["width"] // params["interleave"]) / 1024,
                          measured=None if r is None else (r["ram_bits"] - MERGE_FIFO_BITS) / 1024, unit="Kbits",
-                         source="formula", reason=why),
+                         source="formula", reason=why, run=why is None),
             ]
     why_r = "a reading of the paper's number, not a measurement"
     out += [make_row("zbm", "section 7", "chip RAM, like for like: the paper's 49 Kbits read as 49,152 bits (48 x 1024; "

@@ -232,10 +232,10 @@ def _rows(results: list[dict], *, engine: str, fast: bool, rows_only: bool = Fal
         out.append(make_row("zbm", "5.3", f"output pixels per segment clock, interleave {i} (one unit, "
                             f"{PIXEL_RATE_WIDTH}-px merge-bound lines; {cycles_per_line:.0f} cycles/line)",
                             paper=None, formula=float(i), measured=rate, unit="px/cycle",
-                            source="hdl:pysim", reason=why))
+                            source="hdl:pysim", reason=why, run=why is None))
         out.append(make_row("zbm", "5.3", f"output pixel rate / interleave-1 rate, interleave {i}",
                             paper=None, formula=float(i), measured=None if p is None else rate / base, unit="x",
-                            source="hdl:pysim", reason=why))
+                            source="hdl:pysim", reason=why, run=why is None))
     s, why = result("skew", 0)
     if s is None:   # the label from skew()'s defaults; "alone": the paper schedule's cycle model
         d = _defaults(skew)
@@ -245,9 +245,9 @@ def _rows(results: list[dict], *, engine: str, fast: bool, rows_only: bool = Fal
                         f"{s['offset']} lines apart (interleave {s['interleave']}, paper schedule; alone "
                         f"{s['alone']:.1f}; formula: 2 x the paper's cycles per edge pair, derived)", paper=None,
                         formula=2 * C.formula_cycles_per_edge_pair(s["interleave"]), measured=s["pair"],
-                        unit="cycles", source=f"hdl:{engine}", reason=why))
+                        unit="cycles", source=f"hdl:{engine}", reason=why, run=why is None))
     out.append(make_row("zbm", "6.1 cond. 7", "fraction of time lost to skew with the neighbour",
-                        paper=0.5, formula=None, measured=s["loss"], unit="", source=f"hdl:{engine}", reason=why))
+                        paper=0.5, formula=None, measured=s["loss"], unit="", source=f"hdl:{engine}", reason=why, run=why is None))
     one = None
     for u in CHAIN_UNITS:
         c, why = result("chain", u)
@@ -262,10 +262,10 @@ def _rows(results: list[dict], *, engine: str, fast: bool, rows_only: bool = Fal
                f"{c['width']}x{c['height']}")
         out.append(make_row("zbm", "6.1 (chain)", f"{tag}: speed-up over 1 unit", paper=None, formula=float(u),
                             measured=None if why else c["polygons_per_s"] / one, unit="x",
-                            source=f"hdl:{engine}", reason=why))
+                            source=f"hdl:{engine}", reason=why, run=why is None))
         # the run's cycles are not in the label (a row's name must not change with its value)
         out.append(make_row("zbm", "6.1 (chain)", f"{tag}: merge-bus occupancy (words per clock per slot; "
                             f"bus-bound frame {c['merge_bound_cycles']} cycles)",
                             paper=None, formula=None, measured=c["merge_occupancy"], unit="",
-                            source=f"hdl:{engine}", reason=why))
+                            source=f"hdl:{engine}", reason=why, run=why is None))
     return out

@@ -14,35 +14,47 @@ from rasterhw.golden_model.zbm.cycles import check_schedule
 from rasterhw.golden_model.zbm.words import words_to_doublez
 from rasterhw.sim import engines
 from rasterhw.sim.engines.scene import Job, SceneRun, run_job
-from rasterhw.sim.testbench import find_testbench
+from rasterhw.sim.testbench import Expected, find_testbench
 from rasterhw.sim.zbm.edge_check import check_edge_pairs
 from rasterhw.sim.zbm.testbench import deal, unit_watchdog
 
-__all__ = ["PLAIN_BUILD", "SPEED_BUILD", "ZbmScene", "float_tolerance", "run_scene", "run_units_equal_clocks",
-           "simulate", "unit_job"]
+__all__ = ["CYCLE_MODEL", "PLAIN_BUILD", "SPEED_BUILD", "ZbmScene", "float_reference", "float_tolerance",
+           "line_cycle_check", "run_scene", "run_units_equal_clocks", "scene_golden", "simulate",
+           "unit_job"]
 
 
 # ====================================================================== float tolerance
-def float_tolerance(tris, px: G.DoubleZ, rgb8: np.ndarray, eps: G.EdgePairs, tags: np.ndarray, segs=None) -> dict:
-    """Compare the composited HDL frame with ``render_zbm_float`` under docs/zbm.md's stated
-    tolerance: coverage identical; nearest triangle identical (pixels with a different nearest
-    triangle -- Z ties -- are counted and left out of the value checks); Z within
-    ``1 + |dz/dx| * 2**-16`` LSB; opaque colour within 1 LSB (2 where the front sample is
-    translucent); ``segs``: ``eps``' segments, when the caller has them (``render_zbm_float``)."""
+def float_reference(tris, gtag0: np.ndarray, segs=None) -> dict:
+    """What :func:`float_tolerance` takes from the golden models, computed without the HDL:
+    ``render_zbm_float``'s coverage (``cov``), nearest sample's Z in LSBs (``zf``, rounded and
+    clamped), colour in LSBs (``frgb``) and whether its nearest triangle is the bit-accurate frame's
+    (``same_tag``: ``gtag0``, that frame's nearest tags), and ``gtag0`` itself (int32). ``segs``:
+    the edge pairs' segments, when the caller has them (one unit)."""
     fl = G.render_zbm_float(tris, segs=segs)
+    cov = np.isfinite(fl["z"][..., 0])
+    zf = np.clip(np.floor(np.where(cov, fl["z"][..., 0], 0) * G.Z_SCALE + 0.5), 0, F.Z_MAX_SAMPLE)
+    return {"cov": cov, "zf": zf.astype(np.int32), "frgb": np.floor(fl["rgb"] * 255 + 0.5).astype(np.uint8),
+            "same_tag": np.asarray(gtag0) == fl["tag"][..., 0], "gtag0": np.asarray(gtag0, np.int32)}
+
+
+def float_tolerance(ref: dict, px: G.DoubleZ, rgb8: np.ndarray, eps: G.EdgePairs) -> dict:
+    """Compare the composited HDL frame with ``render_zbm_float`` (``ref``: :func:`float_reference`)
+    under docs/zbm.md's stated tolerance: coverage identical; nearest triangle identical (pixels with
+    a different nearest triangle -- Z ties -- are counted and left out of the value checks); Z within
+    ``1 + |dz/dx| * 2**-16`` LSB; opaque colour within 1 LSB (2 where the front sample is
+    translucent)."""
     cov_h = px.z[..., 0] != F.Z_EMPTY
-    cov_f = np.isfinite(fl["z"][..., 0])
-    same = cov_h & cov_f & (tags[..., 0] == fl["tag"][..., 0])
-    zf = np.clip(np.floor(np.where(cov_f, fl["z"][..., 0], 0) * G.Z_SCALE + 0.5), 0, F.Z_MAX_SAMPLE)
-    dz = np.abs(px.z[..., 0] - zf)
+    cov_f = ref["cov"]
+    tags0 = ref["gtag0"]
+    same = cov_h & cov_f & ref["same_tag"]
+    dz = np.abs(px.z[..., 0] - ref["zf"])
     # one slot per triangle tag (visible or not) plus a spare zero at index -1 for pixels
     # whose front sample is not the float model's
-    dzdx = np.zeros(max(int(tags.max(initial=-1)), int(eps.tag.max(initial=-1))) + 2)
+    dzdx = np.zeros(max(int(tags0.max(initial=-1)), int(eps.tag.max(initial=-1))) + 2)
     if len(eps):
         np.maximum.at(dzdx, eps.tag, np.abs(eps.ddx[:, 0]) / float(1 << F.ATTR_FRAC))
-    zbound = 1 + dzdx[np.where(same, tags[..., 0], -1)] * 2.0 ** -16
-    frgb = np.floor(fl["rgb"] * 255 + 0.5)
-    drgb = np.abs(rgb8.astype(np.int64) - frgb).max(axis=-1)
+    zbound = 1 + dzdx[np.where(same, tags0, -1)] * 2.0 ** -16
+    drgb = np.abs(rgb8.astype(np.int16) - ref["frgb"]).max(axis=-1)
     opaque = px.a[..., 0] == 255
     rbound = np.where(opaque, 1, 2)
     z_over = int(np.count_nonzero(same & (dz > zbound)))
@@ -75,7 +87,7 @@ PLAIN_BUILD = {"speed": False, "opt": "-O1", "pgo": False}
 def unit_job(eps_per_unit: list, *, width: int, height: int, interleave: int, schedule: str = "overlap",
              capacity: int = F.AEP_CAPACITY, engine: str = "verilator", stall: int = 0, seed: int = 1,
              gap_seed: int | None = None, build: dict | None = None, clocks: dict | None = None,
-             segments: list | None = None) -> Job:
+             segments: list | None = None, expect: Expected | None = None) -> Job:
     """Edge pairs through ``len(eps_per_unit)`` chained ZB/M units (unit ``k`` gets
     ``eps_per_unit[k]``; a scene's: ``testbench.deal``) as one job of the ``zbm-unit`` testbench
     (:class:`rasterhw.sim.zbm.testbench.UnitBench`; its expected words come from ``chain_frame``, the
@@ -84,7 +96,8 @@ def unit_job(eps_per_unit: list, *, width: int, height: int, interleave: int, sc
     edge-pair input (None: none); ``clocks``: separate segment and merge clocks (``{"sync": Clock,
     "merge": Clock}``, e.g. the cocotb bench's at a ratio: ``testbench.bench_clocks``; one build for
     every ratio; cycles stay in segment clocks); None: one clock for both. ``segments``: each unit's
-    segments, when the caller has them (``chain_frame``)."""
+    segments, when the caller has them (``chain_frame``); ``expect``: the expected words, when the
+    caller has them (``rasterhw sim zbm``: from the build cache, :func:`scene_golden`)."""
     tb = find_testbench("zbm-unit")
     p = tb.params(interleave=interleave, width=width, height=height, capacity=capacity, schedule=schedule,
                   units=len(eps_per_unit))
@@ -93,7 +106,7 @@ def unit_job(eps_per_unit: list, *, width: int, height: int, interleave: int, sc
                         ratio=(clocks["sync"].half, clocks["merge"].half) if clocks else (5, 5))
     run = {"stall": stall, "seed": seed, "max_cycles": cap, "clocks": clocks, "packed": True,
            "build": (SPEED_BUILD if build is None else build) if engine == "verilator" else None}
-    return Job(tb, p, stim, tb.expect(p, stim, segments), run, cycle_exact=False)
+    return Job(tb, p, stim, tb.expect(p, stim, segments) if expect is None else expect, run, cycle_exact=False)
 
 
 def run_scene(eps_per_unit: list, *, engine: str = "verilator", line_log: bool = False, **kw) -> dict:
@@ -127,6 +140,65 @@ def run_units_equal_clocks(per_unit: list, *, width: int, height: int, interleav
                      line_log=line_log, engine=engines.ALIASES.get(engine, engine))
 
 
+# ====================================================================== the golden cycle model, per line
+#: what ``cycle_mismatches`` of ``rasterhw sim zbm`` compares (``extra.cycle_model``)
+CYCLE_MODEL = ("golden_model/zbm/cycles.py: hdl_cycles, per line: the segment clock after the last merge "
+               "word of line y left every chip slot")
+#: why a chain of units compares no cycles (``extra.cycle_model``)
+NO_CHAIN_MODEL = ("none: hdl_cycles models one unit; a chain's line timing also waits on the upstream "
+                  "unit's merge words (its words are compared, its cycles are not)")
+
+
+def line_cycle_check(model, hdl) -> dict:
+    """The HDL's per-line log (``UnitBench.line_cycles``) against the exact cycle model's
+    (``hdl_cycles(...)["line_cycles"]``: the segment clock, per line, after the last merge word of that line
+    left every chip slot of one unit, words back to back, outputs ready, one clock: a scene run's
+    conditions; :func:`scene_golden`; None: no model, a chain): ``cycle_mismatches`` (lines whose cycle differs, a line the HDL never
+    finished counted too; None without a model), ``lines_compared``, ``cycles_golden`` (the model's
+    last line: the frame's cycles) and ``cycle_model`` (what was compared)."""
+    if model is None:
+        return {"cycle_mismatches": None, "lines_compared": 0, "cycles_golden": None, "cycle_model": NO_CHAIN_MODEL}
+    model, hdl = np.asarray(model, np.int64), np.asarray(hdl, np.int64)
+    n = min(len(model), len(hdl))
+    bad = int(np.count_nonzero(model[:n] != hdl[:n])) + abs(len(model) - len(hdl))
+    return {"cycle_mismatches": bad, "lines_compared": len(model),
+            "cycles_golden": int(model[-1]) if len(model) else 0, "cycle_model": CYCLE_MODEL}
+
+
+def scene_golden(tris, eps, *, width: int, height: int, interleave: int, units: int, schedule: str) -> dict:
+    """Everything ``rasterhw sim zbm`` compares the HDL with, from the golden models alone, kept in the
+    build cache (``verilog_cache.arrays_cached``: ``build/verilog/zbm-scene-<digest>.npz``, SHA-256
+    checked, keyed by the triangles, the parameters and the digest of this module and every module of
+    ours it imports, transitively: an edit to a golden model computes it again): ``rows`` (every chip
+    slot's expected merge words, packed rows, slot after slot; ``counts``: words per slot), the
+    ``zbm-unit`` testbench's ``expect`` (``chain_frame``: the one golden route); :func:`float_reference`'s
+    arrays (the float twin); and, for one unit, ``lines`` (``hdl_cycles(...)["line_cycles"]``, what :func:`line_cycle_check` compares). A warm run
+    so neither renders the bit-accurate nor the float frame nor walks the cycle model (c300, I = 8:
+    ~0.15 CPU-s of golden models and 1.1 CPU-s of the cycle model)."""
+    from pathlib import Path
+
+    from rasterhw.golden_model.zbm import cycles as C
+    from rasterhw.sim.engines.verilog_cache import arrays_cached
+
+    def compute() -> dict:
+        tb = find_testbench("zbm-unit")
+        p = tb.params(interleave=interleave, width=width, height=height, units=units)
+        # one unit: its segments are the float twin's too (the same generator on the same edge pairs)
+        segs = G.segment_generator(eps, height, width=width) if units == 1 else None
+        stim = tb.scene_stimulus(p, deal(eps, units))
+        exp = tb.expect(p, stim, None if segs is None else [segs])
+        rows = [exp.words[o] for o in tb.outputs_of(p)]
+        out = {"rows": np.concatenate(rows), "counts": np.array([len(r) for r in rows], np.int64),
+               **float_reference(tris, exp.golden.tag[..., 0], segs)}
+        if units == 1:
+            out["lines"] = C.hdl_cycles(eps, height, width=width, interleave=interleave,
+                                        schedule=schedule)["line_cycles"]
+        return out
+
+    key = [x for k, v in sorted(vars(tris).items()) for x in (k, v)] + [width, height, interleave, units, schedule]
+    return arrays_cached("zbm-scene", Path(__file__), key, compute)
+
+
 class ZbmScene(SceneRun):
     """``rasterhw sim zbm``: ``run_geometry`` -> ``edge_pairs`` -> checks (:func:`check_edge_pairs`: bad
     or over-capacity streams raise ``RasterhwError`` before any simulation) -> triangles dealt to
@@ -134,7 +206,10 @@ class ZbmScene(SceneRun):
     compared with the ``zbm-unit`` testbench's golden frame (``chain_frame``) -> composite -> the
     float tolerance. ``schedule``: ``"overlap"`` (ours) or ``"paper"`` (sec. 6.1's; the image is the
     same, only the timing differs). ``cycles``: segment clocks until the last merge word left the
-    chain; ``mismatches``: merge words (pixels' 128-bit double-Z words) that differ; extra:
+    chain; ``mismatches``: merge words (pixels' 128-bit double-Z words) that differ;
+    ``cycle_mismatches``: lines whose cycle in the HDL's per-line log (``UnitBench.line_cycles``) differs
+    from the exact cycle model's (:func:`line_cycle_check`; one unit: a chain has no cycle model, None);
+    extra: ``lines_compared``, ``cycles_golden``, ``cycle_model``,
     ``edge_pairs``, ``aep_peak``, ``triangles``, ``polygons_per_s`` (triangles x 25 MHz / cycles),
     ``float_tolerance``."""
 
@@ -155,16 +230,19 @@ class ZbmScene(SceneRun):
         tris = run_geometry(scene, width, height)
         eps = G.edge_pairs(tris)
         peak = check_edge_pairs(eps, width, height, units=units)
-        # one unit: its segments are the float twin's too (the same generator on the same edge pairs)
-        segs = G.segment_generator(eps, height, width=width) if units == 1 else None
-        return {"tris": tris, "eps": eps, "peak": peak, "width": width, "height": height, "segs": segs}
+        g = scene_golden(tris, eps, width=width, height=height, interleave=interleave, units=units, schedule=schedule)
+        return {"tris": tris, "eps": eps, "peak": peak, "width": width, "height": height, **g}
 
     def jobs(self, gold: dict, *, engine: str, interleave: int = 8, units: int = 1, schedule: str = "overlap"):
         # icarus: the unit's testbench under cocotb on Icarus (the generic cocotb engine). On Verilator
         # the profiled build, trained with the first build (said on stderr; RASTERHW_PGO=0 skips it)
         engine = engines.ALIASES.get(engine, engine)
+        tb = find_testbench("zbm-unit")
+        outs = tb.outputs_of(tb.params(interleave=interleave, width=gold["width"], height=gold["height"], units=units))
+        at = np.cumsum(np.concatenate([[0], gold["counts"]]))
+        expect = Expected({o: gold["rows"][at[k]:at[k + 1]] for k, o in enumerate(outs)})
         return [unit_job(deal(gold["eps"], units), width=gold["width"], height=gold["height"], interleave=interleave,
-                         schedule=schedule, engine=engine, segments=None if gold["segs"] is None else [gold["segs"]],
+                         schedule=schedule, engine=engine, expect=expect,
                          build={**SPEED_BUILD, "pgo": "train"} if engine == "verilator" else None)]
 
     def result(self, gold: dict, done: list, *, engine: str, interleave: int = 8, units: int = 1,
@@ -176,11 +254,10 @@ class ZbmScene(SceneRun):
         clock = self.clock_hz(done)
         return {"interleave": interleave, "units": units, "schedule": schedule, "width": gold["width"],
                 "height": gold["height"], "pixels_compared": gold["width"] * gold["height"],
-                "cycle_mismatches": None,   # a scene has no golden cycle count here (the Table 1 rows compare cycles)
+                **line_cycle_check(gold.get("lines"), d.job.tb.line_cycles(d.job.params, d.got)),
                 "edge_pairs": len(gold["eps"]), "aep_peak": gold["peak"], "triangles": n_tri,
                 "polygons_per_s": n_tri * clock / cycles if cycles else float("inf"), "frame_rgb": rgb8,
-                "float_tolerance": float_tolerance(gold["tris"], px, rgb8, gold["eps"], d.job.expect.golden.tag,
-                                                   gold["segs"])}
+                "float_tolerance": float_tolerance(gold, px, rgb8, gold["eps"])}
 
 
 simulate = ZbmScene().simulate

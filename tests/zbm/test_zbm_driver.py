@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from rasterhw.golden_model import zbm as G
@@ -27,6 +29,8 @@ def test_simulate_zbm_pysim_tiny_frame():
     r = simulate(_scene(), 32, 8, interleave=2, engine="pysim")
     assert r["block"] == "zbm" and r["engine"] == "pysim" and r["units"] == 1
     assert r["pixels_compared"] == 32 * 8 and r["mismatches"] == 0
+    # every line's cycle = the exact cycle model's (issue 46)
+    assert r["cycle_mismatches"] == 0 and r["lines_compared"] == 8 and r["cycles"] == r["cycles_golden"]
     assert r["edge_pairs"] > 0 and r["cycles"] > 0 and r["frame_rgb"].shape == (8, 32, 3)
     assert r["frame_rgb"].dtype == np.uint8 and r["frame_rgb"].any()
     assert r["float_tolerance"]["ok"], r["float_tolerance"]
@@ -93,3 +97,75 @@ def test_bench_without_golden_frame_must_say_speed_run():
     with pytest.raises(RasterhwError, match="speed_run"):
         run_unit_bench([G.edge_pairs(random_triangles(np.random.default_rng(0), 2, 8, 8))], width=8,
                          height=8, interleave=1, sim="verilator")
+
+
+@pytest.mark.parametrize("interleave,seed,schedule", [(1, 0, "overlap"), (2, 1, "paper"), (8, 2, "overlap"),
+                                                      (4, 3, "paper")])
+def test_line_log_equals_cycle_model(interleave, seed, schedule):
+    """The unit's per-line log on the engine (``UnitBench.line_cycles``: the clock after every chip
+    slot's last merge word of line y) == the exact cycle model's ``hdl_cycles(...)["line_cycles"]``
+    (its swaps + chip pixels + ``MERGE_OUT_LATENCY``) line for line, on random streams (empty and
+    clipped segments, several pairs per line), both schedules: what ``sim zbm``'s
+    ``cycle_mismatches`` compares."""
+    from rasterhw.golden_model.zbm import cycles as C
+    from rasterhw.sim.zbm.scene import run_scene
+
+    w, h = 8 * interleave if interleave > 1 else 24, 10
+    eps = G.edge_pairs(random_triangles(np.random.default_rng(seed), 6, w, h, size=10))
+    model = C.hdl_cycles(eps, h, width=w, interleave=interleave, schedule=schedule)
+    r = run_scene([eps], width=w, height=h, interleave=interleave, schedule=schedule, engine="pysim", line_log=True)
+    assert r["mismatches"] == 0 and len(eps) >= 5
+    assert r["line_cycles"] == model["line_cycles"].tolist() and r["cycles"] == model["line_cycles"][-1]
+
+
+def test_cycle_mismatches_counts_perturbed_lines(monkeypatch):
+    """``cycle_mismatches`` can fail: the same run with the HDL's stamps of the last line one clock
+    late (every chip slot) counts that line; one clock early everywhere, every line."""
+    from rasterhw.sim.engines import scene as S
+
+    real = S.run_job
+
+    def shifted(by, last_only):
+        def run(job, engine):
+            d = real(job, engine)
+            npx = {p: len(range(c, 32, 2)) for c, p in enumerate(job.tb.outputs_of(job.params))}
+            st = {p: [s + by if (not last_only or k >= len(v) - npx[p]) else s for k, s in enumerate(v)]
+                  for p, v in d.got.stamps.items()}
+            return S.Done(d.job, dataclasses.replace(d.got, stamps=st), d.cmp)
+        return run
+
+    for by, last_only, want in ((1, True, 1), (-1, False, 8)):
+        monkeypatch.setattr(S, "run_job", shifted(by, last_only))
+        r = simulate(_scene(), 32, 8, interleave=2, engine="pysim")
+        assert r["mismatches"] == 0 and r["cycle_mismatches"] == want, (by, r["cycle_mismatches"])
+        assert r["cycles"] != r["cycles_golden"]
+
+
+def test_scene_golden_is_the_golden_models_and_cached(monkeypatch):
+    """``scene_golden`` (what ``sim zbm`` compares with): every slot's rows = the ``zbm-unit``
+    testbench's expected words, ``lines`` = ``hdl_cycles``' line log, the float arrays =
+    ``float_reference``; a second call is served from the build cache (no golden model runs)."""
+    from rasterhw.golden_model.pipeline import run_geometry
+    from rasterhw.golden_model.zbm import cycles as C
+    from rasterhw.sim.testbench import find_testbench
+    from rasterhw.sim.zbm import scene as S
+
+    tris = run_geometry(build_scene("c50"), 32, 16)
+    eps = G.edge_pairs(tris)
+    g = S.scene_golden(tris, eps, width=32, height=16, interleave=2, units=1, schedule="paper")
+    tb = find_testbench("zbm-unit")
+    p = tb.params(interleave=2, width=32, height=16)
+    exp = tb.expect(p, tb.scene_stimulus(p, [eps]))
+    assert np.array_equal(g["rows"], np.concatenate([exp.words[o] for o in tb.outputs_of(p)]))
+    assert g["counts"].tolist() == [len(exp.words[o]) for o in tb.outputs_of(p)]
+    assert g["lines"].tolist() == C.hdl_cycles(eps, 16, width=32, interleave=2, schedule="paper")["line_cycles"].tolist()
+    ref = S.float_reference(tris, exp.golden.tag[..., 0])
+    assert all(np.array_equal(g[k], v) for k, v in ref.items())
+
+    def no(*a, **k):
+        raise AssertionError("computed again")
+
+    monkeypatch.setattr(G, "render_zbm_float", no)
+    monkeypatch.setattr(C, "hdl_cycles", no)
+    again = S.scene_golden(tris, eps, width=32, height=16, interleave=2, units=1, schedule="paper")
+    assert all(np.array_equal(again[k], v) for k, v in g.items())
