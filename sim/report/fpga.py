@@ -152,6 +152,13 @@ def _reason(r) -> str | None:
     return FAST_SKIP if r is None else not_measured_reason(r)
 
 
+def _ran(r) -> bool:
+    """Whether a tool produced this configuration's row in this run (a measurement, or a finding such
+    as "does not fit" or a stop in the time limit); a fast run's skip or a configuration not run
+    or not recorded is ``rows.NOT_RUN`` (issue 46: the row's source says what produced it)."""
+    return r is not None and not (r.get("finished") is False and not r.get("stage"))
+
+
 def sweep_plot(sw: FpgaSweep, points: list[tuple[object, dict]], path, missing: dict | None = None) -> None:
     """Fmax of every clock of ``sw.block`` against ``sw.param``, with the clocks the paper names;
     ``missing``: value -> why it has no point (written at the bottom of the plot)."""
@@ -219,9 +226,9 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
         fig = f"{block} on {dev} ({_cfg(block, params, kind)})"
         src = "hdl:yosys" if (r is not None and "ram_bits" in r and "utilization" not in r) else "hdl:nextpnr"
 
-        def row(q, measured, unit, paper=None, fig=fig, system=system, why=why, src=src):
+        def row(q, measured, unit, paper=None, fig=fig, system=system, why=why, src=src, ran=_ran(r)):
             return make_row(system, fig, q, paper=paper, formula=None, measured=measured, unit=unit,
-                            source=src, reason=why)
+                            source=src, reason=why, run=ran)
 
         out += [row("LUT4s", r["luts"] if ok else None, "LUT4"),
                 row("flip-flops", r["ffs"] if ok else None, "flip-flops"),
@@ -244,9 +251,9 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
         system = registry.block_machine(block).name
         fig = f"{block} on {ice} ({_cfg(block, params, kind)})"
 
-        def row(q, measured, unit, paper=None, fig=fig, system=system, why=why):
+        def row(q, measured, unit, paper=None, fig=fig, system=system, why=why, ran=_ran(r)):
             return make_row(system, fig, q, paper=paper, formula=None, measured=measured, unit=unit,
-                            source="hdl:nextpnr", reason=why)
+                            source="hdl:nextpnr", reason=why, run=ran)
 
         out += [row("logic cells (ICESTORM_LC)", r["luts"] if ok else None, "LC"),
                 row("flip-flops", r["ffs"] if ok else None, "flip-flops"),
@@ -281,7 +288,7 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
                 f = r["fmax_mhz"].get(c.domain) if why is None else None
                 out.append(make_row(registry.block_machine(sw.block).name, figure, f"Fmax, {c.name}, {sw.param} {v}",
                                     paper=None if c.hz is None else c.hz / 1e6, formula=None, measured=f,
-                                    unit="MHz", source="hdl:nextpnr", reason=why))
+                                    unit="MHz", source="hdl:nextpnr", reason=why, run=_ran(r)))
         plots.append((sw, figure, points, missing))
     sections = ["", "## Place and route", "",
                 "Made by `rasterhw report fpga` (slow: one nextpnr run per row group, minutes to an hour each; "

@@ -1027,7 +1027,7 @@ def _large_matrix_hdl_rows(engine: str, *, fast: bool, progress: bool) -> tuple[
                  "headers)_i / (n P frame cycles) (formula: (10) on (1)'s counts, k_p/k_e = 0)", round(Rp_f, 4),
                  got["Rp_h"], "")]
         out += [make_row(SYSTEM, fig, qty, paper=None, formula=f, measured=v, unit=u, source=src,
-                         reason=None if v is not None else why) for fig, qty, f, v, u in spec]
+                         reason=None if v is not None else why, run=why is None) for fig, qty, f, v, u in spec]
     sec = ["## The 8x8 and 16x16 matrices in HDL at 1024²\n"]
     if tab:
         sec += [f"c300 at {W}², the default processor, input FIFO depth {D}, each matrix one Verilator simulation "
