@@ -246,8 +246,9 @@ def test_stack_matrix_hdl_rows_on_pysim():
 
 def test_large_matrix_rows_stay_with_their_reason():
     """The 8x8 and 16x16 matrices at 1024² in HDL: a fast run and pysim keep every row unmeasured with
-    its reason (the formula column filled); an engine that is no HDL simulator gives none."""
-    from rasterhw.sim.report.rows import make_row
+    its reason and source "not run" (what measures it in ``source_when_run``; the formula column
+    filled); an engine that is no HDL simulator gives none."""
+    from rasterhw.sim.report.rows import NOT_RUN, make_row
     from rasterhw.sim.sparse.report import (
         LARGE_ENGINE_SKIP,
         LARGE_FAST_SKIP,
@@ -256,8 +257,8 @@ def test_large_matrix_rows_stay_with_their_reason():
 
     for engine, fast, why in (("verilator", True, LARGE_FAST_SKIP), ("pysim", False, LARGE_ENGINE_SKIP)):
         rows, sec = _large_matrix_hdl_rows(engine, fast=fast, progress=False)
-        assert len(rows) == 14 and all(r["measured"] is None and r["reason"] == why and r["source"] == "hdl:verilator"
-                                       for r in rows)
+        assert len(rows) == 14 and all(r["measured"] is None and r["reason"] == why and r["source"] == NOT_RUN
+                                       and r["source_when_run"] == "hdl:verilator" for r in rows)
         assert sum("c300 1024x1024, 8x8," in r["quantity"] for r in rows) == 7
         assert sum("c300 1024x1024, 16x16," in r["quantity"] for r in rows) == 7
         rp = [r["formula"] for r in rows if "R_p from HDL frame time" in r["quantity"]]
@@ -265,7 +266,7 @@ def test_large_matrix_rows_stay_with_their_reason():
         assert why in sec[-1]
         for r in rows:   # the report's own check of a row accepts them
             make_row(r["system"], r["figure"], r["quantity"], paper=r["paper"], formula=r["formula"],
-                     measured=None, unit=r["unit"], source=r["source"], reason=r["reason"])
+                     measured=None, unit=r["unit"], source=r["source_when_run"], reason=r["reason"], run=False)
     assert _large_matrix_hdl_rows("none", fast=False, progress=False) == ([], [])
 
 
