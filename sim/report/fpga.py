@@ -225,8 +225,9 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
         system = registry.block_machine(block).name
         fig = f"{block} on {dev} ({_cfg(block, params, kind)})"
         src = "hdl:yosys" if (r is not None and "ram_bits" in r and "utilization" not in r) else "hdl:nextpnr"
+        ran = _ran(r)
 
-        def row(q, measured, unit, paper=None, fig=fig, system=system, why=why, src=src, ran=_ran(r)):
+        def row(q, measured, unit, paper=None, fig=fig, system=system, why=why, src=src, ran=ran):
             return make_row(system, fig, q, paper=paper, formula=None, measured=measured, unit=unit,
                             source=src, reason=why, run=ran)
 
@@ -250,8 +251,9 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir, fast: bool =
         ok = why is None
         system = registry.block_machine(block).name
         fig = f"{block} on {ice} ({_cfg(block, params, kind)})"
+        ran = _ran(r)
 
-        def row(q, measured, unit, paper=None, fig=fig, system=system, why=why, ran=_ran(r)):
+        def row(q, measured, unit, paper=None, fig=fig, system=system, why=why, ran=ran):
             return make_row(system, fig, q, paper=paper, formula=None, measured=measured, unit=unit,
                             source="hdl:nextpnr", reason=why, run=ran)
 
