@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 from rasterhw.sim.report import mutation as R
-from rasterhw.sim.report.rows import run_report
+from rasterhw.sim.report.rows import NOT_RUN, run_report
 
 
 def _record():
@@ -38,9 +38,10 @@ def test_report_is_made_from_the_record(tmp_path, monkeypatch):
     assert dmm["mutation score"]["source"] == "hdl:verilator"
     zbm = [r for r in rows if r["figure"].startswith("zbm-merger ")]
     assert zbm and all(r["measured"] is None and "Yosys took too long" in r["reason"] for r in zbm)
-    # a block of the registry that the record lacks stays, unmeasured, with why
+    assert all(r["source"] == NOT_RUN and r["source_when_run"] == "hdl:verilator" for r in zbm)   # stopped on an error
+    # a block of the registry that the record lacks stays, unmeasured, with why, and says nothing ran it
     lacking = [r for r in rows if r["figure"].startswith("pixelbus-bank ")]
-    assert lacking and all("not in the record" in r["reason"] for r in lacking)
+    assert lacking and all("not in the record" in r["reason"] and r["source"] == NOT_RUN for r in lacking)
     md = (tmp_path / "mutation.md").read_text()
     assert "| `experts-dmm` | depth 16 | 2 | 1 | 0 | 1 | 0.500 | k-induction, depth 7, passed (latency 3) | — |" in md
     assert "`hdl/experts/dmm.py:76`: inv on $x port Q bit 0" in md
@@ -51,7 +52,7 @@ def test_without_a_record_every_row_says_how_to_make_one(tmp_path, monkeypatch):
     monkeypatch.setattr(R, "RECORD", tmp_path / "none.json")
     rows, sections = R.rows(out_dir=tmp_path)
     assert rows and sections == []
-    assert all(r["measured"] is None and "--rerun" in r["reason"] for r in rows)
+    assert all(r["measured"] is None and "--rerun" in r["reason"] and r["source"] == NOT_RUN for r in rows)
 
 
 def test_survivors_show_their_class_and_a_block_that_could_not_be_mutated_is_merged_with_why(tmp_path):

@@ -160,17 +160,17 @@ def _table21_hdl(out: list, engine: str, progress: bool) -> None:
             base = None if res is None else res[k, v, "none"]
             aj = None if res is None else res[k, v, "c"]
             out.append(make_row(SYS, "table 2.1 (HDL)", f"HDL cycles without A.J., {what}", paper=None, formula=None,
-                                measured=base, unit="cycles", source=src, reason=None if res else why))
+                                measured=base, unit="cycles", source=src, reason=None if res else why, run=res is not None))
             out.append(make_row(SYS, "table 2.1 (HDL)", f"HDL cycles with A.J. (c) at a segment's boundary pixels, "
                                 f"{what}", paper=None, formula=None, measured=aj, unit="cycles", source=src,
-                                reason=None if res else why))
+                                reason=None if res else why, run=res is not None))
             out.append(make_row(SYS, "table 2.1 (HDL)", f"A.J. (c) increase in HDL cycles, {what}", paper=paper,
                                 formula=None, measured=None if res is None else round(100.0 * (aj - base) / base, 2),
-                                unit="%", source=src, reason=None if res else why))
+                                unit="%", source=src, reason=None if res else why, run=res is not None))
         out.append(make_row(SYS, "table 2.2 (HDL)", f"work with A.J. (c) in HDL cycles, 8 line segments (no A.J. = 1), "
                             f"{label}, 1 SLP x 1 PXP, 512x512", paper=PAPER_T22["c"], formula=None,
                             measured=None if res is None else round(res["lines", v, "c"] / res["lines", v, "none"], 4),
-                            unit="x", source=src, reason=None if res else why))
+                            unit="x", source=src, reason=None if res else why, run=res is not None))
 
 
 def _tables(out: list, sections: list, out_dir: Path, progress: bool, engine: str = "pysim") -> None:

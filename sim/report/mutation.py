@@ -374,7 +374,10 @@ def rows(*, engine: str = "pysim", progress: bool = False, out_dir=None, fast: b
         for q, key, unit in (("mutants", "mutants", "mutants"), ("killed", "killed", "mutants"),
                              ("survived", "survived", "mutants"), ("mutation score", "score", "")):
             v = None if why else b[key]
+            # a block the record has no run of (or whose run stopped on an error) is "not run"; a void
+            # baseline is a finding the run produced
             out.append(make_row(system, fig, q, paper=None, formula=None, measured=v, unit=unit,
-                                source="hdl:verilator", reason=why))
+                                source="hdl:verilator", reason=why,
+                                run=b is not None and "error" not in b))
     run_all = _read(ALL_RECORD) if record else None
     return out, (sections(record) if record else []) + (all_section(run_all, record) if run_all else [])
