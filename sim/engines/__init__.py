@@ -45,7 +45,7 @@ def _cocotb(*args, sim: str, **kw) -> Run:
     return cocotb.run(*args, sim=sim, **kw)
 
 
-#: the cocotb engines' names (``cocotb.SIMULATORS``: one per simulator of the cocotb runner)
+#: engine name -> cocotb simulator: one per simulator of the cocotb runner (``runner.SIMULATORS``)
 _COCOTB = {f"cocotb-{sim}": sim for sim in _COCOTB_SIMS}
 ENGINES = {"pysim": _pysim, "verilator": verilator.run,
            **{name: partial(_cocotb, sim=sim) for name, sim in _COCOTB.items()}}

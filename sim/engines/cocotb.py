@@ -31,10 +31,7 @@ from rasterhw.sim.outfile import write_if_changed
 from rasterhw.sim.testbench import Run, Stimulus, Testbench
 from rasterhw.sim.workdirs import keep, release, temp_run_folder
 
-__all__ = ["SIMULATORS", "run"]
-
-#: engine name -> cocotb simulator
-SIMULATORS = {f"cocotb-{sim}": sim for sim in runner.SIMULATORS}
+__all__ = ["run"]
 
 
 def run(tb: Testbench, params: dict, stim: Stimulus, *, stall: int, seed: int, expect_words: dict[str, int],
