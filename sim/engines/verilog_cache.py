@@ -30,7 +30,7 @@ from rasterhw.sim.outfile import write_text
 from rasterhw.sim.paths import BUILD_ROOT, REPO_ROOT
 from rasterhw.sim.registry import blocks
 
-__all__ = ["amaranth_version", "arrays_cached", "closure_cached", "convert_cached", "factory_params", "design_sources", "generate_cached", "module_sources", "source_digest", "sources_digest",
+__all__ = ["amaranth_version", "arrays_cached", "closure_cached", "fields_key", "convert_cached", "factory_params", "design_sources", "generate_cached", "module_sources", "source_digest", "sources_digest",
            "write_verilog"]
 
 PKG_ROOT = REPO_ROOT
@@ -184,6 +184,12 @@ def amaranth_version() -> str:
         return importlib.metadata.version("amaranth")
     except importlib.metadata.PackageNotFoundError:
         return "unknown"
+
+
+def fields_key(obj) -> list:
+    """An object's fields as :func:`arrays_cached` key items: name, value, name, value, ... sorted by
+    name (e.g. a scene's screen triangles: every array by its bytes)."""
+    return [x for k, v in sorted(vars(obj).items()) for x in (k, v)]
 
 
 def arrays_cached(name: str, sources: Path, key: Sequence, compute: Callable[[], dict[str, np.ndarray]]

@@ -96,7 +96,7 @@ def _cached_jobs(tris, compute, **options) -> dict:
     import json
     from pathlib import Path
 
-    from rasterhw.sim.engines.verilog_cache import arrays_cached
+    from rasterhw.sim.engines.verilog_cache import arrays_cached, fields_key
     from rasterhw.sim.experts.pxp_jobs import RANGE_BITS
     from rasterhw.sim.packed import as_bytes
 
@@ -112,7 +112,7 @@ def _cached_jobs(tris, compute, **options) -> dict:
         out["meta"] = np.frombuffer(json.dumps(meta).encode(), np.uint8)
         return out
 
-    key = [x for k, v in sorted(vars(tris).items()) for x in (k, v)] + [options]
+    key = fields_key(tris) + [options]
     jb = arrays_cached("experts-pxp-jobs", Path(__file__), key, arrays)
     meta = json.loads(jb.pop("meta").tobytes())
     fr = meta.pop("fr")

@@ -44,6 +44,7 @@ from rasterhw.golden_model.snu import pixelbus as golden
 from rasterhw.golden_model.snu.formats import CLOCK_HZ, MEM_CYCLE, N_BANKS, RGB_BITS, Z_BITS
 from rasterhw.golden_model.snu.pixelstream import PixelStream
 from rasterhw.sim import engines
+from rasterhw.sim.engines.memh import memh_uint64
 from rasterhw.sim.engines.scene import Done, Job, SceneRun, run_job
 from rasterhw.sim.packed import as_ints
 from rasterhw.sim.snu.frame_format import GAP_BITS, SCHEDULE
@@ -335,9 +336,7 @@ def _int64(words) -> np.ndarray:
     """A port's words of up to 63 bits (ints, or packed rows: ``sim/packed.py``) as int64."""
     if not isinstance(words, np.ndarray):
         return np.array(words, dtype=np.int64)
-    full = np.zeros((len(words), 8), np.uint8)   # big-endian rows, right-aligned in 8 bytes
-    full[:, 8 - words.shape[1]:] = words
-    return full.view(">u8").ravel().astype(np.int64)
+    return memh_uint64(words, 0, words.shape[1]).astype(np.int64)   # big-endian rows of up to 8 bytes
 
 
 def run_frame_engine(stream: PixelStream, gaps: np.ndarray, sched: dict, *, engine: str = "verilator") -> dict:
@@ -370,7 +369,7 @@ def frame_golden(tris, cpu: i860.I860, *, cached: bool = True) -> dict:
 
     import json
 
-    from rasterhw.sim.engines.verilog_cache import arrays_cached
+    from rasterhw.sim.engines.verilog_cache import arrays_cached, fields_key
 
     def arrays() -> dict:
         g = compute()
@@ -384,7 +383,7 @@ def frame_golden(tris, cpu: i860.I860, *, cached: bool = True) -> dict:
         return {**{k: v.astype(np.int32) if _fits32(v) else v for k, v in cols.items()},
                 "meta": np.frombuffer(json.dumps(meta).encode(), np.uint8)}
 
-    key = [x for k, v in sorted(vars(tris).items()) for x in (k, v)] + [repr(cpu)]
+    key = fields_key(tris) + [repr(cpu)]
     got = arrays_cached("snu-frame-golden", Path(__file__), key, arrays)
     meta = json.loads(got["meta"].tobytes())
     m = meta["stream"]

@@ -178,7 +178,7 @@ def scene_golden(tris, eps, *, width: int, height: int, interleave: int, units: 
     from pathlib import Path
 
     from rasterhw.golden_model.zbm import cycles as C
-    from rasterhw.sim.engines.verilog_cache import arrays_cached
+    from rasterhw.sim.engines.verilog_cache import arrays_cached, fields_key
 
     def compute() -> dict:
         tb = find_testbench("zbm-unit")
@@ -195,7 +195,7 @@ def scene_golden(tris, eps, *, width: int, height: int, interleave: int, units: 
                                         schedule=schedule)["line_cycles"]
         return out
 
-    key = [x for k, v in sorted(vars(tris).items()) for x in (k, v)] + [width, height, interleave, units, schedule]
+    key = fields_key(tris) + [width, height, interleave, units, schedule]
     return arrays_cached("zbm-scene", Path(__file__), key, compute)
 
 
