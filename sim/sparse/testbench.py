@@ -321,9 +321,10 @@ class MatrixFrameBench(MatrixBench):
                        record_bits=layouts(params["colour"])[0].size, extra=extra)
 
     def _check_lanes(self, params: dict) -> int:
-        if self.lanes > 1 << (2 * params["n"]):
-            raise ValueError(f"sparse frame bench: {self.lanes} lanes read more than the {1 << (2 * params['n'])} "
-                             "sparse addresses")
+        """``lanes``, checked against the matrix's sparse addresses (``benchread.check_lanes``)."""
+        from rasterhw.hdl.sparse.benchread import check_lanes
+
+        check_lanes(params["n"], self.lanes)
         return self.lanes
 
     def pixel_words(self, params: dict) -> int:
